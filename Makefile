@@ -1,0 +1,37 @@
+# The README's two commands: `make demo` and `make check`. CMake does the building underneath.
+BUILD_DIR ?= build
+ASAN_DIR ?= build-asan
+JOBS ?= $(shell nproc)
+PREFIX ?= /usr/local
+
+.PHONY: all deps build demo check test test-asan install clean
+
+all: build
+
+deps:
+	./scripts/install-deps.sh
+
+build: deps
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGDR_WERROR=ON -DCMAKE_INSTALL_PREFIX=$(PREFIX)
+	cmake --build $(BUILD_DIR) -j $(JOBS)
+
+# Renders the built-in scene to demo.png and prints the statistics.
+demo: build
+	$(BUILD_DIR)/tools/gdr/gdr render demo --out demo.png --stats demo.json
+
+# The whole suite: every test on lavapipe with validation on, then the unit tests under ASan+UBSan.
+check: build test test-asan
+
+test:
+	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+
+test-asan: deps
+	cmake -S . -B $(ASAN_DIR) -DCMAKE_BUILD_TYPE=Debug -DGDR_WERROR=ON -DGDR_SANITIZE=ON
+	cmake --build $(ASAN_DIR) -j $(JOBS)
+	cd $(ASAN_DIR) && ctest --output-on-failure -j $(JOBS) -L unit
+
+install: build
+	cmake --install $(BUILD_DIR)
+
+clean:
+	rm -rf $(BUILD_DIR) $(ASAN_DIR)

@@ -1,0 +1,59 @@
+#!/bin/sh
+# Installs what gdr needs to build, test and run, on Debian 12 (bookworm), as root.
+# Idempotent: packages already present are left alone; only missing ones are fetched.
+# Mesa (lavapipe >= 25, which has VK_EXT_mesh_shader) comes from bookworm-backports.
+set -eu
+
+PACKAGES="build-essential cmake pkg-config clang \
+libvulkan-dev glslc vulkan-validationlayers \
+libmeshoptimizer-dev libmetis-dev libcjson-dev libstb-dev libzstd-dev"
+BACKPORTS_PACKAGES="mesa-vulkan-drivers"
+
+missing=""
+for p in $PACKAGES $BACKPORTS_PACKAGES; do
+    if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed"; then
+        missing="$missing $p"
+    fi
+done
+
+# lavapipe must be new enough for mesh shaders, even if an older Mesa is installed.
+mesa_version=$(dpkg-query -W -f='${Version}' mesa-vulkan-drivers 2>/dev/null || true)
+need_backports_mesa=0
+case "$mesa_version" in
+    "" ) need_backports_mesa=1 ;;
+    * ) if dpkg --compare-versions "$mesa_version" lt 25.0; then need_backports_mesa=1; fi ;;
+esac
+
+if [ -z "$missing" ] && [ "$need_backports_mesa" = 0 ]; then
+    echo "install-deps: everything is installed"
+    exit 0
+fi
+
+if [ "$(id -u)" != 0 ]; then
+    echo "install-deps: missing packages:$missing; run this script as root" >&2
+    exit 1
+fi
+
+. /etc/os-release
+if [ "${VERSION_CODENAME:-}" != bookworm ]; then
+    echo "install-deps: warning: written for Debian 12 (bookworm), this is ${PRETTY_NAME:-unknown}" >&2
+fi
+
+if ! grep -rqs "bookworm-backports" /etc/apt/sources.list /etc/apt/sources.list.d/; then
+    echo "deb http://deb.debian.org/debian bookworm-backports main" \
+        > /etc/apt/sources.list.d/bookworm-backports.list
+fi
+
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -q
+regular=""
+for p in $missing; do
+    case " $BACKPORTS_PACKAGES " in *" $p "*) ;; *) regular="$regular $p" ;; esac
+done
+if [ -n "$regular" ]; then
+    # shellcheck disable=SC2086
+    apt-get install -y -q --no-install-recommends $regular
+fi
+# shellcheck disable=SC2086
+apt-get install -y -q --no-install-recommends -t bookworm-backports $BACKPORTS_PACKAGES
+echo "install-deps: done"

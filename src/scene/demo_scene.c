@@ -1,0 +1,105 @@
+/* The built-in procedural scene: the default input, needing no file. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gdr/scene.h"
+#include "scene/procedural_meshes.h"
+
+#define PI_F 3.14159265358979f
+
+/* Stateless integer hash (a mix of multiply-xorshift rounds), so instance i's properties do not
+ * depend on how many instances come before it. */
+static uint32_t hash_u32(uint32_t x)
+{
+    x ^= x >> 16;
+    x *= 0x7feb352dU;
+    x ^= x >> 15;
+    x *= 0x846ca68bU;
+    x ^= x >> 16;
+    return x;
+}
+
+static float hash_unit(uint32_t seed, uint32_t index, uint32_t channel)
+{
+    return (float)(hash_u32(seed * 0x9E3779B9U ^ hash_u32(index * 8U + channel)) >> 8) / 16777216.0f;
+}
+
+static gdr_vec4 hue_color(float hue)
+{
+    float r = fabsf(hue * 6.0f - 3.0f) - 1.0f;
+    float g = 2.0f - fabsf(hue * 6.0f - 2.0f);
+    float b = 2.0f - fabsf(hue * 6.0f - 4.0f);
+    r = fminf(fmaxf(r, 0.0f), 1.0f);
+    g = fminf(fmaxf(g, 0.0f), 1.0f);
+    b = fminf(fmaxf(b, 0.0f), 1.0f);
+    return (gdr_vec4){0.25f + 0.7f * r, 0.25f + 0.7f * g, 0.25f + 0.7f * b, 1.0f};
+}
+
+gdr_status gdr_scene_create_demo(const gdr_demo_desc *desc_in, gdr_scene **out, gdr_error *err)
+{
+    gdr_demo_desc desc = desc_in ? *desc_in : (gdr_demo_desc){0};
+    if (desc.instances == 0)
+        desc.instances = 10000;
+    if (desc.seed == 0)
+        desc.seed = 1;
+    if (desc.spacing == 0.0f)
+        desc.spacing = 4.0f;
+    if (!(desc.spacing >= 3.0f && desc.spacing <= 1000.0f))
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "demo: spacing %g is outside [3, 1000]",
+                             (double)desc.spacing);
+
+    gdr_scene *scene;
+    gdr_status status = gdr_scene_create(&scene, err);
+    if (status != GDR_OK)
+        return status;
+    uint32_t shapes[4], ground;
+    uint32_t side = (uint32_t)ceil(sqrt((double)desc.instances));
+    float half = 0.5f * (float)side * desc.spacing + desc.spacing;
+    if (status == GDR_OK) status = gdr_procedural_sphere(scene, 32, 16, &shapes[0], err);
+    if (status == GDR_OK) status = gdr_procedural_torus(scene, 0.7f, 0.3f, 32, 16, &shapes[1], err);
+    if (status == GDR_OK) status = gdr_procedural_box(scene, (gdr_vec3){0.7f, 0.7f, 0.7f}, &shapes[2], err);
+    if (status == GDR_OK) status = gdr_procedural_blob(scene, 4, &shapes[3], err);
+    if (status == GDR_OK) status = gdr_procedural_ground(scene, half, 32, &ground, err);
+
+    if (status == GDR_OK) {
+        gdr_instance floor = {gdr_mat4_identity(), ground, GDR_NO_INDEX, {0.55f, 0.55f, 0.5f, 1.0f}};
+        status = gdr_scene_add_instance(scene, &floor, err);
+    }
+    for (uint32_t i = 0; i < desc.instances && status == GDR_OK; i++) {
+        uint32_t shape = (uint32_t)(hash_unit(desc.seed, i, 0) * 4.0f) & 3u;
+        float scale = 0.6f + 0.6f * hash_unit(desc.seed, i, 1); /* radius <= 1.2 * 1.25 < spacing / 2 */
+        float yaw = 2.0f * PI_F * hash_unit(desc.seed, i, 2);
+        float tilt = 0.5f * hash_unit(desc.seed, i, 3);
+        const gdr_mesh *mesh = &scene->meshes[shapes[shape]];
+        float x = ((float)(i % side) - 0.5f * (float)(side - 1)) * desc.spacing;
+        float z = ((float)(i / side) - 0.5f * (float)(side - 1)) * desc.spacing;
+        /* Rest above the ground: no shared depth with the floor, so draw order never matters. */
+        float y = mesh->bounds.w * scale + 0.05f;
+        gdr_quat rotation = gdr_quat_mul(gdr_quat_from_axis_angle((gdr_vec3){0, 1, 0}, yaw),
+                                         gdr_quat_from_axis_angle((gdr_vec3){1, 0, 0}, tilt));
+        gdr_instance instance = {
+            .transform = gdr_mat4_from_trs((gdr_vec3){x, y, z}, rotation, (gdr_vec3){scale, scale, scale}),
+            .mesh = shapes[shape],
+            .material = GDR_NO_INDEX,
+            .color = hue_color(hash_unit(desc.seed, i, 4)),
+        };
+        status = gdr_scene_add_instance(scene, &instance, err);
+    }
+    if (status == GDR_OK) {
+        /* Inside the grid, a little above the objects, looking along a diagonal and slightly down. */
+        gdr_quat yaw = gdr_quat_from_axis_angle((gdr_vec3){0, 1, 0}, 0.25f * PI_F);
+        gdr_quat pitch = gdr_quat_from_axis_angle((gdr_vec3){1, 0, 0}, -0.12f);
+        gdr_camera camera = {.name = "demo", .position = {0.5f * desc.spacing, 3.0f, 0.5f * desc.spacing},
+                             .rotation = gdr_quat_mul(yaw, pitch), .yfov = 60.0f * PI_F / 180.0f,
+                             .znear = 0.1f, .zfar = 0.0f, .aspect = 0.0f};
+        status = gdr_scene_add_camera(scene, &camera, err);
+    }
+    if (status != GDR_OK) {
+        gdr_scene_destroy(scene);
+        return status;
+    }
+    *out = scene;
+    return GDR_OK;
+}

@@ -1,0 +1,193 @@
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gdr/scene.h"
+
+/* Grows *array (of element_size bytes each) so it holds at least count + 1 elements. */
+static gdr_status reserve_one(void **array, uint32_t *capacity, uint32_t count, size_t element_size,
+                              gdr_error *err)
+{
+    if (count < *capacity)
+        return GDR_OK;
+    if (count == UINT32_MAX)
+        return gdr_error_set(err, GDR_ERROR_CAPACITY, "scene: more than %u elements", UINT32_MAX - 1);
+    uint64_t wanted = *capacity ? (uint64_t)*capacity * 2 : 16;
+    if (wanted > UINT32_MAX)
+        wanted = UINT32_MAX;
+    void *grown = realloc(*array, (size_t)wanted * element_size);
+    if (!grown)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene: out of memory growing an array to %llu",
+                             (unsigned long long)wanted);
+    *array = grown;
+    *capacity = (uint32_t)wanted;
+    return GDR_OK;
+}
+
+gdr_status gdr_scene_create(gdr_scene **out, gdr_error *err)
+{
+    *out = calloc(1, sizeof **out);
+    return *out ? GDR_OK : gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene: out of memory");
+}
+
+void gdr_scene_destroy(gdr_scene *scene)
+{
+    if (!scene)
+        return;
+    for (uint32_t i = 0; i < scene->mesh_count; i++) {
+        free(scene->meshes[i].positions);
+        free(scene->meshes[i].normals);
+        free(scene->meshes[i].uvs);
+        free(scene->meshes[i].indices);
+    }
+    free(scene->meshes);
+    free(scene->materials);
+    free(scene->instances);
+    free(scene->cameras);
+    free(scene);
+}
+
+/* Area-weighted face normals summed per vertex; degenerate vertices get +Y. */
+static void generate_normals(gdr_mesh *mesh)
+{
+    memset(mesh->normals, 0, sizeof(gdr_vec3) * mesh->vertex_count);
+    for (uint32_t t = 0; t + 2 < mesh->index_count; t += 3) {
+        uint32_t a = mesh->indices[t], b = mesh->indices[t + 1], c = mesh->indices[t + 2];
+        gdr_vec3 n = gdr_vec3_cross(gdr_vec3_sub(mesh->positions[b], mesh->positions[a]),
+                                    gdr_vec3_sub(mesh->positions[c], mesh->positions[a]));
+        mesh->normals[a] = gdr_vec3_add(mesh->normals[a], n);
+        mesh->normals[b] = gdr_vec3_add(mesh->normals[b], n);
+        mesh->normals[c] = gdr_vec3_add(mesh->normals[c], n);
+    }
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        float length = gdr_vec3_length(mesh->normals[v]);
+        mesh->normals[v] = length > 0.0f ? gdr_vec3_scale(mesh->normals[v], 1.0f / length)
+                                         : (gdr_vec3){0.0f, 1.0f, 0.0f};
+    }
+}
+
+/* Sphere around the centre of the bounding box: not minimal, but contains every vertex. */
+static gdr_vec4 compute_bounds(const gdr_vec3 *positions, uint32_t count)
+{
+    if (count == 0)
+        return (gdr_vec4){0.0f, 0.0f, 0.0f, 0.0f};
+    gdr_vec3 lo = positions[0], hi = positions[0];
+    for (uint32_t i = 1; i < count; i++) {
+        lo = (gdr_vec3){fminf(lo.x, positions[i].x), fminf(lo.y, positions[i].y), fminf(lo.z, positions[i].z)};
+        hi = (gdr_vec3){fmaxf(hi.x, positions[i].x), fmaxf(hi.y, positions[i].y), fmaxf(hi.z, positions[i].z)};
+    }
+    gdr_vec3 center = gdr_vec3_scale(gdr_vec3_add(lo, hi), 0.5f);
+    float radius = 0.0f;
+    for (uint32_t i = 0; i < count; i++)
+        radius = fmaxf(radius, gdr_vec3_length(gdr_vec3_sub(positions[i], center)));
+    /* One ulp of slack per unit so float rounding in transforms cannot shrink the sphere. */
+    radius *= 1.0f + 1e-6f;
+    return (gdr_vec4){center.x, center.y, center.z, radius};
+}
+
+gdr_status gdr_scene_add_mesh(gdr_scene *scene, const char *name, const gdr_vec3 *positions,
+                              const gdr_vec3 *normals, const gdr_vec2 *uvs, uint32_t vertex_count,
+                              const uint32_t *indices, uint32_t index_count, uint32_t *out_index,
+                              gdr_error *err)
+{
+    if (index_count % 3 != 0)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "mesh '%s': index count %u is not a multiple of 3",
+                             name, index_count);
+    for (uint32_t i = 0; i < index_count; i++)
+        if (indices[i] >= vertex_count)
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
+                                 "mesh '%s': index %u (at %u) is out of range (vertex count %u)", name,
+                                 indices[i], i, vertex_count);
+    for (uint32_t v = 0; v < vertex_count; v++)
+        if (!isfinite(positions[v].x) || !isfinite(positions[v].y) || !isfinite(positions[v].z))
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "mesh '%s': position %u is not finite",
+                                 name, v);
+    gdr_status status = reserve_one((void **)&scene->meshes, &scene->mesh_capacity, scene->mesh_count,
+                                    sizeof(gdr_mesh), err);
+    if (status != GDR_OK)
+        return status;
+
+    gdr_mesh mesh = {0};
+    snprintf(mesh.name, sizeof mesh.name, "%s", name ? name : "");
+    mesh.vertex_count = vertex_count;
+    mesh.index_count = index_count;
+    size_t vertex_bytes = sizeof(gdr_vec3) * (size_t)vertex_count;
+    mesh.positions = malloc(vertex_bytes ? vertex_bytes : 1);
+    mesh.normals = malloc(vertex_bytes ? vertex_bytes : 1);
+    mesh.uvs = calloc(vertex_count ? vertex_count : 1, sizeof(gdr_vec2));
+    mesh.indices = malloc(sizeof(uint32_t) * (index_count ? index_count : 1));
+    if (!mesh.positions || !mesh.normals || !mesh.uvs || !mesh.indices) {
+        free(mesh.positions);
+        free(mesh.normals);
+        free(mesh.uvs);
+        free(mesh.indices);
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory", name);
+    }
+    memcpy(mesh.positions, positions, vertex_bytes);
+    memcpy(mesh.indices, indices, sizeof(uint32_t) * index_count);
+    if (uvs)
+        memcpy(mesh.uvs, uvs, sizeof(gdr_vec2) * vertex_count);
+    if (normals)
+        memcpy(mesh.normals, normals, vertex_bytes);
+    else
+        generate_normals(&mesh);
+    mesh.bounds = compute_bounds(positions, vertex_count);
+
+    if (out_index)
+        *out_index = scene->mesh_count;
+    scene->meshes[scene->mesh_count++] = mesh;
+    return GDR_OK;
+}
+
+gdr_status gdr_scene_add_material(gdr_scene *scene, const gdr_material *material, uint32_t *out_index,
+                                  gdr_error *err)
+{
+    gdr_status status = reserve_one((void **)&scene->materials, &scene->material_capacity,
+                                    scene->material_count, sizeof(gdr_material), err);
+    if (status != GDR_OK)
+        return status;
+    if (out_index)
+        *out_index = scene->material_count;
+    scene->materials[scene->material_count++] = *material;
+    return GDR_OK;
+}
+
+gdr_status gdr_scene_add_instance(gdr_scene *scene, const gdr_instance *instance, gdr_error *err)
+{
+    if (instance->mesh >= scene->mesh_count)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "instance %u: mesh %u does not exist (%u meshes)",
+                             scene->instance_count, instance->mesh, scene->mesh_count);
+    if (instance->material != GDR_NO_INDEX && instance->material >= scene->material_count)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
+                             "instance %u: material %u does not exist (%u materials)", scene->instance_count,
+                             instance->material, scene->material_count);
+    for (int i = 0; i < 16; i++)
+        if (!isfinite(instance->transform.m[i]))
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "instance %u: transform is not finite",
+                                 scene->instance_count);
+    gdr_status status = reserve_one((void **)&scene->instances, &scene->instance_capacity,
+                                    scene->instance_count, sizeof(gdr_instance), err);
+    if (status != GDR_OK)
+        return status;
+    scene->instances[scene->instance_count++] = *instance;
+    return GDR_OK;
+}
+
+gdr_status gdr_scene_add_camera(gdr_scene *scene, const gdr_camera *camera, gdr_error *err)
+{
+    gdr_status status = reserve_one((void **)&scene->cameras, &scene->camera_capacity, scene->camera_count,
+                                    sizeof(gdr_camera), err);
+    if (status != GDR_OK)
+        return status;
+    scene->cameras[scene->camera_count++] = *camera;
+    return GDR_OK;
+}
+
+uint64_t gdr_scene_triangle_count(const gdr_scene *scene)
+{
+    uint64_t total = 0;
+    for (uint32_t i = 0; i < scene->instance_count; i++)
+        total += scene->meshes[scene->instances[i].mesh].index_count / 3;
+    return total;
+}
