@@ -6,6 +6,7 @@
 #define GDR_CORE_H
 
 #include <stdarg.h>
+#include <stdbool.h>
 #include <stddef.h>
 
 #ifdef __cplusplus
@@ -39,6 +40,10 @@ GDR_API const char *gdr_status_name(gdr_status status);
 /* Records status and a printf-style message in err (which may be NULL); returns status. */
 GDR_API gdr_status gdr_error_set(gdr_error *err, gdr_status status, const char *format, ...)
     __attribute__((format(printf, 3, 4)));
+
+/* Writes a whole file through a temporary file in the same folder and a rename, so a crash or a
+ * full disk never leaves a half-written file at `path`. */
+GDR_API gdr_status gdr_write_file_atomic(const char *path, const void *data, size_t size, gdr_error *err);
 
 /* Version string of the library, e.g. "0.1.0". */
 GDR_API const char *gdr_version(void);

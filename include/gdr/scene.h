@@ -34,7 +34,24 @@ typedef struct gdr_material {
     uint32_t base_color_texture;         /* texture index or GDR_NO_INDEX */
     uint32_t normal_texture;             /* recorded for later use, or GDR_NO_INDEX */
     uint32_t metallic_roughness_texture; /* recorded for later use, or GDR_NO_INDEX */
+    /* Additions (issue 3). A zero-initialised material keeps its old meaning: opaque,
+     * single-sided; metallic/roughness 0 unless an importer sets them. */
+    float metallic_factor;
+    float roughness_factor;
+    float alpha_cutoff;   /* used when alpha_mode is GDR_ALPHA_MASK */
+    uint32_t alpha_mode;  /* gdr_alpha_mode */
+    uint32_t double_sided; /* 0 or 1 */
 } gdr_material;
+
+typedef enum gdr_alpha_mode { GDR_ALPHA_OPAQUE = 0, GDR_ALPHA_MASK = 1, GDR_ALPHA_BLEND = 2 } gdr_alpha_mode;
+
+/* A decoded image: tightly packed RGBA8 rows, top row first (issue 3). */
+typedef struct gdr_texture {
+    char name[GDR_NAME_MAX];
+    uint32_t width, height;
+    uint8_t *rgba; /* width * height * 4 bytes */
+    uint32_t srgb; /* 1: colour data (base colour); 0: linear data (normals, metallic-roughness) */
+} gdr_texture;
 
 typedef struct gdr_instance {
     gdr_mat4 transform; /* mesh space -> world space */
@@ -62,6 +79,10 @@ typedef struct gdr_scene {
     uint32_t instance_count, instance_capacity;
     gdr_camera *cameras;
     uint32_t camera_count, camera_capacity;
+    /* Additions (issue 3). */
+    gdr_texture *textures;
+    uint32_t texture_count, texture_capacity;
+    char *extensions; /* the source's extensionsUsed, comma-separated, or NULL */
 } gdr_scene;
 
 GDR_API gdr_status gdr_scene_create(gdr_scene **out, gdr_error *err);
@@ -78,6 +99,15 @@ GDR_API gdr_status gdr_scene_add_material(gdr_scene *scene, const gdr_material *
 GDR_API gdr_status gdr_scene_add_instance(gdr_scene *scene, const gdr_instance *instance,
                                           gdr_error *err);
 GDR_API gdr_status gdr_scene_add_camera(gdr_scene *scene, const gdr_camera *camera, gdr_error *err);
+/* Adds a texture whose pixels (width * height * 4 bytes, RGBA8) are copied. */
+GDR_API gdr_status gdr_scene_add_texture(gdr_scene *scene, const char *name, uint32_t width, uint32_t height,
+                                         const uint8_t *rgba, uint32_t srgb, uint32_t *out_index,
+                                         gdr_error *err);
+/* Replaces the scene's extension list (copied; NULL clears it). */
+GDR_API gdr_status gdr_scene_set_extensions(gdr_scene *scene, const char *extensions, gdr_error *err);
+
+/* A camera that sees every instance: for scenes that bring no camera. */
+GDR_API gdr_camera gdr_scene_framing_camera(const gdr_scene *scene);
 
 /* Total triangles over all instances. */
 GDR_API uint64_t gdr_scene_triangle_count(const gdr_scene *scene);
@@ -95,6 +125,25 @@ GDR_API gdr_status gdr_scene_create_demo(const gdr_demo_desc *desc, gdr_scene **
 /* Loads a scene from a specification: "demo" or "demo:instances=N,seed=S,spacing=X", or a file
  * path of a supported format. */
 GDR_API gdr_status gdr_scene_load(const char *spec, gdr_scene **out, gdr_error *err);
+
+/* Warnings from importers (a file that loads, but not entirely as written): `message` names the
+ * file and the place, e.g. "box.gltf: meshes[0].primitives[1]: mode 1 (lines) skipped". */
+typedef void (*gdr_warning_fn)(void *user, const char *message);
+
+/* Options of gdr_scene_load_ex; zero-initialise, every field has a default. */
+typedef struct gdr_load_options {
+    int no_cache;          /* 1: import the source, never read or write a .gdrc cache */
+    const char *cache_dir; /* NULL: next to the source (FILE.gdrc), falling back to
+                              $XDG_CACHE_HOME/gdr or ~/.cache/gdr when that is not writable */
+    int no_progress;       /* 1: never draw a progress bar (default: on a terminal only) */
+    gdr_warning_fn warning; /* NULL: warnings go to stderr as "gdr: warning: ..." */
+    void *warning_user;
+} gdr_load_options;
+
+/* gdr_scene_load with options (NULL: defaults). Source files (.gltf, .glb, .obj) go through the
+ * processed-scene cache unless options->no_cache; a .gdrc file is read directly. */
+GDR_API gdr_status gdr_scene_load_ex(const char *spec, const gdr_load_options *options, gdr_scene **out,
+                                     gdr_error *err);
 
 #ifdef __cplusplus
 }

@@ -2,6 +2,7 @@
 #include <string.h>
 
 #include "gdr/math.h"
+#include "shaders/shared/cull_math.h"
 
 #define AT(a, row, col) ((a).m[(col) * 4 + (row)])
 
@@ -121,12 +122,6 @@ gdr_mat4 gdr_mat4_from_trs(gdr_vec3 translation, gdr_quat rotation, gdr_vec3 sca
 
 float gdr_mat4_max_axis_scale(gdr_mat4 a)
 {
-    float best = 0.0f;
-    for (int col = 0; col < 3; col++) {
-        gdr_vec3 axis = {AT(a, 0, col), AT(a, 1, col), AT(a, 2, col)};
-        float length = gdr_vec3_length(axis);
-        if (length > best)
-            best = length;
-    }
-    return best;
+    return gdr_max_axis_scale((gdr_vec3){a.m[0], a.m[1], a.m[2]}, (gdr_vec3){a.m[4], a.m[5], a.m[6]},
+                              (gdr_vec3){a.m[8], a.m[9], a.m[10]});
 }

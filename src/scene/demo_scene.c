@@ -91,7 +91,9 @@ gdr_status gdr_scene_create_demo(const gdr_demo_desc *desc_in, gdr_scene **out, 
         /* Inside the grid, a little above the objects, looking along a diagonal and slightly down. */
         gdr_quat yaw = gdr_quat_from_axis_angle((gdr_vec3){0, 1, 0}, 0.25f * PI_F);
         gdr_quat pitch = gdr_quat_from_axis_angle((gdr_vec3){1, 0, 0}, -0.12f);
-        gdr_camera camera = {.name = "demo", .position = {0.5f * desc.spacing, 3.0f, 0.5f * desc.spacing},
+        /* Between grid points whatever the parity of the grid, above the tallest object (2.95 m). */
+        float offset = (side % 2) ? 0.5f * desc.spacing : 0.0f;
+        gdr_camera camera = {.name = "demo", .position = {offset, 3.5f, offset},
                              .rotation = gdr_quat_mul(yaw, pitch), .yfov = 60.0f * PI_F / 180.0f,
                              .znear = 0.1f, .zfar = 0.0f, .aspect = 0.0f};
         status = gdr_scene_add_camera(scene, &camera, err);

@@ -45,6 +45,10 @@ void gdr_scene_destroy(gdr_scene *scene)
     free(scene->materials);
     free(scene->instances);
     free(scene->cameras);
+    for (uint32_t i = 0; i < scene->texture_count; i++)
+        free(scene->textures[i].rgba);
+    free(scene->textures);
+    free(scene->extensions);
     free(scene);
 }
 
@@ -190,4 +194,45 @@ uint64_t gdr_scene_triangle_count(const gdr_scene *scene)
     for (uint32_t i = 0; i < scene->instance_count; i++)
         total += scene->meshes[scene->instances[i].mesh].index_count / 3;
     return total;
+}
+
+gdr_status gdr_scene_add_texture(gdr_scene *scene, const char *name, uint32_t width, uint32_t height,
+                                 const uint8_t *rgba, uint32_t srgb, uint32_t *out_index, gdr_error *err)
+{
+    if (width == 0 || height == 0 || width > 32768 || height > 32768)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "texture '%s': size %ux%u is out of range",
+                             name ? name : "", width, height);
+    gdr_status status = reserve_one((void **)&scene->textures, &scene->texture_capacity, scene->texture_count,
+                                    sizeof(gdr_texture), err);
+    if (status != GDR_OK)
+        return status;
+    size_t bytes = (size_t)width * height * 4;
+    gdr_texture texture = {0};
+    snprintf(texture.name, sizeof texture.name, "%s", name ? name : "");
+    texture.width = width;
+    texture.height = height;
+    texture.srgb = srgb ? 1u : 0u;
+    texture.rgba = malloc(bytes);
+    if (!texture.rgba)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "texture '%s': out of memory", texture.name);
+    memcpy(texture.rgba, rgba, bytes);
+    if (out_index)
+        *out_index = scene->texture_count;
+    scene->textures[scene->texture_count++] = texture;
+    return GDR_OK;
+}
+
+gdr_status gdr_scene_set_extensions(gdr_scene *scene, const char *extensions, gdr_error *err)
+{
+    char *copy = NULL;
+    if (extensions) {
+        size_t length = strlen(extensions);
+        copy = malloc(length + 1);
+        if (!copy)
+            return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene: out of memory");
+        memcpy(copy, extensions, length + 1);
+    }
+    free(scene->extensions);
+    scene->extensions = copy;
+    return GDR_OK;
 }

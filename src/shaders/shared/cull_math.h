@@ -17,4 +17,14 @@ GDR_SHARED_FN bool gdr_sphere_visible(gdr_vec4 ijkl, gdr_vec3 c, float r, float 
     return visible;
 }
 
+/* Largest length of a transform's three basis columns: how much a bounding sphere's radius must
+ * grow under that transform (seed 001: the radius is scaled by the largest axis scale). */
+GDR_SHARED_FN float gdr_max_axis_scale(gdr_vec3 c0, gdr_vec3 c1, gdr_vec3 c2)
+{
+    float s0 = c0.x * c0.x + c0.y * c0.y + c0.z * c0.z;
+    float s1 = c1.x * c1.x + c1.y * c1.y + c1.z * c1.z;
+    float s2 = c2.x * c2.x + c2.y * c2.y + c2.z * c2.z;
+    return gdr_sqrt(gdr_max(s0, gdr_max(s1, s2)));
+}
+
 #endif

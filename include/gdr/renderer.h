@@ -1,0 +1,96 @@
+/* gdr renderer: a GPU-driven frame on Vulkan, headless.
+ *
+ * Per frame the CPU records a fixed number of commands whatever the scene: a compute pass culls
+ * every instance and appends the visible ones as indirect draw commands, and one
+ * vkCmdDrawIndexedIndirectCount draws them (seed 003). */
+#ifndef GDR_RENDERER_H
+#define GDR_RENDERER_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "gdr/core.h"
+#include "gdr/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct gdr_renderer gdr_renderer;
+
+typedef struct gdr_renderer_desc {
+    uint32_t width, height; /* render target size; 0: 1280 x 720 */
+    const char *device;     /* NULL: first discrete GPU, else any; "N": index; else a name substring */
+    bool validate;          /* Khronos validation layer; messages are counted in the stats */
+    bool synchronization_validation; /* also synchronization validation (implies validate) */
+} gdr_renderer_desc;
+
+typedef enum gdr_cull_mode {
+    GDR_CULL_DEFAULT = 0, /* on */
+    GDR_CULL_ON,
+    GDR_CULL_OFF, /* every instance is drawn: the reference image for culling tests */
+} gdr_cull_mode;
+
+typedef struct gdr_frame_desc {
+    gdr_camera camera;  /* aspect 0: width / height; zfar 0: infinite reverse-Z projection */
+    gdr_cull_mode cull;
+    bool read_back;     /* copy the last frame's image for gdr_renderer_read_color / write_png */
+} gdr_frame_desc;
+
+#define GDR_MAX_PASSES 8
+
+typedef struct gdr_pass_timing {
+    const char *name;
+    double gpu_ms; /* mean over the frames */
+} gdr_pass_timing;
+
+typedef struct gdr_frame_stats {
+    uint32_t frames;
+    uint32_t instances_total;
+    uint32_t instances_visible; /* of the last frame */
+    uint64_t triangles;         /* drawn in the last frame */
+    uint32_t draws;             /* indirect draw commands executed in the last frame */
+    uint32_t draw_calls;        /* draw calls the CPU recorded per frame */
+    double cpu_ms_per_frame;    /* recording + submission, mean over the frames */
+    double gpu_ms_per_frame;    /* first to last timestamp, mean over the frames */
+    gdr_pass_timing passes[GDR_MAX_PASSES];
+    uint32_t pass_count;
+    char device[256];
+    char driver[528];
+    uint32_t validation_messages; /* since the renderer was created */
+} gdr_frame_stats;
+
+GDR_API gdr_status gdr_renderer_create(const gdr_renderer_desc *desc, gdr_renderer **out, gdr_error *err);
+GDR_API void gdr_renderer_destroy(gdr_renderer *renderer);
+
+/* Uploads the scene's geometry into the geometry pool and its instances into the instance buffer.
+ * The renderer keeps no pointer into `scene`. */
+GDR_API gdr_status gdr_renderer_set_scene(gdr_renderer *renderer, const gdr_scene *scene, gdr_error *err);
+
+/* Changes an instance's transform and colour; sent to the GPU through the instance ring with the
+ * next frame (at most GDR_INSTANCE_UPDATES_PER_FRAME records per frame; more wait for later frames). */
+GDR_API gdr_status gdr_renderer_update_instance(gdr_renderer *renderer, uint32_t index, const gdr_mat4 *transform,
+                                                const gdr_vec4 *color, gdr_error *err);
+
+/* Renders `frames` frames of the same view (at least 1) and fills `stats` (may be NULL). */
+GDR_API gdr_status gdr_renderer_render(gdr_renderer *renderer, const gdr_frame_desc *frame, uint32_t frames,
+                                       gdr_frame_stats *stats, gdr_error *err);
+
+/* The last frame's image as tightly packed RGBA8 rows, top row first (width * height * 4 bytes);
+ * needs a frame rendered with read_back. */
+GDR_API gdr_status gdr_renderer_read_color(gdr_renderer *renderer, uint8_t *rgba, gdr_error *err);
+
+/* Indices of the instances the GPU found visible in the last frame, in draw order. */
+GDR_API gdr_status gdr_renderer_read_visible(gdr_renderer *renderer, uint32_t *indices, uint32_t capacity,
+                                             uint32_t *count, gdr_error *err);
+
+GDR_API void gdr_renderer_size(const gdr_renderer *renderer, uint32_t *width, uint32_t *height);
+
+/* Writes RGBA8 pixels as a PNG through a temporary file and a rename: never a half-written file. */
+GDR_API gdr_status gdr_write_png(const char *path, const uint8_t *rgba, uint32_t width, uint32_t height,
+                                 gdr_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,186 @@
+/* One GPU-driven frame: instance updates -> instance culling -> one indirect-count draw. The number
+ * of commands recorded does not depend on the scene. */
+#include <math.h>
+#include <string.h>
+
+#include "render/renderer_internal.h"
+
+static void memory_barrier(VkCommandBuffer cmd, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                           VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access)
+{
+    VkMemoryBarrier2 barrier = {.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2, .srcStageMask = src_stage,
+                                .srcAccessMask = src_access, .dstStageMask = dst_stage, .dstAccessMask = dst_access};
+    VkDependencyInfo dependency = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .memoryBarrierCount = 1,
+                                   .pMemoryBarriers = &barrier};
+    vkCmdPipelineBarrier2(cmd, &dependency);
+}
+
+static void timestamp(gdr_renderer *r, VkCommandBuffer cmd, gdr_frame_slot *slot, enum gdr_timestamp which)
+{
+    uint32_t base = (uint32_t)(slot - r->slots) * GDR_TS_COUNT;
+    vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, r->timestamps, base + which);
+}
+
+static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame, uint32_t update_count)
+{
+    const gdr_camera *camera = &frame->camera;
+    float aspect = camera->aspect > 0.0f ? camera->aspect : (float)r->width / (float)r->height;
+    gdr_mat4 projection = camera->zfar > 0.0f
+                              ? gdr_perspective_reverse_z(camera->yfov, aspect, camera->znear, camera->zfar)
+                              : gdr_perspective_reverse_z_infinite(camera->yfov, aspect, camera->znear);
+    gdr_mat4 view = gdr_view_from_pose(camera->position, camera->rotation);
+    gdr_vec3 light = gdr_vec3_normalize((gdr_vec3){0.35f, 0.85f, 0.4f});
+    GdrGpuFrameGlobals globals = {
+        .view = view,
+        .view_projection = gdr_mat4_mul(projection, view),
+        .frustum = gdr_frustum_symmetric(projection),
+        .camera_position = {camera->position.x, camera->position.y, camera->position.z, 1.0f},
+        .light_direction = {light.x, light.y, light.z, 0.0f},
+        .znear = camera->znear,
+        .zfar = camera->zfar > 0.0f ? camera->zfar : INFINITY,
+        .instance_count = r->scene.instance_count,
+        .cull_enabled = frame->cull != GDR_CULL_OFF,
+        .update_count = update_count,
+    };
+    memcpy(slot->globals.mapped, &globals, sizeof globals);
+}
+
+/* Moves up to one frame's worth of pending instance updates into the slot's ring segment. */
+static uint32_t take_updates(gdr_renderer *r, gdr_frame_slot *slot)
+{
+    gdr_gpu_scene *g = &r->scene;
+    uint32_t count = g->pending_count < GDR_INSTANCE_UPDATES_PER_FRAME ? g->pending_count : GDR_INSTANCE_UPDATES_PER_FRAME;
+    memcpy(slot->updates.mapped, g->pending, sizeof(GdrGpuInstanceUpdate) * count);
+    memmove(g->pending, g->pending + count, sizeof(GdrGpuInstanceUpdate) * (g->pending_count - count));
+    g->pending_count -= count;
+    return count;
+}
+
+gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame,
+                                       bool copy_color, gdr_error *err)
+{
+    VkCommandBuffer cmd = slot->cmd;
+    uint32_t update_count = take_updates(r, slot);
+    write_globals(r, slot, frame, update_count);
+    GdrGpuPushConstants push = {
+        .globals = slot->globals.address,
+        .instances = r->scene.instances.address,
+        .meshes = r->scene.meshes.address,
+        .draws = slot->draws.address,
+        .draw_stats = slot->draw_stats.address,
+        .updates = slot->updates.address,
+    };
+
+    GDR_VK_TRY(err, vkResetCommandBuffer(cmd, 0));
+    VkCommandBufferBeginInfo begin = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+                                      .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
+    GDR_VK_TRY(err, vkBeginCommandBuffer(cmd, &begin));
+    uint32_t query_base = (uint32_t)(slot - r->slots) * GDR_TS_COUNT;
+    vkResetQueryPool(r->ctx->device, r->timestamps, query_base, GDR_TS_COUNT);
+    /* The previous frame shares the instance buffer and the render targets: let it finish with them. */
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
+    timestamp(r, cmd, slot, GDR_TS_BEGIN);
+    vkCmdPushConstants(cmd, r->layout, VK_SHADER_STAGE_ALL, 0, sizeof push, &push);
+
+    /* 1. Instance updates from the ring. */
+    if (update_count > 0) {
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->scatter_pipeline);
+        vkCmdDispatch(cmd, (update_count + GDR_SCATTER_WORKGROUP_SIZE - 1) / GDR_SCATTER_WORKGROUP_SIZE, 1, 1);
+    }
+    vkCmdFillBuffer(cmd, slot->draw_stats.buffer, 0, VK_WHOLE_SIZE, 0);
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_CLEAR_BIT,
+                   VK_ACCESS_2_SHADER_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                   VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
+    timestamp(r, cmd, slot, GDR_TS_AFTER_UPDATE);
+
+    /* 2. Instance culling: appends visible instances as indirect draws. */
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->cull_pipeline);
+    if (r->scene.instance_count > 0)
+        vkCmdDispatch(cmd, (r->scene.instance_count + GDR_CULL_WORKGROUP_SIZE - 1) / GDR_CULL_WORKGROUP_SIZE, 1, 1);
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT |
+                       VK_PIPELINE_STAGE_2_COPY_BIT,
+                   VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
+    timestamp(r, cmd, slot, GDR_TS_AFTER_CULL);
+
+    /* 3. One indirect-count draw for the whole scene. */
+    gdr_vk_image_barrier(cmd, r->color.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                         VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT, 0,
+                         VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+    gdr_vk_image_barrier(cmd, r->depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                         VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, 0,
+                         VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                         VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+    VkRenderingAttachmentInfo color = {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+                                       .imageView = r->color.view, .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                                       .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR, .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+                                       .clearValue.color = {{0.42f, 0.55f, 0.72f, 1.0f}}};
+    VkRenderingAttachmentInfo depth = {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+                                       .imageView = r->depth.view, .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                                       .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR, .storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
+                                       .clearValue.depthStencil = {0.0f, 0}}; /* reverse-Z: 0 is infinitely far */
+    VkRenderingInfo rendering = {.sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
+                                 .renderArea = {{0, 0}, {r->width, r->height}}, .layerCount = 1,
+                                 .colorAttachmentCount = 1, .pColorAttachments = &color, .pDepthAttachment = &depth};
+    vkCmdBeginRendering(cmd, &rendering);
+    gdr_viewport flipped = gdr_viewport_flip_y((float)r->width, (float)r->height);
+    VkViewport viewport = {flipped.x, flipped.y, flipped.width, flipped.height, 0.0f, 1.0f};
+    VkRect2D scissor = {{0, 0}, {r->width, r->height}};
+    vkCmdSetViewport(cmd, 0, 1, &viewport);
+    vkCmdSetScissor(cmd, 0, 1, &scissor);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->draw_pipeline);
+    VkDeviceSize zero = 0;
+    vkCmdBindVertexBuffers(cmd, 0, 1, &r->scene.vertices.buffer, &zero);
+    vkCmdBindIndexBuffer(cmd, r->scene.indices.buffer, 0, VK_INDEX_TYPE_UINT32);
+    vkCmdDrawIndexedIndirectCount(cmd, slot->draws.buffer, 0, slot->draw_stats.buffer,
+                                  offsetof(GdrGpuDrawStats, draw_count), r->scene.instance_count,
+                                  sizeof(GdrGpuDrawCommand));
+    vkCmdEndRendering(cmd);
+    timestamp(r, cmd, slot, GDR_TS_AFTER_DRAW);
+
+    /* 4. Statistics (always) and the image (when asked) for the CPU. */
+    VkBufferCopy stats_copy = {0, 0, sizeof(GdrGpuDrawStats)};
+    vkCmdCopyBuffer(cmd, slot->draw_stats.buffer, slot->stats_readback.buffer, 1, &stats_copy);
+    if (copy_color) {
+        gdr_vk_image_barrier(cmd, r->color.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                             VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                             VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
+                             VK_ACCESS_2_TRANSFER_READ_BIT);
+        VkBufferImageCopy region = {.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+                                    .imageExtent = {r->width, r->height, 1}};
+        vkCmdCopyImageToBuffer(cmd, r->color.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, r->color_readback.buffer, 1,
+                               &region);
+    }
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                   VK_ACCESS_2_HOST_READ_BIT);
+    timestamp(r, cmd, slot, GDR_TS_END);
+    GDR_VK_TRY(err, vkEndCommandBuffer(cmd));
+
+    VkCommandBufferSubmitInfo cmd_info = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO, .commandBuffer = cmd};
+    VkSubmitInfo2 submit = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2, .commandBufferInfoCount = 1,
+                            .pCommandBufferInfos = &cmd_info};
+    GDR_VK_TRY(err, vkQueueSubmit2(r->ctx->queue, 1, &submit, slot->fence));
+    slot->submitted = true;
+    slot->timestamps_written = true;
+    return GDR_OK;
+}
+
+gdr_status gdr_frame_slot_wait(gdr_renderer *r, gdr_frame_slot *slot, double gpu_ms[GDR_TS_COUNT - 1], gdr_error *err)
+{
+    if (!slot->submitted)
+        return GDR_OK;
+    GDR_VK_TRY(err, vkWaitForFences(r->ctx->device, 1, &slot->fence, VK_TRUE, UINT64_MAX));
+    GDR_VK_TRY(err, vkResetFences(r->ctx->device, 1, &slot->fence));
+    slot->submitted = false;
+    if (gpu_ms && slot->timestamps_written) {
+        uint64_t ticks[GDR_TS_COUNT];
+        uint32_t base = (uint32_t)(slot - r->slots) * GDR_TS_COUNT;
+        GDR_VK_TRY(err, vkGetQueryPoolResults(r->ctx->device, r->timestamps, base, GDR_TS_COUNT, sizeof ticks, ticks,
+                                              sizeof ticks[0], VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+        double period_ms = r->ctx->properties.limits.timestampPeriod * 1e-6;
+        for (int i = 0; i + 1 < GDR_TS_COUNT; i++)
+            gpu_ms[i] = (double)(ticks[i + 1] - ticks[i]) * period_ms;
+    }
+    return GDR_OK;
+}

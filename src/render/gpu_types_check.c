@@ -1,0 +1,25 @@
+/* Compile-time checks that the C view of the shared GPU structs matches the scalar layout GLSL
+ * uses, and that the draw command matches Vulkan's. */
+#include <stddef.h>
+#include <vulkan/vulkan.h>
+
+#include "shaders/shared/gpu_types.h"
+
+_Static_assert(sizeof(GdrGpuVertex) == 32, "GdrGpuVertex");
+_Static_assert(offsetof(GdrGpuVertex, normal) == 12 && offsetof(GdrGpuVertex, uv) == 24, "GdrGpuVertex offsets");
+_Static_assert(sizeof(GdrGpuMesh) == 32 && offsetof(GdrGpuMesh, bounds) == 16, "GdrGpuMesh");
+_Static_assert(sizeof(GdrGpuInstance) == 96 && offsetof(GdrGpuInstance, color) == 64 &&
+                   offsetof(GdrGpuInstance, mesh) == 80, "GdrGpuInstance");
+_Static_assert(sizeof(GdrGpuInstanceUpdate) == 112 && offsetof(GdrGpuInstanceUpdate, instance) == 16,
+               "GdrGpuInstanceUpdate");
+_Static_assert(sizeof(GdrGpuDrawCommand) == sizeof(VkDrawIndexedIndirectCommand), "GdrGpuDrawCommand");
+_Static_assert(offsetof(GdrGpuDrawCommand, vertex_offset) == offsetof(VkDrawIndexedIndirectCommand, vertexOffset) &&
+                   offsetof(GdrGpuDrawCommand, first_instance) == offsetof(VkDrawIndexedIndirectCommand, firstInstance),
+               "GdrGpuDrawCommand offsets");
+_Static_assert(sizeof(GdrGpuDrawStats) == 16 && offsetof(GdrGpuDrawStats, draw_count) == 0, "GdrGpuDrawStats");
+_Static_assert(sizeof(GdrGpuFrameGlobals) == 208 && offsetof(GdrGpuFrameGlobals, frustum) == 128 &&
+                   offsetof(GdrGpuFrameGlobals, znear) == 176 && offsetof(GdrGpuFrameGlobals, update_count) == 192,
+               "GdrGpuFrameGlobals");
+_Static_assert(sizeof(GdrGpuPushConstants) == 48 && offsetof(GdrGpuPushConstants, updates) == 40,
+               "GdrGpuPushConstants");
+_Static_assert(sizeof(GdrGpuPushConstants) <= 128, "push constants must fit the guaranteed 128 bytes");

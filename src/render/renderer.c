@@ -1,0 +1,290 @@
+/* The public renderer API: device and resources, scene upload, the frame loop and its statistics. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "render/renderer_internal.h"
+#include "vk/vk_pipeline.h"
+
+static double now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec * 1e3 + (double)t.tv_nsec * 1e-6;
+}
+
+static gdr_status create_pipelines(gdr_renderer *r, gdr_error *err)
+{
+    gdr_status status = gdr_vk_pipeline_layout_create(r->ctx, sizeof(GdrGpuPushConstants), &r->layout, err);
+    if (status == GDR_OK)
+        status = gdr_vk_compute_pipeline_create(r->ctx, r->layout, &gdr_shader_drawcull_comp, &r->cull_pipeline, err);
+    if (status == GDR_OK)
+        status = gdr_vk_compute_pipeline_create(r->ctx, r->layout, &gdr_shader_instance_scatter_comp,
+                                                &r->scatter_pipeline, err);
+    if (status != GDR_OK)
+        return status;
+    VkVertexInputBindingDescription binding = {0, sizeof(GdrGpuVertex), VK_VERTEX_INPUT_RATE_VERTEX};
+    /* uv stays in the vertex (for textures later) but the forward shading does not read it yet. */
+    VkVertexInputAttributeDescription attributes[2] = {
+        {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(GdrGpuVertex, position)},
+        {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(GdrGpuVertex, normal)},
+    };
+    gdr_vk_graphics_pipeline_desc desc = {
+        .layout = r->layout, .vertex_shader = &gdr_shader_mesh_vert, .fragment_shader = &gdr_shader_mesh_frag,
+        .vertex_binding = &binding, .vertex_attributes = attributes, .vertex_attribute_count = 2,
+        .color_format = GDR_COLOR_FORMAT, .depth_format = GDR_DEPTH_FORMAT, .cull_mode = VK_CULL_MODE_BACK_BIT};
+    return gdr_vk_graphics_pipeline_create(r->ctx, &desc, &r->draw_pipeline, err);
+}
+
+static gdr_status create_targets(gdr_renderer *r, gdr_error *err)
+{
+    gdr_status status = gdr_vk_image_create(&r->allocator, r->width, r->height, GDR_COLOR_FORMAT,
+                                            VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                                            VK_IMAGE_ASPECT_COLOR_BIT, &r->color, err);
+    if (status == GDR_OK)
+        status = gdr_vk_image_create(&r->allocator, r->width, r->height, GDR_DEPTH_FORMAT,
+                                     VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT, &r->depth, err);
+    if (status == GDR_OK)
+        status = gdr_vk_buffer_create(&r->allocator, (VkDeviceSize)r->width * r->height * 4,
+                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT, GDR_VK_BUFFER_READBACK, &r->color_readback, err);
+    if (status != GDR_OK)
+        return status;
+    VkQueryPoolCreateInfo query = {.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO, .queryType = VK_QUERY_TYPE_TIMESTAMP,
+                                   .queryCount = GDR_FRAMES_IN_FLIGHT * GDR_TS_COUNT};
+    GDR_VK_TRY(err, vkCreateQueryPool(r->ctx->device, &query, NULL, &r->timestamps));
+    return GDR_OK;
+}
+
+gdr_status gdr_renderer_create(const gdr_renderer_desc *desc_in, gdr_renderer **out, gdr_error *err)
+{
+    gdr_renderer_desc desc = desc_in ? *desc_in : (gdr_renderer_desc){0};
+    if (desc.width == 0)
+        desc.width = 1280;
+    if (desc.height == 0)
+        desc.height = 720;
+    if (desc.width > 16384 || desc.height > 16384)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render size %ux%u exceeds 16384x16384", desc.width,
+                             desc.height);
+    gdr_renderer *r = calloc(1, sizeof *r);
+    if (!r)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "out of memory");
+    r->width = desc.width;
+    r->height = desc.height;
+    r->last_slot = -1;
+    gdr_vk_context_desc context_desc = {.device = desc.device, .validate = desc.validate,
+                                        .synchronization_validation = desc.synchronization_validation};
+    gdr_status status = gdr_vk_context_create(&context_desc, &r->ctx, err);
+    if (status == GDR_OK) {
+        gdr_vk_allocator_init(&r->allocator, r->ctx);
+        status = gdr_vk_staging_create(&r->allocator, &r->staging, err);
+    }
+    if (status == GDR_OK)
+        status = create_targets(r, err);
+    if (status == GDR_OK)
+        status = create_pipelines(r, err);
+    if (status != GDR_OK) {
+        gdr_renderer_destroy(r);
+        return status;
+    }
+    *out = r;
+    return GDR_OK;
+}
+
+void gdr_renderer_destroy(gdr_renderer *r)
+{
+    if (!r)
+        return;
+    if (r->ctx) {
+        vkDeviceWaitIdle(r->ctx->device);
+        gdr_frame_slots_destroy(r);
+        gdr_gpu_scene_destroy(r);
+        VkDevice device = r->ctx->device;
+        if (r->timestamps)
+            vkDestroyQueryPool(device, r->timestamps, NULL);
+        if (r->cull_pipeline)
+            vkDestroyPipeline(device, r->cull_pipeline, NULL);
+        if (r->scatter_pipeline)
+            vkDestroyPipeline(device, r->scatter_pipeline, NULL);
+        if (r->draw_pipeline)
+            vkDestroyPipeline(device, r->draw_pipeline, NULL);
+        if (r->layout)
+            vkDestroyPipelineLayout(device, r->layout, NULL);
+        gdr_vk_image_destroy(r->ctx, &r->color);
+        gdr_vk_image_destroy(r->ctx, &r->depth);
+        gdr_vk_buffer_destroy(r->ctx, &r->color_readback);
+        gdr_vk_buffer_destroy(r->ctx, &r->staging);
+        gdr_vk_allocator_destroy(&r->allocator);
+        gdr_vk_context_destroy(r->ctx);
+    }
+    free(r);
+}
+
+gdr_status gdr_renderer_set_scene(gdr_renderer *r, const gdr_scene *scene, gdr_error *err)
+{
+    /* Device memory is sub-allocated linearly and released with the renderer. */
+    if (r->has_scene)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
+                             "the renderer already holds a scene: create another renderer for a new scene");
+    gdr_status status = gdr_gpu_scene_upload(r, scene, err);
+    if (status == GDR_OK)
+        status = gdr_frame_slots_create(r, err);
+    if (status == GDR_OK)
+        r->has_scene = true;
+    return status;
+}
+
+gdr_status gdr_renderer_update_instance(gdr_renderer *r, uint32_t index, const gdr_mat4 *transform,
+                                        const gdr_vec4 *color, gdr_error *err)
+{
+    gdr_gpu_scene *g = &r->scene;
+    if (!r->has_scene || index >= g->instance_count)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "update_instance: instance %u does not exist (%u instances)",
+                             index, g->instance_count);
+    if (g->pending_count == g->pending_capacity) {
+        uint32_t capacity = g->pending_capacity ? g->pending_capacity * 2 : 256;
+        GdrGpuInstanceUpdate *grown = realloc(g->pending, sizeof *grown * capacity);
+        if (!grown)
+            return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "update_instance: out of memory");
+        g->pending = grown;
+        g->pending_capacity = capacity;
+    }
+    GdrGpuInstance *instance = &g->cpu_instances[index];
+    if (transform)
+        instance->model = *transform;
+    if (color)
+        instance->color = *color;
+    g->pending[g->pending_count++] = (GdrGpuInstanceUpdate){.tag = GDR_UPDATE_TAG_INSTANCE, .index = index,
+                                                            .instance = *instance};
+    return GDR_OK;
+}
+
+static const char *const pass_names[GDR_TS_COUNT - 1] = {"instance_update", "cull", "draw", "readback"};
+
+gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uint32_t frames, gdr_frame_stats *stats,
+                               gdr_error *err)
+{
+    if (!r->has_scene)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: no scene (call gdr_renderer_set_scene first)");
+    if (frames == 0)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: frames must be at least 1");
+    const gdr_camera *camera = &frame->camera;
+    if (!(camera->yfov > 0.0f && camera->yfov < 3.14159f) || !(camera->znear > 0.0f) ||
+        !(camera->zfar == 0.0f || camera->zfar > camera->znear))
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
+                             "render: camera needs 0 < yfov < pi, znear > 0 and zfar = 0 or > znear "
+                             "(yfov %g, znear %g, zfar %g)", (double)camera->yfov, (double)camera->znear,
+                             (double)camera->zfar);
+
+    double cpu_ms = 0.0, pass_ms[GDR_TS_COUNT - 1] = {0};
+    uint32_t timed_frames = 0;
+    r->color_read_back = false;
+    for (uint32_t f = 0; f < frames; f++) {
+        gdr_frame_slot *slot = &r->slots[r->frame_index % GDR_FRAMES_IN_FLIGHT];
+        double ms[GDR_TS_COUNT - 1];
+        bool had_frame = slot->submitted;
+        gdr_status status = gdr_frame_slot_wait(r, slot, ms, err);
+        if (status != GDR_OK)
+            return status;
+        if (had_frame) {
+            for (int i = 0; i < GDR_TS_COUNT - 1; i++)
+                pass_ms[i] += ms[i];
+            timed_frames++;
+        }
+        double start = now_ms();
+        bool last = f + 1 == frames;
+        status = gdr_frame_record_and_submit(r, slot, frame, last && frame->read_back, err);
+        cpu_ms += now_ms() - start;
+        if (status != GDR_OK)
+            return status;
+        r->last_slot = (int)(slot - r->slots);
+        r->frame_index++;
+    }
+    /* Drain every slot so the last frame's results are on the host. */
+    for (uint32_t i = 0; i < GDR_FRAMES_IN_FLIGHT; i++) {
+        double ms[GDR_TS_COUNT - 1];
+        bool had_frame = r->slots[i].submitted;
+        gdr_status status = gdr_frame_slot_wait(r, &r->slots[i], ms, err);
+        if (status != GDR_OK)
+            return status;
+        if (had_frame) {
+            for (int p = 0; p < GDR_TS_COUNT - 1; p++)
+                pass_ms[p] += ms[p];
+            timed_frames++;
+        }
+    }
+    r->color_read_back = frame->read_back;
+    if (!stats)
+        return GDR_OK;
+
+    memset(stats, 0, sizeof *stats);
+    GdrGpuDrawStats gpu;
+    memcpy(&gpu, r->slots[r->last_slot].stats_readback.mapped, sizeof gpu);
+    stats->frames = frames;
+    stats->instances_total = r->scene.instance_count;
+    stats->instances_visible = gpu.draw_count;
+    stats->draws = gpu.draw_count;
+    stats->draw_calls = 1;
+    stats->triangles = ((uint64_t)gpu.triangles_high << 32) | gpu.triangles_low;
+    stats->cpu_ms_per_frame = cpu_ms / frames;
+    stats->pass_count = GDR_TS_COUNT - 1;
+    for (int p = 0; p < GDR_TS_COUNT - 1; p++) {
+        stats->passes[p].name = pass_names[p];
+        stats->passes[p].gpu_ms = timed_frames ? pass_ms[p] / timed_frames : 0.0;
+        stats->gpu_ms_per_frame += stats->passes[p].gpu_ms;
+    }
+    snprintf(stats->device, sizeof stats->device, "%s", r->ctx->properties.deviceName);
+    snprintf(stats->driver, sizeof stats->driver, "%s", r->ctx->driver_info);
+    stats->validation_messages = r->ctx->validation_messages;
+    return GDR_OK;
+}
+
+gdr_status gdr_renderer_read_color(gdr_renderer *r, uint8_t *rgba, gdr_error *err)
+{
+    if (!r->color_read_back)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "read_color: the last frame was not rendered with read_back");
+    memcpy(rgba, r->color_readback.mapped, (size_t)r->width * r->height * 4);
+    return GDR_OK;
+}
+
+gdr_status gdr_renderer_read_visible(gdr_renderer *r, uint32_t *indices, uint32_t capacity, uint32_t *count,
+                                     gdr_error *err)
+{
+    if (r->last_slot < 0)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "read_visible: no frame rendered yet");
+    gdr_frame_slot *slot = &r->slots[r->last_slot];
+    GdrGpuDrawStats gpu;
+    memcpy(&gpu, slot->stats_readback.mapped, sizeof gpu);
+    *count = gpu.draw_count;
+    if (gpu.draw_count > capacity)
+        return gdr_error_set(err, GDR_ERROR_CAPACITY, "read_visible: %u visible instances, room for %u", gpu.draw_count,
+                             capacity);
+    if (gpu.draw_count == 0)
+        return GDR_OK;
+    /* A test/debug path: its readback memory is only reclaimed with the renderer (linear allocator). */
+    gdr_vk_buffer readback;
+    VkDeviceSize size = sizeof(GdrGpuDrawCommand) * gpu.draw_count;
+    gdr_status status = gdr_vk_buffer_create(&r->allocator, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                             GDR_VK_BUFFER_READBACK, &readback, err);
+    VkCommandBuffer cmd;
+    if (status == GDR_OK)
+        status = gdr_vk_begin_one_time(r->ctx, &cmd, err);
+    if (status == GDR_OK) {
+        VkBufferCopy region = {0, 0, size};
+        vkCmdCopyBuffer(cmd, slot->draws.buffer, readback.buffer, 1, &region);
+        status = gdr_vk_end_one_time(r->ctx, cmd, err);
+    }
+    if (status == GDR_OK) {
+        const GdrGpuDrawCommand *draws = readback.mapped;
+        for (uint32_t i = 0; i < gpu.draw_count; i++)
+            indices[i] = draws[i].first_instance;
+    }
+    gdr_vk_buffer_destroy(r->ctx, &readback);
+    return status;
+}
+
+void gdr_renderer_size(const gdr_renderer *r, uint32_t *width, uint32_t *height)
+{
+    *width = r->width;
+    *height = r->height;
+}

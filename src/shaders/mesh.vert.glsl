@@ -1,0 +1,24 @@
+#version 460
+// Forward path vertex shader: the instance comes from gl_InstanceIndex (= the draw's first_instance).
+#include "shared/glsl_buffers.h"
+
+layout(location = 0) in vec3 in_position;
+layout(location = 1) in vec3 in_normal;
+
+layout(location = 0) out vec3 out_normal;
+layout(location = 1) out vec3 out_world_position;
+layout(location = 2) flat out vec4 out_color;
+
+void main()
+{
+    GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
+    GdrGpuInstance instance = InstancesRef(push.instances).items[gl_InstanceIndex];
+    vec4 world = instance.model * vec4(in_position, 1.0);
+    gl_Position = g.view_projection * world;
+    // The cofactor matrix transforms normals correctly under non-uniform scale (up to length).
+    mat3 m = mat3(instance.model);
+    mat3 cofactor = mat3(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1]));
+    out_normal = cofactor * in_normal;
+    out_world_position = world.xyz;
+    out_color = instance.color;
+}

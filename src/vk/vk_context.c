@@ -1,0 +1,347 @@
+#include "vk/vk_context.h"
+
+#include <ctype.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *gdr_vk_result_name(VkResult result)
+{
+    switch (result) {
+#define NAME(x) case x: return #x
+    NAME(VK_SUCCESS); NAME(VK_NOT_READY); NAME(VK_TIMEOUT); NAME(VK_INCOMPLETE);
+    NAME(VK_ERROR_OUT_OF_HOST_MEMORY); NAME(VK_ERROR_OUT_OF_DEVICE_MEMORY);
+    NAME(VK_ERROR_INITIALIZATION_FAILED); NAME(VK_ERROR_DEVICE_LOST); NAME(VK_ERROR_MEMORY_MAP_FAILED);
+    NAME(VK_ERROR_LAYER_NOT_PRESENT); NAME(VK_ERROR_EXTENSION_NOT_PRESENT); NAME(VK_ERROR_FEATURE_NOT_PRESENT);
+    NAME(VK_ERROR_INCOMPATIBLE_DRIVER); NAME(VK_ERROR_TOO_MANY_OBJECTS); NAME(VK_ERROR_FORMAT_NOT_SUPPORTED);
+    NAME(VK_ERROR_FRAGMENTED_POOL); NAME(VK_ERROR_OUT_OF_POOL_MEMORY); NAME(VK_ERROR_UNKNOWN);
+#undef NAME
+    default: return "VkResult(unknown)";
+    }
+}
+
+static VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                            VkDebugUtilsMessageTypeFlagsEXT type,
+                                                            const VkDebugUtilsMessengerCallbackDataEXT *data,
+                                                            void *user)
+{
+    (void)type;
+    gdr_vk_context *ctx = user;
+    __atomic_add_fetch(&ctx->validation_messages, 1, __ATOMIC_RELAXED);
+    fprintf(stderr, "gdr: validation %s: %s\n",
+            severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error" : "warning",
+            data->pMessage ? data->pMessage : "(no message)");
+    return VK_FALSE;
+}
+
+static bool layer_available(const char *name)
+{
+    uint32_t count = 0;
+    vkEnumerateInstanceLayerProperties(&count, NULL);
+    VkLayerProperties *layers = calloc(count ? count : 1, sizeof *layers);
+    bool found = false;
+    if (layers && vkEnumerateInstanceLayerProperties(&count, layers) == VK_SUCCESS)
+        for (uint32_t i = 0; i < count && !found; i++)
+            found = strcmp(layers[i].layerName, name) == 0;
+    free(layers);
+    return found;
+}
+
+static bool device_extension_available(VkPhysicalDevice device, const char *name)
+{
+    uint32_t count = 0;
+    vkEnumerateDeviceExtensionProperties(device, NULL, &count, NULL);
+    VkExtensionProperties *extensions = calloc(count ? count : 1, sizeof *extensions);
+    bool found = false;
+    if (extensions && vkEnumerateDeviceExtensionProperties(device, NULL, &count, extensions) == VK_SUCCESS)
+        for (uint32_t i = 0; i < count && !found; i++)
+            found = strcmp(extensions[i].extensionName, name) == 0;
+    free(extensions);
+    return found;
+}
+
+static bool contains_ignoring_case(const char *haystack, const char *needle)
+{
+    size_t n = strlen(needle);
+    for (; *haystack; haystack++) {
+        size_t i = 0;
+        while (i < n && haystack[i] && tolower((unsigned char)haystack[i]) == tolower((unsigned char)needle[i]))
+            i++;
+        if (i == n)
+            return true;
+    }
+    return n == 0;
+}
+
+static gdr_status create_instance(gdr_vk_context *ctx, const gdr_vk_context_desc *desc, gdr_error *err)
+{
+    VkApplicationInfo app = {.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO, .pApplicationName = "gdr",
+                             .pEngineName = "gdr", .apiVersion = VK_API_VERSION_1_3};
+    const char *layers[1] = {"VK_LAYER_KHRONOS_validation"};
+    const char *extensions[1] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME};
+    bool validate = desc->validate || desc->synchronization_validation;
+    if (validate && !layer_available(layers[0]))
+        return gdr_error_set(err, GDR_ERROR_UNSUPPORTED,
+                             "validation requested but VK_LAYER_KHRONOS_validation is not installed "
+                             "(Debian package vulkan-validationlayers)");
+    VkValidationFeatureEnableEXT sync_feature = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
+    VkValidationFeaturesEXT features = {.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT,
+                                        .enabledValidationFeatureCount = 1,
+                                        .pEnabledValidationFeatures = &sync_feature};
+    VkDebugUtilsMessengerCreateInfoEXT messenger_info = {
+        .sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT,
+        .pNext = desc->synchronization_validation ? &features : NULL,
+        .messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
+        .messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                       VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT,
+        .pfnUserCallback = on_validation_message,
+        .pUserData = ctx,
+    };
+    VkInstanceCreateInfo info = {
+        .sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO,
+        .pNext = validate ? &messenger_info : NULL,
+        .pApplicationInfo = &app,
+        .enabledLayerCount = validate ? 1u : 0u,
+        .ppEnabledLayerNames = layers,
+        .enabledExtensionCount = validate ? 1u : 0u,
+        .ppEnabledExtensionNames = extensions,
+    };
+    VkResult result = vkCreateInstance(&info, NULL, &ctx->instance);
+    if (result == VK_ERROR_INCOMPATIBLE_DRIVER || result == VK_ERROR_INITIALIZATION_FAILED)
+        return gdr_error_set(err, GDR_ERROR_UNSUPPORTED,
+                             "no Vulkan 1.3 driver found (%s); install mesa-vulkan-drivers for lavapipe",
+                             gdr_vk_result_name(result));
+    GDR_VK_TRY(err, result);
+    if (validate) {
+        PFN_vkCreateDebugUtilsMessengerEXT create_messenger =
+            (PFN_vkCreateDebugUtilsMessengerEXT)vkGetInstanceProcAddr(ctx->instance, "vkCreateDebugUtilsMessengerEXT");
+        if (!create_messenger)
+            return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "VK_EXT_debug_utils is not available");
+        messenger_info.pNext = NULL;
+        GDR_VK_TRY(err, create_messenger(ctx->instance, &messenger_info, NULL, &ctx->messenger));
+    }
+    return GDR_OK;
+}
+
+static gdr_status choose_physical_device(gdr_vk_context *ctx, const char *wanted, gdr_error *err)
+{
+    uint32_t count = 0;
+    GDR_VK_TRY(err, vkEnumeratePhysicalDevices(ctx->instance, &count, NULL));
+    if (count == 0)
+        return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "no Vulkan device found");
+    VkPhysicalDevice devices[16];
+    if (count > 16)
+        count = 16;
+    VkResult result = vkEnumeratePhysicalDevices(ctx->instance, &count, devices);
+    if (result != VK_SUCCESS && result != VK_INCOMPLETE)
+        GDR_VK_TRY(err, result);
+
+    int chosen = -1;
+    if (!wanted) {
+        for (uint32_t i = 0; i < count && chosen < 0; i++) {
+            VkPhysicalDeviceProperties p;
+            vkGetPhysicalDeviceProperties(devices[i], &p);
+            if (p.deviceType == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU)
+                chosen = (int)i;
+        }
+        if (chosen < 0)
+            chosen = 0;
+    } else {
+        char *end;
+        long index = strtol(wanted, &end, 10);
+        if (*wanted && *end == '\0') {
+            if (index < 0 || index >= (long)count)
+                return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "--device %s: there are %u device(s), 0..%u",
+                                     wanted, count, count - 1);
+            chosen = (int)index;
+        } else {
+            for (uint32_t i = 0; i < count && chosen < 0; i++) {
+                VkPhysicalDeviceProperties p;
+                vkGetPhysicalDeviceProperties(devices[i], &p);
+                if (contains_ignoring_case(p.deviceName, wanted))
+                    chosen = (int)i;
+            }
+            if (chosen < 0) {
+                char names[512] = "";
+                for (uint32_t i = 0; i < count; i++) {
+                    VkPhysicalDeviceProperties p;
+                    vkGetPhysicalDeviceProperties(devices[i], &p);
+                    size_t used = strlen(names);
+                    snprintf(names + used, sizeof names - used, "%s%u: %s", i ? ", " : "", i, p.deviceName);
+                }
+                return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "--device %s: no such device (have %s)",
+                                     wanted, names);
+            }
+        }
+    }
+    ctx->physical_device = devices[chosen];
+    vkGetPhysicalDeviceProperties(ctx->physical_device, &ctx->properties);
+    vkGetPhysicalDeviceMemoryProperties(ctx->physical_device, &ctx->memory_properties);
+    return GDR_OK;
+}
+
+/* Appends "name" to a comma-separated list of missing features. */
+static void note_missing(char *list, size_t size, bool present, const char *name)
+{
+    if (present)
+        return;
+    size_t used = strlen(list);
+    snprintf(list + used, size - used, "%s%s", used ? ", " : "", name);
+}
+
+static gdr_status create_device(gdr_vk_context *ctx, gdr_error *err)
+{
+    VkPhysicalDevice pd = ctx->physical_device;
+    if (ctx->properties.apiVersion < VK_API_VERSION_1_3)
+        return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "device '%s' supports Vulkan %u.%u; gdr needs 1.3",
+                             ctx->properties.deviceName, VK_API_VERSION_MAJOR(ctx->properties.apiVersion),
+                             VK_API_VERSION_MINOR(ctx->properties.apiVersion));
+
+    VkPhysicalDeviceVulkan13Features f13 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+    VkPhysicalDeviceVulkan12Features f12 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, .pNext = &f13};
+    VkPhysicalDeviceVulkan11Features f11 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES, .pNext = &f12};
+    VkPhysicalDeviceFeatures2 f2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, .pNext = &f11};
+    vkGetPhysicalDeviceFeatures2(pd, &f2);
+
+    VkPhysicalDeviceSubgroupProperties subgroup = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+    VkPhysicalDeviceDriverProperties driver = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES, .pNext = &subgroup};
+    VkPhysicalDeviceProperties2 p2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &driver};
+    vkGetPhysicalDeviceProperties2(pd, &p2);
+    ctx->subgroup_size = subgroup.subgroupSize;
+    snprintf(ctx->driver_info, sizeof ctx->driver_info, "%s %s", driver.driverName, driver.driverInfo);
+
+    char missing[512] = "";
+    note_missing(missing, sizeof missing, f2.features.multiDrawIndirect, "multiDrawIndirect");
+    note_missing(missing, sizeof missing, f2.features.drawIndirectFirstInstance, "drawIndirectFirstInstance");
+    note_missing(missing, sizeof missing, f2.features.shaderInt64, "shaderInt64");
+    note_missing(missing, sizeof missing, f11.shaderDrawParameters, "shaderDrawParameters");
+    note_missing(missing, sizeof missing, f12.drawIndirectCount, "drawIndirectCount");
+    note_missing(missing, sizeof missing, f12.bufferDeviceAddress, "bufferDeviceAddress");
+    note_missing(missing, sizeof missing, f12.scalarBlockLayout, "scalarBlockLayout");
+    note_missing(missing, sizeof missing, f12.hostQueryReset, "hostQueryReset");
+    note_missing(missing, sizeof missing, f13.dynamicRendering, "dynamicRendering");
+    note_missing(missing, sizeof missing, f13.synchronization2, "synchronization2");
+    note_missing(missing, sizeof missing, f13.maintenance4, "maintenance4");
+    note_missing(missing, sizeof missing, (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0,
+                 "subgroup operations in compute shaders");
+    note_missing(missing, sizeof missing, (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_BALLOT_BIT) != 0,
+                 "subgroup ballot");
+    note_missing(missing, sizeof missing, (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT) != 0,
+                 "subgroup arithmetic");
+    note_missing(missing, sizeof missing, ctx->properties.limits.timestampComputeAndGraphics, "timestampComputeAndGraphics");
+    if (missing[0])
+        return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "device '%s' lacks required features: %s",
+                             ctx->properties.deviceName, missing);
+
+    uint32_t family_count = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(pd, &family_count, NULL);
+    VkQueueFamilyProperties families[32];
+    if (family_count > 32)
+        family_count = 32;
+    vkGetPhysicalDeviceQueueFamilyProperties(pd, &family_count, families);
+    ctx->queue_family = UINT32_MAX;
+    for (uint32_t i = 0; i < family_count && ctx->queue_family == UINT32_MAX; i++)
+        if ((families[i].queueFlags & (VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT)) ==
+                (VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT) && families[i].timestampValidBits > 0)
+            ctx->queue_family = i;
+    if (ctx->queue_family == UINT32_MAX)
+        return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "device '%s' has no graphics+compute queue with timestamps",
+                             ctx->properties.deviceName);
+
+    /* Enable exactly what gdr uses. */
+    VkPhysicalDeviceMeshShaderFeaturesEXT mesh = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
+    ctx->has_mesh_shader = device_extension_available(pd, VK_EXT_MESH_SHADER_EXTENSION_NAME);
+    VkPhysicalDeviceVulkan13Features e13 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES,
+                                            .dynamicRendering = VK_TRUE, .synchronization2 = VK_TRUE,
+                                            .maintenance4 = VK_TRUE};
+    VkPhysicalDeviceVulkan12Features e12 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, .pNext = &e13,
+                                            .drawIndirectCount = VK_TRUE, .bufferDeviceAddress = VK_TRUE,
+                                            .scalarBlockLayout = VK_TRUE, .hostQueryReset = VK_TRUE};
+    VkPhysicalDeviceVulkan11Features e11 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES, .pNext = &e12,
+                                            .shaderDrawParameters = VK_TRUE};
+    VkPhysicalDeviceFeatures2 e2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, .pNext = &e11};
+    e2.features.multiDrawIndirect = VK_TRUE;
+    e2.features.drawIndirectFirstInstance = VK_TRUE;
+    e2.features.shaderInt64 = VK_TRUE;
+    float priority = 1.0f;
+    VkDeviceQueueCreateInfo queue_info = {.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO,
+                                          .queueFamilyIndex = ctx->queue_family, .queueCount = 1,
+                                          .pQueuePriorities = &priority};
+    (void)mesh; /* mesh shaders are enabled by the meshlet pipeline once it exists */
+    VkDeviceCreateInfo info = {.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, .pNext = &e2, .queueCreateInfoCount = 1,
+                               .pQueueCreateInfos = &queue_info};
+    GDR_VK_TRY(err, vkCreateDevice(pd, &info, NULL, &ctx->device));
+    vkGetDeviceQueue(ctx->device, ctx->queue_family, 0, &ctx->queue);
+    VkCommandPoolCreateInfo pool_info = {.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
+                                         .flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT,
+                                         .queueFamilyIndex = ctx->queue_family};
+    GDR_VK_TRY(err, vkCreateCommandPool(ctx->device, &pool_info, NULL, &ctx->command_pool));
+    return GDR_OK;
+}
+
+gdr_status gdr_vk_context_create(const gdr_vk_context_desc *desc, gdr_vk_context **out, gdr_error *err)
+{
+    gdr_vk_context *ctx = calloc(1, sizeof *ctx);
+    if (!ctx)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "out of memory");
+    gdr_status status = create_instance(ctx, desc, err);
+    if (status == GDR_OK)
+        status = choose_physical_device(ctx, desc->device, err);
+    if (status == GDR_OK)
+        status = create_device(ctx, err);
+    if (status != GDR_OK) {
+        gdr_vk_context_destroy(ctx);
+        return status;
+    }
+    *out = ctx;
+    return GDR_OK;
+}
+
+void gdr_vk_context_destroy(gdr_vk_context *ctx)
+{
+    if (!ctx)
+        return;
+    if (ctx->device) {
+        vkDeviceWaitIdle(ctx->device);
+        if (ctx->command_pool)
+            vkDestroyCommandPool(ctx->device, ctx->command_pool, NULL);
+        vkDestroyDevice(ctx->device, NULL);
+    }
+    if (ctx->messenger) {
+        PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger =
+            (PFN_vkDestroyDebugUtilsMessengerEXT)vkGetInstanceProcAddr(ctx->instance, "vkDestroyDebugUtilsMessengerEXT");
+        if (destroy_messenger)
+            destroy_messenger(ctx->instance, ctx->messenger, NULL);
+    }
+    if (ctx->instance)
+        vkDestroyInstance(ctx->instance, NULL);
+    free(ctx);
+}
+
+gdr_status gdr_vk_begin_one_time(gdr_vk_context *ctx, VkCommandBuffer *out, gdr_error *err)
+{
+    VkCommandBufferAllocateInfo alloc = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
+                                         .commandPool = ctx->command_pool,
+                                         .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY, .commandBufferCount = 1};
+    GDR_VK_TRY(err, vkAllocateCommandBuffers(ctx->device, &alloc, out));
+    VkCommandBufferBeginInfo begin = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+                                      .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
+    GDR_VK_TRY(err, vkBeginCommandBuffer(*out, &begin));
+    return GDR_OK;
+}
+
+gdr_status gdr_vk_end_one_time(gdr_vk_context *ctx, VkCommandBuffer cmd, gdr_error *err)
+{
+    gdr_status status = GDR_OK;
+    VkResult result = vkEndCommandBuffer(cmd);
+    if (result == VK_SUCCESS) {
+        VkSubmitInfo submit = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO, .commandBufferCount = 1, .pCommandBuffers = &cmd};
+        result = vkQueueSubmit(ctx->queue, 1, &submit, VK_NULL_HANDLE);
+        if (result == VK_SUCCESS)
+            result = vkQueueWaitIdle(ctx->queue);
+    }
+    if (result != VK_SUCCESS)
+        status = gdr_error_set(err, GDR_ERROR_VULKAN, "one-time command buffer failed: %s", gdr_vk_result_name(result));
+    vkFreeCommandBuffers(ctx->device, ctx->command_pool, 1, &cmd);
+    return status;
+}

@@ -1,0 +1,65 @@
+#include "cli_args.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+bool cli_parse_u32(const char *option, const char *text, uint32_t min, uint32_t max, uint32_t *out)
+{
+    char *end;
+    errno = 0;
+    unsigned long long value = strtoull(text, &end, 10);
+    if (errno || end == text || *end || text[0] == '-' || text[0] == '+' || value < min || value > max) {
+        fprintf(stderr, "gdr: %s %s: expected an integer from %u to %u\n", option, text, min, max);
+        return false;
+    }
+    *out = (uint32_t)value;
+    return true;
+}
+
+bool cli_parse_on_off(const char *option, const char *text, bool *out)
+{
+    if (strcmp(text, "on") == 0 || strcmp(text, "off") == 0) {
+        *out = text[1] == 'n';
+        return true;
+    }
+    fprintf(stderr, "gdr: %s %s: expected 'on' or 'off'\n", option, text);
+    return false;
+}
+
+bool cli_parse_camera(const char *option, const char *text, gdr_vec3 *position, gdr_quat *rotation)
+{
+    float v[7];
+    const char *cursor = text;
+    for (int i = 0; i < 7; i++) {
+        char *end;
+        errno = 0;
+        v[i] = strtof(cursor, &end);
+        bool separator_ok = i < 6 ? *end == ',' : *end == '\0';
+        if (errno || end == cursor || !separator_ok || !isfinite(v[i])) {
+            fprintf(stderr, "gdr: %s %s: expected 7 finite numbers px,py,pz,qx,qy,qz,qw\n", option, text);
+            return false;
+        }
+        cursor = end + 1;
+    }
+    float length = sqrtf(v[3] * v[3] + v[4] * v[4] + v[5] * v[5] + v[6] * v[6]);
+    if (length < 1e-6f) {
+        fprintf(stderr, "gdr: %s %s: the rotation quaternion must not be zero\n", option, text);
+        return false;
+    }
+    *position = (gdr_vec3){v[0], v[1], v[2]};
+    *rotation = gdr_quat_normalize((gdr_quat){v[3], v[4], v[5], v[6]});
+    return true;
+}
+
+const char *cli_value(int argc, char **argv, int *i)
+{
+    if (*i + 1 >= argc) {
+        fprintf(stderr, "gdr: %s needs a value\n", argv[*i]);
+        return NULL;
+    }
+    *i += 1;
+    return argv[*i];
+}

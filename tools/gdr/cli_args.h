@@ -1,0 +1,18 @@
+/* Strict parsing of command-line values: the whole string must be a valid value in range. */
+#ifndef GDR_CLI_ARGS_H
+#define GDR_CLI_ARGS_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "gdr/scene.h"
+
+/* Each prints "gdr: OPTION VALUE: why" on failure and returns false. */
+bool cli_parse_u32(const char *option, const char *text, uint32_t min, uint32_t max, uint32_t *out);
+bool cli_parse_on_off(const char *option, const char *text, bool *out);
+/* "px,py,pz,qx,qy,qz,qw": position and rotation quaternion (normalised; must not be zero). */
+bool cli_parse_camera(const char *option, const char *text, gdr_vec3 *position, gdr_quat *rotation);
+/* Returns the option's value (argv[*i + 1]) and advances *i, or prints an error and returns NULL. */
+const char *cli_value(int argc, char **argv, int *i);
+
+#endif

@@ -1,0 +1,133 @@
+/* gdr bench: the demo scene at several sizes; CPU ms per frame (record + submit) and GPU ms per pass. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cjson/cJSON.h>
+
+#include "cli_args.h"
+#include "commands.h"
+#include "gdr/gdr.h"
+
+#define MAX_SIZES 16
+
+static bool parse_sizes(const char *text, uint32_t *sizes, uint32_t *count)
+{
+    char buffer[256];
+    if (strlen(text) >= sizeof buffer) {
+        fprintf(stderr, "gdr: --sizes: too long\n");
+        return false;
+    }
+    strcpy(buffer, text);
+    *count = 0;
+    for (char *save = NULL, *item = strtok_r(buffer, ",", &save); item; item = strtok_r(NULL, ",", &save)) {
+        if (*count == MAX_SIZES) {
+            fprintf(stderr, "gdr: --sizes: at most %d sizes\n", MAX_SIZES);
+            return false;
+        }
+        if (!cli_parse_u32("--sizes", item, 1, 16000000, &sizes[(*count)++]))
+            return false;
+    }
+    if (*count == 0)
+        fprintf(stderr, "gdr: --sizes: no sizes given\n");
+    return *count > 0;
+}
+
+int gdr_cmd_bench(int argc, char **argv)
+{
+    uint32_t sizes[MAX_SIZES] = {1000, 10000, 100000, 1000000}, size_count = 4;
+    uint32_t frames = 20, width = 1920, height = 1080;
+    const char *device = NULL, *json_path = NULL;
+    bool validate = false;
+    for (int i = 1; i < argc; i++) {
+        const char *arg = argv[i], *value;
+        if (strcmp(arg, "--validate") == 0) {
+            validate = true;
+            continue;
+        }
+        if (!(value = cli_value(argc, argv, &i)))
+            return 2;
+        bool ok = true;
+        if (strcmp(arg, "--sizes") == 0)
+            ok = parse_sizes(value, sizes, &size_count);
+        else if (strcmp(arg, "--frames") == 0)
+            ok = cli_parse_u32(arg, value, 1, 100000, &frames);
+        else if (strcmp(arg, "--width") == 0)
+            ok = cli_parse_u32(arg, value, 1, 16384, &width);
+        else if (strcmp(arg, "--height") == 0)
+            ok = cli_parse_u32(arg, value, 1, 16384, &height);
+        else if (strcmp(arg, "--device") == 0)
+            device = value;
+        else if (strcmp(arg, "--json") == 0)
+            json_path = value;
+        else {
+            fprintf(stderr, "gdr bench: unknown option '%s' (see gdr --help)\n", arg);
+            return 2;
+        }
+        if (!ok)
+            return 2;
+    }
+
+    cJSON *rows = cJSON_CreateArray();
+    printf("%10s %10s %12s %10s %10s %10s %10s %10s\n", "instances", "visible", "triangles", "cpu_ms", "gpu_update",
+           "gpu_cull", "gpu_draw", "gpu_frame");
+    double first_cpu = 0.0;
+    int result = 0;
+    for (uint32_t s = 0; s < size_count && result == 0; s++) {
+        gdr_error err = {0};
+        gdr_scene *scene = NULL;
+        gdr_renderer *renderer = NULL;
+        gdr_frame_stats stats;
+        gdr_demo_desc demo = {.instances = sizes[s]};
+        gdr_renderer_desc desc = {.width = width, .height = height, .device = device, .validate = validate};
+        if (gdr_scene_create_demo(&demo, &scene, &err) != GDR_OK || gdr_renderer_create(&desc, &renderer, &err) != GDR_OK ||
+            gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK) {
+            fprintf(stderr, "gdr: %s\n", err.message);
+            result = 1;
+        } else {
+            gdr_frame_desc frame = {.camera = scene->cameras[0], .cull = GDR_CULL_ON};
+            if (gdr_renderer_render(renderer, &frame, frames, &stats, &err) != GDR_OK) {
+                fprintf(stderr, "gdr: %s\n", err.message);
+                result = 1;
+            }
+        }
+        if (result == 0) {
+            if (s == 0)
+                first_cpu = stats.cpu_ms_per_frame;
+            printf("%10u %10u %12llu %10.4f %10.4f %10.4f %10.4f %10.4f\n", stats.instances_total, stats.instances_visible,
+                   (unsigned long long)stats.triangles, stats.cpu_ms_per_frame, stats.passes[0].gpu_ms,
+                   stats.passes[1].gpu_ms, stats.passes[2].gpu_ms, stats.gpu_ms_per_frame);
+            fflush(stdout);
+            cJSON *row = cJSON_CreateObject();
+            cJSON_AddNumberToObject(row, "instances_total", stats.instances_total);
+            cJSON_AddNumberToObject(row, "instances_visible", stats.instances_visible);
+            cJSON_AddNumberToObject(row, "triangles", (double)stats.triangles);
+            cJSON_AddNumberToObject(row, "cpu_ms_per_frame", stats.cpu_ms_per_frame);
+            cJSON_AddNumberToObject(row, "cpu_ratio_to_first", first_cpu > 0 ? stats.cpu_ms_per_frame / first_cpu : 0);
+            cJSON *passes = cJSON_AddObjectToObject(row, "gpu_ms");
+            for (uint32_t p = 0; p < stats.pass_count; p++)
+                cJSON_AddNumberToObject(passes, stats.passes[p].name, stats.passes[p].gpu_ms);
+            cJSON_AddNumberToObject(row, "gpu_ms_per_frame", stats.gpu_ms_per_frame);
+            cJSON_AddStringToObject(row, "device", stats.device);
+            cJSON_AddStringToObject(row, "driver", stats.driver);
+            cJSON_AddNumberToObject(row, "validation_messages", stats.validation_messages);
+            cJSON_AddItemToArray(rows, row);
+            if (stats.validation_messages)
+                result = 3;
+        }
+        gdr_renderer_destroy(renderer);
+        gdr_scene_destroy(scene);
+    }
+    char *json = cJSON_Print(rows);
+    cJSON_Delete(rows);
+    if (json) {
+        gdr_error err = {0};
+        printf("%s\n", json);
+        if (json_path && gdr_write_file_atomic(json_path, json, strlen(json), &err) != GDR_OK) {
+            fprintf(stderr, "gdr: %s\n", err.message);
+            result = result ? result : 1;
+        }
+        free(json);
+    }
+    return result;
+}

@@ -1,0 +1,145 @@
+/* gdr render SCENE: renders frames of a scene headless, writes a PNG and statistics. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli_args.h"
+#include "commands.h"
+#include "gdr/gdr.h"
+#include "stats_output.h"
+
+typedef struct render_options {
+    const char *scene;
+    const char *out_png;
+    const char *stats_json;
+    uint32_t width, height, frames, camera_index;
+    bool has_camera, has_camera_index, cull, validate;
+    gdr_vec3 camera_position;
+    gdr_quat camera_rotation;
+    const char *device;
+} render_options;
+
+static int parse_render_options(int argc, char **argv, render_options *o)
+{
+    *o = (render_options){.width = 1280, .height = 720, .frames = 1, .cull = true};
+    for (int i = 1; i < argc; i++) {
+        const char *arg = argv[i], *value;
+        if (arg[0] != '-' || strcmp(arg, "-") == 0) {
+            if (o->scene) {
+                fprintf(stderr, "gdr render: only one scene, got '%s' and '%s'\n", o->scene, arg);
+                return 2;
+            }
+            o->scene = arg;
+            continue;
+        }
+        if (strcmp(arg, "--validate") == 0) {
+            o->validate = true;
+            continue;
+        }
+        if (!(value = cli_value(argc, argv, &i)))
+            return 2;
+        bool ok = true;
+        if (strcmp(arg, "--out") == 0 || strcmp(arg, "-o") == 0)
+            o->out_png = value;
+        else if (strcmp(arg, "--stats") == 0)
+            o->stats_json = value;
+        else if (strcmp(arg, "--width") == 0)
+            ok = cli_parse_u32(arg, value, 1, 16384, &o->width);
+        else if (strcmp(arg, "--height") == 0)
+            ok = cli_parse_u32(arg, value, 1, 16384, &o->height);
+        else if (strcmp(arg, "--frames") == 0)
+            ok = cli_parse_u32(arg, value, 1, 100000, &o->frames);
+        else if (strcmp(arg, "--camera") == 0)
+            ok = o->has_camera = cli_parse_camera(arg, value, &o->camera_position, &o->camera_rotation);
+        else if (strcmp(arg, "--camera-index") == 0)
+            ok = o->has_camera_index = cli_parse_u32(arg, value, 0, 1000000, &o->camera_index);
+        else if (strcmp(arg, "--cull") == 0)
+            ok = cli_parse_on_off(arg, value, &o->cull);
+        else if (strcmp(arg, "--device") == 0)
+            o->device = value;
+        else {
+            fprintf(stderr, "gdr render: unknown option '%s' (see gdr --help)\n", arg);
+            return 2;
+        }
+        if (!ok)
+            return 2;
+    }
+    if (!o->scene) {
+        fprintf(stderr, "gdr render: which scene? e.g. 'gdr render demo' (see gdr --help)\n");
+        return 2;
+    }
+    return 0;
+}
+
+static int fail(const gdr_error *err)
+{
+    fprintf(stderr, "gdr: %s\n", err->message);
+    return 1;
+}
+
+static gdr_camera choose_camera(const gdr_scene *scene, const render_options *o)
+{
+    gdr_camera camera = scene->camera_count > 0 ? scene->cameras[o->has_camera_index ? o->camera_index : 0]
+                                                : gdr_scene_framing_camera(scene);
+    if (o->has_camera) {
+        camera.position = o->camera_position;
+        camera.rotation = o->camera_rotation;
+    }
+    return camera;
+}
+
+int gdr_cmd_render(int argc, char **argv)
+{
+    render_options o;
+    int usage = parse_render_options(argc, argv, &o);
+    if (usage)
+        return usage;
+    gdr_error err = {0};
+    gdr_scene *scene = NULL;
+    if (gdr_scene_load(o.scene, &scene, &err) != GDR_OK)
+        return fail(&err);
+    if (o.has_camera_index && o.camera_index >= scene->camera_count) {
+        fprintf(stderr, "gdr: --camera-index %u: the scene has %u camera(s)\n", o.camera_index, scene->camera_count);
+        gdr_scene_destroy(scene);
+        return 2;
+    }
+    gdr_renderer_desc desc = {.width = o.width, .height = o.height, .device = o.device, .validate = o.validate};
+    gdr_renderer *renderer = NULL;
+    gdr_frame_stats stats;
+    uint8_t *pixels = NULL;
+    int result = 0;
+    gdr_frame_desc frame = {.camera = choose_camera(scene, &o), .cull = o.cull ? GDR_CULL_ON : GDR_CULL_OFF,
+                            .read_back = o.out_png != NULL};
+    if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK || gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK ||
+        gdr_renderer_render(renderer, &frame, o.frames, &stats, &err) != GDR_OK) {
+        result = fail(&err);
+        goto done;
+    }
+    if (o.out_png) {
+        pixels = malloc((size_t)o.width * o.height * 4);
+        if (!pixels || gdr_renderer_read_color(renderer, pixels, &err) != GDR_OK ||
+            gdr_write_png(o.out_png, pixels, o.width, o.height, &err) != GDR_OK) {
+            result = pixels ? fail(&err) : 1;
+            goto done;
+        }
+    }
+    stats_context context = {o.scene, o.width, o.height, o.cull ? "on" : "off"};
+    stats_print(stdout, &context, &stats);
+    if (o.out_png)
+        printf("image               %s\n", o.out_png);
+    if (o.stats_json) {
+        char *json = stats_to_json(&context, &stats);
+        if (!json || gdr_write_file_atomic(o.stats_json, json, strlen(json), &err) != GDR_OK)
+            result = json ? fail(&err) : 1;
+        free(json);
+    }
+    if (result == 0 && stats.validation_messages > 0) {
+        fprintf(stderr, "gdr: the validation layer reported %u message(s)\n", stats.validation_messages);
+        result = 3;
+    }
+done:
+    free(pixels);
+    gdr_renderer_destroy(renderer);
+    gdr_scene_destroy(scene);
+    return result;
+}

@@ -1,0 +1,9 @@
+/* The subcommands of the gdr program. Each takes argv with argv[0] = the subcommand's name and
+ * returns the process exit status: 0 success, 1 failure, 2 bad usage. */
+#ifndef GDR_COMMANDS_H
+#define GDR_COMMANDS_H
+
+int gdr_cmd_render(int argc, char **argv);
+int gdr_cmd_bench(int argc, char **argv);
+
+#endif

@@ -1,0 +1,19 @@
+/* Frame statistics printed for people and written as JSON for programs. */
+#ifndef GDR_STATS_OUTPUT_H
+#define GDR_STATS_OUTPUT_H
+
+#include <stdio.h>
+
+#include "gdr/renderer.h"
+
+typedef struct stats_context {
+    const char *scene;
+    uint32_t width, height;
+    const char *cull;
+} stats_context;
+
+void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats *stats);
+/* Returns a malloc'ed JSON text, or NULL when out of memory. */
+char *stats_to_json(const stats_context *context, const gdr_frame_stats *stats);
+
+#endif
