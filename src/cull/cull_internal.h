@@ -1,0 +1,102 @@
+/* Internal to src/cull: the scene's storage, the octree, and the hot tests in inline form. */
+#ifndef GDR_CULL_INTERNAL_H
+#define GDR_CULL_INTERNAL_H
+
+#include <math.h>
+#include <stdint.h>
+
+#include "gdr/cull.h"
+
+/* object_node values that are not node indices */
+#define CULL_NODE_NONE UINT32_MAX          /* in no node: tested on its own every time */
+#define CULL_NODE_INVALID (UINT32_MAX - 1) /* invalid or empty bounds: never visible */
+
+#define CULL_OCTREE_DEFAULT_DEPTH 12u
+#define CULL_OCTREE_MAX_DEPTH 20u
+#define CULL_OCTREE_DEFAULT_LEAF 16u
+
+/* A node of the loose octree. Nodes are stored in pre-order, so a subtree is the index range
+ * [node, skip): culling walks the array and jumps over subtrees that need no more tests. */
+typedef struct cull_node {
+    gdr_vec3 center;
+    float extent;         /* half-size of the node's loose cube, with the safety margin */
+    float cell_half;      /* half-size of the node's cell (objects centred in it) */
+    float fit_extent;     /* half-size an object box must fit in (loose cube without margin) */
+    uint32_t skip;        /* first node after this subtree */
+    uint32_t depth;
+    uint32_t children[8]; /* octant (x >= cx) | (y >= cy) << 1 | (z >= cz) << 2; UINT32_MAX none */
+} cull_node;
+
+struct gdr_cull_scene {
+    uint32_t object_count;
+    gdr_cull_object *objects;
+    uint32_t *object_node;
+    cull_node *nodes;
+    uint32_t node_count, node_capacity;
+    uint32_t max_depth, leaf_objects;
+};
+
+/* octree.c */
+gdr_status cull_octree_build(gdr_cull_scene *scene, gdr_error *err);
+/* Node index for an object with valid bounds (CULL_NODE_NONE if outside the root). */
+uint32_t cull_octree_place(const gdr_cull_scene *scene, gdr_vec3 center, gdr_vec3 extent);
+/* Two bits per node into node_bits (gdr_cull_word_count(2 * node_count) words, zeroed by the
+ * caller): bit 2n = intersects the frustum, bit 2n + 1 = partly outside. */
+void cull_octree_classify(const gdr_cull_scene *scene, const gdr_frustum *frustum, uint32_t *node_bits,
+                          uint32_t *nodes_tested, uint32_t *nodes_inside);
+static inline uint32_t cull_node_bits(const uint32_t *node_bits, uint32_t node)
+{
+    return (node_bits[node >> 4] >> ((node & 15u) * 2u)) & 3u;
+}
+
+/* bounds_tests.c */
+bool cull_object_bounds_valid(const gdr_cull_object *object);
+
+/* distance_cull.c: returns false when culled; sets *fading. */
+typedef struct cull_distance_params {
+    gdr_vec3 origin;
+    float scale, fade_range;
+    bool to_sphere_edge;
+} cull_distance_params;
+bool cull_distance_visible(const cull_distance_params *p, const gdr_cull_object *o, float center_distance,
+                           bool *fading);
+
+/* screen_size.c */
+float cull_screen_size(float screen_scale, float radius, float center_distance);
+bool cull_screen_size_visible(float size, float view_min, const gdr_cull_object *o);
+
+/* The permuted 8-lane tests. A sphere is outside when some plane has dist < -r. */
+static inline bool cull_sphere_outside(const gdr_frustum *f, gdr_vec3 c, float r)
+{
+    int outside = 0;
+    for (int i = 0; i < 8; i++) {
+        float dist = f->px[i] * c.x + f->py[i] * c.y + f->pz[i] * c.z + f->pd[i];
+        outside |= dist < -r;
+    }
+    return outside != 0;
+}
+
+static inline bool cull_box_outside(const gdr_frustum *f, gdr_vec3 c, gdr_vec3 e)
+{
+    int outside = 0;
+    for (int i = 0; i < 8; i++) {
+        float dist = f->px[i] * c.x + f->py[i] * c.y + f->pz[i] * c.z + f->pd[i];
+        float push = fabsf(f->px[i]) * e.x + fabsf(f->py[i]) * e.y + fabsf(f->pz[i]) * e.z;
+        outside |= dist < -push;
+    }
+    return outside != 0;
+}
+
+static inline gdr_cull_outcome cull_box_classify(const gdr_frustum *f, gdr_vec3 c, gdr_vec3 e)
+{
+    int outside = 0, partly = 0;
+    for (int i = 0; i < 8; i++) {
+        float dist = f->px[i] * c.x + f->py[i] * c.y + f->pz[i] * c.z + f->pd[i];
+        float push = fabsf(f->px[i]) * e.x + fabsf(f->py[i]) * e.y + fabsf(f->pz[i]) * e.z;
+        outside |= dist < -push;
+        partly |= dist < push;
+    }
+    return outside ? GDR_CULL_OUTSIDE : partly ? GDR_CULL_INTERSECTS : GDR_CULL_INSIDE;
+}
+
+#endif

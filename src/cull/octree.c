@@ -1,0 +1,226 @@
+/* The loose octree over object bounds, and its per-view classification (two bits per node).
+ *
+ * An object lives in the deepest node whose cell holds its centre and whose cell half-size h is
+ * at least the object's largest half-extent, so its box lies inside the node's loose cube (the
+ * cell grown to half-size 2h). The root's cube holds every box. Each node cube is also grown by
+ * a margin much larger than float rounding, so "node fully inside / fully outside a plane"
+ * implies the same for each object box in it: culling with the tree gives exactly the result of
+ * testing every object. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cull/cull_internal.h"
+
+typedef struct octree_builder {
+    gdr_cull_scene *scene;
+    uint32_t *scratch; /* object indices while partitioning */
+    float margin;
+    gdr_error *err;
+} octree_builder;
+
+static float max3f(float a, float b, float c) { return fmaxf(a, fmaxf(b, c)); }
+
+static uint32_t octant_of(gdr_vec3 node_center, gdr_vec3 p)
+{
+    return (uint32_t)(p.x >= node_center.x) | (uint32_t)(p.y >= node_center.y) << 1 |
+           (uint32_t)(p.z >= node_center.z) << 2;
+}
+
+static gdr_vec3 child_center(gdr_vec3 c, float child_half, uint32_t octant)
+{
+    return (gdr_vec3){c.x + ((octant & 1) ? child_half : -child_half),
+                      c.y + ((octant & 2) ? child_half : -child_half),
+                      c.z + ((octant & 4) ? child_half : -child_half)};
+}
+
+static gdr_status add_node(octree_builder *b, gdr_vec3 center, float cell_half, float fit_extent, uint32_t depth,
+                           uint32_t *out_index)
+{
+    gdr_cull_scene *s = b->scene;
+    if (s->node_count == s->node_capacity) {
+        uint32_t capacity = s->node_capacity ? s->node_capacity * 2 : 64;
+        cull_node *nodes = realloc(s->nodes, (size_t)capacity * sizeof(*nodes));
+        if (!nodes)
+            return gdr_error_set(b->err, GDR_ERROR_OUT_OF_MEMORY, "cull scene: out of memory for octree nodes");
+        s->nodes = nodes;
+        s->node_capacity = capacity;
+    }
+    cull_node *n = &s->nodes[s->node_count];
+    memset(n, 0, sizeof(*n));
+    n->center = center;
+    n->cell_half = cell_half;
+    n->fit_extent = fit_extent;
+    /* The margin: relative to the node and to the whole tree (coordinates' rounding scale). */
+    n->extent = fit_extent * (1.0f + 1.0f / 4096.0f) + b->margin;
+    n->depth = depth;
+    for (int i = 0; i < 8; i++)
+        n->children[i] = UINT32_MAX;
+    *out_index = s->node_count++;
+    return GDR_OK;
+}
+
+/* Builds the subtree of node `index` over objects[0, count) (indices into the scene). */
+static gdr_status build_node(octree_builder *b, uint32_t index, uint32_t *objects, uint32_t count)
+{
+    gdr_cull_scene *s = b->scene;
+    cull_node node = s->nodes[index];
+    float child_half = node.cell_half * 0.5f;
+    uint32_t counts[9] = {0}; /* bucket 8: stays in this node */
+    uint32_t *bucket_of = b->scratch;
+
+    bool split = count > s->leaf_objects && node.depth < s->max_depth;
+    for (uint32_t i = 0; i < count; i++) {
+        const gdr_cull_object *o = &s->objects[objects[i]];
+        uint32_t bucket = 8;
+        if (split && max3f(o->extent.x, o->extent.y, o->extent.z) <= child_half)
+            bucket = octant_of(node.center, o->center);
+        bucket_of[i] = bucket;
+        counts[bucket]++;
+    }
+    if (!split || counts[8] == count) {
+        for (uint32_t i = 0; i < count; i++)
+            s->object_node[objects[i]] = index;
+        s->nodes[index].skip = s->node_count;
+        return GDR_OK;
+    }
+    /* Sort the indices by bucket (stable) through the second half of the scratch space. */
+    uint32_t offsets[9], start = 0;
+    for (int k = 0; k < 9; k++) {
+        offsets[k] = start;
+        start += counts[k];
+    }
+    uint32_t *sorted = b->scratch + s->object_count;
+    for (uint32_t i = 0; i < count; i++)
+        sorted[offsets[bucket_of[i]]++] = objects[i];
+    memcpy(objects, sorted, (size_t)count * sizeof(uint32_t));
+
+    uint32_t first = 0;
+    for (uint32_t k = 0; k < 8; first += counts[k], k++) {
+        if (!counts[k])
+            continue;
+        uint32_t child;
+        gdr_status st = add_node(b, child_center(node.center, child_half, k), child_half, 2.0f * child_half,
+                                 node.depth + 1, &child);
+        if (st != GDR_OK)
+            return st;
+        s->nodes[index].children[k] = child;
+        st = build_node(b, child, objects + first, counts[k]);
+        if (st != GDR_OK)
+            return st;
+    }
+    for (uint32_t i = first; i < count; i++)
+        s->object_node[objects[i]] = index;
+    s->nodes[index].skip = s->node_count;
+    return GDR_OK;
+}
+
+gdr_status cull_octree_build(gdr_cull_scene *s, gdr_error *err)
+{
+    s->node_count = 0;
+    gdr_vec3 lo = {INFINITY, INFINITY, INFINITY}, hi = {-INFINITY, -INFINITY, -INFINITY};
+    uint32_t valid = 0;
+    for (uint32_t i = 0; i < s->object_count; i++) {
+        const gdr_cull_object *o = &s->objects[i];
+        if (s->object_node[i] == CULL_NODE_INVALID)
+            continue;
+        valid++;
+        lo.x = fminf(lo.x, o->center.x - o->extent.x);
+        lo.y = fminf(lo.y, o->center.y - o->extent.y);
+        lo.z = fminf(lo.z, o->center.z - o->extent.z);
+        hi.x = fmaxf(hi.x, o->center.x + o->extent.x);
+        hi.y = fmaxf(hi.y, o->center.y + o->extent.y);
+        hi.z = fmaxf(hi.z, o->center.z + o->extent.z);
+    }
+    if (valid == 0)
+        return GDR_OK;
+
+    uint32_t *objects = malloc((size_t)valid * sizeof(uint32_t));
+    uint32_t *scratch = malloc((size_t)s->object_count * 2 * sizeof(uint32_t));
+    if (!objects || !scratch) {
+        free(objects);
+        free(scratch);
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "cull scene: out of memory for the octree");
+    }
+    valid = 0;
+    for (uint32_t i = 0; i < s->object_count; i++)
+        if (s->object_node[i] != CULL_NODE_INVALID)
+            objects[valid++] = i;
+
+    gdr_vec3 center = {0.5f * (lo.x + hi.x), 0.5f * (lo.y + hi.y), 0.5f * (lo.z + hi.z)};
+    float half = 0.5f * max3f(hi.x - lo.x, hi.y - lo.y, hi.z - lo.z);
+    float scale = max3f(fabsf(center.x), fabsf(center.y), fabsf(center.z)) + half;
+    if (!(half > 0.0f))
+        half = fmaxf(scale, 1.0f) * 1e-6f; /* every box is a point: any small cube will do */
+    octree_builder b = {s, scratch, scale * (1.0f / 65536.0f) + 1e-30f, err};
+    uint32_t root;
+    gdr_status st = add_node(&b, center, half, half, 0, &root);
+    if (st == GDR_OK)
+        st = build_node(&b, root, objects, valid);
+    free(objects);
+    free(scratch);
+    return st;
+}
+
+static bool box_fits(const cull_node *n, gdr_vec3 c, gdr_vec3 e)
+{
+    return fabsf(c.x - n->center.x) + e.x <= n->fit_extent && fabsf(c.y - n->center.y) + e.y <= n->fit_extent &&
+           fabsf(c.z - n->center.z) + e.z <= n->fit_extent;
+}
+
+uint32_t cull_octree_place(const gdr_cull_scene *s, gdr_vec3 center, gdr_vec3 extent)
+{
+    if (s->node_count == 0 || !box_fits(&s->nodes[0], center, extent))
+        return CULL_NODE_NONE;
+    uint32_t index = 0;
+    for (;;) {
+        const cull_node *n = &s->nodes[index];
+        uint32_t child = n->children[octant_of(n->center, center)];
+        if (child == UINT32_MAX || !box_fits(&s->nodes[child], center, extent))
+            return index;
+        index = child;
+    }
+}
+
+static gdr_cull_outcome node_classify(const gdr_frustum *f, const float slack[8], gdr_vec3 c, float extent)
+{
+    int outside = 0, partly = 0;
+    for (int i = 0; i < 8; i++) {
+        float dist = f->px[i] * c.x + f->py[i] * c.y + f->pz[i] * c.z + f->pd[i];
+        float push = (fabsf(f->px[i]) + fabsf(f->py[i]) + fabsf(f->pz[i])) * extent + slack[i];
+        outside |= dist < -push;
+        partly |= dist < push;
+    }
+    return outside ? GDR_CULL_OUTSIDE : partly ? GDR_CULL_INTERSECTS : GDR_CULL_INSIDE;
+}
+
+void cull_octree_classify(const gdr_cull_scene *s, const gdr_frustum *frustum, uint32_t *node_bits,
+                          uint32_t *nodes_tested, uint32_t *nodes_inside)
+{
+    /* Slack for the rounding of the plane offset itself (a far-away camera has a large d): a
+     * node counts as inside or outside only with that much room to spare. */
+    float slack[8];
+    for (int k = 0; k < 8; k++)
+        slack[k] = isfinite(frustum->pd[k]) ? fabsf(frustum->pd[k]) * (1.0f / 65536.0f) : 0.0f;
+    uint32_t tested = 0, inside = 0;
+    uint32_t i = 0;
+    while (i < s->node_count) {
+        const cull_node *n = &s->nodes[i];
+        tested++;
+        gdr_cull_outcome outcome = node_classify(frustum, slack, n->center, n->extent);
+        if (outcome == GDR_CULL_OUTSIDE) {
+            i = n->skip; /* bits stay 00 for the whole subtree */
+        } else if (outcome == GDR_CULL_INSIDE) {
+            /* Fully inside: every node below is inside too and skips its own test. */
+            inside++;
+            for (uint32_t k = i; k < n->skip; k++)
+                node_bits[k >> 4] |= 1u << ((k & 15u) * 2u);
+            i = n->skip;
+        } else {
+            node_bits[i >> 4] |= 3u << ((i & 15u) * 2u);
+            i++;
+        }
+    }
+    *nodes_tested = tested;
+    *nodes_inside = inside;
+}
