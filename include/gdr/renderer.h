@@ -23,6 +23,9 @@ typedef struct gdr_renderer_desc {
     const char *device;     /* NULL: first discrete GPU, else any; "N": index; else a name substring */
     bool validate;          /* Khronos validation layer; messages are counted in the stats */
     bool synchronization_validation; /* also synchronization validation (implies validate) */
+    /* Poll frame fences instead of sleeping on them. For benchmarks: a core that sleeps through a
+     * long GPU frame wakes up slower, which would make CPU timings depend on the GPU's load. */
+    bool busy_wait;
 } gdr_renderer_desc;
 
 typedef enum gdr_cull_mode {

@@ -170,7 +170,14 @@ gdr_status gdr_frame_slot_wait(gdr_renderer *r, gdr_frame_slot *slot, double gpu
 {
     if (!slot->submitted)
         return GDR_OK;
-    GDR_VK_TRY(err, vkWaitForFences(r->ctx->device, 1, &slot->fence, VK_TRUE, UINT64_MAX));
+    if (r->busy_wait) {
+        VkResult result;
+        while ((result = vkGetFenceStatus(r->ctx->device, slot->fence)) == VK_NOT_READY)
+            ;
+        GDR_VK_TRY(err, result);
+    } else {
+        GDR_VK_TRY(err, vkWaitForFences(r->ctx->device, 1, &slot->fence, VK_TRUE, UINT64_MAX));
+    }
     GDR_VK_TRY(err, vkResetFences(r->ctx->device, 1, &slot->fence));
     slot->submitted = false;
     if (gpu_ms && slot->timestamps_written) {

@@ -72,6 +72,7 @@ gdr_status gdr_renderer_create(const gdr_renderer_desc *desc_in, gdr_renderer **
     r->width = desc.width;
     r->height = desc.height;
     r->last_slot = -1;
+    r->busy_wait = desc.busy_wait;
     gdr_vk_context_desc context_desc = {.device = desc.device, .validate = desc.validate,
                                         .synchronization_validation = desc.synchronization_validation};
     gdr_status status = gdr_vk_context_create(&context_desc, &r->ctx, err);

@@ -51,6 +51,7 @@ struct gdr_renderer {
     gdr_vk_allocator allocator;
     gdr_vk_buffer staging;
     uint32_t width, height;
+    bool busy_wait;
     gdr_vk_image color, depth;
     gdr_vk_buffer color_readback; /* width * height * 4 bytes */
     bool color_read_back;

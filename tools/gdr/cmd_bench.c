@@ -79,7 +79,8 @@ int gdr_cmd_bench(int argc, char **argv)
         gdr_renderer *renderer = NULL;
         gdr_frame_stats stats;
         gdr_demo_desc demo = {.instances = sizes[s]};
-        gdr_renderer_desc desc = {.width = width, .height = height, .device = device, .validate = validate};
+        gdr_renderer_desc desc = {.width = width, .height = height, .device = device, .validate = validate,
+                                  .busy_wait = true};
         if (gdr_scene_create_demo(&demo, &scene, &err) != GDR_OK || gdr_renderer_create(&desc, &renderer, &err) != GDR_OK ||
             gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK) {
             fprintf(stderr, "gdr: %s\n", err.message);
