@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gdr/io.h"
 #include "gdr/scene.h"
 
 static gdr_status parse_demo_options(const char *options, gdr_demo_desc *desc, gdr_error *err)
@@ -42,8 +43,9 @@ static gdr_status parse_demo_options(const char *options, gdr_demo_desc *desc, g
     return GDR_OK;
 }
 
-gdr_status gdr_scene_load(const char *spec, gdr_scene **out, gdr_error *err)
+gdr_status gdr_scene_load_ex(const char *spec, const gdr_load_options *options, gdr_scene **out, gdr_error *err)
 {
+    *out = NULL;
     if (strcmp(spec, "demo") == 0 || strncmp(spec, "demo:", 5) == 0) {
         gdr_demo_desc desc = {0};
         gdr_status status = parse_demo_options(spec[4] ? spec + 5 : "", &desc, err);
@@ -51,5 +53,11 @@ gdr_status gdr_scene_load(const char *spec, gdr_scene **out, gdr_error *err)
             return status;
         return gdr_scene_create_demo(&desc, out, err);
     }
-    return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: unsupported scene (only 'demo' is built in)", spec);
+    /* Files: .gltf / .glb / .obj through the processed-scene cache, .gdrc directly (src/io). */
+    return gdr_scene_load_file(spec, options, out, err);
+}
+
+gdr_status gdr_scene_load(const char *spec, gdr_scene **out, gdr_error *err)
+{
+    return gdr_scene_load_ex(spec, NULL, out, err);
 }

@@ -1,0 +1,124 @@
+/* gdr io: importers (glTF 2.0, GLB, OBJ) and the processed-scene cache (.gdrc).
+ *
+ * Every importer treats its input as untrusted: each index, offset, count and length is checked
+ * before use, and errors name the file and the place in it, e.g.
+ *   "box.gltf: accessors[3].count: exceeds bufferView 2 length".
+ * A file that loads but not exactly as written (lines skipped, bad normals regenerated, ...)
+ * reports warnings through gdr_import_options.warning (NULL: printed to stderr as
+ * "gdr: warning: ..."); the number of warnings is returned in gdr_import_result.
+ *
+ * The cache format is described in docs/CACHE_FORMAT.md, the importers in docs/IMPORT.md. */
+#ifndef GDR_IO_H
+#define GDR_IO_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "gdr/core.h"
+#include "gdr/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* --- source files -------------------------------------------------------------------------- */
+
+/* A file an import read: its identity is what makes a cache stale. */
+typedef struct gdr_source_file {
+    char *path;        /* absolute (realpath) when it can be resolved, else as opened */
+    uint64_t size;     /* bytes */
+    int64_t mtime_ns;  /* modification time, nanoseconds since the epoch */
+    uint64_t hash;     /* XXH3-64 of the contents */
+} gdr_source_file;
+
+typedef struct gdr_source_list {
+    gdr_source_file *files;
+    uint32_t count, capacity;
+} gdr_source_list;
+
+GDR_API void gdr_source_list_free(gdr_source_list *list);
+
+/* --- importers ------------------------------------------------------------------------------ */
+
+/* Zero-initialise; every field has a default. */
+typedef struct gdr_import_options {
+    gdr_warning_fn warning; /* NULL: "gdr: warning: <message>" on stderr */
+    void *warning_user;
+    int no_progress;          /* 1: no progress bar (default: shown on a terminal for long work) */
+    gdr_source_list *sources; /* optional: receives every file read (the source and its buffers,
+                                 images), for the cache's staleness check */
+} gdr_import_options;
+
+typedef struct gdr_import_result {
+    uint32_t warning_count;
+} gdr_import_result;
+
+/* Imports a .gltf or .glb file (told apart by content: GLB starts with "glTF"). External
+ * buffers and images are resolved relative to the file's folder. result may be NULL. */
+GDR_API gdr_status gdr_import_gltf(const char *path, const gdr_import_options *options, gdr_scene **out,
+                                   gdr_import_result *result, gdr_error *err);
+
+/* Imports glTF JSON or GLB from memory. `name` is used in messages; `base_dir` resolves external
+ * URIs (NULL: external URIs are refused, only data: URIs and the GLB chunk are used). */
+GDR_API gdr_status gdr_import_gltf_memory(const void *data, size_t size, const char *name, const char *base_dir,
+                                          const gdr_import_options *options, gdr_scene **out,
+                                          gdr_import_result *result, gdr_error *err);
+
+/* Imports a Wavefront .obj file: v/vt/vn/f, polygons fan-triangulated, negative indices, one mesh
+ * per group/object (g, o) and one instance of each with the identity transform. */
+GDR_API gdr_status gdr_import_obj(const char *path, const gdr_import_options *options, gdr_scene **out,
+                                  gdr_import_result *result, gdr_error *err);
+GDR_API gdr_status gdr_import_obj_memory(const void *data, size_t size, const char *name,
+                                         const gdr_import_options *options, gdr_scene **out,
+                                         gdr_import_result *result, gdr_error *err);
+
+/* Decodes a PNG or JPEG (anything stb_image reads) into RGBA8. *out_rgba is malloc'ed. */
+GDR_API gdr_status gdr_image_decode(const void *data, size_t size, const char *name, uint8_t **out_rgba,
+                                    uint32_t *out_width, uint32_t *out_height, gdr_error *err);
+
+/* --- processed-scene cache ------------------------------------------------------------------ */
+
+#define GDR_CACHE_FORMAT_VERSION 1u
+
+/* What a cache was built from: the build options (a string that changes whenever the processing
+ * would produce different data, e.g. "import=1") and the source files. */
+typedef struct gdr_cache_source {
+    const char *build_options;
+    const gdr_source_list *files; /* NULL or empty for the built-in demo scene */
+} gdr_cache_source;
+
+/* Writes scene to path through a temporary file in the same folder and a rename. */
+GDR_API gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_cache_source *source,
+                                   gdr_error *err);
+
+/* Reads a cache. Checks magic, version, every size, offset and checksum. When build_options is
+ * not NULL, a cache built with different options is refused (stale); each recorded source file
+ * that exists with a different size or contents makes it stale too (a missing one does not:
+ * a cache may travel without its sources). On GDR_OK, *out is the scene. */
+GDR_API gdr_status gdr_cache_read(const char *path, const char *build_options, gdr_scene **out, gdr_error *err);
+
+/* Parses a cache from memory without any staleness check (the fuzz target uses this). */
+GDR_API gdr_status gdr_cache_read_memory(const void *data, size_t size, const char *name, gdr_scene **out,
+                                         gdr_error *err);
+
+/* The cache path used for a source: SOURCE.gdrc next to it, or in cache_dir (named after a hash
+ * of the absolute source path) when cache_dir is given. Returns the length written, or 0 when
+ * it does not fit. */
+GDR_API size_t gdr_cache_path_for(const char *source_path, const char *cache_dir, char *out, size_t out_size);
+
+/* The build options string of this version of the importers. */
+GDR_API const char *gdr_cache_build_options(void);
+
+/* Imports any supported source file (.gltf, .glb, .obj by extension) without the cache. */
+GDR_API gdr_status gdr_import_file(const char *path, const gdr_import_options *options, gdr_scene **out,
+                                   gdr_import_result *result, gdr_error *err);
+
+/* A source file (.gltf, .glb, .obj) through the cache, or a .gdrc file directly: what
+ * gdr_scene_load_ex does for paths. See gdr_load_options in scene.h. */
+GDR_API gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options, gdr_scene **out,
+                                       gdr_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

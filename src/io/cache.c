@@ -1,0 +1,674 @@
+/* The processed-scene cache (.gdrc): see docs/CACHE_FORMAT.md. Little-endian, a 64-byte header,
+ * a table of checksummed sections; the reader trusts nothing in the file. */
+#define _XOPEN_SOURCE 700 /* realpath */
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "io/io_internal.h"
+
+#if !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
+#error "the cache reader and writer assume a little-endian host"
+#endif
+
+#define CACHE_MAGIC "GDRCACHE"
+#define CACHE_HEADER_SIZE 64u
+#define CACHE_ENTRY_SIZE 32u
+#define CACHE_MAX_SECTIONS 1024u
+#define CACHE_SECTION_REQUIRED 1u
+
+#define FOURCC(a, b, c, d) ((uint32_t)(a) | (uint32_t)(b) << 8 | (uint32_t)(c) << 16 | (uint32_t)(d) << 24)
+enum {
+    SEC_SOURCE = FOURCC('S', 'R', 'C', 'E'),
+    SEC_SCENE = FOURCC('S', 'C', 'N', 'E'),
+    SEC_MESHES = FOURCC('M', 'E', 'S', 'H'),
+    SEC_GEOMETRY = FOURCC('G', 'E', 'O', 'M'),
+    SEC_MATERIALS = FOURCC('M', 'A', 'T', 'L'),
+    SEC_INSTANCES = FOURCC('I', 'N', 'S', 'T'),
+    SEC_CAMERAS = FOURCC('C', 'A', 'M', 'R'),
+    SEC_TEXTURES = FOURCC('T', 'E', 'X', 'R'),
+    SEC_PIXELS = FOURCC('T', 'X', 'P', 'X'),
+};
+
+enum { MESH_RECORD = 64 + 8 + 16, MATERIAL_RECORD = 64 + 16 + 12 + 12 + 8, INSTANCE_RECORD = 64 + 8 + 16,
+       CAMERA_RECORD = 64 + 12 + 16 + 16, TEXTURE_RECORD = 64 + 12 };
+
+const char *gdr_cache_build_options(void)
+{
+    /* Bump when the importers' output for the same input changes. */
+    return "import=1";
+}
+
+/* --- writing --------------------------------------------------------------------------------- */
+
+typedef struct writer {
+    uint8_t *data;
+    size_t size, capacity;
+    int failed;
+} writer;
+
+static void put(writer *w, const void *bytes, size_t n)
+{
+    if (w->failed)
+        return;
+    if (w->size + n > w->capacity) {
+        size_t capacity = w->capacity ? w->capacity : 4096;
+        while (capacity < w->size + n)
+            capacity *= 2;
+        uint8_t *grown = realloc(w->data, capacity);
+        if (!grown) {
+            w->failed = 1;
+            return;
+        }
+        w->data = grown;
+        w->capacity = capacity;
+    }
+    if (n)
+        memcpy(w->data + w->size, bytes, n);
+    w->size += n;
+}
+
+static void put_u32(writer *w, uint32_t v) { put(w, &v, 4); }
+static void put_u64(writer *w, uint64_t v) { put(w, &v, 8); }
+static void put_f32s(writer *w, const float *v, size_t n) { put(w, v, 4 * n); }
+static void put_name(writer *w, const char *name)
+{
+    char buffer[GDR_NAME_MAX] = {0};
+    snprintf(buffer, sizeof buffer, "%s", name);
+    put(w, buffer, sizeof buffer);
+}
+static void put_string(writer *w, const char *s)
+{
+    uint32_t n = s ? (uint32_t)strlen(s) : 0;
+    put_u32(w, n);
+    put(w, s, n);
+}
+static void align8(writer *w)
+{
+    static const uint8_t zeros[8] = {0};
+    put(w, zeros, (8 - w->size % 8) % 8);
+}
+
+typedef struct section_entry {
+    uint32_t id, flags;
+    uint64_t offset, size, checksum;
+} section_entry;
+
+static void write_sections(writer *w, const gdr_scene *s, const gdr_cache_source *source, section_entry *entries,
+                           uint32_t *count)
+{
+    uint32_t n = 0;
+#define BEGIN(sid, sflags) do { align8(w); entries[n] = (section_entry){sid, sflags, w->size, 0, 0}; } while (0)
+#define END() do { entries[n].size = w->size - entries[n].offset; n++; } while (0)
+    BEGIN(SEC_SOURCE, 0);
+    put_string(w, source && source->build_options ? source->build_options : "");
+    uint32_t files = source && source->files ? source->files->count : 0;
+    put_u32(w, files);
+    for (uint32_t i = 0; i < files; i++) {
+        const gdr_source_file *f = &source->files->files[i];
+        put_string(w, f->path);
+        put_u64(w, f->size);
+        put_u64(w, (uint64_t)f->mtime_ns);
+        put_u64(w, f->hash);
+    }
+    END();
+
+    BEGIN(SEC_SCENE, CACHE_SECTION_REQUIRED);
+    put_u32(w, s->mesh_count);
+    put_u32(w, s->material_count);
+    put_u32(w, s->instance_count);
+    put_u32(w, s->camera_count);
+    put_u32(w, s->texture_count);
+    put_string(w, s->extensions);
+    END();
+
+    BEGIN(SEC_MESHES, CACHE_SECTION_REQUIRED);
+    for (uint32_t i = 0; i < s->mesh_count; i++) {
+        const gdr_mesh *m = &s->meshes[i];
+        put_name(w, m->name);
+        put_u32(w, m->vertex_count);
+        put_u32(w, m->index_count);
+        put_f32s(w, &m->bounds.x, 4);
+    }
+    END();
+
+    BEGIN(SEC_GEOMETRY, CACHE_SECTION_REQUIRED);
+    for (uint32_t i = 0; i < s->mesh_count; i++) {
+        const gdr_mesh *m = &s->meshes[i];
+        put(w, m->positions, sizeof(gdr_vec3) * m->vertex_count);
+        put(w, m->normals, sizeof(gdr_vec3) * m->vertex_count);
+        put(w, m->uvs, sizeof(gdr_vec2) * m->vertex_count);
+        put(w, m->indices, sizeof(uint32_t) * m->index_count);
+    }
+    END();
+
+    BEGIN(SEC_MATERIALS, CACHE_SECTION_REQUIRED);
+    for (uint32_t i = 0; i < s->material_count; i++) {
+        const gdr_material *m = &s->materials[i];
+        put_name(w, m->name);
+        put_f32s(w, &m->base_color.x, 4);
+        put_u32(w, m->base_color_texture);
+        put_u32(w, m->normal_texture);
+        put_u32(w, m->metallic_roughness_texture);
+        put_f32s(w, (const float[3]){m->metallic_factor, m->roughness_factor, m->alpha_cutoff}, 3);
+        put_u32(w, m->alpha_mode);
+        put_u32(w, m->double_sided);
+    }
+    END();
+
+    BEGIN(SEC_INSTANCES, CACHE_SECTION_REQUIRED);
+    for (uint32_t i = 0; i < s->instance_count; i++) {
+        const gdr_instance *inst = &s->instances[i];
+        put_f32s(w, inst->transform.m, 16);
+        put_u32(w, inst->mesh);
+        put_u32(w, inst->material);
+        put_f32s(w, &inst->color.x, 4);
+    }
+    END();
+
+    BEGIN(SEC_CAMERAS, CACHE_SECTION_REQUIRED);
+    for (uint32_t i = 0; i < s->camera_count; i++) {
+        const gdr_camera *cam = &s->cameras[i];
+        put_name(w, cam->name);
+        put_f32s(w, &cam->position.x, 3);
+        put_f32s(w, &cam->rotation.x, 4);
+        put_f32s(w, (const float[4]){cam->yfov, cam->znear, cam->zfar, cam->aspect}, 4);
+    }
+    END();
+
+    BEGIN(SEC_TEXTURES, CACHE_SECTION_REQUIRED);
+    for (uint32_t i = 0; i < s->texture_count; i++) {
+        put_name(w, s->textures[i].name);
+        put_u32(w, s->textures[i].width);
+        put_u32(w, s->textures[i].height);
+        put_u32(w, s->textures[i].srgb);
+    }
+    END();
+
+    BEGIN(SEC_PIXELS, CACHE_SECTION_REQUIRED);
+    for (uint32_t i = 0; i < s->texture_count; i++)
+        put(w, s->textures[i].rgba, (size_t)s->textures[i].width * s->textures[i].height * 4);
+    END();
+#undef BEGIN
+#undef END
+    *count = n;
+}
+
+static void store_u32(uint8_t *p, uint32_t v) { memcpy(p, &v, 4); }
+static void store_u64(uint8_t *p, uint64_t v) { memcpy(p, &v, 8); }
+
+gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_cache_source *source, gdr_error *err)
+{
+    enum { SECTION_COUNT = 9 };
+    section_entry entries[SECTION_COUNT];
+    uint32_t count = 0;
+    writer w = {0};
+    uint8_t zeros[CACHE_HEADER_SIZE + SECTION_COUNT * CACHE_ENTRY_SIZE] = {0};
+    put(&w, zeros, sizeof zeros); /* header and table, filled in below */
+    write_sections(&w, scene, source, entries, &count);
+    if (w.failed) {
+        free(w.data);
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory serialising the scene", path);
+    }
+    uint8_t *table = w.data + CACHE_HEADER_SIZE;
+    for (uint32_t i = 0; i < count; i++) {
+        entries[i].checksum = gdr_io_hash(w.data + entries[i].offset, entries[i].size);
+        uint8_t *e = table + i * CACHE_ENTRY_SIZE;
+        store_u32(e, entries[i].id);
+        store_u32(e + 4, entries[i].flags);
+        store_u64(e + 8, entries[i].offset);
+        store_u64(e + 16, entries[i].size);
+        store_u64(e + 24, entries[i].checksum);
+    }
+    memcpy(w.data, CACHE_MAGIC, 8);
+    store_u32(w.data + 8, GDR_CACHE_FORMAT_VERSION);
+    store_u32(w.data + 12, CACHE_HEADER_SIZE);
+    store_u32(w.data + 16, count);
+    store_u32(w.data + 20, 0);
+    store_u64(w.data + 24, w.size);
+    store_u64(w.data + 32, gdr_io_hash(table, (size_t)count * CACHE_ENTRY_SIZE));
+    store_u64(w.data + 40, gdr_io_hash(w.data, 40));
+
+    /* A temporary file in the same folder, then rename: readers see the old file or the new one. */
+    size_t length = strlen(path);
+    char *temp = malloc(length + 32);
+    if (!temp) {
+        free(w.data);
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+    }
+    snprintf(temp, length + 32, "%s.tmp.%ld", path, (long)getpid());
+    gdr_status status = GDR_OK;
+    FILE *file = fopen(temp, "wb");
+    if (!file) {
+        status = gdr_error_set(err, GDR_ERROR_IO, "%s: cannot create: %s", temp, strerror(errno));
+    } else {
+        gdr_progress progress;
+        gdr_progress_begin(&progress, "write cache", w.size, 0);
+        size_t done = 0;
+        while (done < w.size) {
+            size_t chunk = w.size - done < (16u << 20) ? w.size - done : (16u << 20);
+            if (fwrite(w.data + done, 1, chunk, file) != chunk)
+                break;
+            done += chunk;
+            gdr_progress_update(&progress, done);
+        }
+        gdr_progress_end(&progress);
+        int flush_failed = fflush(file) != 0 || fsync(fileno(file)) != 0;
+        int close_failed = fclose(file) != 0;
+        if (done != w.size || flush_failed || close_failed)
+            status = gdr_error_set(err, GDR_ERROR_IO, "%s: write failed: %s", temp, strerror(errno));
+        else if (rename(temp, path) != 0)
+            status = gdr_error_set(err, GDR_ERROR_IO, "%s: cannot rename to %s: %s", temp, path, strerror(errno));
+        if (status != GDR_OK)
+            remove(temp);
+    }
+    free(temp);
+    free(w.data);
+    return status;
+}
+
+/* --- reading --------------------------------------------------------------------------------- */
+
+typedef struct reader {
+    const uint8_t *data;
+    size_t size, at;
+    int failed;
+} reader;
+
+static const uint8_t *take(reader *r, size_t n)
+{
+    if (r->failed || n > r->size - r->at) {
+        r->failed = 1;
+        return NULL;
+    }
+    const uint8_t *p = r->data + r->at;
+    r->at += n;
+    return p;
+}
+static uint32_t get_u32(reader *r)
+{
+    uint32_t v = 0;
+    const uint8_t *p = take(r, 4);
+    if (p)
+        memcpy(&v, p, 4);
+    return v;
+}
+static uint64_t get_u64(reader *r)
+{
+    uint64_t v = 0;
+    const uint8_t *p = take(r, 8);
+    if (p)
+        memcpy(&v, p, 8);
+    return v;
+}
+static void get_f32s(reader *r, float *out, size_t n)
+{
+    const uint8_t *p = take(r, 4 * n);
+    if (p)
+        memcpy(out, p, 4 * n);
+    else
+        memset(out, 0, 4 * n);
+}
+static void get_name(reader *r, char *out)
+{
+    const uint8_t *p = take(r, GDR_NAME_MAX);
+    if (p)
+        memcpy(out, p, GDR_NAME_MAX);
+    else
+        out[0] = 0;
+    out[GDR_NAME_MAX - 1] = 0;
+}
+/* A length-prefixed string: points into the data (not NUL-terminated). */
+static const char *get_string(reader *r, uint32_t *length)
+{
+    *length = get_u32(r);
+    return (const char *)take(r, *length);
+}
+
+typedef struct cache_view {
+    const uint8_t *data;
+    size_t size;
+    reader sections[9]; /* by the order of the known ids below */
+    int present[9];
+} cache_view;
+
+static const uint32_t known_ids[9] = {SEC_SOURCE, SEC_SCENE, SEC_MESHES, SEC_GEOMETRY, SEC_MATERIALS,
+                                      SEC_INSTANCES, SEC_CAMERAS, SEC_TEXTURES, SEC_PIXELS};
+enum { K_SOURCE, K_SCENE, K_MESHES, K_GEOMETRY, K_MATERIALS, K_INSTANCES, K_CAMERAS, K_TEXTURES, K_PIXELS };
+
+static void fourcc_text(uint32_t id, char out[5])
+{
+    for (int i = 0; i < 4; i++) {
+        char ch = (char)(id >> (8 * i));
+        out[i] = ch >= 32 && ch < 127 ? ch : '?';
+    }
+    out[4] = 0;
+}
+
+static gdr_status parse_container(const char *name, const uint8_t *data, size_t size, cache_view *v, gdr_error *err)
+{
+    memset(v, 0, sizeof *v);
+    if (size < CACHE_HEADER_SIZE)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: truncated: %zu bytes, shorter than the header", name, size);
+    if (memcmp(data, CACHE_MAGIC, 8) != 0)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: not a gdr cache (bad magic)", name);
+    reader h = {data, CACHE_HEADER_SIZE, 8, 0};
+    uint32_t version = get_u32(&h), header_size = get_u32(&h), count = get_u32(&h);
+    (void)get_u32(&h);
+    uint64_t file_size = get_u64(&h), table_hash = get_u64(&h), header_hash = get_u64(&h);
+    if (version != GDR_CACHE_FORMAT_VERSION)
+        return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: cache format version %u, this build reads %u; rebuild it",
+                             name, version, GDR_CACHE_FORMAT_VERSION);
+    if (header_hash != gdr_io_hash(data, 40))
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: header checksum mismatch", name);
+    if (header_size != CACHE_HEADER_SIZE)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: header size %u, expected %u", name, header_size,
+                             CACHE_HEADER_SIZE);
+    if (file_size != size)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: truncated or extended: %zu bytes, the header says %llu", name,
+                             size, (unsigned long long)file_size);
+    if (count > CACHE_MAX_SECTIONS || CACHE_HEADER_SIZE + (uint64_t)count * CACHE_ENTRY_SIZE > size)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section table (%u entries) does not fit", name, count);
+    const uint8_t *table = data + CACHE_HEADER_SIZE;
+    if (table_hash != gdr_io_hash(table, (size_t)count * CACHE_ENTRY_SIZE))
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: section table checksum mismatch", name);
+    uint64_t table_end = CACHE_HEADER_SIZE + (uint64_t)count * CACHE_ENTRY_SIZE;
+    reader t = {table, (size_t)count * CACHE_ENTRY_SIZE, 0, 0};
+    for (uint32_t i = 0; i < count; i++) {
+        uint32_t id = get_u32(&t), flags = get_u32(&t);
+        uint64_t offset = get_u64(&t), length = get_u64(&t), checksum = get_u64(&t);
+        char text[5];
+        fourcc_text(id, text);
+        if (offset < table_end || offset > size || length > size - offset)
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section %u '%s' (offset %llu, %llu bytes) lies outside "
+                                 "the file", name, i, text, (unsigned long long)offset, (unsigned long long)length);
+        if (checksum != gdr_io_hash(data + offset, (size_t)length))
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: section '%s' checksum mismatch", name, text);
+        int known = -1;
+        for (int k = 0; k < 9; k++)
+            if (known_ids[k] == id)
+                known = k;
+        if (known < 0) {
+            if (flags & CACHE_SECTION_REQUIRED)
+                return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: requires section '%s', unknown to this build",
+                                     name, text);
+            continue; /* an optional section of a later version */
+        }
+        if (v->present[known])
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section '%s' appears twice", name, text);
+        v->present[known] = 1;
+        v->sections[known] = (reader){data + offset, (size_t)length, 0, 0};
+    }
+    for (int k = K_SCENE; k <= K_PIXELS; k++)
+        if (!v->present[k]) {
+            char text[5];
+            fourcc_text(known_ids[k], text);
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section '%s' is missing", name, text);
+        }
+    v->data = data;
+    v->size = size;
+    return GDR_OK;
+}
+
+static int all_finite(const float *v, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(v[i]))
+            return 0;
+    return 1;
+}
+
+#define BAD(...) do { status = gdr_error_set(err, GDR_ERROR_PARSE, __VA_ARGS__); goto done; } while (0)
+
+static gdr_status build_scene(const char *name, cache_view *v, gdr_scene **out, gdr_error *err)
+{
+    gdr_scene *s = NULL;
+    gdr_status status = gdr_scene_create(&s, err);
+    if (status != GDR_OK)
+        return status;
+    reader *sc = &v->sections[K_SCENE];
+    uint32_t mesh_count = get_u32(sc), material_count = get_u32(sc), instance_count = get_u32(sc);
+    uint32_t camera_count = get_u32(sc), texture_count = get_u32(sc), ext_length;
+    const char *ext = get_string(sc, &ext_length);
+    if (sc->failed || sc->at != sc->size)
+        BAD("%s: section 'SCNE' has the wrong size", name);
+    if (ext_length) {
+        char *copy = malloc(ext_length + 1);
+        if (!copy)
+            BAD("%s: out of memory", name);
+        memcpy(copy, ext, ext_length);
+        copy[ext_length] = 0;
+        status = gdr_scene_set_extensions(s, copy, err);
+        free(copy);
+        if (status != GDR_OK)
+            goto done;
+    }
+    struct { int k; uint32_t count, record; const char *id; } sizes[] = {
+        {K_MESHES, mesh_count, MESH_RECORD, "MESH"},       {K_MATERIALS, material_count, MATERIAL_RECORD, "MATL"},
+        {K_INSTANCES, instance_count, INSTANCE_RECORD, "INST"}, {K_CAMERAS, camera_count, CAMERA_RECORD, "CAMR"},
+        {K_TEXTURES, texture_count, TEXTURE_RECORD, "TEXR"},
+    };
+    for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++)
+        if (v->sections[sizes[i].k].size != (uint64_t)sizes[i].count * sizes[i].record)
+            BAD("%s: section '%s' holds %zu bytes, %u records need %llu", name, sizes[i].id,
+                v->sections[sizes[i].k].size, sizes[i].count, (unsigned long long)sizes[i].count * sizes[i].record);
+
+    reader *tr = &v->sections[K_TEXTURES], *px = &v->sections[K_PIXELS];
+    for (uint32_t i = 0; i < texture_count; i++) {
+        char tname[GDR_NAME_MAX];
+        get_name(tr, tname);
+        uint32_t width = get_u32(tr), height = get_u32(tr), srgb = get_u32(tr);
+        if (width == 0 || height == 0 || width > 32768 || height > 32768 || srgb > 1)
+            BAD("%s: texture %u: size %ux%u or flags are out of range", name, i, width, height);
+        const uint8_t *pixels = take(px, (size_t)width * height * 4);
+        if (!pixels)
+            BAD("%s: texture %u: pixel data runs past section 'TXPX'", name, i);
+        status = gdr_scene_add_texture(s, tname, width, height, pixels, srgb, NULL, err);
+        if (status != GDR_OK)
+            goto done;
+    }
+    if (px->at != px->size)
+        BAD("%s: section 'TXPX' has %zu bytes left over", name, px->size - px->at);
+
+    reader *mr = &v->sections[K_MESHES], *geo = &v->sections[K_GEOMETRY];
+    for (uint32_t i = 0; i < mesh_count; i++) {
+        char mname[GDR_NAME_MAX];
+        get_name(mr, mname);
+        uint32_t vertex_count = get_u32(mr), index_count = get_u32(mr);
+        gdr_vec4 bounds;
+        get_f32s(mr, &bounds.x, 4);
+        uint64_t need = (uint64_t)vertex_count * 32 + (uint64_t)index_count * 4;
+        if (need > geo->size - geo->at)
+            BAD("%s: mesh %u: %u vertices and %u indices run past section 'GEOM'", name, i, vertex_count, index_count);
+        const void *positions = take(geo, (size_t)vertex_count * 12), *normals = take(geo, (size_t)vertex_count * 12);
+        const void *uvs = take(geo, (size_t)vertex_count * 8), *indices = take(geo, (size_t)index_count * 4);
+        /* Copies are needed anyway; aligned ones let gdr_scene_add_mesh read them as arrays. */
+        gdr_vec3 *p = malloc((size_t)vertex_count * 12 + 1), *n = malloc((size_t)vertex_count * 12 + 1);
+        gdr_vec2 *t = malloc((size_t)vertex_count * 8 + 1);
+        uint32_t *idx = malloc((size_t)index_count * 4 + 1);
+        if (p && n && t && idx) {
+            memcpy(p, positions, (size_t)vertex_count * 12);
+            memcpy(n, normals, (size_t)vertex_count * 12);
+            memcpy(t, uvs, (size_t)vertex_count * 8);
+            memcpy(idx, indices, (size_t)index_count * 4);
+            if (!all_finite((const float *)n, (size_t)vertex_count * 3) ||
+                !all_finite((const float *)t, (size_t)vertex_count * 2) || !all_finite(&bounds.x, 4))
+                status = gdr_error_set(err, GDR_ERROR_PARSE, "%s: mesh %u: normals, uvs or bounds are not finite", name,
+                                       i);
+            else
+                status = gdr_scene_add_mesh(s, mname, p, n, t, vertex_count, idx, index_count, NULL, err);
+        } else {
+            status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", name);
+        }
+        free(p);
+        free(n);
+        free(t);
+        free(idx);
+        if (status != GDR_OK)
+            goto done;
+        s->meshes[s->mesh_count - 1].bounds = bounds;
+    }
+    if (geo->at != geo->size)
+        BAD("%s: section 'GEOM' has %zu bytes left over", name, geo->size - geo->at);
+
+    reader *ma = &v->sections[K_MATERIALS];
+    for (uint32_t i = 0; i < material_count; i++) {
+        gdr_material m;
+        float factors[3];
+        get_name(ma, m.name);
+        get_f32s(ma, &m.base_color.x, 4);
+        m.base_color_texture = get_u32(ma);
+        m.normal_texture = get_u32(ma);
+        m.metallic_roughness_texture = get_u32(ma);
+        get_f32s(ma, factors, 3);
+        m.metallic_factor = factors[0];
+        m.roughness_factor = factors[1];
+        m.alpha_cutoff = factors[2];
+        m.alpha_mode = get_u32(ma);
+        m.double_sided = get_u32(ma);
+        uint32_t textures[3] = {m.base_color_texture, m.normal_texture, m.metallic_roughness_texture};
+        for (int k = 0; k < 3; k++)
+            if (textures[k] != GDR_NO_INDEX && textures[k] >= texture_count)
+                BAD("%s: material %u: texture %u does not exist (%u textures)", name, i, textures[k], texture_count);
+        if (!all_finite(&m.base_color.x, 4) || !all_finite(factors, 3) || m.alpha_mode > GDR_ALPHA_BLEND ||
+            m.double_sided > 1)
+            BAD("%s: material %u: values out of range", name, i);
+        status = gdr_scene_add_material(s, &m, NULL, err);
+        if (status != GDR_OK)
+            goto done;
+    }
+
+    reader *in = &v->sections[K_INSTANCES];
+    for (uint32_t i = 0; i < instance_count; i++) {
+        gdr_instance inst;
+        get_f32s(in, inst.transform.m, 16);
+        inst.mesh = get_u32(in);
+        inst.material = get_u32(in);
+        get_f32s(in, &inst.color.x, 4);
+        if (!all_finite(&inst.color.x, 4))
+            BAD("%s: instance %u: colour is not finite", name, i);
+        status = gdr_scene_add_instance(s, &inst, err);
+        if (status != GDR_OK)
+            goto done;
+    }
+
+    reader *ca = &v->sections[K_CAMERAS];
+    for (uint32_t i = 0; i < camera_count; i++) {
+        gdr_camera cam;
+        float lens[4];
+        get_name(ca, cam.name);
+        get_f32s(ca, &cam.position.x, 3);
+        get_f32s(ca, &cam.rotation.x, 4);
+        get_f32s(ca, lens, 4);
+        cam.yfov = lens[0];
+        cam.znear = lens[1];
+        cam.zfar = lens[2];
+        cam.aspect = lens[3];
+        if (!all_finite(&cam.position.x, 3) || !all_finite(&cam.rotation.x, 4) || !all_finite(lens, 4))
+            BAD("%s: camera %u: values are not finite", name, i);
+        status = gdr_scene_add_camera(s, &cam, err);
+        if (status != GDR_OK)
+            goto done;
+    }
+done:
+    if (status != GDR_OK) {
+        gdr_scene_destroy(s);
+        return status;
+    }
+    *out = s;
+    return GDR_OK;
+}
+
+gdr_status gdr_cache_read_memory(const void *data, size_t size, const char *name, gdr_scene **out, gdr_error *err)
+{
+    *out = NULL;
+    cache_view v;
+    gdr_status status = parse_container(name ? name : "(memory)", data, size, &v, err);
+    if (status != GDR_OK)
+        return status;
+    return build_scene(name ? name : "(memory)", &v, out, err);
+}
+
+/* Compares the SRCE section with the build options and the files on disk. */
+static gdr_status check_fresh(const char *name, cache_view *v, const char *build_options, gdr_error *err)
+{
+    if (!v->present[K_SOURCE])
+        return GDR_OK;
+    reader r = v->sections[K_SOURCE];
+    uint32_t length;
+    const char *options = get_string(&r, &length);
+    if (r.failed)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'SRCE' is truncated", name);
+    if (build_options && (strlen(build_options) != length || memcmp(options, build_options, length) != 0))
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: built with options '%.*s', now '%s'", name,
+                             (int)(length > 64 ? 64 : length), options, build_options);
+    uint32_t files = get_u32(&r);
+    for (uint32_t i = 0; i < files; i++) {
+        const char *path = get_string(&r, &length);
+        uint64_t size = get_u64(&r), mtime = get_u64(&r), hash = get_u64(&r);
+        if (r.failed || length == 0 || length >= PATH_MAX || memchr(path, 0, length))
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'SRCE' is malformed", name);
+        char file[PATH_MAX];
+        memcpy(file, path, length);
+        file[length] = 0;
+        uint64_t now_size;
+        int64_t now_mtime;
+        if (gdr_io_stat(file, &now_size, &now_mtime) != 0)
+            continue; /* the source is not here: the cache stands alone */
+        if (now_size != size)
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: %s changed size (%llu -> %llu bytes)",
+                                 name, file, (unsigned long long)size, (unsigned long long)now_size);
+        if ((uint64_t)now_mtime == mtime)
+            continue;
+        uint8_t *contents;
+        size_t contents_size;
+        gdr_error read_err;
+        if (gdr_io_read_file(file, &contents, &contents_size, NULL, &read_err) != GDR_OK)
+            continue;
+        uint64_t now_hash = gdr_io_hash(contents, contents_size);
+        free(contents);
+        if (now_hash != hash)
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: %s changed since the cache was built",
+                                 name, file);
+    }
+    return GDR_OK;
+}
+
+gdr_status gdr_cache_read(const char *path, const char *build_options, gdr_scene **out, gdr_error *err)
+{
+    *out = NULL;
+    uint8_t *data;
+    size_t size;
+    gdr_status status = gdr_io_read_file(path, &data, &size, NULL, err);
+    if (status != GDR_OK)
+        return status;
+    cache_view v;
+    status = parse_container(path, data, size, &v, err);
+    if (status == GDR_OK)
+        status = check_fresh(path, &v, build_options, err);
+    if (status == GDR_OK)
+        status = build_scene(path, &v, out, err);
+    free(data);
+    return status;
+}
+
+size_t gdr_cache_path_for(const char *source_path, const char *cache_dir, char *out, size_t out_size)
+{
+    int n;
+    if (!cache_dir) {
+        n = snprintf(out, out_size, "%s.gdrc", source_path);
+    } else {
+        char absolute[PATH_MAX];
+        const char *key = realpath(source_path, absolute) ? absolute : source_path;
+        const char *base = strrchr(source_path, '/');
+        base = base ? base + 1 : source_path;
+        n = snprintf(out, out_size, "%s/%.64s-%016llx.gdrc", cache_dir, base,
+                     (unsigned long long)gdr_io_hash(key, strlen(key)));
+    }
+    return n > 0 && (size_t)n < out_size ? (size_t)n : 0;
+}

@@ -1,0 +1,218 @@
+/* File reading, file identities for the cache, warnings, base64 and a terminal progress bar. */
+#define _XOPEN_SOURCE 700 /* realpath */
+#include <errno.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <xxhash.h>
+
+#include "io/io_internal.h"
+
+uint64_t gdr_io_hash(const void *data, size_t size)
+{
+    return (uint64_t)XXH3_64bits(data, size);
+}
+
+int gdr_io_stat(const char *path, uint64_t *size, int64_t *mtime_ns)
+{
+    struct stat st;
+    if (stat(path, &st) != 0)
+        return -1;
+    *size = (uint64_t)st.st_size;
+    *mtime_ns = (int64_t)st.st_mtim.tv_sec * 1000000000ll + st.st_mtim.tv_nsec;
+    return 0;
+}
+
+gdr_status gdr_io_source_add(gdr_source_list *list, const char *path, uint64_t size, int64_t mtime_ns,
+                             uint64_t hash, gdr_error *err)
+{
+    if (list->count == list->capacity) {
+        uint32_t capacity = list->capacity ? list->capacity * 2 : 8;
+        gdr_source_file *grown = realloc(list->files, sizeof *grown * capacity);
+        if (!grown)
+            return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+        list->files = grown;
+        list->capacity = capacity;
+    }
+    size_t length = strlen(path);
+    char *copy = malloc(length + 1);
+    if (!copy)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+    memcpy(copy, path, length + 1);
+    list->files[list->count++] = (gdr_source_file){copy, size, mtime_ns, hash};
+    return GDR_OK;
+}
+
+void gdr_source_list_free(gdr_source_list *list)
+{
+    if (!list)
+        return;
+    for (uint32_t i = 0; i < list->count; i++)
+        free(list->files[i].path);
+    free(list->files);
+    *list = (gdr_source_list){0};
+}
+
+gdr_status gdr_io_read_file(const char *path, uint8_t **out_data, size_t *out_size, gdr_source_list *sources,
+                            gdr_error *err)
+{
+    *out_data = NULL;
+    *out_size = 0;
+    FILE *file = fopen(path, "rb");
+    if (!file)
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
+    struct stat st;
+    if (fstat(fileno(file), &st) != 0 || !S_ISREG(st.st_mode)) {
+        fclose(file);
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: not a regular file", path);
+    }
+    if ((uint64_t)st.st_size > GDR_IO_MAX_FILE_SIZE) {
+        fclose(file);
+        return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: %llu bytes is larger than the %llu byte limit",
+                             path, (unsigned long long)st.st_size, (unsigned long long)GDR_IO_MAX_FILE_SIZE);
+    }
+    size_t size = (size_t)st.st_size;
+    uint8_t *data = malloc(size + 1);
+    if (!data) {
+        fclose(file);
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory reading %zu bytes", path, size);
+    }
+    size_t got = size ? fread(data, 1, size, file) : 0;
+    int failed = ferror(file);
+    fclose(file);
+    if (got != size || failed) {
+        free(data);
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: read %zu of %zu bytes", path, got, size);
+    }
+    data[size] = 0;
+    if (sources) {
+        /* Absolute, so the cache can be checked from any working directory. */
+        char absolute[PATH_MAX];
+        gdr_status status = gdr_io_source_add(sources, realpath(path, absolute) ? absolute : path, size,
+                                              (int64_t)st.st_mtim.tv_sec * 1000000000ll + st.st_mtim.tv_nsec,
+                                              gdr_io_hash(data, size), err);
+        if (status != GDR_OK) {
+            free(data);
+            return status;
+        }
+    }
+    *out_data = data;
+    *out_size = size;
+    return GDR_OK;
+}
+
+void gdr_io_warn(gdr_io_warnings *w, const char *format, ...)
+{
+    char message[GDR_ERROR_MESSAGE_MAX];
+    va_list args;
+    va_start(args, format);
+    vsnprintf(message, sizeof message, format, args);
+    va_end(args);
+    w->count++;
+    if (w->fn)
+        w->fn(w->user, message);
+    else
+        fprintf(stderr, "gdr: warning: %s\n", message);
+}
+
+double gdr_io_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+void gdr_progress_begin(gdr_progress *p, const char *label, uint64_t total, int disabled)
+{
+    *p = (gdr_progress){.label = label, .total = total ? total : 1, .start = gdr_io_now(), .last_permille = -1};
+    p->enabled = !disabled && isatty(STDERR_FILENO);
+}
+
+void gdr_progress_update(gdr_progress *p, uint64_t done)
+{
+    if (!p->enabled)
+        return;
+    double elapsed = gdr_io_now() - p->start;
+    if (!p->drawn && elapsed < 0.3)
+        return;
+    int permille = (int)(done >= p->total ? 1000 : done * 1000 / p->total);
+    if (permille == p->last_permille)
+        return;
+    p->last_permille = permille;
+    p->drawn = 1;
+    enum { WIDTH = 32 };
+    char bar[WIDTH + 1];
+    int filled = permille * WIDTH / 1000;
+    for (int i = 0; i < WIDTH; i++)
+        bar[i] = i < filled ? '#' : '.';
+    bar[WIDTH] = 0;
+    fprintf(stderr, "\r%-12s [%s] %5.1f%%  %.1f s", p->label, bar, permille / 10.0, elapsed);
+    fflush(stderr);
+}
+
+void gdr_progress_end(gdr_progress *p)
+{
+    if (p->enabled && p->drawn) {
+        p->last_permille = -1;
+        gdr_progress_update(p, p->total);
+        fputc('\n', stderr);
+    }
+}
+
+static int base64_value(unsigned char c)
+{
+    if (c >= 'A' && c <= 'Z')
+        return c - 'A';
+    if (c >= 'a' && c <= 'z')
+        return c - 'a' + 26;
+    if (c >= '0' && c <= '9')
+        return c - '0' + 52;
+    if (c == '+' || c == '-')
+        return 62;
+    if (c == '/' || c == '_')
+        return 63;
+    return -1;
+}
+
+size_t gdr_base64_decode(uint8_t *out, const char *in, size_t length)
+{
+    while (length > 0 && in[length - 1] == '=')
+        length--;
+    size_t written = 0;
+    uint32_t accumulator = 0;
+    int bits = 0;
+    for (size_t i = 0; i < length; i++) {
+        int v = base64_value((unsigned char)in[i]);
+        if (v < 0)
+            return SIZE_MAX;
+        accumulator = (accumulator << 6) | (uint32_t)v;
+        bits += 6;
+        if (bits >= 8) {
+            bits -= 8;
+            out[written++] = (uint8_t)(accumulator >> bits);
+        }
+    }
+    return written;
+}
+
+void gdr_io_dirname(const char *path, char *out, size_t out_size)
+{
+    const char *slash = strrchr(path, '/');
+    size_t length = slash ? (size_t)(slash - path) + 1 : 0;
+    if (length >= out_size)
+        length = 0;
+    memcpy(out, path, length);
+    out[length] = 0;
+}
+
+int gdr_io_has_extension(const char *path, const char *ext)
+{
+    size_t n = strlen(path), e = strlen(ext);
+    return n >= e && strcasecmp(path + n - e, ext) == 0;
+}

@@ -1,0 +1,105 @@
+/* Source files -> scenes, through the processed-scene cache when allowed. */
+#define _XOPEN_SOURCE 700 /* realpath */
+#include <errno.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "io/io_internal.h"
+
+gdr_status gdr_import_file(const char *path, const gdr_import_options *options, gdr_scene **out,
+                           gdr_import_result *result, gdr_error *err)
+{
+    if (gdr_io_has_extension(path, ".gltf") || gdr_io_has_extension(path, ".glb"))
+        return gdr_import_gltf(path, options, out, result, err);
+    if (gdr_io_has_extension(path, ".obj"))
+        return gdr_import_obj(path, options, out, result, err);
+    *out = NULL;
+    return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: unknown file type (.gltf, .glb, .obj or .gdrc)", path);
+}
+
+/* $XDG_CACHE_HOME/gdr or ~/.cache/gdr, created when missing; 0 when there is none. */
+static int fallback_cache_dir(char *out, size_t size)
+{
+    const char *xdg = getenv("XDG_CACHE_HOME"), *home = getenv("HOME");
+    char parent[PATH_MAX];
+    if (xdg && xdg[0] == '/')
+        snprintf(parent, sizeof parent, "%s", xdg);
+    else if (home && home[0] == '/')
+        snprintf(parent, sizeof parent, "%s/.cache", home);
+    else
+        return 0;
+    mkdir(parent, 0755);
+    int n = snprintf(out, size, "%s/gdr", parent);
+    if (n <= 0 || (size_t)n >= size)
+        return 0;
+    return mkdir(out, 0755) == 0 || errno == EEXIST;
+}
+
+static void warn(const gdr_load_options *o, const char *format, ...) __attribute__((format(printf, 2, 3)));
+static void warn(const gdr_load_options *o, const char *format, ...)
+{
+    char message[GDR_ERROR_MESSAGE_MAX + 128];
+    va_list args;
+    va_start(args, format);
+    vsnprintf(message, sizeof message, format, args);
+    va_end(args);
+    if (o->warning)
+        o->warning(o->warning_user, message);
+    else
+        fprintf(stderr, "gdr: warning: %s\n", message);
+}
+
+gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options, gdr_scene **out, gdr_error *err)
+{
+    static const gdr_load_options defaults = {0};
+    if (!options)
+        options = &defaults;
+    *out = NULL;
+    const char *build_options = gdr_cache_build_options();
+    if (gdr_io_has_extension(path, ".gdrc"))
+        return gdr_cache_read(path, build_options, out, err);
+    gdr_import_options import = {.warning = options->warning, .warning_user = options->warning_user,
+                                 .no_progress = options->no_progress};
+    if (options->no_cache)
+        return gdr_import_file(path, &import, out, NULL, err);
+
+    /* Candidates: the given cache_dir, or next to the source then the per-user folder. */
+    char candidates[2][PATH_MAX], fallback[PATH_MAX];
+    int count = 0;
+    if (options->cache_dir) {
+        mkdir(options->cache_dir, 0755);
+        count += gdr_cache_path_for(path, options->cache_dir, candidates[count], PATH_MAX) != 0;
+    } else {
+        count += gdr_cache_path_for(path, NULL, candidates[count], PATH_MAX) != 0;
+        if (fallback_cache_dir(fallback, sizeof fallback))
+            count += gdr_cache_path_for(path, fallback, candidates[count], PATH_MAX) != 0;
+    }
+    for (int i = 0; i < count; i++) {
+        if (access(candidates[i], F_OK) != 0)
+            continue;
+        gdr_error cache_err;
+        if (gdr_cache_read(candidates[i], build_options, out, &cache_err) == GDR_OK)
+            return GDR_OK;
+        if (!strstr(cache_err.message, ": stale: "))
+            warn(options, "%s; rebuilding it", cache_err.message);
+    }
+
+    gdr_source_list sources = {0};
+    import.sources = &sources;
+    gdr_status status = gdr_import_file(path, &import, out, NULL, err);
+    if (status == GDR_OK) {
+        gdr_cache_source source = {build_options, &sources};
+        int written = 0;
+        gdr_error write_err = {0};
+        for (int i = 0; i < count && !written; i++)
+            written = gdr_cache_write(candidates[i], *out, &source, &write_err) == GDR_OK;
+        if (!written && count)
+            warn(options, "cache not written: %s", write_err.message);
+    }
+    gdr_source_list_free(&sources);
+    return status;
+}

@@ -1,0 +1,252 @@
+/* Every glTF 2.0 file of Debian's assimp-testmodels: valid ones import with the counts the file
+ * declares (computed here independently from the JSON); broken ones fail or warn with a clear
+ * message naming the problem. Runs under ASan + UBSan too (label "unit"). */
+#include <dirent.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include <cJSON.h>
+
+#include "gdr/io.h"
+#include "test_util.h"
+
+#ifndef ASSIMP_GLTF2_DIR
+#define ASSIMP_GLTF2_DIR "/usr/share/assimp/models/glTF2"
+#endif
+
+/* Files that must be refused, with a part of the expected message. */
+static const struct { const char *file, *message; } broken[] = {
+    {"IndexOutOfRange/IndexOutOfRange.gltf", "is out of range"},
+    {"IndexOutOfRange/AllIndicesOutOfRange.gltf", "is out of range"},
+    {"MissingBin/BoxTextured.gltf", "BoxTextured0.bin: cannot open"},
+    {"RecursiveNodes/RecursiveNodes.gltf", "reached twice"},
+    {"SchemaFailures/sceneWrongType.gltf", "scene: expected a scene index"},
+    {"TestNoRootNode/NoScene.gltf", "scene: scene 0 does not exist"},
+    {"wrongTypes/badArray.gltf", "meshes[0].primitives: expected an array"},
+    {"wrongTypes/badExtension.gltf", "KHR_texture_transform: expected an object"},
+    {"wrongTypes/badNumber.gltf", "normalTexture.scale: expected a finite number"},
+    {"wrongTypes/badObject.gltf", "pbrMetallicRoughness: expected an object"},
+    {"wrongTypes/badString.gltf", "name: expected a string"},
+    {"wrongTypes/badUint.gltf", "baseColorTexture.index: expected an integer"},
+    {"BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb", "is not finite"},
+    {"draco/2CylinderEngine.gltf", "extensionsRequired: KHR_draco_mesh_compression is not supported"},
+    {"BoxTextured-glTF-techniqueWebGL/BoxTextured.gltf", "extensionsRequired: KHR_technique_webgl"},
+};
+
+/* Files that load but must warn, with a part of one expected warning. */
+static const struct { const char *file, *warning; } warned[] = {
+    {"BoxBadNormals-glTF-Binary/BoxBadNormals.glb", "normals generated from the faces"},
+    {"IncorrectVertexArrays/Cube.gltf", "is not a multiple of 3"},
+    {"TestNoRootNode/SceneWithoutNodes.gltf", "has no nodes"},
+    {"glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_00.gltf", "(points) skipped"},
+    {"glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_01.gltf", "(lines) skipped"},
+    {"glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_02.gltf", "(line loop) skipped"},
+    {"glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_03.gltf", "(line strip) skipped"},
+    {"glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_07.gltf", "(points) skipped"},
+    {"glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_08.gltf", "(lines) skipped"},
+    {"glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_09.gltf", "(line loop) skipped"},
+    {"glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_10.gltf", "(line strip) skipped"},
+    {"cameras/Cameras.gltf", "only perspective cameras"},
+};
+
+typedef struct collected {
+    unsigned count;
+    char text[8192];
+} collected;
+
+static void collect(void *user, const char *message)
+{
+    collected *c = user;
+    c->count++;
+    size_t used = strlen(c->text);
+    snprintf(c->text + used, sizeof c->text - used, "%s\n", message);
+}
+
+/* --- expected counts from the JSON, by a plain recursive walk (valid files only) ---------------- */
+
+typedef struct expected {
+    uint32_t instances, meshes, cameras, materials;
+    uint8_t used[4096]; /* (mesh, primitive) pairs seen, mesh * 16 + primitive */
+} expected;
+
+static int triangle_primitive(const cJSON *prim)
+{
+    const cJSON *mode = cJSON_GetObjectItem(prim, "mode");
+    const cJSON *attributes = cJSON_GetObjectItem(prim, "attributes");
+    int m = mode ? mode->valueint : 4;
+    return m >= 4 && cJSON_GetObjectItem(attributes, "POSITION") != NULL;
+}
+
+static void walk(const cJSON *root, int node, expected *e)
+{
+    const cJSON *n = cJSON_GetArrayItem(cJSON_GetObjectItem(root, "nodes"), node);
+    const cJSON *mesh = cJSON_GetObjectItem(n, "mesh"), *camera = cJSON_GetObjectItem(n, "camera");
+    if (mesh) {
+        const cJSON *m = cJSON_GetArrayItem(cJSON_GetObjectItem(root, "meshes"), mesh->valueint);
+        int p = 0;
+        for (const cJSON *prim = cJSON_GetObjectItem(m, "primitives")->child; prim; prim = prim->next, p++) {
+            if (!triangle_primitive(prim))
+                continue;
+            e->instances++;
+            int key = mesh->valueint * 16 + p;
+            if (key < 4096 && !e->used[key]) {
+                e->used[key] = 1;
+                e->meshes++;
+            }
+        }
+    }
+    if (camera) {
+        const cJSON *cam = cJSON_GetArrayItem(cJSON_GetObjectItem(root, "cameras"), camera->valueint);
+        const cJSON *type = cJSON_GetObjectItem(cam, "type");
+        e->cameras += type && strcmp(type->valuestring, "perspective") == 0;
+    }
+    for (const cJSON *child = cJSON_GetObjectItem(n, "children") ? cJSON_GetObjectItem(n, "children")->child : NULL;
+         child; child = child->next)
+        walk(root, child->valueint, e);
+}
+
+static int expected_counts(const char *path, expected *e)
+{
+    memset(e, 0, sizeof *e);
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return 0;
+    fseek(f, 0, SEEK_END);
+    long size = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *data = malloc((size_t)size + 1);
+    size_t got = fread(data, 1, (size_t)size, f);
+    fclose(f);
+    data[got] = 0;
+    const char *json = data;
+    size_t json_size = got;
+    if (got >= 20 && memcmp(data, "glTF", 4) == 0) {
+        uint32_t length;
+        memcpy(&length, data + 12, 4);
+        json = data + 20;
+        json_size = length;
+    }
+    cJSON *root = cJSON_ParseWithLength(json, json_size);
+    free(data);
+    if (!root)
+        return 0;
+    const cJSON *scene = cJSON_GetObjectItem(root, "scene");
+    const cJSON *s = cJSON_GetArrayItem(cJSON_GetObjectItem(root, "scenes"), scene ? scene->valueint : 0);
+    for (const cJSON *n = s && cJSON_GetObjectItem(s, "nodes") ? cJSON_GetObjectItem(s, "nodes")->child : NULL; n;
+         n = n->next)
+        walk(root, n->valueint, e);
+    e->materials = (uint32_t)cJSON_GetArraySize(cJSON_GetObjectItem(root, "materials"));
+    cJSON_Delete(root);
+    return 1;
+}
+
+/* --- the walk over the folder ------------------------------------------------------------------ */
+
+static unsigned files_total, files_imported, files_refused, files_warned;
+
+static void check_file(const char *relative)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s", ASSIMP_GLTF2_DIR, relative);
+    collected warnings = {0};
+    gdr_import_options options = {.warning = collect, .warning_user = &warnings, .no_progress = 1};
+    gdr_scene *scene = NULL;
+    gdr_error err = {0};
+    gdr_status status = gdr_import_gltf(path, &options, &scene, NULL, &err);
+    files_total++;
+    for (size_t i = 0; i < sizeof broken / sizeof broken[0]; i++)
+        if (strcmp(relative, broken[i].file) == 0) {
+            files_refused++;
+            if (status == GDR_OK || !strstr(err.message, broken[i].message)) {
+                fprintf(stderr, "%s: expected an error containing '%s', got status %d: %s\n", relative,
+                        broken[i].message, status, err.message);
+                test_failure_count++;
+            } else {
+                printf("refused  %-60s %s\n", relative, err.message + strlen(ASSIMP_GLTF2_DIR) + 1);
+            }
+            gdr_scene_destroy(scene);
+            return;
+        }
+    if (status != GDR_OK) {
+        fprintf(stderr, "%s: import failed: %s\n", relative, err.message);
+        test_failure_count++;
+        return;
+    }
+    files_imported++;
+    int expect_warning = 0;
+    for (size_t i = 0; i < sizeof warned / sizeof warned[0]; i++)
+        if (strcmp(relative, warned[i].file) == 0) {
+            expect_warning = 1;
+            files_warned++;
+            if (!strstr(warnings.text, warned[i].warning)) {
+                fprintf(stderr, "%s: expected a warning containing '%s', got:\n%s", relative, warned[i].warning,
+                        warnings.text);
+                test_failure_count++;
+            }
+        }
+    if (!expect_warning && warnings.count && !strstr(warnings.text, "texture left out")) {
+        fprintf(stderr, "%s: unexpected warnings:\n%s", relative, warnings.text);
+        test_failure_count++;
+    }
+    expected e;
+    if (expected_counts(path, &e)) {
+        if (scene->instance_count != e.instances || scene->mesh_count != e.meshes || scene->camera_count != e.cameras ||
+            scene->material_count != e.materials) {
+            fprintf(stderr, "%s: got %u instances, %u meshes, %u cameras, %u materials; the file declares %u, %u, %u, "
+                    "%u\n", relative, scene->instance_count, scene->mesh_count, scene->camera_count,
+                    scene->material_count, e.instances, e.meshes, e.cameras, e.materials);
+            test_failure_count++;
+        }
+    }
+    for (uint32_t i = 0; i < scene->mesh_count; i++)
+        CHECK(scene->meshes[i].index_count % 3 == 0 && scene->meshes[i].index_count > 0);
+    printf("imported %-60s %u meshes, %u instances, %llu triangles, %u textures%s\n", relative, scene->mesh_count,
+           scene->instance_count, (unsigned long long)gdr_scene_triangle_count(scene), scene->texture_count,
+           warnings.count ? " (warned)" : "");
+    gdr_scene_destroy(scene);
+}
+
+static void scan(const char *relative)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s", ASSIMP_GLTF2_DIR, relative);
+    struct dirent **entries;
+    int n = scandir(path, &entries, NULL, alphasort);
+    for (int i = 0; i < n; i++) {
+        const char *name = entries[i]->d_name;
+        char child[1024 + 300];
+        snprintf(child, sizeof child, "%s%s%s", relative, relative[0] ? "/" : "", name);
+        size_t length = strlen(name);
+        if (name[0] != '.') {
+            char full[2600];
+            struct stat st;
+            snprintf(full, sizeof full, "%s/%s", ASSIMP_GLTF2_DIR, child);
+            if (stat(full, &st) == 0 && S_ISDIR(st.st_mode))
+                scan(child);
+            else if ((length > 5 && strcmp(name + length - 5, ".gltf") == 0) ||
+                     (length > 4 && strcmp(name + length - 4, ".glb") == 0))
+                check_file(child);
+        }
+        free(entries[i]);
+    }
+    if (n >= 0)
+        free(entries);
+}
+
+int main(void)
+{
+    struct stat st;
+    if (stat(ASSIMP_GLTF2_DIR, &st) != 0) {
+        printf("test_gltf_assimp: %s not found (install assimp-testmodels); skipped\n", ASSIMP_GLTF2_DIR);
+        return 77;
+    }
+    scan("");
+    printf("%u files: %u imported (%u with expected warnings), %u refused as expected\n", files_total,
+           files_imported, files_warned, files_refused);
+    CHECK(files_total >= 40);
+    CHECK(files_refused == sizeof broken / sizeof broken[0]);
+    return test_finish("test_gltf_assimp");
+}

@@ -1,0 +1,61 @@
+/* gdr info FILE: a summary of a scene (meshes, instances, triangles, materials, cameras, ...). */
+#include <stdio.h>
+#include <string.h>
+
+#include "commands.h"
+#include "gdr/io.h"
+
+static void count_warning(void *user, const char *message)
+{
+    (*(unsigned *)user)++;
+    fprintf(stderr, "gdr: warning: %s\n", message);
+}
+
+int gdr_cmd_info(int argc, char **argv)
+{
+    const char *input = NULL;
+    gdr_load_options options = {0};
+    unsigned warnings = 0;
+    options.warning = count_warning;
+    options.warning_user = &warnings;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--no-cache") == 0) {
+            options.no_cache = 1;
+        } else if (strcmp(argv[i], "--cache-dir") == 0 && i + 1 < argc) {
+            options.cache_dir = argv[++i];
+        } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0 || argv[i][0] == '-' || input) {
+            fputs("usage: gdr info FILE|demo[:...] [--no-cache] [--cache-dir DIR]\n", stderr);
+            return strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0 ? 0 : 2;
+        } else {
+            input = argv[i];
+        }
+    }
+    if (!input) {
+        fputs("usage: gdr info FILE|demo[:...] [--no-cache] [--cache-dir DIR]\n", stderr);
+        return 2;
+    }
+    gdr_error err = {0};
+    gdr_scene *scene = NULL;
+    if (gdr_scene_load_ex(input, &options, &scene, &err) != GDR_OK) {
+        fprintf(stderr, "gdr: %s\n", err.message);
+        return 1;
+    }
+    uint64_t vertices = 0, unique_triangles = 0;
+    for (uint32_t i = 0; i < scene->mesh_count; i++) {
+        vertices += scene->meshes[i].vertex_count;
+        unique_triangles += scene->meshes[i].index_count / 3;
+    }
+    printf("scene:       %s\n", input);
+    printf("meshes:      %u (%llu vertices, %llu triangles)\n", scene->mesh_count, (unsigned long long)vertices,
+           (unsigned long long)unique_triangles);
+    printf("instances:   %u\n", scene->instance_count);
+    printf("triangles:   %llu (over all instances)\n", (unsigned long long)gdr_scene_triangle_count(scene));
+    printf("materials:   %u\n", scene->material_count);
+    printf("textures:    %u\n", scene->texture_count);
+    printf("cameras:     %u\n", scene->camera_count);
+    printf("extensions:  %s\n", scene->extensions ? scene->extensions : "(none)");
+    if (warnings)
+        printf("warnings:    %u\n", warnings);
+    gdr_scene_destroy(scene);
+    return 0;
+}
