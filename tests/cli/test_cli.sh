@@ -1,0 +1,75 @@
+#!/bin/sh
+# The gdr program: good runs produce their files; bad arguments get a message and a non-zero exit.
+# usage: test_cli.sh GDR_BINARY WORK_DIR
+set -u
+gdr=$1
+work=$2
+rm -rf "$work" && mkdir -p "$work"
+failures=0
+
+# expect STATUS DESCRIPTION -- COMMAND...: runs the command, checks its exit status and that a
+# failing command said something on stderr.
+expect() {
+    want=$1; shift
+    what=$1; shift
+    "$@" >"$work/stdout" 2>"$work/stderr"
+    got=$?
+    if [ "$got" != "$want" ]; then
+        echo "FAIL ($what): exit $got, expected $want: $*"; cat "$work/stderr"; failures=$((failures + 1))
+    elif [ "$want" != 0 ] && [ ! -s "$work/stderr" ]; then
+        echo "FAIL ($what): exit $got without a message: $*"; failures=$((failures + 1))
+    fi
+}
+
+expect 0 help "$gdr" --help
+expect 0 version "$gdr" --version
+grep -q '^gdr [0-9]' "$work/stdout" || { echo "FAIL: --version printed $(cat "$work/stdout")"; failures=$((failures + 1)); }
+expect 2 "no command" "$gdr"
+expect 2 "unknown command" "$gdr" paint demo
+
+small="--width 64 --height 48"
+# shellcheck disable=SC2086
+expect 0 "render with validation" "$gdr" render demo:instances=50 $small --out "$work/a.png" --stats "$work/a.json" --validate --frames 3
+[ -s "$work/a.png" ] || { echo "FAIL: no PNG written"; failures=$((failures + 1)); }
+for key in instances_total instances_visible triangles draws cpu_ms_per_frame gpu_ms device validation_messages; do
+    grep -q "\"$key\"" "$work/a.json" || { echo "FAIL: stats JSON lacks $key"; failures=$((failures + 1)); }
+done
+grep -q '"validation_messages":[[:space:]]*0' "$work/a.json" || { echo "FAIL: validation messages"; failures=$((failures + 1)); }
+# shellcheck disable=SC2086
+expect 0 "render with culling off and a camera" "$gdr" render demo:instances=50 $small --cull off --camera 0,3,10,0,0,0,1
+
+# shellcheck disable=SC2086
+{
+expect 2 "no scene" "$gdr" render $small
+expect 2 "two scenes" "$gdr" render demo demo
+expect 2 "width 0" "$gdr" render demo $small --width 0
+expect 2 "width not a number" "$gdr" render demo --width 12abc
+expect 2 "height too large" "$gdr" render demo --height 99999
+expect 2 "negative frames" "$gdr" render demo --frames -1
+expect 2 "cull maybe" "$gdr" render demo --cull maybe
+expect 2 "short camera" "$gdr" render demo --camera 1,2,3
+expect 2 "camera with NaN" "$gdr" render demo --camera 0,0,0,nan,0,0,1
+expect 2 "zero quaternion" "$gdr" render demo --camera 0,0,0,0,0,0,0
+expect 2 "missing value" "$gdr" render demo --width
+expect 2 "unknown option" "$gdr" render demo --colour red
+expect 2 "camera index out of range" "$gdr" render demo:instances=10 $small --camera-index 3
+expect 1 "zero instances" "$gdr" render demo:instances=0 $small
+expect 1 "unknown demo option" "$gdr" render demo:size=3 $small
+expect 1 "missing scene file" "$gdr" render "$work/does-not-exist.gltf" $small
+expect 1 "no such device" "$gdr" render demo:instances=10 $small --device 99
+expect 1 "no such device name" "$gdr" render demo:instances=10 $small --device "no such gpu"
+expect 1 "unwritable PNG" "$gdr" render demo:instances=10 $small --out "$work/missing-dir/a.png"
+expect 2 "bench bad sizes" "$gdr" bench --sizes 10,abc
+}
+[ ! -e "$work/missing-dir" ] || { echo "FAIL: created a folder for the PNG"; failures=$((failures + 1)); }
+ls "$work" | grep -q '\.tmp\.' && { echo "FAIL: temporary files left behind"; failures=$((failures + 1)); }
+
+# shellcheck disable=SC2086
+expect 0 "bench" "$gdr" bench --sizes 20,40 --frames 2 $small --json "$work/bench.json" --validate
+grep -q '"instances_total"' "$work/bench.json" || { echo "FAIL: bench JSON"; failures=$((failures + 1)); }
+
+if [ "$failures" != 0 ]; then
+    echo "test_cli: $failures failure(s)"
+    exit 1
+fi
+echo "test_cli: all checks passed"

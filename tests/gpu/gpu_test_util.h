@@ -1,0 +1,50 @@
+/* Helpers for GPU tests: a validated renderer on the default device (lavapipe in CI) and a CPU
+ * reference of the instance culling test. */
+#ifndef GDR_GPU_TEST_UTIL_H
+#define GDR_GPU_TEST_UTIL_H
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "gdr/gdr.h"
+#include "test_util.h"
+
+static inline gdr_renderer *gpu_test_renderer(uint32_t width, uint32_t height, const gdr_scene *scene)
+{
+    gdr_error err = {0};
+    gdr_renderer *renderer = NULL;
+    gdr_renderer_desc desc = {.width = width, .height = height, .validate = true};
+    if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK || gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK) {
+        fprintf(stderr, "renderer: %s\n", err.message);
+        gdr_renderer_destroy(renderer);
+        return NULL;
+    }
+    return renderer;
+}
+
+/* CPU reference of one instance's culling test, with the sphere grown/shrunk by `slack` so that
+ * cases within float rounding of the boundary can be told apart: returns +1 visible for sure,
+ * -1 culled for sure, 0 too close to call. */
+static inline int cpu_instance_visibility(const gdr_scene *scene, uint32_t index, const gdr_camera *camera, float aspect)
+{
+    const gdr_instance *instance = &scene->instances[index];
+    gdr_vec4 b = scene->meshes[instance->mesh].bounds;
+    gdr_mat4 view = gdr_view_from_pose(camera->position, camera->rotation);
+    gdr_mat4 projection = gdr_perspective_reverse_z_infinite(camera->yfov, aspect, camera->znear);
+    gdr_vec4 ijkl = gdr_frustum_symmetric(projection);
+    gdr_vec3 world = gdr_mat4_transform_point(instance->transform, (gdr_vec3){b.x, b.y, b.z});
+    gdr_vec3 c = gdr_mat4_transform_point(view, world);
+    float r = b.w * gdr_mat4_max_axis_scale(instance->transform);
+    float slack = 1e-3f * (1.0f + r);
+    bool surely_visible = gdr_sphere_in_frustum(ijkl, c, r - slack, camera->znear, INFINITY);
+    bool maybe_visible = gdr_sphere_in_frustum(ijkl, c, r + slack, camera->znear, INFINITY);
+    return surely_visible ? 1 : maybe_visible ? 0 : -1;
+}
+
+static inline int compare_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+#endif
