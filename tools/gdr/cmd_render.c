@@ -17,6 +17,7 @@ typedef struct render_options {
     gdr_vec3 camera_position;
     gdr_quat camera_rotation;
     const char *device;
+    gdr_load_options load;
 } render_options;
 
 static int parse_render_options(int argc, char **argv, render_options *o)
@@ -34,6 +35,10 @@ static int parse_render_options(int argc, char **argv, render_options *o)
         }
         if (strcmp(arg, "--validate") == 0) {
             o->validate = true;
+            continue;
+        }
+        if (strcmp(arg, "--no-cache") == 0) {
+            o->load.no_cache = 1;
             continue;
         }
         if (!(value = cli_value(argc, argv, &i)))
@@ -57,6 +62,8 @@ static int parse_render_options(int argc, char **argv, render_options *o)
             ok = cli_parse_on_off(arg, value, &o->cull);
         else if (strcmp(arg, "--device") == 0)
             o->device = value;
+        else if (strcmp(arg, "--cache-dir") == 0)
+            o->load.cache_dir = value;
         else {
             fprintf(stderr, "gdr render: unknown option '%s' (see gdr --help)\n", arg);
             return 2;
@@ -96,7 +103,7 @@ int gdr_cmd_render(int argc, char **argv)
         return usage;
     gdr_error err = {0};
     gdr_scene *scene = NULL;
-    if (gdr_scene_load(o.scene, &scene, &err) != GDR_OK)
+    if (gdr_scene_load_ex(o.scene, &o.load, &scene, &err) != GDR_OK)
         return fail(&err);
     if (o.has_camera_index && o.camera_index >= scene->camera_count) {
         fprintf(stderr, "gdr: --camera-index %u: the scene has %u camera(s)\n", o.camera_index, scene->camera_count);

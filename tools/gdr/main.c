@@ -12,9 +12,12 @@ static void print_help(FILE *out)
           "usage:\n"
           "  gdr render SCENE [options]   render SCENE headless; print statistics\n"
           "  gdr bench [options]          render the demo scene at several sizes; print a table and JSON\n"
+          "  gdr build INPUT -o OUT.gdrc  import INPUT and write the processed-scene cache\n"
+          "  gdr info FILE                summarise a scene: meshes, instances, triangles, materials, ...\n"
           "  gdr --help | --version\n"
           "\n"
-          "SCENE is 'demo' or 'demo:instances=N,seed=S,spacing=M' (the built-in procedural scene).\n"
+          "SCENE is a .gltf, .glb, .obj or .gdrc file, or 'demo' / 'demo:instances=N,seed=S,spacing=M'\n"
+          "(the built-in procedural scene). Source files go through a .gdrc cache next to them.\n"
           "\n"
           "render options:\n"
           "  --out FILE.png          write the last frame's image\n"
@@ -27,6 +30,8 @@ static void print_help(FILE *out)
           "  --device N|NAME         Vulkan device by index or name substring (default: first discrete GPU)\n"
           "  --validate              enable the Khronos validation layer; messages are counted and\n"
           "                          make the exit status 3\n"
+          "  --no-cache              import the source file, never read or write its .gdrc cache\n"
+          "  --cache-dir DIR         keep caches in DIR instead of next to the source\n"
           "\n"
           "bench options:\n"
           "  --sizes N,N,...         instance counts (default 1000,10000,100000,1000000)\n"
@@ -57,6 +62,10 @@ int main(int argc, char **argv)
         return gdr_cmd_render(argc - 1, argv + 1);
     if (strcmp(command, "bench") == 0)
         return gdr_cmd_bench(argc - 1, argv + 1);
+    if (strcmp(command, "build") == 0)
+        return gdr_cmd_build(argc - 1, argv + 1);
+    if (strcmp(command, "info") == 0)
+        return gdr_cmd_info(argc - 1, argv + 1);
     fprintf(stderr, "gdr: unknown command '%s' (see gdr --help)\n", command);
     return 2;
 }
