@@ -7,6 +7,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#ifndef ASSIMP_GLTF2_DIR
+#define ASSIMP_GLTF2_DIR "/usr/share/assimp/models/glTF2"
+#endif
+
 typedef struct test_warnings {
     unsigned count;
     char text[8192];
