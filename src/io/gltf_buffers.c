@@ -233,7 +233,7 @@ gdr_status gltf_buffer_get(gltf_ctx *c, uint32_t index, const char *place, const
 static gdr_status decode_meshopt(gltf_ctx *c, const cJSON *ext, const char *place, uint32_t byte_length,
                                  gltf_view *v)
 {
-    char here[80];
+    char here[128];
     snprintf(here, sizeof here, "%s.extensions.EXT_meshopt_compression", place);
     uint32_t buffer = 0, offset = 0, length = 0, stride = 0, count = 0;
     const char *mode = NULL, *filter = "NONE";

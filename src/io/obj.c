@@ -218,7 +218,7 @@ static gdr_status parse_face(obj_ctx *c, const char *p, const char *end)
             return status;
         if (k.vn == UINT32_MAX)
             c->mesh.missing_normal = 1;
-        uint32_t index;
+        uint32_t index = 0;
         status = corner_index(c, k, &index);
         if (status != GDR_OK)
             return status;

@@ -149,7 +149,7 @@ static unsigned files_total, files_imported, files_refused, files_warned;
 
 static void check_file(const char *relative)
 {
-    char path[1200];
+    char path[4096];
     snprintf(path, sizeof path, "%s/%s", ASSIMP_GLTF2_DIR, relative);
     collected warnings = {0};
     gdr_import_options options = {.warning = collect, .warning_user = &warnings, .no_progress = 1};
