@@ -57,7 +57,7 @@ static uint32_t take_updates(gdr_renderer *r, gdr_frame_slot *slot)
 }
 
 gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame,
-                                       bool copy_color, gdr_error *err)
+                                       bool copy_color, double *submit_ms, gdr_error *err)
 {
     VkCommandBuffer cmd = slot->cmd;
     uint32_t update_count = take_updates(r, slot);
@@ -160,7 +160,9 @@ gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, co
     VkCommandBufferSubmitInfo cmd_info = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO, .commandBuffer = cmd};
     VkSubmitInfo2 submit = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2, .commandBufferInfoCount = 1,
                             .pCommandBufferInfos = &cmd_info};
+    double start = gdr_now_ms();
     GDR_VK_TRY(err, vkQueueSubmit2(r->ctx->queue, 1, &submit, slot->fence));
+    *submit_ms += gdr_now_ms() - start;
     slot->submitted = true;
     slot->timestamps_written = true;
     return GDR_OK;

@@ -7,7 +7,7 @@
 #include "render/renderer_internal.h"
 #include "vk/vk_pipeline.h"
 
-static double now_ms(void)
+double gdr_now_ms(void)
 {
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
@@ -177,7 +177,7 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
                              "(yfov %g, znear %g, zfar %g)", (double)camera->yfov, (double)camera->znear,
                              (double)camera->zfar);
 
-    double cpu_ms = 0.0, pass_ms[GDR_TS_COUNT - 1] = {0};
+    double cpu_ms = 0.0, submit_ms = 0.0, pass_ms[GDR_TS_COUNT - 1] = {0};
     uint32_t timed_frames = 0;
     r->color_read_back = false;
     for (uint32_t f = 0; f < frames; f++) {
@@ -192,10 +192,10 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
                 pass_ms[i] += ms[i];
             timed_frames++;
         }
-        double start = now_ms();
+        double start = gdr_now_ms();
         bool last = f + 1 == frames;
-        status = gdr_frame_record_and_submit(r, slot, frame, last && frame->read_back, err);
-        cpu_ms += now_ms() - start;
+        status = gdr_frame_record_and_submit(r, slot, frame, last && frame->read_back, &submit_ms, err);
+        cpu_ms += gdr_now_ms() - start;
         if (status != GDR_OK)
             return status;
         r->last_slot = (int)(slot - r->slots);
@@ -228,6 +228,7 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
     stats->draw_calls = 1;
     stats->triangles = ((uint64_t)gpu.triangles_high << 32) | gpu.triangles_low;
     stats->cpu_ms_per_frame = cpu_ms / frames;
+    stats->cpu_submit_ms_per_frame = submit_ms / frames;
     stats->pass_count = GDR_TS_COUNT - 1;
     for (int p = 0; p < GDR_TS_COUNT - 1; p++) {
         stats->passes[p].name = pass_names[p];

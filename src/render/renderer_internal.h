@@ -75,8 +75,9 @@ void gdr_frame_slots_destroy(gdr_renderer *r);
 
 /* Waits for the slot's previous frame (if any) and gathers its timings into `gpu_ms` (may be NULL). */
 gdr_status gdr_frame_slot_wait(gdr_renderer *r, gdr_frame_slot *slot, double gpu_ms[GDR_TS_COUNT - 1], gdr_error *err);
-/* Records and submits one frame into `slot`. */
+/* Records and submits one frame into `slot`; adds the time spent in vkQueueSubmit2 to *submit_ms. */
 gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame,
-                                       bool copy_color, gdr_error *err);
+                                       bool copy_color, double *submit_ms, gdr_error *err);
+double gdr_now_ms(void);
 
 #endif

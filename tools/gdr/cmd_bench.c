@@ -38,7 +38,9 @@ int gdr_cmd_bench(int argc, char **argv)
     uint32_t sizes[MAX_SIZES] = {1000, 10000, 100000, 1000000}, size_count = 4;
     uint32_t frames = 20, width = 1920, height = 1080;
     const char *device = NULL, *json_path = NULL;
-    bool validate = false;
+    bool validate = false, has_camera = false;
+    gdr_vec3 camera_position;
+    gdr_quat camera_rotation;
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i], *value;
         if (strcmp(arg, "--validate") == 0) {
@@ -58,6 +60,8 @@ int gdr_cmd_bench(int argc, char **argv)
             ok = cli_parse_u32(arg, value, 1, 16384, &height);
         else if (strcmp(arg, "--device") == 0)
             device = value;
+        else if (strcmp(arg, "--camera") == 0)
+            ok = has_camera = cli_parse_camera(arg, value, &camera_position, &camera_rotation);
         else if (strcmp(arg, "--json") == 0)
             json_path = value;
         else {
@@ -69,7 +73,8 @@ int gdr_cmd_bench(int argc, char **argv)
     }
 
     cJSON *rows = cJSON_CreateArray();
-    printf("%10s %10s %12s %10s %10s %10s %10s %10s\n", "instances", "visible", "triangles", "cpu_ms", "gpu_update",
+    printf("%10s %10s %12s %10s %10s %10s %10s %10s %10s\n", "instances", "visible", "triangles", "cpu_ms", "submit_ms",
+           "gpu_update",
            "gpu_cull", "gpu_draw", "gpu_frame");
     double first_cpu = 0.0;
     int result = 0;
@@ -87,6 +92,10 @@ int gdr_cmd_bench(int argc, char **argv)
             result = 1;
         } else {
             gdr_frame_desc frame = {.camera = scene->cameras[0], .cull = GDR_CULL_ON};
+            if (has_camera) {
+                frame.camera.position = camera_position;
+                frame.camera.rotation = camera_rotation;
+            }
             if (gdr_renderer_render(renderer, &frame, frames, &stats, &err) != GDR_OK) {
                 fprintf(stderr, "gdr: %s\n", err.message);
                 result = 1;
@@ -95,8 +104,9 @@ int gdr_cmd_bench(int argc, char **argv)
         if (result == 0) {
             if (s == 0)
                 first_cpu = stats.cpu_ms_per_frame;
-            printf("%10u %10u %12llu %10.4f %10.4f %10.4f %10.4f %10.4f\n", stats.instances_total, stats.instances_visible,
-                   (unsigned long long)stats.triangles, stats.cpu_ms_per_frame, stats.passes[0].gpu_ms,
+            printf("%10u %10u %12llu %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f\n", stats.instances_total,
+                   stats.instances_visible, (unsigned long long)stats.triangles, stats.cpu_ms_per_frame,
+                   stats.cpu_submit_ms_per_frame, stats.passes[0].gpu_ms,
                    stats.passes[1].gpu_ms, stats.passes[2].gpu_ms, stats.gpu_ms_per_frame);
             fflush(stdout);
             cJSON *row = cJSON_CreateObject();
@@ -104,6 +114,7 @@ int gdr_cmd_bench(int argc, char **argv)
             cJSON_AddNumberToObject(row, "instances_visible", stats.instances_visible);
             cJSON_AddNumberToObject(row, "triangles", (double)stats.triangles);
             cJSON_AddNumberToObject(row, "cpu_ms_per_frame", stats.cpu_ms_per_frame);
+            cJSON_AddNumberToObject(row, "cpu_submit_ms_per_frame", stats.cpu_submit_ms_per_frame);
             cJSON_AddNumberToObject(row, "cpu_ratio_to_first", first_cpu > 0 ? stats.cpu_ms_per_frame / first_cpu : 0);
             cJSON *passes = cJSON_AddObjectToObject(row, "gpu_ms");
             for (uint32_t p = 0; p < stats.pass_count; p++)

@@ -37,6 +37,7 @@ static void print_help(FILE *out)
           "  --sizes N,N,...         instance counts (default 1000,10000,100000,1000000)\n"
           "  --frames N              frames per size (default 20)\n"
           "  --width W --height H    render target size (default 1920x1080)\n"
+          "  --camera px,py,pz,qx,qy,qz,qw   instead of the demo camera\n"
           "  --device N|NAME, --validate, --json FILE\n"
           "\n"
           "exit status: 0 success, 1 failure, 2 bad usage, 3 validation messages\n",

@@ -12,7 +12,8 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
     fprintf(out, "instances_visible   %u\n", s->instances_visible);
     fprintf(out, "triangles           %llu\n", (unsigned long long)s->triangles);
     fprintf(out, "draws               %u (in %u indirect draw call)\n", s->draws, s->draw_calls);
-    fprintf(out, "cpu_ms_per_frame    %.4f\n", s->cpu_ms_per_frame);
+    fprintf(out, "cpu_ms_per_frame    %.4f (of which vkQueueSubmit2 %.4f)\n", s->cpu_ms_per_frame,
+            s->cpu_submit_ms_per_frame);
     fprintf(out, "gpu_ms_per_frame    %.4f\n", s->gpu_ms_per_frame);
     for (uint32_t p = 0; p < s->pass_count; p++)
         fprintf(out, "  gpu_ms.%-16s %.4f\n", s->passes[p].name, s->passes[p].gpu_ms);
@@ -37,6 +38,7 @@ char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
     cJSON_AddNumberToObject(root, "draws", s->draws);
     cJSON_AddNumberToObject(root, "draw_calls", s->draw_calls);
     cJSON_AddNumberToObject(root, "cpu_ms_per_frame", s->cpu_ms_per_frame);
+    cJSON_AddNumberToObject(root, "cpu_submit_ms_per_frame", s->cpu_submit_ms_per_frame);
     cJSON_AddNumberToObject(root, "gpu_ms_per_frame", s->gpu_ms_per_frame);
     cJSON *passes = cJSON_AddObjectToObject(root, "gpu_ms");
     for (uint32_t p = 0; passes && p < s->pass_count; p++)
