@@ -65,6 +65,55 @@ bool cull_distance_visible(const cull_distance_params *p, const gdr_cull_object 
 float cull_screen_size(float screen_scale, float radius, float center_distance);
 bool cull_screen_size_visible(float size, float view_min, const gdr_cull_object *o);
 
+/* bvh.c */
+void cull_bvh_bounds(const gdr_bvh *bvh, gdr_vec3 *lo, gdr_vec3 *hi);
+
+/* Precomputed visibility (precomputed_visibility.c bakes, pvs_blob.c (de)serialises,
+ * pvs_query.c looks up). Cells are sorted by bucket; a bucket's cells are contiguous. */
+#define PVS_CHUNK_ZSTD 1u
+#define PVS_MAX_OBJECTS (1u << 28)
+#define PVS_MAX_GRID_CELLS (1u << 24)
+#define PVS_MAX_BUCKETS_PER_AXIS 4096u
+#define PVS_MAX_CHUNK_BYTES (1u << 28)
+
+typedef struct pvs_cell {
+    uint32_t x, y, z;
+    uint32_t chunk;  /* global chunk index */
+    uint32_t offset; /* byte offset of the bitset in the chunk's uncompressed data */
+} pvs_cell;
+
+typedef struct pvs_bucket {
+    uint32_t first_cell, cell_count;
+} pvs_bucket;
+
+typedef struct pvs_chunk {
+    uint64_t data_offset;
+    uint32_t compressed_size, uncompressed_size;
+    uint32_t flags; /* PVS_CHUNK_ZSTD, or 0: stored */
+} pvs_chunk;
+
+struct gdr_pvs {
+    uint32_t object_count;
+    uint32_t grid[3];
+    gdr_vec3 origin;
+    float cell_size;
+    uint32_t bucket_x, bucket_z;
+    uint32_t cell_count, chunk_count;
+    pvs_bucket *buckets; /* bucket_x * bucket_z; bucket = x % bucket_x + (z % bucket_z) * bucket_x */
+    pvs_cell *cells;
+    pvs_chunk *chunks;
+    uint8_t *data;
+    uint64_t data_size;
+    uint32_t max_chunk_bytes;
+    gdr_vec3 *samples; /* cell_count * samples_per_cell, or NULL */
+    uint32_t samples_per_cell;
+};
+
+static inline uint32_t pvs_bucket_of(const gdr_pvs *p, uint32_t x, uint32_t z)
+{
+    return x % p->bucket_x + (z % p->bucket_z) * p->bucket_x;
+}
+
 /* The permuted 8-lane tests. A sphere is outside when some plane has dist < -r. */
 static inline bool cull_sphere_outside(const gdr_frustum *f, gdr_vec3 c, float r)
 {
