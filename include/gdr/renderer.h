@@ -56,6 +56,7 @@ typedef struct gdr_frame_stats {
     uint32_t draw_calls;        /* draw calls the CPU recorded per frame */
     double cpu_ms_per_frame;    /* recording + submission, mean over the frames */
     double cpu_submit_ms_per_frame; /* the vkQueueSubmit2 part of it */
+    double cpu_ms_per_frame_median; /* recording + submission, median over the frames */
     double gpu_ms_per_frame;    /* first to last timestamp, mean over the frames */
     gdr_pass_timing passes[GDR_MAX_PASSES];
     uint32_t pass_count;

@@ -160,6 +160,12 @@ gdr_status gdr_renderer_update_instance(gdr_renderer *r, uint32_t index, const g
     return GDR_OK;
 }
 
+static int compare_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
 static const char *const pass_names[GDR_TS_COUNT - 1] = {"instance_update", "cull", "draw", "readback"};
 
 gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uint32_t frames, gdr_frame_stats *stats,
@@ -178,6 +184,9 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
                              (double)camera->zfar);
 
     double cpu_ms = 0.0, submit_ms = 0.0, pass_ms[GDR_TS_COUNT - 1] = {0};
+    double *frame_cpu_ms = malloc(sizeof(double) * frames);
+    if (!frame_cpu_ms)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "render: out of memory");
     uint32_t timed_frames = 0;
     r->color_read_back = false;
     for (uint32_t f = 0; f < frames; f++) {
@@ -185,8 +194,10 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
         double ms[GDR_TS_COUNT - 1];
         bool had_frame = slot->submitted;
         gdr_status status = gdr_frame_slot_wait(r, slot, ms, err);
-        if (status != GDR_OK)
+        if (status != GDR_OK) {
+            free(frame_cpu_ms);
             return status;
+        }
         if (had_frame) {
             for (int i = 0; i < GDR_TS_COUNT - 1; i++)
                 pass_ms[i] += ms[i];
@@ -195,9 +206,12 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
         double start = gdr_now_ms();
         bool last = f + 1 == frames;
         status = gdr_frame_record_and_submit(r, slot, frame, last && frame->read_back, &submit_ms, err);
-        cpu_ms += gdr_now_ms() - start;
-        if (status != GDR_OK)
+        frame_cpu_ms[f] = gdr_now_ms() - start;
+        cpu_ms += frame_cpu_ms[f];
+        if (status != GDR_OK) {
+            free(frame_cpu_ms);
             return status;
+        }
         r->last_slot = (int)(slot - r->slots);
         r->frame_index++;
     }
@@ -206,8 +220,10 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
         double ms[GDR_TS_COUNT - 1];
         bool had_frame = r->slots[i].submitted;
         gdr_status status = gdr_frame_slot_wait(r, &r->slots[i], ms, err);
-        if (status != GDR_OK)
+        if (status != GDR_OK) {
+            free(frame_cpu_ms);
             return status;
+        }
         if (had_frame) {
             for (int p = 0; p < GDR_TS_COUNT - 1; p++)
                 pass_ms[p] += ms[p];
@@ -215,8 +231,13 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
         }
     }
     r->color_read_back = frame->read_back;
-    if (!stats)
+    if (!stats) {
+        free(frame_cpu_ms);
         return GDR_OK;
+    }
+    qsort(frame_cpu_ms, frames, sizeof *frame_cpu_ms, compare_double);
+    double median = frames % 2 ? frame_cpu_ms[frames / 2] : 0.5 * (frame_cpu_ms[frames / 2 - 1] + frame_cpu_ms[frames / 2]);
+    free(frame_cpu_ms);
 
     memset(stats, 0, sizeof *stats);
     GdrGpuDrawStats gpu;
@@ -229,6 +250,7 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
     stats->triangles = ((uint64_t)gpu.triangles_high << 32) | gpu.triangles_low;
     stats->cpu_ms_per_frame = cpu_ms / frames;
     stats->cpu_submit_ms_per_frame = submit_ms / frames;
+    stats->cpu_ms_per_frame_median = median;
     stats->pass_count = GDR_TS_COUNT - 1;
     for (int p = 0; p < GDR_TS_COUNT - 1; p++) {
         stats->passes[p].name = pass_names[p];

@@ -39,6 +39,7 @@ char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
     cJSON_AddNumberToObject(root, "draw_calls", s->draw_calls);
     cJSON_AddNumberToObject(root, "cpu_ms_per_frame", s->cpu_ms_per_frame);
     cJSON_AddNumberToObject(root, "cpu_submit_ms_per_frame", s->cpu_submit_ms_per_frame);
+    cJSON_AddNumberToObject(root, "cpu_ms_per_frame_median", s->cpu_ms_per_frame_median);
     cJSON_AddNumberToObject(root, "gpu_ms_per_frame", s->gpu_ms_per_frame);
     cJSON *passes = cJSON_AddObjectToObject(root, "gpu_ms");
     for (uint32_t p = 0; passes && p < s->pass_count; p++)
