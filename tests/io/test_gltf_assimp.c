@@ -211,17 +211,17 @@ static void check_file(const char *relative)
 
 static void scan(const char *relative)
 {
-    char path[1200];
+    char path[4096];
     snprintf(path, sizeof path, "%s/%s", ASSIMP_GLTF2_DIR, relative);
     struct dirent **entries;
     int n = scandir(path, &entries, NULL, alphasort);
     for (int i = 0; i < n; i++) {
         const char *name = entries[i]->d_name;
-        char child[1024 + 300];
+        char child[2048];
         snprintf(child, sizeof child, "%s%s%s", relative, relative[0] ? "/" : "", name);
         size_t length = strlen(name);
         if (name[0] != '.') {
-            char full[2600];
+            char full[8192];
             struct stat st;
             snprintf(full, sizeof full, "%s/%s", ASSIMP_GLTF2_DIR, child);
             if (stat(full, &st) == 0 && S_ISDIR(st.st_mode))
