@@ -211,8 +211,8 @@ GDR_API bool gdr_triangle_overlaps_box(const gdr_vec3 corners[3], gdr_vec3 cente
  * space and get no data (a lookup there returns NULL: nothing is culled). In every other cell,
  * samples_per_cell camera points are taken (stratified, jittered); from each, rays go in
  * direction_rays uniform directions and, for every object not yet seen from the cell, up to
- * rays_per_object rays towards points on its triangles (area-weighted, one at each triangle's
- * centroid first). The first object a ray hits is visible from the cell. So the result is
+ * rays_per_object rays towards area-weighted random points on its triangles. The first object a
+ * ray hits is visible from the cell. So the result is
  * conservative for the sampled points and the rays cast: every object hit first by a bake ray
  * is marked; an object seen only through a gap no ray went through can be missed. */
 typedef struct gdr_pvs_bake_desc {
