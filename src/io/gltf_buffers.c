@@ -416,7 +416,7 @@ static gdr_status locate_elements(gltf_ctx *c, const char *place, uint32_t view_
                                   uint32_t count, uint32_t element_size, int allow_stride, const uint8_t **data,
                                   uint32_t *stride)
 {
-    const gltf_view *view;
+    const gltf_view *view = NULL;
     gdr_status status = gltf_view_get(c, view_index, place, &view);
     if (status != GDR_OK)
         return status;
