@@ -3,6 +3,7 @@
 #define GDR_GDR_H
 
 #include "gdr/core.h"
+#include "gdr/geometry.h"
 #include "gdr/math.h"
 #include "gdr/renderer.h"
 #include "gdr/scene.h"

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "gdr/core.h"
+#include "gdr/geometry.h"
 #include "gdr/math.h"
 
 #ifdef __cplusplus
@@ -26,6 +27,7 @@ typedef struct gdr_mesh {
     uint32_t index_count; /* a multiple of 3: a triangle list, counter-clockwise front faces */
     uint32_t *indices;
     gdr_vec4 bounds; /* bounding sphere in mesh space: centre xyz, radius w */
+    gdr_mesh_clusters clusters; /* meshlets and LOD DAG (gdr/geometry.h); empty until built */
 } gdr_mesh;
 
 typedef struct gdr_material {

@@ -40,6 +40,7 @@ void gdr_scene_destroy(gdr_scene *scene)
         free(scene->meshes[i].normals);
         free(scene->meshes[i].uvs);
         free(scene->meshes[i].indices);
+        gdr_mesh_clusters_free(&scene->meshes[i].clusters);
     }
     free(scene->meshes);
     free(scene->materials);

@@ -1,0 +1,16 @@
+/* Ownership of gdr_mesh_clusters. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "gdr/geometry.h"
+
+void gdr_mesh_clusters_free(gdr_mesh_clusters *clusters)
+{
+    if (!clusters)
+        return;
+    free(clusters->clusters);
+    free(clusters->vertices);
+    free(clusters->triangles);
+    free(clusters->groups);
+    memset(clusters, 0, sizeof *clusters);
+}
