@@ -1,4 +1,4 @@
-/* File reading, file identities for the cache, warnings, base64 and a terminal progress bar. */
+/* File reading, file identities for the cache, warnings and base64. */
 #define _XOPEN_SOURCE 700 /* realpath */
 #include <errno.h>
 #include <limits.h>
@@ -119,50 +119,6 @@ void gdr_io_warn(gdr_io_warnings *w, const char *format, ...)
         w->fn(w->user, message);
     else
         fprintf(stderr, "gdr: warning: %s\n", message);
-}
-
-double gdr_io_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
-
-void gdr_progress_begin(gdr_progress *p, const char *label, uint64_t total, int disabled)
-{
-    *p = (gdr_progress){.label = label, .total = total ? total : 1, .start = gdr_io_now(), .last_permille = -1};
-    p->enabled = !disabled && isatty(STDERR_FILENO);
-}
-
-void gdr_progress_update(gdr_progress *p, uint64_t done)
-{
-    if (!p->enabled)
-        return;
-    double elapsed = gdr_io_now() - p->start;
-    if (!p->drawn && elapsed < 0.3)
-        return;
-    int permille = (int)(done >= p->total ? 1000 : done * 1000 / p->total);
-    if (permille == p->last_permille)
-        return;
-    p->last_permille = permille;
-    p->drawn = 1;
-    enum { WIDTH = 32 };
-    char bar[WIDTH + 1];
-    int filled = permille * WIDTH / 1000;
-    for (int i = 0; i < WIDTH; i++)
-        bar[i] = i < filled ? '#' : '.';
-    bar[WIDTH] = 0;
-    fprintf(stderr, "\r%-12s [%s] %5.1f%%  %.1f s", p->label, bar, permille / 10.0, elapsed);
-    fflush(stderr);
-}
-
-void gdr_progress_end(gdr_progress *p)
-{
-    if (p->enabled && p->drawn) {
-        p->last_permille = -1;
-        gdr_progress_update(p, p->total);
-        fputc('\n', stderr);
-    }
 }
 
 static int base64_value(unsigned char c)

@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "core/progress.h"
 #include "gdr/io.h"
 
 /* Largest file an importer reads whole (bytes). */
@@ -35,19 +36,6 @@ typedef struct gdr_io_warnings {
 } gdr_io_warnings;
 
 void gdr_io_warn(gdr_io_warnings *w, const char *format, ...) __attribute__((format(printf, 2, 3)));
-
-/* A progress bar on stderr, drawn only on a terminal and only once the work has taken 0.3 s. */
-typedef struct gdr_progress {
-    const char *label;
-    uint64_t total;
-    double start;
-    int enabled, drawn, last_permille;
-} gdr_progress;
-
-void gdr_progress_begin(gdr_progress *p, const char *label, uint64_t total, int disabled);
-void gdr_progress_update(gdr_progress *p, uint64_t done);
-void gdr_progress_end(gdr_progress *p);
-double gdr_io_now(void);
 
 /* Decodes standard base64 (with or without padding); returns the decoded length, or SIZE_MAX
  * on a character outside the alphabet. out must hold gdr_base64_decoded_max(length) bytes. */
