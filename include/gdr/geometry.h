@@ -26,15 +26,24 @@ extern "C" {
 
 typedef struct gdr_cluster {
     uint32_t vertex_offset;   /* first entry of this cluster in gdr_mesh_clusters.vertices */
-    uint32_t triangle_offset; /* first byte in gdr_mesh_clusters.triangles (3 bytes per triangle) */
+    uint32_t triangle_offset; /* first byte in gdr_mesh_clusters.triangles (3 bytes per triangle); a
+                                 multiple of 4, so a shader can read whole 32-bit words (the bytes
+                                 between clusters are zero) */
     uint32_t vertex_count;    /* 1 .. GDR_CLUSTER_MAX_VERTICES */
     uint32_t triangle_count;  /* 1 .. GDR_CLUSTER_MAX_TRIANGLES */
-    gdr_vec4 sphere;          /* bounding sphere in mesh space: centre xyz, radius w */
-    gdr_vec3 cone_apex;       /* normal cone in mesh space (meshopt_computeMeshletBounds) */
-    gdr_vec3 cone_axis;
-    float cone_cutoff;        /* cluster is back-facing from p when
-                                 dot(normalize(cone_apex - p), cone_axis) >= cone_cutoff;
-                                 1 or more: never cone-culled */
+    gdr_vec4 sphere;          /* bounding sphere in mesh space: centre xyz, radius w; contains every
+                                 vertex of the cluster */
+    gdr_vec3 cone_apex;       /* normal cone in mesh space (meshopt_computeMeshletBounds, checked and
+                                 made conservative in double: the test below is exact on these floats) */
+    gdr_vec3 cone_axis;       /* unit length, or zero when the cluster has no useful cone */
+    float cone_cutoff;        /* every triangle of the cluster is back-facing (or edge-on) from p when
+                                 dot(normalize(cone_apex - p), cone_axis) >= cone_cutoff
+                                 (meshoptimizer's perspective test; cutoff = sine of the half-angle
+                                 of the cone of triangle normals around the axis). 1 with a zero
+                                 axis: no useful cone, never cone-culled. In world space: apex as a
+                                 point, axis as a direction (renormalised); valid under rotation,
+                                 translation and uniform scale, not mirroring or non-uniform scale.
+                                 Guard p == apex (NaN: do not cull). docs/GEOMETRY.md */
     uint32_t group;           /* LOD DAG: the group this cluster is part of (merged and simplified into
                                  coarser clusters); GDR_NO_INDEX without a DAG */
     uint32_t refined_group;   /* LOD DAG: the more detailed group this cluster was made from;
@@ -68,18 +77,30 @@ typedef struct gdr_mesh_clusters {
 typedef struct gdr_meshlet_options {
     uint32_t max_vertices;  /* 0: GDR_CLUSTER_MAX_VERTICES; at most that */
     uint32_t max_triangles; /* 0: GDR_CLUSTER_MAX_TRIANGLES; at most that, a multiple of 4 */
-    float cone_weight;      /* 0: the default (0.25); favours clusters with tight normal cones */
+    float cone_weight;      /* 0: the default (0.25); in (0, 1]; favours clusters with tight normal
+                               cones over small ones */
+    uint32_t thread_count;  /* gdr_scene_build_clusters: workers including the caller, at most 256;
+                               0: one per processor. The result does not depend on it. */
 } gdr_meshlet_options;
 
 typedef struct gdr_mesh gdr_mesh;   /* gdr/scene.h */
 typedef struct gdr_scene gdr_scene; /* gdr/scene.h */
 
 /* Splits `mesh` into level-0 clusters (meshoptimizer), written to `out`, which must be zeroed;
- * on failure `out` stays empty. */
+ * on failure `out` stays empty. The mesh needs at least one triangle, indices below vertex_count
+ * and finite positions; options (NULL: defaults) need max_vertices in [3, 64] and max_triangles a
+ * multiple of 4 in [4, 124]. Every input triangle is in exactly one cluster, with its corners in
+ * the same order; clusters, vertices and triangles arrays are sized exactly; every cluster's
+ * group and refined_group are GDR_NO_INDEX and level0_cluster_count is cluster_count. */
 GDR_API gdr_status gdr_meshlets_build(const gdr_mesh *mesh, const gdr_meshlet_options *options,
                                       gdr_mesh_clusters *out, gdr_error *err);
 
-/* Builds the clusters of every mesh of `scene` whose clusters are empty (options may be NULL). */
+/* Builds the clusters of every mesh of `scene` whose clusters are empty and that has triangles
+ * (options may be NULL), one mesh per task on a thread pool; the result does not depend on the
+ * thread count. Each mesh built also has its vertices renumbered in the order its clusters first
+ * use them (positions, normals, uvs, indices and cluster vertices together; the triangles and
+ * their order are unchanged), for fetch locality. On failure the error names the first failing
+ * mesh ("meshes[3]: mesh 'rock': ...") and no mesh keeps clusters from this call. */
 GDR_API gdr_status gdr_scene_build_clusters(gdr_scene *scene, const gdr_meshlet_options *options, gdr_error *err);
 
 GDR_API void gdr_mesh_clusters_free(gdr_mesh_clusters *clusters);
