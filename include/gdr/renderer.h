@@ -26,6 +26,7 @@ typedef struct gdr_renderer_desc {
     /* Poll frame fences instead of sleeping on them. For benchmarks: a core that sleeps through a
      * long GPU frame wakes up slower, which would make CPU timings depend on the GPU's load. */
     bool busy_wait;
+    bool disable_mesh_shaders; /* behave as a device without VK_EXT_mesh_shader (tests the fallback) */
 } gdr_renderer_desc;
 
 typedef enum gdr_cull_mode {
@@ -34,11 +35,44 @@ typedef enum gdr_cull_mode {
     GDR_CULL_OFF, /* every instance is drawn: the reference image for culling tests */
 } gdr_cull_mode;
 
+/* How a frame is culled and submitted. */
+typedef enum gdr_pipeline {
+    GDR_PIPELINE_DEFAULT = 0, /* mesh where the device has VK_EXT_mesh_shader, else indirect */
+    GDR_PIPELINE_MESH,        /* compute instance cull -> task shader meshlet cull -> mesh shader (issue 4) */
+    GDR_PIPELINE_INDIRECT,    /* compute instance cull -> one vkCmdDrawIndexedIndirectCount (seed 003) */
+    GDR_PIPELINE_CPU,         /* CPU-driven baseline: gdr/cull.h on the CPU, then one vkCmdDrawIndexed
+                                 with its own binds per visible instance (seed 003's "before") */
+} gdr_pipeline;
+
+/* What the image shows. */
+typedef enum gdr_view {
+    GDR_VIEW_MODE_SHADED = 0,
+    GDR_VIEW_MODE_MESHLETS,  /* each cluster in a colour from a hash of its index (mesh pipeline) */
+    GDR_VIEW_MODE_INSTANCES, /* each instance in a colour of its own */
+    GDR_VIEW_MODE_TRIANGLES, /* each triangle in a colour of its own: triangle density (mesh pipeline) */
+    GDR_VIEW_MODE_OVERDRAW,  /* fragments per pixel as a heat map normalised by the frame's maximum */
+} gdr_view;
+
 typedef struct gdr_frame_desc {
     gdr_camera camera;  /* aspect 0: width / height; zfar 0: infinite reverse-Z projection */
-    gdr_cull_mode cull;
+    gdr_cull_mode cull; /* OFF: nothing is culled at any level (instances, clusters, triangles) */
     bool read_back;     /* copy the last frame's image for gdr_renderer_read_color / write_png */
+    gdr_pipeline pipeline;
+    gdr_view view;
+    /* Mesh pipeline, when cull is on: each level can be switched off on its own (DEFAULT: on). */
+    gdr_cull_mode meshlet_frustum_cull;
+    gdr_cull_mode meshlet_cone_cull;
+    gdr_cull_mode triangle_cull; /* back-facing triangles and triangles that cover no sample */
+    /* Mesh pipeline: keep the list of clusters the task shaders passed, for
+     * gdr_renderer_read_visible_meshlets (tests, tools; costs an append per cluster). */
+    bool record_visible_meshlets;
 } gdr_frame_desc;
+
+/* "shaded", "meshlets", "instances", "triangles" or "overdraw". */
+GDR_API const char *gdr_view_name(gdr_view view);
+
+/* "mesh", "indirect" or "cpu". */
+GDR_API const char *gdr_pipeline_name(gdr_pipeline pipeline);
 
 #define GDR_MAX_PASSES 8
 
@@ -63,6 +97,21 @@ typedef struct gdr_frame_stats {
     char device[256];
     char driver[528];
     uint32_t validation_messages; /* since the renderer was created */
+    gdr_pipeline pipeline;        /* the path that rendered (never DEFAULT) */
+    char pipeline_reason[160];    /* why that path: asked for, or the device's capabilities */
+    double cpu_cull_ms_per_frame; /* CPU pipeline: the culling part of cpu_ms_per_frame */
+    /* Mesh pipeline, last frame. meshlets_total counts the clusters of every instance; the culled
+     * counts are of the clusters of instances that passed the instance cull. */
+    uint64_t meshlets_total;
+    uint32_t meshlets_tested;
+    uint32_t meshlets_frustum_culled;
+    uint32_t meshlets_cone_culled;
+    uint32_t meshlets_visible;            /* drawn */
+    uint32_t triangles_backface_culled;   /* by the mesh shader */
+    uint32_t triangles_small_culled;      /* covering no sample */
+    uint32_t task_workgroups;
+    uint32_t task_overflow;               /* task commands lost for want of room: always 0 (sized from the scene) */
+    uint32_t overdraw_max;                /* overdraw view: the most fragments one pixel received */
 } gdr_frame_stats;
 
 GDR_API gdr_status gdr_renderer_create(const gdr_renderer_desc *desc, gdr_renderer **out, gdr_error *err);
@@ -85,9 +134,25 @@ GDR_API gdr_status gdr_renderer_render(gdr_renderer *renderer, const gdr_frame_d
  * needs a frame rendered with read_back. */
 GDR_API gdr_status gdr_renderer_read_color(gdr_renderer *renderer, uint8_t *rgba, gdr_error *err);
 
-/* Indices of the instances the GPU found visible in the last frame, in draw order. */
+/* What the device can do: whether the mesh pipeline is available, and if not, why (may be NULL). */
+GDR_API bool gdr_renderer_has_mesh_pipeline(const gdr_renderer *renderer, const char **why_not);
+
+/* Indices of the instances found visible in the last frame (by the GPU, or by the CPU on the CPU
+ * pipeline), in draw order. */
 GDR_API gdr_status gdr_renderer_read_visible(gdr_renderer *renderer, uint32_t *indices, uint32_t capacity,
                                              uint32_t *count, gdr_error *err);
+
+/* A cluster drawn in the last frame: instance index and the cluster's index within its mesh's
+ * clusters (gdr_mesh.clusters.clusters). */
+typedef struct gdr_visible_meshlet {
+    uint32_t instance;
+    uint32_t meshlet;
+} gdr_visible_meshlet;
+
+/* The clusters the last frame drew, in no particular order; needs a mesh-pipeline frame rendered
+ * with record_visible_meshlets. */
+GDR_API gdr_status gdr_renderer_read_visible_meshlets(gdr_renderer *renderer, gdr_visible_meshlet *meshlets,
+                                                      uint32_t capacity, uint32_t *count, gdr_error *err);
 
 GDR_API void gdr_renderer_size(const gdr_renderer *renderer, uint32_t *width, uint32_t *height);
 

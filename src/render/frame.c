@@ -1,5 +1,6 @@
-/* One GPU-driven frame: instance updates -> instance culling -> one indirect-count draw. The number
- * of commands recorded does not depend on the scene. */
+/* One frame. GPU-driven (indirect: instance culling -> one indirect-count draw; mesh: instance
+ * culling -> task commands -> one mesh-tasks launch), where the number of commands recorded does
+ * not depend on the scene, or CPU-driven (culling on the CPU, a draw per visible instance). */
 #include <math.h>
 #include <string.h>
 
@@ -21,14 +22,19 @@ static void timestamp(gdr_renderer *r, VkCommandBuffer cmd, gdr_frame_slot *slot
     vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, r->timestamps, base + which);
 }
 
+void gdr_frame_matrices(const gdr_renderer *r, const gdr_camera *camera, gdr_mat4 *projection, gdr_mat4 *view)
+{
+    float aspect = camera->aspect > 0.0f ? camera->aspect : (float)r->width / (float)r->height;
+    *projection = camera->zfar > 0.0f ? gdr_perspective_reverse_z(camera->yfov, aspect, camera->znear, camera->zfar)
+                                      : gdr_perspective_reverse_z_infinite(camera->yfov, aspect, camera->znear);
+    *view = gdr_view_from_pose(camera->position, camera->rotation);
+}
+
 static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame, uint32_t update_count)
 {
     const gdr_camera *camera = &frame->camera;
-    float aspect = camera->aspect > 0.0f ? camera->aspect : (float)r->width / (float)r->height;
-    gdr_mat4 projection = camera->zfar > 0.0f
-                              ? gdr_perspective_reverse_z(camera->yfov, aspect, camera->znear, camera->zfar)
-                              : gdr_perspective_reverse_z_infinite(camera->yfov, aspect, camera->znear);
-    gdr_mat4 view = gdr_view_from_pose(camera->position, camera->rotation);
+    gdr_mat4 projection, view;
+    gdr_frame_matrices(r, camera, &projection, &view);
     gdr_vec3 light = gdr_vec3_normalize((gdr_vec3){0.35f, 0.85f, 0.4f});
     GdrGpuFrameGlobals globals = {
         .view = view,
@@ -41,6 +47,13 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .instance_count = r->scene.instance_count,
         .cull_enabled = frame->cull != GDR_CULL_OFF,
         .update_count = update_count,
+        .flags = (frame->meshlet_frustum_cull != GDR_CULL_OFF ? GDR_FRAME_MESHLET_FRUSTUM : 0u) |
+                 (frame->meshlet_cone_cull != GDR_CULL_OFF ? GDR_FRAME_MESHLET_CONE : 0u) |
+                 (frame->triangle_cull != GDR_CULL_OFF ? GDR_FRAME_TRIANGLE_CULL : 0u) |
+                 (frame->record_visible_meshlets ? GDR_FRAME_RECORD_MESHLETS : 0u),
+        .view_mode = (uint32_t)frame->view,
+        .task_capacity = r->scene.task_capacity,
+        .viewport = {(float)r->width, (float)r->height},
     };
     memcpy(slot->globals.mapped, &globals, sizeof globals);
 }
@@ -56,55 +69,8 @@ static uint32_t take_updates(gdr_renderer *r, gdr_frame_slot *slot)
     return count;
 }
 
-gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame,
-                                       bool copy_color, double *submit_ms, gdr_error *err)
+static void begin_rendering(gdr_renderer *r, VkCommandBuffer cmd)
 {
-    VkCommandBuffer cmd = slot->cmd;
-    uint32_t update_count = take_updates(r, slot);
-    write_globals(r, slot, frame, update_count);
-    GdrGpuPushConstants push = {
-        .globals = slot->globals.address,
-        .instances = r->scene.instances.address,
-        .meshes = r->scene.meshes.address,
-        .draws = slot->draws.address,
-        .draw_stats = slot->draw_stats.address,
-        .updates = slot->updates.address,
-    };
-
-    GDR_VK_TRY(err, vkResetCommandBuffer(cmd, 0));
-    VkCommandBufferBeginInfo begin = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
-                                      .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
-    GDR_VK_TRY(err, vkBeginCommandBuffer(cmd, &begin));
-    uint32_t query_base = (uint32_t)(slot - r->slots) * GDR_TS_COUNT;
-    vkResetQueryPool(r->ctx->device, r->timestamps, query_base, GDR_TS_COUNT);
-    /* The previous frame shares the instance buffer and the render targets: let it finish with them. */
-    memory_barrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
-                   VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
-    timestamp(r, cmd, slot, GDR_TS_BEGIN);
-    vkCmdPushConstants(cmd, r->layout, VK_SHADER_STAGE_ALL, 0, sizeof push, &push);
-
-    /* 1. Instance updates from the ring. */
-    if (update_count > 0) {
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->scatter_pipeline);
-        vkCmdDispatch(cmd, (update_count + GDR_SCATTER_WORKGROUP_SIZE - 1) / GDR_SCATTER_WORKGROUP_SIZE, 1, 1);
-    }
-    vkCmdFillBuffer(cmd, slot->draw_stats.buffer, 0, VK_WHOLE_SIZE, 0);
-    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_CLEAR_BIT,
-                   VK_ACCESS_2_SHADER_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                   VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
-    timestamp(r, cmd, slot, GDR_TS_AFTER_UPDATE);
-
-    /* 2. Instance culling: appends visible instances as indirect draws. */
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->cull_pipeline);
-    if (r->scene.instance_count > 0)
-        vkCmdDispatch(cmd, (r->scene.instance_count + GDR_CULL_WORKGROUP_SIZE - 1) / GDR_CULL_WORKGROUP_SIZE, 1, 1);
-    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
-                   VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT |
-                       VK_PIPELINE_STAGE_2_COPY_BIT,
-                   VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
-    timestamp(r, cmd, slot, GDR_TS_AFTER_CULL);
-
-    /* 3. One indirect-count draw for the whole scene. */
     gdr_vk_image_barrier(cmd, r->color.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                          VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT, 0,
                          VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
@@ -129,6 +95,22 @@ gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, co
     VkRect2D scissor = {{0, 0}, {r->width, r->height}};
     vkCmdSetViewport(cmd, 0, 1, &viewport);
     vkCmdSetScissor(cmd, 0, 1, &scissor);
+}
+
+/* Indirect pipeline: the cull appends VkDrawIndexedIndirectCommands; one indirect-count draw. */
+static void cull_for_indirect(gdr_renderer *r, VkCommandBuffer cmd)
+{
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->cull_pipeline);
+    if (r->scene.instance_count > 0)
+        vkCmdDispatch(cmd, (r->scene.instance_count + GDR_CULL_WORKGROUP_SIZE - 1) / GDR_CULL_WORKGROUP_SIZE, 1, 1);
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT |
+                       VK_PIPELINE_STAGE_2_COPY_BIT,
+                   VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
+}
+
+static void draw_indirect(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer cmd)
+{
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->draw_pipeline);
     VkDeviceSize zero = 0;
     vkCmdBindVertexBuffers(cmd, 0, 1, &r->scene.vertices.buffer, &zero);
@@ -136,10 +118,138 @@ gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, co
     vkCmdDrawIndexedIndirectCount(cmd, slot->draws.buffer, 0, slot->draw_stats.buffer,
                                   offsetof(GdrGpuDrawStats, draw_count), r->scene.instance_count,
                                   sizeof(GdrGpuDrawCommand));
+}
+
+/* Mesh pipeline: the cull appends task commands; the submit pass turns their count into the launch. */
+static void cull_for_mesh(gdr_renderer *r, VkCommandBuffer cmd)
+{
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->cull_tasks_pipeline);
+    if (r->scene.instance_count > 0)
+        vkCmdDispatch(cmd, (r->scene.instance_count + GDR_CULL_WORKGROUP_SIZE - 1) / GDR_CULL_WORKGROUP_SIZE, 1, 1);
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->task_submit_pipeline);
+    vkCmdDispatch(cmd, 1, 1, 1);
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_TASK_SHADER_BIT_EXT |
+                       VK_PIPELINE_STAGE_2_MESH_SHADER_BIT_EXT | VK_PIPELINE_STAGE_2_COPY_BIT,
+                   VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT |
+                       VK_ACCESS_2_TRANSFER_READ_BIT);
+}
+
+static void draw_mesh(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer cmd)
+{
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->mesh_pipeline);
+    r->ctx->cmd_draw_mesh_tasks_indirect(cmd, slot->draw_stats.buffer, offsetof(GdrGpuDrawStats, task_groups_x), 1,
+                                         sizeof(VkDrawMeshTasksIndirectCommandEXT));
+}
+
+/* Overdraw view: the fragment shaders counted fragments per pixel; find the maximum, then paint the
+ * counts over the image as a heat map. */
+static void overdraw_resolve(gdr_renderer *r, VkCommandBuffer cmd)
+{
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->overdraw_max_pipeline);
+    uint32_t pixels = r->width * r->height;
+    vkCmdDispatch(cmd, (pixels + GDR_REDUCE_WORKGROUP_SIZE - 1) / GDR_REDUCE_WORKGROUP_SIZE, 1, 1);
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_READ_BIT);
+    VkRenderingAttachmentInfo color = {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+                                       .imageView = r->color.view, .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                                       .loadOp = VK_ATTACHMENT_LOAD_OP_LOAD, .storeOp = VK_ATTACHMENT_STORE_OP_STORE};
+    VkRenderingInfo rendering = {.sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
+                                 .renderArea = {{0, 0}, {r->width, r->height}}, .layerCount = 1,
+                                 .colorAttachmentCount = 1, .pColorAttachments = &color};
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                   VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+    vkCmdBeginRendering(cmd, &rendering);
+    VkViewport viewport = {0.0f, 0.0f, (float)r->width, (float)r->height, 0.0f, 1.0f};
+    VkRect2D scissor = {{0, 0}, {r->width, r->height}};
+    vkCmdSetViewport(cmd, 0, 1, &viewport);
+    vkCmdSetScissor(cmd, 0, 1, &scissor);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->overdraw_paint_pipeline);
+    vkCmdDraw(cmd, 3, 1, 0, 0);
     vkCmdEndRendering(cmd);
+}
+
+gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame,
+                                       gdr_pipeline pipeline, bool copy_color, double *submit_ms, gdr_error *err)
+{
+    VkCommandBuffer cmd = slot->cmd;
+    uint32_t update_count = take_updates(r, slot);
+    write_globals(r, slot, frame, update_count);
+    GdrGpuPushConstants push = {
+        .globals = slot->globals.address,
+        .instances = r->scene.instances.address,
+        .meshes = r->scene.meshes.address,
+        .draws = slot->draws.address,
+        .draw_stats = slot->draw_stats.address,
+        .updates = slot->updates.address,
+        .vertices = r->scene.vertices.address,
+        .meshlets = r->scene.meshlets.address,
+        .meshlet_vertices = r->scene.meshlet_vertices.address,
+        .meshlet_triangles = r->scene.meshlet_triangles.address,
+        .tasks = slot->tasks.address,
+        .overdraw = r->overdraw.address,
+        .visible_meshlets = r->visible_meshlets.address,
+    };
+    bool overdraw = frame->view == GDR_VIEW_MODE_OVERDRAW;
+    /* Task and mesh stages may only be named where the device has them enabled. */
+    const VkPipelineStageFlags2 mesh_stages =
+        r->ctx->has_mesh_shader ? VK_PIPELINE_STAGE_2_TASK_SHADER_BIT_EXT | VK_PIPELINE_STAGE_2_MESH_SHADER_BIT_EXT : 0;
+
+    GDR_VK_TRY(err, vkResetCommandBuffer(cmd, 0));
+    VkCommandBufferBeginInfo begin = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+                                      .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
+    GDR_VK_TRY(err, vkBeginCommandBuffer(cmd, &begin));
+    uint32_t query_base = (uint32_t)(slot - r->slots) * GDR_TS_COUNT;
+    vkResetQueryPool(r->ctx->device, r->timestamps, query_base, GDR_TS_COUNT);
+    /* The previous frame shares the instance buffer and the render targets: let it finish with them. */
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
+    timestamp(r, cmd, slot, GDR_TS_BEGIN);
+    vkCmdPushConstants(cmd, r->layout, VK_SHADER_STAGE_ALL, 0, sizeof push, &push);
+
+    /* 1. Instance updates from the ring; counters (and overdraw counts) to zero. */
+    if (update_count > 0) {
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->scatter_pipeline);
+        vkCmdDispatch(cmd, (update_count + GDR_SCATTER_WORKGROUP_SIZE - 1) / GDR_SCATTER_WORKGROUP_SIZE, 1, 1);
+    }
+    vkCmdFillBuffer(cmd, slot->draw_stats.buffer, 0, VK_WHOLE_SIZE, 0);
+    if (overdraw)
+        vkCmdFillBuffer(cmd, r->overdraw.buffer, 0, VK_WHOLE_SIZE, 0);
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_CLEAR_BIT,
+                   VK_ACCESS_2_SHADER_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT | mesh_stages |
+                       VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
+                   VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
+    timestamp(r, cmd, slot, GDR_TS_AFTER_UPDATE);
+
+    /* 2. Culling: on the GPU, or (CPU pipeline) already done before recording. */
+    if (pipeline == GDR_PIPELINE_INDIRECT)
+        cull_for_indirect(r, cmd);
+    else if (pipeline == GDR_PIPELINE_MESH)
+        cull_for_mesh(r, cmd);
+    timestamp(r, cmd, slot, GDR_TS_AFTER_CULL);
+
+    /* 3. Raster. */
+    begin_rendering(r, cmd);
+    if (pipeline == GDR_PIPELINE_INDIRECT)
+        draw_indirect(r, slot, cmd);
+    else if (pipeline == GDR_PIPELINE_MESH)
+        draw_mesh(r, slot, cmd);
+    else
+        gdr_cpu_path_record_draws(r, cmd, &push);
+    vkCmdEndRendering(cmd);
+    if (overdraw)
+        overdraw_resolve(r, cmd);
     timestamp(r, cmd, slot, GDR_TS_AFTER_DRAW);
 
     /* 4. Statistics (always) and the image (when asked) for the CPU. */
+    memory_barrier(cmd, mesh_stages | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                   VK_ACCESS_2_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
     VkBufferCopy stats_copy = {0, 0, sizeof(GdrGpuDrawStats)};
     vkCmdCopyBuffer(cmd, slot->draw_stats.buffer, slot->stats_readback.buffer, 1, &stats_copy);
     if (copy_color) {
@@ -165,6 +275,7 @@ gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, co
     *submit_ms += gdr_now_ms() - start;
     slot->submitted = true;
     slot->timestamps_written = true;
+    slot->pipeline = pipeline;
     return GDR_OK;
 }
 

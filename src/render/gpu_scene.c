@@ -15,6 +15,106 @@ static GdrGpuInstance gpu_instance_from(const gdr_scene *scene, const gdr_instan
     return g;
 }
 
+/* The clusters of every mesh: the scene's own, or built here for meshes that have none (a scene
+ * assembled through the API). built[m] holds what was built and is freed by the caller. */
+static gdr_status gather_clusters(const gdr_scene *scene, const gdr_mesh_clusters **clusters, gdr_mesh_clusters *built,
+                                  gdr_error *err)
+{
+    for (uint32_t m = 0; m < scene->mesh_count; m++) {
+        const gdr_mesh *mesh = &scene->meshes[m];
+        clusters[m] = &mesh->clusters;
+        if (mesh->clusters.cluster_count > 0 || mesh->index_count == 0)
+            continue;
+        gdr_status status = gdr_meshlets_build(mesh, NULL, &built[m], err);
+        if (status != GDR_OK)
+            return status;
+        clusters[m] = &built[m];
+    }
+    return GDR_OK;
+}
+
+/* The cluster pool: GdrGpuMeshlet[] with pool-global offsets, global vertex indices, and the
+ * triangle bytes packed into words. Fills the meshes' meshlet fields and the task capacity. */
+static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const gdr_mesh_clusters *const *clusters,
+                                  gdr_error *err)
+{
+    gdr_gpu_scene *g = &r->scene;
+    uint64_t meshlet_total = 0, vertex_total = 0, byte_total = 0;
+    for (uint32_t m = 0; m < scene->mesh_count; m++) {
+        meshlet_total += clusters[m]->cluster_count;
+        vertex_total += clusters[m]->vertex_count;
+        byte_total += clusters[m]->triangle_byte_count;
+    }
+    if (meshlet_total > UINT32_MAX / 2 || vertex_total > UINT32_MAX / 2 || byte_total > UINT32_MAX / 2)
+        return gdr_error_set(err, GDR_ERROR_CAPACITY, "scene: %llu clusters exceed the cluster pool's 32-bit offsets",
+                             (unsigned long long)meshlet_total);
+    uint64_t word_total = (byte_total + 3) / 4;
+    GdrGpuMeshlet *meshlets = calloc(meshlet_total ? meshlet_total : 1, sizeof *meshlets);
+    uint32_t *vertex_refs = malloc(sizeof(uint32_t) * (vertex_total ? vertex_total : 1));
+    uint32_t *words = calloc(word_total ? word_total : 1, sizeof(uint32_t));
+    gdr_status status = GDR_OK;
+    if (!meshlets || !vertex_refs || !words)
+        status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory");
+    uint32_t meshlet_cursor = 0, vertex_cursor = 0, byte_cursor = 0;
+    for (uint32_t m = 0; m < scene->mesh_count && status == GDR_OK; m++) {
+        const gdr_mesh_clusters *c = clusters[m];
+        GdrGpuMesh *mesh = &g->cpu_meshes[m];
+        mesh->meshlet_offset = meshlet_cursor;
+        mesh->meshlet_count = c->level0_cluster_count;
+        mesh->task_count = (c->level0_cluster_count + GDR_TASK_WORKGROUP_SIZE - 1) / GDR_TASK_WORKGROUP_SIZE;
+        for (uint32_t i = 0; i < c->cluster_count; i++) {
+            const gdr_cluster *k = &c->clusters[i];
+            meshlets[meshlet_cursor + i] = (GdrGpuMeshlet){
+                .vertex_offset = vertex_cursor + k->vertex_offset, .triangle_offset = byte_cursor + k->triangle_offset,
+                .vertex_count = k->vertex_count, .triangle_count = k->triangle_count, .sphere = k->sphere,
+                .cone_apex = k->cone_apex, .cone_cutoff = k->cone_cutoff, .cone_axis = k->cone_axis,
+                .group = k->group, .refined_group = k->refined_group};
+        }
+        for (uint32_t v = 0; v < c->vertex_count; v++)
+            vertex_refs[vertex_cursor + v] = mesh->vertex_offset + c->vertices[v];
+        for (uint32_t b = 0; b < c->triangle_byte_count; b++) {
+            uint32_t at = byte_cursor + b;
+            words[at / 4] |= (uint32_t)c->triangles[b] << (8 * (at % 4));
+        }
+        meshlet_cursor += c->cluster_count;
+        vertex_cursor += c->vertex_count;
+        byte_cursor += c->triangle_byte_count;
+    }
+    uint64_t tasks = 0;
+    for (uint32_t i = 0; i < scene->instance_count; i++)
+        tasks += g->cpu_meshes[scene->instances[i].mesh].task_count;
+    if (status == GDR_OK && tasks > UINT32_MAX / sizeof(GdrGpuTaskCommand))
+        status = gdr_error_set(err, GDR_ERROR_CAPACITY, "scene: %llu task workgroups per frame is too many",
+                               (unsigned long long)tasks);
+    g->task_capacity = (uint32_t)tasks;
+    g->meshlet_count = (uint32_t)meshlet_total;
+    const VkBufferUsageFlags usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    if (status == GDR_OK)
+        status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuMeshlet) * (meshlet_total ? meshlet_total : 1), usage,
+                                      GDR_VK_BUFFER_DEVICE, &g->meshlets, err);
+    if (status == GDR_OK)
+        status = gdr_vk_buffer_create(&r->allocator, sizeof(uint32_t) * (vertex_total ? vertex_total : 1), usage,
+                                      GDR_VK_BUFFER_DEVICE, &g->meshlet_vertices, err);
+    if (status == GDR_OK)
+        status = gdr_vk_buffer_create(&r->allocator, sizeof(uint32_t) * (word_total ? word_total : 1), usage,
+                                      GDR_VK_BUFFER_DEVICE, &g->meshlet_triangles, err);
+    if (status == GDR_OK)
+        status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->meshlets, 0, meshlets, sizeof(GdrGpuMeshlet) * meshlet_total, err);
+    if (status == GDR_OK)
+        status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->meshlet_vertices, 0, vertex_refs,
+                                      sizeof(uint32_t) * vertex_total, err);
+    if (status == GDR_OK)
+        status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->meshlet_triangles, 0, words, sizeof(uint32_t) * word_total, err);
+    if (status == GDR_OK) {
+        g->cpu_meshlets = meshlets; /* kept for references and statistics */
+        meshlets = NULL;
+    }
+    free(meshlets);
+    free(vertex_refs);
+    free(words);
+    return status;
+}
+
 gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_error *err)
 {
     gdr_gpu_scene *g = &r->scene;
@@ -39,7 +139,8 @@ gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
     uint32_t vertex_cursor = 0, index_cursor = 0;
     for (uint32_t m = 0; m < scene->mesh_count; m++) {
         const gdr_mesh *mesh = &scene->meshes[m];
-        g->cpu_meshes[m] = (GdrGpuMesh){vertex_cursor, index_cursor, mesh->index_count, 0, mesh->bounds};
+        g->cpu_meshes[m] = (GdrGpuMesh){.vertex_offset = vertex_cursor, .first_index = index_cursor,
+                                        .index_count = mesh->index_count, .bounds = mesh->bounds};
         for (uint32_t v = 0; v < mesh->vertex_count; v++)
             vertices[vertex_cursor + v] = (GdrGpuVertex){mesh->positions[v], mesh->normals[v], mesh->uvs[v]};
         memcpy(indices + index_cursor, mesh->indices, sizeof(uint32_t) * mesh->index_count);
@@ -59,6 +160,19 @@ gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
         status = gdr_vk_buffer_create(&r->allocator, sizeof(uint32_t) * index_total,
                                       dst | VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                       GDR_VK_BUFFER_DEVICE, &g->indices, err);
+    /* The cluster pool first: it fills the meshes' cluster fields. */
+    const gdr_mesh_clusters **clusters = calloc(scene->mesh_count ? scene->mesh_count : 1, sizeof *clusters);
+    gdr_mesh_clusters *built = calloc(scene->mesh_count ? scene->mesh_count : 1, sizeof *built);
+    if (status == GDR_OK && (!clusters || !built))
+        status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory");
+    if (status == GDR_OK)
+        status = gather_clusters(scene, clusters, built, err);
+    if (status == GDR_OK)
+        status = upload_clusters(r, scene, clusters, err);
+    for (uint32_t m = 0; built && m < scene->mesh_count; m++)
+        gdr_mesh_clusters_free(&built[m]);
+    free(built);
+    free(clusters);
     if (status == GDR_OK)
         status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuMesh) * g->mesh_count,
                                       dst | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GDR_VK_BUFFER_DEVICE, &g->meshes, err);
@@ -86,6 +200,10 @@ void gdr_gpu_scene_destroy(gdr_renderer *r)
     gdr_vk_buffer_destroy(r->ctx, &g->indices);
     gdr_vk_buffer_destroy(r->ctx, &g->meshes);
     gdr_vk_buffer_destroy(r->ctx, &g->instances);
+    gdr_vk_buffer_destroy(r->ctx, &g->meshlets);
+    gdr_vk_buffer_destroy(r->ctx, &g->meshlet_vertices);
+    gdr_vk_buffer_destroy(r->ctx, &g->meshlet_triangles);
+    free(g->cpu_meshlets);
     free(g->cpu_meshes);
     free(g->cpu_instances);
     free(g->pending);
@@ -122,6 +240,11 @@ gdr_status gdr_frame_slots_create(gdr_renderer *r, gdr_error *err)
         if (status == GDR_OK)
             status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuDrawStats), VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                           GDR_VK_BUFFER_READBACK, &slot->stats_readback, err);
+        if (status == GDR_OK) /* every task workgroup of every instance at most: cannot overflow */
+            status = gdr_vk_buffer_create(&r->allocator,
+                                          sizeof(GdrGpuTaskCommand) * (r->scene.task_capacity ? r->scene.task_capacity : 1),
+                                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                          GDR_VK_BUFFER_DEVICE, &slot->tasks, err);
         if (status != GDR_OK)
             return status;
     }
@@ -141,6 +264,7 @@ void gdr_frame_slots_destroy(gdr_renderer *r)
         gdr_vk_buffer_destroy(r->ctx, &slot->draws);
         gdr_vk_buffer_destroy(r->ctx, &slot->draw_stats);
         gdr_vk_buffer_destroy(r->ctx, &slot->stats_readback);
+        gdr_vk_buffer_destroy(r->ctx, &slot->tasks);
         memset(slot, 0, sizeof *slot);
     }
 }

@@ -3,11 +3,19 @@
 #include <stddef.h>
 #include <vulkan/vulkan.h>
 
+#include "gdr/geometry.h"
 #include "shaders/shared/gpu_types.h"
 
 _Static_assert(sizeof(GdrGpuVertex) == 32, "GdrGpuVertex");
 _Static_assert(offsetof(GdrGpuVertex, normal) == 12 && offsetof(GdrGpuVertex, uv) == 24, "GdrGpuVertex offsets");
-_Static_assert(sizeof(GdrGpuMesh) == 32 && offsetof(GdrGpuMesh, bounds) == 16, "GdrGpuMesh");
+_Static_assert(sizeof(GdrGpuMesh) == 48 && offsetof(GdrGpuMesh, bounds) == 16 && offsetof(GdrGpuMesh, task_count) == 36,
+               "GdrGpuMesh");
+_Static_assert(sizeof(GdrGpuMeshlet) == 80 && offsetof(GdrGpuMeshlet, sphere) == 16 &&
+                   offsetof(GdrGpuMeshlet, cone_cutoff) == 44 && offsetof(GdrGpuMeshlet, group) == 60,
+               "GdrGpuMeshlet");
+_Static_assert(sizeof(GdrGpuTaskCommand) == 16, "GdrGpuTaskCommand");
+_Static_assert(GDR_MESH_MAX_VERTICES == GDR_CLUSTER_MAX_VERTICES && GDR_MESH_MAX_TRIANGLES == GDR_CLUSTER_MAX_TRIANGLES,
+               "the mesh shader's limits are gdr/geometry.h's");
 _Static_assert(sizeof(GdrGpuInstance) == 96 && offsetof(GdrGpuInstance, color) == 64 &&
                    offsetof(GdrGpuInstance, mesh) == 80, "GdrGpuInstance");
 _Static_assert(sizeof(GdrGpuInstanceUpdate) == 112 && offsetof(GdrGpuInstanceUpdate, instance) == 16,
@@ -16,10 +24,14 @@ _Static_assert(sizeof(GdrGpuDrawCommand) == sizeof(VkDrawIndexedIndirectCommand)
 _Static_assert(offsetof(GdrGpuDrawCommand, vertex_offset) == offsetof(VkDrawIndexedIndirectCommand, vertexOffset) &&
                    offsetof(GdrGpuDrawCommand, first_instance) == offsetof(VkDrawIndexedIndirectCommand, firstInstance),
                "GdrGpuDrawCommand offsets");
-_Static_assert(sizeof(GdrGpuDrawStats) == 16 && offsetof(GdrGpuDrawStats, draw_count) == 0, "GdrGpuDrawStats");
-_Static_assert(sizeof(GdrGpuFrameGlobals) == 208 && offsetof(GdrGpuFrameGlobals, frustum) == 128 &&
+_Static_assert(sizeof(GdrGpuDrawStats) == 64 && offsetof(GdrGpuDrawStats, draw_count) == 0 &&
+                   offsetof(GdrGpuDrawStats, task_groups_x) == 16, "GdrGpuDrawStats");
+_Static_assert(offsetof(GdrGpuDrawStats, task_groups_z) - offsetof(GdrGpuDrawStats, task_groups_x) ==
+                   offsetof(VkDrawMeshTasksIndirectCommandEXT, groupCountZ), "the mesh tasks command inside GdrGpuDrawStats");
+_Static_assert(offsetof(GdrGpuFrameGlobals, viewport) == 208, "GdrGpuFrameGlobals.viewport");
+_Static_assert(sizeof(GdrGpuFrameGlobals) == 224 && offsetof(GdrGpuFrameGlobals, frustum) == 128 &&
                    offsetof(GdrGpuFrameGlobals, znear) == 176 && offsetof(GdrGpuFrameGlobals, update_count) == 192,
                "GdrGpuFrameGlobals");
-_Static_assert(sizeof(GdrGpuPushConstants) == 48 && offsetof(GdrGpuPushConstants, updates) == 40,
+_Static_assert(sizeof(GdrGpuPushConstants) == 104 && offsetof(GdrGpuPushConstants, updates) == 40,
                "GdrGpuPushConstants");
 _Static_assert(sizeof(GdrGpuPushConstants) <= 128, "push constants must fit the guaranteed 128 bytes");

@@ -22,6 +22,31 @@ static gdr_status create_pipelines(gdr_renderer *r, gdr_error *err)
     if (status == GDR_OK)
         status = gdr_vk_compute_pipeline_create(r->ctx, r->layout, &gdr_shader_instance_scatter_comp,
                                                 &r->scatter_pipeline, err);
+    if (status == GDR_OK) {
+        const uint32_t emit_tasks = 1;
+        status = gdr_vk_compute_pipeline_create_specialized(r->ctx, r->layout, &gdr_shader_drawcull_comp, &emit_tasks, 1,
+                                                            &r->cull_tasks_pipeline, err);
+    }
+    if (status == GDR_OK)
+        status = gdr_vk_compute_pipeline_create(r->ctx, r->layout, &gdr_shader_tasksubmit_comp, &r->task_submit_pipeline,
+                                                err);
+    if (status == GDR_OK)
+        status = gdr_vk_compute_pipeline_create(r->ctx, r->layout, &gdr_shader_overdraw_max_comp,
+                                                &r->overdraw_max_pipeline, err);
+    if (status == GDR_OK) {
+        gdr_vk_graphics_pipeline_desc paint = {
+            .layout = r->layout, .vertex_shader = &gdr_shader_overdraw_paint_vert,
+            .fragment_shader = &gdr_shader_overdraw_paint_frag, .color_format = GDR_COLOR_FORMAT,
+            .depth_format = VK_FORMAT_UNDEFINED, .cull_mode = VK_CULL_MODE_NONE, .no_depth_test = true};
+        status = gdr_vk_graphics_pipeline_create(r->ctx, &paint, &r->overdraw_paint_pipeline, err);
+    }
+    if (status == GDR_OK && r->ctx->has_mesh_shader) {
+        gdr_vk_graphics_pipeline_desc mesh = {
+            .layout = r->layout, .task_shader = &gdr_shader_meshlet_task, .mesh_shader = &gdr_shader_meshlet_mesh,
+            .fragment_shader = &gdr_shader_meshlet_frag, .color_format = GDR_COLOR_FORMAT,
+            .depth_format = GDR_DEPTH_FORMAT, .cull_mode = VK_CULL_MODE_BACK_BIT};
+        status = gdr_vk_graphics_pipeline_create(r->ctx, &mesh, &r->mesh_pipeline, err);
+    }
     if (status != GDR_OK)
         return status;
     VkVertexInputBindingDescription binding = {0, sizeof(GdrGpuVertex), VK_VERTEX_INPUT_RATE_VERTEX};
@@ -48,6 +73,11 @@ static gdr_status create_targets(gdr_renderer *r, gdr_error *err)
     if (status == GDR_OK)
         status = gdr_vk_buffer_create(&r->allocator, (VkDeviceSize)r->width * r->height * 4,
                                       VK_BUFFER_USAGE_TRANSFER_DST_BIT, GDR_VK_BUFFER_READBACK, &r->color_readback, err);
+    if (status == GDR_OK) /* a count per pixel, then the maximum */
+        status = gdr_vk_buffer_create(&r->allocator, ((VkDeviceSize)r->width * r->height + 1) * sizeof(uint32_t),
+                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                          VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                      GDR_VK_BUFFER_DEVICE, &r->overdraw, err);
     if (status != GDR_OK)
         return status;
     VkQueryPoolCreateInfo query = {.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO, .queryType = VK_QUERY_TYPE_TIMESTAMP,
@@ -74,7 +104,8 @@ gdr_status gdr_renderer_create(const gdr_renderer_desc *desc_in, gdr_renderer **
     r->last_slot = -1;
     r->busy_wait = desc.busy_wait;
     gdr_vk_context_desc context_desc = {.device = desc.device, .validate = desc.validate,
-                                        .synchronization_validation = desc.synchronization_validation};
+                                        .synchronization_validation = desc.synchronization_validation,
+                                        .disable_mesh_shaders = desc.disable_mesh_shaders};
     gdr_status status = gdr_vk_context_create(&context_desc, &r->ctx, err);
     if (status == GDR_OK) {
         gdr_vk_allocator_init(&r->allocator, r->ctx);
@@ -100,6 +131,7 @@ void gdr_renderer_destroy(gdr_renderer *r)
         vkDeviceWaitIdle(r->ctx->device);
         gdr_frame_slots_destroy(r);
         gdr_gpu_scene_destroy(r);
+        gdr_cpu_path_destroy(r);
         VkDevice device = r->ctx->device;
         if (r->timestamps)
             vkDestroyQueryPool(device, r->timestamps, NULL);
@@ -107,13 +139,18 @@ void gdr_renderer_destroy(gdr_renderer *r)
             vkDestroyPipeline(device, r->cull_pipeline, NULL);
         if (r->scatter_pipeline)
             vkDestroyPipeline(device, r->scatter_pipeline, NULL);
-        if (r->draw_pipeline)
-            vkDestroyPipeline(device, r->draw_pipeline, NULL);
+        VkPipeline pipelines[] = {r->draw_pipeline, r->cull_tasks_pipeline, r->task_submit_pipeline, r->mesh_pipeline,
+                                  r->overdraw_max_pipeline, r->overdraw_paint_pipeline};
+        for (size_t i = 0; i < sizeof pipelines / sizeof pipelines[0]; i++)
+            if (pipelines[i])
+                vkDestroyPipeline(device, pipelines[i], NULL);
         if (r->layout)
             vkDestroyPipelineLayout(device, r->layout, NULL);
         gdr_vk_image_destroy(r->ctx, &r->color);
         gdr_vk_image_destroy(r->ctx, &r->depth);
         gdr_vk_buffer_destroy(r->ctx, &r->color_readback);
+        gdr_vk_buffer_destroy(r->ctx, &r->overdraw);
+        gdr_vk_buffer_destroy(r->ctx, &r->visible_meshlets);
         gdr_vk_buffer_destroy(r->ctx, &r->staging);
         gdr_vk_allocator_destroy(&r->allocator);
         gdr_vk_context_destroy(r->ctx);
@@ -130,6 +167,8 @@ gdr_status gdr_renderer_set_scene(gdr_renderer *r, const gdr_scene *scene, gdr_e
     gdr_status status = gdr_gpu_scene_upload(r, scene, err);
     if (status == GDR_OK)
         status = gdr_frame_slots_create(r, err);
+    if (status == GDR_OK)
+        status = gdr_cpu_path_create(r, scene, err);
     if (status == GDR_OK)
         r->has_scene = true;
     return status;
@@ -157,7 +196,7 @@ gdr_status gdr_renderer_update_instance(gdr_renderer *r, uint32_t index, const g
         instance->color = *color;
     g->pending[g->pending_count++] = (GdrGpuInstanceUpdate){.tag = GDR_UPDATE_TAG_INSTANCE, .index = index,
                                                             .instance = *instance};
-    return GDR_OK;
+    return gdr_cpu_path_update_instance(r, index, err);
 }
 
 static int compare_double(const void *a, const void *b)
@@ -167,6 +206,55 @@ static int compare_double(const void *a, const void *b)
 }
 
 static const char *const pass_names[GDR_TS_COUNT - 1] = {"instance_update", "cull", "draw", "readback"};
+
+const char *gdr_pipeline_name(gdr_pipeline pipeline)
+{
+    switch (pipeline) {
+    case GDR_PIPELINE_MESH: return "mesh";
+    case GDR_PIPELINE_INDIRECT: return "indirect";
+    case GDR_PIPELINE_CPU: return "cpu";
+    default: return "default";
+    }
+}
+
+const char *gdr_view_name(gdr_view view)
+{
+    static const char *const names[] = {"shaded", "meshlets", "instances", "triangles", "overdraw"};
+    return (unsigned)view < sizeof names / sizeof names[0] ? names[view] : "unknown";
+}
+
+bool gdr_renderer_has_mesh_pipeline(const gdr_renderer *r, const char **why_not)
+{
+    if (why_not)
+        *why_not = r->ctx->has_mesh_shader ? "" : r->ctx->mesh_shader_missing;
+    return r->ctx->has_mesh_shader;
+}
+
+/* The pipeline a frame asks for, resolved against the device; fails for mesh without mesh shaders. */
+static gdr_status resolve_pipeline(const gdr_renderer *r, const gdr_frame_desc *frame, gdr_pipeline *out, char *reason,
+                                   size_t reason_size, gdr_error *err)
+{
+    switch (frame->pipeline) {
+    case GDR_PIPELINE_DEFAULT:
+        *out = r->ctx->has_mesh_shader ? GDR_PIPELINE_MESH : GDR_PIPELINE_INDIRECT;
+        if (r->ctx->has_mesh_shader)
+            snprintf(reason, reason_size, "default: the device has VK_EXT_mesh_shader");
+        else
+            snprintf(reason, reason_size, "default: no mesh pipeline (%s)", r->ctx->mesh_shader_missing);
+        return GDR_OK;
+    case GDR_PIPELINE_MESH:
+        if (!r->ctx->has_mesh_shader)
+            return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "pipeline mesh: not available on '%s': %s",
+                                 r->ctx->properties.deviceName, r->ctx->mesh_shader_missing);
+        /* fall through */
+    case GDR_PIPELINE_INDIRECT:
+    case GDR_PIPELINE_CPU:
+        *out = frame->pipeline;
+        snprintf(reason, reason_size, "asked for");
+        return GDR_OK;
+    }
+    return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: unknown pipeline %d", (int)frame->pipeline);
+}
 
 gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uint32_t frames, gdr_frame_stats *stats,
                                gdr_error *err)
@@ -182,6 +270,26 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
                              "render: camera needs 0 < yfov < pi, znear > 0 and zfar = 0 or > znear "
                              "(yfov %g, znear %g, zfar %g)", (double)camera->yfov, (double)camera->znear,
                              (double)camera->zfar);
+
+    if ((unsigned)frame->view > GDR_VIEW_MODE_OVERDRAW)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: unknown view %d", (int)frame->view);
+    gdr_pipeline pipeline = GDR_PIPELINE_INDIRECT;
+    char reason[160] = "";
+    gdr_status resolved = resolve_pipeline(r, frame, &pipeline, reason, sizeof reason, err);
+    if (resolved != GDR_OK)
+        return resolved;
+    r->cpu.cull_ms = 0.0;
+    if (frame->record_visible_meshlets && !r->visible_meshlets.buffer) {
+        /* Every cluster of every instance at most: cannot overflow. */
+        uint64_t total = 0;
+        for (uint32_t i = 0; i < r->scene.instance_count; i++)
+            total += r->scene.cpu_meshes[r->scene.cpu_instances[i].mesh].meshlet_count;
+        gdr_status status = gdr_vk_buffer_create(&r->allocator, 8 * (total ? total : 1),
+                                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                                 GDR_VK_BUFFER_DEVICE, &r->visible_meshlets, err);
+        if (status != GDR_OK)
+            return status;
+    }
 
     double cpu_ms = 0.0, submit_ms = 0.0, pass_ms[GDR_TS_COUNT - 1] = {0};
     double *frame_cpu_ms = malloc(sizeof(double) * frames);
@@ -205,7 +313,13 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
         }
         double start = gdr_now_ms();
         bool last = f + 1 == frames;
-        status = gdr_frame_record_and_submit(r, slot, frame, last && frame->read_back, &submit_ms, err);
+        if (pipeline == GDR_PIPELINE_CPU)
+            status = gdr_cpu_path_cull(r, frame, err);
+        if (status == GDR_OK) {
+            slot->cpu_visible_count = r->cpu.visible_count;
+            slot->cpu_triangles = r->cpu.triangles;
+            status = gdr_frame_record_and_submit(r, slot, frame, pipeline, last && frame->read_back, &submit_ms, err);
+        }
         frame_cpu_ms[f] = gdr_now_ms() - start;
         cpu_ms += frame_cpu_ms[f];
         if (status != GDR_OK) {
@@ -240,14 +354,37 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
     free(frame_cpu_ms);
 
     memset(stats, 0, sizeof *stats);
+    const gdr_frame_slot *last_slot = &r->slots[r->last_slot];
     GdrGpuDrawStats gpu;
-    memcpy(&gpu, r->slots[r->last_slot].stats_readback.mapped, sizeof gpu);
+    memcpy(&gpu, last_slot->stats_readback.mapped, sizeof gpu);
     stats->frames = frames;
     stats->instances_total = r->scene.instance_count;
-    stats->instances_visible = gpu.draw_count;
-    stats->draws = gpu.draw_count;
-    stats->draw_calls = 1;
-    stats->triangles = ((uint64_t)gpu.triangles_high << 32) | gpu.triangles_low;
+    stats->pipeline = pipeline;
+    snprintf(stats->pipeline_reason, sizeof stats->pipeline_reason, "%s", reason);
+    if (pipeline == GDR_PIPELINE_CPU) {
+        stats->instances_visible = last_slot->cpu_visible_count;
+        stats->draws = last_slot->cpu_visible_count;
+        stats->draw_calls = last_slot->cpu_visible_count;
+        stats->triangles = last_slot->cpu_triangles;
+        stats->cpu_cull_ms_per_frame = r->cpu.cull_ms / frames;
+    } else {
+        stats->instances_visible = gpu.draw_count;
+        stats->draws = pipeline == GDR_PIPELINE_MESH ? gpu.task_groups_x * gpu.task_groups_y : gpu.draw_count;
+        stats->draw_calls = 1;
+        stats->triangles = ((uint64_t)gpu.triangles_high << 32) | gpu.triangles_low;
+    }
+    if (pipeline == GDR_PIPELINE_MESH) {
+        for (uint32_t i = 0; i < r->scene.instance_count; i++)
+            stats->meshlets_total += r->scene.cpu_meshes[r->scene.cpu_instances[i].mesh].meshlet_count;
+        stats->meshlets_tested = gpu.meshlets_tested;
+        stats->meshlets_frustum_culled = gpu.meshlets_frustum_culled;
+        stats->meshlets_cone_culled = gpu.meshlets_cone_culled;
+        stats->meshlets_visible = gpu.meshlets_visible;
+        stats->triangles_backface_culled = gpu.triangles_backface_culled;
+        stats->triangles_small_culled = gpu.triangles_small_culled;
+        stats->task_workgroups = gpu.task_count;
+        stats->task_overflow = gpu.task_overflow;
+    }
     stats->cpu_ms_per_frame = cpu_ms / frames;
     stats->cpu_submit_ms_per_frame = submit_ms / frames;
     stats->cpu_ms_per_frame_median = median;
@@ -271,6 +408,24 @@ gdr_status gdr_renderer_read_color(gdr_renderer *r, uint8_t *rgba, gdr_error *er
     return GDR_OK;
 }
 
+/* Copies `size` bytes of a device buffer into a new host-visible buffer. A test/debug path: the
+ * readback memory is only reclaimed with the renderer (linear allocator). */
+static gdr_status read_device_buffer(gdr_renderer *r, VkBuffer source, VkDeviceSize size, gdr_vk_buffer *readback,
+                                     gdr_error *err)
+{
+    gdr_status status = gdr_vk_buffer_create(&r->allocator, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                             GDR_VK_BUFFER_READBACK, readback, err);
+    VkCommandBuffer cmd;
+    if (status == GDR_OK)
+        status = gdr_vk_begin_one_time(r->ctx, &cmd, err);
+    if (status == GDR_OK) {
+        VkBufferCopy region = {0, 0, size};
+        vkCmdCopyBuffer(cmd, source, readback->buffer, 1, &region);
+        status = gdr_vk_end_one_time(r->ctx, cmd, err);
+    }
+    return status;
+}
+
 gdr_status gdr_renderer_read_visible(gdr_renderer *r, uint32_t *indices, uint32_t capacity, uint32_t *count,
                                      gdr_error *err)
 {
@@ -279,29 +434,63 @@ gdr_status gdr_renderer_read_visible(gdr_renderer *r, uint32_t *indices, uint32_
     gdr_frame_slot *slot = &r->slots[r->last_slot];
     GdrGpuDrawStats gpu;
     memcpy(&gpu, slot->stats_readback.mapped, sizeof gpu);
-    *count = gpu.draw_count;
-    if (gpu.draw_count > capacity)
-        return gdr_error_set(err, GDR_ERROR_CAPACITY, "read_visible: %u visible instances, room for %u", gpu.draw_count,
+    *count = slot->pipeline == GDR_PIPELINE_CPU ? slot->cpu_visible_count : gpu.draw_count;
+    if (*count > capacity)
+        return gdr_error_set(err, GDR_ERROR_CAPACITY, "read_visible: %u visible instances, room for %u", *count,
                              capacity);
-    if (gpu.draw_count == 0)
+    if (slot->pipeline == GDR_PIPELINE_CPU) {
+        /* The CPU's list of the last frame (frames are culled and recorded in order). */
+        memcpy(indices, r->cpu.visible, sizeof(uint32_t) * *count);
         return GDR_OK;
-    /* A test/debug path: its readback memory is only reclaimed with the renderer (linear allocator). */
-    gdr_vk_buffer readback;
-    VkDeviceSize size = sizeof(GdrGpuDrawCommand) * gpu.draw_count;
-    gdr_status status = gdr_vk_buffer_create(&r->allocator, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                             GDR_VK_BUFFER_READBACK, &readback, err);
-    VkCommandBuffer cmd;
-    if (status == GDR_OK)
-        status = gdr_vk_begin_one_time(r->ctx, &cmd, err);
-    if (status == GDR_OK) {
-        VkBufferCopy region = {0, 0, size};
-        vkCmdCopyBuffer(cmd, slot->draws.buffer, readback.buffer, 1, &region);
-        status = gdr_vk_end_one_time(r->ctx, cmd, err);
     }
-    if (status == GDR_OK) {
-        const GdrGpuDrawCommand *draws = readback.mapped;
-        for (uint32_t i = 0; i < gpu.draw_count; i++)
-            indices[i] = draws[i].first_instance;
+    if (*count == 0)
+        return GDR_OK;
+    gdr_vk_buffer readback = {0};
+    gdr_status status;
+    if (slot->pipeline == GDR_PIPELINE_MESH) {
+        /* The task commands: each visible instance's run of commands, in append order. */
+        uint32_t tasks = gpu.task_count < r->scene.task_capacity ? gpu.task_count : r->scene.task_capacity;
+        status = read_device_buffer(r, slot->tasks.buffer, sizeof(GdrGpuTaskCommand) * tasks, &readback, err);
+        uint32_t n = 0;
+        for (uint32_t i = 0; status == GDR_OK && i < tasks; i++) {
+            const GdrGpuTaskCommand *task = (const GdrGpuTaskCommand *)readback.mapped + i;
+            if (task->meshlet_first == r->scene.cpu_meshes[r->scene.cpu_instances[task->instance].mesh].meshlet_offset &&
+                n < *count)
+                indices[n++] = task->instance; /* the instance's first command */
+        }
+        if (status == GDR_OK && n != *count)
+            status = gdr_error_set(err, GDR_ERROR_VULKAN, "read_visible: %u instances counted, %u in the task list",
+                                   *count, n);
+    } else {
+        status = read_device_buffer(r, slot->draws.buffer, sizeof(GdrGpuDrawCommand) * *count, &readback, err);
+        for (uint32_t i = 0; status == GDR_OK && i < *count; i++)
+            indices[i] = ((const GdrGpuDrawCommand *)readback.mapped)[i].first_instance;
+    }
+    gdr_vk_buffer_destroy(r->ctx, &readback);
+    return status;
+}
+
+gdr_status gdr_renderer_read_visible_meshlets(gdr_renderer *r, gdr_visible_meshlet *meshlets, uint32_t capacity,
+                                              uint32_t *count, gdr_error *err)
+{
+    if (r->last_slot < 0 || r->slots[r->last_slot].pipeline != GDR_PIPELINE_MESH || !r->visible_meshlets.buffer)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
+                             "read_visible_meshlets: the last frame was not a mesh-pipeline frame with "
+                             "record_visible_meshlets");
+    GdrGpuDrawStats gpu;
+    memcpy(&gpu, r->slots[r->last_slot].stats_readback.mapped, sizeof gpu);
+    *count = gpu.meshlets_recorded;
+    if (*count > capacity)
+        return gdr_error_set(err, GDR_ERROR_CAPACITY, "read_visible_meshlets: %u clusters, room for %u", *count,
+                             capacity);
+    if (*count == 0)
+        return GDR_OK;
+    gdr_vk_buffer readback = {0};
+    gdr_status status = read_device_buffer(r, r->visible_meshlets.buffer, 8 * (VkDeviceSize)*count, &readback, err);
+    for (uint32_t i = 0; status == GDR_OK && i < *count; i++) {
+        const uint32_t *pair = (const uint32_t *)readback.mapped + 2 * i;
+        uint32_t mesh = r->scene.cpu_instances[pair[0]].mesh;
+        meshlets[i] = (gdr_visible_meshlet){pair[0], pair[1] - r->scene.cpu_meshes[mesh].meshlet_offset};
     }
     gdr_vk_buffer_destroy(r->ctx, &readback);
     return status;

@@ -19,15 +19,32 @@ enum gdr_timestamp {
     GDR_TS_COUNT
 };
 
+/* The CPU-driven baseline (seed 003's "before"): the gdr/cull.h library culls on the CPU, then
+ * one vkCmdDrawIndexed with its own binds per visible instance. */
+typedef struct gdr_cpu_path {
+    struct gdr_cull_scene *cull_scene;
+    uint32_t *visible_bits;   /* gdr_cull_word_count(instances) words */
+    uint32_t *visible;        /* indices of the visible instances of the last culled frame */
+    uint32_t visible_count;
+    uint64_t triangles;
+    double cull_ms;           /* summed over the frames of one gdr_renderer_render */
+} gdr_cpu_path;
+
 /* The geometry pool and the instances on the GPU (seed 000's PrimitiveBuffer and InstanceBuffer). */
 typedef struct gdr_gpu_scene {
     gdr_vk_buffer vertices;  /* GdrGpuVertex[], all meshes merged */
     gdr_vk_buffer indices;   /* uint32[], mesh-local indices, all meshes merged */
     gdr_vk_buffer meshes;    /* GdrGpuMesh[] */
     gdr_vk_buffer instances; /* GdrGpuInstance[], persistent; changed through the update ring */
+    gdr_vk_buffer meshlets;          /* GdrGpuMeshlet[], all meshes' clusters */
+    gdr_vk_buffer meshlet_vertices;  /* uint32[]: global vertex index per cluster-local vertex */
+    gdr_vk_buffer meshlet_triangles; /* uint32[] holding 3 bytes per cluster triangle */
     uint32_t mesh_count;
     uint32_t instance_count;
+    uint32_t meshlet_count;
+    uint32_t task_capacity;        /* task commands of all instances: the task buffer's size */
     GdrGpuMesh *cpu_meshes;        /* host copies, for references and statistics */
+    GdrGpuMeshlet *cpu_meshlets;
     GdrGpuInstance *cpu_instances;
     GdrGpuInstanceUpdate *pending; /* updates not yet sent to the GPU */
     uint32_t pending_count, pending_capacity;
@@ -44,6 +61,11 @@ typedef struct gdr_frame_slot {
     gdr_vk_buffer draws;         /* GdrGpuDrawCommand[instance_count] */
     gdr_vk_buffer draw_stats;    /* GdrGpuDrawStats, device-local */
     gdr_vk_buffer stats_readback;/* GdrGpuDrawStats copied for the CPU */
+    gdr_vk_buffer tasks;         /* GdrGpuTaskCommand[task_capacity] (meshlet pipeline) */
+    gdr_pipeline pipeline;       /* of the frame last recorded into this slot */
+    /* CPU pipeline: what the CPU decided for the frame last recorded into this slot. */
+    uint32_t cpu_visible_count;
+    uint64_t cpu_triangles;
 } gdr_frame_slot;
 
 struct gdr_renderer {
@@ -57,6 +79,11 @@ struct gdr_renderer {
     bool color_read_back;
     VkPipelineLayout layout;
     VkPipeline cull_pipeline, scatter_pipeline, draw_pipeline;
+    VkPipeline cull_tasks_pipeline, task_submit_pipeline, mesh_pipeline; /* NULL without mesh shaders */
+    VkPipeline overdraw_max_pipeline, overdraw_paint_pipeline;
+    gdr_vk_buffer overdraw;       /* uint32 per pixel, then the maximum (overdraw view) */
+    gdr_vk_buffer visible_meshlets; /* uint32 pairs, one per cluster of every instance; made on first use */
+    gdr_cpu_path cpu;
     VkQueryPool timestamps;
     gdr_gpu_scene scene;
     bool has_scene;
@@ -77,7 +104,19 @@ void gdr_frame_slots_destroy(gdr_renderer *r);
 gdr_status gdr_frame_slot_wait(gdr_renderer *r, gdr_frame_slot *slot, double gpu_ms[GDR_TS_COUNT - 1], gdr_error *err);
 /* Records and submits one frame into `slot`; adds the time spent in vkQueueSubmit2 to *submit_ms. */
 gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame,
-                                       bool copy_color, double *submit_ms, gdr_error *err);
+                                       gdr_pipeline pipeline, bool copy_color, double *submit_ms, gdr_error *err);
+
+/* CPU pipeline (cpu_driven.c). */
+gdr_status gdr_cpu_path_create(gdr_renderer *r, const gdr_scene *scene, gdr_error *err);
+void gdr_cpu_path_destroy(gdr_renderer *r);
+/* Instance `index` has moved: refresh its culling bounds. */
+gdr_status gdr_cpu_path_update_instance(gdr_renderer *r, uint32_t index, gdr_error *err);
+/* Culls on the CPU for this frame's camera (before recording). */
+gdr_status gdr_cpu_path_cull(gdr_renderer *r, const gdr_frame_desc *frame, gdr_error *err);
+/* One bind + draw sequence per visible instance, inside the render pass. */
+void gdr_cpu_path_record_draws(gdr_renderer *r, VkCommandBuffer cmd, const GdrGpuPushConstants *push);
+/* The camera's projection and view for a frame (shared by the GPU globals and the CPU cull). */
+void gdr_frame_matrices(const gdr_renderer *r, const gdr_camera *camera, gdr_mat4 *projection, gdr_mat4 *view);
 double gdr_now_ms(void);
 
 #endif

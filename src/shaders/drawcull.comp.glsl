@@ -1,7 +1,9 @@
 #version 460
 // Instance culling (seeds 000/001/003): one thread per instance; visible instances are appended,
 // compacted with subgroup ballots, as VkDrawIndexedIndirectCommands for one
-// vkCmdDrawIndexedIndirectCount. first_instance carries the instance index to the vertex shader.
+// vkCmdDrawIndexedIndirectCount (first_instance carries the instance index to the vertex shader),
+// or, for the meshlet pipeline (EMIT_TASKS), as task commands: one task workgroup per up to
+// GDR_TASK_WORKGROUP_SIZE clusters of the instance.
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 
@@ -9,6 +11,30 @@
 #include "shared/cull_math.h"
 
 layout(local_size_x = GDR_CULL_WORKGROUP_SIZE) in;
+layout(constant_id = 0) const bool EMIT_TASKS = false;
+
+layout(buffer_reference, scalar) writeonly buffer TaskCommandsRef { GdrGpuTaskCommand items[]; };
+
+void append_tasks(GdrGpuFrameGlobals g, bool visible, uint instance, GdrGpuMesh mesh)
+{
+    DrawStatsRef stats = DrawStatsRef(push.draw_stats);
+    uint count = visible ? mesh.task_count : 0u;
+    uint subgroup_total = subgroupAdd(count);
+    uint base = 0u;
+    if (subgroupElect() && subgroup_total > 0u)
+        base = atomicAdd(stats.value.task_count, subgroup_total);
+    base = subgroupBroadcastFirst(base) + subgroupExclusiveAdd(count);
+    TaskCommandsRef tasks = TaskCommandsRef(push.tasks);
+    for (uint t = 0u; t < count; t++) {
+        uint slot = base + t;
+        uint first = t * GDR_TASK_WORKGROUP_SIZE;
+        if (slot < g.task_capacity)
+            tasks.items[slot] = GdrGpuTaskCommand(instance, mesh.meshlet_offset + first,
+                                                  min(mesh.meshlet_count - first, GDR_TASK_WORKGROUP_SIZE), 0u);
+        else
+            atomicAdd(stats.value.task_overflow, 1u);
+    }
+}
 
 void main()
 {
@@ -19,8 +45,8 @@ void main()
     if (id < g.instance_count) {
         mat4 model = InstancesRef(push.instances).items[id].model;
         mesh = MeshesRef(push.meshes).items[InstancesRef(push.instances).items[id].mesh];
-        visible = true;
-        if (g.cull_enabled != 0u) {
+        visible = mesh.index_count > 0u; // nothing to draw otherwise
+        if (visible && g.cull_enabled != 0u) {
             vec3 center = (g.view * (model * vec4(mesh.bounds.xyz, 1.0))).xyz;
             float radius = mesh.bounds.w * gdr_max_axis_scale(model[0].xyz, model[1].xyz, model[2].xyz);
             visible = gdr_sphere_visible(g.frustum, center, radius, g.znear, g.zfar);
@@ -30,7 +56,8 @@ void main()
     DrawStatsRef stats = DrawStatsRef(push.draw_stats);
     uvec4 ballot = subgroupBallot(visible);
     uint subgroup_count = subgroupBallotBitCount(ballot);
-    uint triangles = subgroupAdd(visible ? mesh.index_count / 3u : 0u);
+    // The meshlet pipeline counts the triangles its mesh shader emits instead.
+    uint triangles = EMIT_TASKS ? 0u : subgroupAdd(visible ? mesh.index_count / 3u : 0u);
     uint base = 0u;
     if (subgroupElect() && subgroup_count > 0u) {
         base = atomicAdd(stats.value.draw_count, subgroup_count);
@@ -39,7 +66,9 @@ void main()
             atomicAdd(stats.value.triangles_high, 1u);
     }
     base = subgroupBroadcastFirst(base);
-    if (visible) {
+    if (EMIT_TASKS) {
+        append_tasks(g, visible, id, mesh);
+    } else if (visible) {
         uint slot = base + subgroupBallotExclusiveBitCount(ballot);
         DrawCommandsRef(push.draws).items[slot] =
             GdrGpuDrawCommand(mesh.index_count, 1u, mesh.first_index, int(mesh.vertex_offset), id);

@@ -1,6 +1,7 @@
 #version 460
 // Forward path vertex shader: the instance comes from gl_InstanceIndex (= the draw's first_instance).
 #include "shared/glsl_buffers.h"
+#include "shared/shading.h"
 
 layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec3 in_normal;
@@ -20,5 +21,5 @@ void main()
     mat3 cofactor = mat3(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1]));
     out_normal = cofactor * in_normal;
     out_world_position = world.xyz;
-    out_color = instance.color;
+    out_color = g.view_mode == GDR_VIEW_INSTANCES ? vec4(gdr_id_color(gl_InstanceIndex), 1.0) : instance.color;
 }

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "gdr/geometry.h"
 
 const char *gdr_vk_result_name(VkResult result)
 {
@@ -180,6 +181,42 @@ static gdr_status choose_physical_device(gdr_vk_context *ctx, const char *wanted
     return GDR_OK;
 }
 
+/* The meshlet pipeline needs task + mesh shaders, subgroup ballots in task shaders and room for a
+ * cluster (GDR_MESH_* in gpu_config.h) in one mesh workgroup. */
+static void check_mesh_shader_support(gdr_vk_context *ctx, VkShaderStageFlags subgroup_stages, bool disabled)
+{
+    ctx->has_mesh_shader = false;
+    const char *why = NULL;
+    VkPhysicalDeviceMeshShaderFeaturesEXT features = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
+    VkPhysicalDeviceFeatures2 f2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, .pNext = &features};
+    ctx->mesh_shader_properties = (VkPhysicalDeviceMeshShaderPropertiesEXT){
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_PROPERTIES_EXT};
+    VkPhysicalDeviceProperties2 p2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2,
+                                      .pNext = &ctx->mesh_shader_properties};
+    if (disabled)
+        why = "mesh shaders disabled by the caller";
+    else if (!device_extension_available(ctx->physical_device, VK_EXT_MESH_SHADER_EXTENSION_NAME))
+        why = "the device has no VK_EXT_mesh_shader";
+    if (!why) {
+        vkGetPhysicalDeviceFeatures2(ctx->physical_device, &f2);
+        vkGetPhysicalDeviceProperties2(ctx->physical_device, &p2);
+        ctx->mesh_shader_properties.pNext = NULL;
+        const VkPhysicalDeviceMeshShaderPropertiesEXT *m = &ctx->mesh_shader_properties;
+        if (!features.taskShader || !features.meshShader)
+            why = "VK_EXT_mesh_shader without task or mesh shaders";
+        else if (!(subgroup_stages & VK_SHADER_STAGE_TASK_BIT_EXT))
+            why = "no subgroup operations in task shaders";
+        else if (m->maxMeshOutputVertices < GDR_CLUSTER_MAX_VERTICES || m->maxMeshOutputPrimitives < GDR_CLUSTER_MAX_TRIANGLES)
+            why = "mesh shaders cannot output a whole cluster";
+    }
+    if (why) {
+        snprintf(ctx->mesh_shader_missing, sizeof ctx->mesh_shader_missing, "%s", why);
+        return;
+    }
+    ctx->has_mesh_shader = true;
+    ctx->mesh_shader_missing[0] = '\0';
+}
+
 /* Appends "name" to a comma-separated list of missing features. */
 static void note_missing(char *list, size_t size, bool present, const char *name)
 {
@@ -189,7 +226,7 @@ static void note_missing(char *list, size_t size, bool present, const char *name
     snprintf(list + used, size - used, "%s%s", used ? ", " : "", name);
 }
 
-static gdr_status create_device(gdr_vk_context *ctx, gdr_error *err)
+static gdr_status create_device(gdr_vk_context *ctx, bool disable_mesh_shaders, gdr_error *err)
 {
     VkPhysicalDevice pd = ctx->physical_device;
     if (ctx->properties.apiVersion < VK_API_VERSION_1_3)
@@ -214,11 +251,13 @@ static gdr_status create_device(gdr_vk_context *ctx, gdr_error *err)
     note_missing(missing, sizeof missing, f2.features.multiDrawIndirect, "multiDrawIndirect");
     note_missing(missing, sizeof missing, f2.features.drawIndirectFirstInstance, "drawIndirectFirstInstance");
     note_missing(missing, sizeof missing, f2.features.shaderInt64, "shaderInt64");
+    note_missing(missing, sizeof missing, f2.features.fragmentStoresAndAtomics, "fragmentStoresAndAtomics");
     note_missing(missing, sizeof missing, f11.shaderDrawParameters, "shaderDrawParameters");
     note_missing(missing, sizeof missing, f12.drawIndirectCount, "drawIndirectCount");
     note_missing(missing, sizeof missing, f12.bufferDeviceAddress, "bufferDeviceAddress");
     note_missing(missing, sizeof missing, f12.scalarBlockLayout, "scalarBlockLayout");
     note_missing(missing, sizeof missing, f12.hostQueryReset, "hostQueryReset");
+    note_missing(missing, sizeof missing, f12.samplerFilterMinmax, "samplerFilterMinmax"); /* depth pyramid */
     note_missing(missing, sizeof missing, f13.dynamicRendering, "dynamicRendering");
     note_missing(missing, sizeof missing, f13.synchronization2, "synchronization2");
     note_missing(missing, sizeof missing, f13.maintenance4, "maintenance4");
@@ -249,28 +288,46 @@ static gdr_status create_device(gdr_vk_context *ctx, gdr_error *err)
                              ctx->properties.deviceName);
 
     /* Enable exactly what gdr uses. */
-    VkPhysicalDeviceMeshShaderFeaturesEXT mesh = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
-    ctx->has_mesh_shader = device_extension_available(pd, VK_EXT_MESH_SHADER_EXTENSION_NAME);
     VkPhysicalDeviceVulkan13Features e13 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES,
                                             .dynamicRendering = VK_TRUE, .synchronization2 = VK_TRUE,
                                             .maintenance4 = VK_TRUE};
     VkPhysicalDeviceVulkan12Features e12 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, .pNext = &e13,
                                             .drawIndirectCount = VK_TRUE, .bufferDeviceAddress = VK_TRUE,
-                                            .scalarBlockLayout = VK_TRUE, .hostQueryReset = VK_TRUE};
+                                            .scalarBlockLayout = VK_TRUE, .hostQueryReset = VK_TRUE,
+                                            .samplerFilterMinmax = VK_TRUE};
     VkPhysicalDeviceVulkan11Features e11 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES, .pNext = &e12,
                                             .shaderDrawParameters = VK_TRUE};
     VkPhysicalDeviceFeatures2 e2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, .pNext = &e11};
     e2.features.multiDrawIndirect = VK_TRUE;
     e2.features.drawIndirectFirstInstance = VK_TRUE;
     e2.features.shaderInt64 = VK_TRUE;
+    e2.features.fragmentStoresAndAtomics = VK_TRUE; /* the overdraw view counts fragments */
+    VkPhysicalDeviceMeshShaderFeaturesEXT mesh = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT,
+                                                  .taskShader = VK_TRUE, .meshShader = VK_TRUE};
+    check_mesh_shader_support(ctx, subgroup.supportedStages, disable_mesh_shaders);
+    const char *extensions[1];
+    uint32_t extension_count = 0;
+    if (ctx->has_mesh_shader) {
+        extensions[extension_count++] = VK_EXT_MESH_SHADER_EXTENSION_NAME;
+        e13.pNext = &mesh;
+    }
     float priority = 1.0f;
     VkDeviceQueueCreateInfo queue_info = {.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO,
                                           .queueFamilyIndex = ctx->queue_family, .queueCount = 1,
                                           .pQueuePriorities = &priority};
-    (void)mesh; /* mesh shaders are enabled by the meshlet pipeline once it exists */
     VkDeviceCreateInfo info = {.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, .pNext = &e2, .queueCreateInfoCount = 1,
-                               .pQueueCreateInfos = &queue_info};
+                               .pQueueCreateInfos = &queue_info, .enabledExtensionCount = extension_count,
+                               .ppEnabledExtensionNames = extensions};
     GDR_VK_TRY(err, vkCreateDevice(pd, &info, NULL, &ctx->device));
+    if (ctx->has_mesh_shader) {
+        ctx->cmd_draw_mesh_tasks_indirect =
+            (PFN_vkCmdDrawMeshTasksIndirectEXT)vkGetDeviceProcAddr(ctx->device, "vkCmdDrawMeshTasksIndirectEXT");
+        if (!ctx->cmd_draw_mesh_tasks_indirect) {
+            ctx->has_mesh_shader = false;
+            snprintf(ctx->mesh_shader_missing, sizeof ctx->mesh_shader_missing,
+                     "vkCmdDrawMeshTasksIndirectEXT could not be loaded");
+        }
+    }
     vkGetDeviceQueue(ctx->device, ctx->queue_family, 0, &ctx->queue);
     VkCommandPoolCreateInfo pool_info = {.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
                                          .flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT,
@@ -288,7 +345,7 @@ gdr_status gdr_vk_context_create(const gdr_vk_context_desc *desc, gdr_vk_context
     if (status == GDR_OK)
         status = choose_physical_device(ctx, desc->device, err);
     if (status == GDR_OK)
-        status = create_device(ctx, err);
+        status = create_device(ctx, desc->disable_mesh_shaders, err);
     if (status != GDR_OK) {
         gdr_vk_context_destroy(ctx);
         return status;

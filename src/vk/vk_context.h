@@ -11,6 +11,7 @@ typedef struct gdr_vk_context_desc {
     const char *device;   /* NULL: first discrete GPU, else the first device; "N": index; else a name substring */
     bool validate;        /* enable VK_LAYER_KHRONOS_validation and count its messages */
     bool synchronization_validation; /* also enable synchronization validation (implies validate) */
+    bool disable_mesh_shaders; /* behave as a device without VK_EXT_mesh_shader (tests of the fallback) */
 } gdr_vk_context_desc;
 
 typedef struct gdr_vk_context {
@@ -23,7 +24,12 @@ typedef struct gdr_vk_context {
     VkQueue queue;
     uint32_t queue_family;
     VkCommandPool command_pool;
+    /* VK_EXT_mesh_shader with task shaders, enabled when the device has it (and subgroup ballots in
+     * task shaders); otherwise mesh_shader_missing says why. */
     bool has_mesh_shader;
+    char mesh_shader_missing[128];
+    VkPhysicalDeviceMeshShaderPropertiesEXT mesh_shader_properties;
+    PFN_vkCmdDrawMeshTasksIndirectEXT cmd_draw_mesh_tasks_indirect;
     uint32_t subgroup_size;
     char driver_info[VK_MAX_DRIVER_NAME_SIZE + VK_MAX_DRIVER_INFO_SIZE + 2]; /* driver name and version, for stats and PERFORMANCE.md */
     /* Validation messages seen so far (warnings and errors); every one is also printed. */

@@ -21,6 +21,19 @@ gdr_status gdr_vk_pipeline_layout_create(gdr_vk_context *ctx, uint32_t push_cons
 gdr_status gdr_vk_compute_pipeline_create(gdr_vk_context *ctx, VkPipelineLayout layout, const gdr_spirv *shader,
                                           VkPipeline *out, gdr_error *err)
 {
+    return gdr_vk_compute_pipeline_create_specialized(ctx, layout, shader, NULL, 0, out, err);
+}
+
+gdr_status gdr_vk_compute_pipeline_create_specialized(gdr_vk_context *ctx, VkPipelineLayout layout,
+                                                      const gdr_spirv *shader, const uint32_t *constants,
+                                                      uint32_t constant_count, VkPipeline *out, gdr_error *err)
+{
+    VkSpecializationMapEntry entries[8];
+    if (constant_count > 8)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "at most 8 specialization constants");
+    for (uint32_t i = 0; i < constant_count; i++)
+        entries[i] = (VkSpecializationMapEntry){i, i * (uint32_t)sizeof(uint32_t), sizeof(uint32_t)};
+    VkSpecializationInfo specialization = {constant_count, entries, constant_count * sizeof(uint32_t), constants};
     VkShaderModule module;
     gdr_status status = create_module(ctx, shader, &module, err);
     if (status != GDR_OK)
@@ -28,7 +41,7 @@ gdr_status gdr_vk_compute_pipeline_create(gdr_vk_context *ctx, VkPipelineLayout 
     VkComputePipelineCreateInfo info = {
         .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
         .stage = {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = VK_SHADER_STAGE_COMPUTE_BIT,
-                  .module = module, .pName = "main"},
+                  .module = module, .pName = "main", .pSpecializationInfo = constant_count ? &specialization : NULL},
         .layout = layout,
     };
     VkResult result = vkCreateComputePipelines(ctx->device, VK_NULL_HANDLE, 1, &info, NULL, out);
@@ -40,21 +53,31 @@ gdr_status gdr_vk_compute_pipeline_create(gdr_vk_context *ctx, VkPipelineLayout 
 gdr_status gdr_vk_graphics_pipeline_create(gdr_vk_context *ctx, const gdr_vk_graphics_pipeline_desc *desc,
                                            VkPipeline *out, gdr_error *err)
 {
-    VkShaderModule vertex, fragment;
-    gdr_status status = create_module(ctx, desc->vertex_shader, &vertex, err);
-    if (status != GDR_OK)
-        return status;
-    status = create_module(ctx, desc->fragment_shader, &fragment, err);
+    /* Vertex + fragment, or task + mesh + fragment. */
+    struct {
+        const gdr_spirv *code;
+        VkShaderStageFlagBits stage;
+    } wanted[3] = {{desc->task_shader, VK_SHADER_STAGE_TASK_BIT_EXT},
+                   {desc->mesh_shader ? desc->mesh_shader : desc->vertex_shader,
+                    desc->mesh_shader ? VK_SHADER_STAGE_MESH_BIT_EXT : VK_SHADER_STAGE_VERTEX_BIT},
+                   {desc->fragment_shader, VK_SHADER_STAGE_FRAGMENT_BIT}};
+    VkPipelineShaderStageCreateInfo stages[3];
+    uint32_t stage_count = 0;
+    gdr_status status = GDR_OK;
+    for (uint32_t i = 0; i < 3 && status == GDR_OK; i++) {
+        if (!wanted[i].code)
+            continue;
+        stages[stage_count] = (VkPipelineShaderStageCreateInfo){
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = wanted[i].stage, .pName = "main"};
+        status = create_module(ctx, wanted[i].code, &stages[stage_count].module, err);
+        if (status == GDR_OK)
+            stage_count++;
+    }
     if (status != GDR_OK) {
-        vkDestroyShaderModule(ctx->device, vertex, NULL);
+        for (uint32_t i = 0; i < stage_count; i++)
+            vkDestroyShaderModule(ctx->device, stages[i].module, NULL);
         return status;
     }
-    VkPipelineShaderStageCreateInfo stages[2] = {
-        {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = VK_SHADER_STAGE_VERTEX_BIT,
-         .module = vertex, .pName = "main"},
-        {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = VK_SHADER_STAGE_FRAGMENT_BIT,
-         .module = fragment, .pName = "main"},
-    };
     VkPipelineVertexInputStateCreateInfo vertex_input = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
         .vertexBindingDescriptionCount = desc->vertex_binding ? 1u : 0u,
@@ -74,8 +97,8 @@ gdr_status gdr_vk_graphics_pipeline_create(gdr_vk_context *ctx, const gdr_vk_gra
     VkPipelineMultisampleStateCreateInfo multisample = {.sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO,
                                                         .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT};
     VkPipelineDepthStencilStateCreateInfo depth = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO, .depthTestEnable = VK_TRUE,
-        .depthWriteEnable = VK_TRUE, .depthCompareOp = VK_COMPARE_OP_GREATER};
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO, .depthTestEnable = !desc->no_depth_test,
+        .depthWriteEnable = !desc->no_depth_test, .depthCompareOp = VK_COMPARE_OP_GREATER};
     VkPipelineColorBlendAttachmentState blend_attachment = {.colorWriteMask = 0xF};
     VkPipelineColorBlendStateCreateInfo blend = {.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
                                                  .attachmentCount = 1, .pAttachments = &blend_attachment};
@@ -87,13 +110,14 @@ gdr_status gdr_vk_graphics_pipeline_create(gdr_vk_context *ctx, const gdr_vk_gra
                                                .pColorAttachmentFormats = &desc->color_format,
                                                .depthAttachmentFormat = desc->depth_format};
     VkGraphicsPipelineCreateInfo info = {
-        .sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO, .pNext = &rendering, .stageCount = 2,
-        .pStages = stages, .pVertexInputState = &vertex_input, .pInputAssemblyState = &input_assembly,
+        .sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO, .pNext = &rendering, .stageCount = stage_count,
+        .pStages = stages, .pVertexInputState = desc->mesh_shader ? NULL : &vertex_input,
+        .pInputAssemblyState = desc->mesh_shader ? NULL : &input_assembly,
         .pViewportState = &viewport, .pRasterizationState = &raster, .pMultisampleState = &multisample,
         .pDepthStencilState = &depth, .pColorBlendState = &blend, .pDynamicState = &dynamic, .layout = desc->layout};
     VkResult result = vkCreateGraphicsPipelines(ctx->device, VK_NULL_HANDLE, 1, &info, NULL, out);
-    vkDestroyShaderModule(ctx->device, vertex, NULL);
-    vkDestroyShaderModule(ctx->device, fragment, NULL);
+    for (uint32_t i = 0; i < stage_count; i++)
+        vkDestroyShaderModule(ctx->device, stages[i].module, NULL);
     GDR_VK_TRY(err, result);
     return GDR_OK;
 }

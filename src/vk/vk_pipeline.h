@@ -10,10 +10,16 @@ gdr_status gdr_vk_pipeline_layout_create(gdr_vk_context *ctx, uint32_t push_cons
                                          gdr_error *err);
 gdr_status gdr_vk_compute_pipeline_create(gdr_vk_context *ctx, VkPipelineLayout layout, const gdr_spirv *shader,
                                           VkPipeline *out, gdr_error *err);
+/* The same with specialization constants: constants[i] is constant_id i (32-bit each, at most 8). */
+gdr_status gdr_vk_compute_pipeline_create_specialized(gdr_vk_context *ctx, VkPipelineLayout layout,
+                                                      const gdr_spirv *shader, const uint32_t *constants,
+                                                      uint32_t constant_count, VkPipeline *out, gdr_error *err);
 
 typedef struct gdr_vk_graphics_pipeline_desc {
     VkPipelineLayout layout;
-    const gdr_spirv *vertex_shader;
+    const gdr_spirv *vertex_shader; /* or: */
+    const gdr_spirv *task_shader;   /* optional, with mesh_shader */
+    const gdr_spirv *mesh_shader;   /* replaces the vertex stage (VK_EXT_mesh_shader) */
     const gdr_spirv *fragment_shader;
     const VkVertexInputBindingDescription *vertex_binding; /* NULL: no vertex input */
     const VkVertexInputAttributeDescription *vertex_attributes;
@@ -21,6 +27,7 @@ typedef struct gdr_vk_graphics_pipeline_desc {
     VkFormat color_format;
     VkFormat depth_format;
     VkCullModeFlags cull_mode;
+    bool no_depth_test;             /* a full-screen pass over the colour target */
 } gdr_vk_graphics_pipeline_desc;
 
 /* A graphics pipeline for dynamic rendering, reverse-Z depth (compare GREATER, write on), with a

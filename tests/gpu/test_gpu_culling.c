@@ -15,7 +15,7 @@ static uint8_t *image_culled, *image_all;
 static bool render(const gdr_camera *camera, gdr_cull_mode cull, uint8_t *pixels, gdr_frame_stats *stats)
 {
     gdr_error err = {0};
-    gdr_frame_desc frame = {.camera = *camera, .cull = cull, .read_back = true};
+    gdr_frame_desc frame = {.camera = *camera, .cull = cull, .read_back = true, .pipeline = GDR_PIPELINE_INDIRECT};
     if (gdr_renderer_render(renderer, &frame, 1, stats, &err) != GDR_OK ||
         gdr_renderer_read_color(renderer, pixels, &err) != GDR_OK) {
         fprintf(stderr, "render: %s\n", err.message);

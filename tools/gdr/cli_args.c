@@ -29,6 +29,23 @@ bool cli_parse_on_off(const char *option, const char *text, bool *out)
     return false;
 }
 
+bool cli_parse_choice(const char *option, const char *text, const char *const *names, int count, int *out)
+{
+    for (int i = 0; i < count; i++) {
+        if (strcmp(text, names[i]) == 0) {
+            *out = i;
+            return true;
+        }
+    }
+    char list[256] = "";
+    for (int i = 0; i < count; i++) {
+        size_t used = strlen(list);
+        snprintf(list + used, sizeof list - used, "%s%s", i ? ", " : "", names[i]);
+    }
+    fprintf(stderr, "gdr: %s %s: expected one of %s\n", option, text, list);
+    return false;
+}
+
 bool cli_parse_camera(const char *option, const char *text, gdr_vec3 *position, gdr_quat *rotation)
 {
     float v[7];
@@ -62,4 +79,15 @@ const char *cli_value(int argc, char **argv, int *i)
     }
     *i += 1;
     return argv[*i];
+}
+
+bool cli_parse_pipeline(const char *option, const char *text, gdr_pipeline *out)
+{
+    static const char *const names[] = {"mesh", "indirect", "cpu"};
+    static const gdr_pipeline values[] = {GDR_PIPELINE_MESH, GDR_PIPELINE_INDIRECT, GDR_PIPELINE_CPU};
+    int index;
+    if (!cli_parse_choice(option, text, names, 3, &index))
+        return false;
+    *out = values[index];
+    return true;
 }

@@ -5,11 +5,16 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "gdr/renderer.h"
 #include "gdr/scene.h"
 
 /* Each prints "gdr: OPTION VALUE: why" on failure and returns false. */
 bool cli_parse_u32(const char *option, const char *text, uint32_t min, uint32_t max, uint32_t *out);
 bool cli_parse_on_off(const char *option, const char *text, bool *out);
+/* One of names[0 .. count): *out is its index. */
+bool cli_parse_choice(const char *option, const char *text, const char *const *names, int count, int *out);
+/* --pipeline mesh|indirect|cpu */
+bool cli_parse_pipeline(const char *option, const char *text, gdr_pipeline *out);
 /* "px,py,pz,qx,qy,qz,qw": position and rotation quaternion (normalised; must not be zero). */
 bool cli_parse_camera(const char *option, const char *text, gdr_vec3 *position, gdr_quat *rotation);
 /* Returns the option's value (argv[*i + 1]) and advances *i, or prints an error and returns NULL. */

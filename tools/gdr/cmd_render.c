@@ -14,6 +14,9 @@ typedef struct render_options {
     const char *stats_json;
     uint32_t width, height, frames, camera_index;
     bool has_camera, has_camera_index, cull, validate;
+    bool meshlet_cull, cone_cull, triangle_cull;
+    gdr_pipeline pipeline;
+    gdr_view view;
     gdr_vec3 camera_position;
     gdr_quat camera_rotation;
     const char *device;
@@ -22,7 +25,9 @@ typedef struct render_options {
 
 static int parse_render_options(int argc, char **argv, render_options *o)
 {
-    *o = (render_options){.width = 1280, .height = 720, .frames = 1, .cull = true};
+    *o = (render_options){.width = 1280, .height = 720, .frames = 1, .cull = true, .meshlet_cull = true,
+                          .cone_cull = true, .triangle_cull = true};
+    static const char *const view_names[] = {"shaded", "meshlets", "instances", "triangles", "overdraw"};
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i], *value;
         if (arg[0] != '-' || strcmp(arg, "-") == 0) {
@@ -60,6 +65,19 @@ static int parse_render_options(int argc, char **argv, render_options *o)
             ok = o->has_camera_index = cli_parse_u32(arg, value, 0, 1000000, &o->camera_index);
         else if (strcmp(arg, "--cull") == 0)
             ok = cli_parse_on_off(arg, value, &o->cull);
+        else if (strcmp(arg, "--meshlet-cull") == 0)
+            ok = cli_parse_on_off(arg, value, &o->meshlet_cull);
+        else if (strcmp(arg, "--cone-cull") == 0)
+            ok = cli_parse_on_off(arg, value, &o->cone_cull);
+        else if (strcmp(arg, "--triangle-cull") == 0)
+            ok = cli_parse_on_off(arg, value, &o->triangle_cull);
+        else if (strcmp(arg, "--pipeline") == 0)
+            ok = cli_parse_pipeline(arg, value, &o->pipeline);
+        else if (strcmp(arg, "--view") == 0) {
+            int view;
+            ok = cli_parse_choice(arg, value, view_names, 5, &view);
+            o->view = (gdr_view)view;
+        }
         else if (strcmp(arg, "--device") == 0)
             o->device = value;
         else if (strcmp(arg, "--cache-dir") == 0)
@@ -116,7 +134,10 @@ int gdr_cmd_render(int argc, char **argv)
     uint8_t *pixels = NULL;
     int result = 0;
     gdr_frame_desc frame = {.camera = choose_camera(scene, &o), .cull = o.cull ? GDR_CULL_ON : GDR_CULL_OFF,
-                            .read_back = o.out_png != NULL};
+                            .read_back = o.out_png != NULL, .pipeline = o.pipeline, .view = o.view,
+                            .meshlet_frustum_cull = o.meshlet_cull ? GDR_CULL_ON : GDR_CULL_OFF,
+                            .meshlet_cone_cull = o.cone_cull ? GDR_CULL_ON : GDR_CULL_OFF,
+                            .triangle_cull = o.triangle_cull ? GDR_CULL_ON : GDR_CULL_OFF};
     if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK || gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK ||
         gdr_renderer_render(renderer, &frame, o.frames, &stats, &err) != GDR_OK) {
         result = fail(&err);
@@ -130,7 +151,7 @@ int gdr_cmd_render(int argc, char **argv)
             goto done;
         }
     }
-    stats_context context = {o.scene, o.width, o.height, o.cull ? "on" : "off"};
+    stats_context context = {o.scene, o.width, o.height, o.cull ? "on" : "off", gdr_view_name(o.view)};
     stats_print(stdout, &context, &stats);
     if (o.out_png)
         printf("image               %s\n", o.out_png);

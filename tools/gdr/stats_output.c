@@ -1,5 +1,7 @@
 #include "stats_output.h"
 
+#include <string.h>
+
 #include <cjson/cJSON.h>
 
 void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats *s)
@@ -8,10 +10,28 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
     fprintf(out, "device              %s (%s)\n", s->device, s->driver);
     fprintf(out, "resolution          %ux%u, %u frame(s), culling %s\n", context->width, context->height, s->frames,
             context->cull);
+    fprintf(out, "pipeline            %s (%s)\n", gdr_pipeline_name(s->pipeline), s->pipeline_reason);
+    if (context->view && strcmp(context->view, "shaded") != 0)
+        fprintf(out, "view                %s\n", context->view);
     fprintf(out, "instances_total     %u\n", s->instances_total);
     fprintf(out, "instances_visible   %u\n", s->instances_visible);
     fprintf(out, "triangles           %llu\n", (unsigned long long)s->triangles);
-    fprintf(out, "draws               %u (in %u indirect draw call)\n", s->draws, s->draw_calls);
+    if (s->pipeline == GDR_PIPELINE_MESH) {
+        fprintf(out, "meshlets_total      %llu\n", (unsigned long long)s->meshlets_total);
+        fprintf(out, "meshlets_tested     %u (of visible instances)\n", s->meshlets_tested);
+        fprintf(out, "meshlets_frustum_culled %u\n", s->meshlets_frustum_culled);
+        fprintf(out, "meshlets_cone_culled %u\n", s->meshlets_cone_culled);
+        fprintf(out, "meshlets_visible    %u\n", s->meshlets_visible);
+        fprintf(out, "triangles_culled    %u back-facing, %u covering no sample\n", s->triangles_backface_culled,
+                s->triangles_small_culled);
+        fprintf(out, "task_workgroups     %u (in 1 indirect mesh-tasks launch; %u lost to overflow)\n",
+                s->task_workgroups, s->task_overflow);
+    } else if (s->pipeline == GDR_PIPELINE_CPU) {
+        fprintf(out, "draws               %u (in %u draw calls recorded by the CPU)\n", s->draws, s->draw_calls);
+        fprintf(out, "cpu_cull_ms_per_frame %.4f\n", s->cpu_cull_ms_per_frame);
+    } else {
+        fprintf(out, "draws               %u (in %u indirect draw call)\n", s->draws, s->draw_calls);
+    }
     fprintf(out, "cpu_ms_per_frame    %.4f (of which vkQueueSubmit2 %.4f)\n", s->cpu_ms_per_frame,
             s->cpu_submit_ms_per_frame);
     fprintf(out, "gpu_ms_per_frame    %.4f\n", s->gpu_ms_per_frame);
@@ -32,11 +52,27 @@ char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
     cJSON_AddNumberToObject(root, "height", context->height);
     cJSON_AddNumberToObject(root, "frames", s->frames);
     cJSON_AddStringToObject(root, "cull", context->cull);
+    cJSON_AddStringToObject(root, "pipeline", gdr_pipeline_name(s->pipeline));
+    cJSON_AddStringToObject(root, "pipeline_reason", s->pipeline_reason);
+    cJSON_AddStringToObject(root, "view", context->view ? context->view : "shaded");
     cJSON_AddNumberToObject(root, "instances_total", s->instances_total);
     cJSON_AddNumberToObject(root, "instances_visible", s->instances_visible);
     cJSON_AddNumberToObject(root, "triangles", (double)s->triangles);
     cJSON_AddNumberToObject(root, "draws", s->draws);
     cJSON_AddNumberToObject(root, "draw_calls", s->draw_calls);
+    if (s->pipeline == GDR_PIPELINE_MESH) {
+        cJSON_AddNumberToObject(root, "meshlets_total", (double)s->meshlets_total);
+        cJSON_AddNumberToObject(root, "meshlets_tested", s->meshlets_tested);
+        cJSON_AddNumberToObject(root, "meshlets_frustum_culled", s->meshlets_frustum_culled);
+        cJSON_AddNumberToObject(root, "meshlets_cone_culled", s->meshlets_cone_culled);
+        cJSON_AddNumberToObject(root, "meshlets_visible", s->meshlets_visible);
+        cJSON_AddNumberToObject(root, "triangles_backface_culled", s->triangles_backface_culled);
+        cJSON_AddNumberToObject(root, "triangles_small_culled", s->triangles_small_culled);
+        cJSON_AddNumberToObject(root, "task_workgroups", s->task_workgroups);
+        cJSON_AddNumberToObject(root, "task_overflow", s->task_overflow);
+    }
+    if (s->pipeline == GDR_PIPELINE_CPU)
+        cJSON_AddNumberToObject(root, "cpu_cull_ms_per_frame", s->cpu_cull_ms_per_frame);
     cJSON_AddNumberToObject(root, "cpu_ms_per_frame", s->cpu_ms_per_frame);
     cJSON_AddNumberToObject(root, "cpu_submit_ms_per_frame", s->cpu_submit_ms_per_frame);
     cJSON_AddNumberToObject(root, "cpu_ms_per_frame_median", s->cpu_ms_per_frame_median);

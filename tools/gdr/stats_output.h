@@ -10,6 +10,7 @@ typedef struct stats_context {
     const char *scene;
     uint32_t width, height;
     const char *cull;
+    const char *view;
 } stats_context;
 
 void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats *stats);

@@ -27,4 +27,15 @@ GDR_SHARED_FN float gdr_max_axis_scale(gdr_vec3 c0, gdr_vec3 c1, gdr_vec3 c2)
     return gdr_sqrt(gdr_max(s0, gdr_max(s1, s2)));
 }
 
+/* Cluster normal cone (meshoptimizer's meshopt_Bounds, with apex), everything in mesh space: every
+ * triangle of the cluster faces away from a camera at p when dot(normalize(apex - p), axis) >= cutoff.
+ * The test holds in mesh space for any invertible transform with a positive determinant (back-facing
+ * is preserved), so the camera is brought into mesh space rather than the cone into world space. */
+GDR_SHARED_FN bool gdr_cone_backfacing(gdr_vec3 apex, gdr_vec3 axis, float cutoff, gdr_vec3 camera)
+{
+    float dx = apex.x - camera.x, dy = apex.y - camera.y, dz = apex.z - camera.z;
+    float d = dx * axis.x + dy * axis.y + dz * axis.z;
+    return d >= cutoff * gdr_sqrt(dx * dx + dy * dy + dz * dz);
+}
+
 #endif

@@ -4,7 +4,17 @@
 
 #define GDR_CULL_WORKGROUP_SIZE 64
 #define GDR_SCATTER_WORKGROUP_SIZE 64
+#define GDR_REDUCE_WORKGROUP_SIZE 256
 #define GDR_FRAMES_IN_FLIGHT 2
+/* Meshlet pipeline: a task workgroup tests up to this many clusters of one instance (one thread
+ * each); a mesh workgroup draws one cluster (at most GDR_CLUSTER_MAX_VERTICES / _TRIANGLES of
+ * gdr/geometry.h, repeated here for GLSL and checked in gpu_types_check.c). */
+#define GDR_TASK_WORKGROUP_SIZE 32
+#define GDR_MESH_WORKGROUP_SIZE 32
+#define GDR_MESH_MAX_VERTICES 64
+#define GDR_MESH_MAX_TRIANGLES 124
+/* maxTaskWorkGroupCount[0] is at least this on every device: larger launches use y too. */
+#define GDR_TASK_GROUPS_PER_ROW 65535
 /* Instance records the CPU can send per frame through the update ring. */
 #define GDR_INSTANCE_UPDATES_PER_FRAME 4096
 

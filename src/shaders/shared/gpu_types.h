@@ -13,14 +13,44 @@ GDR_STRUCT_BEGIN(GdrGpuVertex)
     gdr_vec2 uv;
 GDR_STRUCT_END(GdrGpuVertex)
 
-/* Where a mesh lives in the merged vertex and index buffers, and its bounds (seed 003, plan A). */
+/* Where a mesh lives in the merged vertex, index and cluster buffers, and its bounds (seed 003, plan A). */
 GDR_STRUCT_BEGIN(GdrGpuMesh)
     gdr_uint vertex_offset;
     gdr_uint first_index;
     gdr_uint index_count;
-    gdr_uint reserved;
-    gdr_vec4 bounds; /* mesh-space sphere: centre xyz, radius w */
+    gdr_uint meshlet_count;  /* level-0 clusters */
+    gdr_vec4 bounds;         /* mesh-space sphere: centre xyz, radius w */
+    gdr_uint meshlet_offset; /* first GdrGpuMeshlet of the mesh */
+    gdr_uint task_count;     /* task workgroups per instance: ceil(meshlet_count / GDR_TASK_WORKGROUP_SIZE) */
+    gdr_uint reserved0;
+    gdr_uint reserved1;
 GDR_STRUCT_END(GdrGpuMesh)
+
+/* One cluster of the geometry pool (gdr_cluster of gdr/geometry.h, with pool-global offsets). */
+GDR_STRUCT_BEGIN(GdrGpuMeshlet)
+    gdr_uint vertex_offset;   /* first entry in the meshlet vertex pool (global vertex indices) */
+    gdr_uint triangle_offset; /* first byte in the meshlet triangle pool (3 bytes per triangle) */
+    gdr_uint vertex_count;
+    gdr_uint triangle_count;
+    gdr_vec4 sphere;          /* mesh space */
+    gdr_vec3 cone_apex;       /* mesh space */
+    float cone_cutoff;        /* back-facing from p when dot(normalize(apex - p), axis) >= cutoff */
+    gdr_vec3 cone_axis;
+    gdr_uint group;           /* LOD DAG (issue 5) */
+    gdr_uint refined_group;
+    gdr_uint reserved0;
+    gdr_uint reserved1;
+    gdr_uint reserved2;
+GDR_STRUCT_END(GdrGpuMeshlet)
+
+/* Task-shader work written by the instance cull of the meshlet pipeline: one task workgroup tests
+ * clusters [meshlet_first, meshlet_first + meshlet_count) of one instance. */
+GDR_STRUCT_BEGIN(GdrGpuTaskCommand)
+    gdr_uint instance;
+    gdr_uint meshlet_first; /* global GdrGpuMeshlet index */
+    gdr_uint meshlet_count; /* 1 .. GDR_TASK_WORKGROUP_SIZE */
+    gdr_uint reserved;
+GDR_STRUCT_END(GdrGpuTaskCommand)
 
 /* One instance of the persistent instance buffer. */
 GDR_STRUCT_BEGIN(GdrGpuInstance)
@@ -51,12 +81,26 @@ GDR_STRUCT_BEGIN(GdrGpuDrawCommand)
     gdr_uint first_instance;
 GDR_STRUCT_END(GdrGpuDrawCommand)
 
-/* Counters of the cull pass; draw_count (offset 0) is the count for vkCmdDrawIndexedIndirectCount. */
+/* Counters of a frame, zeroed before the cull. draw_count (offset 0) is the count for
+ * vkCmdDrawIndexedIndirectCount; task_groups (offset 16) is the VkDrawMeshTasksIndirectCommandEXT
+ * of the meshlet pipeline, written by the submit pass. */
 GDR_STRUCT_BEGIN(GdrGpuDrawStats)
-    gdr_uint draw_count;
-    gdr_uint triangles_low;  /* 64-bit triangle count as two words: the carry is added by the */
-    gdr_uint triangles_high; /* thread whose add wrapped the low word                          */
-    gdr_uint reserved;
+    gdr_uint draw_count;     /* visible instances (indirect draws appended) */
+    gdr_uint triangles_low;  /* 64-bit count of triangles drawn as two words: the carry is added */
+    gdr_uint triangles_high; /* by the thread whose add wrapped the low word                     */
+    gdr_uint task_count;     /* task commands appended (meshlet pipeline) */
+    gdr_uint task_groups_x;  /* VkDrawMeshTasksIndirectCommandEXT */
+    gdr_uint task_groups_y;
+    gdr_uint task_groups_z;
+    gdr_uint task_overflow;  /* task commands that did not fit (never expected: sized from the scene) */
+    gdr_uint meshlets_tested;
+    gdr_uint meshlets_frustum_culled;
+    gdr_uint meshlets_cone_culled;
+    gdr_uint meshlets_visible;
+    gdr_uint triangles_backface_culled;
+    gdr_uint triangles_small_culled; /* covering no sample */
+    gdr_uint meshlets_recorded;      /* entries appended to the visible-meshlet record */
+    gdr_uint reserved0;
 GDR_STRUCT_END(GdrGpuDrawStats)
 
 /* Per-frame constants, written by the CPU into its frame's slot. */
@@ -71,10 +115,24 @@ GDR_STRUCT_BEGIN(GdrGpuFrameGlobals)
     gdr_uint instance_count;
     gdr_uint cull_enabled;
     gdr_uint update_count;    /* records in this frame's ring slot */
+    gdr_uint flags;           /* GDR_FRAME_* */
+    gdr_uint view_mode;       /* GDR_VIEW_* */
+    gdr_uint task_capacity;   /* GdrGpuTaskCommand entries in the task buffer */
+    gdr_vec2 viewport;        /* render target size in pixels */
     gdr_uint reserved0;
     gdr_uint reserved1;
-    gdr_uint reserved2;
 GDR_STRUCT_END(GdrGpuFrameGlobals)
+
+#define GDR_FRAME_MESHLET_FRUSTUM 1u  /* task shader: cluster sphere vs frustum */
+#define GDR_FRAME_MESHLET_CONE 2u     /* task shader: cluster normal cone vs camera */
+#define GDR_FRAME_TRIANGLE_CULL 4u    /* mesh shader: back-facing triangles and triangles covering no sample */
+#define GDR_FRAME_RECORD_MESHLETS 8u  /* task shader: append (instance, cluster) of every visible cluster */
+
+#define GDR_VIEW_SHADED 0u
+#define GDR_VIEW_MESHLETS 1u  /* colour from a hash of the cluster's global index */
+#define GDR_VIEW_INSTANCES 2u /* colour from a hash of the instance index */
+#define GDR_VIEW_TRIANGLES 3u /* colour from a hash of the triangle: triangle density */
+#define GDR_VIEW_OVERDRAW 4u  /* fragments per pixel, as a heat map */
 
 /* Push constants of every pass: device addresses of the buffers it uses. */
 GDR_STRUCT_BEGIN(GdrGpuPushConstants)
@@ -84,6 +142,13 @@ GDR_STRUCT_BEGIN(GdrGpuPushConstants)
     gdr_uint64 draws;      /* GdrGpuDrawCommand[] */
     gdr_uint64 draw_stats; /* GdrGpuDrawStats */
     gdr_uint64 updates;    /* GdrGpuInstanceUpdate[] of this frame's ring slot */
+    gdr_uint64 vertices;   /* GdrGpuVertex[] */
+    gdr_uint64 meshlets;   /* GdrGpuMeshlet[] */
+    gdr_uint64 meshlet_vertices;  /* uint[]: global vertex index per cluster-local vertex */
+    gdr_uint64 meshlet_triangles; /* uint[] holding the bytes of the cluster-local triangles */
+    gdr_uint64 tasks;      /* GdrGpuTaskCommand[] */
+    gdr_uint64 overdraw;   /* uint[] per pixel (overdraw view) */
+    gdr_uint64 visible_meshlets; /* uvec2[] (instance, global cluster index) when recording */
 GDR_STRUCT_END(GdrGpuPushConstants)
 
 #endif

@@ -1,0 +1,99 @@
+/* The CPU-driven baseline (issue 7, seed 003's "before"): every frame the CPU culls the instances
+ * with the gdr/cull.h library (octree, frustum planes) and records, per visible instance, its own
+ * binds (vertex buffer, index buffer, push constants) and one vkCmdDrawIndexed. It exists to be
+ * measured against the GPU-driven pipelines on the same scene and camera, and to draw the same image. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gdr/cull.h"
+#include "render/renderer_internal.h"
+#include "shaders/shared/cull_math.h"
+
+/* The bounds of a moved instance: the mesh sphere under its transform, as the GPU culls it. */
+static gdr_cull_object object_from_instance(const GdrGpuInstance *instance, const GdrGpuMesh *mesh)
+{
+    const float *m = instance->model.m;
+    gdr_vec4 b = mesh->bounds;
+    gdr_vec3 center = {m[0] * b.x + m[4] * b.y + m[8] * b.z + m[12], m[1] * b.x + m[5] * b.y + m[9] * b.z + m[13],
+                       m[2] * b.x + m[6] * b.y + m[10] * b.z + m[14]};
+    float radius = b.w * gdr_max_axis_scale((gdr_vec3){m[0], m[1], m[2]}, (gdr_vec3){m[4], m[5], m[6]},
+                                            (gdr_vec3){m[8], m[9], m[10]});
+    return (gdr_cull_object){.center = center, .radius = radius, .extent = {radius, radius, radius}};
+}
+
+gdr_status gdr_cpu_path_create(gdr_renderer *r, const gdr_scene *scene, gdr_error *err)
+{
+    gdr_cpu_path *cpu = &r->cpu;
+    uint32_t count = scene->instance_count;
+    gdr_cull_object *objects = malloc(sizeof *objects * (count ? count : 1));
+    cpu->visible_bits = calloc(gdr_cull_word_count(count) + 1, sizeof(uint32_t));
+    cpu->visible = malloc(sizeof(uint32_t) * (count ? count : 1));
+    if (!objects || !cpu->visible_bits || !cpu->visible) {
+        free(objects);
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "CPU pipeline: out of memory");
+    }
+    /* The library's own bounds: a box and a sphere from the transformed mesh. */
+    gdr_cull_objects_from_scene(objects, scene);
+    gdr_cull_scene_desc desc = {.objects = objects, .object_count = count};
+    gdr_status status = gdr_cull_scene_create(&desc, &cpu->cull_scene, err);
+    free(objects);
+    return status;
+}
+
+void gdr_cpu_path_destroy(gdr_renderer *r)
+{
+    gdr_cull_scene_destroy(r->cpu.cull_scene);
+    free(r->cpu.visible_bits);
+    free(r->cpu.visible);
+    memset(&r->cpu, 0, sizeof r->cpu);
+}
+
+gdr_status gdr_cpu_path_update_instance(gdr_renderer *r, uint32_t index, gdr_error *err)
+{
+    const GdrGpuInstance *instance = &r->scene.cpu_instances[index];
+    gdr_cull_object object = object_from_instance(instance, &r->scene.cpu_meshes[instance->mesh]);
+    return gdr_cull_scene_update(r->cpu.cull_scene, index, 1, &object, err);
+}
+
+gdr_status gdr_cpu_path_cull(gdr_renderer *r, const gdr_frame_desc *frame, gdr_error *err)
+{
+    gdr_cpu_path *cpu = &r->cpu;
+    double start = gdr_now_ms();
+    gdr_cull_view view = {.skip_frustum = frame->cull == GDR_CULL_OFF};
+    gdr_frame_matrices(r, &frame->camera, &view.projection, &view.view);
+    gdr_cull_result result = {.visible = cpu->visible_bits};
+    gdr_status status = gdr_cull_execute(cpu->cull_scene, &view, NULL, &result, NULL, err);
+    if (status != GDR_OK)
+        return status;
+    uint32_t count = 0;
+    uint64_t triangles = 0;
+    for (uint32_t w = 0; w < gdr_cull_word_count(r->scene.instance_count); w++) {
+        for (uint32_t bits = cpu->visible_bits[w]; bits; bits &= bits - 1) {
+            uint32_t i = w * 32 + (uint32_t)__builtin_ctz(bits);
+            cpu->visible[count++] = i;
+            triangles += r->scene.cpu_meshes[r->scene.cpu_instances[i].mesh].index_count / 3;
+        }
+    }
+    cpu->visible_count = count;
+    cpu->triangles = triangles;
+    cpu->cull_ms += gdr_now_ms() - start;
+    return GDR_OK;
+}
+
+void gdr_cpu_path_record_draws(gdr_renderer *r, VkCommandBuffer cmd, const GdrGpuPushConstants *push)
+{
+    const gdr_gpu_scene *g = &r->scene;
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->draw_pipeline);
+    for (uint32_t v = 0; v < r->cpu.visible_count; v++) {
+        uint32_t i = r->cpu.visible[v];
+        const GdrGpuMesh *mesh = &g->cpu_meshes[g->cpu_instances[i].mesh];
+        /* As a renderer with a buffer pair and constants per object would: bind, push, draw. */
+        VkDeviceSize vertex_offset = (VkDeviceSize)mesh->vertex_offset * sizeof(GdrGpuVertex);
+        vkCmdBindVertexBuffers(cmd, 0, 1, &g->vertices.buffer, &vertex_offset);
+        vkCmdBindIndexBuffer(cmd, g->indices.buffer, (VkDeviceSize)mesh->first_index * sizeof(uint32_t),
+                             VK_INDEX_TYPE_UINT32);
+        vkCmdPushConstants(cmd, r->layout, VK_SHADER_STAGE_ALL, 0, sizeof *push, push);
+        vkCmdDrawIndexed(cmd, mesh->index_count, 1, 0, 0, i);
+    }
+}

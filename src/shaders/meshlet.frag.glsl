@@ -1,0 +1,22 @@
+#version 460
+// Shading for the meshlet pipeline: as mesh.frag, with the colour per primitive (debug views).
+#extension GL_EXT_mesh_shader : require
+#include "shared/glsl_buffers.h"
+#include "shared/shading.h"
+
+layout(early_fragment_tests) in;
+
+layout(location = 0) in vec3 in_normal;
+layout(location = 1) in vec3 in_world_position;
+layout(location = 2) perprimitiveEXT flat in vec4 in_color;
+
+layout(location = 0) out vec4 out_color;
+layout(buffer_reference, scalar) buffer OverdrawRef { uint items[]; };
+
+void main()
+{
+    GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
+    if (g.view_mode == GDR_VIEW_OVERDRAW) // fragments that passed the depth test, per pixel
+        atomicAdd(OverdrawRef(push.overdraw).items[uint(gl_FragCoord.y) * uint(g.viewport.x) + uint(gl_FragCoord.x)], 1u);
+    out_color = gdr_shade(g, in_normal, in_world_position, in_color.rgb);
+}

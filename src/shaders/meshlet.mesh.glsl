@@ -1,0 +1,109 @@
+#version 460
+// Draws one cluster per workgroup (seed 004): vertices transformed once, then per triangle the
+// back-face test and the "covers no sample" test (seed 000) mark triangles culled before raster.
+// Both tests are conservative against the rasteriser: a triangle is culled only when its 8-bit
+// sub-pixel snapped form (Vulkan's minimum precision) could not produce a fragment either.
+#extension GL_EXT_mesh_shader : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+
+#include "shared/glsl_buffers.h"
+#include "shared/meshlet_payload.h"
+#include "shared/shading.h"
+
+layout(local_size_x = GDR_MESH_WORKGROUP_SIZE) in;
+layout(triangles, max_vertices = GDR_MESH_MAX_VERTICES, max_primitives = GDR_MESH_MAX_TRIANGLES) out;
+
+taskPayloadSharedEXT GdrTaskPayload payload;
+
+// Only the built-ins used: the implicit blocks would also declare the shading-rate built-in, whose
+// capability the device does not enable.
+out gl_MeshPerVertexEXT { vec4 gl_Position; } gl_MeshVerticesEXT[];
+out gl_MeshPerPrimitiveEXT { perprimitiveEXT bool gl_CullPrimitiveEXT; } gl_MeshPrimitivesEXT[];
+
+layout(location = 0) out vec3 out_normal[];
+layout(location = 1) out vec3 out_world_position[];
+layout(location = 2) perprimitiveEXT flat out vec4 out_color[];
+
+shared vec3 screen[GDR_MESH_MAX_VERTICES]; // pixels (y up) and clip w
+
+uint triangle_byte(uint at)
+{
+    return (UintsRef(push.meshlet_triangles).items[at >> 2] >> ((at & 3u) * 8u)) & 255u;
+}
+
+// Non-zero when the triangle surely produces no fragment: 1 when back-facing beyond the snapping
+// error, 2 when its bounding box (grown by the snapping error) holds no pixel centre. Only for
+// triangles wholly in front of the camera; others are left to the clipper.
+uint triangle_culled(vec3 a, vec3 b, vec3 c)
+{
+    if (a.z <= 0.0 || b.z <= 0.0 || c.z <= 0.0)
+        return 0u;
+    const float snap = 1.0 / 256.0;
+    vec2 ab = b.xy - a.xy, ac = c.xy - a.xy;
+    float area = ab.x * ac.y - ab.y * ac.x; // counter-clockwise (front, y up) is positive
+    float perimeter = length(ab) + length(ac) + length(c.xy - b.xy);
+    if (area < -2.0 * snap * perimeter)
+        return 1u;
+    vec2 lo = min(a.xy, min(b.xy, c.xy)) - snap, hi = max(a.xy, max(b.xy, c.xy)) + snap;
+    // Pixel centres sit at k + 0.5; none in [lo, hi] on some axis means no sample is covered.
+    return any(lessThan(floor(hi - 0.5), ceil(lo - 0.5))) ? 2u : 0u;
+}
+
+void main()
+{
+    GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
+    uint meshlet_index = payload.meshlets[gl_WorkGroupID.x];
+    GdrGpuMeshlet meshlet = MeshletsRef(push.meshlets).items[meshlet_index];
+    GdrGpuInstance instance = InstancesRef(push.instances).items[payload.instance];
+    uint lane = gl_LocalInvocationIndex;
+    SetMeshOutputsEXT(meshlet.vertex_count, meshlet.triangle_count);
+
+    mat3 m = mat3(instance.model);
+    mat3 cofactor = mat3(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1]));
+    for (uint v = lane; v < meshlet.vertex_count; v += GDR_MESH_WORKGROUP_SIZE) {
+        uint vertex_index = UintsRef(push.meshlet_vertices).items[meshlet.vertex_offset + v];
+        GdrGpuVertex vertex = VerticesRef(push.vertices).items[vertex_index];
+        vec4 world = instance.model * vec4(vertex.position, 1.0);
+        vec4 clip = g.view_projection * world;
+        gl_MeshVerticesEXT[v].gl_Position = clip;
+        out_normal[v] = cofactor * vertex.normal;
+        out_world_position[v] = world.xyz;
+        vec2 ndc = clip.xy / clip.w;
+        screen[v] = vec3((ndc * 0.5 + 0.5) * g.viewport, clip.w);
+    }
+    barrier();
+
+    bool cull = g.cull_enabled != 0u && (g.flags & GDR_FRAME_TRIANGLE_CULL) != 0u;
+    uint emitted = 0u, backfacing = 0u, small = 0u;
+    for (uint t = lane; t < meshlet.triangle_count; t += GDR_MESH_WORKGROUP_SIZE) {
+        uint at = meshlet.triangle_offset + t * 3u;
+        uvec3 corners = uvec3(triangle_byte(at), triangle_byte(at + 1u), triangle_byte(at + 2u));
+        gl_PrimitiveTriangleIndicesEXT[t] = corners;
+        uint why = cull ? triangle_culled(screen[corners.x], screen[corners.y], screen[corners.z]) : 0u;
+        gl_MeshPrimitivesEXT[t].gl_CullPrimitiveEXT = why != 0u;
+        vec3 albedo = instance.color.rgb;
+        if (g.view_mode == GDR_VIEW_MESHLETS)
+            albedo = gdr_id_color(meshlet_index);
+        else if (g.view_mode == GDR_VIEW_INSTANCES)
+            albedo = gdr_id_color(payload.instance);
+        else if (g.view_mode == GDR_VIEW_TRIANGLES)
+            albedo = gdr_id_color(meshlet_index * 128u + t);
+        out_color[t] = vec4(albedo, 1.0);
+        emitted += why == 0u ? 1u : 0u;
+        backfacing += why == 1u ? 1u : 0u;
+        small += why == 2u ? 1u : 0u;
+    }
+    uint total_emitted = subgroupAdd(emitted);
+    uint total_backfacing = subgroupAdd(backfacing);
+    uint total_small = subgroupAdd(small);
+    if (subgroupElect()) {
+        DrawStatsRef stats = DrawStatsRef(push.draw_stats);
+        uint old = atomicAdd(stats.value.triangles_low, total_emitted);
+        if (old + total_emitted < old)
+            atomicAdd(stats.value.triangles_high, 1u);
+        if (total_backfacing > 0u)
+            atomicAdd(stats.value.triangles_backface_culled, total_backfacing);
+        if (total_small > 0u)
+            atomicAdd(stats.value.triangles_small_culled, total_small);
+    }
+}

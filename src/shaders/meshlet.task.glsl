@@ -1,0 +1,82 @@
+#version 460
+// Meshlet culling (seeds 000/001/004): one task workgroup per task command (up to
+// GDR_TASK_WORKGROUP_SIZE clusters of one visible instance), one thread per cluster: the cluster's
+// sphere against the frustum (the instance test's math), then its normal cone against the camera.
+// Survivors are compacted into the payload with subgroup ballots; one mesh workgroup each.
+#extension GL_EXT_mesh_shader : require
+#extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+
+#include "shared/glsl_buffers.h"
+#include "shared/cull_math.h"
+#include "shared/meshlet_payload.h"
+
+layout(local_size_x = GDR_TASK_WORKGROUP_SIZE) in;
+
+taskPayloadSharedEXT GdrTaskPayload payload;
+layout(buffer_reference, scalar) writeonly buffer VisibleMeshletsRef { uvec2 items[]; };
+shared uint visible_count;
+
+void main()
+{
+    GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
+    DrawStatsRef stats = DrawStatsRef(push.draw_stats);
+    uint task_index = gl_WorkGroupID.x + gl_WorkGroupID.y * GDR_TASK_GROUPS_PER_ROW;
+    uint task_count = min(stats.value.task_count, g.task_capacity);
+    uint lane = gl_LocalInvocationIndex;
+    if (lane == 0u)
+        visible_count = 0u;
+
+    bool in_task = false, visible = false, frustum_culled = false, cone_culled = false;
+    GdrGpuTaskCommand task = GdrGpuTaskCommand(0u, 0u, 0u, 0u);
+    if (task_index < task_count) {
+        task = TaskCommandsRef(push.tasks).items[task_index];
+        in_task = lane < task.meshlet_count;
+    }
+    if (in_task) {
+        GdrGpuMeshlet meshlet = MeshletsRef(push.meshlets).items[task.meshlet_first + lane];
+        mat4 model = InstancesRef(push.instances).items[task.instance].model;
+        visible = true;
+        bool cull = g.cull_enabled != 0u;
+        if (cull && (g.flags & GDR_FRAME_MESHLET_FRUSTUM) != 0u) {
+            vec3 center = (g.view * (model * vec4(meshlet.sphere.xyz, 1.0))).xyz;
+            float radius = meshlet.sphere.w * gdr_max_axis_scale(model[0].xyz, model[1].xyz, model[2].xyz);
+            visible = gdr_sphere_visible(g.frustum, center, radius, g.znear, g.zfar);
+            frustum_culled = !visible;
+        }
+        mat3 linear = mat3(model);
+        if (visible && cull && (g.flags & GDR_FRAME_MESHLET_CONE) != 0u && determinant(linear) > 0.0) {
+            vec3 camera = inverse(linear) * (g.camera_position.xyz - model[3].xyz);
+            cone_culled = gdr_cone_backfacing(meshlet.cone_apex, meshlet.cone_axis, meshlet.cone_cutoff, camera);
+            visible = !cone_culled;
+        }
+    }
+    barrier();
+
+    uvec4 ballot = subgroupBallot(visible);
+    uint base = 0u;
+    if (subgroupElect())
+        base = atomicAdd(visible_count, subgroupBallotBitCount(ballot));
+    base = subgroupBroadcastFirst(base);
+    if (visible)
+        payload.meshlets[base + subgroupBallotExclusiveBitCount(ballot)] = task.meshlet_first + lane;
+    if (lane == 0u)
+        payload.instance = task.instance;
+    if ((g.flags & GDR_FRAME_RECORD_MESHLETS) != 0u && visible) {
+        uint at = atomicAdd(stats.value.meshlets_recorded, 1u);
+        VisibleMeshletsRef(push.visible_meshlets).items[at] = uvec2(task.instance, task.meshlet_first + lane);
+    }
+
+    uint tested = subgroupAdd(in_task ? 1u : 0u);
+    uint frustum = subgroupAdd(frustum_culled ? 1u : 0u);
+    uint cone = subgroupAdd(cone_culled ? 1u : 0u);
+    uint drawn = subgroupAdd(visible ? 1u : 0u);
+    if (subgroupElect() && tested > 0u) {
+        atomicAdd(stats.value.meshlets_tested, tested);
+        atomicAdd(stats.value.meshlets_frustum_culled, frustum);
+        atomicAdd(stats.value.meshlets_cone_culled, cone);
+        atomicAdd(stats.value.meshlets_visible, drawn);
+    }
+    barrier();
+    EmitMeshTasksEXT(visible_count, 1u, 1u);
+}

@@ -1,0 +1,7 @@
+#version 460
+// Overdraw view, step 2: one triangle that covers the target.
+void main()
+{
+    vec2 corner = vec2(float((gl_VertexIndex << 1) & 2), float(gl_VertexIndex & 2));
+    gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0);
+}

@@ -1,0 +1,34 @@
+/* GLSL only: the forward shading every raster path uses, and the debug-view colours. */
+#ifndef GDR_SHADING_H
+#define GDR_SHADING_H
+
+/* A directional light, a sky/ground ambient term and a faint world grid; returns sRGB-encoded colour. */
+vec4 gdr_shade(GdrGpuFrameGlobals g, vec3 normal, vec3 world_position, vec3 albedo)
+{
+    vec3 n = normalize(normal);
+    float diffuse = max(dot(n, g.light_direction.xyz), 0.0);
+    float sky = 0.5 + 0.5 * n.y;
+    vec3 checker = vec3(0.92 + 0.08 * mod(floor(world_position.x) + floor(world_position.z), 2.0));
+    vec3 color = albedo * checker * (0.18 + 0.17 * sky + 0.7 * diffuse);
+    return vec4(pow(color, vec3(1.0 / 2.2)), 1.0);
+}
+
+/* A well-spread 32-bit hash (integer mix), for debug colours. */
+uint gdr_hash(uint x)
+{
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x;
+}
+
+/* A bright colour from an id: three bytes of its hash, lifted away from black. */
+vec3 gdr_id_color(uint id)
+{
+    uint h = gdr_hash(id);
+    return vec3(float(h & 255u), float((h >> 8) & 255u), float((h >> 16) & 255u)) * (0.75 / 255.0) + 0.25;
+}
+
+#endif
