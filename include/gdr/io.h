@@ -78,7 +78,7 @@ GDR_API gdr_status gdr_image_decode(const void *data, size_t size, const char *n
 
 /* --- processed-scene cache ------------------------------------------------------------------ */
 
-#define GDR_CACHE_FORMAT_VERSION 1u
+#define GDR_CACHE_FORMAT_VERSION 2u
 
 /* What a cache was built from: the build options (a string that changes whenever the processing
  * would produce different data, e.g. "import=1") and the source files. */
@@ -109,12 +109,14 @@ GDR_API size_t gdr_cache_path_for(const char *source_path, const char *cache_dir
 /* The build options string of this version of the importers. */
 GDR_API const char *gdr_cache_build_options(void);
 
-/* Imports any supported source file (.gltf, .glb, .obj by extension) without the cache. */
+/* Imports any supported source file (.gltf, .glb, .obj by extension) without the cache, and
+ * builds every mesh's clusters (gdr_scene_build_clusters, include/gdr/geometry.h). */
 GDR_API gdr_status gdr_import_file(const char *path, const gdr_import_options *options, gdr_scene **out,
                                    gdr_import_result *result, gdr_error *err);
 
 /* A source file (.gltf, .glb, .obj) through the cache, or a .gdrc file directly: what
- * gdr_scene_load_ex does for paths. See gdr_load_options in scene.h. */
+ * gdr_scene_load_ex does for paths. See gdr_load_options in scene.h. Every mesh of the scene has
+ * its clusters: read from the cache, or built (a cache written from a scene without them). */
 GDR_API gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options, gdr_scene **out,
                                        gdr_error *err);
 

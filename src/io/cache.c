@@ -33,15 +33,18 @@ enum {
     SEC_CAMERAS = FOURCC('C', 'A', 'M', 'R'),
     SEC_TEXTURES = FOURCC('T', 'E', 'X', 'R'),
     SEC_PIXELS = FOURCC('T', 'X', 'P', 'X'),
+    SEC_CLUSTERS = FOURCC('C', 'L', 'U', 'S'),
+    SEC_CLUSTER_DATA = FOURCC('C', 'L', 'D', 'T'),
 };
 
 enum { MESH_RECORD = 64 + 8 + 16, MATERIAL_RECORD = 64 + 16 + 12 + 12 + 8, INSTANCE_RECORD = 64 + 8 + 16,
-       CAMERA_RECORD = 64 + 12 + 16 + 16, TEXTURE_RECORD = 64 + 12 };
+       CAMERA_RECORD = 64 + 12 + 16 + 16, TEXTURE_RECORD = 64 + 12, CLUSTERS_RECORD = 6 * 4,
+       CLUSTER_RECORD = 4 * 4 + 16 + 12 + 12 + 4 + 3 * 4, GROUP_RECORD = 16 + 4 + 3 * 4 };
 
 const char *gdr_cache_build_options(void)
 {
-    /* Bump when the importers' output for the same input changes. */
-    return "import=1";
+    /* Bump when the importers' or the geometry processing's output for the same input changes. */
+    return "import=1;meshlets=1";
 }
 
 /* --- writing --------------------------------------------------------------------------------- */
@@ -92,6 +95,11 @@ static void align8(writer *w)
 {
     static const uint8_t zeros[8] = {0};
     put(w, zeros, (8 - w->size % 8) % 8);
+}
+static void align4(writer *w)
+{
+    static const uint8_t zeros[4] = {0};
+    put(w, zeros, (4 - w->size % 4) % 4);
 }
 
 typedef struct section_entry {
@@ -194,6 +202,49 @@ static void write_sections(writer *w, const gdr_scene *s, const gdr_cache_source
     for (uint32_t i = 0; i < s->texture_count; i++)
         put(w, s->textures[i].rgba, (size_t)s->textures[i].width * s->textures[i].height * 4);
     END();
+
+    BEGIN(SEC_CLUSTERS, CACHE_SECTION_REQUIRED);
+    for (uint32_t i = 0; i < s->mesh_count; i++) {
+        const gdr_mesh_clusters *c = &s->meshes[i].clusters;
+        put_u32(w, c->cluster_count);
+        put_u32(w, c->level0_cluster_count);
+        put_u32(w, c->vertex_count);
+        put_u32(w, c->triangle_byte_count);
+        put_u32(w, c->group_count);
+        put_u32(w, c->dag_depth);
+    }
+    END();
+
+    BEGIN(SEC_CLUSTER_DATA, CACHE_SECTION_REQUIRED);
+    for (uint32_t i = 0; i < s->mesh_count; i++) {
+        const gdr_mesh_clusters *c = &s->meshes[i].clusters;
+        for (uint32_t k = 0; k < c->cluster_count; k++) {
+            const gdr_cluster *cl = &c->clusters[k];
+            put_u32(w, cl->vertex_offset);
+            put_u32(w, cl->triangle_offset);
+            put_u32(w, cl->vertex_count);
+            put_u32(w, cl->triangle_count);
+            put_f32s(w, &cl->sphere.x, 4);
+            put_f32s(w, &cl->cone_apex.x, 3);
+            put_f32s(w, &cl->cone_axis.x, 3);
+            put_f32s(w, &cl->cone_cutoff, 1);
+            put_u32(w, cl->group);
+            put_u32(w, cl->refined_group);
+            put_u32(w, cl->reserved);
+        }
+        for (uint32_t k = 0; k < c->group_count; k++) {
+            const gdr_cluster_group *g = &c->groups[k];
+            put_f32s(w, &g->sphere.x, 4);
+            put_f32s(w, &g->error, 1);
+            put_u32(w, g->depth);
+            put_u32(w, g->first_cluster);
+            put_u32(w, g->cluster_count);
+        }
+        put(w, c->vertices, sizeof(uint32_t) * c->vertex_count);
+        put(w, c->triangles, c->triangle_byte_count);
+        align4(w);
+    }
+    END();
 #undef BEGIN
 #undef END
     *count = n;
@@ -204,7 +255,7 @@ static void store_u64(uint8_t *p, uint64_t v) { memcpy(p, &v, 8); }
 
 gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_cache_source *source, gdr_error *err)
 {
-    enum { SECTION_COUNT = 9 };
+    enum { SECTION_COUNT = 11 };
     section_entry entries[SECTION_COUNT];
     uint32_t count = 0;
     writer w = {0};
@@ -330,16 +381,18 @@ static const char *get_string(reader *r, uint32_t *length)
     return (const char *)take(r, *length);
 }
 
+enum { K_SOURCE, K_SCENE, K_MESHES, K_GEOMETRY, K_MATERIALS, K_INSTANCES, K_CAMERAS, K_TEXTURES, K_PIXELS,
+       K_CLUSTERS, K_CLUSTER_DATA, K_COUNT };
+static const uint32_t known_ids[K_COUNT] = {SEC_SOURCE, SEC_SCENE, SEC_MESHES, SEC_GEOMETRY, SEC_MATERIALS,
+                                            SEC_INSTANCES, SEC_CAMERAS, SEC_TEXTURES, SEC_PIXELS, SEC_CLUSTERS,
+                                            SEC_CLUSTER_DATA};
+
 typedef struct cache_view {
     const uint8_t *data;
     size_t size;
-    reader sections[9]; /* by the order of the known ids below */
-    int present[9];
+    reader sections[K_COUNT]; /* by the order of the known ids above */
+    int present[K_COUNT];
 } cache_view;
-
-static const uint32_t known_ids[9] = {SEC_SOURCE, SEC_SCENE, SEC_MESHES, SEC_GEOMETRY, SEC_MATERIALS,
-                                      SEC_INSTANCES, SEC_CAMERAS, SEC_TEXTURES, SEC_PIXELS};
-enum { K_SOURCE, K_SCENE, K_MESHES, K_GEOMETRY, K_MATERIALS, K_INSTANCES, K_CAMERAS, K_TEXTURES, K_PIXELS };
 
 static void fourcc_text(uint32_t id, char out[5])
 {
@@ -390,7 +443,7 @@ static gdr_status parse_container(const char *name, const uint8_t *data, size_t 
         if (checksum != gdr_io_hash(data + offset, (size_t)length))
             return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: section '%s' checksum mismatch", name, text);
         int known = -1;
-        for (int k = 0; k < 9; k++)
+        for (int k = 0; k < K_COUNT; k++)
             if (known_ids[k] == id)
                 known = k;
         if (known < 0) {
@@ -404,7 +457,7 @@ static gdr_status parse_container(const char *name, const uint8_t *data, size_t 
         v->present[known] = 1;
         v->sections[known] = (reader){data + offset, (size_t)length, 0, 0};
     }
-    for (int k = K_SCENE; k <= K_PIXELS; k++)
+    for (int k = K_SCENE; k < K_COUNT; k++)
         if (!v->present[k]) {
             char text[5];
             fourcc_text(known_ids[k], text);
@@ -424,6 +477,137 @@ static int all_finite(const float *v, size_t n)
 }
 
 #define BAD(...) do { status = gdr_error_set(err, GDR_ERROR_PARSE, __VA_ARGS__); goto done; } while (0)
+
+/* --- clusters: CLUS (per mesh counts) and CLDT (per mesh arrays) ------------------------------ */
+
+static int bad_sphere(const gdr_vec4 *sphere) { return !all_finite(&sphere->x, 4) || !(sphere->w >= 0.0f); }
+
+/* Reads the arrays of one mesh's clusters (counts already set in c, arrays allocated) and checks
+ * every offset, count and index against the limits, the arrays and the mesh. */
+static gdr_status read_mesh_clusters(const char *name, reader *r, uint32_t m, const gdr_mesh *mesh,
+                                     gdr_mesh_clusters *c, gdr_error *err)
+{
+#define CLDT(fmt, ...) gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLDT': mesh %u" fmt, name, m, __VA_ARGS__)
+    for (uint32_t k = 0; k < c->cluster_count; k++) {
+        gdr_cluster *cl = &c->clusters[k];
+        cl->vertex_offset = get_u32(r);
+        cl->triangle_offset = get_u32(r);
+        cl->vertex_count = get_u32(r);
+        cl->triangle_count = get_u32(r);
+        get_f32s(r, &cl->sphere.x, 4);
+        get_f32s(r, &cl->cone_apex.x, 3);
+        get_f32s(r, &cl->cone_axis.x, 3);
+        get_f32s(r, &cl->cone_cutoff, 1);
+        cl->group = get_u32(r);
+        cl->refined_group = get_u32(r);
+        cl->reserved = get_u32(r);
+        if (cl->vertex_count < 1 || cl->vertex_count > GDR_CLUSTER_MAX_VERTICES || cl->triangle_count < 1 ||
+            cl->triangle_count > GDR_CLUSTER_MAX_TRIANGLES)
+            return CLDT(" cluster %u: %u vertices and %u triangles (1 to %u and %u)", k, cl->vertex_count,
+                        cl->triangle_count, GDR_CLUSTER_MAX_VERTICES, GDR_CLUSTER_MAX_TRIANGLES);
+        if ((uint64_t)cl->vertex_offset + cl->vertex_count > c->vertex_count)
+            return CLDT(" cluster %u: vertices %u..%u lie outside the mesh's %u cluster vertices", k,
+                        cl->vertex_offset, cl->vertex_offset + (cl->vertex_count - 1), c->vertex_count);
+        if (cl->triangle_offset % 4 != 0 || (uint64_t)cl->triangle_offset + 3ull * cl->triangle_count >
+                                                c->triangle_byte_count)
+            return CLDT(" cluster %u: triangle bytes at %u (%u triangles) are unaligned or lie outside the mesh's %u",
+                        k, cl->triangle_offset, cl->triangle_count, c->triangle_byte_count);
+        if (bad_sphere(&cl->sphere) || !all_finite(&cl->cone_apex.x, 3) || !all_finite(&cl->cone_axis.x, 3) ||
+            !all_finite(&cl->cone_cutoff, 1))
+            return CLDT(" cluster %u: bounds are not finite (or a negative radius)", k);
+        if ((cl->group != GDR_NO_INDEX && cl->group >= c->group_count) ||
+            (cl->refined_group != GDR_NO_INDEX && cl->refined_group >= c->group_count))
+            return CLDT(" cluster %u: group %u / refined group %u does not exist (%u groups)", k, cl->group,
+                        cl->refined_group, c->group_count);
+    }
+    for (uint32_t k = 0; k < c->group_count; k++) {
+        gdr_cluster_group *g = &c->groups[k];
+        get_f32s(r, &g->sphere.x, 4);
+        get_f32s(r, &g->error, 1);
+        g->depth = get_u32(r);
+        g->first_cluster = get_u32(r);
+        g->cluster_count = get_u32(r);
+        if (bad_sphere(&g->sphere) || isnan(g->error))
+            return CLDT(" group %u: sphere or error is not a number", k);
+        if ((uint64_t)g->first_cluster + g->cluster_count > c->cluster_count)
+            return CLDT(" group %u: clusters %u (+%u) lie outside the mesh's %u", k, g->first_cluster,
+                        g->cluster_count, c->cluster_count);
+    }
+    const uint8_t *vertices = take(r, sizeof(uint32_t) * (size_t)c->vertex_count);
+    const uint8_t *triangles = take(r, c->triangle_byte_count);
+    take(r, (4 - c->triangle_byte_count % 4) % 4);
+    if (r->failed) /* the caller checked the sizes: only a programming error gets here */
+        return CLDT(" %s", "runs past the section");
+    memcpy(c->vertices, vertices, sizeof(uint32_t) * (size_t)c->vertex_count);
+    memcpy(c->triangles, triangles, c->triangle_byte_count);
+    for (uint32_t k = 0; k < c->vertex_count; k++)
+        if (c->vertices[k] >= mesh->vertex_count)
+            return CLDT(" cluster vertex %u: mesh vertex %u does not exist (%u vertices)", k, c->vertices[k],
+                        mesh->vertex_count);
+    uint64_t level0_triangles = 0;
+    for (uint32_t k = 0; k < c->cluster_count; k++) {
+        const gdr_cluster *cl = &c->clusters[k];
+        const uint8_t *local = c->triangles + cl->triangle_offset;
+        for (uint32_t t = 0; t < 3 * cl->triangle_count; t++)
+            if (local[t] >= cl->vertex_count)
+                return CLDT(" cluster %u triangle %u: local vertex %u, the cluster has %u", k, t / 3, local[t],
+                            cl->vertex_count);
+        if (k < c->level0_cluster_count)
+            level0_triangles += cl->triangle_count;
+    }
+    if (level0_triangles != mesh->index_count / 3)
+        return CLDT(": level-0 clusters hold %llu triangles, the mesh %u", (unsigned long long)level0_triangles,
+                    mesh->index_count / 3);
+#undef CLDT
+    return GDR_OK;
+}
+
+static gdr_status read_clusters(const char *name, cache_view *v, gdr_scene *s, gdr_error *err)
+{
+    reader *counts = &v->sections[K_CLUSTERS], *data = &v->sections[K_CLUSTER_DATA];
+    for (uint32_t m = 0; m < s->mesh_count; m++) {
+        gdr_mesh *mesh = &s->meshes[m];
+        uint32_t cluster_count = get_u32(counts), level0 = get_u32(counts), vertex_count = get_u32(counts);
+        uint32_t triangle_bytes = get_u32(counts), group_count = get_u32(counts), dag_depth = get_u32(counts);
+        if (level0 > cluster_count || (cluster_count == 0 && (vertex_count || triangle_bytes || group_count ||
+                                                              dag_depth)) ||
+            (cluster_count > 0 && (level0 == 0 || mesh->index_count == 0)))
+            return gdr_error_set(err, GDR_ERROR_PARSE,
+                                 "%s: section 'CLUS': mesh %u: %u clusters (%u of level 0) for %u indices, %u cluster "
+                                 "vertices, %u triangle bytes, %u groups: inconsistent", name, m, cluster_count,
+                                 level0, mesh->index_count, vertex_count, triangle_bytes, group_count);
+        uint64_t need = (uint64_t)cluster_count * CLUSTER_RECORD + (uint64_t)group_count * GROUP_RECORD +
+                        (uint64_t)vertex_count * 4 + ((uint64_t)triangle_bytes + 3) / 4 * 4;
+        if (need > data->size - data->at)
+            return gdr_error_set(err, GDR_ERROR_PARSE,
+                                 "%s: section 'CLDT': mesh %u: %u clusters, %u groups, %u vertices and %u triangle "
+                                 "bytes run past the section", name, m, cluster_count, group_count, vertex_count,
+                                 triangle_bytes);
+        if (cluster_count == 0)
+            continue;
+        gdr_mesh_clusters *c = &mesh->clusters; /* owned by the scene from here: freed with it */
+        c->clusters = malloc(sizeof(gdr_cluster) * (size_t)cluster_count);
+        c->vertices = malloc(sizeof(uint32_t) * (size_t)vertex_count + 1);
+        c->triangles = malloc((size_t)triangle_bytes + 1);
+        c->groups = group_count ? malloc(sizeof(gdr_cluster_group) * (size_t)group_count) : NULL;
+        if (!c->clusters || !c->vertices || !c->triangles || (group_count && !c->groups))
+            return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: mesh %u: out of memory for %u clusters", name, m,
+                                 cluster_count);
+        c->cluster_count = cluster_count;
+        c->level0_cluster_count = level0;
+        c->vertex_count = vertex_count;
+        c->triangle_byte_count = triangle_bytes;
+        c->group_count = group_count;
+        c->dag_depth = dag_depth;
+        gdr_status status = read_mesh_clusters(name, data, m, mesh, c, err);
+        if (status != GDR_OK)
+            return status;
+    }
+    if (data->at != data->size)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLDT' has %zu bytes left over", name,
+                             data->size - data->at);
+    return GDR_OK;
+}
 
 static gdr_status build_scene(const char *name, cache_view *v, gdr_scene **out, gdr_error *err)
 {
@@ -451,7 +635,7 @@ static gdr_status build_scene(const char *name, cache_view *v, gdr_scene **out, 
     struct { int k; uint32_t count, record; const char *id; } sizes[] = {
         {K_MESHES, mesh_count, MESH_RECORD, "MESH"},       {K_MATERIALS, material_count, MATERIAL_RECORD, "MATL"},
         {K_INSTANCES, instance_count, INSTANCE_RECORD, "INST"}, {K_CAMERAS, camera_count, CAMERA_RECORD, "CAMR"},
-        {K_TEXTURES, texture_count, TEXTURE_RECORD, "TEXR"},
+        {K_TEXTURES, texture_count, TEXTURE_RECORD, "TEXR"}, {K_CLUSTERS, mesh_count, CLUSTERS_RECORD, "CLUS"},
     };
     for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++)
         if (v->sections[sizes[i].k].size != (uint64_t)sizes[i].count * sizes[i].record)
@@ -515,6 +699,9 @@ static gdr_status build_scene(const char *name, cache_view *v, gdr_scene **out, 
     }
     if (geo->at != geo->size)
         BAD("%s: section 'GEOM' has %zu bytes left over", name, geo->size - geo->at);
+    status = read_clusters(name, v, s, err);
+    if (status != GDR_OK)
+        goto done;
 
     reader *ma = &v->sections[K_MATERIALS];
     for (uint32_t i = 0; i < material_count; i++) {

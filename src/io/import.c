@@ -10,15 +10,31 @@
 
 #include "io/io_internal.h"
 
+/* Builds the clusters of every mesh that has none (all of them after an import; none, normally,
+ * after a cache read); on failure destroys the scene. */
+static gdr_status build_clusters(const char *path, gdr_scene **scene, gdr_error *err)
+{
+    gdr_error build_err;
+    if (gdr_scene_build_clusters(*scene, NULL, &build_err) == GDR_OK)
+        return GDR_OK;
+    gdr_scene_destroy(*scene);
+    *scene = NULL;
+    return gdr_error_set(err, build_err.status, "%s: %s", path, build_err.message);
+}
+
 gdr_status gdr_import_file(const char *path, const gdr_import_options *options, gdr_scene **out,
                            gdr_import_result *result, gdr_error *err)
 {
-    if (gdr_io_has_extension(path, ".gltf") || gdr_io_has_extension(path, ".glb"))
-        return gdr_import_gltf(path, options, out, result, err);
-    if (gdr_io_has_extension(path, ".obj"))
-        return gdr_import_obj(path, options, out, result, err);
-    *out = NULL;
-    return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: unknown file type (.gltf, .glb, .obj or .gdrc)", path);
+    gdr_status status;
+    if (gdr_io_has_extension(path, ".gltf") || gdr_io_has_extension(path, ".glb")) {
+        status = gdr_import_gltf(path, options, out, result, err);
+    } else if (gdr_io_has_extension(path, ".obj")) {
+        status = gdr_import_obj(path, options, out, result, err);
+    } else {
+        *out = NULL;
+        return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: unknown file type (.gltf, .glb, .obj or .gdrc)", path);
+    }
+    return status == GDR_OK ? build_clusters(path, out, err) : status;
 }
 
 /* $XDG_CACHE_HOME/gdr or ~/.cache/gdr, created when missing; 0 when there is none. */
@@ -60,8 +76,10 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
         options = &defaults;
     *out = NULL;
     const char *build_options = gdr_cache_build_options();
-    if (gdr_io_has_extension(path, ".gdrc"))
-        return gdr_cache_read(path, build_options, out, err);
+    if (gdr_io_has_extension(path, ".gdrc")) {
+        gdr_status status = gdr_cache_read(path, build_options, out, err);
+        return status == GDR_OK ? build_clusters(path, out, err) : status;
+    }
     gdr_import_options import = {.warning = options->warning, .warning_user = options->warning_user,
                                  .no_progress = options->no_progress};
     if (options->no_cache)
@@ -83,7 +101,7 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
             continue;
         gdr_error cache_err;
         if (gdr_cache_read(candidates[i], build_options, out, &cache_err) == GDR_OK)
-            return GDR_OK;
+            return build_clusters(candidates[i], out, err);
         if (!strstr(cache_err.message, ": stale: "))
             warn(options, "%s; rebuilding it", cache_err.message);
     }

@@ -98,6 +98,8 @@ gdr_status gdr_scene_create_demo(const gdr_demo_desc *desc_in, gdr_scene **out, 
                              .znear = 0.1f, .zfar = 0.0f, .aspect = 0.0f};
         status = gdr_scene_add_camera(scene, &camera, err);
     }
+    if (status == GDR_OK)
+        status = gdr_scene_build_clusters(scene, NULL, err); /* meshlets (src/geometry) */
     if (status != GDR_OK) {
         gdr_scene_destroy(scene);
         return status;

@@ -10,6 +10,7 @@
 #include <xxhash.h>
 
 #include "gdr/io.h"
+#include "geometry/cluster_checks.h"
 #include "io_test_helpers.h"
 #include "test_util.h"
 
@@ -29,7 +30,7 @@ static int same_scene(const gdr_scene *a, const gdr_scene *b)
             memcmp(x->positions, y->positions, 12 * (size_t)x->vertex_count) ||
             memcmp(x->normals, y->normals, 12 * (size_t)x->vertex_count) ||
             memcmp(x->uvs, y->uvs, 8 * (size_t)x->vertex_count) ||
-            memcmp(x->indices, y->indices, 4 * (size_t)x->index_count))
+            memcmp(x->indices, y->indices, 4 * (size_t)x->index_count) || !same_clusters(&x->clusters, &y->clusters))
             return 0;
     }
     for (uint32_t i = 0; i < a->material_count; i++)
@@ -103,7 +104,9 @@ static void test_round_trip_and_corruption(const char *label, gdr_scene *scene)
     copy[8] = 99;
     gdr_scene *s = NULL;
     CHECK(gdr_cache_read_memory(copy, size, label, &s, &err) == GDR_ERROR_UNSUPPORTED);
-    CHECK(strstr(err.message, "cache format version 99, this build reads 1") != NULL);
+    char expected[80];
+    snprintf(expected, sizeof expected, "cache format version 99, this build reads %u", GDR_CACHE_FORMAT_VERSION);
+    CHECK(strstr(err.message, expected) != NULL);
     free(copy);
     free(data);
     printf("%s: %zu bytes, %u truncations refused, 2000 corruptions refused\n", label, size, refused);

@@ -40,14 +40,28 @@ int gdr_cmd_info(int argc, char **argv)
         fprintf(stderr, "gdr: %s\n", err.message);
         return 1;
     }
-    uint64_t vertices = 0, unique_triangles = 0;
+    uint64_t vertices = 0, unique_triangles = 0, clusters = 0, level0 = 0, cluster_triangles = 0;
+    uint64_t cluster_vertices = 0;
     for (uint32_t i = 0; i < scene->mesh_count; i++) {
+        const gdr_mesh_clusters *c = &scene->meshes[i].clusters;
         vertices += scene->meshes[i].vertex_count;
         unique_triangles += scene->meshes[i].index_count / 3;
+        clusters += c->cluster_count;
+        level0 += c->level0_cluster_count;
+        for (uint32_t k = 0; k < c->cluster_count; k++) {
+            cluster_triangles += c->clusters[k].triangle_count;
+            cluster_vertices += c->clusters[k].vertex_count;
+        }
     }
     printf("scene:       %s\n", input);
     printf("meshes:      %u (%llu vertices, %llu triangles)\n", scene->mesh_count, (unsigned long long)vertices,
            (unsigned long long)unique_triangles);
+    printf("clusters:    %llu (%.1f triangles, %.1f vertices each on average", (unsigned long long)clusters,
+           clusters ? (double)cluster_triangles / (double)clusters : 0.0,
+           clusters ? (double)cluster_vertices / (double)clusters : 0.0);
+    if (level0 != clusters)
+        printf("; %llu at level 0", (unsigned long long)level0);
+    printf(")\n");
     printf("instances:   %u\n", scene->instance_count);
     printf("triangles:   %llu (over all instances)\n", (unsigned long long)gdr_scene_triangle_count(scene));
     printf("materials:   %u\n", scene->material_count);
