@@ -39,6 +39,8 @@ int gdr_cmd_bench(int argc, char **argv)
     uint32_t frames = 20, width = 1920, height = 1080;
     const char *device = NULL, *json_path = NULL;
     bool validate = false, has_camera = false;
+    gdr_pipeline pipelines[3] = {GDR_PIPELINE_DEFAULT};
+    uint32_t pipeline_count = 1;
     gdr_vec3 camera_position;
     gdr_quat camera_rotation;
     for (int i = 1; i < argc; i++) {
@@ -64,6 +66,19 @@ int gdr_cmd_bench(int argc, char **argv)
             ok = has_camera = cli_parse_camera(arg, value, &camera_position, &camera_rotation);
         else if (strcmp(arg, "--json") == 0)
             json_path = value;
+        else if (strcmp(arg, "--pipelines") == 0) {
+            char list[64];
+            snprintf(list, sizeof list, "%s", value);
+            pipeline_count = 0;
+            for (char *save = NULL, *item = strtok_r(list, ",", &save); item && ok; item = strtok_r(NULL, ",", &save)) {
+                if (pipeline_count == 3) {
+                    fprintf(stderr, "gdr: --pipelines: at most 3\n");
+                    return 2;
+                }
+                ok = cli_parse_pipeline(arg, item, &pipelines[pipeline_count++]);
+            }
+            ok = ok && pipeline_count > 0;
+        }
         else {
             fprintf(stderr, "gdr bench: unknown option '%s' (see gdr --help)\n", arg);
             return 2;
@@ -73,10 +88,9 @@ int gdr_cmd_bench(int argc, char **argv)
     }
 
     cJSON *rows = cJSON_CreateArray();
-    printf("%10s %10s %12s %10s %10s %10s %10s %10s %10s %10s\n", "instances", "visible", "triangles", "cpu_ms",
-           "cpu_median", "submit_ms",
-           "gpu_update",
-           "gpu_cull", "gpu_draw", "gpu_frame");
+    printf("%10s %9s %10s %12s %10s %10s %10s %10s %10s %10s %10s %10s\n", "instances", "pipeline", "visible",
+           "triangles", "meshlets", "cpu_ms", "cpu_median", "submit_ms", "gpu_update", "gpu_cull", "gpu_draw",
+           "gpu_frame");
     double first_cpu = 0.0;
     int result = 0;
     for (uint32_t s = 0; s < size_count && result == 0; s++) {
@@ -91,8 +105,10 @@ int gdr_cmd_bench(int argc, char **argv)
             gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK) {
             fprintf(stderr, "gdr: %s\n", err.message);
             result = 1;
-        } else {
-            gdr_frame_desc frame = {.camera = scene->cameras[0], .cull = GDR_CULL_ON};
+        }
+        /* Every pipeline on the same scene, renderer and camera, one after the other. */
+        for (uint32_t p = 0; p < pipeline_count && result == 0; p++) {
+            gdr_frame_desc frame = {.camera = scene->cameras[0], .cull = GDR_CULL_ON, .pipeline = pipelines[p]};
             if (has_camera) {
                 frame.camera.position = camera_position;
                 frame.camera.rotation = camera_rotation;
@@ -102,17 +118,27 @@ int gdr_cmd_bench(int argc, char **argv)
                 gdr_renderer_render(renderer, &frame, frames, &stats, &err) != GDR_OK) {
                 fprintf(stderr, "gdr: %s\n", err.message);
                 result = 1;
+                break;
             }
-        }
-        if (result == 0) {
-            if (s == 0)
+            if (s == 0 && p == 0)
                 first_cpu = stats.cpu_ms_per_frame_median;
-            printf("%10u %10u %12llu %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f\n", stats.instances_total,
-                   stats.instances_visible, (unsigned long long)stats.triangles, stats.cpu_ms_per_frame,
-                   stats.cpu_ms_per_frame_median, stats.cpu_submit_ms_per_frame, stats.passes[0].gpu_ms,
-                   stats.passes[1].gpu_ms, stats.passes[2].gpu_ms, stats.gpu_ms_per_frame);
+            printf("%10u %9s %10u %12llu %10u %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f\n", stats.instances_total,
+                   gdr_pipeline_name(stats.pipeline), stats.instances_visible, (unsigned long long)stats.triangles,
+                   stats.meshlets_visible, stats.cpu_ms_per_frame, stats.cpu_ms_per_frame_median,
+                   stats.cpu_submit_ms_per_frame, stats.passes[0].gpu_ms, stats.passes[1].gpu_ms, stats.passes[2].gpu_ms,
+                   stats.gpu_ms_per_frame);
             fflush(stdout);
             cJSON *row = cJSON_CreateObject();
+            cJSON_AddStringToObject(row, "pipeline", gdr_pipeline_name(stats.pipeline));
+            cJSON_AddNumberToObject(row, "draw_calls", stats.draw_calls);
+            cJSON_AddNumberToObject(row, "cpu_cull_ms_per_frame", stats.cpu_cull_ms_per_frame);
+            cJSON_AddNumberToObject(row, "meshlets_total", (double)stats.meshlets_total);
+            cJSON_AddNumberToObject(row, "meshlets_tested", stats.meshlets_tested);
+            cJSON_AddNumberToObject(row, "meshlets_frustum_culled", stats.meshlets_frustum_culled);
+            cJSON_AddNumberToObject(row, "meshlets_cone_culled", stats.meshlets_cone_culled);
+            cJSON_AddNumberToObject(row, "meshlets_visible", stats.meshlets_visible);
+            cJSON_AddNumberToObject(row, "triangles_backface_culled", stats.triangles_backface_culled);
+            cJSON_AddNumberToObject(row, "triangles_small_culled", stats.triangles_small_culled);
             cJSON_AddNumberToObject(row, "instances_total", stats.instances_total);
             cJSON_AddNumberToObject(row, "instances_visible", stats.instances_visible);
             cJSON_AddNumberToObject(row, "triangles", (double)stats.triangles);
@@ -122,8 +148,8 @@ int gdr_cmd_bench(int argc, char **argv)
             cJSON_AddNumberToObject(row, "cpu_median_ratio_to_first",
                                     first_cpu > 0 ? stats.cpu_ms_per_frame_median / first_cpu : 0);
             cJSON *passes = cJSON_AddObjectToObject(row, "gpu_ms");
-            for (uint32_t p = 0; p < stats.pass_count; p++)
-                cJSON_AddNumberToObject(passes, stats.passes[p].name, stats.passes[p].gpu_ms);
+            for (uint32_t pass = 0; pass < stats.pass_count; pass++)
+                cJSON_AddNumberToObject(passes, stats.passes[pass].name, stats.passes[pass].gpu_ms);
             cJSON_AddNumberToObject(row, "gpu_ms_per_frame", stats.gpu_ms_per_frame);
             cJSON_AddStringToObject(row, "device", stats.device);
             cJSON_AddStringToObject(row, "driver", stats.driver);
