@@ -105,6 +105,100 @@ GDR_API gdr_status gdr_scene_build_clusters(gdr_scene *scene, const gdr_meshlet_
 
 GDR_API void gdr_mesh_clusters_free(gdr_mesh_clusters *clusters);
 
+/* --- LOD DAG (issue 5) -----------------------------------------------------------------------
+ *
+ * gdr_mesh_build_lod_dag turns level 0 into a DAG (seed 004, Nanite): the current clusters are
+ * partitioned into groups of neighbours holding about as many triangles as four level-0 clusters
+ * (METIS over the graph of clusters that share edges, weighted by the number of shared edges);
+ * each group's triangles are merged, simplified to about half (meshoptimizer) with every vertex
+ * that the group shares with other groups locked, and split into new clusters; repeat until one
+ * cluster is left or nothing simplifies any more. The clusters that remain form the root group.
+ *
+ * After the build:
+ *  - every cluster has a `group` (the group it is part of); level-0 clusters have refined_group
+ *    GDR_NO_INDEX, every other cluster has the group it was made from as refined_group;
+ *  - the clusters of group g are clusters[groups[g].first_cluster .. + cluster_count), so the
+ *    clusters are ordered by group; level 0 still comes first (level0_cluster_count of them,
+ *    reordered by group), and clusters' data offsets need not increase with the cluster index;
+ *  - errors are mesh-space distances; every group's error is > 0 (at least 1e-6 of the mesh's
+ *    bounding radius) and at least the error of every group its clusters were made from; its
+ *    sphere contains their spheres and its clusters' spheres; the root group (the last one) has
+ *    error INFINITY; groups[g].depth is the build step that formed the group (0 for groups of
+ *    level-0 clusters), strictly greater than the depth of the groups its clusters were made from;
+ *    dag_depth is the root's depth.
+ *
+ * The cut (what to draw for one view), with E(g) the projected error of group g in pixels:
+ *     E(g) = error_w / max(distance(camera, centre_w) - radius_w, znear) * P[1][1] * 0.5 * viewport_height
+ * where centre_w is the group sphere's centre through the instance transform and radius_w, error_w
+ * are the radius and error times the transform's largest axis scale (E is INFINITY for the root):
+ *     a cluster is drawn  <=>  passes(refined_group) && !passes(group),
+ *     passes(GDR_NO_INDEX as refined_group) = true,  passes(GDR_NO_INDEX as group) = false,
+ *     passes(g) = E(g) <= threshold.
+ * Because E only grows from a group to the groups made from its clusters, this draws every part of
+ * the surface exactly once, without cracks: threshold 0 draws exactly level 0, a threshold larger
+ * than every finite E draws exactly the root group's clusters. A mesh without a DAG (no groups)
+ * draws level 0. The same rule with passes(g) = (depth(g) < N and g is not the root) is a discrete
+ * cut at DAG depth N (N = 0: level 0). src/geometry/lod_cut.h holds the CPU reference of both.
+ *
+ * A group whose simplification does not remove at least 15% of its triangles, or that would move
+ * a locked border, is not formed: its clusters are grouped again at the next step with other
+ * neighbours (at step 0 it is formed as a group whose new clusters are its clusters unchanged,
+ * sharing their data, so that level 0 stays whole). When a whole step makes no progress the build
+ * stops and what is left becomes the root group: gdr_lod_stats says why the build stopped. */
+
+#define GDR_LOD_MAX_LEVELS 64u
+
+typedef enum gdr_lod_stop {
+    GDR_LOD_STOP_NONE = 0,       /* nothing built */
+    GDR_LOD_STOP_SINGLE_CLUSTER, /* simplified down to one cluster: the root group holds it */
+    GDR_LOD_STOP_NO_PROGRESS,    /* no group of the last step simplified enough: the root group
+                                    holds the clusters that were left */
+    GDR_LOD_STOP_LEVEL_LIMIT,    /* GDR_LOD_MAX_LEVELS steps; the root group holds what was left */
+    GDR_LOD_STOP_COUNT
+} gdr_lod_stop;
+
+/* Options of the DAG build; zero-initialise, every field has a default. */
+typedef struct gdr_lod_options {
+    uint32_t group_size;   /* a group holds about as many triangles as this many level-0 clusters;
+                              0: 4; in [2, 32] */
+    float target_ratio;    /* share of a group's triangles that simplification aims to keep; 0: 0.5;
+                              in (0, 0.85) */
+    uint32_t thread_count; /* workers including the caller, at most 256; 0: one per processor. The
+                              result does not depend on it (same bytes). */
+    int no_progress;       /* 1: never draw a progress bar (default: on a terminal, after 0.3 s) */
+} gdr_lod_options;
+
+/* What a build did; for a scene, sums over the meshes built. */
+typedef struct gdr_lod_stats {
+    uint32_t mesh_count;              /* meshes whose DAG was built */
+    uint32_t stop_counts[GDR_LOD_STOP_COUNT]; /* meshes by the reason their build stopped */
+    uint32_t max_depth;               /* largest dag_depth */
+    uint64_t group_count;
+    uint64_t cluster_count;           /* all levels */
+    uint64_t input_triangles;         /* level 0 */
+    uint64_t dag_triangles;           /* all clusters, level 0 included */
+    uint64_t root_clusters, root_triangles;
+    uint64_t stuck_groups;            /* groups not formed (too little reduction), regrouped later */
+    uint64_t border_rejects;          /* of those, simplifications that moved a locked border */
+    uint64_t passthrough_clusters;    /* clusters copied unchanged at step 0 (sharing their data) */
+} gdr_lod_stats;
+
+/* Builds the LOD DAG of `mesh` over its level-0 clusters (gdr_meshlets_build), appending the
+ * coarser clusters, their vertices and triangles (indices of the mesh's own vertices: no vertex is
+ * added) and the groups to mesh->clusters; a DAG already there is replaced. Needs level-0 clusters
+ * whose data is in range and finite positions. options and stats may be NULL. On failure the mesh
+ * keeps its level-0 clusters (order unchanged) and no DAG. */
+GDR_API gdr_status gdr_mesh_build_lod_dag(gdr_mesh *mesh, const gdr_lod_options *options, gdr_lod_stats *stats,
+                                          gdr_error *err);
+
+/* Builds level-0 clusters where a mesh with triangles has none (gdr_scene_build_clusters, default
+ * meshlet options but options->thread_count) and then the DAG of every mesh that has clusters but
+ * no DAG. Large meshes are built one at a time with all threads, small ones side by side; the
+ * result does not depend on the thread count. On failure the error names the first failing mesh
+ * ("meshes[3]: mesh 'rock': ...") and no mesh keeps a DAG from this call. */
+GDR_API gdr_status gdr_scene_build_lod(gdr_scene *scene, const gdr_lod_options *options, gdr_lod_stats *stats,
+                                       gdr_error *err);
+
 #ifdef __cplusplus
 }
 #endif

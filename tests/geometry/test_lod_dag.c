@@ -1,0 +1,673 @@
+/* The cluster LOD DAG (issue 5): the invariants of gdr/geometry.h on closed, open, seamed,
+ * degenerate and disconnected meshes, the CPU cut (exactly level 0 at threshold 0, exactly the
+ * root at a huge one, every source-to-sink path of the DAG crossed exactly once and no crack for
+ * random views), the discrete depth cut, determinism over thread counts, options and bad input. */
+#include <float.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cluster_checks.h"
+#include "gdr/geometry.h"
+#include "gdr/scene.h"
+#include "geometry/lod_cut.h"
+#include "scene/procedural_meshes.h"
+#include "test_util.h"
+
+/* --- meshes --------------------------------------------------------------------------------- */
+
+static gdr_scene *new_scene(void)
+{
+    gdr_scene *s = NULL;
+    gdr_error err = {0};
+    if (gdr_scene_create(&s, &err) != GDR_OK) {
+        fprintf(stderr, "gdr_scene_create: %s\n", err.message);
+        exit(1);
+    }
+    return s;
+}
+
+static void check_ok(gdr_status status, const gdr_error *err, const char *what)
+{
+    if (status != GDR_OK) {
+        fprintf(stderr, "%s: %s\n", what, err->message);
+        exit(1);
+    }
+}
+
+static uint32_t add_mesh(gdr_scene *s, const char *name, const gdr_vec3 *p, uint32_t vertex_count, const uint32_t *idx,
+                         uint32_t index_count)
+{
+    uint32_t m = 0;
+    gdr_error err = {0};
+    check_ok(gdr_scene_add_mesh(s, name, p, NULL, NULL, vertex_count, idx, index_count, &m, &err), &err, name);
+    return m;
+}
+
+static uint32_t add_single_triangle(gdr_scene *s)
+{
+    const gdr_vec3 p[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    const uint32_t idx[3] = {0, 1, 2};
+    return add_mesh(s, "triangle", p, 3, idx, 3);
+}
+
+/* Many separate pieces in one mesh: small closed octahedra on a lattice and loose triangles. */
+static uint32_t add_pieces(gdr_scene *s, uint32_t count)
+{
+    gdr_vec3 *p = malloc(sizeof *p * count * 6 + sizeof *p * 3 * count);
+    uint32_t *idx = malloc(sizeof *idx * count * 24 + sizeof *idx * 3 * count);
+    uint32_t v = 0, k = 0;
+    static const uint32_t faces[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                                         {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+    for (uint32_t i = 0; i < count; i++) {
+        float x = (float)(i % 8) * 3.0f, y = (float)(i / 8 % 8) * 3.0f, z = (float)(i / 64) * 3.0f;
+        const gdr_vec3 o[6] = {{x + 1, y, z}, {x - 1, y, z}, {x, y + 1, z}, {x, y - 1, z}, {x, y, z + 1}, {x, y, z - 1}};
+        for (int j = 0; j < 6; j++)
+            p[v + j] = o[j];
+        for (int f = 0; f < 8; f++)
+            for (int c = 0; c < 3; c++)
+                idx[k++] = v + faces[f][c];
+        v += 6;
+        if (i % 3 == 0) { /* a loose triangle next to it */
+            p[v] = (gdr_vec3){x + 1.5f, y, z};
+            p[v + 1] = (gdr_vec3){x + 1.5f, y + 1, z};
+            p[v + 2] = (gdr_vec3){x + 1.5f, y, z + 1};
+            idx[k++] = v, idx[k++] = v + 1, idx[k++] = v + 2;
+            v += 3;
+        }
+    }
+    uint32_t m = add_mesh(s, "pieces", p, v, idx, k);
+    free(p);
+    free(idx);
+    return m;
+}
+
+/* The blob with a seam: triangles on the +Z side use their own copies of their vertices, with the
+ * same coordinates (as UV seams do), so the mesh is closed by position but not by index. */
+static uint32_t add_seamed_blob(gdr_scene *s)
+{
+    gdr_scene *t = new_scene();
+    gdr_error err = {0};
+    uint32_t b;
+    check_ok(gdr_procedural_blob(t, 4, &b, &err), &err, "blob");
+    const gdr_mesh *m = &t->meshes[b];
+    gdr_vec3 *p = malloc(sizeof *p * m->vertex_count * 2);
+    uint32_t *idx = malloc(sizeof *idx * m->index_count);
+    memcpy(p, m->positions, sizeof *p * m->vertex_count);
+    memcpy(p + m->vertex_count, m->positions, sizeof *p * m->vertex_count);
+    for (uint32_t i = 0; i < m->index_count; i += 3) {
+        float z = 0.0f;
+        for (int k = 0; k < 3; k++)
+            z += m->positions[m->indices[i + k]].z;
+        for (int k = 0; k < 3; k++)
+            idx[i + k] = m->indices[i + k] + (z > 0.0f ? m->vertex_count : 0);
+    }
+    uint32_t out = add_mesh(s, "seamed", p, m->vertex_count * 2, idx, m->index_count);
+    free(p);
+    free(idx);
+    gdr_scene_destroy(t);
+    return out;
+}
+
+/* A blob among hard-edged boxes (split normals: every box corner holds three vertices, which the
+ * simplifier never moves): groups of boxes alone cannot simplify, so step 0 passes them through
+ * and the build ends with them in the root. */
+static uint32_t add_blob_and_boxes(gdr_scene *s, uint32_t boxes)
+{
+    gdr_scene *t = new_scene();
+    gdr_error err = {0};
+    uint32_t blob, box;
+    check_ok(gdr_procedural_blob(t, 3, &blob, &err), &err, "blob");
+    check_ok(gdr_procedural_box(t, (gdr_vec3){0.2f, 0.2f, 0.2f}, &box, &err), &err, "box");
+    const gdr_mesh *mb = &t->meshes[blob], *mx = &t->meshes[box];
+    uint32_t vertices = mb->vertex_count + boxes * mx->vertex_count, indices = mb->index_count + boxes * mx->index_count;
+    gdr_vec3 *p = malloc(sizeof *p * vertices);
+    uint32_t *idx = malloc(sizeof *idx * indices);
+    memcpy(p, mb->positions, sizeof *p * mb->vertex_count);
+    memcpy(idx, mb->indices, sizeof *idx * mb->index_count);
+    uint32_t v = mb->vertex_count, k = mb->index_count;
+    for (uint32_t i = 0; i < boxes; i++) {
+        gdr_vec3 o = {3.0f + (float)(i % 10), (float)(i / 10 % 10), 0.0f};
+        for (uint32_t j = 0; j < mx->vertex_count; j++)
+            p[v + j] = gdr_vec3_add(mx->positions[j], o);
+        for (uint32_t j = 0; j < mx->index_count; j++)
+            idx[k++] = v + mx->indices[j];
+        v += mx->vertex_count;
+    }
+    uint32_t out = add_mesh(s, "boxes", p, vertices, idx, indices);
+    free(p);
+    free(idx);
+    gdr_scene_destroy(t);
+    return out;
+}
+
+static void build_level0(gdr_mesh *mesh)
+{
+    gdr_error err = {0};
+    check_ok(gdr_meshlets_build(mesh, NULL, &mesh->clusters, &err), &err, mesh->name);
+}
+
+static gdr_lod_stats build_dag(gdr_mesh *mesh, uint32_t threads)
+{
+    gdr_error err = {0};
+    gdr_lod_stats stats;
+    gdr_lod_options o = {.thread_count = threads, .no_progress = 1};
+    check_ok(gdr_mesh_build_lod_dag(mesh, &o, &stats, &err), &err, mesh->name);
+    return stats;
+}
+
+/* --- invariants ------------------------------------------------------------------------------- */
+
+typedef struct tri_key {
+    uint32_t v[3];
+} tri_key;
+
+static int compare_tri(const void *a, const void *b) { return memcmp(a, b, sizeof(tri_key)); }
+
+/* The corners rotated so the smallest index comes first (same triangle, same winding). */
+static tri_key canonical(uint32_t a, uint32_t b, uint32_t c)
+{
+    if (b < a && b <= c)
+        return (tri_key){{b, c, a}};
+    if (c < a && c < b)
+        return (tri_key){{c, a, b}};
+    return (tri_key){{a, b, c}};
+}
+
+static int level0_covers_input(const gdr_mesh *mesh)
+{
+    const gdr_mesh_clusters *mc = &mesh->clusters;
+    uint32_t n = mesh->index_count / 3, k = 0;
+    tri_key *a = malloc(sizeof *a * n), *b = malloc(sizeof *b * n);
+    for (uint32_t t = 0; t < n; t++)
+        a[t] = canonical(mesh->indices[3 * t], mesh->indices[3 * t + 1], mesh->indices[3 * t + 2]);
+    int ok = 1;
+    for (uint32_t i = 0; i < mc->level0_cluster_count && ok; i++) {
+        const gdr_cluster *c = &mc->clusters[i];
+        for (uint32_t t = 0; t < c->triangle_count && ok; t++) {
+            ok = k < n;
+            if (ok)
+                b[k++] = canonical(cluster_corner(mc, c, t, 0), cluster_corner(mc, c, t, 1),
+                                   cluster_corner(mc, c, t, 2));
+        }
+    }
+    ok = ok && k == n;
+    if (ok) {
+        qsort(a, n, sizeof *a, compare_tri);
+        qsort(b, n, sizeof *b, compare_tri);
+        ok = memcmp(a, b, sizeof *a * n) == 0;
+    }
+    free(a);
+    free(b);
+    return ok;
+}
+
+/* Sphere b inside sphere a (with the builder's relative slack to spare). */
+static int sphere_contains(gdr_vec4 a, gdr_vec4 b)
+{
+    double dx = (double)a.x - b.x, dy = (double)a.y - b.y, dz = (double)a.z - b.z;
+    return sqrt(dx * dx + dy * dy + dz * dz) + b.w <= (double)a.w * (1.0 + 1e-6) + 1e-30;
+}
+
+static uint64_t triangles_of(const gdr_mesh_clusters *mc, uint32_t first, uint32_t count)
+{
+    uint64_t t = 0;
+    for (uint32_t i = first; i < first + count; i++)
+        t += mc->clusters[i].triangle_count;
+    return t;
+}
+
+/* Everything gdr/geometry.h promises about a built DAG; returns 1 when it all holds. */
+static int check_dag(const gdr_mesh *mesh, const gdr_lod_stats *st)
+{
+    const gdr_mesh_clusters *mc = &mesh->clusters;
+    int failures = test_failure_count;
+    CHECK(mc->group_count >= 1 && mc->groups && mc->cluster_count >= mc->level0_cluster_count);
+    if (test_failure_count != failures)
+        return 0;
+    CHECK(level0_covers_input(mesh));
+    uint32_t root = mc->group_count - 1;
+    CHECK(isinf(mc->groups[root].error) && mc->groups[root].error > 0);
+    CHECK(mc->groups[root].depth == mc->dag_depth);
+    /* Layout: every cluster in range, 4-byte aligned triangles, its sphere reaching its vertices. */
+    for (uint32_t i = 0; i < mc->cluster_count; i++) {
+        const gdr_cluster *c = &mc->clusters[i];
+        int in_range = c->vertex_count >= 1 && c->vertex_count <= GDR_CLUSTER_MAX_VERTICES &&
+                       c->triangle_count >= 1 && c->triangle_count <= GDR_CLUSTER_MAX_TRIANGLES &&
+                       c->triangle_offset % 4 == 0 && c->reserved == 0 &&
+                       (uint64_t)c->vertex_offset + c->vertex_count <= mc->vertex_count &&
+                       (uint64_t)c->triangle_offset + 3ull * c->triangle_count <= mc->triangle_byte_count &&
+                       c->group < mc->group_count;
+        CHECK(in_range);
+        if (!in_range)
+            return 0;
+        for (uint32_t k = 0; k < 3 * c->triangle_count; k++)
+            CHECK(mc->triangles[c->triangle_offset + k] < c->vertex_count);
+        for (uint32_t v = 0; v < c->vertex_count; v++) {
+            uint32_t mv = mc->vertices[c->vertex_offset + v];
+            CHECK(mv < mesh->vertex_count);
+            if (mv < mesh->vertex_count)
+                CHECK(sphere_contains(c->sphere, (gdr_vec4){mesh->positions[mv].x, mesh->positions[mv].y,
+                                                            mesh->positions[mv].z, 0.0f}));
+        }
+        if (i < mc->level0_cluster_count) {
+            CHECK(c->refined_group == GDR_NO_INDEX);
+            CHECK(mc->groups[c->group].depth == 0);
+        } else {
+            CHECK(c->refined_group < mc->group_count);
+            if (c->refined_group >= mc->group_count)
+                return 0;
+            const gdr_cluster_group *from = &mc->groups[c->refined_group], *to = &mc->groups[c->group];
+            /* Monotonic: error, depth and spheres only grow up the DAG. */
+            CHECK(to->error >= from->error);
+            CHECK(to->depth > from->depth);
+            CHECK(sphere_contains(to->sphere, from->sphere));
+            CHECK(c->refined_group != root);
+        }
+        CHECK(sphere_contains(mc->groups[c->group].sphere, c->sphere));
+    }
+    /* Groups: contiguous clusters, finite positive errors below the root, triangles reduced. */
+    uint32_t next = 0;
+    for (uint32_t g = 0; g < mc->group_count; g++) {
+        const gdr_cluster_group *gr = &mc->groups[g];
+        CHECK(gr->first_cluster == next && gr->cluster_count >= 1);
+        next = gr->first_cluster + gr->cluster_count;
+        if (next > mc->cluster_count)
+            return 0;
+        for (uint32_t i = gr->first_cluster; i < next; i++)
+            CHECK(mc->clusters[i].group == g);
+        if (g != root)
+            CHECK(isfinite(gr->error) && gr->error > 0.0f);
+        if (g > 0)
+            CHECK(gr->depth >= mc->groups[g - 1].depth);
+        uint64_t in = triangles_of(mc, gr->first_cluster, gr->cluster_count), out = 0;
+        uint32_t outputs = 0, passthrough = 0;
+        for (uint32_t i = mc->level0_cluster_count; i < mc->cluster_count; i++)
+            if (mc->clusters[i].refined_group == g) {
+                out += mc->clusters[i].triangle_count;
+                outputs++;
+                for (uint32_t j = gr->first_cluster; j < next; j++)
+                    passthrough += mc->clusters[j].triangle_offset == mc->clusters[i].triangle_offset &&
+                                   mc->clusters[j].vertex_offset == mc->clusters[i].vertex_offset;
+            }
+        if (g == root) {
+            CHECK(outputs == 0);
+        } else if (passthrough) {
+            /* A step-0 group that did not simplify: its clusters passed on unchanged. */
+            CHECK(gr->depth == 0 && passthrough == outputs && outputs == gr->cluster_count && out == in);
+        } else {
+            CHECK(outputs >= 1 && (double)out <= 0.85 * (double)in);
+        }
+    }
+    CHECK(next == mc->cluster_count);
+    /* Each step reduces the triangle count of what it formed groups over. */
+    for (uint32_t d = 0; d < mc->dag_depth; d++) {
+        uint64_t in = 0, out = 0;
+        for (uint32_t g = 0; g < root; g++)
+            if (mc->groups[g].depth == d) {
+                in += triangles_of(mc, mc->groups[g].first_cluster, mc->groups[g].cluster_count);
+                for (uint32_t i = mc->level0_cluster_count; i < mc->cluster_count; i++)
+                    out += mc->clusters[i].refined_group == g ? mc->clusters[i].triangle_count : 0;
+            }
+        CHECK(in > 0 && out < in);
+    }
+    /* The stats agree with the data. */
+    uint64_t total = triangles_of(mc, 0, mc->cluster_count);
+    uint32_t stops = 0;
+    for (int i = 0; i < GDR_LOD_STOP_COUNT; i++)
+        stops += st->stop_counts[i];
+    CHECK(st->mesh_count == 1 && stops == 1 && st->stop_counts[GDR_LOD_STOP_NONE] == 0);
+    CHECK(st->group_count == mc->group_count && st->cluster_count == mc->cluster_count);
+    CHECK(st->input_triangles == mesh->index_count / 3 && st->dag_triangles == total);
+    CHECK(st->root_clusters == mc->groups[root].cluster_count);
+    CHECK(st->root_triangles == triangles_of(mc, mc->groups[root].first_cluster, mc->groups[root].cluster_count));
+    CHECK(st->max_depth == mc->dag_depth);
+    if (st->stop_counts[GDR_LOD_STOP_SINGLE_CLUSTER])
+        CHECK(mc->groups[root].cluster_count == 1);
+    return test_failure_count == failures;
+}
+
+/* --- the cut ------------------------------------------------------------------------------------- */
+
+/* Every path from a level-0 cluster to a root cluster (cluster -> the clusters made from its group)
+ * holds exactly one selected cluster: the selection is an antichain that covers the DAG. Clusters
+ * are ordered by group and groups by depth, so successors come later in the array. */
+static int cut_is_exact(const gdr_mesh_clusters *mc, const uint8_t *selected)
+{
+    uint32_t n = mc->cluster_count;
+    uint32_t *lo = malloc(sizeof *lo * n), *hi = malloc(sizeof *hi * n);
+    uint32_t *succ_lo = malloc(sizeof *succ_lo * mc->group_count), *succ_hi = malloc(sizeof *succ_hi * mc->group_count);
+    for (uint32_t g = 0; g < mc->group_count; g++)
+        succ_lo[g] = UINT32_MAX, succ_hi[g] = 0;
+    int ok = 1;
+    for (uint32_t i = n; i-- > 0;) {
+        const gdr_cluster *c = &mc->clusters[i];
+        uint32_t g = c->group;
+        uint32_t min = succ_lo[g] == UINT32_MAX ? 0 : succ_lo[g], max = succ_lo[g] == UINT32_MAX ? 0 : succ_hi[g];
+        lo[i] = min + selected[i];
+        hi[i] = max + selected[i];
+        if (c->refined_group != GDR_NO_INDEX) {
+            uint32_t r = c->refined_group;
+            ok = ok && r < g;
+            succ_lo[r] = lo[i] < succ_lo[r] ? lo[i] : succ_lo[r];
+            succ_hi[r] = hi[i] > succ_hi[r] ? hi[i] : succ_hi[r];
+        }
+    }
+    for (uint32_t i = 0; i < mc->level0_cluster_count && ok; i++)
+        ok = lo[i] == 1 && hi[i] == 1;
+    free(lo);
+    free(hi);
+    free(succ_lo);
+    free(succ_hi);
+    return ok;
+}
+
+static int compare_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Position ids: vertices with equal coordinates share one (so seams count as connected). */
+static uint32_t *position_ids(const gdr_mesh *mesh)
+{
+    uint32_t *id = malloc(sizeof *id * mesh->vertex_count);
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        id[v] = v;
+        for (uint32_t w = 0; w < v; w++)
+            if (memcmp(&mesh->positions[w], &mesh->positions[v], sizeof(gdr_vec3)) == 0) {
+                id[v] = id[w];
+                break;
+            }
+    }
+    return id;
+}
+
+/* Directed edges (by position) of the selected clusters' triangles that no selected triangle runs
+ * the other way: 0 for a closed mesh means the cut has no crack. */
+static uint64_t open_edges(const gdr_mesh_clusters *mc, const uint8_t *selected, const uint32_t *pos)
+{
+    size_t n = 0;
+    for (uint32_t i = 0; i < mc->cluster_count; i++)
+        n += selected[i] ? 3u * mc->clusters[i].triangle_count : 0;
+    uint64_t *e = malloc(sizeof *e * (n ? n : 1));
+    size_t k = 0;
+    for (uint32_t i = 0; i < mc->cluster_count; i++) {
+        if (!selected[i])
+            continue;
+        const gdr_cluster *c = &mc->clusters[i];
+        for (uint32_t t = 0; t < c->triangle_count; t++)
+            for (uint32_t j = 0; j < 3; j++) {
+                uint32_t a = pos[cluster_corner(mc, c, t, j)], b = pos[cluster_corner(mc, c, t, (j + 1) % 3)];
+                if (a != b)
+                    e[k++] = (uint64_t)a << 32 | b;
+            }
+    }
+    qsort(e, k, sizeof *e, compare_u64);
+    uint64_t open = 0;
+    for (size_t i = 0; i < k;) {
+        size_t j = i;
+        while (j < k && e[j] == e[i])
+            j++;
+        uint64_t reverse = e[i] << 32 | e[i] >> 32;
+        size_t lo = 0, hi = k;
+        while (lo < hi) {
+            size_t mid = (lo + hi) / 2;
+            if (e[mid] < reverse)
+                lo = mid + 1;
+            else
+                hi = mid;
+        }
+        size_t r = lo;
+        while (r < k && e[r] == reverse)
+            r++;
+        open += (j - i) > (r - lo) ? (j - i) - (r - lo) : 0;
+        i = j;
+    }
+    free(e);
+    return open;
+}
+
+static gdr_lod_view random_view(const gdr_mesh *mesh, unsigned *rng)
+{
+    gdr_vec3 axis = gdr_vec3_normalize((gdr_vec3){test_random_range(rng, -1, 1), test_random_range(rng, -1, 1),
+                                                  test_random_range(rng, -1, 1) + 0.01f});
+    float s = test_random_range(rng, 0.2f, 5.0f);
+    gdr_vec3 scale = {s, s * test_random_range(rng, 0.5f, 1.5f), s};
+    gdr_vec3 t = {test_random_range(rng, -10, 10), test_random_range(rng, -10, 10), test_random_range(rng, -10, 10)};
+    gdr_lod_view v = {.transform = gdr_mat4_from_trs(t, gdr_quat_from_axis_angle(axis, test_random(rng) * 6.28f), scale),
+                      .projection_y = 1.0f / tanf(0.5f * test_random_range(rng, 0.3f, 1.6f)),
+                      .viewport_height = test_random_range(rng, 240.0f, 2160.0f),
+                      .znear = test_random_range(rng, 0.01f, 0.5f),
+                      .threshold = test_random_range(rng, 0.05f, 40.0f)};
+    /* A camera from inside the mesh to far away from it. */
+    gdr_vec3 dir = gdr_vec3_normalize((gdr_vec3){test_random_range(rng, -1, 1), test_random_range(rng, -1, 1),
+                                                 test_random_range(rng, -1, 1) + 0.01f});
+    float distance = mesh->bounds.w * s * powf(10.0f, test_random_range(rng, -1.0f, 2.5f));
+    gdr_vec3 centre = gdr_mat4_transform_point(v.transform, (gdr_vec3){mesh->bounds.x, mesh->bounds.y, mesh->bounds.z});
+    v.camera_position = gdr_vec3_add(centre, gdr_vec3_scale(dir, distance));
+    return v;
+}
+
+/* The CPU cut at the extremes and for random views. No cut may have more open edges than level 0
+ * (a crack adds some; simplifying the mesh's own open border only removes some); `closed`: level
+ * 0 has none. Returns how many different cut sizes the random views gave. */
+static uint32_t check_cuts(const gdr_mesh *mesh, int closed, unsigned seed, uint32_t views)
+{
+    const gdr_mesh_clusters *mc = &mesh->clusters;
+    uint8_t *sel = malloc(mc->cluster_count);
+    uint32_t *pos = position_ids(mesh);
+    uint64_t level0_open = 0;
+    unsigned rng = seed;
+    gdr_lod_view v = random_view(mesh, &rng);
+    /* Threshold 0: exactly level 0. */
+    v.threshold = 0.0f;
+    uint32_t count = gdr_lod_cut_select(mc, &v, sel);
+    level0_open = open_edges(mc, sel, pos);
+    CHECK(!closed || level0_open == 0);
+    CHECK(count == mc->level0_cluster_count);
+    for (uint32_t i = 0; i < mc->cluster_count; i++)
+        CHECK(sel[i] == (i < mc->level0_cluster_count));
+    /* A huge threshold: exactly the root group's clusters. */
+    const gdr_cluster_group *root = &mc->groups[mc->group_count - 1];
+    v.threshold = 1e30f;
+    count = gdr_lod_cut_select(mc, &v, sel);
+    CHECK(count == root->cluster_count);
+    for (uint32_t i = 0; i < mc->cluster_count; i++)
+        CHECK(sel[i] == (i >= root->first_cluster && i < root->first_cluster + root->cluster_count));
+    /* Random views: an exact cover of the DAG, without cracks. */
+    uint32_t sizes[64], distinct = 0;
+    for (uint32_t k = 0; k < views; k++) {
+        v = random_view(mesh, &rng);
+        count = gdr_lod_cut_select(mc, &v, sel);
+        CHECK(count > 0);
+        CHECK(cut_is_exact(mc, sel));
+        uint64_t open = open_edges(mc, sel, pos);
+        CHECK(open <= level0_open);
+        if (open > level0_open)
+            fprintf(stderr, "mesh '%s': %llu open edges (level 0: %llu) in a cut of %u clusters\n", mesh->name,
+                    (unsigned long long)open, (unsigned long long)level0_open, count);
+        int seen = 0;
+        for (uint32_t j = 0; j < distinct; j++)
+            seen |= sizes[j] == count;
+        if (!seen && distinct < 64)
+            sizes[distinct++] = count;
+    }
+    /* The discrete depth cut: level 0 at depth 0, the root past the last depth, exact between. */
+    for (uint32_t d = 0; d <= mc->dag_depth + 1; d++) {
+        count = gdr_lod_cut_select_depth(mc, d, sel);
+        CHECK(cut_is_exact(mc, sel));
+        CHECK(open_edges(mc, sel, pos) <= level0_open);
+        if (d == 0)
+            CHECK(count == mc->level0_cluster_count);
+        if (d > mc->dag_depth)
+            CHECK(count == root->cluster_count);
+    }
+    free(pos);
+    free(sel);
+    return distinct;
+}
+
+/* --- tests ----------------------------------------------------------------------------------- */
+
+static void report(const gdr_mesh *m, const gdr_lod_stats *st)
+{
+    const char *stop = st->stop_counts[GDR_LOD_STOP_SINGLE_CLUSTER] ? "single cluster"
+                       : st->stop_counts[GDR_LOD_STOP_NO_PROGRESS] ? "no progress"
+                                                                    : "level limit";
+    printf("%-9s %7llu tris -> DAG %7llu (%.2fx), %5u clusters, %4u groups, depth %2u, root %llu clusters / %llu tris "
+           "(%s), stuck %llu (border %llu), pass-through %llu\n",
+           m->name, (unsigned long long)st->input_triangles, (unsigned long long)st->dag_triangles,
+           (double)st->dag_triangles / (double)st->input_triangles, m->clusters.cluster_count,
+           m->clusters.group_count, m->clusters.dag_depth, (unsigned long long)st->root_clusters,
+           (unsigned long long)st->root_triangles, stop, (unsigned long long)st->stuck_groups,
+           (unsigned long long)st->border_rejects, (unsigned long long)st->passthrough_clusters);
+}
+
+static void test_meshes(void)
+{
+    gdr_scene *s = new_scene();
+    gdr_error err = {0};
+    uint32_t blob, sphere, ground, torus, box, tri, pieces, seamed, boxes;
+    check_ok(gdr_procedural_blob(s, 4, &blob, &err), &err, "blob");         /* closed, welded */
+    /* UV sphere and torus: their seams are not bit-equal (sinf(2 pi) != 0), so they are open. */
+    check_ok(gdr_procedural_sphere(s, 96, 48, &sphere, &err), &err, "sphere"); /* degenerate poles */
+    check_ok(gdr_procedural_ground(s, 10.0f, 48, &ground, &err), &err, "ground"); /* flat, open border */
+    check_ok(gdr_procedural_torus(s, 1.0f, 0.3f, 64, 24, &torus, &err), &err, "torus"); /* seams, genus 1 */
+    check_ok(gdr_procedural_box(s, (gdr_vec3){1, 2, 3}, &box, &err), &err, "box"); /* hard edges, 12 tris */
+    tri = add_single_triangle(s);
+    pieces = add_pieces(s, 150);
+    seamed = add_seamed_blob(s);
+    boxes = add_blob_and_boxes(s, 100);
+    struct {
+        uint32_t mesh;
+        int closed, curved;
+    } cases[] = {{blob, 1, 1},   {seamed, 1, 1}, {sphere, 0, 1}, {ground, 0, 0},
+                 {torus, 0, 1},  {box, 1, 0},    {tri, 0, 0},    {pieces, 0, 1}, {boxes, 1, 1}};
+    gdr_lod_stats stats[sizeof cases / sizeof cases[0]];
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        gdr_mesh *m = &s->meshes[cases[i].mesh];
+        build_level0(m);
+        gdr_lod_stats st = stats[i] = build_dag(m, 2);
+        report(m, &st);
+        if (!check_dag(m, &st)) {
+            fprintf(stderr, "mesh '%s': DAG invariants broken\n", m->name);
+            continue;
+        }
+        uint32_t distinct = check_cuts(m, cases[i].closed, 1234u + (unsigned)i, 40);
+        /* Curved meshes with a real DAG must give different cuts for different views (a flat
+         * grid simplifies without error: its root is always enough). */
+        if (cases[i].curved && m->clusters.dag_depth >= 2 && distinct < 4) {
+            CHECK(distinct >= 4);
+            fprintf(stderr, "mesh '%s': only %u different cuts\n", m->name, distinct);
+        }
+    }
+    /* What the shapes must come to. */
+    const gdr_mesh *m = &s->meshes[blob];
+    CHECK(m->clusters.dag_depth >= 3);
+    CHECK(m->clusters.groups[m->clusters.group_count - 1].cluster_count <= 2);
+    m = &s->meshes[ground];
+    /* Its open border is not locked (only what groups share is): the grid simplifies away. */
+    CHECK(m->clusters.dag_depth >= 3 && m->clusters.groups[m->clusters.group_count - 1].cluster_count == 1);
+    /* The boxes cannot simplify: passed through at step 0, left in the root when nothing else can. */
+    CHECK(stats[8].passthrough_clusters > 0 && stats[8].stuck_groups > 0);
+    CHECK(stats[8].stop_counts[GDR_LOD_STOP_NO_PROGRESS] == 1 && stats[8].root_triangles >= 100 * 12);
+    m = &s->meshes[tri];
+    CHECK(m->clusters.cluster_count == 1 && m->clusters.group_count == 1 && m->clusters.dag_depth == 0);
+    gdr_scene_destroy(s);
+}
+
+/* Same bytes whatever the thread count, and a rebuild replaces the DAG with the same bytes. */
+static void test_determinism(void)
+{
+    gdr_scene *s = new_scene();
+    gdr_error err = {0};
+    uint32_t a, b;
+    check_ok(gdr_procedural_blob(s, 5, &a, &err), &err, "blob");
+    check_ok(gdr_procedural_blob(s, 5, &b, &err), &err, "blob");
+    build_level0(&s->meshes[a]);
+    build_level0(&s->meshes[b]);
+    gdr_lod_stats sa = build_dag(&s->meshes[a], 1);
+    gdr_lod_stats sb = build_dag(&s->meshes[b], 2);
+    CHECK(same_clusters(&s->meshes[a].clusters, &s->meshes[b].clusters));
+    CHECK(memcmp(&sa, &sb, sizeof sa) == 0);
+    build_dag(&s->meshes[b], 3);
+    CHECK(same_clusters(&s->meshes[a].clusters, &s->meshes[b].clusters));
+    gdr_scene_destroy(s);
+}
+
+/* The whole demo scene through gdr_scene_build_lod (clusters first), 1 vs 2 threads. */
+static void test_scene(void)
+{
+    gdr_scene *one = NULL, *two = NULL;
+    gdr_error err = {0};
+    gdr_demo_desc desc = {.instances = 16};
+    check_ok(gdr_scene_create_demo(&desc, &one, &err), &err, "demo");
+    check_ok(gdr_scene_create_demo(&desc, &two, &err), &err, "demo");
+    gdr_lod_stats s1, s2;
+    check_ok(gdr_scene_build_lod(one, &(gdr_lod_options){.thread_count = 1, .no_progress = 1}, &s1, &err), &err,
+             "scene 1");
+    check_ok(gdr_scene_build_lod(two, &(gdr_lod_options){.thread_count = 2, .no_progress = 1}, &s2, &err), &err,
+             "scene 2");
+    CHECK(memcmp(&s1, &s2, sizeof s1) == 0);
+    CHECK(s1.mesh_count == one->mesh_count);
+    uint64_t input = 0;
+    for (uint32_t m = 0; m < one->mesh_count; m++) {
+        CHECK(same_clusters(&one->meshes[m].clusters, &two->meshes[m].clusters));
+        CHECK(one->meshes[m].clusters.group_count > 0);
+        input += one->meshes[m].index_count / 3;
+    }
+    CHECK(s1.input_triangles == input);
+    /* Meshes that already have a DAG are left alone. */
+    gdr_lod_stats again;
+    check_ok(gdr_scene_build_lod(one, NULL, &again, &err), &err, "scene again");
+    CHECK(again.mesh_count == 0);
+    for (uint32_t m = 0; m < one->mesh_count; m++)
+        CHECK(same_clusters(&one->meshes[m].clusters, &two->meshes[m].clusters));
+    gdr_scene_destroy(one);
+    gdr_scene_destroy(two);
+}
+
+static void test_bad_input(void)
+{
+    gdr_scene *s = new_scene();
+    gdr_error err = {0};
+    uint32_t blob;
+    check_ok(gdr_procedural_blob(s, 2, &blob, &err), &err, "blob");
+    gdr_mesh *m = &s->meshes[blob];
+    /* No level 0 yet. */
+    CHECK(gdr_mesh_build_lod_dag(m, NULL, NULL, &err) == GDR_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(err.message, "level-0") != NULL);
+    build_level0(m);
+    const gdr_lod_options bad[] = {{.group_size = 1}, {.group_size = 33}, {.target_ratio = 0.9f},
+                                   {.target_ratio = -0.5f}, {.thread_count = 1000}};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        CHECK(gdr_mesh_build_lod_dag(m, &bad[i], NULL, &err) == GDR_ERROR_INVALID_ARGUMENT);
+        CHECK(m->clusters.group_count == 0 && m->clusters.cluster_count == m->clusters.level0_cluster_count);
+    }
+    /* A corner out of range is refused before anything reads it, and level 0 is left as it was. */
+    gdr_mesh_clusters before = m->clusters;
+    uint8_t saved = m->clusters.triangles[4];
+    m->clusters.triangles[4] = 200;
+    CHECK(gdr_mesh_build_lod_dag(m, NULL, NULL, &err) == GDR_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(err.message, "clusters[0]") != NULL);
+    m->clusters.triangles[4] = saved;
+    CHECK(m->clusters.cluster_count == before.cluster_count && m->clusters.group_count == 0);
+    /* Other options still give a valid DAG. */
+    gdr_lod_stats st;
+    gdr_lod_options o = {.group_size = 8, .target_ratio = 0.3f, .thread_count = 2, .no_progress = 1};
+    CHECK(gdr_mesh_build_lod_dag(m, &o, &st, &err) == GDR_OK);
+    CHECK(check_dag(m, &st));
+    gdr_scene_destroy(s);
+}
+
+int main(void)
+{
+    test_meshes();
+    test_determinism();
+    test_scene();
+    test_bad_input();
+    return test_finish("test_lod_dag");
+}
