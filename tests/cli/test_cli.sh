@@ -35,6 +35,26 @@ for key in instances_total instances_visible triangles draws cpu_ms_per_frame gp
     grep -q "\"$key\"" "$work/a.json" || { echo "FAIL: stats JSON lacks $key"; failures=$((failures + 1)); }
 done
 grep -q '"validation_messages":[[:space:]]*0' "$work/a.json" || { echo "FAIL: validation messages"; failures=$((failures + 1)); }
+# Every pipeline and view renders with validation on; the mesh pipeline reports its cluster counts.
+for pipeline in mesh indirect cpu; do
+    # shellcheck disable=SC2086
+    expect 0 "pipeline $pipeline" "$gdr" render demo:instances=50 $small --pipeline $pipeline --validate --stats "$work/p.json"
+    grep -q "\"pipeline\":[[:space:]]*\"$pipeline\"" "$work/p.json" || { echo "FAIL: stats do not name pipeline $pipeline"; failures=$((failures + 1)); }
+done
+for key in meshlets_total meshlets_frustum_culled meshlets_cone_culled meshlets_visible task_overflow; do
+    # shellcheck disable=SC2086
+    "$gdr" render demo:instances=50 $small --pipeline mesh --stats "$work/m.json" >/dev/null 2>&1
+    grep -q "\"$key\"" "$work/m.json" || { echo "FAIL: mesh stats JSON lacks $key"; failures=$((failures + 1)); }
+done
+for view in shaded meshlets instances triangles overdraw; do
+    # shellcheck disable=SC2086
+    expect 0 "view $view" "$gdr" render demo:instances=50 $small --view $view --validate --out "$work/v.png"
+done
+# shellcheck disable=SC2086
+expect 0 "single culling levels off" "$gdr" render demo:instances=50 $small --pipeline mesh --cone-cull off --triangle-cull off --meshlet-cull off --validate
+# shellcheck disable=SC2086
+expect 0 "bench, three pipelines" "$gdr" bench --sizes 20 --pipelines cpu,indirect,mesh --frames 2 --width 64 --height 48 --validate
+
 # shellcheck disable=SC2086
 expect 0 "render with culling off and a camera" "$gdr" render demo:instances=50 $small --cull off --camera 0,3,10,0,0,0,1
 
@@ -47,6 +67,10 @@ expect 2 "width not a number" "$gdr" render demo --width 12abc
 expect 2 "height too large" "$gdr" render demo --height 99999
 expect 2 "negative frames" "$gdr" render demo --frames -1
 expect 2 "cull maybe" "$gdr" render demo --cull maybe
+expect 2 "unknown pipeline" "$gdr" render demo --pipeline vertex
+expect 2 "unknown view" "$gdr" render demo --view wireframe
+expect 2 "cone cull maybe" "$gdr" render demo --cone-cull 1
+expect 2 "bench unknown pipeline" "$gdr" bench --pipelines mesh,fast
 expect 2 "short camera" "$gdr" render demo --camera 1,2,3
 expect 2 "camera with NaN" "$gdr" render demo --camera 0,0,0,nan,0,0,1
 expect 2 "zero quaternion" "$gdr" render demo --camera 0,0,0,0,0,0,0
