@@ -44,7 +44,7 @@ enum { MESH_RECORD = 64 + 8 + 16, MATERIAL_RECORD = 64 + 16 + 12 + 12 + 8, INSTA
 const char *gdr_cache_build_options(void)
 {
     /* Bump when the importers' or the geometry processing's output for the same input changes. */
-    return "import=1;meshlets=1";
+    return "import=1;meshlets=1;lod=1";
 }
 
 /* --- writing --------------------------------------------------------------------------------- */

@@ -11,11 +11,14 @@
 #include "io/io_internal.h"
 
 /* Builds the clusters of every mesh that has none (all of them after an import; none, normally,
- * after a cache read); on failure destroys the scene. */
-static gdr_status build_clusters(const char *path, gdr_scene **scene, gdr_error *err)
+ * after a cache read) and, with `lod` (imports: what the cache then stores), the LOD DAG of every
+ * mesh that has none; on failure destroys the scene. */
+static gdr_status build_clusters(const char *path, gdr_scene **scene, int lod, int no_progress, gdr_error *err)
 {
     gdr_error build_err;
-    if (gdr_scene_build_clusters(*scene, NULL, &build_err) == GDR_OK)
+    gdr_lod_options lod_options = {.no_progress = no_progress};
+    if ((lod ? gdr_scene_build_lod(*scene, &lod_options, NULL, &build_err)
+             : gdr_scene_build_clusters(*scene, NULL, &build_err)) == GDR_OK)
         return GDR_OK;
     gdr_scene_destroy(*scene);
     *scene = NULL;
@@ -34,7 +37,7 @@ gdr_status gdr_import_file(const char *path, const gdr_import_options *options, 
         *out = NULL;
         return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: unknown file type (.gltf, .glb, .obj or .gdrc)", path);
     }
-    return status == GDR_OK ? build_clusters(path, out, err) : status;
+    return status == GDR_OK ? build_clusters(path, out, 1, options && options->no_progress, err) : status;
 }
 
 /* $XDG_CACHE_HOME/gdr or ~/.cache/gdr, created when missing; 0 when there is none. */
@@ -78,7 +81,7 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
     const char *build_options = gdr_cache_build_options();
     if (gdr_io_has_extension(path, ".gdrc")) {
         gdr_status status = gdr_cache_read(path, build_options, out, err);
-        return status == GDR_OK ? build_clusters(path, out, err) : status;
+        return status == GDR_OK ? build_clusters(path, out, 0, 1, err) : status;
     }
     gdr_import_options import = {.warning = options->warning, .warning_user = options->warning_user,
                                  .no_progress = options->no_progress};
@@ -101,7 +104,7 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
             continue;
         gdr_error cache_err;
         if (gdr_cache_read(candidates[i], build_options, out, &cache_err) == GDR_OK)
-            return build_clusters(candidates[i], out, err);
+            return build_clusters(candidates[i], out, 0, 1, err);
         if (!strstr(cache_err.message, ": stale: "))
             warn(options, "%s; rebuilding it", cache_err.message);
     }

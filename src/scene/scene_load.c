@@ -49,9 +49,15 @@ gdr_status gdr_scene_load_ex(const char *spec, const gdr_load_options *options, 
     if (strcmp(spec, "demo") == 0 || strncmp(spec, "demo:", 5) == 0) {
         gdr_demo_desc desc = {0};
         gdr_status status = parse_demo_options(spec[4] ? spec + 5 : "", &desc, err);
-        if (status != GDR_OK)
-            return status;
-        return gdr_scene_create_demo(&desc, out, err);
+        if (status == GDR_OK)
+            status = gdr_scene_create_demo(&desc, out, err);
+        /* The LOD DAG over the meshlets the demo scene comes with (src/geometry). */
+        gdr_lod_options lod = {.no_progress = options && options->no_progress};
+        if (status == GDR_OK && (status = gdr_scene_build_lod(*out, &lod, NULL, err)) != GDR_OK) {
+            gdr_scene_destroy(*out);
+            *out = NULL;
+        }
+        return status;
     }
     /* Files: .gltf / .glb / .obj through the processed-scene cache, .gdrc directly (src/io). */
     return gdr_scene_load_file(spec, options, out, err);
