@@ -9,6 +9,7 @@
 #include <meshoptimizer.h>
 
 #include "core/thread_pool.h"
+#include "geometry/cluster_bounds.h"
 #include "gdr/geometry.h"
 #include "gdr/scene.h"
 
@@ -214,6 +215,13 @@ static void cluster_bounds(gdr_cluster *c, const uint32_t *vertices, const uint8
     } else {
         set_no_cone(c);
     }
+}
+
+/* The same bounds for the clusters of the LOD DAG (lod_group.c). */
+void gdr_cluster_compute_bounds(gdr_cluster *c, const uint32_t *vertices, const uint8_t *triangles,
+                                const gdr_mesh *mesh)
+{
+    cluster_bounds(c, vertices, triangles, mesh);
 }
 
 /* --- one mesh ----------------------------------------------------------------------------- */

@@ -219,6 +219,58 @@ static uint64_t triangles_of(const gdr_mesh_clusters *mc, uint32_t first, uint32
     return t;
 }
 
+/* Seen from points just inside the region the cone test culls (on its boundary cone behind the
+ * apex, in 8 directions around the axis, near and far), every triangle of the cluster must be
+ * back-facing or edge-on, in double on the stored floats. */
+static int cone_is_conservative(const gdr_mesh *mesh, const gdr_mesh_clusters *mc, const gdr_cluster *c)
+{
+    if (c->cone_cutoff >= 1.0f)
+        return 1;
+    double axis[3] = {c->cone_axis.x, c->cone_axis.y, c->cone_axis.z};
+    double length = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
+    for (int k = 0; k < 3; k++)
+        axis[k] /= length;
+    /* Two unit vectors perpendicular to the axis. */
+    double helper[3] = {fabs(axis[0]) < 0.9 ? 1.0 : 0.0, fabs(axis[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+    double u[3] = {axis[1] * helper[2] - axis[2] * helper[1], axis[2] * helper[0] - axis[0] * helper[2],
+                   axis[0] * helper[1] - axis[1] * helper[0]};
+    double ul = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (int k = 0; k < 3; k++)
+        u[k] /= ul;
+    double w[3] = {axis[1] * u[2] - axis[2] * u[1], axis[2] * u[0] - axis[0] * u[2], axis[0] * u[1] - axis[1] * u[0]};
+    /* The test culls p when dot(normalize(apex - p), axis_stored) >= cutoff. */
+    double cos_edge = fmin(1.0, (double)c->cone_cutoff / length + 1e-6), sin_edge = sqrt(1.0 - cos_edge * cos_edge);
+    for (int around = 0; around < 8; around++) {
+        double angle = around * 0.785398163397448;
+        double d[3];
+        for (int k = 0; k < 3; k++)
+            d[k] = axis[k] * cos_edge + (u[k] * cos(angle) + w[k] * sin(angle)) * sin_edge;
+        for (int far = 0; far < 2; far++) {
+            double t = (far ? 100.0 : 0.01) * (c->sphere.w + 1e-3);
+            double p[3] = {c->cone_apex.x - d[0] * t, c->cone_apex.y - d[1] * t, c->cone_apex.z - d[2] * t};
+            for (uint32_t k = 0; k < c->triangle_count; k++) {
+                double v[3][3];
+                for (int j = 0; j < 3; j++) {
+                    gdr_vec3 q = mesh->positions[cluster_corner(mc, c, k, (uint32_t)j)];
+                    v[j][0] = q.x, v[j][1] = q.y, v[j][2] = q.z;
+                }
+                double e1[3] = {v[1][0] - v[0][0], v[1][1] - v[0][1], v[1][2] - v[0][2]};
+                double e2[3] = {v[2][0] - v[0][0], v[2][1] - v[0][1], v[2][2] - v[0][2]};
+                double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                               e1[0] * e2[1] - e1[1] * e2[0]};
+                double nl = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+                double facing = n[0] * (p[0] - v[0][0]) + n[1] * (p[1] - v[0][1]) + n[2] * (p[2] - v[0][2]);
+                if (facing > 1e-9 * nl * t) {
+                    fprintf(stderr, "mesh '%s': a cluster's triangle %u faces a point its cone culls\n", mesh->name,
+                            k);
+                    return 0;
+                }
+            }
+        }
+    }
+    return 1;
+}
+
 /* Everything gdr/geometry.h promises about a built DAG; returns 1 when it all holds. */
 static int check_dag(const gdr_mesh *mesh, const gdr_lod_stats *st)
 {
@@ -245,13 +297,9 @@ static int check_dag(const gdr_mesh *mesh, const gdr_lod_stats *st)
             return 0;
         for (uint32_t k = 0; k < 3 * c->triangle_count; k++)
             CHECK(mc->triangles[c->triangle_offset + k] < c->vertex_count);
-        for (uint32_t v = 0; v < c->vertex_count; v++) {
-            uint32_t mv = mc->vertices[c->vertex_offset + v];
-            CHECK(mv < mesh->vertex_count);
-            if (mv < mesh->vertex_count)
-                CHECK(sphere_contains(c->sphere, (gdr_vec4){mesh->positions[mv].x, mesh->positions[mv].y,
-                                                            mesh->positions[mv].z, 0.0f}));
-        }
+        for (uint32_t v = 0; v < c->vertex_count; v++)
+            CHECK(mc->vertices[c->vertex_offset + v] < mesh->vertex_count);
+        CHECK(cone_is_conservative(mesh, mc, c));
         if (i < mc->level0_cluster_count) {
             CHECK(c->refined_group == GDR_NO_INDEX);
             CHECK(mc->groups[c->group].depth == 0);
@@ -268,6 +316,7 @@ static int check_dag(const gdr_mesh *mesh, const gdr_lod_stats *st)
         }
         CHECK(sphere_contains(mc->groups[c->group].sphere, c->sphere));
     }
+    CHECK(check_cluster_spheres(mesh, mc)); /* every vertex inside its cluster's sphere */
     /* Groups: contiguous clusters, finite positive errors below the root, triangles reduced. */
     uint32_t next = 0;
     for (uint32_t g = 0; g < mc->group_count; g++) {

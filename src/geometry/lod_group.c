@@ -1,0 +1,255 @@
+/* Simplifying one group of a DAG step: merge its clusters' triangles over a compact local vertex
+ * list, simplify to about half with the shared border locked (meshoptimizer), check the border,
+ * split into new clusters with their bounds. Runs as a thread-pool task; it writes only its own
+ * group_result and its worker's scratch. */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "geometry/cluster_bounds.h"
+#include "geometry/lod_internal.h"
+
+/* The smallest float >= x. */
+static float round_up_to_float(double x)
+{
+    float f = (float)x;
+    return (double)f < x ? nextafterf(f, INFINITY) : f;
+}
+
+/* A sphere containing every sphere of the list, in double, rounded up, with a relative slack of
+ * 1e-6 so that containment survives float evaluation of the distances. */
+gdr_vec4 gdr_lod_enclosing_sphere(const gdr_vec4 *s, size_t n)
+{
+    double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+    for (size_t i = 0; i < n; i++) {
+        const double c[3] = {s[i].x, s[i].y, s[i].z}, r = s[i].w;
+        for (int k = 0; k < 3; k++) {
+            lo[k] = c[k] - r < lo[k] ? c[k] - r : lo[k];
+            hi[k] = c[k] + r > hi[k] ? c[k] + r : hi[k];
+        }
+    }
+    float centre[3];
+    for (int k = 0; k < 3; k++)
+        centre[k] = (float)(0.5 * (lo[k] + hi[k]));
+    double radius = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        double dx = (double)s[i].x - centre[0], dy = (double)s[i].y - centre[1], dz = (double)s[i].z - centre[2];
+        double d = sqrt(dx * dx + dy * dy + dz * dz) + s[i].w;
+        radius = d > radius ? d : radius;
+    }
+    return (gdr_vec4){centre[0], centre[1], centre[2], round_up_to_float(radius * (1.0 + 1e-6))};
+}
+
+static int compare_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+static int contains_u64(const uint64_t *sorted, size_t n, uint64_t key)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (sorted[mid] < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < n && sorted[lo] == key;
+}
+
+/* The sphere and error that group g would have: over its members and the groups they came from. */
+static void group_bounds(lod_build *b, lod_scratch *s, uint32_t first, uint32_t count, group_result *r)
+{
+    uint32_t n = 0;
+    float child_error = 0.0f;
+    for (uint32_t i = 0; i < count; i++) {
+        const gdr_cluster *c = &b->clusters[b->members[first + i]];
+        s->spheres[n++] = c->sphere;
+        if (c->refined_group != GDR_NO_INDEX) {
+            const gdr_cluster_group *from = &b->groups[c->refined_group];
+            s->spheres[n++] = from->sphere;
+            child_error = from->error > child_error ? from->error : child_error;
+        }
+    }
+    r->sphere = gdr_lod_enclosing_sphere(s->spheres, n);
+    r->error = child_error;
+}
+
+/* Every border edge of the input (an edge between two locked positions that no other input
+ * triangle runs the other way) must still be there: else the group would no longer meet its
+ * neighbours exactly. (A locked vertex may lose all its triangles, when they only touched other
+ * groups at that point: that leaves no gap.) */
+static int border_kept(lod_build *b, lod_scratch *s, size_t in_count, size_t out_count)
+{
+    size_t na = 0, nb = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        const unsigned int *idx = pass ? s->simplified : s->indices;
+        size_t count = pass ? out_count : in_count;
+        uint64_t *keys = pass ? s->edges_out : s->edges_in;
+        size_t k = 0;
+        for (size_t i = 0; i < count; i++) {
+            unsigned int a = idx[i], e = idx[i - i % 3 + (i % 3 + 1) % 3];
+            if (s->locked[a] && s->locked[e])
+                keys[k++] = (uint64_t)b->position_id[s->local_to_mesh[a]] << 32 |
+                            b->position_id[s->local_to_mesh[e]];
+        }
+        qsort(keys, k, sizeof *keys, compare_u64);
+        *(pass ? &nb : &na) = k;
+    }
+    for (size_t i = 0; i < na; i++) {
+        uint64_t reverse = s->edges_in[i] << 32 | s->edges_in[i] >> 32;
+        if ((uint32_t)s->edges_in[i] == (uint32_t)(s->edges_in[i] >> 32))
+            continue;
+        if (!contains_u64(s->edges_in, na, reverse) && !contains_u64(s->edges_out, nb, s->edges_in[i]))
+            return 0;
+    }
+    return 1;
+}
+
+/* Splits the simplified triangles into clusters (meshoptimizer), written to r. */
+static int split_into_clusters(lod_build *b, lod_scratch *s, size_t index_count, uint32_t local_count,
+                               group_result *r)
+{
+    const uint32_t max_v = GDR_CLUSTER_MAX_VERTICES, max_t = GDR_CLUSTER_MAX_TRIANGLES;
+    size_t bound = meshopt_buildMeshletsBound(index_count, max_v, max_t);
+    if (!LOD_RESERVE(s, meshlets, bound) || !LOD_RESERVE(s, meshlet_vertices, bound * max_v) ||
+        !LOD_RESERVE(s, meshlet_triangles, bound * max_t * 3))
+        return 0;
+    size_t count = meshopt_buildMeshlets(s->meshlets, s->meshlet_vertices, s->meshlet_triangles, s->simplified,
+                                         index_count, s->positions, local_count, sizeof(float) * 3, max_v, max_t,
+                                         LOD_CONE_WEIGHT);
+    size_t vertex_total = 0, triangle_bytes = 0;
+    for (size_t i = 0; i < count; i++) {
+        vertex_total += s->meshlets[i].vertex_count;
+        triangle_bytes += gdr_lod_align4((size_t)s->meshlets[i].triangle_count * 3);
+    }
+    r->clusters = malloc(count * sizeof *r->clusters);
+    r->vertices = malloc(vertex_total * sizeof *r->vertices);
+    r->triangles = calloc(triangle_bytes, 1);
+    if (!r->clusters || !r->vertices || !r->triangles)
+        return 0;
+    size_t vo = 0, to = 0;
+    for (size_t i = 0; i < count; i++) {
+        const struct meshopt_Meshlet *m = &s->meshlets[i];
+        gdr_cluster *c = &r->clusters[i];
+        *c = (gdr_cluster){.vertex_offset = (uint32_t)vo, .triangle_offset = (uint32_t)to,
+                           .vertex_count = m->vertex_count, .triangle_count = m->triangle_count,
+                           .group = GDR_NO_INDEX, .refined_group = GDR_NO_INDEX};
+        for (uint32_t k = 0; k < m->vertex_count; k++)
+            r->vertices[vo + k] = s->local_to_mesh[s->meshlet_vertices[m->vertex_offset + k]];
+        memcpy(r->triangles + to, s->meshlet_triangles + m->triangle_offset, (size_t)m->triangle_count * 3);
+        gdr_cluster_compute_bounds(c, r->vertices + vo, r->triangles + to, b->mesh);
+        vo += m->vertex_count;
+        to += gdr_lod_align4((size_t)m->triangle_count * 3);
+    }
+    r->cluster_count = (uint32_t)count;
+    r->vertex_count = (uint32_t)vo;
+    r->triangle_bytes = (uint32_t)to;
+    return 1;
+}
+
+void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker)
+{
+    lod_build *b = user;
+    lod_scratch *s = &b->scratch[worker];
+    group_result *r = &b->results[g];
+    uint32_t first = b->member_start[g], count = b->member_start[g + 1] - first;
+    const gdr_vec3 *mesh_positions = b->mesh->positions;
+
+    size_t triangles = 0;
+    for (uint32_t i = 0; i < count; i++)
+        triangles += b->clusters[b->members[first + i]].triangle_count;
+    r->input_triangles = (uint32_t)triangles;
+    size_t index_count = triangles * 3;
+    if (!LOD_RESERVE(s, spheres, (size_t)count * 2) || !LOD_RESERVE(s, indices, index_count) ||
+        !LOD_RESERVE(s, simplified, index_count) || !LOD_RESERVE(s, local_to_mesh, index_count) ||
+        !LOD_RESERVE(s, locked, index_count) || !LOD_RESERVE(s, edges_in, index_count) ||
+        !LOD_RESERVE(s, edges_out, index_count) || !LOD_RESERVE(s, positions, index_count * 9)) {
+        r->out_of_memory = 1;
+        return;
+    }
+    group_bounds(b, s, first, count, r);
+
+    /* Merge: the members' triangles over a compact local vertex list. */
+    uint32_t local_count = 0;
+    size_t k = 0;
+    for (uint32_t i = 0; i < count; i++) {
+        const gdr_cluster *c = &b->clusters[b->members[first + i]];
+        const uint8_t *t = gdr_lod_cluster_triangles(b, c);
+        const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+        for (uint32_t j = 0; j < c->triangle_count * 3; j++) {
+            uint32_t mv = v[t[j]];
+            if (s->map[mv] == UINT32_MAX) {
+                s->map[mv] = local_count;
+                s->local_to_mesh[local_count++] = mv;
+            }
+            s->indices[k++] = s->map[mv];
+        }
+    }
+    /* Lock what other groups share. meshoptimizer 0.18 can only lock topological borders, which
+     * would also freeze the mesh's own open edges; instead each shared vertex gets two unused
+     * copies of its position, and the simplifier never moves a position held by more than two
+     * vertices. border_kept() checks that it held. */
+    uint32_t padded = local_count;
+    for (uint32_t l = 0; l < local_count; l++) {
+        uint32_t mv = s->local_to_mesh[l];
+        s->map[mv] = UINT32_MAX;
+        const gdr_vec3 p = mesh_positions[mv];
+        memcpy(s->positions + (size_t)l * 3, &p, sizeof p);
+        s->locked[l] = b->owner[b->position_id[mv]] == OWNER_SHARED;
+    }
+    for (uint32_t l = 0; l < local_count; l++)
+        if (s->locked[l])
+            for (int copy = 0; copy < 2; copy++, padded++)
+                memcpy(s->positions + (size_t)padded * 3, s->positions + (size_t)l * 3, sizeof(float) * 3);
+
+    size_t target = (size_t)((double)triangles * b->opt.target_ratio) * 3;
+    target = target < 3 ? 3 : target;
+    float relative_error = 0.0f;
+    size_t out_count = meshopt_simplify(s->simplified, s->indices, index_count, s->positions, padded,
+                                        sizeof(float) * 3, target, FLT_MAX, 0, &relative_error);
+    int enough = out_count > 0 && (double)out_count <= (double)index_count * LOD_MAX_KEPT_SHARE;
+    for (size_t i = 0; i < out_count && enough; i++)
+        enough = s->simplified[i] < local_count;
+    if (enough && !border_kept(b, s, index_count, out_count)) {
+        r->border_reject = 1;
+        enough = 0;
+    }
+    gdr_lod_progress_add(b, triangles / 2, worker);
+    if (!enough)
+        return;
+    float scale = meshopt_simplifyScale(s->positions, local_count, sizeof(float) * 3);
+    r->error = r->error + relative_error * scale;
+    if (!split_into_clusters(b, s, out_count, local_count, r)) {
+        r->out_of_memory = 1;
+        return;
+    }
+    r->formed = 1;
+}
+
+void gdr_lod_result_free(group_result *r)
+{
+    free(r->clusters);
+    free(r->vertices);
+    free(r->triangles);
+    memset(r, 0, sizeof *r);
+}
+
+void gdr_lod_scratch_free(lod_scratch *s)
+{
+    free(s->map);
+    free(s->local_to_mesh);
+    free(s->locked);
+    free(s->positions);
+    free(s->indices);
+    free(s->simplified);
+    free(s->edges_in);
+    free(s->edges_out);
+    free(s->spheres);
+    free(s->meshlets);
+    free(s->meshlet_vertices);
+    free(s->meshlet_triangles);
+}

@@ -1,0 +1,145 @@
+/* Internals of the LOD DAG build (lod_dag.c drives it, lod_graph.c partitions a step's clusters,
+ * lod_group.c simplifies one group). Not part of the public API. */
+#ifndef GDR_GEOMETRY_LOD_INTERNAL_H
+#define GDR_GEOMETRY_LOD_INTERNAL_H
+
+#include <stdatomic.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <meshoptimizer.h>
+
+#include "core/progress.h"
+#include "core/thread_pool.h"
+#include "gdr/geometry.h"
+#include "gdr/scene.h"
+
+/* A group is formed only when simplification keeps at most this share of its triangles. */
+#define LOD_MAX_KEPT_SHARE 0.85
+#define LOD_CONE_WEIGHT 0.25f
+
+/* lod_build.owner: a position no group of the step uses, or that two groups share. */
+#define OWNER_NONE UINT32_MAX
+#define OWNER_SHARED (UINT32_MAX - 1)
+
+_Static_assert(GDR_CLUSTER_MAX_VERTICES <= 64, "boundary edges are counted in a 64 x 64 table");
+
+/* A 64-bit key with a payload, for radix sorting. */
+typedef struct key_record {
+    uint64_t key;
+    uint32_t value;
+    uint32_t pad;
+} key_record;
+
+/* Progress shared by the meshes of one call; only worker 0 (the calling thread) draws. */
+typedef struct lod_progress {
+    gdr_progress bar;
+    atomic_uint_fast64_t done;
+} lod_progress;
+
+/* Per-worker scratch, reused from task to task. */
+typedef struct lod_scratch {
+    uint32_t *map; /* mesh vertex -> local vertex, UINT32_MAX when unused (mesh vertex_count entries) */
+    uint32_t *local_to_mesh;
+    size_t local_to_mesh_cap;
+    uint8_t *locked;
+    size_t locked_cap;
+    float *positions;
+    size_t positions_cap;
+    unsigned int *indices, *simplified;
+    size_t indices_cap, simplified_cap;
+    uint64_t *edges_in, *edges_out;
+    size_t edges_in_cap, edges_out_cap;
+    gdr_vec4 *spheres;
+    size_t spheres_cap;
+    struct meshopt_Meshlet *meshlets;
+    size_t meshlets_cap;
+    unsigned int *meshlet_vertices;
+    size_t meshlet_vertices_cap;
+    unsigned char *meshlet_triangles;
+    size_t meshlet_triangles_cap;
+    uint8_t edge_count[64 * 64];
+} lod_scratch;
+
+/* What simplifying one group produced. */
+typedef struct group_result {
+    int formed;        /* simplified enough: the group is formed and `clusters` replace its members */
+    int border_reject; /* simplification moved a locked border */
+    int out_of_memory;
+    float error;       /* own simplification error plus the largest error its members came with */
+    gdr_vec4 sphere;
+    uint32_t input_triangles;
+    gdr_cluster *clusters; /* offsets relative to the arrays below */
+    uint32_t cluster_count;
+    uint32_t *vertices;
+    uint32_t vertex_count;
+    uint8_t *triangles;
+    uint32_t triangle_bytes;
+} group_result;
+
+typedef struct lod_build {
+    gdr_mesh *mesh;
+    gdr_lod_options opt;
+    gdr_thread_pool *pool;
+    uint32_t worker_base; /* worker index offset of this build's scratch (0: draws progress) */
+    lod_scratch *scratch;
+    uint32_t scratch_count;
+    uint32_t *position_id; /* mesh vertex -> id of its position (vertices with equal coordinates share it) */
+    uint32_t position_count;
+    uint32_t *owner;       /* position id -> group using it in this step, OWNER_SHARED or OWNER_NONE */
+    float min_error;
+    uint64_t group_triangles; /* triangles a group aims at: group_size average level-0 clusters */
+    lod_progress *progress;
+    uint64_t progress_budget;
+    atomic_uint_fast64_t progress_given;
+    gdr_lod_stats stats;
+    int out_of_memory;
+    /* the growing result (owned by mesh->clusters' arrays once done) */
+    gdr_cluster *clusters;
+    size_t cluster_count, cluster_cap;
+    uint32_t *vertices;
+    size_t vertex_count, vertex_cap;
+    uint8_t *triangles;
+    size_t triangle_bytes, triangle_cap;
+    gdr_cluster_group *groups;
+    size_t group_count, group_cap;
+    /* one step */
+    const uint32_t *members;      /* frontier cluster ids ordered by group */
+    const uint32_t *member_start; /* group g: members[member_start[g] .. member_start[g + 1]) */
+    group_result *results;
+    const uint32_t *frontier;
+    uint32_t frontier_count;
+    key_record *edge_records;      /* boundary edges of frontier clusters, per chunk */
+    uint32_t *edge_record_counts;  /* per frontier cluster */
+} lod_build;
+
+/* Grows *p (a pointer to an array) to hold at least `need` elements of `size` bytes; returns 0 when
+ * out of memory. */
+int gdr_lod_reserve(void *p, size_t *cap, size_t need, size_t size);
+#define LOD_RESERVE(s, field, need) gdr_lod_reserve(&(s)->field, &(s)->field##_cap, (need), sizeof *(s)->field)
+
+static inline size_t gdr_lod_align4(size_t n) { return (n + 3) & ~(size_t)3; }
+static inline const uint8_t *gdr_lod_cluster_triangles(const lod_build *b, const gdr_cluster *c)
+{
+    return b->triangles + c->triangle_offset;
+}
+static inline const uint32_t *gdr_lod_cluster_vertices(const lod_build *b, const gdr_cluster *c)
+{
+    return b->vertices + c->vertex_offset;
+}
+
+/* Adds to the shared progress; only worker 0 of the calling thread draws. */
+void gdr_lod_progress_add(lod_build *b, uint64_t amount, uint32_t worker);
+
+/* lod_graph.c: partitions the frontier (b->frontier) into `*parts` groups of neighbours; part[f]
+ * in [0, *parts). */
+gdr_status gdr_lod_partition(lod_build *b, int32_t *part, uint32_t *parts, gdr_error *err);
+
+/* lod_group.c: a thread-pool task that simplifies group g of the step into b->results[g]. */
+void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker);
+/* A sphere containing every sphere of the list (rounded up, with a relative slack of 1e-6). */
+gdr_vec4 gdr_lod_enclosing_sphere(const gdr_vec4 *spheres, size_t count);
+void gdr_lod_result_free(group_result *r);
+void gdr_lod_scratch_free(lod_scratch *s);
+
+#endif
