@@ -1,11 +1,12 @@
 /* LOD DAG build benchmark (issue 5): build throughput in input triangles per second with 1 and 2
  * threads, peak heap memory per input triangle and DAG triangles / input triangles, for a dense
- * procedural mesh (the displaced icosphere of the demo scene) and the largest mesh of a real file.
- * Prints a table and JSON.
+ * procedural mesh (the displaced icosphere of the demo scene), the largest mesh of a real file and
+ * that file's whole scene (gdr_scene_build_lod: small meshes are built side by side). Prints a
+ * table and JSON.
  *
  * usage: lod_bench [--levels N] [--file PATH] [--repeat R] [--json FILE]
  *   --levels N  icosphere subdivisions of the procedural mesh (default 8: 1,310,720 triangles)
- *   --file PATH glTF/GLB/OBJ whose largest mesh is built
+ *   --file PATH glTF/GLB/OBJ whose largest mesh, then whole scene, is built
  *               (default: assimp-testmodels' 2CylinderEngine.glb when installed)
  *   --repeat R  builds per configuration, the fastest is reported (default 1)
  *
@@ -156,12 +157,18 @@ static result run(const char *input, gdr_mesh *mesh, const gdr_mesh_clusters *le
 
 static void print_row(const result *r)
 {
+    char stop[64];
+    const uint32_t *n = r->stats.stop_counts;
+    if (r->stats.mesh_count == 1)
+        snprintf(stop, sizeof stop, "%s", n[GDR_LOD_STOP_SINGLE_CLUSTER] ? "single" : n[GDR_LOD_STOP_NO_PROGRESS] ? "no-progress" : "limit");
+    else
+        snprintf(stop, sizeof stop, "%u single, %u no-progress, %u limit", n[GDR_LOD_STOP_SINGLE_CLUSTER],
+                 n[GDR_LOD_STOP_NO_PROGRESS], n[GDR_LOD_STOP_LEVEL_LIMIT]);
     double dag_rate = (double)r->triangles / r->dag_s / 1e6;
     double all_rate = (double)r->triangles / (r->dag_s + r->meshlet_s) / 1e6;
     printf("%-28s %7u %10llu %9.3f %9.3f %10.3f %10.3f %10.3f %8.2fx %9.1f %5u %s\n", r->input, r->threads,
            (unsigned long long)r->triangles, r->meshlet_s, r->dag_s, dag_rate, dag_rate / r->threads, all_rate,
-           (double)r->stats.dag_triangles / (double)r->triangles, r->heap_bytes_per_triangle, r->stats.max_depth,
-           r->stats.stop_counts[GDR_LOD_STOP_SINGLE_CLUSTER] ? "single" : r->stats.stop_counts[GDR_LOD_STOP_NO_PROGRESS] ? "no-progress" : "limit");
+           (double)r->stats.dag_triangles / (double)r->triangles, r->heap_bytes_per_triangle, r->stats.max_depth, stop);
 }
 
 static void json_row(FILE *f, const result *r, int last)
@@ -170,12 +177,15 @@ static void json_row(FILE *f, const result *r, int last)
             "  {\"input\": \"%s\", \"threads\": %u, \"triangles\": %llu, \"meshlet_s\": %.4f, \"dag_s\": %.4f, "
             "\"dag_mtris_per_s\": %.4f, \"dag_mtris_per_s_per_thread\": %.4f, \"dag_ratio\": %.4f, "
             "\"peak_heap_bytes_per_triangle\": %.1f, \"depth\": %u, \"groups\": %llu, "
-            "\"clusters\": %llu, \"root_clusters\": %llu, \"stuck_groups\": %llu, \"border_rejects\": %llu}%s\n",
+            "\"clusters\": %llu, \"root_clusters\": %llu, \"stuck_groups\": %llu, \"border_rejects\": %llu, "
+            "\"meshes\": %u, \"stopped_single\": %u, \"stopped_no_progress\": %u}%s\n",
             r->input, r->threads, (unsigned long long)r->triangles, r->meshlet_s, r->dag_s,
             (double)r->triangles / r->dag_s / 1e6, (double)r->triangles / r->dag_s / 1e6 / r->threads,
             (double)r->stats.dag_triangles / (double)r->triangles, r->heap_bytes_per_triangle, r->stats.max_depth, (unsigned long long)r->stats.group_count,
             (unsigned long long)r->stats.cluster_count, (unsigned long long)r->stats.root_clusters,
-            (unsigned long long)r->stats.stuck_groups, (unsigned long long)r->stats.border_rejects, last ? "" : ",");
+            (unsigned long long)r->stats.stuck_groups, (unsigned long long)r->stats.border_rejects, r->stats.mesh_count,
+            r->stats.stop_counts[GDR_LOD_STOP_SINGLE_CLUSTER], r->stats.stop_counts[GDR_LOD_STOP_NO_PROGRESS],
+            last ? "" : ",");
 }
 
 /* Level 0 of `mesh`, timed. */
@@ -188,6 +198,37 @@ static gdr_mesh_clusters level0_of(gdr_mesh *mesh, double *seconds)
         die(mesh->name, &err);
     *seconds = now() - t0;
     return c;
+}
+
+static gdr_scene *import(const char *path);
+
+/* The whole scene of `file` through gdr_scene_build_lod (small meshes side by side, one per
+ * thread): level 0 is built first with gdr_scene_build_clusters and timed apart. */
+static result run_scene(const char *name, const char *file, uint32_t threads, int repeat)
+{
+    result r = {.input = name, .threads = threads, .dag_s = 1e30};
+    for (int k = 0; k < repeat; k++) {
+        gdr_scene *scene = import(file);
+        gdr_error err = {0};
+        double t0 = now();
+        if (gdr_scene_build_clusters(scene, &(gdr_meshlet_options){.thread_count = threads}, &err) != GDR_OK)
+            die(file, &err);
+        r.meshlet_s = now() - t0;
+        r.triangles = 0;
+        for (uint32_t m = 0; m < scene->mesh_count; m++)
+            r.triangles += scene->meshes[m].index_count / 3;
+        gdr_lod_options o = {.thread_count = threads, .no_progress = 1};
+        long long heap_before = atomic_load(&heap_in_use);
+        atomic_store(&heap_peak, heap_before);
+        t0 = now();
+        if (gdr_scene_build_lod(scene, &o, &r.stats, &err) != GDR_OK)
+            die(file, &err);
+        double t = now() - t0;
+        r.dag_s = t < r.dag_s ? t : r.dag_s;
+        r.heap_bytes_per_triangle = (double)(atomic_load(&heap_peak) - heap_before) / (double)r.triangles;
+        gdr_scene_destroy(scene);
+    }
+    return r;
 }
 
 static gdr_scene *import(const char *path)
@@ -227,7 +268,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "lod_bench: --levels at most 9, --repeat at least 1\n");
         return 2;
     }
-    result results[4];
+    result results[6];
     int count = 0;
     gdr_error err = {0};
 
@@ -262,6 +303,10 @@ int main(int argc, char **argv)
             results[count++] = run(real_name, &scene->meshes[largest], &level0, meshlet_s, threads, repeat);
         gdr_mesh_clusters_free(&level0);
         gdr_scene_destroy(scene);
+        static char scene_name[96];
+        snprintf(scene_name, sizeof scene_name, "%.40s all meshes", base);
+        for (uint32_t threads = 1; threads <= 2; threads++)
+            results[count++] = run_scene(scene_name, file, threads, repeat);
     } else {
         fprintf(stderr, "lod_bench: %s not found: real mesh skipped\n", file);
     }
