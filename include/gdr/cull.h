@@ -209,19 +209,20 @@ GDR_API bool gdr_triangle_overlaps_box(const gdr_vec3 corners[3], gdr_vec3 cente
 
 /* The bake: the region is cut into cells of cell_size; cells touched by a triangle are not empty
  * space and get no data (a lookup there returns NULL: nothing is culled). In every other cell,
- * samples_per_cell camera points are taken (stratified, jittered); from each, rays go in
- * direction_rays uniform directions and, for every object not yet seen from the cell, up to
- * rays_per_object rays towards area-weighted random points on its triangles. The first object a
- * ray hits is visible from the cell. So the result is
- * conservative for the sampled points and the rays cast: every object hit first by a bake ray
- * is marked; an object seen only through a gap no ray went through can be missed. */
+ * samples_per_cell camera points are taken (stratified, jittered). From each, a depth cube map of
+ * cube_resolution^2 texels per face is built conservatively: a texel holds a distance only where
+ * one object's front (or back) surface provably covers all of it, and then the farthest that
+ * surface can be in it. An object is hidden from the point only when its bounds lie strictly
+ * behind every texel they project to; every other object with triangles is listed.
+ * Guarantee (docs/CULLING.md): from every sample point, every object that some ray from that
+ * point hits first is listed, whatever the ray. Points of the cell that were not sampled have no
+ * guarantee (the tests measure how often they see an unlisted object). */
 typedef struct gdr_pvs_bake_desc {
     const gdr_scene *scene;    /* static geometry; object i = instance i */
     gdr_vec3 region_min, region_max; /* both zero: the scene's bounds */
     float cell_size;           /* 0: the region's largest side / 16 */
-    uint32_t samples_per_cell; /* 0: 8 */
-    uint32_t direction_rays;   /* per sample; 0: 256 */
-    uint32_t rays_per_object;  /* per sample and object; 0: 32 */
+    uint32_t samples_per_cell; /* 0: 8; at most 4096 */
+    uint32_t cube_resolution;  /* texels along a side of each of the 6 cube faces; 0: 64; 4..1024 */
     uint32_t cells_per_chunk;  /* cells compressed together; 0: 16 */
     uint32_t bucket_count_x, bucket_count_z; /* the 2D bucket grid; 0: 16 each */
     int zstd_level;            /* 0: 3 */
@@ -233,8 +234,9 @@ typedef struct gdr_pvs_bake_desc {
 typedef struct gdr_pvs_bake_report {
     uint32_t grid[3];          /* cells along x, y, z */
     uint32_t cells_total, cells_baked, cells_occupied; /* occupied: touched by geometry */
-    uint64_t samples_used;     /* camera points */
-    uint64_t rays_cast;
+    uint64_t samples_used;     /* camera points (samples_per_cell per baked cell) */
+    uint64_t object_tests;     /* (sample, object) pairs tested against a depth cube */
+    uint64_t unproven_samples; /* samples too close to geometry for the proof: every object listed */
     uint64_t visible_pairs;    /* (cell, object) pairs marked visible */
     size_t compressed_bytes, uncompressed_bytes;
 } gdr_pvs_bake_report;

@@ -68,6 +68,29 @@ bool cull_screen_size_visible(float size, float view_min, const gdr_cull_object 
 /* bvh.c */
 void cull_bvh_bounds(const gdr_bvh *bvh, gdr_vec3 *lo, gdr_vec3 *hi);
 
+/* pvs_occlusion.c: conservative visibility from one point (the bake's proof). Each object's
+ * triangles with a cross product that is not exactly zero (the only ones a ray can hit), with
+ * the twin of each edge: the object's triangle sharing it in the opposite direction. */
+typedef struct pvs_geometry {
+    uint32_t object_count;
+    uint32_t *first;   /* object_count + 1: object o owns triangles [first[o], first[o + 1]) */
+    gdr_vec3 *corners; /* 3 per triangle */
+    uint32_t *twin;    /* 3 per triangle (edge k: corner k to corner k + 1), or UINT32_MAX */
+    gdr_vec3 *lo, *hi; /* per object: bounds of its triangles */
+    uint32_t max_triangles;
+} pvs_geometry;
+gdr_status pvs_geometry_build(pvs_geometry *g, const gdr_bvh *bvh, uint32_t object_count, gdr_error *err);
+void pvs_geometry_free(pvs_geometry *g);
+typedef struct pvs_view_scratch pvs_view_scratch; /* a depth cube and buffers; one per thread */
+gdr_status pvs_view_scratch_create(uint32_t resolution, uint32_t max_triangles, uint32_t object_count,
+                                   pvs_view_scratch **out, gdr_error *err);
+void pvs_view_scratch_destroy(pvs_view_scratch *s);
+/* Sets the bit of every object with triangles that is not provably hidden from p. Requires that
+ * no triangle touches the cube of half-size delta about p (the caller checks with the BVH).
+ * Returns how many objects were tested (those whose bit was not set already). */
+uint64_t pvs_visible_from_point(const pvs_geometry *g, pvs_view_scratch *s, gdr_vec3 p, float delta,
+                                uint32_t *bits);
+
 /* Precomputed visibility (precomputed_visibility.c bakes, pvs_blob.c (de)serialises,
  * pvs_query.c looks up). Cells are sorted by bucket; a bucket's cells are contiguous. */
 #define PVS_CHUNK_ZSTD 1u

@@ -1,6 +1,7 @@
-/* The precomputed-visibility bake: cells of empty space, camera points sampled in each, rays
- * against the static geometry through the BVH, one visibility bitset per cell, cells hashed into
- * 2D buckets, bitsets compressed with zstd in chunks of cells. */
+/* The precomputed-visibility bake: cells of empty space, camera points sampled in each, a
+ * conservative depth cube per point (pvs_occlusion.c) deciding which objects it may see, one
+ * visibility bitset per cell, cells hashed into 2D buckets, bitsets compressed with zstd in chunks
+ * of cells. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,17 +15,17 @@ enum { CELL_UNTOUCHED = 0, CELL_BAKED = 1, CELL_OCCUPIED = 2 };
 typedef struct bake_context {
     gdr_pvs_bake_desc desc; /* defaults applied */
     const gdr_bvh *bvh;
+    pvs_geometry geometry;
+    pvs_view_scratch **scratch; /* per worker */
     uint32_t object_count, words;
     gdr_vec3 origin;
     float cell;
     uint32_t grid[3];
-    uint32_t *object_first; /* object_count + 1: ranges of object_triangles */
-    uint32_t *object_triangles;
-    float *object_cdf;      /* cumulative area, 1 at each object's last triangle */
     uint32_t *bits;         /* per grid cell: words */
     uint8_t *state;         /* per grid cell */
     gdr_vec3 *samples;      /* per grid cell: samples_per_cell, or NULL */
-    uint64_t *rays;         /* per grid cell */
+    uint64_t *tests;        /* per grid cell: objects tested against a depth cube */
+    uint32_t *unproven;     /* per grid cell: samples too near geometry for the proof */
 } bake_context;
 
 static uint64_t splitmix(uint64_t *s)
@@ -37,37 +38,15 @@ static uint64_t splitmix(uint64_t *s)
 
 static float rand01(uint64_t *s) { return (float)(splitmix(s) >> 40) * (1.0f / 16777216.0f); }
 
-static void mark(uint32_t *bits, uint32_t object) { bits[object >> 5] |= 1u << (object & 31u); }
-
-static gdr_vec3 sample_triangle_point(const bake_context *ctx, uint32_t object, uint64_t *rng)
-{
-    uint32_t first = ctx->object_first[object], last = ctx->object_first[object + 1];
-    float u = rand01(rng);
-    uint32_t lo = first, hi = last - 1;
-    while (lo < hi) { /* the first triangle whose cumulative area exceeds u */
-        uint32_t mid = (lo + hi) / 2;
-        if (ctx->object_cdf[mid] > u)
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
-    gdr_vec3 c[3];
-    gdr_bvh_triangle(ctx->bvh, ctx->object_triangles[lo], c, NULL);
-    float r1 = sqrtf(rand01(rng)), r2 = rand01(rng);
-    float a = 1.0f - r1, b = r1 * (1.0f - r2), w = r1 * r2;
-    return (gdr_vec3){a * c[0].x + b * c[1].x + w * c[2].x, a * c[0].y + b * c[1].y + w * c[2].y,
-                      a * c[0].z + b * c[1].z + w * c[2].z};
-}
-
 static void bake_cell(void *user, uint32_t index, uint32_t worker)
 {
-    (void)worker;
     bake_context *ctx = user;
     const gdr_pvs_bake_desc *d = &ctx->desc;
     uint32_t x = index % ctx->grid[0], y = index / ctx->grid[0] % ctx->grid[1], z = index / ctx->grid[0] / ctx->grid[1];
     float h = 0.5f * ctx->cell;
     gdr_vec3 lo = {ctx->origin.x + (float)x * ctx->cell, ctx->origin.y + (float)y * ctx->cell,
                    ctx->origin.z + (float)z * ctx->cell};
+    gdr_vec3 hi = {lo.x + ctx->cell, lo.y + ctx->cell, lo.z + ctx->cell};
     if (gdr_bvh_overlaps_box(ctx->bvh, (gdr_vec3){lo.x + h, lo.y + h, lo.z + h}, (gdr_vec3){h, h, h})) {
         ctx->state[index] = CELL_OCCUPIED;
         return;
@@ -76,7 +55,6 @@ static void bake_cell(void *user, uint32_t index, uint32_t worker)
     uint32_t *bits = &ctx->bits[(size_t)index * ctx->words];
     uint64_t rng = ((uint64_t)d->seed << 32) ^ index;
     splitmix(&rng);
-    uint64_t rays = 0;
     uint32_t strata = 1;
     while (strata * strata * strata < d->samples_per_cell)
         strata++;
@@ -88,77 +66,19 @@ static void bake_cell(void *user, uint32_t index, uint32_t worker)
                       lo.z + ctx->cell * (((float)sz + 0.02f + 0.96f * rand01(&rng)) / (float)strata)};
         if (ctx->samples)
             ctx->samples[(size_t)index * d->samples_per_cell + s] = p;
-        gdr_ray_hit hit;
-        for (uint32_t r = 0; r < d->direction_rays; r++) {
-            float cz = 2.0f * rand01(&rng) - 1.0f, phi = 6.2831853f * rand01(&rng);
-            float sxy = sqrtf(fmaxf(0.0f, 1.0f - cz * cz));
-            gdr_vec3 dir = {sxy * cosf(phi), sxy * sinf(phi), cz};
-            rays++;
-            if (gdr_bvh_raycast(ctx->bvh, p, dir, INFINITY, &hit))
-                mark(bits, hit.object);
+        /* The proof needs a small cube about p free of triangles: half the distance to the
+         * (empty) cell's faces, checked again with the exact triangle/box test. */
+        float delta = 0.5f * fminf(fminf(fminf(p.x - lo.x, hi.x - p.x), fminf(p.y - lo.y, hi.y - p.y)),
+                                   fminf(p.z - lo.z, hi.z - p.z));
+        if (!(delta > 0.0f) || gdr_bvh_overlaps_box(ctx->bvh, p, (gdr_vec3){delta, delta, delta})) {
+            for (uint32_t o = 0; o < ctx->object_count; o++)
+                if (ctx->geometry.first[o + 1] > ctx->geometry.first[o])
+                    bits[o >> 5] |= 1u << (o & 31u);
+            ctx->unproven[index]++;
+            continue;
         }
-        for (uint32_t o = 0; o < ctx->object_count; o++) {
-            if (ctx->object_first[o] == ctx->object_first[o + 1])
-                continue; /* no triangle with area */
-            for (uint32_t r = 0; r < d->rays_per_object && !gdr_cull_bit(bits, o); r++) {
-                gdr_vec3 target = sample_triangle_point(ctx, o, &rng);
-                rays++;
-                /* the target lies at t = 1; whatever is hit first up to there is visible */
-                if (gdr_bvh_raycast(ctx->bvh, p, gdr_vec3_sub(target, p), 1.0001f, &hit))
-                    mark(bits, hit.object);
-            }
-        }
+        ctx->tests[index] += pvs_visible_from_point(&ctx->geometry, ctx->scratch[worker], p, delta, bits);
     }
-    ctx->rays[index] = rays;
-}
-
-static gdr_status prepare_objects(bake_context *ctx, gdr_error *err)
-{
-    uint32_t tris = gdr_bvh_triangle_count(ctx->bvh);
-    ctx->object_first = calloc((size_t)ctx->object_count + 2, sizeof(uint32_t));
-    ctx->object_triangles = malloc((size_t)(tris ? tris : 1) * sizeof(uint32_t));
-    ctx->object_cdf = malloc((size_t)(tris ? tris : 1) * sizeof(float));
-    float *areas = malloc((size_t)(tris ? tris : 1) * sizeof(float));
-    if (!ctx->object_first || !ctx->object_triangles || !ctx->object_cdf || !areas) {
-        free(areas);
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "pvs bake: out of memory");
-    }
-    for (uint32_t t = 0; t < tris; t++) {
-        gdr_vec3 c[3];
-        uint32_t o;
-        gdr_bvh_triangle(ctx->bvh, t, c, &o);
-        areas[t] = 0.5f * gdr_vec3_length(gdr_vec3_cross(gdr_vec3_sub(c[1], c[0]), gdr_vec3_sub(c[2], c[0])));
-        if (o < ctx->object_count && areas[t] > 0.0f)
-            ctx->object_first[o + 1]++;
-    }
-    for (uint32_t o = 0; o < ctx->object_count; o++)
-        ctx->object_first[o + 1] += ctx->object_first[o];
-    uint32_t *fill = calloc((size_t)ctx->object_count + 1, sizeof(uint32_t));
-    if (!fill) {
-        free(areas);
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "pvs bake: out of memory");
-    }
-    for (uint32_t t = 0; t < tris; t++) {
-        uint32_t o;
-        gdr_vec3 c[3];
-        gdr_bvh_triangle(ctx->bvh, t, c, &o);
-        if (o < ctx->object_count && areas[t] > 0.0f)
-            ctx->object_triangles[ctx->object_first[o] + fill[o]++] = t;
-    }
-    for (uint32_t o = 0; o < ctx->object_count; o++) {
-        double total = 0.0, running = 0.0;
-        for (uint32_t i = ctx->object_first[o]; i < ctx->object_first[o + 1]; i++)
-            total += areas[ctx->object_triangles[i]];
-        for (uint32_t i = ctx->object_first[o]; i < ctx->object_first[o + 1]; i++) {
-            running += areas[ctx->object_triangles[i]];
-            ctx->object_cdf[i] = (float)(running / total);
-        }
-        if (ctx->object_first[o + 1] > ctx->object_first[o])
-            ctx->object_cdf[ctx->object_first[o + 1] - 1] = 2.0f; /* always above u < 1 */
-    }
-    free(fill);
-    free(areas);
-    return GDR_OK;
 }
 
 /* Sorts the baked cells into buckets and compresses their bitsets in chunks. */
@@ -258,15 +178,18 @@ static gdr_status assemble(bake_context *ctx, gdr_pvs *pvs, gdr_error *err)
     return st;
 }
 
-static void bake_context_free(bake_context *ctx)
+static void bake_context_free(bake_context *ctx, uint32_t workers)
 {
-    free(ctx->object_first);
-    free(ctx->object_triangles);
-    free(ctx->object_cdf);
+    pvs_geometry_free(&ctx->geometry);
+    if (ctx->scratch)
+        for (uint32_t w = 0; w < workers; w++)
+            pvs_view_scratch_destroy(ctx->scratch[w]);
+    free(ctx->scratch);
     free(ctx->bits);
     free(ctx->state);
     free(ctx->samples);
-    free(ctx->rays);
+    free(ctx->tests);
+    free(ctx->unproven);
 }
 
 gdr_status gdr_pvs_bake(const gdr_pvs_bake_desc *desc_in, gdr_pvs **out, gdr_pvs_bake_report *report, gdr_error *err)
@@ -277,8 +200,7 @@ gdr_status gdr_pvs_bake(const gdr_pvs_bake_desc *desc_in, gdr_pvs **out, gdr_pvs
     bake_context ctx = {0};
     gdr_pvs_bake_desc d = *desc_in;
     if (!d.samples_per_cell) d.samples_per_cell = 8;
-    if (!d.direction_rays) d.direction_rays = 256;
-    if (!d.rays_per_object) d.rays_per_object = 32;
+    if (!d.cube_resolution) d.cube_resolution = 64;
     if (!d.cells_per_chunk) d.cells_per_chunk = 16;
     if (!d.bucket_count_x) d.bucket_count_x = 16;
     if (!d.bucket_count_z) d.bucket_count_z = 16;
@@ -287,6 +209,9 @@ gdr_status gdr_pvs_bake(const gdr_pvs_bake_desc *desc_in, gdr_pvs **out, gdr_pvs
     if (d.bucket_count_x > PVS_MAX_BUCKETS_PER_AXIS || d.bucket_count_z > PVS_MAX_BUCKETS_PER_AXIS)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "pvs bake: more than %u buckets along an axis",
                              PVS_MAX_BUCKETS_PER_AXIS);
+    if (d.cube_resolution < 4 || d.cube_resolution > 1024)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "pvs bake: cube_resolution %u is outside 4..1024",
+                             d.cube_resolution);
     if (d.samples_per_cell > 4096 || d.cells_per_chunk > 4096)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "pvs bake: samples_per_cell and cells_per_chunk "
                                                               "must be at most 4096");
@@ -336,14 +261,21 @@ gdr_status gdr_pvs_bake(const gdr_pvs_bake_desc *desc_in, gdr_pvs **out, gdr_pvs
     ctx.cell = cell;
     ctx.bits = calloc((size_t)total * ctx.words + 1, sizeof(uint32_t));
     ctx.state = calloc(total, 1);
-    ctx.rays = calloc(total, sizeof(uint64_t));
+    ctx.tests = calloc(total, sizeof(uint64_t));
+    ctx.unproven = calloc(total, sizeof(uint32_t));
     if (d.keep_samples)
         ctx.samples = calloc((size_t)total * d.samples_per_cell, sizeof(gdr_vec3));
+    uint32_t workers = gdr_thread_pool_thread_count(d.pool);
+    ctx.scratch = calloc(workers, sizeof(pvs_view_scratch *));
     gdr_pvs *pvs = calloc(1, sizeof(*pvs));
-    if (!ctx.bits || !ctx.state || !ctx.rays || (d.keep_samples && !ctx.samples) || !pvs)
+    if (!ctx.bits || !ctx.state || !ctx.tests || !ctx.unproven || (d.keep_samples && !ctx.samples) ||
+        !ctx.scratch || !pvs)
         st = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "pvs bake: out of memory for %u cells", total);
     if (st == GDR_OK)
-        st = prepare_objects(&ctx, err);
+        st = pvs_geometry_build(&ctx.geometry, bvh, ctx.object_count, err);
+    for (uint32_t w = 0; w < workers && st == GDR_OK; w++)
+        st = pvs_view_scratch_create(d.cube_resolution, ctx.geometry.max_triangles, ctx.object_count, &ctx.scratch[w],
+                                    err);
     if (st == GDR_OK) {
         gdr_thread_pool_run(d.pool, total, bake_cell, &ctx);
         pvs->object_count = ctx.object_count;
@@ -361,7 +293,8 @@ gdr_status gdr_pvs_bake(const gdr_pvs_bake_desc *desc_in, gdr_pvs **out, gdr_pvs
         for (uint32_t i = 0; i < total; i++) {
             r.cells_baked += ctx.state[i] == CELL_BAKED;
             r.cells_occupied += ctx.state[i] == CELL_OCCUPIED;
-            r.rays_cast += ctx.rays[i];
+            r.object_tests += ctx.tests[i];
+            r.unproven_samples += ctx.unproven[i];
             if (ctx.state[i] == CELL_BAKED)
                 for (uint32_t w = 0; w < ctx.words; w++)
                     r.visible_pairs += (uint64_t)__builtin_popcount(ctx.bits[(size_t)i * ctx.words + w]);
@@ -371,7 +304,7 @@ gdr_status gdr_pvs_bake(const gdr_pvs_bake_desc *desc_in, gdr_pvs **out, gdr_pvs
         r.uncompressed_bytes = (size_t)r.cells_baked * ctx.words * 4;
         *report = r;
     }
-    bake_context_free(&ctx);
+    bake_context_free(&ctx, workers);
     gdr_bvh_destroy(bvh);
     if (st != GDR_OK) {
         gdr_pvs_destroy(pvs);
@@ -379,16 +312,4 @@ gdr_status gdr_pvs_bake(const gdr_pvs_bake_desc *desc_in, gdr_pvs **out, gdr_pvs
     }
     *out = pvs;
     return GDR_OK;
-}
-
-void gdr_pvs_destroy(gdr_pvs *pvs)
-{
-    if (!pvs)
-        return;
-    free(pvs->buckets);
-    free(pvs->cells);
-    free(pvs->chunks);
-    free(pvs->data);
-    free(pvs->samples);
-    free(pvs);
 }

@@ -14,6 +14,18 @@ struct gdr_pvs_cache {
     uint64_t decompressions;
 };
 
+void gdr_pvs_destroy(gdr_pvs *pvs)
+{
+    if (!pvs)
+        return;
+    free(pvs->buckets);
+    free(pvs->cells);
+    free(pvs->chunks);
+    free(pvs->data);
+    free(pvs->samples);
+    free(pvs);
+}
+
 uint32_t gdr_pvs_object_count(const gdr_pvs *pvs) { return pvs->object_count; }
 uint32_t gdr_pvs_cell_count(const gdr_pvs *pvs) { return pvs->cell_count; }
 
