@@ -34,6 +34,9 @@ struct gdr_cull_scene {
     cull_node *nodes;
     uint32_t node_count, node_capacity;
     uint32_t max_depth, leaf_objects;
+    /* The per-view pass runs subtrees of at most task_nodes nodes as tasks; no view has more
+     * than task_capacity of them (both fixed when the tree is built). */
+    uint32_t task_nodes, task_capacity;
 };
 
 /* octree.c */
@@ -41,9 +44,12 @@ gdr_status cull_octree_build(gdr_cull_scene *scene, gdr_error *err);
 /* Node index for an object with valid bounds (CULL_NODE_NONE if outside the root). */
 uint32_t cull_octree_place(const gdr_cull_scene *scene, gdr_vec3 center, gdr_vec3 extent);
 /* Two bits per node into node_bits (gdr_cull_word_count(2 * node_count) words, zeroed by the
- * caller): bit 2n = intersects the frustum, bit 2n + 1 = partly outside. */
-void cull_octree_classify(const gdr_cull_scene *scene, const gdr_frustum *frustum, uint32_t *node_bits,
-                          uint32_t *nodes_tested, uint32_t *nodes_inside);
+ * caller): bit 2n = intersects the frustum, bit 2n + 1 = partly outside. The top of the tree is
+ * walked on the calling thread, the subtrees below it as tasks on pool (NULL: all on the calling
+ * thread); the bits and counts do not depend on the thread count. Fails only out of memory. */
+gdr_status cull_octree_classify(const gdr_cull_scene *scene, const gdr_frustum *frustum, gdr_thread_pool *pool,
+                                uint32_t *node_bits, uint32_t *nodes_tested, uint32_t *nodes_inside,
+                                gdr_error *err);
 static inline uint32_t cull_node_bits(const uint32_t *node_bits, uint32_t node)
 {
     return (node_bits[node >> 4] >> ((node & 15u) * 2u)) & 3u;

@@ -1,4 +1,5 @@
-/* One view: the octree pass, then tasks over 32-bit words of the visibility bitset. */
+/* One view: the octree pass (its subtrees as tasks), then tasks over 32-bit words of the visibility
+ * bitset. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -189,7 +190,13 @@ gdr_status gdr_cull_execute(const gdr_cull_scene *scene, const gdr_cull_view *vi
     }
     gdr_cull_stats total = {0};
     if (use_octree) {
-        cull_octree_classify(scene, &ctx.frustum, node_bits, &total.nodes_tested, &total.nodes_inside);
+        gdr_status st = cull_octree_classify(scene, &ctx.frustum, pool, node_bits, &total.nodes_tested,
+                                             &total.nodes_inside, err);
+        if (st != GDR_OK) {
+            free(ctx.task_stats);
+            free(node_bits);
+            return st;
+        }
         ctx.node_bits = node_bits;
     }
 

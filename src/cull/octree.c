@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/thread_pool.h"
 #include "cull/cull_internal.h"
 
 typedef struct octree_builder {
@@ -18,6 +19,8 @@ typedef struct octree_builder {
     float margin;
     gdr_error *err;
 } octree_builder;
+
+static void cull_octree_plan_tasks(gdr_cull_scene *s);
 
 static float max3f(float a, float b, float c) { return fmaxf(a, fmaxf(b, c)); }
 
@@ -159,6 +162,8 @@ gdr_status cull_octree_build(gdr_cull_scene *s, gdr_error *err)
         st = build_node(&b, root, objects, valid);
     free(objects);
     free(scratch);
+    if (st == GDR_OK)
+        cull_octree_plan_tasks(s);
     return st;
 }
 
@@ -194,33 +199,135 @@ static gdr_cull_outcome node_classify(const gdr_frustum *f, const float slack[8]
     return outside ? GDR_CULL_OUTSIDE : partly ? GDR_CULL_INTERSECTS : GDR_CULL_INSIDE;
 }
 
-void cull_octree_classify(const gdr_cull_scene *s, const gdr_frustum *frustum, uint32_t *node_bits,
-                          uint32_t *nodes_tested, uint32_t *nodes_inside)
+/* The tree's top: nodes whose subtree has more than task_nodes nodes. The view pass walks them on
+ * one thread and hands every subtree it reaches below them to a task; a subtree of at most
+ * 1/64 of the tree keeps the tasks many and even. */
+static void cull_octree_plan_tasks(gdr_cull_scene *s)
 {
+    s->task_nodes = s->node_count / 64 > 256 ? s->node_count / 64 : 256;
+    s->task_capacity = 0;
+    for (uint32_t i = 0; i < s->node_count; i++) {
+        const cull_node *n = &s->nodes[i];
+        if (n->skip - i <= s->task_nodes)
+            continue; /* counted from its parent */
+        for (int k = 0; k < 8; k++)
+            if (n->children[k] != UINT32_MAX) {
+                const cull_node *c = &s->nodes[n->children[k]];
+                s->task_capacity += c->skip - n->children[k] <= s->task_nodes;
+            }
+    }
+    if (s->node_count && s->nodes[0].skip <= s->task_nodes)
+        s->task_capacity = 1; /* the whole tree is one task */
+}
+
+typedef struct octree_pass {
+    const gdr_cull_scene *scene;
+    const gdr_frustum *frustum;
+    float slack[8];
+    uint32_t *node_bits;
+    const uint32_t *roots;
+    uint32_t (*counts)[2]; /* per task: nodes tested, nodes found inside */
+} octree_pass;
+
+/* ORs value into word w of node_bits. A task owns the words wholly inside its node range; the
+ * two end words may hold bits of other tasks' nodes and are written atomically. */
+static void or_word(uint32_t *bits, uint32_t w, uint32_t value, uint32_t shared_lo, uint32_t shared_hi)
+{
+    if (w == shared_lo || w == shared_hi)
+        __atomic_fetch_or(&bits[w], value, __ATOMIC_RELAXED);
+    else
+        bits[w] |= value;
+}
+
+/* Bits "intersects, not partly outside" (01) for nodes [first, last). */
+static void mark_inside(uint32_t *bits, uint32_t first, uint32_t last, uint32_t shared_lo, uint32_t shared_hi)
+{
+    while (first < last) {
+        uint32_t w = first >> 4, end = (w + 1) * 16 < last ? (w + 1) * 16 : last;
+        uint32_t lo = (first & 15u) * 2, hi = end - w * 16 == 16 ? 32 : (end & 15u) * 2;
+        uint32_t mask = (hi == 32 ? 0xFFFFFFFFu : (1u << hi) - 1u) & ~((1u << lo) - 1u);
+        or_word(bits, w, 0x55555555u & mask, shared_lo, shared_hi);
+        first = end;
+    }
+}
+
+/* Tests node i and writes its bits (and its subtree's when fully inside). */
+static gdr_cull_outcome classify_node(const octree_pass *pass, uint32_t i, uint32_t counts[2], uint32_t shared_lo,
+                                      uint32_t shared_hi)
+{
+    const cull_node *n = &pass->scene->nodes[i];
+    counts[0]++;
+    gdr_cull_outcome outcome = node_classify(pass->frustum, pass->slack, n->center, n->extent);
+    if (outcome == GDR_CULL_INSIDE) {
+        /* Fully inside: every node below is inside too and skips its own test. */
+        counts[1]++;
+        mark_inside(pass->node_bits, i, n->skip, shared_lo, shared_hi);
+    } else if (outcome == GDR_CULL_INTERSECTS) {
+        or_word(pass->node_bits, i >> 4, 3u << ((i & 15u) * 2u), shared_lo, shared_hi);
+    }
+    return outcome; /* outside: the bits stay 00 for the whole subtree */
+}
+
+/* Walks nodes [first, last) in pre-order, jumping over subtrees found outside or inside. */
+static void classify_range(const octree_pass *pass, uint32_t first, uint32_t last, uint32_t counts[2],
+                           uint32_t shared_lo, uint32_t shared_hi)
+{
+    uint32_t i = first;
+    while (i < last)
+        i = classify_node(pass, i, counts, shared_lo, shared_hi) == GDR_CULL_INTERSECTS ? i + 1
+                                                                                       : pass->scene->nodes[i].skip;
+}
+
+static void classify_task(void *user, uint32_t task, uint32_t worker)
+{
+    (void)worker;
+    const octree_pass *pass = user;
+    uint32_t root = pass->roots[task], last = pass->scene->nodes[root].skip;
+    classify_range(pass, root, last, pass->counts[task], root >> 4, (last - 1) >> 4);
+}
+
+gdr_status cull_octree_classify(const gdr_cull_scene *s, const gdr_frustum *frustum, gdr_thread_pool *pool,
+                                uint32_t *node_bits, uint32_t *nodes_tested, uint32_t *nodes_inside,
+                                gdr_error *err)
+{
+    *nodes_tested = *nodes_inside = 0;
+    if (s->node_count == 0)
+        return GDR_OK;
+    octree_pass pass = {s, frustum, {0}, node_bits, NULL, NULL};
     /* Slack for the rounding of the plane offset itself (a far-away camera has a large d): a
      * node counts as inside or outside only with that much room to spare. */
-    float slack[8];
     for (int k = 0; k < 8; k++)
-        slack[k] = isfinite(frustum->pd[k]) ? fabsf(frustum->pd[k]) * (1.0f / 65536.0f) : 0.0f;
-    uint32_t tested = 0, inside = 0;
+        pass.slack[k] = isfinite(frustum->pd[k]) ? fabsf(frustum->pd[k]) * (1.0f / 65536.0f) : 0.0f;
+    uint32_t *roots = malloc((size_t)s->task_capacity * sizeof(uint32_t));
+    uint32_t (*counts)[2] = calloc(s->task_capacity, sizeof(*counts));
+    if (!roots || !counts) {
+        free(roots);
+        free(counts);
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "cull: out of memory for %u octree tasks",
+                             s->task_capacity);
+    }
+    /* The top, on this thread (before any task runs, so plain writes are safe). */
+    uint32_t top[2] = {0, 0}, task_count = 0;
     uint32_t i = 0;
     while (i < s->node_count) {
         const cull_node *n = &s->nodes[i];
-        tested++;
-        gdr_cull_outcome outcome = node_classify(frustum, slack, n->center, n->extent);
-        if (outcome == GDR_CULL_OUTSIDE) {
-            i = n->skip; /* bits stay 00 for the whole subtree */
-        } else if (outcome == GDR_CULL_INSIDE) {
-            /* Fully inside: every node below is inside too and skips its own test. */
-            inside++;
-            for (uint32_t k = i; k < n->skip; k++)
-                node_bits[k >> 4] |= 1u << ((k & 15u) * 2u);
+        if (n->skip - i <= s->task_nodes) {
+            roots[task_count++] = i;
             i = n->skip;
-        } else {
-            node_bits[i >> 4] |= 3u << ((i & 15u) * 2u);
-            i++;
+            continue;
         }
+        i = classify_node(&pass, i, top, UINT32_MAX, UINT32_MAX) == GDR_CULL_INTERSECTS ? i + 1 : n->skip;
     }
-    *nodes_tested = tested;
-    *nodes_inside = inside;
+    pass.roots = roots;
+    pass.counts = counts;
+    gdr_thread_pool_run(pool, task_count, classify_task, &pass);
+    *nodes_tested = top[0];
+    *nodes_inside = top[1];
+    for (uint32_t t = 0; t < task_count; t++) {
+        *nodes_tested += counts[t][0];
+        *nodes_inside += counts[t][1];
+    }
+    free(roots);
+    free(counts);
+    return GDR_OK;
 }

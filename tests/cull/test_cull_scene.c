@@ -184,6 +184,7 @@ static void compare_scene(const gdr_cull_scene *scene, const gdr_cull_object *ob
             clipping_total += (uint64_t)__builtin_popcount(ref.clipping[w]);
         }
         /* every pool, octree and brute force, a few task sizes */
+        gdr_cull_stats first_octree = {0};
         for (uint32_t p = 0; p < pool_count; p++) {
             for (int brute = 0; brute < 2; brute++) {
                 uint32_t task_words[] = {0, 1, 3};
@@ -219,6 +220,12 @@ static void compare_scene(const gdr_cull_scene *scene, const gdr_cull_object *ob
                           stats.distance + stats.screen_size + stats.clip_plane ==
                       count);
                 if (!brute) {
+                    /* the octree pass (run as tasks over subtrees) does the same work on any pool */
+                    if (p == 0)
+                        first_octree = stats;
+                    CHECK(stats.nodes_tested == first_octree.nodes_tested &&
+                          stats.nodes_inside == first_octree.nodes_inside &&
+                          stats.objects_tested == first_octree.objects_tested);
                     inside_nodes += stats.nodes_inside;
                     if (count >= 1000 && !v.skip_frustum)
                         CHECK(stats.objects_tested < count); /* the octree spared some tests */
