@@ -608,7 +608,7 @@ static void test_shapes(gdr_thread_pool *pool, unsigned *rng)
     desc.region_max = (gdr_vec3){10, 5.2f, 10};
     desc.cell_size = 1.25f;
     desc.samples_per_cell = 2;
-    desc.cube_resolution = 48;
+    desc.cube_resolution = 32;
     desc.keep_samples = true;
     desc.pool = pool;
     gdr_pvs *pvs;
@@ -628,7 +628,7 @@ static void test_shapes(gdr_thread_pool *pool, unsigned *rng)
         const uint32_t *bits = gdr_pvs_lookup(cache, samples[0]);
         CHECK(bits != NULL);
         for (uint32_t s = 0; bits && s < count; s++)
-            check_point(bvh, &map, scene->instance_count, bits, samples[s], rng, 800, 3, &tally);
+            check_point(bvh, &map, scene->instance_count, bits, samples[s], rng, 400, 2, &tally);
     }
     printf("shapes: bake %.0f ms, %u cells baked, %llu samples, %llu visible pairs of %llu; %llu fresh rays from the "
            "samples, %llu hits, %llu on unlisted objects\n",
