@@ -516,7 +516,8 @@ static bool reaches_beyond(const pvs_view_scratch *s, int f, double ulo, double 
                            double depth)
 {
     uint32_t r = s->resolution, i0, i1, j0, j1;
-    if (!texel_range(ulo, uhi, 0.0, r, &i0, &i1) || !texel_range(vlo, vhi, 0.0, r, &j0, &j1))
+    double margin = 1e-4 * 2.0 / r; /* the rasteriser's: every texel it could touch is looked at */
+    if (!texel_range(ulo, uhi, margin, r, &i0, &i1) || !texel_range(vlo, vhi, margin, r, &j0, &j1))
         return false;
     const float *z = s->depth + (size_t)f * r * r;
     for (uint32_t j = j0; j <= j1; j++)
