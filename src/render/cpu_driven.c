@@ -8,17 +8,13 @@
 
 #include "gdr/cull.h"
 #include "render/renderer_internal.h"
-#include "shaders/shared/cull_math.h"
 
 /* The bounds of a moved instance: the mesh sphere under its transform, as the GPU culls it. */
 static gdr_cull_object object_from_instance(const GdrGpuInstance *instance, const GdrGpuMesh *mesh)
 {
-    const float *m = instance->model.m;
     gdr_vec4 b = mesh->bounds;
-    gdr_vec3 center = {m[0] * b.x + m[4] * b.y + m[8] * b.z + m[12], m[1] * b.x + m[5] * b.y + m[9] * b.z + m[13],
-                       m[2] * b.x + m[6] * b.y + m[10] * b.z + m[14]};
-    float radius = b.w * gdr_max_axis_scale((gdr_vec3){m[0], m[1], m[2]}, (gdr_vec3){m[4], m[5], m[6]},
-                                            (gdr_vec3){m[8], m[9], m[10]});
+    gdr_vec3 center = gdr_mat4_transform_point(instance->model, (gdr_vec3){b.x, b.y, b.z});
+    float radius = b.w * gdr_mat4_max_axis_scale(instance->model);
     return (gdr_cull_object){.center = center, .radius = radius, .extent = {radius, radius, radius}};
 }
 

@@ -80,9 +80,12 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
         vertex_cursor += c->vertex_count;
         byte_cursor += c->triangle_byte_count;
     }
-    uint64_t tasks = 0;
-    for (uint32_t i = 0; i < scene->instance_count; i++)
+    uint64_t tasks = 0, instance_meshlets = 0;
+    for (uint32_t i = 0; i < scene->instance_count; i++) {
         tasks += g->cpu_meshes[scene->instances[i].mesh].task_count;
+        instance_meshlets += g->cpu_meshes[scene->instances[i].mesh].meshlet_count;
+    }
+    g->instance_meshlet_count = instance_meshlets;
     if (status == GDR_OK && tasks > UINT32_MAX / sizeof(GdrGpuTaskCommand))
         status = gdr_error_set(err, GDR_ERROR_CAPACITY, "scene: %llu task workgroups per frame is too many",
                                (unsigned long long)tasks);

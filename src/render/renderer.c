@@ -281,9 +281,7 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
     r->cpu.cull_ms = 0.0;
     if (frame->record_visible_meshlets && !r->visible_meshlets.buffer) {
         /* Every cluster of every instance at most: cannot overflow. */
-        uint64_t total = 0;
-        for (uint32_t i = 0; i < r->scene.instance_count; i++)
-            total += r->scene.cpu_meshes[r->scene.cpu_instances[i].mesh].meshlet_count;
+        uint64_t total = r->scene.instance_meshlet_count;
         gdr_status status = gdr_vk_buffer_create(&r->allocator, 8 * (total ? total : 1),
                                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                                  GDR_VK_BUFFER_DEVICE, &r->visible_meshlets, err);
@@ -374,8 +372,7 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
         stats->triangles = ((uint64_t)gpu.triangles_high << 32) | gpu.triangles_low;
     }
     if (pipeline == GDR_PIPELINE_MESH) {
-        for (uint32_t i = 0; i < r->scene.instance_count; i++)
-            stats->meshlets_total += r->scene.cpu_meshes[r->scene.cpu_instances[i].mesh].meshlet_count;
+        stats->meshlets_total = r->scene.instance_meshlet_count;
         stats->meshlets_tested = gpu.meshlets_tested;
         stats->meshlets_frustum_culled = gpu.meshlets_frustum_culled;
         stats->meshlets_cone_culled = gpu.meshlets_cone_culled;

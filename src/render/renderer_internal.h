@@ -43,6 +43,7 @@ typedef struct gdr_gpu_scene {
     uint32_t instance_count;
     uint32_t meshlet_count;
     uint32_t task_capacity;        /* task commands of all instances: the task buffer's size */
+    uint64_t instance_meshlet_count; /* level-0 clusters summed over the instances (meshlets_total) */
     GdrGpuMesh *cpu_meshes;        /* host copies, for references and statistics */
     GdrGpuMeshlet *cpu_meshlets;
     GdrGpuInstance *cpu_instances;

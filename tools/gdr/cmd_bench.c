@@ -7,6 +7,7 @@
 
 #include "cli_args.h"
 #include "commands.h"
+#include "stats_output.h"
 #include "gdr/gdr.h"
 
 #define MAX_SIZES 16
@@ -132,13 +133,7 @@ int gdr_cmd_bench(int argc, char **argv)
             cJSON_AddStringToObject(row, "pipeline", gdr_pipeline_name(stats.pipeline));
             cJSON_AddNumberToObject(row, "draw_calls", stats.draw_calls);
             cJSON_AddNumberToObject(row, "cpu_cull_ms_per_frame", stats.cpu_cull_ms_per_frame);
-            cJSON_AddNumberToObject(row, "meshlets_total", (double)stats.meshlets_total);
-            cJSON_AddNumberToObject(row, "meshlets_tested", stats.meshlets_tested);
-            cJSON_AddNumberToObject(row, "meshlets_frustum_culled", stats.meshlets_frustum_culled);
-            cJSON_AddNumberToObject(row, "meshlets_cone_culled", stats.meshlets_cone_culled);
-            cJSON_AddNumberToObject(row, "meshlets_visible", stats.meshlets_visible);
-            cJSON_AddNumberToObject(row, "triangles_backface_culled", stats.triangles_backface_culled);
-            cJSON_AddNumberToObject(row, "triangles_small_culled", stats.triangles_small_culled);
+            stats_add_meshlet_json(row, &stats);
             cJSON_AddNumberToObject(row, "instances_total", stats.instances_total);
             cJSON_AddNumberToObject(row, "instances_visible", stats.instances_visible);
             cJSON_AddNumberToObject(row, "triangles", (double)stats.triangles);

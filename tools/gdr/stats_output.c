@@ -40,6 +40,17 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
     fprintf(out, "validation_messages %u\n", s->validation_messages);
 }
 
+void stats_add_meshlet_json(cJSON *object, const gdr_frame_stats *s)
+{
+    cJSON_AddNumberToObject(object, "meshlets_total", (double)s->meshlets_total);
+    cJSON_AddNumberToObject(object, "meshlets_tested", s->meshlets_tested);
+    cJSON_AddNumberToObject(object, "meshlets_frustum_culled", s->meshlets_frustum_culled);
+    cJSON_AddNumberToObject(object, "meshlets_cone_culled", s->meshlets_cone_culled);
+    cJSON_AddNumberToObject(object, "meshlets_visible", s->meshlets_visible);
+    cJSON_AddNumberToObject(object, "triangles_backface_culled", s->triangles_backface_culled);
+    cJSON_AddNumberToObject(object, "triangles_small_culled", s->triangles_small_culled);
+}
+
 char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
 {
     cJSON *root = cJSON_CreateObject();
@@ -61,13 +72,7 @@ char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
     cJSON_AddNumberToObject(root, "draws", s->draws);
     cJSON_AddNumberToObject(root, "draw_calls", s->draw_calls);
     if (s->pipeline == GDR_PIPELINE_MESH) {
-        cJSON_AddNumberToObject(root, "meshlets_total", (double)s->meshlets_total);
-        cJSON_AddNumberToObject(root, "meshlets_tested", s->meshlets_tested);
-        cJSON_AddNumberToObject(root, "meshlets_frustum_culled", s->meshlets_frustum_culled);
-        cJSON_AddNumberToObject(root, "meshlets_cone_culled", s->meshlets_cone_culled);
-        cJSON_AddNumberToObject(root, "meshlets_visible", s->meshlets_visible);
-        cJSON_AddNumberToObject(root, "triangles_backface_culled", s->triangles_backface_culled);
-        cJSON_AddNumberToObject(root, "triangles_small_culled", s->triangles_small_culled);
+        stats_add_meshlet_json(root, s);
         cJSON_AddNumberToObject(root, "task_workgroups", s->task_workgroups);
         cJSON_AddNumberToObject(root, "task_overflow", s->task_overflow);
     }

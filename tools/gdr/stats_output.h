@@ -14,6 +14,9 @@ typedef struct stats_context {
 } stats_context;
 
 void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats *stats);
+typedef struct cJSON cJSON;
+/* Adds the mesh pipeline's cluster and triangle counts (meshlets_*, triangles_*_culled). */
+void stats_add_meshlet_json(cJSON *object, const gdr_frame_stats *stats);
 /* Returns a malloc'ed JSON text, or NULL when out of memory. */
 char *stats_to_json(const stats_context *context, const gdr_frame_stats *stats);
 
