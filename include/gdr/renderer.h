@@ -51,6 +51,7 @@ typedef enum gdr_view {
     GDR_VIEW_MODE_INSTANCES, /* each instance in a colour of its own */
     GDR_VIEW_MODE_TRIANGLES, /* each triangle in a colour of its own: triangle density (mesh pipeline) */
     GDR_VIEW_MODE_OVERDRAW,  /* fragments per pixel as a heat map normalised by the frame's maximum */
+    GDR_VIEW_MODE_LOD,       /* each cluster in the colour of its LOD DAG depth (mesh pipeline) */
 } gdr_view;
 
 typedef struct gdr_frame_desc {
@@ -66,15 +67,23 @@ typedef struct gdr_frame_desc {
     /* Mesh pipeline: keep the list of clusters the task shaders passed, for
      * gdr_renderer_read_visible_meshlets (tests, tools; costs an append per cluster). */
     bool record_visible_meshlets;
+    /* Mesh pipeline, meshes with a LOD DAG (issue 5; gdr/geometry.h "The cut"): the clusters drawn
+     * are the cut whose projected error is within lod_error_px pixels (0, the default: full detail,
+     * level 0), or with lod_fixed_depth the discrete cut at DAG depth lod_depth (0: level 0). The
+     * indirect and CPU pipelines always draw full detail. */
+    float lod_error_px;
+    bool lod_fixed_depth;
+    uint32_t lod_depth;
 } gdr_frame_desc;
 
-/* "shaded", "meshlets", "instances", "triangles" or "overdraw". */
+/* "shaded", "meshlets", "instances", "triangles", "overdraw" or "lod". */
 GDR_API const char *gdr_view_name(gdr_view view);
 
 /* "mesh", "indirect" or "cpu". */
 GDR_API const char *gdr_pipeline_name(gdr_pipeline pipeline);
 
 #define GDR_MAX_PASSES 8
+#define GDR_LOD_STATS_DEPTH_COUNT 32 /* = GDR_LOD_STATS_DEPTHS of the shaders */
 
 typedef struct gdr_pass_timing {
     const char *name;
@@ -112,6 +121,14 @@ typedef struct gdr_frame_stats {
     uint32_t task_workgroups;
     uint32_t task_overflow;               /* task commands lost for want of room: always 0 (sized from the scene) */
     uint32_t overdraw_max;                /* overdraw view: the most fragments one pixel received */
+    /* The LOD cut (mesh pipeline), last frame: whether it was applied, the clusters it left out,
+     * and the clusters and triangles drawn per DAG depth (the last entry: that depth or deeper;
+     * triangles before triangle culling). */
+    bool lod_applied;
+    uint32_t meshlets_lod_culled;
+    uint32_t lod_depth_count;             /* entries used below: deepest depth drawn + 1 */
+    uint32_t lod_clusters_per_depth[GDR_LOD_STATS_DEPTH_COUNT];
+    uint64_t lod_triangles_per_depth[GDR_LOD_STATS_DEPTH_COUNT];
 } gdr_frame_stats;
 
 GDR_API gdr_status gdr_renderer_create(const gdr_renderer_desc *desc, gdr_renderer **out, gdr_error *err);

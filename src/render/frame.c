@@ -30,12 +30,17 @@ void gdr_frame_matrices(const gdr_renderer *r, const gdr_camera *camera, gdr_mat
     *view = gdr_view_from_pose(camera->position, camera->rotation);
 }
 
-static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame, uint32_t update_count)
+static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame, gdr_pipeline pipeline,
+                          uint32_t update_count)
 {
     const gdr_camera *camera = &frame->camera;
     gdr_mat4 projection, view;
     gdr_frame_matrices(r, camera, &projection, &view);
     gdr_vec3 light = gdr_vec3_normalize((gdr_vec3){0.35f, 0.85f, 0.4f});
+    /* The LOD cut (issue 5): only where the mesh pipeline draws clusters, and only when it asks for
+     * something other than level 0 (threshold 0 and depth 0 both select exactly level 0). */
+    bool lod = pipeline == GDR_PIPELINE_MESH &&
+               (frame->lod_fixed_depth ? frame->lod_depth > 0 : frame->lod_error_px > 0.0f);
     GdrGpuFrameGlobals globals = {
         .view = view,
         .view_projection = gdr_mat4_mul(projection, view),
@@ -50,12 +55,17 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .flags = (frame->meshlet_frustum_cull != GDR_CULL_OFF ? GDR_FRAME_MESHLET_FRUSTUM : 0u) |
                  (frame->meshlet_cone_cull != GDR_CULL_OFF ? GDR_FRAME_MESHLET_CONE : 0u) |
                  (frame->triangle_cull != GDR_CULL_OFF ? GDR_FRAME_TRIANGLE_CULL : 0u) |
-                 (frame->record_visible_meshlets ? GDR_FRAME_RECORD_MESHLETS : 0u),
+                 (frame->record_visible_meshlets ? GDR_FRAME_RECORD_MESHLETS : 0u) |
+                 (lod ? GDR_FRAME_LOD : 0u) | (lod && frame->lod_fixed_depth ? GDR_FRAME_LOD_DEPTH : 0u),
         .view_mode = (uint32_t)frame->view,
         .task_capacity = r->scene.task_capacity,
         .viewport = {(float)r->width, (float)r->height},
+        .lod_threshold = frame->lod_error_px,
+        .lod_projection_scale = fabsf(projection.m[5]) * 0.5f * (float)r->height,
+        .lod_depth = frame->lod_depth > INT32_MAX ? INT32_MAX : (int32_t)frame->lod_depth,
     };
     memcpy(slot->globals.mapped, &globals, sizeof globals);
+    slot->lod_applied = lod;
 }
 
 /* Moves up to one frame's worth of pending instance updates into the slot's ring segment. */
@@ -179,7 +189,7 @@ gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, co
 {
     VkCommandBuffer cmd = slot->cmd;
     uint32_t update_count = take_updates(r, slot);
-    write_globals(r, slot, frame, update_count);
+    write_globals(r, slot, frame, pipeline, update_count);
     GdrGpuPushConstants push = {
         .globals = slot->globals.address,
         .instances = r->scene.instances.address,

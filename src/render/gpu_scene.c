@@ -1,8 +1,10 @@
 /* The GPU scene: one geometry pool (merged vertex and index buffers, seed 003 plan A) and the
  * persistent instance buffer, with per-frame resources sized from the scene so they cannot overflow. */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "geometry/lod_internal.h"
 #include "render/renderer_internal.h"
 
 static GdrGpuInstance gpu_instance_from(const gdr_scene *scene, const gdr_instance *instance)
@@ -31,6 +33,68 @@ static gdr_status gather_clusters(const gdr_scene *scene, const gdr_mesh_cluster
         clusters[m] = &built[m];
     }
     return GDR_OK;
+}
+
+/* Cluster i of c with pool-global data offsets and its groups' LOD data inline. */
+static GdrGpuMeshlet gpu_meshlet_from(const gdr_mesh_clusters *c, uint32_t i, uint32_t vertex_base, uint32_t byte_base)
+{
+    const gdr_cluster *k = &c->clusters[i];
+    GdrGpuMeshlet m = {
+        .vertex_offset = vertex_base + k->vertex_offset, .triangle_offset = byte_base + k->triangle_offset,
+        .vertex_count = k->vertex_count, .triangle_count = k->triangle_count, .sphere = k->sphere,
+        .cone_apex = k->cone_apex, .cone_cutoff = k->cone_cutoff, .cone_axis = k->cone_axis,
+        .group = k->group, .refined_group = k->refined_group,
+        .group_depth = 0, .refined_depth = -1, .group_error = INFINITY, .refined_error = 0.0f};
+    if (k->group != GDR_NO_INDEX) {
+        const gdr_cluster_group *g = &c->groups[k->group];
+        m.group_depth = (int32_t)g->depth;
+        m.group_sphere = g->sphere;
+        m.group_error = g->error;
+    }
+    if (k->refined_group != GDR_NO_INDEX) {
+        const gdr_cluster_group *g = &c->groups[k->refined_group];
+        m.refined_depth = (int32_t)g->depth;
+        m.refined_sphere = g->sphere;
+        m.refined_error = g->error;
+    }
+    return m;
+}
+
+/* The root shortcut of a mesh with a DAG (GdrGpuMesh.root_*): the root group is the last one. */
+static void set_root_shortcut(const gdr_mesh_clusters *c, GdrGpuMesh *mesh)
+{
+    const gdr_cluster_group *root = &c->groups[c->group_count - 1];
+    mesh->root_first = root->first_cluster;
+    mesh->root_cluster_count = root->cluster_count;
+    mesh->root_task_count = (root->cluster_count + GDR_TASK_WORKGROUP_SIZE - 1) / GDR_TASK_WORKGROUP_SIZE;
+    /* Each distinct refined group once: the root's clusters come from a handful of groups. */
+    gdr_vec4 spheres[64];
+    uint32_t seen[64], n = 0;
+    float error = 0.0f;
+    bool fits = true;
+    for (uint32_t i = root->first_cluster; i < root->first_cluster + root->cluster_count && fits; i++) {
+        uint32_t refined = c->clusters[i].refined_group;
+        if (refined == GDR_NO_INDEX)
+            continue; /* always passes */
+        bool known = false;
+        for (uint32_t j = 0; j < n && !known; j++)
+            known = seen[j] == refined;
+        if (known)
+            continue;
+        if (n == 64) {
+            fits = false;
+            break;
+        }
+        seen[n] = refined;
+        spheres[n++] = c->groups[refined].sphere;
+        error = fmaxf(error, c->groups[refined].error);
+    }
+    if (!fits) { /* no shortcut: the per-cluster test decides */
+        mesh->root_cluster_count = mesh->root_task_count = 0;
+        return;
+    }
+    mesh->root_refined_sphere = n > 0 ? gdr_lod_enclosing_sphere(spheres, n) : (gdr_vec4){0, 0, 0, 0};
+    mesh->root_refined_error = error;
 }
 
 /* The cluster pool: GdrGpuMeshlet[] with pool-global offsets, global vertex indices, and the
@@ -62,14 +126,12 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
         mesh->meshlet_offset = meshlet_cursor;
         mesh->meshlet_count = c->level0_cluster_count;
         mesh->task_count = (c->level0_cluster_count + GDR_TASK_WORKGROUP_SIZE - 1) / GDR_TASK_WORKGROUP_SIZE;
-        for (uint32_t i = 0; i < c->cluster_count; i++) {
-            const gdr_cluster *k = &c->clusters[i];
-            meshlets[meshlet_cursor + i] = (GdrGpuMeshlet){
-                .vertex_offset = vertex_cursor + k->vertex_offset, .triangle_offset = byte_cursor + k->triangle_offset,
-                .vertex_count = k->vertex_count, .triangle_count = k->triangle_count, .sphere = k->sphere,
-                .cone_apex = k->cone_apex, .cone_cutoff = k->cone_cutoff, .cone_axis = k->cone_axis,
-                .group = k->group, .refined_group = k->refined_group};
-        }
+        mesh->lod_cluster_count = c->cluster_count;
+        mesh->lod_task_count = (c->cluster_count + GDR_TASK_WORKGROUP_SIZE - 1) / GDR_TASK_WORKGROUP_SIZE;
+        for (uint32_t i = 0; i < c->cluster_count; i++)
+            meshlets[meshlet_cursor + i] = gpu_meshlet_from(c, i, vertex_cursor, byte_cursor);
+        if (c->group_count > 0)
+            set_root_shortcut(c, mesh);
         for (uint32_t v = 0; v < c->vertex_count; v++)
             vertex_refs[vertex_cursor + v] = mesh->vertex_offset + c->vertices[v];
         for (uint32_t b = 0; b < c->triangle_byte_count; b++) {
@@ -80,12 +142,14 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
         vertex_cursor += c->vertex_count;
         byte_cursor += c->triangle_byte_count;
     }
-    uint64_t tasks = 0, instance_meshlets = 0;
+    uint64_t tasks = 0, instance_meshlets = 0, instance_lod_clusters = 0;
     for (uint32_t i = 0; i < scene->instance_count; i++) {
-        tasks += g->cpu_meshes[scene->instances[i].mesh].task_count;
+        tasks += g->cpu_meshes[scene->instances[i].mesh].lod_task_count; /* >= task_count and root_task_count */
         instance_meshlets += g->cpu_meshes[scene->instances[i].mesh].meshlet_count;
+        instance_lod_clusters += g->cpu_meshes[scene->instances[i].mesh].lod_cluster_count;
     }
     g->instance_meshlet_count = instance_meshlets;
+    g->instance_lod_cluster_count = instance_lod_clusters;
     if (status == GDR_OK && tasks > UINT32_MAX / sizeof(GdrGpuTaskCommand))
         status = gdr_error_set(err, GDR_ERROR_CAPACITY, "scene: %llu task workgroups per frame is too many",
                                (unsigned long long)tasks);

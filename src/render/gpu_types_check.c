@@ -4,14 +4,16 @@
 #include <vulkan/vulkan.h>
 
 #include "gdr/geometry.h"
+#include "gdr/renderer.h"
 #include "shaders/shared/gpu_types.h"
 
 _Static_assert(sizeof(GdrGpuVertex) == 32, "GdrGpuVertex");
 _Static_assert(offsetof(GdrGpuVertex, normal) == 12 && offsetof(GdrGpuVertex, uv) == 24, "GdrGpuVertex offsets");
-_Static_assert(sizeof(GdrGpuMesh) == 48 && offsetof(GdrGpuMesh, bounds) == 16 && offsetof(GdrGpuMesh, task_count) == 36,
-               "GdrGpuMesh");
-_Static_assert(sizeof(GdrGpuMeshlet) == 80 && offsetof(GdrGpuMeshlet, sphere) == 16 &&
-                   offsetof(GdrGpuMeshlet, cone_cutoff) == 44 && offsetof(GdrGpuMeshlet, group) == 60,
+_Static_assert(sizeof(GdrGpuMesh) == 96 && offsetof(GdrGpuMesh, bounds) == 16 && offsetof(GdrGpuMesh, task_count) == 36 &&
+                   offsetof(GdrGpuMesh, root_refined_sphere) == 64, "GdrGpuMesh");
+_Static_assert(sizeof(GdrGpuMeshlet) == 128 && offsetof(GdrGpuMeshlet, sphere) == 16 &&
+                   offsetof(GdrGpuMeshlet, cone_cutoff) == 44 && offsetof(GdrGpuMeshlet, group) == 60 &&
+                   offsetof(GdrGpuMeshlet, group_sphere) == 80 && offsetof(GdrGpuMeshlet, group_error) == 112,
                "GdrGpuMeshlet");
 _Static_assert(sizeof(GdrGpuTaskCommand) == 16, "GdrGpuTaskCommand");
 _Static_assert(GDR_MESH_MAX_VERTICES == GDR_CLUSTER_MAX_VERTICES && GDR_MESH_MAX_TRIANGLES == GDR_CLUSTER_MAX_TRIANGLES,
@@ -24,12 +26,13 @@ _Static_assert(sizeof(GdrGpuDrawCommand) == sizeof(VkDrawIndexedIndirectCommand)
 _Static_assert(offsetof(GdrGpuDrawCommand, vertex_offset) == offsetof(VkDrawIndexedIndirectCommand, vertexOffset) &&
                    offsetof(GdrGpuDrawCommand, first_instance) == offsetof(VkDrawIndexedIndirectCommand, firstInstance),
                "GdrGpuDrawCommand offsets");
-_Static_assert(sizeof(GdrGpuDrawStats) == 64 && offsetof(GdrGpuDrawStats, draw_count) == 0 &&
+_Static_assert(GDR_LOD_STATS_DEPTHS == GDR_LOD_STATS_DEPTH_COUNT, "LOD statistics: shaders and gdr/renderer.h");
+_Static_assert(sizeof(GdrGpuDrawStats) == 64 + 8 * GDR_LOD_STATS_DEPTHS && offsetof(GdrGpuDrawStats, draw_count) == 0 &&
                    offsetof(GdrGpuDrawStats, task_groups_x) == 16, "GdrGpuDrawStats");
 _Static_assert(offsetof(GdrGpuDrawStats, task_groups_z) - offsetof(GdrGpuDrawStats, task_groups_x) ==
                    offsetof(VkDrawMeshTasksIndirectCommandEXT, groupCountZ), "the mesh tasks command inside GdrGpuDrawStats");
 _Static_assert(offsetof(GdrGpuFrameGlobals, viewport) == 208, "GdrGpuFrameGlobals.viewport");
-_Static_assert(sizeof(GdrGpuFrameGlobals) == 224 && offsetof(GdrGpuFrameGlobals, frustum) == 128 &&
+_Static_assert(sizeof(GdrGpuFrameGlobals) == 240 && offsetof(GdrGpuFrameGlobals, frustum) == 128 &&
                    offsetof(GdrGpuFrameGlobals, znear) == 176 && offsetof(GdrGpuFrameGlobals, update_count) == 192,
                "GdrGpuFrameGlobals");
 _Static_assert(sizeof(GdrGpuPushConstants) == 104 && offsetof(GdrGpuPushConstants, updates) == 40,

@@ -219,7 +219,7 @@ const char *gdr_pipeline_name(gdr_pipeline pipeline)
 
 const char *gdr_view_name(gdr_view view)
 {
-    static const char *const names[] = {"shaded", "meshlets", "instances", "triangles", "overdraw"};
+    static const char *const names[] = {"shaded", "meshlets", "instances", "triangles", "overdraw", "lod"};
     return (unsigned)view < sizeof names / sizeof names[0] ? names[view] : "unknown";
 }
 
@@ -271,8 +271,11 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
                              "(yfov %g, znear %g, zfar %g)", (double)camera->yfov, (double)camera->znear,
                              (double)camera->zfar);
 
-    if ((unsigned)frame->view > GDR_VIEW_MODE_OVERDRAW)
+    if ((unsigned)frame->view > GDR_VIEW_MODE_LOD)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: unknown view %d", (int)frame->view);
+    if (!(frame->lod_error_px >= 0.0f && frame->lod_error_px <= 1e30f))
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: lod_error_px must be finite and >= 0 (%g)",
+                             (double)frame->lod_error_px);
     gdr_pipeline pipeline = GDR_PIPELINE_INDIRECT;
     char reason[160] = "";
     gdr_status resolved = resolve_pipeline(r, frame, &pipeline, reason, sizeof reason, err);
@@ -280,8 +283,8 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
         return resolved;
     r->cpu.cull_ms = 0.0;
     if (frame->record_visible_meshlets && !r->visible_meshlets.buffer) {
-        /* Every cluster of every instance at most: cannot overflow. */
-        uint64_t total = r->scene.instance_meshlet_count;
+        /* Every cluster of every instance's DAG at most: cannot overflow. */
+        uint64_t total = r->scene.instance_lod_cluster_count;
         gdr_status status = gdr_vk_buffer_create(&r->allocator, 8 * (total ? total : 1),
                                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                                  GDR_VK_BUFFER_DEVICE, &r->visible_meshlets, err);
@@ -381,6 +384,14 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
         stats->triangles_small_culled = gpu.triangles_small_culled;
         stats->task_workgroups = gpu.task_count;
         stats->task_overflow = gpu.task_overflow;
+        stats->lod_applied = last_slot->lod_applied;
+        stats->meshlets_lod_culled = gpu.meshlets_lod_culled;
+        for (uint32_t d = 0; d < GDR_LOD_STATS_DEPTH_COUNT; d++) {
+            stats->lod_clusters_per_depth[d] = gpu.lod_clusters[d];
+            stats->lod_triangles_per_depth[d] = gpu.lod_triangles[d];
+            if (gpu.lod_clusters[d] > 0)
+                stats->lod_depth_count = d + 1;
+        }
     }
     stats->cpu_ms_per_frame = cpu_ms / frames;
     stats->cpu_submit_ms_per_frame = submit_ms / frames;

@@ -44,6 +44,7 @@ typedef struct gdr_gpu_scene {
     uint32_t meshlet_count;
     uint32_t task_capacity;        /* task commands of all instances: the task buffer's size */
     uint64_t instance_meshlet_count; /* level-0 clusters summed over the instances (meshlets_total) */
+    uint64_t instance_lod_cluster_count; /* every DAG cluster summed over the instances */
     GdrGpuMesh *cpu_meshes;        /* host copies, for references and statistics */
     GdrGpuMeshlet *cpu_meshlets;
     GdrGpuInstance *cpu_instances;
@@ -64,6 +65,7 @@ typedef struct gdr_frame_slot {
     gdr_vk_buffer stats_readback;/* GdrGpuDrawStats copied for the CPU */
     gdr_vk_buffer tasks;         /* GdrGpuTaskCommand[task_capacity] (meshlet pipeline) */
     gdr_pipeline pipeline;       /* of the frame last recorded into this slot */
+    bool lod_applied;            /* that frame selected a LOD cut (GDR_FRAME_LOD) */
     /* CPU pipeline: what the CPU decided for the frame last recorded into this slot. */
     uint32_t cpu_visible_count;
     uint64_t cpu_triangles;

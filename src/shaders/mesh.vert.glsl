@@ -21,5 +21,7 @@ void main()
     mat3 cofactor = mat3(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1]));
     out_normal = cofactor * in_normal;
     out_world_position = world.xyz;
-    out_color = g.view_mode == GDR_VIEW_INSTANCES ? vec4(gdr_id_color(gl_InstanceIndex), 1.0) : instance.color;
+    out_color = g.view_mode == GDR_VIEW_INSTANCES ? vec4(gdr_id_color(gl_InstanceIndex), 1.0)
+              : g.view_mode == GDR_VIEW_LOD    ? vec4(gdr_depth_color(0), 1.0) // full detail: depth 0
+                                               : instance.color;
 }

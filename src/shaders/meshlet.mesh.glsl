@@ -88,6 +88,8 @@ void main()
             albedo = gdr_id_color(payload.instance);
         else if (g.view_mode == GDR_VIEW_TRIANGLES)
             albedo = gdr_id_color(meshlet_index * 128u + t);
+        else if (g.view_mode == GDR_VIEW_LOD)
+            albedo = gdr_depth_color(meshlet.group_depth);
         out_color[t] = vec4(albedo, 1.0);
         emitted += why == 0u ? 1u : 0u;
         backfacing += why == 1u ? 1u : 0u;

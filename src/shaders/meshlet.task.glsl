@@ -1,7 +1,8 @@
 #version 460
 // Meshlet culling (seeds 000/001/004): one task workgroup per task command (up to
-// GDR_TASK_WORKGROUP_SIZE clusters of one visible instance), one thread per cluster: the cluster's
-// sphere against the frustum (the instance test's math), then its normal cone against the camera.
+// GDR_TASK_WORKGROUP_SIZE clusters of one visible instance), one thread per cluster: the LOD cut
+// (issue 5: is the cluster part of the cut this view needs?), then the cluster's sphere against the
+// frustum (the instance test's math), then its normal cone against the camera.
 // Survivors are compacted into the payload with subgroup ballots; one mesh workgroup each.
 #extension GL_EXT_mesh_shader : require
 #extension GL_KHR_shader_subgroup_ballot : require
@@ -9,6 +10,7 @@
 
 #include "shared/glsl_buffers.h"
 #include "shared/cull_math.h"
+#include "shared/lod_math.h"
 #include "shared/meshlet_payload.h"
 
 layout(local_size_x = GDR_TASK_WORKGROUP_SIZE) in;
@@ -16,6 +18,37 @@ layout(local_size_x = GDR_TASK_WORKGROUP_SIZE) in;
 taskPayloadSharedEXT GdrTaskPayload payload;
 layout(buffer_reference, scalar) writeonly buffer VisibleMeshletsRef { uvec2 items[]; };
 shared uint visible_count;
+
+// passes(group) of the cut rule (gdr/geometry.h): projected error within the threshold, or for the
+// discrete debug cut, depth below N and not the root. Without a group the fields make "refined"
+// always pass (error 0, depth -1) and "group" never (error INFINITY).
+bool lod_passes(GdrGpuFrameGlobals g, vec4 sphere, float error, int depth, mat4 model)
+{
+    if ((g.flags & GDR_FRAME_LOD_DEPTH) != 0u)
+        return depth < g.lod_depth && !isinf(error);
+    return gdr_lod_group_projected_error(sphere, error, model[0].xyz, model[1].xyz, model[2].xyz, model[3].xyz,
+                                         g.camera_position.xyz, g.znear, g.lod_projection_scale) <= g.lod_threshold;
+}
+
+// Clusters and triangles drawn per DAG depth: one atomic per distinct depth in the subgroup.
+void count_lod_depths(DrawStatsRef stats, bool visible, int depth, uint triangles)
+{
+    uint bucket = uint(clamp(depth, 0, GDR_LOD_STATS_DEPTHS - 1));
+    bool pending = visible;
+    for (;;) {
+        uint current = subgroupMin(pending ? bucket : 0xffffffffu);
+        if (current == 0xffffffffu)
+            break;
+        bool mine = pending && bucket == current;
+        uint clusters = subgroupAdd(mine ? 1u : 0u);
+        uint tris = subgroupAdd(mine ? triangles : 0u);
+        if (subgroupElect()) {
+            atomicAdd(stats.value.lod_clusters[current], clusters);
+            atomicAdd(stats.value.lod_triangles[current], tris);
+        }
+        pending = pending && !mine;
+    }
+}
 
 void main()
 {
@@ -27,7 +60,9 @@ void main()
     if (lane == 0u)
         visible_count = 0u;
 
-    bool in_task = false, visible = false, frustum_culled = false, cone_culled = false;
+    bool in_task = false, visible = false, lod_culled = false, frustum_culled = false, cone_culled = false;
+    int depth = 0;
+    uint triangles = 0u;
     GdrGpuTaskCommand task = GdrGpuTaskCommand(0u, 0u, 0u, 0u);
     if (task_index < task_count) {
         task = TaskCommandsRef(push.tasks).items[task_index];
@@ -36,9 +71,16 @@ void main()
     if (in_task) {
         GdrGpuMeshlet meshlet = MeshletsRef(push.meshlets).items[task.meshlet_first + lane];
         mat4 model = InstancesRef(push.instances).items[task.instance].model;
+        depth = meshlet.group_depth;
+        triangles = meshlet.triangle_count;
         visible = true;
+        if ((g.flags & GDR_FRAME_LOD) != 0u && (task.flags & GDR_TASK_LOD_ACCEPTED) == 0u) {
+            visible = lod_passes(g, meshlet.refined_sphere, meshlet.refined_error, meshlet.refined_depth, model) &&
+                      !lod_passes(g, meshlet.group_sphere, meshlet.group_error, meshlet.group_depth, model);
+            lod_culled = !visible;
+        }
         bool cull = g.cull_enabled != 0u;
-        if (cull && (g.flags & GDR_FRAME_MESHLET_FRUSTUM) != 0u) {
+        if (visible && cull && (g.flags & GDR_FRAME_MESHLET_FRUSTUM) != 0u) {
             vec3 center = (g.view * (model * vec4(meshlet.sphere.xyz, 1.0))).xyz;
             float radius = meshlet.sphere.w * gdr_max_axis_scale(model[0].xyz, model[1].xyz, model[2].xyz);
             visible = gdr_sphere_visible(g.frustum, center, radius, g.znear, g.zfar);
@@ -67,7 +109,9 @@ void main()
         VisibleMeshletsRef(push.visible_meshlets).items[at] = uvec2(task.instance, task.meshlet_first + lane);
     }
 
+    count_lod_depths(stats, visible, depth, triangles);
     uint tested = subgroupAdd(in_task ? 1u : 0u);
+    uint lod = subgroupAdd(lod_culled ? 1u : 0u);
     uint frustum = subgroupAdd(frustum_culled ? 1u : 0u);
     uint cone = subgroupAdd(cone_culled ? 1u : 0u);
     uint drawn = subgroupAdd(visible ? 1u : 0u);
@@ -76,6 +120,8 @@ void main()
         atomicAdd(stats.value.meshlets_frustum_culled, frustum);
         atomicAdd(stats.value.meshlets_cone_culled, cone);
         atomicAdd(stats.value.meshlets_visible, drawn);
+        if (lod > 0u)
+            atomicAdd(stats.value.meshlets_lod_culled, lod);
     }
     barrier();
     EmitMeshTasksEXT(visible_count, 1u, 1u);

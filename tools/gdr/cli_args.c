@@ -19,6 +19,19 @@ bool cli_parse_u32(const char *option, const char *text, uint32_t min, uint32_t 
     return true;
 }
 
+bool cli_parse_float(const char *option, const char *text, float min, float max, float *out)
+{
+    char *end;
+    errno = 0;
+    float value = strtof(text, &end);
+    if (errno || end == text || *end || !(value >= min && value <= max)) {
+        fprintf(stderr, "gdr: %s %s: expected a number from %g to %g\n", option, text, (double)min, (double)max);
+        return false;
+    }
+    *out = value;
+    return true;
+}
+
 bool cli_parse_on_off(const char *option, const char *text, bool *out)
 {
     if (strcmp(text, "on") == 0 || strcmp(text, "off") == 0) {

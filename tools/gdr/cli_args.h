@@ -10,6 +10,8 @@
 
 /* Each prints "gdr: OPTION VALUE: why" on failure and returns false. */
 bool cli_parse_u32(const char *option, const char *text, uint32_t min, uint32_t max, uint32_t *out);
+/* A finite decimal number in [min, max]. */
+bool cli_parse_float(const char *option, const char *text, float min, float max, float *out);
 bool cli_parse_on_off(const char *option, const char *text, bool *out);
 /* One of names[0 .. count): *out is its index. */
 bool cli_parse_choice(const char *option, const char *text, const char *const *names, int count, int *out);

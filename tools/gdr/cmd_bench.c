@@ -1,4 +1,5 @@
-/* gdr bench: the demo scene at several sizes; CPU ms per frame (record + submit) and GPU ms per pass. */
+/* gdr bench: the demo scene at several sizes (or one scene given with --scene), each pipeline and LOD
+ * threshold asked for; CPU ms per frame (record + submit) and GPU ms per pass. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -34,11 +35,33 @@ static bool parse_sizes(const char *text, uint32_t *sizes, uint32_t *count)
     return *count > 0;
 }
 
+#define MAX_LOD_ERRORS 8
+
+static bool parse_lod_errors(const char *text, float *errors, uint32_t *count)
+{
+    char buffer[256];
+    snprintf(buffer, sizeof buffer, "%s", text);
+    *count = 0;
+    for (char *save = NULL, *item = strtok_r(buffer, ",", &save); item; item = strtok_r(NULL, ",", &save)) {
+        if (*count == MAX_LOD_ERRORS) {
+            fprintf(stderr, "gdr: --lod-errors: at most %d values\n", MAX_LOD_ERRORS);
+            return false;
+        }
+        if (!cli_parse_float("--lod-errors", item, 0.0f, 1e6f, &errors[(*count)++]))
+            return false;
+    }
+    if (*count == 0)
+        fprintf(stderr, "gdr: --lod-errors: no values given\n");
+    return *count > 0;
+}
+
 int gdr_cmd_bench(int argc, char **argv)
 {
     uint32_t sizes[MAX_SIZES] = {1000, 10000, 100000, 1000000}, size_count = 4;
     uint32_t frames = 20, width = 1920, height = 1080;
-    const char *device = NULL, *json_path = NULL;
+    const char *device = NULL, *json_path = NULL, *scene_spec = NULL;
+    float lod_errors[MAX_LOD_ERRORS] = {1.0f};
+    uint32_t lod_error_count = 1;
     bool validate = false, has_camera = false;
     gdr_pipeline pipelines[3] = {GDR_PIPELINE_DEFAULT};
     uint32_t pipeline_count = 1;
@@ -67,6 +90,10 @@ int gdr_cmd_bench(int argc, char **argv)
             ok = has_camera = cli_parse_camera(arg, value, &camera_position, &camera_rotation);
         else if (strcmp(arg, "--json") == 0)
             json_path = value;
+        else if (strcmp(arg, "--scene") == 0)
+            scene_spec = value;
+        else if (strcmp(arg, "--lod-errors") == 0)
+            ok = parse_lod_errors(value, lod_errors, &lod_error_count);
         else if (strcmp(arg, "--pipelines") == 0) {
             char list[64];
             snprintf(list, sizeof list, "%s", value);
@@ -89,7 +116,9 @@ int gdr_cmd_bench(int argc, char **argv)
     }
 
     cJSON *rows = cJSON_CreateArray();
-    printf("%10s %9s %10s %12s %10s %10s %10s %10s %10s %10s %10s %10s\n", "instances", "pipeline", "visible",
+    if (scene_spec)
+        size_count = 1; /* the one scene given */
+    printf("%10s %9s %7s %10s %12s %10s %10s %10s %10s %10s %10s %10s %10s\n", "instances", "pipeline", "lod_px", "visible",
            "triangles", "meshlets", "cpu_ms", "cpu_median", "submit_ms", "gpu_update", "gpu_cull", "gpu_draw",
            "gpu_frame");
     double first_cpu = 0.0;
@@ -102,14 +131,18 @@ int gdr_cmd_bench(int argc, char **argv)
         gdr_demo_desc demo = {.instances = sizes[s]};
         gdr_renderer_desc desc = {.width = width, .height = height, .device = device, .validate = validate,
                                   .busy_wait = true};
-        if (gdr_scene_create_demo(&demo, &scene, &err) != GDR_OK || gdr_renderer_create(&desc, &renderer, &err) != GDR_OK ||
+        gdr_status loaded = scene_spec ? gdr_scene_load(scene_spec, &scene, &err) : gdr_scene_create_demo(&demo, &scene, &err);
+        if (loaded != GDR_OK || gdr_renderer_create(&desc, &renderer, &err) != GDR_OK ||
             gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK) {
             fprintf(stderr, "gdr: %s\n", err.message);
             result = 1;
         }
-        /* Every pipeline on the same scene, renderer and camera, one after the other. */
-        for (uint32_t p = 0; p < pipeline_count && result == 0; p++) {
-            gdr_frame_desc frame = {.camera = scene->cameras[0], .cull = GDR_CULL_ON, .pipeline = pipelines[p]};
+        /* Every pipeline and LOD threshold on the same scene, renderer and camera, one after the other. */
+        for (uint32_t run = 0; run < pipeline_count * lod_error_count && result == 0; run++) {
+            uint32_t p = run / lod_error_count;
+            gdr_camera camera = scene->camera_count > 0 ? scene->cameras[0] : gdr_scene_framing_camera(scene);
+            gdr_frame_desc frame = {.camera = camera, .cull = GDR_CULL_ON, .pipeline = pipelines[p],
+                                    .lod_error_px = lod_errors[run % lod_error_count]};
             if (has_camera) {
                 frame.camera.position = camera_position;
                 frame.camera.rotation = camera_rotation;
@@ -121,16 +154,20 @@ int gdr_cmd_bench(int argc, char **argv)
                 result = 1;
                 break;
             }
-            if (s == 0 && p == 0)
+            if (s == 0 && run == 0)
                 first_cpu = stats.cpu_ms_per_frame_median;
-            printf("%10u %9s %10u %12llu %10u %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f\n", stats.instances_total,
-                   gdr_pipeline_name(stats.pipeline), stats.instances_visible, (unsigned long long)stats.triangles,
+            printf("%10u %9s %7.2f %10u %12llu %10u %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f\n",
+                   stats.instances_total, gdr_pipeline_name(stats.pipeline),
+                   stats.lod_applied ? (double)frame.lod_error_px : 0.0, stats.instances_visible,
+                   (unsigned long long)stats.triangles,
                    stats.meshlets_visible, stats.cpu_ms_per_frame, stats.cpu_ms_per_frame_median,
                    stats.cpu_submit_ms_per_frame, stats.passes[0].gpu_ms, stats.passes[1].gpu_ms, stats.passes[2].gpu_ms,
                    stats.gpu_ms_per_frame);
             fflush(stdout);
             cJSON *row = cJSON_CreateObject();
             cJSON_AddStringToObject(row, "pipeline", gdr_pipeline_name(stats.pipeline));
+            cJSON_AddStringToObject(row, "scene", scene_spec ? scene_spec : "demo");
+            cJSON_AddNumberToObject(row, "lod_error_px", frame.lod_error_px);
             cJSON_AddNumberToObject(row, "draw_calls", stats.draw_calls);
             cJSON_AddNumberToObject(row, "cpu_cull_ms_per_frame", stats.cpu_cull_ms_per_frame);
             stats_add_meshlet_json(row, &stats);

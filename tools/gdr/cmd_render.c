@@ -17,6 +17,9 @@ typedef struct render_options {
     bool meshlet_cull, cone_cull, triangle_cull;
     gdr_pipeline pipeline;
     gdr_view view;
+    float lod_error;
+    bool has_lod_depth;
+    uint32_t lod_depth;
     gdr_vec3 camera_position;
     gdr_quat camera_rotation;
     const char *device;
@@ -26,8 +29,8 @@ typedef struct render_options {
 static int parse_render_options(int argc, char **argv, render_options *o)
 {
     *o = (render_options){.width = 1280, .height = 720, .frames = 1, .cull = true, .meshlet_cull = true,
-                          .cone_cull = true, .triangle_cull = true};
-    static const char *const view_names[] = {"shaded", "meshlets", "instances", "triangles", "overdraw"};
+                          .cone_cull = true, .triangle_cull = true, .lod_error = 1.0f};
+    static const char *const view_names[] = {"shaded", "meshlets", "instances", "triangles", "overdraw", "lod"};
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i], *value;
         if (arg[0] != '-' || strcmp(arg, "-") == 0) {
@@ -75,9 +78,13 @@ static int parse_render_options(int argc, char **argv, render_options *o)
             ok = cli_parse_pipeline(arg, value, &o->pipeline);
         else if (strcmp(arg, "--view") == 0) {
             int view;
-            ok = cli_parse_choice(arg, value, view_names, 5, &view);
+            ok = cli_parse_choice(arg, value, view_names, 6, &view);
             o->view = (gdr_view)view;
         }
+        else if (strcmp(arg, "--lod-error") == 0)
+            ok = cli_parse_float(arg, value, 0.0f, 1e6f, &o->lod_error);
+        else if (strcmp(arg, "--lod-depth") == 0)
+            ok = o->has_lod_depth = cli_parse_u32(arg, value, 0, 64, &o->lod_depth);
         else if (strcmp(arg, "--device") == 0)
             o->device = value;
         else if (strcmp(arg, "--cache-dir") == 0)
@@ -137,7 +144,8 @@ int gdr_cmd_render(int argc, char **argv)
                             .read_back = o.out_png != NULL, .pipeline = o.pipeline, .view = o.view,
                             .meshlet_frustum_cull = o.meshlet_cull ? GDR_CULL_ON : GDR_CULL_OFF,
                             .meshlet_cone_cull = o.cone_cull ? GDR_CULL_ON : GDR_CULL_OFF,
-                            .triangle_cull = o.triangle_cull ? GDR_CULL_ON : GDR_CULL_OFF};
+                            .triangle_cull = o.triangle_cull ? GDR_CULL_ON : GDR_CULL_OFF,
+                            .lod_error_px = o.lod_error, .lod_fixed_depth = o.has_lod_depth, .lod_depth = o.lod_depth};
     if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK || gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK ||
         gdr_renderer_render(renderer, &frame, o.frames, &stats, &err) != GDR_OK) {
         result = fail(&err);

@@ -26,6 +26,14 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
                 s->triangles_small_culled);
         fprintf(out, "task_workgroups     %u (in 1 indirect mesh-tasks launch; %u lost to overflow)\n",
                 s->task_workgroups, s->task_overflow);
+        if (s->lod_applied) {
+            fprintf(out, "meshlets_lod_culled %u (not in the LOD cut)\n", s->meshlets_lod_culled);
+            fprintf(out, "lod_depths          clusters/triangles drawn per DAG depth:");
+            for (uint32_t d = 0; d < s->lod_depth_count; d++)
+                fprintf(out, " %u:%u/%llu", d, s->lod_clusters_per_depth[d],
+                        (unsigned long long)s->lod_triangles_per_depth[d]);
+            fputc('\n', out);
+        }
     } else if (s->pipeline == GDR_PIPELINE_CPU) {
         fprintf(out, "draws               %u (in %u draw calls recorded by the CPU)\n", s->draws, s->draw_calls);
         fprintf(out, "cpu_cull_ms_per_frame %.4f\n", s->cpu_cull_ms_per_frame);
@@ -49,6 +57,14 @@ void stats_add_meshlet_json(cJSON *object, const gdr_frame_stats *s)
     cJSON_AddNumberToObject(object, "meshlets_visible", s->meshlets_visible);
     cJSON_AddNumberToObject(object, "triangles_backface_culled", s->triangles_backface_culled);
     cJSON_AddNumberToObject(object, "triangles_small_culled", s->triangles_small_culled);
+    cJSON_AddBoolToObject(object, "lod_applied", s->lod_applied);
+    cJSON_AddNumberToObject(object, "meshlets_lod_culled", s->meshlets_lod_culled);
+    cJSON *clusters = cJSON_AddArrayToObject(object, "lod_clusters_per_depth");
+    cJSON *triangles = cJSON_AddArrayToObject(object, "lod_triangles_per_depth");
+    for (uint32_t d = 0; clusters && triangles && d < s->lod_depth_count; d++) {
+        cJSON_AddItemToArray(clusters, cJSON_CreateNumber(s->lod_clusters_per_depth[d]));
+        cJSON_AddItemToArray(triangles, cJSON_CreateNumber((double)s->lod_triangles_per_depth[d]));
+    }
 }
 
 char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)

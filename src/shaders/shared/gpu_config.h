@@ -15,6 +15,8 @@
 #define GDR_MESH_MAX_TRIANGLES 124
 /* maxTaskWorkGroupCount[0] is at least this on every device: larger launches use y too. */
 #define GDR_TASK_GROUPS_PER_ROW 65535
+/* LOD statistics: clusters and triangles drawn per DAG depth, the last bucket for deeper ones. */
+#define GDR_LOD_STATS_DEPTHS 32
 /* Instance records the CPU can send per frame through the update ring. */
 #define GDR_INSTANCE_UPDATES_PER_FRAME 4096
 

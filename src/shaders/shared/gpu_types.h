@@ -13,7 +13,9 @@ GDR_STRUCT_BEGIN(GdrGpuVertex)
     gdr_vec2 uv;
 GDR_STRUCT_END(GdrGpuVertex)
 
-/* Where a mesh lives in the merged vertex, index and cluster buffers, and its bounds (seed 003, plan A). */
+/* Where a mesh lives in the merged vertex, index and cluster buffers, and its bounds (seed 003, plan A).
+ * The mesh's clusters are GdrGpuMeshlet[meshlet_offset .. + lod_cluster_count): level 0 first
+ * (meshlet_count of them), then the coarser clusters of its LOD DAG (issue 5), the root group's last. */
 GDR_STRUCT_BEGIN(GdrGpuMesh)
     gdr_uint vertex_offset;
     gdr_uint first_index;
@@ -22,11 +24,26 @@ GDR_STRUCT_BEGIN(GdrGpuMesh)
     gdr_vec4 bounds;         /* mesh-space sphere: centre xyz, radius w */
     gdr_uint meshlet_offset; /* first GdrGpuMeshlet of the mesh */
     gdr_uint task_count;     /* task workgroups per instance: ceil(meshlet_count / GDR_TASK_WORKGROUP_SIZE) */
+    gdr_uint lod_cluster_count; /* every cluster of the DAG (= meshlet_count without a DAG) */
+    gdr_uint lod_task_count;    /* ceil(lod_cluster_count / GDR_TASK_WORKGROUP_SIZE) */
+    gdr_uint root_first;        /* first cluster of the root group, relative to meshlet_offset */
+    gdr_uint root_cluster_count; /* 0 without a DAG: no root shortcut */
+    gdr_uint root_task_count;
     gdr_uint reserved0;
+    /* The root shortcut: a sphere containing, and the largest error of, the groups the root
+     * group's clusters were made from. When it passes, each of them passes (errors and spheres
+     * are monotonic up the DAG), so the cut is exactly the root group's clusters. */
+    gdr_vec4 root_refined_sphere;
+    float root_refined_error;
     gdr_uint reserved1;
+    gdr_uint reserved2;
+    gdr_uint reserved3;
 GDR_STRUCT_END(GdrGpuMesh)
 
-/* One cluster of the geometry pool (gdr_cluster of gdr/geometry.h, with pool-global offsets). */
+/* One cluster of the geometry pool (gdr_cluster of gdr/geometry.h, with pool-global offsets), with
+ * what the LOD cut (issue 5, gdr/geometry.h "The cut") needs of its two groups inline: the group it
+ * is part of ("group": without one, error INFINITY, never passes) and the group it was made from
+ * ("refined": without one, error 0 and depth -1, always passes). */
 GDR_STRUCT_BEGIN(GdrGpuMeshlet)
     gdr_uint vertex_offset;   /* first entry in the meshlet vertex pool (global vertex indices) */
     gdr_uint triangle_offset; /* first byte in the meshlet triangle pool (3 bytes per triangle) */
@@ -36,9 +53,15 @@ GDR_STRUCT_BEGIN(GdrGpuMeshlet)
     gdr_vec3 cone_apex;       /* mesh space */
     float cone_cutoff;        /* back-facing from p when dot(normalize(apex - p), axis) >= cutoff */
     gdr_vec3 cone_axis;
-    gdr_uint group;           /* LOD DAG (issue 5) */
-    gdr_uint refined_group;
+    gdr_uint group;           /* mesh-local group index, or GDR_GPU_NO_GROUP */
+    gdr_uint refined_group;   /* mesh-local group index, or GDR_GPU_NO_GROUP */
+    gdr_int group_depth;      /* DAG depth of the group (0 without one): the cluster's LOD level */
+    gdr_int refined_depth;    /* DAG depth of the refined group, -1 without one */
     gdr_uint reserved0;
+    gdr_vec4 group_sphere;    /* mesh space */
+    gdr_vec4 refined_sphere;  /* mesh space */
+    float group_error;        /* mesh space; INFINITY for the root group and without a group */
+    float refined_error;      /* mesh space; 0 without a refined group */
     gdr_uint reserved1;
     gdr_uint reserved2;
 GDR_STRUCT_END(GdrGpuMeshlet)
@@ -49,8 +72,11 @@ GDR_STRUCT_BEGIN(GdrGpuTaskCommand)
     gdr_uint instance;
     gdr_uint meshlet_first; /* global GdrGpuMeshlet index */
     gdr_uint meshlet_count; /* 1 .. GDR_TASK_WORKGROUP_SIZE */
-    gdr_uint reserved;
+    gdr_uint flags;         /* GDR_TASK_* */
 GDR_STRUCT_END(GdrGpuTaskCommand)
+
+#define GDR_TASK_LOD_ACCEPTED 1u /* the root shortcut chose these clusters: no LOD test */
+#define GDR_GPU_NO_GROUP 0xffffffffu
 
 /* One instance of the persistent instance buffer. */
 GDR_STRUCT_BEGIN(GdrGpuInstance)
@@ -100,7 +126,9 @@ GDR_STRUCT_BEGIN(GdrGpuDrawStats)
     gdr_uint triangles_backface_culled;
     gdr_uint triangles_small_culled; /* covering no sample */
     gdr_uint meshlets_recorded;      /* entries appended to the visible-meshlet record */
-    gdr_uint reserved0;
+    gdr_uint meshlets_lod_culled;    /* not in the LOD cut */
+    gdr_uint lod_clusters[GDR_LOD_STATS_DEPTHS];  /* clusters drawn per DAG depth (last: that depth or more) */
+    gdr_uint lod_triangles[GDR_LOD_STATS_DEPTHS]; /* their triangles, before triangle culling */
 GDR_STRUCT_END(GdrGpuDrawStats)
 
 /* Per-frame constants, written by the CPU into its frame's slot. */
@@ -119,20 +147,27 @@ GDR_STRUCT_BEGIN(GdrGpuFrameGlobals)
     gdr_uint view_mode;       /* GDR_VIEW_* */
     gdr_uint task_capacity;   /* GdrGpuTaskCommand entries in the task buffer */
     gdr_vec2 viewport;        /* render target size in pixels */
+    float lod_threshold;      /* pixels (GDR_FRAME_LOD) */
+    float lod_projection_scale; /* P[1][1] * 0.5 * viewport height */
+    gdr_int lod_depth;        /* GDR_FRAME_LOD_DEPTH: the discrete cut's depth */
     gdr_uint reserved0;
     gdr_uint reserved1;
+    gdr_uint reserved2;
 GDR_STRUCT_END(GdrGpuFrameGlobals)
 
 #define GDR_FRAME_MESHLET_FRUSTUM 1u  /* task shader: cluster sphere vs frustum */
 #define GDR_FRAME_MESHLET_CONE 2u     /* task shader: cluster normal cone vs camera */
 #define GDR_FRAME_TRIANGLE_CULL 4u    /* mesh shader: back-facing triangles and triangles covering no sample */
 #define GDR_FRAME_RECORD_MESHLETS 8u  /* task shader: append (instance, cluster) of every visible cluster */
+#define GDR_FRAME_LOD 16u             /* task shader: the LOD cut over every cluster of the DAG */
+#define GDR_FRAME_LOD_DEPTH 32u       /* with GDR_FRAME_LOD: the discrete cut at depth lod_depth */
 
 #define GDR_VIEW_SHADED 0u
 #define GDR_VIEW_MESHLETS 1u  /* colour from a hash of the cluster's global index */
 #define GDR_VIEW_INSTANCES 2u /* colour from a hash of the instance index */
 #define GDR_VIEW_TRIANGLES 3u /* colour from a hash of the triangle: triangle density */
 #define GDR_VIEW_OVERDRAW 4u  /* fragments per pixel, as a heat map */
+#define GDR_VIEW_LOD 5u       /* colour from the cluster's DAG depth */
 
 /* Push constants of every pass: device addresses of the buffers it uses. */
 GDR_STRUCT_BEGIN(GdrGpuPushConstants)

@@ -31,4 +31,13 @@ vec3 gdr_id_color(uint id)
     return vec3(float(h & 255u), float((h >> 8) & 255u), float((h >> 16) & 255u)) * (0.75 / 255.0) + 0.25;
 }
 
+// LOD view: DAG depth 0 (full detail) blue, through green and yellow, to red at depth 12 and
+// beyond; neighbouring depths stay distinguishable.
+vec3 gdr_depth_color(int depth)
+{
+    float t = clamp(float(depth) / 12.0, 0.0, 1.0);
+    vec3 ramp = clamp(vec3(1.5 * t - 0.25, 1.0 - abs(2.0 * t - 1.0) * 1.2 + 0.2, 1.0 - 1.6 * t), 0.0, 1.0);
+    return (depth & 1) == 0 ? ramp : ramp * 0.75;
+}
+
 #endif
