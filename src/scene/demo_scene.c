@@ -6,36 +6,9 @@
 
 #include "gdr/scene.h"
 #include "scene/procedural_meshes.h"
+#include "scene/scene_random.h"
 
 #define PI_F 3.14159265358979f
-
-/* Stateless integer hash (a mix of multiply-xorshift rounds), so instance i's properties do not
- * depend on how many instances come before it. */
-static uint32_t hash_u32(uint32_t x)
-{
-    x ^= x >> 16;
-    x *= 0x7feb352dU;
-    x ^= x >> 15;
-    x *= 0x846ca68bU;
-    x ^= x >> 16;
-    return x;
-}
-
-static float hash_unit(uint32_t seed, uint32_t index, uint32_t channel)
-{
-    return (float)(hash_u32(seed * 0x9E3779B9U ^ hash_u32(index * 8U + channel)) >> 8) / 16777216.0f;
-}
-
-static gdr_vec4 hue_color(float hue)
-{
-    float r = fabsf(hue * 6.0f - 3.0f) - 1.0f;
-    float g = 2.0f - fabsf(hue * 6.0f - 2.0f);
-    float b = 2.0f - fabsf(hue * 6.0f - 4.0f);
-    r = fminf(fmaxf(r, 0.0f), 1.0f);
-    g = fminf(fmaxf(g, 0.0f), 1.0f);
-    b = fminf(fmaxf(b, 0.0f), 1.0f);
-    return (gdr_vec4){0.25f + 0.7f * r, 0.25f + 0.7f * g, 0.25f + 0.7f * b, 1.0f};
-}
 
 gdr_status gdr_scene_create_demo(const gdr_demo_desc *desc_in, gdr_scene **out, gdr_error *err)
 {
@@ -68,10 +41,10 @@ gdr_status gdr_scene_create_demo(const gdr_demo_desc *desc_in, gdr_scene **out, 
         status = gdr_scene_add_instance(scene, &floor, err);
     }
     for (uint32_t i = 0; i < desc.instances && status == GDR_OK; i++) {
-        uint32_t shape = (uint32_t)(hash_unit(desc.seed, i, 0) * 4.0f) & 3u;
-        float scale = 0.6f + 0.6f * hash_unit(desc.seed, i, 1); /* radius <= 1.2 * 1.25 < spacing / 2 */
-        float yaw = 2.0f * PI_F * hash_unit(desc.seed, i, 2);
-        float tilt = 0.5f * hash_unit(desc.seed, i, 3);
+        uint32_t shape = (uint32_t)(gdr_hash_unit(desc.seed, i, 0) * 4.0f) & 3u;
+        float scale = 0.6f + 0.6f * gdr_hash_unit(desc.seed, i, 1); /* radius <= 1.2 * 1.25 < spacing / 2 */
+        float yaw = 2.0f * PI_F * gdr_hash_unit(desc.seed, i, 2);
+        float tilt = 0.5f * gdr_hash_unit(desc.seed, i, 3);
         const gdr_mesh *mesh = &scene->meshes[shapes[shape]];
         float x = ((float)(i % side) - 0.5f * (float)(side - 1)) * desc.spacing;
         float z = ((float)(i / side) - 0.5f * (float)(side - 1)) * desc.spacing;
@@ -83,7 +56,7 @@ gdr_status gdr_scene_create_demo(const gdr_demo_desc *desc_in, gdr_scene **out, 
             .transform = gdr_mat4_from_trs((gdr_vec3){x, y, z}, rotation, (gdr_vec3){scale, scale, scale}),
             .mesh = shapes[shape],
             .material = GDR_NO_INDEX,
-            .color = hue_color(hash_unit(desc.seed, i, 4)),
+            .color = gdr_hue_color(gdr_hash_unit(desc.seed, i, 4)),
         };
         status = gdr_scene_add_instance(scene, &instance, err);
     }

@@ -250,3 +250,56 @@ gdr_status gdr_procedural_ground(gdr_scene *scene, float half_size, uint32_t cel
     push_lattice_quads(&b, 0, cells, cells);
     return builder_finish(&b, scene, "ground", true, out_mesh, err);
 }
+
+/* Centre line of the (2, 3) torus knot on a torus of radii 1 and 0.45, at t in [0, 2 pi). */
+static gdr_vec3 knot_point(float t)
+{
+    float ring = 1.0f + 0.45f * cosf(3.0f * t);
+    return (gdr_vec3){ring * cosf(2.0f * t), ring * sinf(2.0f * t), 0.45f * sinf(3.0f * t)};
+}
+
+gdr_status gdr_procedural_torus_knot(gdr_scene *scene, uint32_t segments, uint32_t sides, uint32_t *out_mesh,
+                                     gdr_error *err)
+{
+    if (segments < 24 || sides < 4 || (uint64_t)segments * sides > UINT32_MAX / 6)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "torus knot: %u segments x %u sides", segments, sides);
+    mesh_builder b;
+    if (builder_alloc(&b, segments * sides, segments * sides * 6, err) != GDR_OK) {
+        builder_free(&b);
+        return err->status;
+    }
+    /* Strands of this knot stay 0.89 apart and bend no tighter than a radius of 0.74: a tube of
+     * radius at most 0.15 * 1.35 never meets itself. */
+    const float tube = 0.15f, scale = 1.0f / (1.0f + 0.45f + tube * 1.35f);
+    for (uint32_t i = 0; i < segments; i++) {
+        float u = (float)i / (float)segments, t = u * 2.0f * PI_F;
+        gdr_vec3 c = knot_point(t);
+        gdr_vec3 tangent = gdr_vec3_normalize(gdr_vec3_sub(knot_point(t + 1e-3f), knot_point(t - 1e-3f)));
+        /* From the torus' core circle to the knot: perpendicular to the tangent in exact arithmetic
+         * and never zero, so the frame is periodic and has no twist at the seam. */
+        gdr_vec3 out = gdr_vec3_sub(c, (gdr_vec3){cosf(2.0f * t), sinf(2.0f * t), 0.0f});
+        out = gdr_vec3_sub(out, gdr_vec3_scale(tangent, gdr_vec3_dot(out, tangent)));
+        gdr_vec3 normal = gdr_vec3_normalize(out), binormal = gdr_vec3_cross(tangent, normal);
+        for (uint32_t j = 0; j < sides; j++) {
+            float v = (float)j / (float)sides, phi = v * 2.0f * PI_F;
+            /* Knobs: 60 along the knot, 5 around the tube (silhouette detail at every distance),
+             * over a slow swell along the knot. */
+            float knobs = sinf(60.0f * t) * sinf(5.0f * phi);
+            float radius = tube * (1.0f + 0.25f * knobs * fabsf(knobs) + 0.1f * sinf(7.0f * t));
+            gdr_vec3 dir = gdr_vec3_add(gdr_vec3_scale(normal, cosf(phi)), gdr_vec3_scale(binormal, sinf(phi)));
+            gdr_vec3 p = gdr_vec3_scale(gdr_vec3_add(c, gdr_vec3_scale(dir, radius)), scale);
+            push_vertex(&b, p, dir, (gdr_vec2){u, v});
+        }
+    }
+    /* The lattice wraps in both directions: ring `segments` is ring 0, side `sides` is side 0. */
+    for (uint32_t i = 0; i < segments; i++) {
+        uint32_t i1 = (i + 1) % segments;
+        for (uint32_t j = 0; j < sides; j++) {
+            uint32_t j1 = (j + 1) % sides;
+            uint32_t a = i * sides + j, bb = i1 * sides + j, c = i1 * sides + j1, d = i * sides + j1;
+            push_triangle(&b, a, d, c);
+            push_triangle(&b, a, c, bb);
+        }
+    }
+    return builder_finish(&b, scene, "torus_knot", false, out_mesh, err);
+}
