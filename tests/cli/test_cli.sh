@@ -92,6 +92,30 @@ ls "$work" | grep -q '\.tmp\.' && { echo "FAIL: temporary files left behind"; fa
 expect 0 "bench" "$gdr" bench --sizes 20,40 --frames 2 $small --json "$work/bench.json" --validate
 grep -q '"instances_total"' "$work/bench.json" || { echo "FAIL: bench JSON"; failures=$((failures + 1)); }
 
+# The built-in scenes for LOD (issue 5) and occlusion (issue 6), rendered small; info and build
+# accept them; bad options are errors.
+tiny="--width 160 --height 90"
+# shellcheck disable=SC2086
+{
+expect 0 "render lod-field" "$gdr" render lod-field:instances=30,triangles=3000 $tiny --validate --out "$work/lod-field.png"
+[ -s "$work/lod-field.png" ] || { echo "FAIL: no lod-field PNG"; failures=$((failures + 1)); }
+expect 0 "render occlusion" "$gdr" render occlusion $tiny --validate --out "$work/occlusion.png"
+[ -s "$work/occlusion.png" ] || { echo "FAIL: no occlusion PNG"; failures=$((failures + 1)); }
+expect 0 "render occlusion from behind the wall" "$gdr" render occlusion:hidden=300,visible=40,seed=2 $tiny --camera-index 1 --validate
+expect 0 "info lod-field" "$gdr" info lod-field
+grep -q '^instances: *1000$' "$work/stdout" || { echo "FAIL: info lod-field: $(cat "$work/stdout")"; failures=$((failures + 1)); }
+expect 0 "info occlusion" "$gdr" info occlusion:hidden=100,visible=10
+grep -q '^cameras: *6$' "$work/stdout" || { echo "FAIL: info occlusion: $(cat "$work/stdout")"; failures=$((failures + 1)); }
+expect 0 "build lod-field" "$gdr" build lod-field:instances=5,triangles=2000 -o "$work/field.gdrc" --no-progress
+expect 0 "render the built lod-field" "$gdr" render "$work/field.gdrc" $tiny --validate
+expect 1 "lod-field triangles too few" "$gdr" render lod-field:triangles=10 $tiny
+expect 1 "lod-field spacing too small" "$gdr" info lod-field:spacing=1
+expect 1 "occlusion unknown option" "$gdr" info occlusion:walls=3
+grep -q 'seed, hidden, visible' "$work/stderr" || { echo "FAIL: occlusion option message: $(cat "$work/stderr")"; failures=$((failures + 1)); }
+expect 1 "occlusion zero hidden" "$gdr" build occlusion:hidden=0 -o "$work/bad.gdrc"
+}
+[ ! -e "$work/bad.gdrc" ] || { echo "FAIL: a failed build left a cache"; failures=$((failures + 1)); }
+
 if [ "$failures" != 0 ]; then
     echo "test_cli: $failures failure(s)"
     exit 1

@@ -9,7 +9,8 @@
 static void build_usage(void)
 {
     fputs("usage: gdr build INPUT -o OUTPUT.gdrc [--no-progress]\n"
-          "  INPUT: a .gltf, .glb or .obj file, a .gdrc cache, or 'demo[:instances=N,seed=S,spacing=M]'\n",
+          "  INPUT: a .gltf, .glb or .obj file, a .gdrc cache, or a built-in scene: 'demo', 'lod-field'\n"
+          "         or 'occlusion', each with optional ':key=value,...' (see gdr --help)\n",
           stderr);
 }
 
@@ -41,9 +42,9 @@ int gdr_cmd_build(int argc, char **argv)
     gdr_scene *scene = NULL;
     gdr_source_list sources = {0};
     gdr_status status;
-    int is_demo = strcmp(input, "demo") == 0 || strncmp(input, "demo:", 5) == 0;
+    int is_builtin = gdr_scene_spec_is_builtin(input);
     size_t length = strlen(input);
-    if (is_demo || (length > 5 && strcmp(input + length - 5, ".gdrc") == 0)) {
+    if (is_builtin || (length > 5 && strcmp(input + length - 5, ".gdrc") == 0)) {
         gdr_load_options load = {.no_cache = 1, .no_progress = no_progress};
         status = gdr_scene_load_ex(input, &load, &scene, &err);
     } else {

@@ -24,14 +24,14 @@ int gdr_cmd_info(int argc, char **argv)
         } else if (strcmp(argv[i], "--cache-dir") == 0 && i + 1 < argc) {
             options.cache_dir = argv[++i];
         } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0 || argv[i][0] == '-' || input) {
-            fputs("usage: gdr info FILE|demo[:...] [--no-cache] [--cache-dir DIR]\n", stderr);
+            fputs("usage: gdr info FILE|demo|lod-field|occlusion[:...] [--no-cache] [--cache-dir DIR]\n", stderr);
             return strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0 ? 0 : 2;
         } else {
             input = argv[i];
         }
     }
     if (!input) {
-        fputs("usage: gdr info FILE|demo[:...] [--no-cache] [--cache-dir DIR]\n", stderr);
+        fputs("usage: gdr info FILE|demo|lod-field|occlusion[:...] [--no-cache] [--cache-dir DIR]\n", stderr);
         return 2;
     }
     gdr_error err = {0};
