@@ -35,6 +35,18 @@ _Static_assert(offsetof(GdrGpuFrameGlobals, viewport) == 208, "GdrGpuFrameGlobal
 _Static_assert(sizeof(GdrGpuFrameGlobals) == 240 && offsetof(GdrGpuFrameGlobals, frustum) == 128 &&
                    offsetof(GdrGpuFrameGlobals, znear) == 176 && offsetof(GdrGpuFrameGlobals, update_count) == 192,
                "GdrGpuFrameGlobals");
-_Static_assert(sizeof(GdrGpuPushConstants) == 104 && offsetof(GdrGpuPushConstants, updates) == 40,
+_Static_assert(sizeof(GdrGpuPushConstants) == 120 && offsetof(GdrGpuPushConstants, updates) == 40 &&
+                   offsetof(GdrGpuPushConstants, visbuffer) == 104,
                "GdrGpuPushConstants");
 _Static_assert(sizeof(GdrGpuPushConstants) <= 128, "push constants must fit the guaranteed 128 bytes");
+_Static_assert(sizeof(GdrGpuRasterCluster) == 8, "GdrGpuRasterCluster");
+_Static_assert(sizeof(GdrGpuRasterCounters) == 48 && offsetof(GdrGpuRasterCounters, dispatch_z) == 8 &&
+                   offsetof(GdrGpuRasterCounters, dispatch_x) == offsetof(VkDispatchIndirectCommand, x),
+               "GdrGpuRasterCounters starts with a VkDispatchIndirectCommand");
+_Static_assert(sizeof(GdrGpuRasterParams) == 48 && offsetof(GdrGpuRasterParams, mode) == 16 &&
+                   offsetof(GdrGpuRasterParams, ndc_scale) == 32, "GdrGpuRasterParams");
+_Static_assert(GDR_MESH_MAX_TRIANGLES <= (1u << GDR_VISBUFFER_TRIANGLE_BITS) &&
+                   GDR_RASTER_MAX_CLUSTERS <= (1ull << (32 - GDR_VISBUFFER_TRIANGLE_BITS)),
+               "a visibility-buffer id holds a cluster slot and a triangle in 32 bits");
+_Static_assert(GDR_MESH_MAX_VERTICES <= GDR_SW_RASTER_WORKGROUP_SIZE,
+               "the software rasteriser transforms a cluster's vertices in one step");

@@ -98,15 +98,17 @@ gdr_status gdr_vk_graphics_pipeline_create(gdr_vk_context *ctx, const gdr_vk_gra
                                                         .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT};
     VkPipelineDepthStencilStateCreateInfo depth = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO, .depthTestEnable = !desc->no_depth_test,
-        .depthWriteEnable = !desc->no_depth_test, .depthCompareOp = VK_COMPARE_OP_GREATER};
+        .depthWriteEnable = !desc->no_depth_test,
+        .depthCompareOp = desc->depth_always ? VK_COMPARE_OP_ALWAYS : VK_COMPARE_OP_GREATER};
     VkPipelineColorBlendAttachmentState blend_attachment = {.colorWriteMask = 0xF};
+    uint32_t color_count = desc->color_format != VK_FORMAT_UNDEFINED ? 1u : 0u;
     VkPipelineColorBlendStateCreateInfo blend = {.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
-                                                 .attachmentCount = 1, .pAttachments = &blend_attachment};
+                                                 .attachmentCount = color_count, .pAttachments = &blend_attachment};
     VkDynamicState dynamic_states[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
     VkPipelineDynamicStateCreateInfo dynamic = {.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
                                                 .dynamicStateCount = 2, .pDynamicStates = dynamic_states};
     VkPipelineRenderingCreateInfo rendering = {.sType = VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO,
-                                               .colorAttachmentCount = 1,
+                                               .colorAttachmentCount = color_count,
                                                .pColorAttachmentFormats = &desc->color_format,
                                                .depthAttachmentFormat = desc->depth_format};
     VkGraphicsPipelineCreateInfo info = {

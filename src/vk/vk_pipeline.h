@@ -24,10 +24,11 @@ typedef struct gdr_vk_graphics_pipeline_desc {
     const VkVertexInputBindingDescription *vertex_binding; /* NULL: no vertex input */
     const VkVertexInputAttributeDescription *vertex_attributes;
     uint32_t vertex_attribute_count;
-    VkFormat color_format;
+    VkFormat color_format;          /* VK_FORMAT_UNDEFINED: no colour attachment */
     VkFormat depth_format;
     VkCullModeFlags cull_mode;
     bool no_depth_test;             /* a full-screen pass over the colour target */
+    bool depth_always;              /* depth test ALWAYS, write on (a pass that writes gl_FragDepth) */
 } gdr_vk_graphics_pipeline_desc;
 
 /* A graphics pipeline for dynamic rendering, reverse-Z depth (compare GREATER, write on), with a

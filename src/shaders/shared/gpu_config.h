@@ -19,5 +19,14 @@
 #define GDR_LOD_STATS_DEPTHS 32
 /* Instance records the CPU can send per frame through the update ring. */
 #define GDR_INSTANCE_UPDATES_PER_FRAME 4096
+/* Hybrid rasterisation (issue 8): one software-raster workgroup per cluster; a visibility-buffer id
+ * is (visible-cluster slot << GDR_VISBUFFER_TRIANGLE_BITS) | triangle, so a frame can name at most
+ * GDR_RASTER_MAX_CLUSTERS visible clusters; vertices snap to GDR_SW_SUBPIXEL_BITS fractional bits
+ * (subPixelPrecisionBits of lavapipe and of NVIDIA and AMD GPUs; the usual value). */
+#define GDR_SW_RASTER_WORKGROUP_SIZE 64
+#define GDR_VISBUFFER_TRIANGLE_BITS 7
+#define GDR_RASTER_MAX_CLUSTERS (1u << 25)
+#define GDR_SW_SUBPIXEL_BITS 8
+#define GDR_SW_GROUPS_PER_ROW 65535
 
 #endif

@@ -184,6 +184,55 @@ GDR_STRUCT_BEGIN(GdrGpuPushConstants)
     gdr_uint64 tasks;      /* GdrGpuTaskCommand[] */
     gdr_uint64 overdraw;   /* uint[] per pixel (overdraw view) */
     gdr_uint64 visible_meshlets; /* uvec2[] (instance, global cluster index) when recording */
+    gdr_uint64 visbuffer;  /* uint64[] per pixel: the visibility buffer (issue 8) */
+    gdr_uint64 raster;     /* GdrGpuRasterParams of this frame's slot (issue 8) */
 GDR_STRUCT_END(GdrGpuPushConstants)
+
+/* --- Hybrid rasterisation (issue 8): the visibility buffer and the software rasteriser ----------
+ *
+ * A visibility-buffer pixel is 64 bits: the high word the depth as float bits (reverse-Z, so
+ * atomicMax keeps the nearest; 0 is empty), the low word (slot << GDR_VISBUFFER_TRIANGLE_BITS) |
+ * triangle, where slot indexes the frame's list of visible clusters (GdrGpuRasterCluster). The task
+ * shader appends software-rasterised clusters from the front of that list and reserves the mesh
+ * shader's from the back. */
+#define GDR_GPU_RASTER_FORWARD 0u /* the mesh shaders shade (issue 4); no visibility buffer */
+#define GDR_GPU_RASTER_HW 1u      /* every cluster through the mesh shaders into the visibility buffer */
+#define GDR_GPU_RASTER_SW 2u      /* every cluster the compute rasteriser can take (see raster_bin.h) */
+#define GDR_GPU_RASTER_HYBRID 3u  /* clusters whose triangles are small on screen to compute, the rest to mesh */
+
+/* One entry of the frame's visible-cluster list. */
+GDR_STRUCT_BEGIN(GdrGpuRasterCluster)
+    gdr_uint instance;
+    gdr_uint meshlet; /* global GdrGpuMeshlet index */
+GDR_STRUCT_END(GdrGpuRasterCluster)
+
+/* Counters of a frame, zeroed before the cull. The first three words are the
+ * VkDispatchIndirectCommand of the software rasteriser, written by raster_submit.comp. */
+GDR_STRUCT_BEGIN(GdrGpuRasterCounters)
+    gdr_uint dispatch_x;
+    gdr_uint dispatch_y;
+    gdr_uint dispatch_z;
+    gdr_uint used;         /* list entries reserved (both ends) */
+    gdr_uint sw_clusters;  /* entries at the front: software-rasterised clusters */
+    gdr_uint hw_clusters;  /* entries at the back: mesh-shader clusters */
+    gdr_uint sw_triangles; /* triangles of those clusters (before back-face culling) */
+    gdr_uint hw_triangles;
+    gdr_uint overflow;     /* visible clusters dropped for want of room (never expected, see visbuffer.c) */
+    gdr_uint sw_first;     /* first entry of the current software dispatch (raster_submit.comp) */
+    gdr_uint sw_dispatched; /* entries launched by earlier dispatches of the frame (one per raster phase) */
+    gdr_uint reserved0;
+GDR_STRUCT_END(GdrGpuRasterCounters)
+
+/* Per-frame raster parameters, written by the CPU into its frame's slot. */
+GDR_STRUCT_BEGIN(GdrGpuRasterParams)
+    gdr_uint64 clusters;    /* GdrGpuRasterCluster[capacity] */
+    gdr_uint64 counters;    /* GdrGpuRasterCounters */
+    gdr_uint mode;          /* GDR_GPU_RASTER_* */
+    gdr_uint capacity;      /* entries of the cluster list, <= GDR_RASTER_MAX_CLUSTERS */
+    float sw_threshold_px;  /* hybrid: clusters whose triangles are smaller go to the compute rasteriser */
+    gdr_uint reserved0;
+    gdr_vec2 ndc_scale;     /* the projection's P[0][0] and P[1][1] (x and y from view space to NDC) */
+    gdr_vec2 reserved1;
+GDR_STRUCT_END(GdrGpuRasterParams)
 
 #endif
