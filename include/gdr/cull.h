@@ -223,7 +223,8 @@ typedef struct gdr_pvs_bake_desc {
     float cell_size;           /* 0: the region's largest side / 16 */
     uint32_t samples_per_cell; /* 0: 8; at most 4096 */
     uint32_t cube_resolution;  /* texels along a side of each of the 6 cube faces; 0: 64; 4..1024 */
-    uint32_t cells_per_chunk;  /* cells compressed together; 0: 16 */
+    uint32_t cells_per_chunk;  /* cells compressed together; 0: 16; fewer when a chunk would
+                                  exceed 256 MB of bitsets */
     uint32_t bucket_count_x, bucket_count_z; /* the 2D bucket grid; 0: 16 each */
     int zstd_level;            /* 0: 3 */
     uint32_t seed;             /* 0: 1 */
@@ -257,7 +258,9 @@ GDR_API size_t gdr_pvs_serialized_size(const gdr_pvs *pvs);
 /* Writes gdr_pvs_serialized_size bytes; fails if capacity is smaller. */
 GDR_API gdr_status gdr_pvs_serialize(const gdr_pvs *pvs, void *destination, size_t capacity, gdr_error *err);
 /* Untrusted input: every size, offset and compressed chunk is checked; bad data is refused with
- * GDR_ERROR_PARSE. The data is copied. */
+ * GDR_ERROR_PARSE. A chunk must hold exactly the bitsets of its cells (uncompressed size = its
+ * cell count x the bitset size, in the chunk table and in the zstd frame), checked before any
+ * decompression buffer is allocated. The data is copied. */
 GDR_API gdr_status gdr_pvs_load(const void *data, size_t size, gdr_pvs **out, gdr_error *err);
 
 /* The lookup cache keeps the last decompressed chunk (moving within a chunk costs nothing). */

@@ -217,9 +217,13 @@ gdr_status gdr_pvs_bake(const gdr_pvs_bake_desc *desc_in, gdr_pvs **out, gdr_pvs
                                                               "must be at most 4096");
     if (d.scene->instance_count > PVS_MAX_OBJECTS)
         return gdr_error_set(err, GDR_ERROR_CAPACITY, "pvs bake: %u objects is too many", d.scene->instance_count);
-    ctx.desc = d;
     ctx.object_count = d.scene->instance_count;
     ctx.words = gdr_cull_word_count(ctx.object_count);
+    /* a chunk holds at most PVS_MAX_CHUNK_BYTES (what the loader accepts) */
+    uint64_t cell_bytes = (uint64_t)ctx.words * 4;
+    if (cell_bytes && d.cells_per_chunk * cell_bytes > PVS_MAX_CHUNK_BYTES)
+        d.cells_per_chunk = (uint32_t)(PVS_MAX_CHUNK_BYTES / cell_bytes);
+    ctx.desc = d;
 
     gdr_bvh *bvh;
     gdr_status st = gdr_bvh_create_from_scene(d.scene, &bvh, err);

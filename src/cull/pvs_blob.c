@@ -169,10 +169,15 @@ static gdr_status parse_header(const uint8_t *p, size_t size, gdr_pvs *pvs, gdr_
     return GDR_OK;
 }
 
-static gdr_status parse_tables(const uint8_t *p, gdr_pvs *pvs, gdr_error *err)
+/* Reads the bucket, cell and chunk tables and checks them against each other. A chunk holds
+ * exactly the bitsets of the cells that refer to it, one each: its uncompressed size must be
+ * (its cell count) x (bytes per bitset), and its cells' offsets must tile it. So the size of
+ * every buffer the loader and the lookup cache allocate follows from the object count and the
+ * cell table, never from a size field alone. */
+static gdr_status parse_tables(const uint8_t *p, gdr_pvs *pvs, uint32_t *scratch, gdr_error *err)
 {
     uint32_t bucket_count = pvs->bucket_x * pvs->bucket_z;
-    uint32_t cell_bytes = gdr_cull_word_count(pvs->object_count) * 4;
+    uint64_t cell_bytes = (uint64_t)gdr_cull_word_count(pvs->object_count) * 4;
     const uint8_t *q = p + PVS_HEADER_SIZE;
     uint32_t next_cell = 0;
     for (uint32_t b = 0; b < bucket_count; b++, q += PVS_BUCKET_SIZE) {
@@ -201,14 +206,12 @@ static gdr_status parse_tables(const uint8_t *p, gdr_pvs *pvs, gdr_error *err)
                           (unsigned long long)pvs->data_size);
         if ((chunk->flags & ~PVS_CHUNK_ZSTD) || get32(q + 20) != 0)
             return REFUSE("pvs blob: chunks[%u] has unknown flags 0x%x", k, chunk->flags);
-        if (chunk->uncompressed_size > PVS_MAX_CHUNK_BYTES || chunk->uncompressed_size % 4 != 0)
-            return REFUSE("pvs blob: chunks[%u] uncompressed_size %u is invalid", k, chunk->uncompressed_size);
         if (!(chunk->flags & PVS_CHUNK_ZSTD) && chunk->compressed_size != chunk->uncompressed_size)
             return REFUSE("pvs blob: stored chunks[%u] has %u bytes, expected %u", k, chunk->compressed_size,
                           chunk->uncompressed_size);
-        if (chunk->uncompressed_size > pvs->max_chunk_bytes)
-            pvs->max_chunk_bytes = chunk->uncompressed_size;
     }
+    /* scratch[k]: cells of chunk k (first pass), then the first tile of chunk k (second pass) */
+    memset(scratch, 0, sizeof(uint32_t) * pvs->chunk_count);
     for (uint32_t c = 0; c < pvs->cell_count; c++) {
         const uint8_t *e = cells + (size_t)c * PVS_CELL_SIZE;
         pvs_cell *cell = &pvs->cells[c];
@@ -220,18 +223,69 @@ static gdr_status parse_tables(const uint8_t *p, gdr_pvs *pvs, gdr_error *err)
             return REFUSE("pvs blob: cells[%u] is not in its bucket", c);
         if (cell->chunk >= pvs->chunk_count)
             return REFUSE("pvs blob: cells[%u].chunk %u exceeds %u", c, cell->chunk, pvs->chunk_count);
+        scratch[cell->chunk]++;
+    }
+    /* the exact size of each chunk, before anything is decompressed or allocated for it */
+    uint32_t tiles = 0;
+    for (uint32_t k = 0; k < pvs->chunk_count; k++) {
+        pvs_chunk *chunk = &pvs->chunks[k];
+        uint64_t exact = scratch[k] * cell_bytes;
+        if (scratch[k] == 0)
+            return REFUSE("pvs blob: chunks[%u] holds no cell", k);
+        if (exact > PVS_MAX_CHUNK_BYTES)
+            return REFUSE("pvs blob: chunks[%u] holds %u cells of %llu bytes, more than %u bytes", k, scratch[k],
+                          (unsigned long long)cell_bytes, PVS_MAX_CHUNK_BYTES);
+        if (chunk->uncompressed_size != exact)
+            return REFUSE("pvs blob: chunks[%u] uncompressed_size %u, its %u cells of %u objects need %llu", k,
+                          chunk->uncompressed_size, scratch[k], pvs->object_count, (unsigned long long)exact);
+        if (chunk->uncompressed_size > pvs->max_chunk_bytes)
+            pvs->max_chunk_bytes = chunk->uncompressed_size;
+        uint32_t count = scratch[k];
+        scratch[k] = tiles;
+        tiles += count;
+    }
+    /* each cell of a chunk owns one tile of it: offset = tile * cell_bytes, no tile shared */
+    uint32_t *owner = scratch + pvs->chunk_count; /* per tile: cell + 1, or 0 */
+    memset(owner, 0, sizeof(uint32_t) * pvs->cell_count);
+    for (uint32_t c = 0; c < pvs->cell_count; c++) {
+        const pvs_cell *cell = &pvs->cells[c];
         const pvs_chunk *chunk = &pvs->chunks[cell->chunk];
-        if (cell->offset % 4 != 0 || cell->offset > chunk->uncompressed_size ||
-            cell_bytes > chunk->uncompressed_size - cell->offset)
-            return REFUSE("pvs blob: cells[%u] bitset at %u (+%u) exceeds chunk %u of %u bytes", c, cell->offset,
-                          cell_bytes, cell->chunk, chunk->uncompressed_size);
+        uint64_t tile = cell_bytes ? cell->offset / cell_bytes : 0;
+        if ((cell_bytes ? cell->offset % cell_bytes : cell->offset) != 0 ||
+            (uint64_t)cell->offset + cell_bytes > chunk->uncompressed_size)
+            return REFUSE("pvs blob: cells[%u] bitset at %u (+%llu) is not a bitset of chunk %u of %u bytes", c,
+                          cell->offset, (unsigned long long)cell_bytes, cell->chunk, chunk->uncompressed_size);
+        if (cell_bytes == 0)
+            continue; /* no objects: every bitset is empty */
+        uint32_t *slot = &owner[scratch[cell->chunk] + tile];
+        if (*slot)
+            return REFUSE("pvs blob: cells[%u] and cells[%u] share the bitset at %u of chunk %u", *slot - 1, c,
+                          cell->offset, cell->chunk);
+        *slot = c + 1;
     }
     return GDR_OK;
 }
 
-/* Every compressed chunk must decompress to exactly its stated size. */
+/* Every compressed chunk is one zstd frame that states exactly the chunk's size (checked for all
+ * chunks before the buffer is allocated) and decompresses to exactly that size. */
 static gdr_status check_chunks(gdr_pvs *pvs, gdr_error *err)
 {
+    for (uint32_t k = 0; k < pvs->chunk_count; k++) {
+        const pvs_chunk *chunk = &pvs->chunks[k];
+        if (!(chunk->flags & PVS_CHUNK_ZSTD))
+            continue;
+        const uint8_t *src = pvs->data + chunk->data_offset;
+        size_t frame = ZSTD_findFrameCompressedSize(src, chunk->compressed_size);
+        if (ZSTD_isError(frame) || frame != chunk->compressed_size)
+            return REFUSE("pvs blob: chunks[%u] is not one zstd frame of %u bytes", k, chunk->compressed_size);
+        unsigned long long stated = ZSTD_getFrameContentSize(src, chunk->compressed_size);
+        if (stated != chunk->uncompressed_size)
+            return REFUSE("pvs blob: chunks[%u] zstd frame states %s bytes, the chunk has %u", k,
+                          stated == ZSTD_CONTENTSIZE_UNKNOWN ? "no size" : stated == ZSTD_CONTENTSIZE_ERROR
+                                                                               ? "a damaged header and no"
+                                                                               : "another number of",
+                          chunk->uncompressed_size);
+    }
     uint8_t *buffer = malloc(pvs->max_chunk_bytes ? pvs->max_chunk_bytes : 1);
     if (!buffer)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "pvs blob: out of memory");
@@ -240,16 +294,12 @@ static gdr_status check_chunks(gdr_pvs *pvs, gdr_error *err)
         const pvs_chunk *chunk = &pvs->chunks[k];
         if (!(chunk->flags & PVS_CHUNK_ZSTD))
             continue;
-        const uint8_t *src = pvs->data + chunk->data_offset;
-        unsigned long long stated = ZSTD_getFrameContentSize(src, chunk->compressed_size);
-        if (stated != chunk->uncompressed_size) {
-            st = REFUSE("pvs blob: chunks[%u] zstd frame is damaged or of the wrong size", k);
-            break;
-        }
-        size_t n = ZSTD_decompress(buffer, chunk->uncompressed_size, src, chunk->compressed_size);
+        /* capacity = the exact size: a frame that would write more fails instead */
+        size_t n = ZSTD_decompress(buffer, chunk->uncompressed_size, pvs->data + chunk->data_offset,
+                                   chunk->compressed_size);
         if (ZSTD_isError(n) || n != chunk->uncompressed_size)
-            st = REFUSE("pvs blob: chunks[%u] does not decompress: %s", k,
-                        ZSTD_isError(n) ? ZSTD_getErrorName(n) : "wrong size");
+            st = REFUSE("pvs blob: chunks[%u] does not decompress to its %u bytes: %s", k, chunk->uncompressed_size,
+                        ZSTD_isError(n) ? ZSTD_getErrorName(n) : "fewer bytes");
     }
     free(buffer);
     return st;
@@ -264,6 +314,7 @@ gdr_status gdr_pvs_load(const void *data, size_t size, gdr_pvs **out, gdr_error 
     gdr_pvs *pvs = calloc(1, sizeof(*pvs));
     if (!pvs)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "pvs blob: out of memory");
+    uint32_t *scratch = NULL;
     gdr_status st = parse_header(p, size, pvs, err);
     if (st == GDR_OK) {
         /* sizes are now bounded by the blob's own size */
@@ -271,14 +322,16 @@ gdr_status gdr_pvs_load(const void *data, size_t size, gdr_pvs **out, gdr_error 
         pvs->cells = calloc(pvs->cell_count ? pvs->cell_count : 1, sizeof(pvs_cell));
         pvs->chunks = calloc(pvs->chunk_count ? pvs->chunk_count : 1, sizeof(pvs_chunk));
         pvs->data = malloc(pvs->data_size ? (size_t)pvs->data_size : 1);
-        if (!pvs->buckets || !pvs->cells || !pvs->chunks || !pvs->data)
+        scratch = malloc(sizeof(uint32_t) * ((size_t)pvs->chunk_count + pvs->cell_count + 1));
+        if (!pvs->buckets || !pvs->cells || !pvs->chunks || !pvs->data || !scratch)
             st = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "pvs blob: out of memory");
     }
     if (st == GDR_OK) {
         if (pvs->data_size)
             memcpy(pvs->data, p + size - pvs->data_size, (size_t)pvs->data_size);
-        st = parse_tables(p, pvs, err);
+        st = parse_tables(p, pvs, scratch, err);
     }
+    free(scratch);
     if (st == GDR_OK)
         st = check_chunks(pvs, err);
     if (st != GDR_OK) {

@@ -1,9 +1,11 @@
 /* Precomputed visibility: the bake is conservative for its sampled points (fresh rays from them
  * only ever reach objects the cell lists), miss rates for fresh points, culling with it, the blob
- * round trip, and damaged blobs refused cleanly. */
+ * round trip, damaged blobs refused cleanly, and the exact size of every chunk. */
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+
+#include <zstd.h>
 
 #include "core/thread_pool.h"
 #include "gdr/cull.h"
@@ -419,6 +421,223 @@ static void test_blob(gdr_scene *scene, const uint8_t *blob, size_t size, unsign
     free(bad);
 }
 
+/* --- the exact chunk size -------------------------------------------------------------------- */
+
+static uint32_t get32le(const uint8_t *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+static uint64_t get64le(const uint8_t *p) { return (uint64_t)get32le(p) | (uint64_t)get32le(p + 4) << 32; }
+
+static void put64(uint8_t *p, uint64_t v)
+{
+    for (int i = 0; i < 8; i++)
+        p[i] = (uint8_t)(v >> (8 * i));
+}
+
+/* Where the tables of a blob are (docs/CULLING.md, blob layout). */
+typedef struct blob_layout {
+    uint32_t objects, cells, chunks;
+    size_t cells_at, chunks_at, data_at;
+} blob_layout;
+
+static blob_layout layout_of(const uint8_t *b)
+{
+    blob_layout l = {get32le(b + 16), get32le(b + 56), get32le(b + 60), 0, 0, 0};
+    l.cells_at = 80 + 8 * (size_t)get32le(b + 48) * get32le(b + 52);
+    l.chunks_at = l.cells_at + 20 * (size_t)l.cells;
+    l.data_at = l.chunks_at + 24 * (size_t)l.chunks;
+    return l;
+}
+
+/* A copy of the blob whose chunk k holds `payload` (flags and uncompressed size as given), the
+ * other chunks' data moved to follow, and the checksum fixed. */
+static uint8_t *replace_chunk(const uint8_t *b, size_t size, uint32_t k, const void *payload, size_t payload_size,
+                              uint32_t flags, uint32_t uncompressed, size_t *out_size)
+{
+    blob_layout l = layout_of(b);
+    size_t data = 0;
+    for (uint32_t j = 0; j < l.chunks; j++)
+        data += j == k ? payload_size : get32le(b + l.chunks_at + 24 * (size_t)j + 8);
+    uint8_t *out = malloc(l.data_at + data + 1);
+    memcpy(out, b, l.data_at);
+    size_t at = 0;
+    for (uint32_t j = 0; j < l.chunks; j++) {
+        uint8_t *e = out + l.chunks_at + 24 * (size_t)j;
+        const uint8_t *src = j == k ? payload : b + l.data_at + get64le(e);
+        size_t n = j == k ? payload_size : get32le(e + 8);
+        memcpy(out + l.data_at + at, src, n);
+        put64(e, at);
+        put32(e + 8, (uint32_t)n);
+        if (j == k) {
+            put32(e + 12, uncompressed);
+            put32(e + 16, flags);
+        }
+        at += n;
+    }
+    put64(out + 64, data);
+    *out_size = l.data_at + data;
+    fix_checksum(out, *out_size);
+    (void)size;
+    return out;
+}
+
+/* Sets the content size in a zstd frame header (RFC 8878 3.1.1.1) without touching the rest. */
+static void patch_frame_content_size(uint8_t *frame, uint64_t size)
+{
+    uint8_t fhd = frame[4];
+    unsigned fcs_flag = fhd >> 6, single = (fhd >> 5) & 1u, dict_flag = fhd & 3u;
+    static const unsigned dict_bytes[4] = {0, 1, 2, 4}, fcs_bytes[4] = {1, 2, 4, 8};
+    size_t at = 5 + (single ? 0 : 1) + dict_bytes[dict_flag];
+    unsigned n = fcs_flag == 0 && !single ? 0 : fcs_bytes[fcs_flag];
+    CHECK(n > 0);
+    if (n == 2)
+        size -= 256;
+    for (unsigned i = 0; i < n; i++)
+        frame[at + i] = (uint8_t)(size >> (8 * i));
+}
+
+/* Loads a blob that must be refused with GDR_ERROR_PARSE and a message holding `what`. */
+static void expect_refused(const uint8_t *b, size_t n, const char *what)
+{
+    gdr_pvs *pvs = NULL;
+    gdr_error err = {0};
+    gdr_status st = gdr_pvs_load(b, n, &pvs, &err);
+    CHECK(st == GDR_ERROR_PARSE && pvs == NULL);
+    if (st == GDR_OK)
+        gdr_pvs_destroy(pvs);
+    if (!strstr(err.message, what)) {
+        fprintf(stderr, "expected '%s' in: %s\n", what, err.message);
+        CHECK(!"the message names the damage");
+    }
+}
+
+/* A chunk's uncompressed size is exactly (its cells) x (bytes per bitset): refused otherwise, in
+ * the chunk table, in the zstd frame header or in the decompressed data. */
+static void test_exact_chunk_size(const uint8_t *blob, size_t size)
+{
+    blob_layout l = layout_of(blob);
+    uint32_t cell_bytes = gdr_cull_word_count(l.objects) * 4;
+    /* a zstd chunk of several cells */
+    uint32_t k = UINT32_MAX, cells_in_k = 0;
+    for (uint32_t j = 0; j < l.chunks && k == UINT32_MAX; j++) {
+        const uint8_t *e = blob + l.chunks_at + 24 * (size_t)j;
+        uint32_t n = 0;
+        for (uint32_t c = 0; c < l.cells; c++)
+            n += get32le(blob + l.cells_at + 20 * (size_t)c + 12) == j;
+        if ((get32le(e + 16) & 1u) && n >= 2) {
+            k = j;
+            cells_in_k = n;
+        }
+    }
+    CHECK(k != UINT32_MAX);
+    if (k == UINT32_MAX)
+        return;
+    const uint8_t *entry = blob + l.chunks_at + 24 * (size_t)k;
+    uint32_t exact = cells_in_k * cell_bytes;
+    CHECK(get32le(entry + 12) == exact);
+    const uint8_t *frame = blob + l.data_at + get64le(entry);
+    size_t frame_size = get32le(entry + 8);
+    uint8_t *raw = malloc(exact + cell_bytes + 1);
+    CHECK(ZSTD_decompress(raw, exact, frame, frame_size) == exact);
+    memset(raw + exact, 0, cell_bytes);
+    uint8_t *bad = malloc(size);
+    size_t n;
+
+    /* the chunk table's size, off by a word, by a cell, or hostile (nothing that size is allocated) */
+    uint32_t wrong[] = {exact + 4, exact - 4, exact + cell_bytes, exact - cell_bytes, 0, 0x0FFFFFFCu, 0xFFFFFFFCu};
+    for (size_t i = 0; i < sizeof wrong / sizeof wrong[0]; i++) {
+        memcpy(bad, blob, size);
+        put32(bad + l.chunks_at + 24 * (size_t)k + 12, wrong[i]);
+        fix_checksum(bad, size);
+        char what[96];
+        snprintf(what, sizeof what, "chunks[%u] uncompressed_size %u, its %u cells of %u objects need %u", k,
+                 wrong[i], cells_in_k, l.objects, exact);
+        expect_refused(bad, size, what);
+    }
+    /* the same data recompressed differently: loads (the rebuilt blob is sound) */
+    size_t bound = ZSTD_compressBound(exact + cell_bytes);
+    uint8_t *packed = malloc(bound + 64);
+    size_t packed_size = ZSTD_compress(packed, bound, raw, exact, 19);
+    CHECK(!ZSTD_isError(packed_size));
+    uint8_t *b2 = replace_chunk(blob, size, k, packed, packed_size, 1, exact, &n);
+    gdr_pvs *pvs = NULL;
+    gdr_error err;
+    CHECK(gdr_pvs_load(b2, n, &pvs, &err) == GDR_OK);
+    gdr_pvs_destroy(pvs);
+    free(b2);
+    /* stored instead of compressed: loads; one word more (table and data agree): refused */
+    b2 = replace_chunk(blob, size, k, raw, exact, 0, exact, &n);
+    CHECK(gdr_pvs_load(b2, n, &pvs, &err) == GDR_OK);
+    gdr_pvs_destroy(pvs);
+    free(b2);
+    b2 = replace_chunk(blob, size, k, raw, exact + 4, 0, exact + 4, &n);
+    expect_refused(b2, n, "need");
+    free(b2);
+    /* a frame of one more cell, the table saying the exact size: the frame header is refused */
+    packed_size = ZSTD_compress(packed, bound, raw, exact + cell_bytes, 3);
+    b2 = replace_chunk(blob, size, k, packed, packed_size, 1, exact, &n);
+    expect_refused(b2, n, "zstd frame states another number of bytes");
+    free(b2);
+    /* a frame that does not state its size */
+    ZSTD_CCtx *cctx = ZSTD_createCCtx();
+    ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 0);
+    packed_size = ZSTD_compress2(cctx, packed, bound, raw, exact);
+    ZSTD_freeCCtx(cctx);
+    CHECK(!ZSTD_isError(packed_size));
+    b2 = replace_chunk(blob, size, k, packed, packed_size, 1, exact, &n);
+    expect_refused(b2, n, "zstd frame states no size");
+    free(b2);
+    /* the exact frame followed by an empty one: not one frame */
+    packed_size = ZSTD_compress(packed, bound, raw, exact, 3);
+    size_t tail = ZSTD_compress(packed + packed_size, bound + 64 - packed_size, raw, 0, 3);
+    CHECK(!ZSTD_isError(tail));
+    b2 = replace_chunk(blob, size, k, packed, packed_size + tail, 1, exact, &n);
+    expect_refused(b2, n, "is not one zstd frame");
+    free(b2);
+    /* a frame that states the exact size but holds a word less: the decompression is refused */
+    packed_size = ZSTD_compress(packed, bound, raw, exact - 4, 3);
+    patch_frame_content_size(packed, exact);
+    CHECK(ZSTD_getFrameContentSize(packed, packed_size) == exact);
+    b2 = replace_chunk(blob, size, k, packed, packed_size, 1, exact, &n);
+    expect_refused(b2, n, "does not decompress to its");
+    free(b2);
+    /* two cells of the chunk on one bitset (the chunk's size still matches its cell count) */
+    uint32_t first = UINT32_MAX;
+    for (uint32_t c = 0; c < l.cells; c++) {
+        const uint8_t *e = blob + l.cells_at + 20 * (size_t)c;
+        if (get32le(e + 12) != k)
+            continue;
+        if (first == UINT32_MAX) {
+            first = c;
+            continue;
+        }
+        memcpy(bad, blob, size);
+        put32(bad + l.cells_at + 20 * (size_t)c + 16, get32le(blob + l.cells_at + 20 * (size_t)first + 16));
+        fix_checksum(bad, size);
+        expect_refused(bad, size, "share the bitset");
+        /* an offset between bitsets, or past the chunk */
+        put32(bad + l.cells_at + 20 * (size_t)c + 16, cell_bytes / 2);
+        fix_checksum(bad, size);
+        expect_refused(bad, size, "is not a bitset of chunk");
+        put32(bad + l.cells_at + 20 * (size_t)c + 16, exact);
+        fix_checksum(bad, size);
+        expect_refused(bad, size, "is not a bitset of chunk");
+        /* a cell moved to another chunk: both chunks' sizes are now wrong */
+        memcpy(bad, blob, size);
+        put32(bad + l.cells_at + 20 * (size_t)c + 12, k == 0 ? 1 : 0);
+        fix_checksum(bad, size);
+        expect_refused(bad, size, "need");
+        break;
+    }
+    printf("exact chunk size: chunk %u of %u cells x %u bytes = %u; table, frame header, frame data and tiling "
+           "damage refused\n", k, cells_in_k, cell_bytes, exact);
+    free(packed);
+    free(bad);
+    free(raw);
+}
+
 /* A thin wall with a slit 1 cm wide: objects behind it are seen from the room only through the
  * slit, which rays shot at random rarely find. Rays through the slit from every sample point must
  * reach only listed objects, and the bake must still hide most of what is behind the wall. */
@@ -704,6 +923,7 @@ int main(int argc, char **argv)
     size_t size = 0;
     test_bake(scene, pool, &rng, &blob, &size);
     test_blob(scene, blob, size, &rng);
+    test_exact_chunk_size(blob, size);
     free(blob);
     test_slit(pool, &rng);
     test_shapes(pool, &rng);
