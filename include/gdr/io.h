@@ -87,19 +87,38 @@ typedef struct gdr_cache_source {
     const gdr_source_list *files; /* NULL or empty for the built-in demo scene */
 } gdr_cache_source;
 
+/* Precomputed visibility (include/gdr/cull.h): baked offline for a scene's instances (object i =
+ * instance i), it is stored in the cache next to the scene, not in gdr_scene (which stays plain
+ * arrays with no culling dependency). Write it with gdr_cache_write_ex, get it back with
+ * gdr_cache_read_ex or gdr_scene_load_file_ex. */
+typedef struct gdr_pvs gdr_pvs;
+
 /* Writes scene to path through a temporary file in the same folder and a rename. */
 GDR_API gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_cache_source *source,
                                    gdr_error *err);
+/* The same, and when pvs is not NULL its serialised form in the optional section 'PVIS'. pvs must
+ * have been baked for this scene: gdr_pvs_object_count(pvs) == scene->instance_count, else
+ * GDR_ERROR_INVALID_ARGUMENT and nothing is written. */
+GDR_API gdr_status gdr_cache_write_ex(const char *path, const gdr_scene *scene, const gdr_cache_source *source,
+                                      const gdr_pvs *pvs, gdr_error *err);
 
 /* Reads a cache. Checks magic, version, every size, offset and checksum. When build_options is
  * not NULL, a cache built with different options is refused (stale); each recorded source file
  * that exists with a different size or contents makes it stale too (a missing one does not:
  * a cache may travel without its sources). On GDR_OK, *out is the scene. */
 GDR_API gdr_status gdr_cache_read(const char *path, const char *build_options, gdr_scene **out, gdr_error *err);
+/* The same, and the precomputed visibility: *out_pvs is the loaded gdr_pvs (the caller destroys
+ * it with gdr_pvs_destroy), or NULL when the cache holds none. out_pvs may be NULL. Either way a
+ * 'PVIS' section is checked (gdr_pvs_load, and its object count against the scene's instances):
+ * a damaged one makes the whole cache refused, naming the section. */
+GDR_API gdr_status gdr_cache_read_ex(const char *path, const char *build_options, gdr_scene **out,
+                                     gdr_pvs **out_pvs, gdr_error *err);
 
 /* Parses a cache from memory without any staleness check (the fuzz target uses this). */
 GDR_API gdr_status gdr_cache_read_memory(const void *data, size_t size, const char *name, gdr_scene **out,
                                          gdr_error *err);
+GDR_API gdr_status gdr_cache_read_memory_ex(const void *data, size_t size, const char *name, gdr_scene **out,
+                                            gdr_pvs **out_pvs, gdr_error *err);
 
 /* The cache path used for a source: SOURCE.gdrc next to it, or in cache_dir (named after a hash
  * of the absolute source path) when cache_dir is given. Returns the length written, or 0 when
@@ -119,6 +138,11 @@ GDR_API gdr_status gdr_import_file(const char *path, const gdr_import_options *o
  * its clusters: read from the cache, or built (a cache written from a scene without them). */
 GDR_API gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options, gdr_scene **out,
                                        gdr_error *err);
+/* The same, and the precomputed visibility of the cache the scene was read from: *out_pvs is a
+ * gdr_pvs to destroy with gdr_pvs_destroy, or NULL (an import, or a cache without one). A stale
+ * cache is rebuilt from the source without it (the bake is not redone). out_pvs may be NULL. */
+GDR_API gdr_status gdr_scene_load_file_ex(const char *path, const gdr_load_options *options, gdr_scene **out,
+                                          gdr_pvs **out_pvs, gdr_error *err);
 
 #ifdef __cplusplus
 }

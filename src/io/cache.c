@@ -1,6 +1,7 @@
 /* The processed-scene cache (.gdrc): see docs/CACHE_FORMAT.md. Little-endian, a 64-byte header,
  * a table of checksummed sections; the reader trusts nothing in the file. */
 #define _XOPEN_SOURCE 700 /* realpath */
+#include <assert.h>
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -10,6 +11,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "gdr/cull.h"
 #include "io/io_internal.h"
 
 #if !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
@@ -35,6 +37,7 @@ enum {
     SEC_PIXELS = FOURCC('T', 'X', 'P', 'X'),
     SEC_CLUSTERS = FOURCC('C', 'L', 'U', 'S'),
     SEC_CLUSTER_DATA = FOURCC('C', 'L', 'D', 'T'),
+    SEC_PVS = FOURCC('P', 'V', 'I', 'S'), /* optional: the precomputed-visibility blob */
 };
 
 enum { MESH_RECORD = 64 + 8 + 16, MATERIAL_RECORD = 64 + 16 + 12 + 12 + 8, INSTANCE_RECORD = 64 + 8 + 16,
@@ -71,7 +74,7 @@ static void put(writer *w, const void *bytes, size_t n)
         w->data = grown;
         w->capacity = capacity;
     }
-    if (n)
+    if (n && bytes)
         memcpy(w->data + w->size, bytes, n);
     w->size += n;
 }
@@ -96,6 +99,12 @@ static void align8(writer *w)
     static const uint8_t zeros[8] = {0};
     put(w, zeros, (8 - w->size % 8) % 8);
 }
+/* n bytes at the end, for the caller to fill; NULL when out of memory. */
+static uint8_t *put_space(writer *w, size_t n)
+{
+    put(w, NULL, n);
+    return w->failed ? NULL : w->data + w->size - n;
+}
 static void align4(writer *w)
 {
     static const uint8_t zeros[4] = {0};
@@ -107,8 +116,8 @@ typedef struct section_entry {
     uint64_t offset, size, checksum;
 } section_entry;
 
-static void write_sections(writer *w, const gdr_scene *s, const gdr_cache_source *source, section_entry *entries,
-                           uint32_t *count)
+static void write_sections(writer *w, const gdr_scene *s, const gdr_cache_source *source, const gdr_pvs *pvs,
+                           section_entry *entries, uint32_t *count)
 {
     uint32_t n = 0;
 #define BEGIN(sid, sflags) do { align8(w); entries[n] = (section_entry){sid, sflags, w->size, 0, 0}; } while (0)
@@ -245,6 +254,16 @@ static void write_sections(writer *w, const gdr_scene *s, const gdr_cache_source
         align4(w);
     }
     END();
+
+    if (pvs) {
+        /* optional: readers of version 2 that predate it skip it */
+        BEGIN(SEC_PVS, 0);
+        size_t size = gdr_pvs_serialized_size(pvs);
+        uint8_t *blob = put_space(w, size);
+        if (blob && gdr_pvs_serialize(pvs, blob, size, NULL) != GDR_OK)
+            w->failed = 1;
+        END();
+    }
 #undef BEGIN
 #undef END
     *count = n;
@@ -255,13 +274,27 @@ static void store_u64(uint8_t *p, uint64_t v) { memcpy(p, &v, 8); }
 
 gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_cache_source *source, gdr_error *err)
 {
-    enum { SECTION_COUNT = 11 };
-    section_entry entries[SECTION_COUNT];
+    return gdr_cache_write_ex(path, scene, source, NULL, err);
+}
+
+gdr_status gdr_cache_write_ex(const char *path, const gdr_scene *scene, const gdr_cache_source *source,
+                              const gdr_pvs *pvs, gdr_error *err)
+{
+    enum { BASE_SECTIONS = 11, MAX_SECTIONS = BASE_SECTIONS + 1 };
+    if (pvs && gdr_pvs_object_count(pvs) != scene->instance_count)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
+                             "%s: the precomputed visibility was baked for %u objects, the scene has %u instances",
+                             path, gdr_pvs_object_count(pvs), scene->instance_count);
+    /* The table has exactly one entry per section: no byte of the file lies outside a checksum. */
+    uint32_t expected = BASE_SECTIONS + (pvs ? 1u : 0u);
+    section_entry entries[MAX_SECTIONS];
     uint32_t count = 0;
     writer w = {0};
-    uint8_t zeros[CACHE_HEADER_SIZE + SECTION_COUNT * CACHE_ENTRY_SIZE] = {0};
-    put(&w, zeros, sizeof zeros); /* header and table, filled in below */
-    write_sections(&w, scene, source, entries, &count);
+    put_space(&w, CACHE_HEADER_SIZE + (size_t)expected * CACHE_ENTRY_SIZE); /* header and table, below */
+    if (w.data)
+        memset(w.data, 0, w.size);
+    write_sections(&w, scene, source, pvs, entries, &count);
+    assert(w.failed || count == expected);
     if (w.failed) {
         free(w.data);
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory serialising the scene", path);
@@ -382,10 +415,12 @@ static const char *get_string(reader *r, uint32_t *length)
 }
 
 enum { K_SOURCE, K_SCENE, K_MESHES, K_GEOMETRY, K_MATERIALS, K_INSTANCES, K_CAMERAS, K_TEXTURES, K_PIXELS,
-       K_CLUSTERS, K_CLUSTER_DATA, K_COUNT };
+       K_CLUSTERS, K_CLUSTER_DATA, K_PVS, K_COUNT };
 static const uint32_t known_ids[K_COUNT] = {SEC_SOURCE, SEC_SCENE, SEC_MESHES, SEC_GEOMETRY, SEC_MATERIALS,
                                             SEC_INSTANCES, SEC_CAMERAS, SEC_TEXTURES, SEC_PIXELS, SEC_CLUSTERS,
-                                            SEC_CLUSTER_DATA};
+                                            SEC_CLUSTER_DATA, SEC_PVS};
+/* Sections a file may leave out. */
+static int optional_section(int k) { return k == K_SOURCE || k == K_PVS; }
 
 typedef struct cache_view {
     const uint8_t *data;
@@ -457,8 +492,8 @@ static gdr_status parse_container(const char *name, const uint8_t *data, size_t 
         v->present[known] = 1;
         v->sections[known] = (reader){data + offset, (size_t)length, 0, 0};
     }
-    for (int k = K_SCENE; k < K_COUNT; k++)
-        if (!v->present[k]) {
+    for (int k = 0; k < K_COUNT; k++)
+        if (!v->present[k] && !optional_section(k)) {
             char text[5];
             fourcc_text(known_ids[k], text);
             return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section '%s' is missing", name, text);
@@ -771,14 +806,60 @@ done:
     return GDR_OK;
 }
 
+/* PVIS: the precomputed-visibility blob (gdr_pvs_load checks all of it), baked for this scene's
+ * instances. Checked whether or not the caller wants it (out may be NULL), like every section. */
+static gdr_status read_pvs(const char *name, const cache_view *v, const gdr_scene *scene, gdr_pvs **out,
+                           gdr_error *err)
+{
+    if (!v->present[K_PVS])
+        return GDR_OK;
+    const reader *r = &v->sections[K_PVS];
+    gdr_pvs *pvs = NULL;
+    gdr_error pvs_err = {0};
+    gdr_status status = gdr_pvs_load(r->data, r->size, &pvs, &pvs_err);
+    if (status != GDR_OK)
+        return gdr_error_set(err, status, "%s: section 'PVIS' (%zu bytes at offset %zu): %s", name, r->size,
+                             (size_t)(r->data - v->data), pvs_err.message);
+    if (gdr_pvs_object_count(pvs) != scene->instance_count) {
+        status = gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'PVIS': baked for %u objects, the scene has %u "
+                               "instances", name, gdr_pvs_object_count(pvs), scene->instance_count);
+        gdr_pvs_destroy(pvs);
+        return status;
+    }
+    if (out)
+        *out = pvs;
+    else
+        gdr_pvs_destroy(pvs);
+    return GDR_OK;
+}
+
+/* The scene, then the optional sections that refer to it. */
+static gdr_status build_all(const char *name, cache_view *v, gdr_scene **out, gdr_pvs **out_pvs, gdr_error *err)
+{
+    gdr_status status = build_scene(name, v, out, err);
+    if (status == GDR_OK && (status = read_pvs(name, v, *out, out_pvs, err)) != GDR_OK) {
+        gdr_scene_destroy(*out);
+        *out = NULL;
+    }
+    return status;
+}
+
 gdr_status gdr_cache_read_memory(const void *data, size_t size, const char *name, gdr_scene **out, gdr_error *err)
 {
+    return gdr_cache_read_memory_ex(data, size, name, out, NULL, err);
+}
+
+gdr_status gdr_cache_read_memory_ex(const void *data, size_t size, const char *name, gdr_scene **out,
+                                    gdr_pvs **out_pvs, gdr_error *err)
+{
     *out = NULL;
+    if (out_pvs)
+        *out_pvs = NULL;
     cache_view v;
     gdr_status status = parse_container(name ? name : "(memory)", data, size, &v, err);
     if (status != GDR_OK)
         return status;
-    return build_scene(name ? name : "(memory)", &v, out, err);
+    return build_all(name ? name : "(memory)", &v, out, out_pvs, err);
 }
 
 /* Compares the SRCE section with the build options and the files on disk. */
@@ -828,7 +909,15 @@ static gdr_status check_fresh(const char *name, cache_view *v, const char *build
 
 gdr_status gdr_cache_read(const char *path, const char *build_options, gdr_scene **out, gdr_error *err)
 {
+    return gdr_cache_read_ex(path, build_options, out, NULL, err);
+}
+
+gdr_status gdr_cache_read_ex(const char *path, const char *build_options, gdr_scene **out, gdr_pvs **out_pvs,
+                             gdr_error *err)
+{
     *out = NULL;
+    if (out_pvs)
+        *out_pvs = NULL;
     uint8_t *data;
     size_t size;
     gdr_status status = gdr_io_read_file(path, &data, &size, NULL, err);
@@ -839,7 +928,7 @@ gdr_status gdr_cache_read(const char *path, const char *build_options, gdr_scene
     if (status == GDR_OK)
         status = check_fresh(path, &v, build_options, err);
     if (status == GDR_OK)
-        status = build_scene(path, &v, out, err);
+        status = build_all(path, &v, out, out_pvs, err);
     free(data);
     return status;
 }

@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "gdr/cull.h"
 #include "io/io_internal.h"
 
 /* Builds the clusters of every mesh that has none (all of them after an import; none, normally,
@@ -72,16 +73,37 @@ static void warn(const gdr_load_options *o, const char *format, ...)
         fprintf(stderr, "gdr: warning: %s\n", message);
 }
 
+/* After a cache read: clusters for a cache that had none, and the PVS handed out (or freed). */
+static gdr_status finish_cache_read(const char *path, gdr_scene **out, gdr_pvs *pvs, gdr_pvs **out_pvs,
+                                    gdr_error *err)
+{
+    gdr_status status = build_clusters(path, out, 0, 1, err);
+    if (status == GDR_OK && out_pvs)
+        *out_pvs = pvs;
+    else
+        gdr_pvs_destroy(pvs);
+    return status;
+}
+
 gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options, gdr_scene **out, gdr_error *err)
+{
+    return gdr_scene_load_file_ex(path, options, out, NULL, err);
+}
+
+gdr_status gdr_scene_load_file_ex(const char *path, const gdr_load_options *options, gdr_scene **out,
+                                  gdr_pvs **out_pvs, gdr_error *err)
 {
     static const gdr_load_options defaults = {0};
     if (!options)
         options = &defaults;
     *out = NULL;
+    if (out_pvs)
+        *out_pvs = NULL;
     const char *build_options = gdr_cache_build_options();
+    gdr_pvs *pvs = NULL;
     if (gdr_io_has_extension(path, ".gdrc")) {
-        gdr_status status = gdr_cache_read(path, build_options, out, err);
-        return status == GDR_OK ? build_clusters(path, out, 0, 1, err) : status;
+        gdr_status status = gdr_cache_read_ex(path, build_options, out, out_pvs ? &pvs : NULL, err);
+        return status == GDR_OK ? finish_cache_read(path, out, pvs, out_pvs, err) : status;
     }
     gdr_import_options import = {.warning = options->warning, .warning_user = options->warning_user,
                                  .no_progress = options->no_progress};
@@ -103,8 +125,8 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
         if (access(candidates[i], F_OK) != 0)
             continue;
         gdr_error cache_err;
-        if (gdr_cache_read(candidates[i], build_options, out, &cache_err) == GDR_OK)
-            return build_clusters(candidates[i], out, 0, 1, err);
+        if (gdr_cache_read_ex(candidates[i], build_options, out, out_pvs ? &pvs : NULL, &cache_err) == GDR_OK)
+            return finish_cache_read(candidates[i], out, pvs, out_pvs, err);
         if (!strstr(cache_err.message, ": stale: "))
             warn(options, "%s; rebuilding it", cache_err.message);
     }

@@ -1,6 +1,10 @@
 /* libFuzzer target: the .gdrc cache reader. Checksums would reject nearly every mutation before
- * the section parsers, so a flag in the first byte (when odd) recomputes them first: both the
- * container checks and the parsers behind them get exercised. */
+ * the section parsers, so a flag in the first byte (when odd) recomputes them first, the
+ * precomputed-visibility blob's own checksum inside section 'PVIS' included: both the container
+ * checks and the parsers behind them get exercised. A PVS that loads must match the scene and
+ * serialise back to the section's bytes. The seed corpus/cache/pvs.gdrc is a flag byte 1 and
+ * the output of `gdr build tri.obj -o a.gdrc --pvs; gdr build a.gdrc -o pvs.gdrc` (corpus/obj;
+ * the second build keeps the PVS and drops the source path). */
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -8,7 +12,37 @@
 
 #include <xxhash.h>
 
+#include "gdr/cull.h"
 #include "gdr/io.h"
+
+/* FNV-1a 64 over a PVS blob with its checksum field (offset 72) taken as zero (docs/CULLING.md). */
+static void fix_pvs_checksum(uint8_t *blob, size_t size)
+{
+    if (size < 80)
+        return;
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (size_t i = 0; i < size; i++)
+        h = (h ^ ((i >= 72 && i < 80) ? 0 : blob[i])) * 0x100000001b3ull;
+    memcpy(blob + 72, &h, 8);
+}
+
+/* The bytes of section 'PVIS' of a cache that loaded (so its table is sound). */
+static const uint8_t *pvs_section(const uint8_t *data, size_t *length)
+{
+    uint32_t count;
+    memcpy(&count, data + 16, 4);
+    for (uint32_t i = 0; i < count; i++) {
+        const uint8_t *e = data + 64 + (size_t)i * 32;
+        uint64_t offset, n;
+        memcpy(&offset, e + 8, 8);
+        memcpy(&n, e + 16, 8);
+        if (memcmp(e, "PVIS", 4) == 0) {
+            *length = (size_t)n;
+            return data + offset;
+        }
+    }
+    return NULL;
+}
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
@@ -34,6 +68,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 memcpy(&offset, e + 8, 8);
                 memcpy(&length, e + 16, 8);
                 if (offset <= size && length <= size - offset) {
+                    if (memcmp(e, "PVIS", 4) == 0)
+                        fix_pvs_checksum(copy + offset, (size_t)length);
                     uint64_t h = XXH3_64bits(copy + offset, (size_t)length);
                     memcpy(e + 24, &h, 8);
                 }
@@ -45,9 +81,21 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         memcpy(copy + 40, &h, 8);
     }
     gdr_scene *scene = NULL;
+    gdr_pvs *pvs = NULL;
     gdr_error err;
-    if (gdr_cache_read_memory(copy, size, "fuzz.gdrc", &scene, &err) == GDR_OK)
+    if (gdr_cache_read_memory_ex(copy, size, "fuzz.gdrc", &scene, &pvs, &err) == GDR_OK) {
+        if (pvs) {
+            size_t n = gdr_pvs_serialized_size(pvs), length = 0;
+            const uint8_t *section = pvs_section(copy, &length);
+            uint8_t *again = malloc(n ? n : 1);
+            if (gdr_pvs_object_count(pvs) != scene->instance_count || !again || !section || length != n ||
+                gdr_pvs_serialize(pvs, again, n, &err) != GDR_OK || memcmp(section, again, n) != 0)
+                __builtin_trap();
+            free(again);
+        }
+        gdr_pvs_destroy(pvs);
         gdr_scene_destroy(scene);
+    }
     free(copy);
     return 0;
 }

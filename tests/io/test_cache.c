@@ -1,6 +1,7 @@
 /* The processed-scene cache: build -> load gives an identical scene; every truncation and many
  * random byte flips are refused cleanly; stale, foreign-version and unknown-section handling;
- * gdr_scene_load_ex uses and rebuilds the cache next to the source. */
+ * gdr_scene_load_ex uses and rebuilds the cache next to the source; the optional precomputed
+ * visibility section (PVIS): round trip, absent, truncated, flipped, mismatched. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -9,6 +10,7 @@
 
 #include <xxhash.h>
 
+#include "gdr/cull.h"
 #include "gdr/io.h"
 #include "geometry/cluster_checks.h"
 #include "io_test_helpers.h"
@@ -228,6 +230,275 @@ static void test_automatic_cache(void)
     gdr_source_list_free(&sources);
 }
 
+/* --- the PVIS section ------------------------------------------------------------------------- */
+
+/* A room of boxes (a floor, a wall with a doorway, crates on both sides) and a quick bake of it. */
+static gdr_scene *pvs_scene(void)
+{
+    gdr_scene *scene = NULL;
+    gdr_error err;
+    CHECK(gdr_scene_create(&scene, &err) == GDR_OK);
+    gdr_vec3 p[8];
+    for (int i = 0; i < 8; i++)
+        p[i] = (gdr_vec3){(i & 1) ? 1.0f : -1.0f, (i & 2) ? 1.0f : -1.0f, (i & 4) ? 1.0f : -1.0f};
+    uint32_t idx[36] = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+                        2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+    uint32_t box;
+    CHECK(gdr_scene_add_mesh(scene, "box", p, NULL, NULL, 8, idx, 36, &box, &err) == GDR_OK);
+    gdr_vec3 boxes[][2] = {{{0, -0.5f, 0}, {12, 0.5f, 12}}, {{-7, 2, 0}, {5, 2, 0.25f}}, {{7, 2, 0}, {5, 2, 0.25f}}};
+    for (int i = 0; i < 3 + 40; i++) {
+        gdr_vec3 c, h;
+        if (i < 3) {
+            c = boxes[i][0];
+            h = boxes[i][1];
+        } else {
+            int k = i - 3;
+            c = (gdr_vec3){-10.0f + 2.5f * (float)(k % 9), 0.4f, (k / 9 % 2 ? 1.0f : -1.0f) * (3.0f + 2.0f * (float)(k / 18))};
+            h = (gdr_vec3){0.4f, 0.4f, 0.4f};
+        }
+        gdr_instance inst = {gdr_mat4_from_trs(c, gdr_quat_identity(), h), box, GDR_NO_INDEX, {1, 1, 1, 1}};
+        CHECK(gdr_scene_add_instance(scene, &inst, &err) == GDR_OK);
+    }
+    CHECK(gdr_scene_build_clusters(scene, NULL, &err) == GDR_OK);
+    return scene;
+}
+
+static gdr_pvs *pvs_bake_quick(const gdr_scene *scene)
+{
+    gdr_pvs_bake_desc desc = {.scene = scene, .region_min = {-12, 0.2f, -12}, .region_max = {12, 3.4f, 12},
+                              .cell_size = 3.0f, .samples_per_cell = 1, .cube_resolution = 16, .cells_per_chunk = 6,
+                              .bucket_count_x = 4, .bucket_count_z = 4};
+    gdr_pvs *pvs = NULL;
+    gdr_error err;
+    CHECK(gdr_pvs_bake(&desc, &pvs, NULL, &err) == GDR_OK);
+    return pvs;
+}
+
+static uint8_t *pvs_bytes(const gdr_pvs *pvs, size_t *size)
+{
+    *size = gdr_pvs_serialized_size(pvs);
+    uint8_t *blob = malloc(*size);
+    gdr_error err;
+    CHECK(blob && gdr_pvs_serialize(pvs, blob, *size, &err) == GDR_OK);
+    return blob;
+}
+
+/* The entry of section `id` in the table (NULL if absent). */
+static uint8_t *cache_entry(uint8_t *data, const char *id)
+{
+    uint32_t count;
+    memcpy(&count, data + 16, 4);
+    for (uint32_t i = 0; i < count; i++)
+        if (memcmp(data + 64 + (size_t)i * 32, id, 4) == 0)
+            return data + 64 + (size_t)i * 32;
+    return NULL;
+}
+
+/* Recomputes every section checksum, the table's and the header's (after a deliberate edit). */
+static void cache_fix_checksums(uint8_t *data, size_t size)
+{
+    uint64_t file_size = size, h;
+    memcpy(data + 24, &file_size, 8);
+    uint32_t count;
+    memcpy(&count, data + 16, 4);
+    for (uint32_t i = 0; i < count; i++) {
+        uint8_t *e = data + 64 + (size_t)i * 32;
+        uint64_t offset, length;
+        memcpy(&offset, e + 8, 8);
+        memcpy(&length, e + 16, 8);
+        if (offset <= size && length <= size - offset) {
+            h = XXH3_64bits(data + offset, (size_t)length);
+            memcpy(e + 24, &h, 8);
+        }
+    }
+    h = XXH3_64bits(data + 64, (size_t)count * 32);
+    memcpy(data + 32, &h, 8);
+    h = XXH3_64bits(data, 40);
+    memcpy(data + 40, &h, 8);
+}
+
+/* The PVS blob's own checksum (FNV-1a 64 with its field at 72 taken as zero, docs/CULLING.md). */
+static void pvs_fix_checksum(uint8_t *blob, size_t n)
+{
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (size_t i = 0; i < n; i++)
+        h = (h ^ ((i >= 72 && i < 80) ? 0 : blob[i])) * 0x100000001b3ull;
+    memcpy(blob + 72, &h, 8);
+}
+
+/* Reads a damaged cache: must be refused with no scene and no PVS, naming the file and `what`. */
+static void expect_refused(const uint8_t *data, size_t size, const char *what, gdr_status *status_out)
+{
+    gdr_scene *s = (gdr_scene *)(uintptr_t)1;
+    gdr_pvs *pvs = (gdr_pvs *)(uintptr_t)1;
+    gdr_error err = {0};
+    gdr_status status = gdr_cache_read_memory_ex(data, size, "pvs.gdrc", &s, &pvs, &err);
+    CHECK(status != GDR_OK && s == NULL && pvs == NULL);
+    CHECK(strstr(err.message, "pvs.gdrc") != NULL);
+    if (what && !strstr(err.message, what)) {
+        fprintf(stderr, "expected '%s' in: %s\n", what, err.message);
+        CHECK(!"the error names the damage");
+    }
+    if (status == GDR_OK) {
+        gdr_scene_destroy(s);
+        gdr_pvs_destroy(pvs);
+    }
+    if (status_out)
+        *status_out = status;
+}
+
+static void test_pvs_section(void)
+{
+    gdr_scene *scene = pvs_scene();
+    gdr_pvs *pvs = pvs_bake_quick(scene);
+    if (!scene || !pvs)
+        return;
+    size_t blob_size;
+    uint8_t *blob = pvs_bytes(pvs, &blob_size);
+    char path[1024], plain[1024];
+    snprintf(path, sizeof path, "%s/pvs.gdrc", GDR_IO_TEST_TMP);
+    snprintf(plain, sizeof plain, "%s/no-pvs.gdrc", GDR_IO_TEST_TMP);
+    gdr_error err = {0};
+    gdr_cache_source source = {gdr_cache_build_options(), NULL};
+
+    /* Round trip: the same scene and, byte for byte, the same PVS. */
+    CHECK(gdr_cache_write_ex(path, scene, &source, pvs, &err) == GDR_OK);
+    gdr_scene *loaded = NULL;
+    gdr_pvs *back = NULL;
+    CHECK(gdr_cache_read_ex(path, gdr_cache_build_options(), &loaded, &back, &err) == GDR_OK);
+    CHECK(loaded && same_scene(scene, loaded));
+    CHECK(back != NULL);
+    if (back) {
+        size_t n;
+        uint8_t *again = pvs_bytes(back, &n);
+        CHECK(n == blob_size && memcmp(again, blob, n) == 0);
+        CHECK(gdr_pvs_object_count(back) == scene->instance_count);
+        free(again);
+    }
+    gdr_pvs_destroy(back);
+    gdr_scene_destroy(loaded);
+    /* Readers that do not ask for it still load the scene; so does gdr_scene_load_file(_ex). */
+    loaded = NULL;
+    CHECK(gdr_cache_read(path, gdr_cache_build_options(), &loaded, &err) == GDR_OK && loaded);
+    gdr_scene_destroy(loaded);
+    loaded = NULL;
+    back = NULL;
+    CHECK(gdr_scene_load_file_ex(path, NULL, &loaded, &back, &err) == GDR_OK && loaded && back);
+    CHECK(back && gdr_pvs_cell_count(back) == gdr_pvs_cell_count(pvs));
+    gdr_pvs_destroy(back);
+    gdr_scene_destroy(loaded);
+
+    /* A cache without the section: loads, and says there is none. */
+    CHECK(gdr_cache_write(plain, scene, &source, &err) == GDR_OK);
+    loaded = NULL;
+    back = (gdr_pvs *)(uintptr_t)1;
+    CHECK(gdr_cache_read_ex(plain, NULL, &loaded, &back, &err) == GDR_OK && loaded && back == NULL);
+    gdr_scene_destroy(loaded);
+
+    /* A PVS baked for another scene is refused by the writer; nothing is written. */
+    gdr_scene *other = pvs_scene();
+    gdr_instance extra = other->instances[0];
+    CHECK(gdr_scene_add_instance(other, &extra, &err) == GDR_OK);
+    char wrong[1100];
+    snprintf(wrong, sizeof wrong, "%s/wrong-pvs.gdrc", GDR_IO_TEST_TMP);
+    unlink(wrong);
+    CHECK(gdr_cache_write_ex(wrong, other, &source, pvs, &err) == GDR_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(err.message, "baked for 43 objects, the scene has 44 instances") != NULL);
+    CHECK(access(wrong, F_OK) != 0);
+    gdr_scene_destroy(other);
+
+    size_t size, plain_size;
+    uint8_t *data = test_read_file(path, &size);
+    uint8_t *without = test_read_file(plain, &plain_size);
+    CHECK(data && without && size > plain_size);
+    uint8_t *entry = data ? cache_entry(data, "PVIS") : NULL;
+    CHECK(entry != NULL);
+    if (!data || !without || !entry) {
+        free(data);
+        free(without);
+        free(blob);
+        gdr_pvs_destroy(pvs);
+        gdr_scene_destroy(scene);
+        return;
+    }
+    uint32_t flags;
+    uint64_t offset, length;
+    memcpy(&flags, entry + 4, 4);
+    memcpy(&offset, entry + 8, 8);
+    memcpy(&length, entry + 16, 8);
+    CHECK(flags == 0);                  /* optional: older readers skip it */
+    CHECK(offset + length == size);     /* the last section */
+    CHECK(length == blob_size && memcmp(data + offset, blob, blob_size) == 0);
+    uint8_t *bad = malloc(size);
+
+    /* Every truncation of the file is refused. */
+    unsigned truncations = 0;
+    for (size_t cut = 0; cut < size; cut += cut < offset ? 97 : 1, truncations++)
+        expect_refused(data, cut, NULL, NULL);
+    /* Every byte of the section flipped: the section checksum names it. */
+    for (uint64_t i = offset; i < size; i++) {
+        memcpy(bad, data, size);
+        bad[i] ^= (uint8_t)(1u << (i % 8));
+        expect_refused(bad, size, "corrupted: section 'PVIS' checksum mismatch", NULL);
+    }
+    /* The same flips with the cache's checksums recomputed: the blob's own checks name it. */
+    unsigned inner = 0;
+    for (uint64_t i = offset; i < size; i += 1 + (i - offset) / 64) {
+        memcpy(bad, data, size);
+        bad[i] ^= (uint8_t)(1u << (i % 8));
+        cache_fix_checksums(bad, size);
+        gdr_status st;
+        expect_refused(bad, size, "section 'PVIS'", &st);
+        CHECK(st == GDR_ERROR_PARSE);
+        inner++;
+    }
+    /* The section cut short (its size in the table, checksums recomputed): the blob's size check. */
+    for (uint64_t keep = 0; keep < length; keep += 1 + keep / 8) {
+        memcpy(bad, data, size);
+        uint8_t *e = cache_entry(bad, "PVIS");
+        memcpy(e + 16, &keep, 8);
+        cache_fix_checksums(bad, size);
+        expect_refused(bad, size, "section 'PVIS'", NULL);
+    }
+    /* A valid blob for another object count (same bitset size, blob checksum fixed too). */
+    memcpy(bad, data, size);
+    uint32_t objects = (uint32_t)scene->instance_count - 1;
+    memcpy(bad + offset + 16, &objects, 4);
+    pvs_fix_checksum(bad + offset, (size_t)length);
+    cache_fix_checksums(bad, size);
+    expect_refused(bad, size, "section 'PVIS': baked for 42 objects, the scene has 43 instances", NULL);
+    /* Two PVIS sections: the second entry points at the same bytes. */
+    {
+        size_t n = size + 32;
+        uint8_t *two = malloc(n);
+        uint32_t count;
+        memcpy(&count, data + 16, 4);
+        size_t table_end = 64 + (size_t)count * 32;
+        memcpy(two, data, table_end);
+        memcpy(two + table_end, entry, 32);
+        memcpy(two + table_end + 32, data + table_end, size - table_end);
+        count++;
+        memcpy(two + 16, &count, 4);
+        for (uint32_t i = 0; i < count; i++) { /* every offset moves by the new entry */
+            uint64_t o;
+            memcpy(&o, two + 64 + (size_t)i * 32 + 8, 8);
+            o += 32;
+            memcpy(two + 64 + (size_t)i * 32 + 8, &o, 8);
+        }
+        cache_fix_checksums(two, n);
+        expect_refused(two, n, "section 'PVIS' appears twice", NULL);
+        free(two);
+    }
+    printf("pvs section: %llu bytes; %u truncations, %llu flips, %u flips behind fixed checksums refused\n",
+           (unsigned long long)length, truncations, (unsigned long long)length, inner);
+    free(bad);
+    free(data);
+    free(without);
+    free(blob);
+    gdr_pvs_destroy(pvs);
+    gdr_scene_destroy(scene);
+}
+
 int main(void)
 {
     gdr_error err = {0};
@@ -252,5 +523,6 @@ int main(void)
         printf("%s\n", err.message);
     }
     test_automatic_cache();
+    test_pvs_section();
     return test_finish("test_cache");
 }
