@@ -116,6 +116,32 @@ expect 1 "occlusion zero hidden" "$gdr" build occlusion:hidden=0 -o "$work/bad.g
 }
 [ ! -e "$work/bad.gdrc" ] || { echo "FAIL: a failed build left a cache"; failures=$((failures + 1)); }
 
+# Precomputed visibility in the cache (issue 7): gdr build --pvs bakes it, gdr info reports it,
+# a rebuild from the .gdrc keeps it, a damaged section is refused by name, a failed bake writes
+# nothing.
+printf 'g floor\nv -4 0 -4\nv 4 0 -4\nv 4 0 4\nv -4 0 4\nf 1 3 2\nf 1 4 3\ng wall\nv -4 0 0\nv 4 0 0\nv 4 2 0\nv -4 2 0\nf 5 6 7\nf 5 7 8\n' >"$work/room.obj"
+expect 0 "build --pvs" "$gdr" build "$work/room.obj" -o "$work/room.gdrc" --pvs --no-progress
+grep -q '^pvs: .* baked' "$work/stdout" || { echo "FAIL: build --pvs printed no bake report"; failures=$((failures + 1)); }
+expect 0 "info with a pvs" "$gdr" info "$work/room.gdrc"
+grep -q '^pvs: *[1-9][0-9]* cells, 2 objects' "$work/stdout" || { echo "FAIL: info pvs: $(grep pvs "$work/stdout")"; failures=$((failures + 1)); }
+expect 0 "rebuild keeps the pvs" "$gdr" build "$work/room.gdrc" -o "$work/room2.gdrc"
+expect 0 "info of the rebuilt cache" "$gdr" info "$work/room2.gdrc"
+grep -q '^pvs: *[1-9][0-9]* cells, 2 objects' "$work/stdout" || { echo "FAIL: rebuilt cache lost its pvs"; failures=$((failures + 1)); }
+expect 0 "build without --pvs" "$gdr" build "$work/room.obj" -o "$work/plain.gdrc" --no-progress
+expect 0 "info without a pvs" "$gdr" info "$work/plain.gdrc"
+grep -q '^pvs: *none$' "$work/stdout" || { echo "FAIL: info of a cache without pvs: $(grep pvs "$work/stdout")"; failures=$((failures + 1)); }
+size=$(wc -c <"$work/room.gdrc")
+cp "$work/room.gdrc" "$work/damaged.gdrc"
+printf '\252' | dd of="$work/damaged.gdrc" bs=1 seek=$((size - 40)) conv=notrunc 2>/dev/null
+if cmp -s "$work/room.gdrc" "$work/damaged.gdrc"; then
+    echo "FAIL: the damage did not change the file"; failures=$((failures + 1))
+fi
+expect 1 "damaged pvs section" "$gdr" info "$work/damaged.gdrc"
+grep -q "section 'PVIS'" "$work/stderr" || { echo "FAIL: damaged pvs: $(cat "$work/stderr")"; failures=$((failures + 1)); }
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\n' >"$work/points.obj"
+expect 1 "bake without triangles" "$gdr" build "$work/points.obj" -o "$work/points.gdrc" --pvs --no-progress
+[ ! -e "$work/points.gdrc" ] || { echo "FAIL: a failed bake left a cache"; failures=$((failures + 1)); }
+
 if [ "$failures" != 0 ]; then
     echo "test_cli: $failures failure(s)"
     exit 1

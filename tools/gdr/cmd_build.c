@@ -1,28 +1,60 @@
-/* gdr build INPUT -o OUTPUT.gdrc: import a scene (or build the demo) and write the cache. */
+/* gdr build INPUT -o OUTPUT.gdrc [--pvs]: import a scene (or build the demo), optionally bake its
+ * precomputed visibility, and write the cache. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "commands.h"
+#include "core/thread_pool.h"
+#include "gdr/cull.h"
 #include "gdr/io.h"
 
 static void build_usage(void)
 {
-    fputs("usage: gdr build INPUT -o OUTPUT.gdrc [--no-progress]\n"
+    fputs("usage: gdr build INPUT -o OUTPUT.gdrc [--pvs] [--no-progress]\n"
           "  INPUT: a .gltf, .glb or .obj file, a .gdrc cache, or a built-in scene: 'demo', 'lod-field'\n"
-          "         or 'occlusion', each with optional ':key=value,...' (see gdr --help)\n",
+          "         or 'occlusion', each with optional ':key=value,...' (see gdr --help)\n"
+          "  --pvs: bake precomputed visibility (default options, every processor) into the cache\n",
           stderr);
+}
+
+/* The bake with default options (docs/CULLING.md) on a pool of every processor. */
+static gdr_status bake_pvs(const gdr_scene *scene, gdr_pvs **out, gdr_error *err)
+{
+    gdr_thread_pool *pool = NULL;
+    gdr_status status = gdr_thread_pool_create(0, &pool, err);
+    if (status != GDR_OK)
+        return status;
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    gdr_pvs_bake_desc desc = {.scene = scene, .pool = pool};
+    gdr_pvs_bake_report report;
+    status = gdr_pvs_bake(&desc, out, &report, err);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    if (status == GDR_OK)
+        printf("pvs: %ux%ux%u cells, %u baked (%u touched by geometry), %u objects, %llu samples, %zu bytes "
+               "compressed from %zu, %.0f ms on %u threads\n",
+               report.grid[0], report.grid[1], report.grid[2], report.cells_baked, report.cells_occupied,
+               gdr_pvs_object_count(*out), (unsigned long long)report.samples_used, report.compressed_bytes,
+               report.uncompressed_bytes,
+               (double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) * 1e-6,
+               gdr_thread_pool_thread_count(pool));
+    gdr_thread_pool_destroy(pool);
+    return status;
 }
 
 int gdr_cmd_build(int argc, char **argv)
 {
     const char *input = NULL, *output = NULL;
-    int no_progress = 0;
+    int no_progress = 0, pvs_wanted = 0;
     for (int i = 1; i < argc; i++) {
         if ((strcmp(argv[i], "-o") == 0 || strcmp(argv[i], "--out") == 0) && i + 1 < argc) {
             output = argv[++i];
         } else if (strcmp(argv[i], "--no-progress") == 0) {
             no_progress = 1;
+        } else if (strcmp(argv[i], "--pvs") == 0) {
+            pvs_wanted = 1;
         } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             build_usage();
             return 0;
@@ -42,18 +74,29 @@ int gdr_cmd_build(int argc, char **argv)
     gdr_scene *scene = NULL;
     gdr_source_list sources = {0};
     gdr_status status;
+    gdr_pvs *pvs = NULL; /* a .gdrc input's precomputed visibility is carried over unless rebaked */
     int is_builtin = gdr_scene_spec_is_builtin(input);
     size_t length = strlen(input);
-    if (is_builtin || (length > 5 && strcmp(input + length - 5, ".gdrc") == 0)) {
-        gdr_load_options load = {.no_cache = 1, .no_progress = no_progress};
+    gdr_load_options load = {.no_cache = 1, .no_progress = no_progress};
+    if (is_builtin) {
         status = gdr_scene_load_ex(input, &load, &scene, &err);
+    } else if (length > 5 && strcmp(input + length - 5, ".gdrc") == 0) {
+        status = gdr_scene_load_file_ex(input, &load, &scene, &pvs, &err);
+        if (status == GDR_OK && pvs && !pvs_wanted)
+            printf("pvs: kept from %s (%u cells, %u objects)\n", input, gdr_pvs_cell_count(pvs),
+                   gdr_pvs_object_count(pvs));
     } else {
         gdr_import_options import = {.no_progress = no_progress, .sources = &sources};
         status = gdr_import_file(input, &import, &scene, NULL, &err);
     }
+    if (status == GDR_OK && pvs_wanted) {
+        gdr_pvs_destroy(pvs);
+        pvs = NULL;
+        status = bake_pvs(scene, &pvs, &err); /* before writing: a failed bake leaves no file */
+    }
     if (status == GDR_OK) {
         gdr_cache_source source = {gdr_cache_build_options(), &sources};
-        status = gdr_cache_write(output, scene, &source, &err);
+        status = gdr_cache_write_ex(output, scene, &source, pvs, &err);
     }
     if (status == GDR_OK)
         printf("%s: %u meshes, %u instances, %llu triangles, %u materials, %u textures, %u cameras\n", output,
@@ -61,6 +104,7 @@ int gdr_cmd_build(int argc, char **argv)
                scene->material_count, scene->texture_count, scene->camera_count);
     else
         fprintf(stderr, "gdr: %s\n", err.message);
+    gdr_pvs_destroy(pvs);
     gdr_source_list_free(&sources);
     gdr_scene_destroy(scene);
     return status == GDR_OK ? 0 : 1;

@@ -1,8 +1,10 @@
-/* gdr info FILE: a summary of a scene (meshes, instances, triangles, materials, cameras, ...). */
+/* gdr info FILE: a summary of a scene (meshes, instances, triangles, materials, cameras, ...) and
+ * of the precomputed visibility its cache holds. */
 #include <stdio.h>
 #include <string.h>
 
 #include "commands.h"
+#include "gdr/cull.h"
 #include "gdr/io.h"
 
 static void count_warning(void *user, const char *message)
@@ -36,7 +38,11 @@ int gdr_cmd_info(int argc, char **argv)
     }
     gdr_error err = {0};
     gdr_scene *scene = NULL;
-    if (gdr_scene_load_ex(input, &options, &scene, &err) != GDR_OK) {
+    gdr_pvs *pvs = NULL;
+    /* Files go the way gdr_scene_load_ex sends them, asking for their cache's PVS too. */
+    gdr_status status = gdr_scene_spec_is_builtin(input) ? gdr_scene_load_ex(input, &options, &scene, &err)
+                                                         : gdr_scene_load_file_ex(input, &options, &scene, &pvs, &err);
+    if (status != GDR_OK) {
         fprintf(stderr, "gdr: %s\n", err.message);
         return 1;
     }
@@ -68,8 +74,14 @@ int gdr_cmd_info(int argc, char **argv)
     printf("textures:    %u\n", scene->texture_count);
     printf("cameras:     %u\n", scene->camera_count);
     printf("extensions:  %s\n", scene->extensions ? scene->extensions : "(none)");
+    if (pvs)
+        printf("pvs:         %u cells, %u objects (%zu bytes)\n", gdr_pvs_cell_count(pvs), gdr_pvs_object_count(pvs),
+               gdr_pvs_serialized_size(pvs));
+    else
+        printf("pvs:         none\n");
     if (warnings)
         printf("warnings:    %u\n", warnings);
+    gdr_pvs_destroy(pvs);
     gdr_scene_destroy(scene);
     return 0;
 }
