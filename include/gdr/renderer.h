@@ -74,6 +74,13 @@ typedef struct gdr_frame_desc {
     float lod_error_px;
     bool lod_fixed_depth;
     uint32_t lod_depth;
+    /* Two-phase occlusion culling against the depth pyramid (issue 6; indirect pipeline: instances,
+     * mesh pipeline: instances and clusters; DEFAULT: on; off when cull is off). Conservative: the
+     * image is the same with it off. The history it keeps between frames is discarded when the
+     * pipeline changes and on a camera cut (the caller says so: the frame after a jump, a teleport,
+     * a new shot); without history everything goes through the late phase's test. */
+    gdr_cull_mode occlusion;
+    bool occlusion_camera_cut;
 } gdr_frame_desc;
 
 /* "shaded", "meshlets", "instances", "triangles", "overdraw" or "lod". */
@@ -129,6 +136,18 @@ typedef struct gdr_frame_stats {
     uint32_t lod_depth_count;             /* entries used below: deepest depth drawn + 1 */
     uint32_t lod_clusters_per_depth[GDR_LOD_STATS_DEPTH_COUNT];
     uint64_t lod_triangles_per_depth[GDR_LOD_STATS_DEPTH_COUNT];
+    /* Occlusion culling, last frame, per phase (early: what was visible last frame; late: the
+     * rest of what is in the frustum, against this frame's pyramid). Clusters: mesh pipeline. */
+    bool occlusion_applied;
+    uint32_t instances_early_drawn;
+    uint32_t instances_early_occluded; /* visible last frame, hidden behind last frame's pyramid */
+    uint32_t instances_late_tested;
+    uint32_t instances_late_occluded;
+    uint32_t instances_late_drawn;     /* not drawn early */
+    uint32_t meshlets_early_drawn;
+    uint32_t meshlets_late_tested;
+    uint32_t meshlets_late_occluded;
+    uint32_t meshlets_late_drawn;
 } gdr_frame_stats;
 
 GDR_API gdr_status gdr_renderer_create(const gdr_renderer_desc *desc, gdr_renderer **out, gdr_error *err);

@@ -31,7 +31,7 @@ void gdr_frame_matrices(const gdr_renderer *r, const gdr_camera *camera, gdr_mat
 }
 
 static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame, gdr_pipeline pipeline,
-                          uint32_t update_count)
+                          uint32_t update_count, bool occlusion, bool history)
 {
     const gdr_camera *camera = &frame->camera;
     gdr_mat4 projection, view;
@@ -56,16 +56,21 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
                  (frame->meshlet_cone_cull != GDR_CULL_OFF ? GDR_FRAME_MESHLET_CONE : 0u) |
                  (frame->triangle_cull != GDR_CULL_OFF ? GDR_FRAME_TRIANGLE_CULL : 0u) |
                  (frame->record_visible_meshlets ? GDR_FRAME_RECORD_MESHLETS : 0u) |
-                 (lod ? GDR_FRAME_LOD : 0u) | (lod && frame->lod_fixed_depth ? GDR_FRAME_LOD_DEPTH : 0u),
+                 (lod ? GDR_FRAME_LOD : 0u) | (lod && frame->lod_fixed_depth ? GDR_FRAME_LOD_DEPTH : 0u) |
+                 (occlusion ? GDR_FRAME_OCCLUSION : 0u) | (history ? GDR_FRAME_HISTORY : 0u),
         .view_mode = (uint32_t)frame->view,
         .task_capacity = r->scene.task_capacity,
         .viewport = {(float)r->width, (float)r->height},
         .lod_threshold = frame->lod_error_px,
         .lod_projection_scale = fabsf(projection.m[5]) * 0.5f * (float)r->height,
         .lod_depth = frame->lod_depth > INT32_MAX ? INT32_MAX : (int32_t)frame->lod_depth,
+        .instance_visibility = r->occlusion.instance_visibility.address,
+        .meshlet_visibility = r->occlusion.meshlet_visibility.address,
     };
+    gdr_occlusion_params(r, &projection, camera->znear, &globals.occlusion);
     memcpy(slot->globals.mapped, &globals, sizeof globals);
     slot->lod_applied = lod;
+    slot->occlusion_applied = occlusion;
 }
 
 /* Moves up to one frame's worth of pending instance updates into the slot's ring segment. */
@@ -79,22 +84,31 @@ static uint32_t take_updates(gdr_renderer *r, gdr_frame_slot *slot)
     return count;
 }
 
-static void begin_rendering(gdr_renderer *r, VkCommandBuffer cmd)
+/* `clear`: the frame's first raster phase (targets cleared); else the late phase of occlusion
+ * culling, which draws over the early phase's colour and depth. */
+static void begin_rendering(gdr_renderer *r, VkCommandBuffer cmd, bool clear)
 {
-    gdr_vk_image_barrier(cmd, r->color.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                         VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT, 0,
-                         VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
-    gdr_vk_image_barrier(cmd, r->depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                         VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, 0,
-                         VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                         VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+    if (clear) {
+        gdr_vk_image_barrier(cmd, r->color.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                             VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT, 0,
+                             VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+        gdr_vk_image_barrier(cmd, r->depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                             VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, 0,
+                             VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                             VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+    } else { /* depth came back from the pyramid build with its own barrier */
+        memory_barrier(cmd, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                       VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                       VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+    }
+    const VkAttachmentLoadOp load = clear ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_LOAD;
     VkRenderingAttachmentInfo color = {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
                                        .imageView = r->color.view, .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                                       .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR, .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
-                                       .clearValue.color = {{0.42f, 0.55f, 0.72f, 1.0f}}};
+                                       .loadOp = load, .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+                                       .clearValue.color = GDR_CLEAR_COLOR};
     VkRenderingAttachmentInfo depth = {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
                                        .imageView = r->depth.view, .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                                       .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR, .storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
+                                       .loadOp = load, .storeOp = VK_ATTACHMENT_STORE_OP_STORE, /* the pyramid reads it */
                                        .clearValue.depthStencil = {0.0f, 0}}; /* reverse-Z: 0 is infinitely far */
     VkRenderingInfo rendering = {.sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
                                  .renderArea = {{0, 0}, {r->width, r->height}}, .layerCount = 1,
@@ -108,9 +122,9 @@ static void begin_rendering(gdr_renderer *r, VkCommandBuffer cmd)
 }
 
 /* Indirect pipeline: the cull appends VkDrawIndexedIndirectCommands; one indirect-count draw. */
-static void cull_for_indirect(gdr_renderer *r, VkCommandBuffer cmd)
+static void cull_for_indirect(gdr_renderer *r, VkCommandBuffer cmd, VkPipeline cull)
 {
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->cull_pipeline);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, cull);
     if (r->scene.instance_count > 0)
         vkCmdDispatch(cmd, (r->scene.instance_count + GDR_CULL_WORKGROUP_SIZE - 1) / GDR_CULL_WORKGROUP_SIZE, 1, 1);
     memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
@@ -119,26 +133,29 @@ static void cull_for_indirect(gdr_renderer *r, VkCommandBuffer cmd)
                    VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
 }
 
-static void draw_indirect(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer cmd)
+/* `late`: the late phase's draws, which follow the early phase's region of the list. */
+static void draw_indirect(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer cmd, bool late)
 {
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->draw_pipeline);
     VkDeviceSize zero = 0;
     vkCmdBindVertexBuffers(cmd, 0, 1, &r->scene.vertices.buffer, &zero);
     vkCmdBindIndexBuffer(cmd, r->scene.indices.buffer, 0, VK_INDEX_TYPE_UINT32);
-    vkCmdDrawIndexedIndirectCount(cmd, slot->draws.buffer, 0, slot->draw_stats.buffer,
-                                  offsetof(GdrGpuDrawStats, draw_count), r->scene.instance_count,
-                                  sizeof(GdrGpuDrawCommand));
+    vkCmdDrawIndexedIndirectCount(cmd, slot->draws.buffer,
+                                  late ? sizeof(GdrGpuDrawCommand) * (VkDeviceSize)r->scene.instance_count : 0,
+                                  slot->draw_stats.buffer,
+                                  late ? offsetof(GdrGpuDrawStats, late_draw_count) : offsetof(GdrGpuDrawStats, draw_count),
+                                  r->scene.instance_count, sizeof(GdrGpuDrawCommand));
 }
 
 /* Mesh pipeline: the cull appends task commands; the submit pass turns their count into the launch. */
-static void cull_for_mesh(gdr_renderer *r, VkCommandBuffer cmd)
+static void cull_for_mesh(gdr_renderer *r, VkCommandBuffer cmd, VkPipeline cull, VkPipeline submit)
 {
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->cull_tasks_pipeline);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, cull);
     if (r->scene.instance_count > 0)
         vkCmdDispatch(cmd, (r->scene.instance_count + GDR_CULL_WORKGROUP_SIZE - 1) / GDR_CULL_WORKGROUP_SIZE, 1, 1);
     memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
                    VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->task_submit_pipeline);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, submit);
     vkCmdDispatch(cmd, 1, 1, 1);
     memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
                    VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_TASK_SHADER_BIT_EXT |
@@ -147,11 +164,31 @@ static void cull_for_mesh(gdr_renderer *r, VkCommandBuffer cmd)
                        VK_ACCESS_2_TRANSFER_READ_BIT);
 }
 
-static void draw_mesh(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer cmd)
+static void draw_mesh(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer cmd, VkPipeline mesh, bool late)
 {
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->mesh_pipeline);
-    r->ctx->cmd_draw_mesh_tasks_indirect(cmd, slot->draw_stats.buffer, offsetof(GdrGpuDrawStats, task_groups_x), 1,
-                                         sizeof(VkDrawMeshTasksIndirectCommandEXT));
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mesh);
+    r->ctx->cmd_draw_mesh_tasks_indirect(cmd, slot->draw_stats.buffer,
+                                         late ? offsetof(GdrGpuDrawStats, late_task_groups_x)
+                                              : offsetof(GdrGpuDrawStats, task_groups_x),
+                                         1, sizeof(VkDrawMeshTasksIndirectCommandEXT));
+}
+
+/* One phase of a GPU-driven frame: cull, then raster. phase 0: the only one (no occlusion
+ * culling), 1: early, 2: late. */
+static void cull_and_draw(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer cmd, gdr_pipeline pipeline, int phase)
+{
+    if (pipeline == GDR_PIPELINE_INDIRECT)
+        cull_for_indirect(r, cmd, phase ? r->cull_phase_pipelines[phase - 1] : r->cull_pipeline);
+    else if (pipeline == GDR_PIPELINE_MESH)
+        cull_for_mesh(r, cmd, phase ? r->cull_tasks_phase_pipelines[phase - 1] : r->cull_tasks_pipeline,
+                      phase == 2 ? r->task_submit_late_pipeline : r->task_submit_pipeline);
+    timestamp(r, cmd, slot, phase == 2 ? GDR_TS_AFTER_LATE_CULL : GDR_TS_AFTER_CULL);
+    begin_rendering(r, cmd, phase != 2);
+    if (pipeline == GDR_PIPELINE_INDIRECT)
+        draw_indirect(r, slot, cmd, phase == 2);
+    else if (pipeline == GDR_PIPELINE_MESH)
+        draw_mesh(r, slot, cmd, phase ? r->mesh_phase_pipelines[phase - 1] : r->mesh_pipeline, phase == 2);
+    vkCmdEndRendering(cmd);
 }
 
 /* Overdraw view: the fragment shaders counted fragments per pixel; find the maximum, then paint the
@@ -184,12 +221,26 @@ static void overdraw_resolve(gdr_renderer *r, VkCommandBuffer cmd)
     vkCmdEndRendering(cmd);
 }
 
+/* What every frame pipeline expects bound: the push constants and the depth pyramid (set 0). */
+static void bind_frame_state(gdr_renderer *r, VkCommandBuffer cmd, const GdrGpuPushConstants *push)
+{
+    vkCmdPushConstants(cmd, r->layout, VK_SHADER_STAGE_ALL, 0, sizeof *push, push);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->layout, 0, 1, &r->occlusion.set, 0, NULL);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->layout, 0, 1, &r->occlusion.set, 0, NULL);
+}
+
 gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame,
                                        gdr_pipeline pipeline, bool copy_color, double *submit_ms, gdr_error *err)
 {
     VkCommandBuffer cmd = slot->cmd;
     uint32_t update_count = take_updates(r, slot);
-    write_globals(r, slot, frame, pipeline, update_count);
+    /* Occlusion culling (issue 6) with its history when the last frame left a usable one. */
+    bool occlusion = pipeline != GDR_PIPELINE_CPU && frame->cull != GDR_CULL_OFF && frame->occlusion != GDR_CULL_OFF;
+    bool history = occlusion && r->occlusion.history_valid && r->occlusion.history_pipeline == pipeline &&
+                   !frame->occlusion_camera_cut;
+    write_globals(r, slot, frame, pipeline, update_count, occlusion, history);
+    r->occlusion.history_valid = occlusion;
+    r->occlusion.history_pipeline = pipeline;
     GdrGpuPushConstants push = {
         .globals = slot->globals.address,
         .instances = r->scene.instances.address,
@@ -220,7 +271,7 @@ gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, co
     memory_barrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
                    VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
     timestamp(r, cmd, slot, GDR_TS_BEGIN);
-    vkCmdPushConstants(cmd, r->layout, VK_SHADER_STAGE_ALL, 0, sizeof push, &push);
+    bind_frame_state(r, cmd, &push);
 
     /* 1. Instance updates from the ring; counters (and overdraw counts) to zero. */
     if (update_count > 0) {
@@ -237,25 +288,40 @@ gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, co
                    VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
     timestamp(r, cmd, slot, GDR_TS_AFTER_UPDATE);
 
-    /* 2. Culling: on the GPU, or (CPU pipeline) already done before recording. */
-    if (pipeline == GDR_PIPELINE_INDIRECT)
-        cull_for_indirect(r, cmd);
-    else if (pipeline == GDR_PIPELINE_MESH)
-        cull_for_mesh(r, cmd);
-    timestamp(r, cmd, slot, GDR_TS_AFTER_CULL);
-
-    /* 3. Raster. */
-    begin_rendering(r, cmd);
-    if (pipeline == GDR_PIPELINE_INDIRECT)
-        draw_indirect(r, slot, cmd);
-    else if (pipeline == GDR_PIPELINE_MESH)
-        draw_mesh(r, slot, cmd);
-    else
+    /* 2. Culling and raster: on the GPU, or (CPU pipeline) culled before recording. With occlusion
+     * culling: the early phase, the pyramid of its depth, the late phase against it, and the
+     * pyramid of the whole frame for the next one (docs/OCCLUSION.md). */
+    if (pipeline == GDR_PIPELINE_CPU) {
+        timestamp(r, cmd, slot, GDR_TS_AFTER_CULL);
+        begin_rendering(r, cmd, true);
         gdr_cpu_path_record_draws(r, cmd, &push);
-    vkCmdEndRendering(cmd);
+        vkCmdEndRendering(cmd);
+    } else {
+        cull_and_draw(r, slot, cmd, pipeline, occlusion ? 1 : 0);
+    }
+    timestamp(r, cmd, slot, GDR_TS_AFTER_DRAW);
+    if (occlusion) {
+        gdr_occlusion_record_pyramid(r, cmd);
+        bind_frame_state(r, cmd, &push); /* the build bound its own layout */
+        timestamp(r, cmd, slot, GDR_TS_AFTER_PYRAMID);
+        /* The early phase's visibility records and counters before the late phase's culling. */
+        memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | mesh_stages | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                       VK_ACCESS_2_SHADER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | mesh_stages | VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+                       VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT | VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+        cull_and_draw(r, slot, cmd, pipeline, 2);
+    } else {
+        timestamp(r, cmd, slot, GDR_TS_AFTER_PYRAMID);
+        timestamp(r, cmd, slot, GDR_TS_AFTER_LATE_CULL);
+    }
     if (overdraw)
         overdraw_resolve(r, cmd);
-    timestamp(r, cmd, slot, GDR_TS_AFTER_DRAW);
+    timestamp(r, cmd, slot, GDR_TS_AFTER_LATE_DRAW);
+    if (occlusion) {
+        gdr_occlusion_record_pyramid(r, cmd); /* for the next frame's early phase */
+        bind_frame_state(r, cmd, &push);
+    }
+    timestamp(r, cmd, slot, GDR_TS_AFTER_LATE_PYRAMID);
 
     /* 4. Statistics (always) and the image (when asked) for the CPU. */
     memory_barrier(cmd, mesh_stages | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,

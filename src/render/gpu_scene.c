@@ -146,11 +146,15 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
     for (uint32_t i = 0; i < scene->instance_count; i++) {
         tasks += g->cpu_meshes[scene->instances[i].mesh].lod_task_count; /* >= task_count and root_task_count */
         instance_meshlets += g->cpu_meshes[scene->instances[i].mesh].meshlet_count;
+        g->cpu_instances[i].meshlet_visibility_offset = (uint32_t)instance_lod_clusters; /* checked below */
         instance_lod_clusters += g->cpu_meshes[scene->instances[i].mesh].lod_cluster_count;
     }
     g->instance_meshlet_count = instance_meshlets;
     g->instance_lod_cluster_count = instance_lod_clusters;
-    if (status == GDR_OK && tasks > UINT32_MAX / sizeof(GdrGpuTaskCommand))
+    if (status == GDR_OK && instance_lod_clusters > UINT32_MAX)
+        status = gdr_error_set(err, GDR_ERROR_CAPACITY, "scene: %llu clusters over all instances exceed 32-bit indices",
+                               (unsigned long long)instance_lod_clusters);
+    if (status == GDR_OK && tasks > UINT32_MAX / sizeof(GdrGpuTaskCommand) / 2)
         status = gdr_error_set(err, GDR_ERROR_CAPACITY, "scene: %llu task workgroups per frame is too many",
                                (unsigned long long)tasks);
     g->task_capacity = (uint32_t)tasks;
@@ -295,7 +299,7 @@ gdr_status gdr_frame_slots_create(gdr_renderer *r, gdr_error *err)
             status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuInstanceUpdate) * GDR_INSTANCE_UPDATES_PER_FRAME,
                                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GDR_VK_BUFFER_UPLOAD, &slot->updates, err);
         if (status == GDR_OK) /* one command per instance at most: the list cannot overflow */
-            status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuDrawCommand) * (instances ? instances : 1),
+            status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuDrawCommand) * 2 * (instances ? instances : 1),
                                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
                                               VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                           GDR_VK_BUFFER_DEVICE, &slot->draws, err);
@@ -309,7 +313,7 @@ gdr_status gdr_frame_slots_create(gdr_renderer *r, gdr_error *err)
                                           GDR_VK_BUFFER_READBACK, &slot->stats_readback, err);
         if (status == GDR_OK) /* every task workgroup of every instance at most: cannot overflow */
             status = gdr_vk_buffer_create(&r->allocator,
-                                          sizeof(GdrGpuTaskCommand) * (r->scene.task_capacity ? r->scene.task_capacity : 1),
+                                          sizeof(GdrGpuTaskCommand) * 2 * (r->scene.task_capacity ? r->scene.task_capacity : 1),
                                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                           GDR_VK_BUFFER_DEVICE, &slot->tasks, err);
         if (status != GDR_OK)

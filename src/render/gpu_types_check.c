@@ -27,12 +27,12 @@ _Static_assert(offsetof(GdrGpuDrawCommand, vertex_offset) == offsetof(VkDrawInde
                    offsetof(GdrGpuDrawCommand, first_instance) == offsetof(VkDrawIndexedIndirectCommand, firstInstance),
                "GdrGpuDrawCommand offsets");
 _Static_assert(GDR_LOD_STATS_DEPTHS == GDR_LOD_STATS_DEPTH_COUNT, "LOD statistics: shaders and gdr/renderer.h");
-_Static_assert(sizeof(GdrGpuDrawStats) == 64 + 8 * GDR_LOD_STATS_DEPTHS && offsetof(GdrGpuDrawStats, draw_count) == 0 &&
+_Static_assert(sizeof(GdrGpuDrawStats) == 64 + 8 * GDR_LOD_STATS_DEPTHS + 64 && offsetof(GdrGpuDrawStats, draw_count) == 0 &&
                    offsetof(GdrGpuDrawStats, task_groups_x) == 16, "GdrGpuDrawStats");
 _Static_assert(offsetof(GdrGpuDrawStats, task_groups_z) - offsetof(GdrGpuDrawStats, task_groups_x) ==
                    offsetof(VkDrawMeshTasksIndirectCommandEXT, groupCountZ), "the mesh tasks command inside GdrGpuDrawStats");
 _Static_assert(offsetof(GdrGpuFrameGlobals, viewport) == 208, "GdrGpuFrameGlobals.viewport");
-_Static_assert(sizeof(GdrGpuFrameGlobals) == 240 && offsetof(GdrGpuFrameGlobals, frustum) == 128 &&
+_Static_assert(sizeof(GdrGpuFrameGlobals) == 288 && offsetof(GdrGpuFrameGlobals, instance_visibility) == 272 && offsetof(GdrGpuFrameGlobals, frustum) == 128 &&
                    offsetof(GdrGpuFrameGlobals, znear) == 176 && offsetof(GdrGpuFrameGlobals, update_count) == 192,
                "GdrGpuFrameGlobals");
 _Static_assert(sizeof(GdrGpuPushConstants) == 120 && offsetof(GdrGpuPushConstants, updates) == 40 &&

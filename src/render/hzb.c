@@ -58,7 +58,7 @@ static gdr_status create_image(gdr_hzb *hzb, gdr_vk_allocator *allocator, gdr_er
                               .tiling = VK_IMAGE_TILING_OPTIMAL,
                               /* transfer source: tests and debug views read levels back */
                               .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
-                                       VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                                       VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
                               .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED};
     GDR_VK_TRY(err, vkCreateImage(device, &info, NULL, &hzb->image));
     VkMemoryRequirements requirements;

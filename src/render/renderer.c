@@ -5,6 +5,7 @@
 #include <time.h>
 
 #include "render/renderer_internal.h"
+#include "vk/vk_descriptors.h"
 #include "vk/vk_pipeline.h"
 
 double gdr_now_ms(void)
@@ -14,9 +15,43 @@ double gdr_now_ms(void)
     return (double)t.tv_sec * 1e3 + (double)t.tv_nsec * 1e-6;
 }
 
+/* The early and late phases of occlusion culling (issue 6): the culling shaders with their PHASE
+ * constant, and the late phase's launch of its task commands. */
+static gdr_status create_phase_pipelines(gdr_renderer *r, gdr_error *err)
+{
+    gdr_status status = GDR_OK;
+    for (uint32_t phase = 1; phase <= 2 && status == GDR_OK; phase++) {
+        const uint32_t indirect[2] = {0, phase}, tasks[2] = {1, phase};
+        status = gdr_vk_compute_pipeline_create_specialized(r->ctx, r->layout, &gdr_shader_drawcull_comp, indirect, 2,
+                                                            &r->cull_phase_pipelines[phase - 1], err);
+        if (status != GDR_OK || !r->ctx->has_mesh_shader)
+            continue;
+        status = gdr_vk_compute_pipeline_create_specialized(r->ctx, r->layout, &gdr_shader_drawcull_comp, tasks, 2,
+                                                            &r->cull_tasks_phase_pipelines[phase - 1], err);
+        VkSpecializationMapEntry entry = {0, 0, sizeof(uint32_t)};
+        VkSpecializationInfo constants = {1, &entry, sizeof phase, &phase};
+        gdr_vk_graphics_pipeline_desc mesh = {
+            .layout = r->layout, .task_shader = &gdr_shader_meshlet_task, .task_specialization = &constants,
+            .mesh_shader = &gdr_shader_meshlet_mesh, .fragment_shader = &gdr_shader_meshlet_frag,
+            .color_format = GDR_COLOR_FORMAT, .depth_format = GDR_DEPTH_FORMAT, .cull_mode = VK_CULL_MODE_BACK_BIT};
+        if (status == GDR_OK)
+            status = gdr_vk_graphics_pipeline_create(r->ctx, &mesh, &r->mesh_phase_pipelines[phase - 1], err);
+    }
+    if (status == GDR_OK && r->ctx->has_mesh_shader) {
+        const uint32_t late = 1;
+        status = gdr_vk_compute_pipeline_create_specialized(r->ctx, r->layout, &gdr_shader_tasksubmit_comp, &late, 1,
+                                                            &r->task_submit_late_pipeline, err);
+    }
+    return status;
+}
+
 static gdr_status create_pipelines(gdr_renderer *r, gdr_error *err)
 {
-    gdr_status status = gdr_vk_pipeline_layout_create(r->ctx, sizeof(GdrGpuPushConstants), &r->layout, err);
+    /* Every frame pipeline: the push-constant block, and set 0 for the depth pyramid. */
+    gdr_status status = gdr_vk_pipeline_layout_create_with_sets(r->ctx, &r->occlusion.set_layout, 1, VK_SHADER_STAGE_ALL,
+                                                                sizeof(GdrGpuPushConstants), &r->layout, err);
+    if (status == GDR_OK)
+        status = create_phase_pipelines(r, err);
     if (status == GDR_OK)
         status = gdr_vk_compute_pipeline_create(r->ctx, r->layout, &gdr_shader_drawcull_comp, &r->cull_pipeline, err);
     if (status == GDR_OK)
@@ -69,7 +104,8 @@ static gdr_status create_targets(gdr_renderer *r, gdr_error *err)
                                             VK_IMAGE_ASPECT_COLOR_BIT, &r->color, err);
     if (status == GDR_OK)
         status = gdr_vk_image_create(&r->allocator, r->width, r->height, GDR_DEPTH_FORMAT,
-                                     VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT, &r->depth, err);
+                                     VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+                                     VK_IMAGE_ASPECT_DEPTH_BIT, &r->depth, err); /* sampled: the depth pyramid */
     if (status == GDR_OK)
         status = gdr_vk_buffer_create(&r->allocator, (VkDeviceSize)r->width * r->height * 4,
                                       VK_BUFFER_USAGE_TRANSFER_DST_BIT, GDR_VK_BUFFER_READBACK, &r->color_readback, err);
@@ -114,6 +150,8 @@ gdr_status gdr_renderer_create(const gdr_renderer_desc *desc_in, gdr_renderer **
     if (status == GDR_OK)
         status = create_targets(r, err);
     if (status == GDR_OK)
+        status = gdr_occlusion_create(r, err);
+    if (status == GDR_OK)
         status = create_pipelines(r, err);
     if (status != GDR_OK) {
         gdr_renderer_destroy(r);
@@ -140,12 +178,16 @@ void gdr_renderer_destroy(gdr_renderer *r)
         if (r->scatter_pipeline)
             vkDestroyPipeline(device, r->scatter_pipeline, NULL);
         VkPipeline pipelines[] = {r->draw_pipeline, r->cull_tasks_pipeline, r->task_submit_pipeline, r->mesh_pipeline,
-                                  r->overdraw_max_pipeline, r->overdraw_paint_pipeline};
+                                  r->overdraw_max_pipeline, r->overdraw_paint_pipeline, r->cull_phase_pipelines[0],
+                                  r->cull_phase_pipelines[1], r->cull_tasks_phase_pipelines[0],
+                                  r->cull_tasks_phase_pipelines[1], r->mesh_phase_pipelines[0],
+                                  r->mesh_phase_pipelines[1], r->task_submit_late_pipeline};
         for (size_t i = 0; i < sizeof pipelines / sizeof pipelines[0]; i++)
             if (pipelines[i])
                 vkDestroyPipeline(device, pipelines[i], NULL);
         if (r->layout)
             vkDestroyPipelineLayout(device, r->layout, NULL);
+        gdr_occlusion_destroy(r);
         gdr_vk_image_destroy(r->ctx, &r->color);
         gdr_vk_image_destroy(r->ctx, &r->depth);
         gdr_vk_buffer_destroy(r->ctx, &r->color_readback);
@@ -169,6 +211,8 @@ gdr_status gdr_renderer_set_scene(gdr_renderer *r, const gdr_scene *scene, gdr_e
         status = gdr_frame_slots_create(r, err);
     if (status == GDR_OK)
         status = gdr_cpu_path_create(r, scene, err);
+    if (status == GDR_OK)
+        status = gdr_occlusion_scene_create(r, err);
     if (status == GDR_OK)
         r->has_scene = true;
     return status;
@@ -205,7 +249,9 @@ static int compare_double(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-static const char *const pass_names[GDR_TS_COUNT - 1] = {"instance_update", "cull", "draw", "readback"};
+static const char *const pass_names[GDR_TS_COUNT - 1] = {"instance_update", "cull",        "draw",
+                                                         "pyramid",         "late_cull",   "late_draw",
+                                                         "late_pyramid",    "readback"};
 
 const char *gdr_pipeline_name(gdr_pipeline pipeline)
 {
@@ -369,9 +415,22 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
         stats->triangles = last_slot->cpu_triangles;
         stats->cpu_cull_ms_per_frame = r->cpu.cull_ms / frames;
     } else {
-        stats->instances_visible = gpu.draw_count;
-        stats->draws = pipeline == GDR_PIPELINE_MESH ? gpu.task_groups_x * gpu.task_groups_y : gpu.draw_count;
-        stats->draw_calls = 1;
+        bool occlusion = last_slot->occlusion_applied;
+        stats->instances_visible = gpu.draw_count + (occlusion ? gpu.instances_late_drawn : 0);
+        stats->draws = pipeline == GDR_PIPELINE_MESH
+                           ? gpu.task_groups_x * gpu.task_groups_y + gpu.late_task_groups_x * gpu.late_task_groups_y
+                           : gpu.draw_count + gpu.late_draw_count;
+        stats->draw_calls = occlusion ? 2 : 1;
+        stats->occlusion_applied = occlusion;
+        stats->instances_early_drawn = gpu.instances_early_drawn;
+        stats->instances_early_occluded = gpu.instances_early_occluded;
+        stats->instances_late_tested = gpu.instances_late_tested;
+        stats->instances_late_occluded = gpu.instances_late_occluded;
+        stats->instances_late_drawn = gpu.instances_late_drawn;
+        stats->meshlets_early_drawn = gpu.meshlets_early_drawn;
+        stats->meshlets_late_tested = gpu.meshlets_late_tested;
+        stats->meshlets_late_occluded = gpu.meshlets_late_occluded;
+        stats->meshlets_late_drawn = gpu.meshlets_late_drawn;
         stats->triangles = ((uint64_t)gpu.triangles_high << 32) | gpu.triangles_low;
     }
     if (pipeline == GDR_PIPELINE_MESH) {
@@ -382,7 +441,7 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
         stats->meshlets_visible = gpu.meshlets_visible;
         stats->triangles_backface_culled = gpu.triangles_backface_culled;
         stats->triangles_small_culled = gpu.triangles_small_culled;
-        stats->task_workgroups = gpu.task_count;
+        stats->task_workgroups = gpu.task_count + gpu.late_task_count;
         stats->task_overflow = gpu.task_overflow;
         stats->lod_applied = last_slot->lod_applied;
         stats->meshlets_lod_culled = gpu.meshlets_lod_culled;
@@ -442,7 +501,9 @@ gdr_status gdr_renderer_read_visible(gdr_renderer *r, uint32_t *indices, uint32_
     gdr_frame_slot *slot = &r->slots[r->last_slot];
     GdrGpuDrawStats gpu;
     memcpy(&gpu, slot->stats_readback.mapped, sizeof gpu);
-    *count = slot->pipeline == GDR_PIPELINE_CPU ? slot->cpu_visible_count : gpu.draw_count;
+    bool late = slot->occlusion_applied;
+    *count = slot->pipeline == GDR_PIPELINE_CPU ? slot->cpu_visible_count
+                                                : gpu.draw_count + (late ? gpu.instances_late_drawn : 0);
     if (*count > capacity)
         return gdr_error_set(err, GDR_ERROR_CAPACITY, "read_visible: %u visible instances, room for %u", *count,
                              capacity);
@@ -455,25 +516,33 @@ gdr_status gdr_renderer_read_visible(gdr_renderer *r, uint32_t *indices, uint32_
         return GDR_OK;
     gdr_vk_buffer readback = {0};
     gdr_status status;
+    uint32_t n = 0;
     if (slot->pipeline == GDR_PIPELINE_MESH) {
-        /* The task commands: each visible instance's run of commands, in append order. */
-        uint32_t tasks = gpu.task_count < r->scene.task_capacity ? gpu.task_count : r->scene.task_capacity;
-        status = read_device_buffer(r, slot->tasks.buffer, sizeof(GdrGpuTaskCommand) * tasks, &readback, err);
-        uint32_t n = 0;
-        for (uint32_t i = 0; status == GDR_OK && i < tasks; i++) {
-            const GdrGpuTaskCommand *task = (const GdrGpuTaskCommand *)readback.mapped + i;
-            if (task->meshlet_first == r->scene.cpu_meshes[r->scene.cpu_instances[task->instance].mesh].meshlet_offset &&
-                n < *count)
-                indices[n++] = task->instance; /* the instance's first command */
+        /* The task commands, each visible instance's run of commands in append order: the early
+         * (or only) phase's, then those of the late phase for instances it did not draw early. */
+        uint32_t capacity_tasks = r->scene.task_capacity;
+        uint32_t early = gpu.task_count < capacity_tasks ? gpu.task_count : capacity_tasks;
+        uint32_t late_count = late ? (gpu.late_task_count < capacity_tasks ? gpu.late_task_count : capacity_tasks) : 0;
+        status = read_device_buffer(r, slot->tasks.buffer, sizeof(GdrGpuTaskCommand) * 2 * (VkDeviceSize)capacity_tasks,
+                                    &readback, err);
+        const GdrGpuTaskCommand *tasks = readback.mapped;
+        for (uint32_t i = 0; status == GDR_OK && i < early + late_count; i++) {
+            const GdrGpuTaskCommand *task = i < early ? &tasks[i] : &tasks[capacity_tasks + (i - early)];
+            if ((task->flags & GDR_TASK_FIRST) && !(task->flags & GDR_TASK_DRAWN_EARLY) && n < *count)
+                indices[n++] = task->instance;
         }
-        if (status == GDR_OK && n != *count)
-            status = gdr_error_set(err, GDR_ERROR_VULKAN, "read_visible: %u instances counted, %u in the task list",
-                                   *count, n);
     } else {
-        status = read_device_buffer(r, slot->draws.buffer, sizeof(GdrGpuDrawCommand) * *count, &readback, err);
-        for (uint32_t i = 0; status == GDR_OK && i < *count; i++)
-            indices[i] = ((const GdrGpuDrawCommand *)readback.mapped)[i].first_instance;
+        status = read_device_buffer(r, slot->draws.buffer, sizeof(GdrGpuDrawCommand) * 2 * (VkDeviceSize)r->scene.instance_count,
+                                    &readback, err);
+        const GdrGpuDrawCommand *draws = readback.mapped;
+        for (uint32_t i = 0; status == GDR_OK && i < gpu.draw_count && n < *count; i++)
+            indices[n++] = draws[i].first_instance;
+        for (uint32_t i = 0; status == GDR_OK && late && i < gpu.late_draw_count && n < *count; i++)
+            indices[n++] = draws[r->scene.instance_count + i].first_instance;
     }
+    if (status == GDR_OK && n != *count)
+        status = gdr_error_set(err, GDR_ERROR_VULKAN, "read_visible: %u instances counted, %u in the command lists",
+                               *count, n);
     gdr_vk_buffer_destroy(r->ctx, &readback);
     return status;
 }

@@ -3,6 +3,7 @@
 #define GDR_RENDERER_INTERNAL_H
 
 #include "gdr/renderer.h"
+#include "render/occlusion.h"
 #include "shaders/shared/gpu_types.h"
 #include "vk/vk_buffer.h"
 #include "vk/vk_context.h"
@@ -15,6 +16,11 @@ enum gdr_timestamp {
     GDR_TS_AFTER_UPDATE,
     GDR_TS_AFTER_CULL,
     GDR_TS_AFTER_DRAW,
+    /* Occlusion culling's late phase (issue 6); without it these follow each other at once. */
+    GDR_TS_AFTER_PYRAMID,
+    GDR_TS_AFTER_LATE_CULL,
+    GDR_TS_AFTER_LATE_DRAW,
+    GDR_TS_AFTER_LATE_PYRAMID,
     GDR_TS_END,
     GDR_TS_COUNT
 };
@@ -60,12 +66,13 @@ typedef struct gdr_frame_slot {
     bool timestamps_written;
     gdr_vk_buffer globals;       /* GdrGpuFrameGlobals, host-written */
     gdr_vk_buffer updates;       /* GdrGpuInstanceUpdate[GDR_INSTANCE_UPDATES_PER_FRAME], host-written ring slot */
-    gdr_vk_buffer draws;         /* GdrGpuDrawCommand[instance_count] */
+    gdr_vk_buffer draws;         /* GdrGpuDrawCommand[2 * instance_count]: early (or only) phase, late phase */
     gdr_vk_buffer draw_stats;    /* GdrGpuDrawStats, device-local */
     gdr_vk_buffer stats_readback;/* GdrGpuDrawStats copied for the CPU */
-    gdr_vk_buffer tasks;         /* GdrGpuTaskCommand[task_capacity] (meshlet pipeline) */
+    gdr_vk_buffer tasks;         /* GdrGpuTaskCommand[2 * task_capacity]: early (or only) phase, late phase */
     gdr_pipeline pipeline;       /* of the frame last recorded into this slot */
     bool lod_applied;            /* that frame selected a LOD cut (GDR_FRAME_LOD) */
+    bool occlusion_applied;      /* that frame culled in two phases against the depth pyramid */
     /* CPU pipeline: what the CPU decided for the frame last recorded into this slot. */
     uint32_t cpu_visible_count;
     uint64_t cpu_triangles;
@@ -84,6 +91,10 @@ struct gdr_renderer {
     VkPipeline cull_pipeline, scatter_pipeline, draw_pipeline;
     VkPipeline cull_tasks_pipeline, task_submit_pipeline, mesh_pipeline; /* NULL without mesh shaders */
     VkPipeline overdraw_max_pipeline, overdraw_paint_pipeline;
+    /* Two-phase occlusion culling (issue 6): [0] the early phase, [1] the late phase. */
+    VkPipeline cull_phase_pipelines[2], cull_tasks_phase_pipelines[2], mesh_phase_pipelines[2];
+    VkPipeline task_submit_late_pipeline;
+    gdr_occlusion occlusion;
     gdr_vk_buffer overdraw;       /* uint32 per pixel, then the maximum (overdraw view) */
     gdr_vk_buffer visible_meshlets; /* uint32 pairs, one per cluster of every instance; made on first use */
     gdr_cpu_path cpu;
@@ -97,6 +108,7 @@ struct gdr_renderer {
 
 #define GDR_COLOR_FORMAT VK_FORMAT_R8G8B8A8_UNORM
 #define GDR_DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
+#define GDR_CLEAR_COLOR {{0.42f, 0.55f, 0.72f, 1.0f}} /* the background */
 
 gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_error *err);
 void gdr_gpu_scene_destroy(gdr_renderer *r);

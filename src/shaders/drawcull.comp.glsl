@@ -10,9 +10,14 @@
 #include "shared/glsl_buffers.h"
 #include "shared/cull_math.h"
 #include "shared/lod_math.h"
+#include "shared/occlusion_test.h"
 
 layout(local_size_x = GDR_CULL_WORKGROUP_SIZE) in;
 layout(constant_id = 0) const bool EMIT_TASKS = false;
+// Occlusion culling phase (issue 6): none, or the early / late phase of the two-phase scheme.
+layout(constant_id = 1) const uint PHASE = 0u;
+#define PHASE_EARLY 1u
+#define PHASE_LATE 2u
 
 layout(buffer_reference, scalar) writeonly buffer TaskCommandsRef { GdrGpuTaskCommand items[]; };
 
@@ -45,55 +50,103 @@ void append_tasks(GdrGpuFrameGlobals g, bool visible, uint instance, TaskRange r
     uint subgroup_total = subgroupAdd(count);
     uint base = 0u;
     if (subgroupElect() && subgroup_total > 0u)
-        base = atomicAdd(stats.value.task_count, subgroup_total);
+        base = PHASE == PHASE_LATE ? atomicAdd(stats.value.late_task_count, subgroup_total)
+                                   : atomicAdd(stats.value.task_count, subgroup_total);
     base = subgroupBroadcastFirst(base) + subgroupExclusiveAdd(count);
-    TaskCommandsRef tasks = TaskCommandsRef(push.tasks);
+    // The late phase's commands follow the early phase's region (task_capacity entries).
+    TaskCommandsRef tasks = TaskCommandsRef(push.tasks + (PHASE == PHASE_LATE ? uint64_t(g.task_capacity) * 16ul : 0ul));
     for (uint t = 0u; t < count; t++) {
         uint slot = base + t;
         uint first = t * GDR_TASK_WORKGROUP_SIZE;
         if (slot < g.task_capacity)
             tasks.items[slot] = GdrGpuTaskCommand(instance, range.first + first,
-                                                  min(range.count - first, GDR_TASK_WORKGROUP_SIZE), range.flags);
+                                                  min(range.count - first, GDR_TASK_WORKGROUP_SIZE),
+                                                  range.flags | (t == 0u ? GDR_TASK_FIRST : 0u));
         else
             atomicAdd(stats.value.task_overflow, 1u);
     }
 }
 
+// Adds each lane's 0/1 to a counter with one atomic per subgroup.
+#define COUNT(field, condition)                                        \
+    {                                                                  \
+        uint n_ = subgroupAdd((condition) ? 1u : 0u);                  \
+        if (subgroupElect() && n_ > 0u)                                \
+            atomicAdd(stats.value.field, n_);                          \
+    }
+
 void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
+    DrawStatsRef stats = DrawStatsRef(push.draw_stats);
     uint id = gl_GlobalInvocationID.x;
     bool visible = false;
     GdrGpuMesh mesh;
     mat4 model;
+    vec3 center = vec3(0.0);
+    float radius = 0.0;
     if (id < g.instance_count) {
         model = InstancesRef(push.instances).items[id].model;
         mesh = MeshesRef(push.meshes).items[InstancesRef(push.instances).items[id].mesh];
         visible = mesh.index_count > 0u; // nothing to draw otherwise
-        if (visible && g.cull_enabled != 0u) {
-            vec3 center = (g.view * (model * vec4(mesh.bounds.xyz, 1.0))).xyz;
-            float radius = mesh.bounds.w * gdr_max_axis_scale(model[0].xyz, model[1].xyz, model[2].xyz);
+        center = (g.view * (model * vec4(mesh.bounds.xyz, 1.0))).xyz;
+        radius = mesh.bounds.w * gdr_max_axis_scale(model[0].xyz, model[1].xyz, model[2].xyz);
+        if (visible && g.cull_enabled != 0u)
             visible = gdr_sphere_visible(g.frustum, center, radius, g.znear, g.zfar);
-        }
     }
 
-    DrawStatsRef stats = DrawStatsRef(push.draw_stats);
+    // Two-phase occlusion culling (issue 6; seeds 000, 002). Early: what was visible at the end
+    // of the last frame, unless last frame's pyramid hides it. Late: everything in the frustum
+    // against this frame's pyramid (built from the early phase's depth); draws what the early
+    // phase did not, and records what is visible for the next frame.
+    bool drawn_early = false;
+    if (PHASE == PHASE_EARLY && id < g.instance_count) {
+        uint state = VisibilityRef(g.instance_visibility).items[id];
+        bool candidate = visible && (g.flags & GDR_FRAME_HISTORY) != 0u && (state & GDR_INSTANCE_VISIBLE_LAST_FRAME) != 0u;
+        bool occluded = candidate && gdr_sphere_occluded(g, center, radius);
+        COUNT(instances_early_occluded, occluded);
+        visible = candidate && !occluded;
+        COUNT(instances_early_drawn, visible);
+        VisibilityRef(g.instance_visibility).items[id] = (state & GDR_INSTANCE_VISIBLE_LAST_FRAME) |
+                                                         (visible ? GDR_INSTANCE_DRAWN_EARLY : 0u);
+    } else if (PHASE == PHASE_LATE && id < g.instance_count) {
+        uint state = VisibilityRef(g.instance_visibility).items[id];
+        drawn_early = (state & GDR_INSTANCE_DRAWN_EARLY) != 0u;
+        COUNT(instances_late_tested, visible);
+        bool occluded = visible && gdr_sphere_occluded(g, center, radius);
+        COUNT(instances_late_occluded, occluded);
+        visible = visible && !occluded;
+        VisibilityRef(g.instance_visibility).items[id] = visible ? GDR_INSTANCE_VISIBLE_LAST_FRAME : 0u;
+        // The meshlet pipeline goes on testing the clusters of instances drawn early (those not
+        // drawn early may be visible now); the indirect pipeline has drawn them whole.
+        if (!EMIT_TASKS)
+            visible = visible && !drawn_early;
+        COUNT(instances_late_drawn, visible && !drawn_early);
+    }
+
     uvec4 ballot = subgroupBallot(visible);
     uint subgroup_count = subgroupBallotBitCount(ballot);
     // The meshlet pipeline counts the triangles its mesh shader emits instead.
     uint triangles = EMIT_TASKS ? 0u : subgroupAdd(visible ? mesh.index_count / 3u : 0u);
     uint base = 0u;
     if (subgroupElect() && subgroup_count > 0u) {
-        base = atomicAdd(stats.value.draw_count, subgroup_count);
+        if (PHASE == PHASE_LATE)
+            base = atomicAdd(stats.value.late_draw_count, subgroup_count);
+        else
+            base = atomicAdd(stats.value.draw_count, subgroup_count);
         uint old = atomicAdd(stats.value.triangles_low, triangles);
         if (old + triangles < old)
             atomicAdd(stats.value.triangles_high, 1u);
     }
     base = subgroupBroadcastFirst(base);
     if (EMIT_TASKS) {
-        append_tasks(g, visible, id, visible ? task_range(g, mesh, model) : TaskRange(0u, 0u, 0u, 0u));
+        TaskRange range = visible ? task_range(g, mesh, model) : TaskRange(0u, 0u, 0u, 0u);
+        if (drawn_early)
+            range.flags |= GDR_TASK_DRAWN_EARLY;
+        append_tasks(g, visible, id, range);
     } else if (visible) {
-        uint slot = base + subgroupBallotExclusiveBitCount(ballot);
+        // The late phase's draws follow the early phase's region (instance_count entries).
+        uint slot = base + subgroupBallotExclusiveBitCount(ballot) + (PHASE == PHASE_LATE ? g.instance_count : 0u);
         DrawCommandsRef(push.draws).items[slot] =
             GdrGpuDrawCommand(mesh.index_count, 1u, mesh.first_index, int(mesh.vertex_offset), id);
     }

@@ -68,7 +68,8 @@ gdr_status gdr_vk_graphics_pipeline_create(gdr_vk_context *ctx, const gdr_vk_gra
         if (!wanted[i].code)
             continue;
         stages[stage_count] = (VkPipelineShaderStageCreateInfo){
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = wanted[i].stage, .pName = "main"};
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = wanted[i].stage, .pName = "main",
+            .pSpecializationInfo = i == 0 ? desc->task_specialization : NULL};
         status = create_module(ctx, wanted[i].code, &stages[stage_count].module, err);
         if (status == GDR_OK)
             stage_count++;

@@ -19,6 +19,7 @@ typedef struct gdr_vk_graphics_pipeline_desc {
     VkPipelineLayout layout;
     const gdr_spirv *vertex_shader; /* or: */
     const gdr_spirv *task_shader;   /* optional, with mesh_shader */
+    const VkSpecializationInfo *task_specialization; /* optional: the task shader's constants */
     const gdr_spirv *mesh_shader;   /* replaces the vertex stage (VK_EXT_mesh_shader) */
     const gdr_spirv *fragment_shader;
     const VkVertexInputBindingDescription *vertex_binding; /* NULL: no vertex input */

@@ -14,6 +14,7 @@ layout(buffer_reference, scalar) readonly buffer MeshesRef { GdrGpuMesh items[];
 layout(buffer_reference, scalar) writeonly buffer DrawCommandsRef { GdrGpuDrawCommand items[]; };
 layout(buffer_reference, scalar) buffer DrawStatsRef { GdrGpuDrawStats value; };
 layout(buffer_reference, scalar) readonly buffer InstanceUpdatesRef { GdrGpuInstanceUpdate items[]; };
+layout(buffer_reference, scalar) buffer VisibilityRef { uint items[]; }; // occlusion culling's history (issue 6)
 
 layout(push_constant, scalar) uniform PushConstantBlock { GdrGpuPushConstants push; };
 

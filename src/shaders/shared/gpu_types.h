@@ -5,6 +5,7 @@
 
 #include "glsl_c_bridge.h"
 #include "gpu_config.h"
+#include "occlusion_math.h"
 
 /* One vertex of the geometry pool (vertex input binding 0). */
 GDR_STRUCT_BEGIN(GdrGpuVertex)
@@ -76,6 +77,8 @@ GDR_STRUCT_BEGIN(GdrGpuTaskCommand)
 GDR_STRUCT_END(GdrGpuTaskCommand)
 
 #define GDR_TASK_LOD_ACCEPTED 1u /* the root shortcut chose these clusters: no LOD test */
+#define GDR_TASK_DRAWN_EARLY 2u  /* late phase (issue 6): the instance was drawn in the early phase */
+#define GDR_TASK_FIRST 4u        /* the first command of its instance (for read-backs) */
 #define GDR_GPU_NO_GROUP 0xffffffffu
 
 /* One instance of the persistent instance buffer. */
@@ -84,7 +87,7 @@ GDR_STRUCT_BEGIN(GdrGpuInstance)
     gdr_vec4 color;
     gdr_uint mesh;
     gdr_uint flags;
-    gdr_uint reserved0;
+    gdr_uint meshlet_visibility_offset; /* first bit of this instance's clusters in the cluster visibility bits */
     gdr_uint reserved1;
 GDR_STRUCT_END(GdrGpuInstance)
 
@@ -129,6 +132,24 @@ GDR_STRUCT_BEGIN(GdrGpuDrawStats)
     gdr_uint meshlets_lod_culled;    /* not in the LOD cut */
     gdr_uint lod_clusters[GDR_LOD_STATS_DEPTHS];  /* clusters drawn per DAG depth (last: that depth or more) */
     gdr_uint lod_triangles[GDR_LOD_STATS_DEPTHS]; /* their triangles, before triangle culling */
+    /* Two-phase occlusion culling (issue 6). The late phase appends its draws and task commands
+     * after the early phase's region of those buffers and launches them with its own commands. */
+    gdr_uint late_draw_count;
+    gdr_uint late_task_count;
+    gdr_uint late_task_groups_x; /* VkDrawMeshTasksIndirectCommandEXT of the late phase */
+    gdr_uint late_task_groups_y;
+    gdr_uint late_task_groups_z;
+    gdr_uint instances_early_drawn;    /* visible last frame, in the frustum, not behind last frame's pyramid */
+    gdr_uint instances_early_occluded; /* visible last frame, in the frustum, behind last frame's pyramid */
+    gdr_uint instances_late_tested;    /* in the frustum, tested against this frame's pyramid */
+    gdr_uint instances_late_occluded;
+    gdr_uint instances_late_drawn;     /* visible and not drawn early */
+    gdr_uint meshlets_early_drawn;
+    gdr_uint meshlets_late_tested;     /* clusters that passed the other tests, late phase */
+    gdr_uint meshlets_late_occluded;
+    gdr_uint meshlets_late_drawn;      /* visible and not drawn early */
+    gdr_uint reserved_occlusion0;
+    gdr_uint reserved_occlusion1;
 GDR_STRUCT_END(GdrGpuDrawStats)
 
 /* Per-frame constants, written by the CPU into its frame's slot. */
@@ -153,6 +174,9 @@ GDR_STRUCT_BEGIN(GdrGpuFrameGlobals)
     gdr_uint reserved0;
     gdr_uint reserved1;
     gdr_uint reserved2;
+    GdrOcclusionParams occlusion; /* GDR_FRAME_OCCLUSION: the camera and the depth pyramid */
+    gdr_uint64 instance_visibility; /* uint[] per instance: GDR_INSTANCE_VISIBLE_* bits */
+    gdr_uint64 meshlet_visibility;  /* uint[] of bits, one per cluster of every instance */
 GDR_STRUCT_END(GdrGpuFrameGlobals)
 
 #define GDR_FRAME_MESHLET_FRUSTUM 1u  /* task shader: cluster sphere vs frustum */
@@ -161,6 +185,11 @@ GDR_STRUCT_END(GdrGpuFrameGlobals)
 #define GDR_FRAME_RECORD_MESHLETS 8u  /* task shader: append (instance, cluster) of every visible cluster */
 #define GDR_FRAME_LOD 16u             /* task shader: the LOD cut over every cluster of the DAG */
 #define GDR_FRAME_LOD_DEPTH 32u       /* with GDR_FRAME_LOD: the discrete cut at depth lod_depth */
+#define GDR_FRAME_OCCLUSION 64u       /* two-phase occlusion culling against the depth pyramid (issue 6) */
+#define GDR_FRAME_HISTORY 128u        /* with GDR_FRAME_OCCLUSION: last frame's visibility and pyramid are usable */
+
+#define GDR_INSTANCE_VISIBLE_LAST_FRAME 1u /* drawn and not occluded at the end of the last frame */
+#define GDR_INSTANCE_DRAWN_EARLY 2u        /* drawn by this frame's early phase */
 
 #define GDR_VIEW_SHADED 0u
 #define GDR_VIEW_MESHLETS 1u  /* colour from a hash of the cluster's global index */
