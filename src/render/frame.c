@@ -281,11 +281,14 @@ gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, co
     vkCmdFillBuffer(cmd, slot->draw_stats.buffer, 0, VK_WHOLE_SIZE, 0);
     if (overdraw)
         vkCmdFillBuffer(cmd, r->overdraw.buffer, 0, VK_WHOLE_SIZE, 0);
-    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_CLEAR_BIT,
+    /* (vkCmdFillBuffer is a transfer: COPY or CLEAR stage depending on the implementation.) */
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
                    VK_ACCESS_2_SHADER_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT,
                    VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT | mesh_stages |
-                       VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
-                   VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT | VK_ACCESS_2_TRANSFER_READ_BIT);
+                       VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT |
+                       VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+                   VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT | VK_ACCESS_2_TRANSFER_READ_BIT |
+                       VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
     timestamp(r, cmd, slot, GDR_TS_AFTER_UPDATE);
 
     /* 2. Culling and raster: on the GPU, or (CPU pipeline) culled before recording. With occlusion
