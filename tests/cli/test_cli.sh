@@ -46,12 +46,28 @@ for key in meshlets_total meshlets_frustum_culled meshlets_cone_culled meshlets_
     "$gdr" render demo:instances=50 $small --pipeline mesh --stats "$work/m.json" >/dev/null 2>&1
     grep -q "\"$key\"" "$work/m.json" || { echo "FAIL: mesh stats JSON lacks $key"; failures=$((failures + 1)); }
 done
-for view in shaded meshlets instances triangles overdraw; do
+for view in shaded meshlets instances triangles overdraw lod; do
     # shellcheck disable=SC2086
     expect 0 "view $view" "$gdr" render demo:instances=50 $small --view $view --validate --out "$work/v.png"
 done
 # shellcheck disable=SC2086
 expect 0 "single culling levels off" "$gdr" render demo:instances=50 $small --pipeline mesh --cone-cull off --triangle-cull off --meshlet-cull off --validate
+# shellcheck disable=SC2086
+{
+expect 0 "lod error and depth" "$gdr" render demo:instances=50 $small --lod-error 4 --validate
+grep -q '^lod_depths' "$work/stdout" || { echo "FAIL: render printed no lod_depths"; failures=$((failures + 1)); }
+expect 0 "lod depth" "$gdr" render demo:instances=50 $small --lod-depth 2 --validate
+expect 0 "occlusion on" "$gdr" render occlusion $small --occlusion on --frames 3 --validate
+grep -q '^occlusion late' "$work/stdout" || { echo "FAIL: render printed no occlusion statistics"; failures=$((failures + 1)); }
+expect 0 "occlusion off" "$gdr" render occlusion $small --occlusion off --pipeline indirect --validate
+grep -q '^occlusion' "$work/stdout" && { echo "FAIL: occlusion statistics with occlusion off"; failures=$((failures + 1)); }
+expect 0 "bench, lod and occlusion side by side" "$gdr" bench --scene demo:instances=30 --lod-errors 0,2 --occlusion on,off --frames 2 --width 64 --height 48 --validate
+expect 2 "lod error negative" "$gdr" render demo --lod-error -1
+expect 2 "lod error not a number" "$gdr" render demo --lod-error 1px
+expect 2 "lod depth too deep" "$gdr" render demo --lod-depth 65
+expect 2 "occlusion maybe" "$gdr" render demo --occlusion maybe
+expect 2 "view unknown" "$gdr" render demo --view depth
+}
 # shellcheck disable=SC2086
 expect 0 "bench, three pipelines" "$gdr" bench --sizes 20 --pipelines cpu,indirect,mesh --frames 2 --width 64 --height 48 --validate
 

@@ -62,6 +62,8 @@ int gdr_cmd_bench(int argc, char **argv)
     const char *device = NULL, *json_path = NULL, *scene_spec = NULL;
     float lod_errors[MAX_LOD_ERRORS] = {1.0f};
     uint32_t lod_error_count = 1;
+    bool occlusion_modes[2] = {true, false};
+    uint32_t occlusion_count = 1;
     bool validate = false, has_camera = false;
     gdr_pipeline pipelines[3] = {GDR_PIPELINE_DEFAULT};
     uint32_t pipeline_count = 1;
@@ -94,6 +96,14 @@ int gdr_cmd_bench(int argc, char **argv)
             scene_spec = value;
         else if (strcmp(arg, "--lod-errors") == 0)
             ok = parse_lod_errors(value, lod_errors, &lod_error_count);
+        else if (strcmp(arg, "--occlusion") == 0) {
+            /* on, off, or both side by side */
+            occlusion_count = strcmp(value, "on,off") == 0 || strcmp(value, "off,on") == 0 ? 2 : 1;
+            if (occlusion_count == 2)
+                occlusion_modes[0] = value[1] == 'n', occlusion_modes[1] = !occlusion_modes[0];
+            else
+                ok = cli_parse_on_off(arg, value, &occlusion_modes[0]);
+        }
         else if (strcmp(arg, "--pipelines") == 0) {
             char list[64];
             snprintf(list, sizeof list, "%s", value);
@@ -118,7 +128,8 @@ int gdr_cmd_bench(int argc, char **argv)
     cJSON *rows = cJSON_CreateArray();
     if (scene_spec)
         size_count = 1; /* the one scene given */
-    printf("%10s %9s %7s %10s %12s %10s %10s %10s %10s %10s %10s %10s %10s\n", "instances", "pipeline", "lod_px", "visible",
+    printf("%10s %9s %7s %4s %10s %12s %10s %10s %10s %10s %10s %10s %10s %10s\n", "instances", "pipeline", "lod_px", "occl",
+           "visible",
            "triangles", "meshlets", "cpu_ms", "cpu_median", "submit_ms", "gpu_update", "gpu_cull", "gpu_draw",
            "gpu_frame");
     double first_cpu = 0.0;
@@ -138,11 +149,13 @@ int gdr_cmd_bench(int argc, char **argv)
             result = 1;
         }
         /* Every pipeline and LOD threshold on the same scene, renderer and camera, one after the other. */
-        for (uint32_t run = 0; run < pipeline_count * lod_error_count && result == 0; run++) {
-            uint32_t p = run / lod_error_count;
+        for (uint32_t run = 0; run < pipeline_count * lod_error_count * occlusion_count && result == 0; run++) {
+            uint32_t p = run / (lod_error_count * occlusion_count);
+            bool occlusion = occlusion_modes[run % occlusion_count];
             gdr_camera camera = scene->camera_count > 0 ? scene->cameras[0] : gdr_scene_framing_camera(scene);
             gdr_frame_desc frame = {.camera = camera, .cull = GDR_CULL_ON, .pipeline = pipelines[p],
-                                    .lod_error_px = lod_errors[run % lod_error_count]};
+                                    .lod_error_px = lod_errors[run / occlusion_count % lod_error_count],
+                                    .occlusion = occlusion ? GDR_CULL_ON : GDR_CULL_OFF};
             if (has_camera) {
                 frame.camera.position = camera_position;
                 frame.camera.rotation = camera_rotation;
@@ -156,9 +169,10 @@ int gdr_cmd_bench(int argc, char **argv)
             }
             if (s == 0 && run == 0)
                 first_cpu = stats.cpu_ms_per_frame_median;
-            printf("%10u %9s %7.2f %10u %12llu %10u %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f\n",
+            printf("%10u %9s %7.2f %4s %10u %12llu %10u %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f\n",
                    stats.instances_total, gdr_pipeline_name(stats.pipeline),
-                   stats.lod_applied ? (double)frame.lod_error_px : 0.0, stats.instances_visible,
+                   stats.lod_applied ? (double)frame.lod_error_px : 0.0, stats.occlusion_applied ? "on" : "off",
+                   stats.instances_visible,
                    (unsigned long long)stats.triangles,
                    stats.meshlets_visible, stats.cpu_ms_per_frame, stats.cpu_ms_per_frame_median,
                    stats.cpu_submit_ms_per_frame, stats.passes[0].gpu_ms, stats.passes[1].gpu_ms, stats.passes[2].gpu_ms,
@@ -171,6 +185,7 @@ int gdr_cmd_bench(int argc, char **argv)
             cJSON_AddNumberToObject(row, "draw_calls", stats.draw_calls);
             cJSON_AddNumberToObject(row, "cpu_cull_ms_per_frame", stats.cpu_cull_ms_per_frame);
             stats_add_meshlet_json(row, &stats);
+            stats_add_occlusion_json(row, &stats);
             cJSON_AddNumberToObject(row, "instances_total", stats.instances_total);
             cJSON_AddNumberToObject(row, "instances_visible", stats.instances_visible);
             cJSON_AddNumberToObject(row, "triangles", (double)stats.triangles);

@@ -40,6 +40,13 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
     } else {
         fprintf(out, "draws               %u (in %u indirect draw call)\n", s->draws, s->draw_calls);
     }
+    if (s->occlusion_applied) {
+        fprintf(out, "occlusion early     instances %u drawn, %u occluded (by last frame's pyramid); clusters %u drawn\n",
+                s->instances_early_drawn, s->instances_early_occluded, s->meshlets_early_drawn);
+        fprintf(out, "occlusion late      instances %u tested, %u occluded, %u drawn; clusters %u tested, %u occluded, "
+                "%u drawn\n", s->instances_late_tested, s->instances_late_occluded, s->instances_late_drawn,
+                s->meshlets_late_tested, s->meshlets_late_occluded, s->meshlets_late_drawn);
+    }
     fprintf(out, "cpu_ms_per_frame    %.4f (of which vkQueueSubmit2 %.4f)\n", s->cpu_ms_per_frame,
             s->cpu_submit_ms_per_frame);
     fprintf(out, "gpu_ms_per_frame    %.4f\n", s->gpu_ms_per_frame);
@@ -65,6 +72,22 @@ void stats_add_meshlet_json(cJSON *object, const gdr_frame_stats *s)
         cJSON_AddItemToArray(clusters, cJSON_CreateNumber(s->lod_clusters_per_depth[d]));
         cJSON_AddItemToArray(triangles, cJSON_CreateNumber((double)s->lod_triangles_per_depth[d]));
     }
+}
+
+void stats_add_occlusion_json(cJSON *object, const gdr_frame_stats *s)
+{
+    cJSON_AddBoolToObject(object, "occlusion_applied", s->occlusion_applied);
+    if (!s->occlusion_applied)
+        return;
+    cJSON_AddNumberToObject(object, "instances_early_drawn", s->instances_early_drawn);
+    cJSON_AddNumberToObject(object, "instances_early_occluded", s->instances_early_occluded);
+    cJSON_AddNumberToObject(object, "instances_late_tested", s->instances_late_tested);
+    cJSON_AddNumberToObject(object, "instances_late_occluded", s->instances_late_occluded);
+    cJSON_AddNumberToObject(object, "instances_late_drawn", s->instances_late_drawn);
+    cJSON_AddNumberToObject(object, "meshlets_early_drawn", s->meshlets_early_drawn);
+    cJSON_AddNumberToObject(object, "meshlets_late_tested", s->meshlets_late_tested);
+    cJSON_AddNumberToObject(object, "meshlets_late_occluded", s->meshlets_late_occluded);
+    cJSON_AddNumberToObject(object, "meshlets_late_drawn", s->meshlets_late_drawn);
 }
 
 char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
@@ -94,6 +117,7 @@ char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
     }
     if (s->pipeline == GDR_PIPELINE_CPU)
         cJSON_AddNumberToObject(root, "cpu_cull_ms_per_frame", s->cpu_cull_ms_per_frame);
+    stats_add_occlusion_json(root, s);
     cJSON_AddNumberToObject(root, "cpu_ms_per_frame", s->cpu_ms_per_frame);
     cJSON_AddNumberToObject(root, "cpu_submit_ms_per_frame", s->cpu_submit_ms_per_frame);
     cJSON_AddNumberToObject(root, "cpu_ms_per_frame_median", s->cpu_ms_per_frame_median);
