@@ -27,6 +27,7 @@ typedef struct gdr_renderer_desc {
      * long GPU frame wakes up slower, which would make CPU timings depend on the GPU's load. */
     bool busy_wait;
     bool disable_mesh_shaders; /* behave as a device without VK_EXT_mesh_shader (tests the fallback) */
+    bool disable_visibility_buffer; /* behave as a device without 64-bit buffer atomics (issue 8) */
 } gdr_renderer_desc;
 
 typedef enum gdr_cull_mode {
@@ -54,6 +55,23 @@ typedef enum gdr_view {
     GDR_VIEW_MODE_LOD,       /* each cluster in the colour of its LOD DAG depth (mesh pipeline) */
 } gdr_view;
 
+/* How the mesh pipeline rasterises (issue 8). The visibility-buffer modes (HYBRID, HW, SW) write
+ * one 64-bit (depth, cluster, triangle) value per pixel with atomics, then one full-screen pass
+ * shades it; they need 64-bit buffer atomics (shaderBufferInt64Atomics). */
+typedef enum gdr_raster {
+    GDR_RASTER_DEFAULT = 0, /* HYBRID where the device has 64-bit buffer atomics, else FORWARD */
+    GDR_RASTER_HYBRID,      /* clusters whose triangles are smaller than sw_threshold_px on screen go to
+                               the compute rasteriser, the rest to the mesh shaders */
+    GDR_RASTER_HW,          /* every cluster through the mesh shaders, into the visibility buffer */
+    GDR_RASTER_SW,          /* every cluster through the compute rasteriser, except those crossing the
+                               near or far plane (which it cannot clip): the mesh shaders take them */
+    GDR_RASTER_FORWARD,     /* no visibility buffer: the mesh shaders' fragments are shaded (issue 4) */
+} gdr_raster;
+
+/* The hybrid threshold when gdr_frame_desc.sw_threshold_px is 0 (docs/PIPELINE.md says how it was
+ * chosen). */
+#define GDR_DEFAULT_SW_THRESHOLD_PX 8.0f
+
 typedef struct gdr_frame_desc {
     gdr_camera camera;  /* aspect 0: width / height; zfar 0: infinite reverse-Z projection */
     gdr_cull_mode cull; /* OFF: nothing is culled at any level (instances, clusters, triangles) */
@@ -67,6 +85,11 @@ typedef struct gdr_frame_desc {
     /* Mesh pipeline: keep the list of clusters the task shaders passed, for
      * gdr_renderer_read_visible_meshlets (tests, tools; costs an append per cluster). */
     bool record_visible_meshlets;
+    /* Mesh pipeline: the rasteriser (issue 8), and for HYBRID the projected triangle size in pixels
+     * below which a cluster goes to the compute rasteriser (0: GDR_DEFAULT_SW_THRESHOLD_PX). Other
+     * pipelines draw forward; asking them for HYBRID, HW or SW is an error. */
+    gdr_raster raster;
+    float sw_threshold_px;
     /* Mesh pipeline, meshes with a LOD DAG (issue 5; gdr/geometry.h "The cut"): the clusters drawn
      * are the cut whose projected error is within lod_error_px pixels (0, the default: full detail,
      * level 0), or with lod_fixed_depth the discrete cut at DAG depth lod_depth (0: level 0). The
@@ -88,6 +111,9 @@ GDR_API const char *gdr_view_name(gdr_view view);
 
 /* "mesh", "indirect" or "cpu". */
 GDR_API const char *gdr_pipeline_name(gdr_pipeline pipeline);
+
+/* "default", "hybrid", "hw", "sw" or "forward". */
+GDR_API const char *gdr_raster_name(gdr_raster raster);
 
 #define GDR_MAX_PASSES 8
 #define GDR_LOD_STATS_DEPTH_COUNT 32 /* = GDR_LOD_STATS_DEPTHS of the shaders */
@@ -128,6 +154,18 @@ typedef struct gdr_frame_stats {
     uint32_t task_workgroups;
     uint32_t task_overflow;               /* task commands lost for want of room: always 0 (sized from the scene) */
     uint32_t overdraw_max;                /* overdraw view: the most fragments one pixel received */
+    /* Rasterisation (issue 8): the path that rasterised (never DEFAULT; FORWARD off the mesh
+     * pipeline) and why; the threshold HYBRID used; the last frame's visible clusters and their
+     * triangles (before back-face culling) per rasteriser; the GPU time of the mesh-shader pass, of
+     * the compute rasteriser (with its submit pass) and of the resolve, means over the frames (the
+     * three are part of the "draw" pass). */
+    gdr_raster raster;
+    char raster_reason[128];
+    float sw_threshold_px;
+    uint32_t raster_sw_clusters, raster_hw_clusters;
+    uint64_t raster_sw_triangles, raster_hw_triangles;
+    uint32_t raster_overflow;             /* clusters lost for want of room in the list: always 0 */
+    double raster_hw_ms, raster_sw_ms, raster_resolve_ms;
     /* The LOD cut (mesh pipeline), last frame: whether it was applied, the clusters it left out,
      * and the clusters and triangles drawn per DAG depth (the last entry: that depth or deeper;
      * triangles before triangle culling). */

@@ -183,6 +183,13 @@ static void cull_and_draw(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer
         cull_for_mesh(r, cmd, phase ? r->cull_tasks_phase_pipelines[phase - 1] : r->cull_tasks_pipeline,
                       phase == 2 ? r->task_submit_late_pipeline : r->task_submit_pipeline);
     timestamp(r, cmd, slot, phase == 2 ? GDR_TS_AFTER_LATE_CULL : GDR_TS_AFTER_CULL);
+    if (pipeline == GDR_PIPELINE_MESH && r->vis.slot_mode[slot - r->slots] != GDR_GPU_RASTER_FORWARD) {
+        /* issue 8: the visibility buffer, then the resolve */
+        gdr_visbuffer_record_raster(r, slot, cmd, phase,
+                                    phase == 2 ? offsetof(GdrGpuDrawStats, late_task_groups_x)
+                                               : offsetof(GdrGpuDrawStats, task_groups_x));
+        return;
+    }
     begin_rendering(r, cmd, phase != 2);
     if (pipeline == GDR_PIPELINE_INDIRECT)
         draw_indirect(r, slot, cmd, phase == 2);
@@ -255,6 +262,8 @@ gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, co
         .tasks = slot->tasks.address,
         .overdraw = r->overdraw.address,
         .visible_meshlets = r->visible_meshlets.address,
+        .visbuffer = r->vis.pixels.address,
+        .raster = r->vis.params[slot - r->slots].address,
     };
     bool overdraw = frame->view == GDR_VIEW_MODE_OVERDRAW;
     /* Task and mesh stages may only be named where the device has them enabled. */
@@ -281,6 +290,8 @@ gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, co
     vkCmdFillBuffer(cmd, slot->draw_stats.buffer, 0, VK_WHOLE_SIZE, 0);
     if (overdraw)
         vkCmdFillBuffer(cmd, r->overdraw.buffer, 0, VK_WHOLE_SIZE, 0);
+    gdr_visbuffer_begin_frame(r, (uint32_t)(slot - r->slots), frame,
+                              pipeline == GDR_PIPELINE_MESH ? r->vis.mode : GDR_GPU_RASTER_FORWARD, cmd);
     /* (vkCmdFillBuffer is a transfer: COPY or CLEAR stage depending on the implementation.) */
     memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
                    VK_ACCESS_2_SHADER_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT,
@@ -331,6 +342,7 @@ gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, co
                    VK_ACCESS_2_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
     VkBufferCopy stats_copy = {0, 0, sizeof(GdrGpuDrawStats)};
     vkCmdCopyBuffer(cmd, slot->draw_stats.buffer, slot->stats_readback.buffer, 1, &stats_copy);
+    gdr_visbuffer_record_readback(r, (uint32_t)(slot - r->slots), cmd);
     if (copy_color) {
         gdr_vk_image_barrier(cmd, r->color.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                              VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,

@@ -104,7 +104,8 @@ static gdr_status create_targets(gdr_renderer *r, gdr_error *err)
                                             VK_IMAGE_ASPECT_COLOR_BIT, &r->color, err);
     if (status == GDR_OK)
         status = gdr_vk_image_create(&r->allocator, r->width, r->height, GDR_DEPTH_FORMAT,
-                                     VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+                                     VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                                         VK_IMAGE_USAGE_TRANSFER_SRC_BIT, /* tests read it back */
                                      VK_IMAGE_ASPECT_DEPTH_BIT, &r->depth, err); /* sampled: the depth pyramid */
     if (status == GDR_OK)
         status = gdr_vk_buffer_create(&r->allocator, (VkDeviceSize)r->width * r->height * 4,
@@ -153,6 +154,8 @@ gdr_status gdr_renderer_create(const gdr_renderer_desc *desc_in, gdr_renderer **
         status = gdr_occlusion_create(r, err);
     if (status == GDR_OK)
         status = create_pipelines(r, err);
+    if (status == GDR_OK)
+        status = gdr_visbuffer_create(r, desc.disable_visibility_buffer, err);
     if (status != GDR_OK) {
         gdr_renderer_destroy(r);
         return status;
@@ -170,6 +173,7 @@ void gdr_renderer_destroy(gdr_renderer *r)
         gdr_frame_slots_destroy(r);
         gdr_gpu_scene_destroy(r);
         gdr_cpu_path_destroy(r);
+        gdr_visbuffer_destroy(r);
         VkDevice device = r->ctx->device;
         if (r->timestamps)
             vkDestroyQueryPool(device, r->timestamps, NULL);
@@ -211,6 +215,8 @@ gdr_status gdr_renderer_set_scene(gdr_renderer *r, const gdr_scene *scene, gdr_e
         status = gdr_frame_slots_create(r, err);
     if (status == GDR_OK)
         status = gdr_cpu_path_create(r, scene, err);
+    if (status == GDR_OK)
+        status = gdr_visbuffer_set_scene(r, err);
     if (status == GDR_OK)
         status = gdr_occlusion_scene_create(r, err);
     if (status == GDR_OK)
@@ -261,6 +267,12 @@ const char *gdr_pipeline_name(gdr_pipeline pipeline)
     case GDR_PIPELINE_CPU: return "cpu";
     default: return "default";
     }
+}
+
+const char *gdr_raster_name(gdr_raster raster)
+{
+    static const char *const names[] = {"default", "hybrid", "hw", "sw", "forward"};
+    return (unsigned)raster < sizeof names / sizeof names[0] ? names[raster] : "unknown";
 }
 
 const char *gdr_view_name(gdr_view view)
@@ -325,8 +337,11 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
     gdr_pipeline pipeline = GDR_PIPELINE_INDIRECT;
     char reason[160] = "";
     gdr_status resolved = resolve_pipeline(r, frame, &pipeline, reason, sizeof reason, err);
+    if (resolved == GDR_OK)
+        resolved = gdr_visbuffer_resolve_mode(r, frame, pipeline, &r->vis.mode, r->vis.reason, sizeof r->vis.reason, err);
     if (resolved != GDR_OK)
         return resolved;
+    gdr_visbuffer_begin_render(r);
     r->cpu.cull_ms = 0.0;
     if (frame->record_visible_meshlets && !r->visible_meshlets.buffer) {
         /* Every cluster of every instance's DAG at most: cannot overflow. */
@@ -408,6 +423,8 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
     stats->instances_total = r->scene.instance_count;
     stats->pipeline = pipeline;
     snprintf(stats->pipeline_reason, sizeof stats->pipeline_reason, "%s", reason);
+    gdr_visbuffer_stats(r, (uint32_t)r->last_slot, stats);
+    snprintf(stats->raster_reason, sizeof stats->raster_reason, "%s", r->vis.reason);
     if (pipeline == GDR_PIPELINE_CPU) {
         stats->instances_visible = last_slot->cpu_visible_count;
         stats->draws = last_slot->cpu_visible_count;
@@ -432,6 +449,7 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
         stats->meshlets_late_occluded = gpu.meshlets_late_occluded;
         stats->meshlets_late_drawn = gpu.meshlets_late_drawn;
         stats->triangles = ((uint64_t)gpu.triangles_high << 32) | gpu.triangles_low;
+        stats->triangles += stats->raster_sw_triangles; /* the mesh shaders count only their own */
     }
     if (pipeline == GDR_PIPELINE_MESH) {
         stats->meshlets_total = r->scene.instance_meshlet_count;

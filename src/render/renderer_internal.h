@@ -9,6 +9,7 @@
 #include "vk/vk_context.h"
 #include "vk/vk_image.h"
 #include "vk/vk_memory.h"
+#include "render/visbuffer.h"
 
 /* Timestamps written per frame, in order; pass i lasts from timestamp i to i + 1. */
 enum gdr_timestamp {
@@ -97,6 +98,7 @@ struct gdr_renderer {
     gdr_occlusion occlusion;
     gdr_vk_buffer overdraw;       /* uint32 per pixel, then the maximum (overdraw view) */
     gdr_vk_buffer visible_meshlets; /* uint32 pairs, one per cluster of every instance; made on first use */
+    gdr_visbuffer vis;            /* the visibility buffer and the hybrid rasteriser (issue 8) */
     gdr_cpu_path cpu;
     VkQueryPool timestamps;
     gdr_gpu_scene scene;

@@ -9,6 +9,7 @@
 #include "shared/glsl_buffers.h"
 #include "shared/meshlet_payload.h"
 #include "shared/shading.h"
+#include "shared/visbuffer.h"
 
 layout(local_size_x = GDR_MESH_WORKGROUP_SIZE) in;
 layout(triangles, max_vertices = GDR_MESH_MAX_VERTICES, max_primitives = GDR_MESH_MAX_TRIANGLES) out;
@@ -23,6 +24,7 @@ out gl_MeshPerPrimitiveEXT { perprimitiveEXT bool gl_CullPrimitiveEXT; } gl_Mesh
 layout(location = 0) out vec3 out_normal[];
 layout(location = 1) out vec3 out_world_position[];
 layout(location = 2) perprimitiveEXT flat out vec4 out_color[];
+layout(location = 3) perprimitiveEXT flat out uint out_visibility_id[]; // visibility buffer (issue 8)
 
 shared vec3 screen[GDR_MESH_MAX_VERTICES]; // pixels (y up) and clip w
 
@@ -56,7 +58,18 @@ void main()
     GdrGpuMeshlet meshlet = MeshletsRef(push.meshlets).items[meshlet_index];
     GdrGpuInstance instance = InstancesRef(push.instances).items[payload.instance];
     uint lane = gl_LocalInvocationIndex;
+    // Visibility buffer (issue 8): the cluster's entry in the frame's list (reserved by the task
+    // shader; none when the list was full), and an id per triangle.
+    GdrGpuRasterParams raster = RasterParamsRef(push.raster).value;
+    bool visbuffer = raster.mode != GDR_GPU_RASTER_FORWARD;
+    uint slot = payload.raster_first + gl_WorkGroupID.x;
+    if (visbuffer && payload.raster_first == GDR_RASTER_NO_SLOT) {
+        SetMeshOutputsEXT(0u, 0u);
+        return;
+    }
     SetMeshOutputsEXT(meshlet.vertex_count, meshlet.triangle_count);
+    if (visbuffer && lane == 0u)
+        RasterClustersRef(raster.clusters).items[slot] = GdrGpuRasterCluster(payload.instance, meshlet_index);
 
     mat3 m = mat3(instance.model);
     mat3 cofactor = mat3(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1]));
@@ -91,6 +104,7 @@ void main()
         else if (g.view_mode == GDR_VIEW_LOD)
             albedo = gdr_depth_color(meshlet.group_depth);
         out_color[t] = vec4(albedo, 1.0);
+        out_visibility_id[t] = gdr_visbuffer_id(slot, t);
         emitted += why == 0u ? 1u : 0u;
         backfacing += why == 1u ? 1u : 0u;
         small += why == 2u ? 1u : 0u;

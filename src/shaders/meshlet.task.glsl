@@ -13,6 +13,7 @@
 #include "shared/lod_math.h"
 #include "shared/occlusion_test.h"
 #include "shared/meshlet_payload.h"
+#include "shared/raster_bin.h"
 
 layout(local_size_x = GDR_TASK_WORKGROUP_SIZE) in;
 // Occlusion culling phase (issue 6): none, or the early / late phase of the two-phase scheme.
@@ -133,12 +134,13 @@ void main()
     }
     barrier();
 
-    uvec4 ballot = subgroupBallot(visible);
+    bool sw = gdr_raster_bin(g, visible, task.instance, task.meshlet_first + lane); // issue 8: compute raster
+    uvec4 ballot = subgroupBallot(visible && !sw);
     uint base = 0u;
     if (subgroupElect())
         base = atomicAdd(visible_count, subgroupBallotBitCount(ballot));
     base = subgroupBroadcastFirst(base);
-    if (visible)
+    if (visible && !sw)
         payload.meshlets[base + subgroupBallotExclusiveBitCount(ballot)] = task.meshlet_first + lane;
     if (lane == 0u)
         payload.instance = task.instance;
@@ -175,6 +177,9 @@ void main()
         if (lod > 0u)
             atomicAdd(stats.value.meshlets_lod_culled, lod);
     }
+    barrier();
+    if (lane == 0u) // issue 8: the mesh-shader clusters' entries in the visible-cluster list
+        payload.raster_first = gdr_raster_reserve_hw(visible_count);
     barrier();
     EmitMeshTasksEXT(visible_count, 1u, 1u);
 }

@@ -104,3 +104,14 @@ bool cli_parse_pipeline(const char *option, const char *text, gdr_pipeline *out)
     *out = values[index];
     return true;
 }
+
+bool cli_parse_raster(const char *option, const char *text, gdr_raster *out)
+{
+    static const char *const names[] = {"hybrid", "hw", "sw", "forward"};
+    static const gdr_raster values[] = {GDR_RASTER_HYBRID, GDR_RASTER_HW, GDR_RASTER_SW, GDR_RASTER_FORWARD};
+    int index;
+    if (!cli_parse_choice(option, text, names, 4, &index))
+        return false;
+    *out = values[index];
+    return true;
+}

@@ -17,6 +17,8 @@ bool cli_parse_on_off(const char *option, const char *text, bool *out);
 bool cli_parse_choice(const char *option, const char *text, const char *const *names, int count, int *out);
 /* --pipeline mesh|indirect|cpu */
 bool cli_parse_pipeline(const char *option, const char *text, gdr_pipeline *out);
+/* --raster hybrid|hw|sw|forward */
+bool cli_parse_raster(const char *option, const char *text, gdr_raster *out);
 /* "px,py,pz,qx,qy,qz,qw": position and rotation quaternion (normalised; must not be zero). */
 bool cli_parse_camera(const char *option, const char *text, gdr_vec3 *position, gdr_quat *rotation);
 /* Returns the option's value (argv[*i + 1]) and advances *i, or prints an error and returns NULL. */

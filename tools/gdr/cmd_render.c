@@ -16,6 +16,8 @@ typedef struct render_options {
     bool has_camera, has_camera_index, cull, validate;
     bool meshlet_cull, cone_cull, triangle_cull, occlusion;
     gdr_pipeline pipeline;
+    gdr_raster raster;
+    float sw_threshold;
     gdr_view view;
     float lod_error;
     bool has_lod_depth;
@@ -78,6 +80,10 @@ static int parse_render_options(int argc, char **argv, render_options *o)
             ok = cli_parse_on_off(arg, value, &o->occlusion);
         else if (strcmp(arg, "--pipeline") == 0)
             ok = cli_parse_pipeline(arg, value, &o->pipeline);
+        else if (strcmp(arg, "--raster") == 0)
+            ok = cli_parse_raster(arg, value, &o->raster);
+        else if (strcmp(arg, "--sw-threshold") == 0)
+            ok = cli_parse_float(arg, value, 0.01f, 1e6f, &o->sw_threshold);
         else if (strcmp(arg, "--view") == 0) {
             int view;
             ok = cli_parse_choice(arg, value, view_names, 6, &view);
@@ -144,6 +150,7 @@ int gdr_cmd_render(int argc, char **argv)
     int result = 0;
     gdr_frame_desc frame = {.camera = choose_camera(scene, &o), .cull = o.cull ? GDR_CULL_ON : GDR_CULL_OFF,
                             .read_back = o.out_png != NULL, .pipeline = o.pipeline, .view = o.view,
+                            .raster = o.raster, .sw_threshold_px = o.sw_threshold,
                             .meshlet_frustum_cull = o.meshlet_cull ? GDR_CULL_ON : GDR_CULL_OFF,
                             .meshlet_cone_cull = o.cone_cull ? GDR_CULL_ON : GDR_CULL_OFF,
                             .triangle_cull = o.triangle_cull ? GDR_CULL_ON : GDR_CULL_OFF,

@@ -26,6 +26,17 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
                 s->triangles_small_culled);
         fprintf(out, "task_workgroups     %u (in 1 indirect mesh-tasks launch; %u lost to overflow)\n",
                 s->task_workgroups, s->task_overflow);
+        fprintf(out, "raster              %s (%s)\n", gdr_raster_name(s->raster), s->raster_reason);
+        if (s->raster != GDR_RASTER_FORWARD) {
+            fprintf(out, "raster_clusters     compute %u (%llu triangles), mesh shaders %u (%llu triangles)",
+                    s->raster_sw_clusters, (unsigned long long)s->raster_sw_triangles, s->raster_hw_clusters,
+                    (unsigned long long)s->raster_hw_triangles);
+            if (s->raster == GDR_RASTER_HYBRID)
+                fprintf(out, "; threshold %g px", (double)s->sw_threshold_px);
+            fprintf(out, s->raster_overflow ? "; %u lost to overflow\n" : "\n", s->raster_overflow);
+            fprintf(out, "raster_gpu_ms       mesh shaders %.4f, compute %.4f, resolve %.4f (part of draw)\n",
+                    s->raster_hw_ms, s->raster_sw_ms, s->raster_resolve_ms);
+        }
         if (s->lod_applied) {
             fprintf(out, "meshlets_lod_culled %u (not in the LOD cut)\n", s->meshlets_lod_culled);
             fprintf(out, "lod_depths          clusters/triangles drawn per DAG depth:");
@@ -71,6 +82,19 @@ void stats_add_meshlet_json(cJSON *object, const gdr_frame_stats *s)
     for (uint32_t d = 0; clusters && triangles && d < s->lod_depth_count; d++) {
         cJSON_AddItemToArray(clusters, cJSON_CreateNumber(s->lod_clusters_per_depth[d]));
         cJSON_AddItemToArray(triangles, cJSON_CreateNumber((double)s->lod_triangles_per_depth[d]));
+    }
+    cJSON_AddStringToObject(object, "raster", gdr_raster_name(s->raster));
+    cJSON_AddStringToObject(object, "raster_reason", s->raster_reason);
+    if (s->raster != GDR_RASTER_FORWARD) {
+        cJSON_AddNumberToObject(object, "sw_threshold_px", s->sw_threshold_px);
+        cJSON_AddNumberToObject(object, "raster_sw_clusters", s->raster_sw_clusters);
+        cJSON_AddNumberToObject(object, "raster_hw_clusters", s->raster_hw_clusters);
+        cJSON_AddNumberToObject(object, "raster_sw_triangles", (double)s->raster_sw_triangles);
+        cJSON_AddNumberToObject(object, "raster_hw_triangles", (double)s->raster_hw_triangles);
+        cJSON_AddNumberToObject(object, "raster_overflow", s->raster_overflow);
+        cJSON_AddNumberToObject(object, "raster_hw_ms", s->raster_hw_ms);
+        cJSON_AddNumberToObject(object, "raster_sw_ms", s->raster_sw_ms);
+        cJSON_AddNumberToObject(object, "raster_resolve_ms", s->raster_resolve_ms);
     }
 }
 

@@ -5,6 +5,7 @@
 struct GdrTaskPayload {
     uint instance;
     uint meshlets[GDR_TASK_WORKGROUP_SIZE]; /* global GdrGpuMeshlet indices of the visible clusters */
+    uint raster_first; /* visibility buffer (issue 8): list slot of the first, or GDR_RASTER_NO_SLOT */
 };
 
 layout(buffer_reference, scalar) readonly buffer MeshletsRef { GdrGpuMeshlet items[]; };

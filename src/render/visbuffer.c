@@ -1,0 +1,468 @@
+/* The visibility buffer and the hybrid rasteriser of the mesh pipeline (issue 8); see visbuffer.h. */
+#include "render/visbuffer.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "render/renderer_internal.h"
+#include "vk/vk_pipeline.h"
+
+static void memory_barrier(VkCommandBuffer cmd, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                           VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access)
+{
+    VkMemoryBarrier2 barrier = {.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2, .srcStageMask = src_stage,
+                                .srcAccessMask = src_access, .dstStageMask = dst_stage, .dstAccessMask = dst_access};
+    VkDependencyInfo dependency = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .memoryBarrierCount = 1,
+                                   .pMemoryBarriers = &barrier};
+    vkCmdPipelineBarrier2(cmd, &dependency);
+}
+
+static gdr_status create_pipelines(gdr_renderer *r, gdr_error *err)
+{
+    gdr_visbuffer *v = &r->vis;
+    gdr_status status = GDR_OK;
+    /* The mesh-shader pass: no attachments, the atomic is the depth test. One per occlusion-culling
+     * phase of the task shader (its constant 0: none, early, late). */
+    for (uint32_t phase = 0; phase < 3 && status == GDR_OK; phase++) {
+        VkSpecializationMapEntry entry = {0, 0, sizeof(uint32_t)};
+        VkSpecializationInfo constants = {1, &entry, sizeof phase, &phase};
+        gdr_vk_graphics_pipeline_desc hw = {
+            .layout = r->layout, .task_shader = &gdr_shader_meshlet_task, .task_specialization = &constants,
+            .mesh_shader = &gdr_shader_meshlet_mesh, .fragment_shader = &gdr_shader_meshlet_visbuffer_frag,
+            .color_format = VK_FORMAT_UNDEFINED, .depth_format = VK_FORMAT_UNDEFINED,
+            .cull_mode = VK_CULL_MODE_BACK_BIT, .no_depth_test = true};
+        status = gdr_vk_graphics_pipeline_create(r->ctx, &hw, &v->hw_pipelines[phase], err);
+    }
+    if (status == GDR_OK)
+        status = gdr_vk_compute_pipeline_create(r->ctx, r->layout, &gdr_shader_raster_sw_comp, &v->sw_pipeline, err);
+    if (status == GDR_OK)
+        status = gdr_vk_compute_pipeline_create(r->ctx, r->layout, &gdr_shader_raster_submit_comp,
+                                                &v->submit_pipeline, err);
+    if (status == GDR_OK) { /* a full-screen triangle; the fragment shader writes the depth */
+        gdr_vk_graphics_pipeline_desc resolve = {
+            .layout = r->layout, .vertex_shader = &gdr_shader_overdraw_paint_vert,
+            .fragment_shader = &gdr_shader_visbuffer_resolve_frag, .color_format = GDR_COLOR_FORMAT,
+            .depth_format = GDR_DEPTH_FORMAT, .cull_mode = VK_CULL_MODE_NONE, .depth_always = true};
+        status = gdr_vk_graphics_pipeline_create(r->ctx, &resolve, &v->resolve_pipeline, err);
+    }
+    return status;
+}
+
+gdr_status gdr_visbuffer_create(gdr_renderer *r, bool disabled, gdr_error *err)
+{
+    gdr_visbuffer *v = &r->vis;
+    /* The parameters always: the mesh pipeline's shaders read the mode even when drawing forward. */
+    gdr_status status = GDR_OK;
+    for (uint32_t i = 0; i < GDR_FRAMES_IN_FLIGHT && status == GDR_OK; i++)
+        status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuRasterParams), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                      GDR_VK_BUFFER_UPLOAD, &v->params[i], err);
+    if (status != GDR_OK)
+        return status;
+    const char *why = NULL;
+    if (disabled)
+        why = "the visibility buffer was disabled by the caller";
+    else if (!r->ctx->has_mesh_shader)
+        why = r->ctx->mesh_shader_missing;
+    else if (!r->ctx->has_buffer_int64_atomics)
+        why = "the device has no 64-bit buffer atomics (shaderBufferInt64Atomics)";
+    if (why) {
+        snprintf(v->missing, sizeof v->missing, "%s", why);
+        return GDR_OK;
+    }
+    status = create_pipelines(r, err);
+    if (status == GDR_OK)
+        status = gdr_vk_buffer_create(&r->allocator, (VkDeviceSize)r->width * r->height * sizeof(uint64_t),
+                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                          VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                      GDR_VK_BUFFER_DEVICE, &v->pixels, err);
+    if (status == GDR_OK)
+        status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuRasterCounters),
+                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
+                                          VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                      GDR_VK_BUFFER_DEVICE, &v->counters, err);
+    for (uint32_t i = 0; i < GDR_FRAMES_IN_FLIGHT && status == GDR_OK; i++)
+        status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuRasterCounters), VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                      GDR_VK_BUFFER_READBACK, &v->counters_readback[i], err);
+    if (status != GDR_OK)
+        return status;
+    VkQueryPoolCreateInfo query = {.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO, .queryType = VK_QUERY_TYPE_TIMESTAMP,
+                                   .queryCount = GDR_FRAMES_IN_FLIGHT * 2 * GDR_VISBUFFER_TS_COUNT};
+    GDR_VK_TRY(err, vkCreateQueryPool(r->ctx->device, &query, NULL, &v->timestamps));
+    v->supported = true;
+    return GDR_OK;
+}
+
+gdr_status gdr_visbuffer_set_scene(gdr_renderer *r, gdr_error *err)
+{
+    gdr_visbuffer *v = &r->vis;
+    if (!v->supported)
+        return GDR_OK;
+    /* Every cluster of every instance's DAG is the most one frame can draw. */
+    uint64_t total = r->scene.instance_lod_cluster_count;
+    v->capacity = (uint32_t)(total < GDR_RASTER_MAX_CLUSTERS ? (total ? total : 1) : GDR_RASTER_MAX_CLUSTERS);
+    return gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuRasterCluster) * (VkDeviceSize)v->capacity,
+                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                GDR_VK_BUFFER_DEVICE, &v->clusters, err);
+}
+
+void gdr_visbuffer_destroy(gdr_renderer *r)
+{
+    gdr_visbuffer *v = &r->vis;
+    VkDevice device = r->ctx->device;
+    VkPipeline pipelines[] = {v->hw_pipelines[0], v->hw_pipelines[1], v->hw_pipelines[2], v->sw_pipeline,
+                              v->submit_pipeline, v->resolve_pipeline};
+    for (size_t i = 0; i < sizeof pipelines / sizeof pipelines[0]; i++)
+        if (pipelines[i])
+            vkDestroyPipeline(device, pipelines[i], NULL);
+    if (v->timestamps)
+        vkDestroyQueryPool(device, v->timestamps, NULL);
+    gdr_vk_buffer_destroy(r->ctx, &v->pixels);
+    gdr_vk_buffer_destroy(r->ctx, &v->clusters);
+    gdr_vk_buffer_destroy(r->ctx, &v->counters);
+    for (uint32_t i = 0; i < GDR_FRAMES_IN_FLIGHT; i++) {
+        gdr_vk_buffer_destroy(r->ctx, &v->params[i]);
+        gdr_vk_buffer_destroy(r->ctx, &v->counters_readback[i]);
+    }
+    memset(v, 0, sizeof *v);
+}
+
+gdr_raster gdr_visbuffer_public_mode(uint32_t mode)
+{
+    switch (mode) {
+    case GDR_GPU_RASTER_HYBRID: return GDR_RASTER_HYBRID;
+    case GDR_GPU_RASTER_HW: return GDR_RASTER_HW;
+    case GDR_GPU_RASTER_SW: return GDR_RASTER_SW;
+    default: return GDR_RASTER_FORWARD;
+    }
+}
+
+float gdr_visbuffer_threshold(const gdr_frame_desc *frame)
+{
+    return frame->sw_threshold_px > 0.0f ? frame->sw_threshold_px : GDR_DEFAULT_SW_THRESHOLD_PX;
+}
+
+gdr_status gdr_visbuffer_resolve_mode(const gdr_renderer *r, const gdr_frame_desc *frame, gdr_pipeline pipeline,
+                                      uint32_t *mode, char *reason, size_t reason_size, gdr_error *err)
+{
+    const gdr_visbuffer *v = &r->vis;
+    if (!(frame->sw_threshold_px >= 0.0f && frame->sw_threshold_px <= 1e6f))
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: sw_threshold_px must be in [0, 1e6] (%g)",
+                             (double)frame->sw_threshold_px);
+    switch (frame->raster) {
+    case GDR_RASTER_DEFAULT:
+        if (pipeline == GDR_PIPELINE_MESH && v->supported) {
+            *mode = GDR_GPU_RASTER_HYBRID;
+            snprintf(reason, reason_size, "default: the device has 64-bit buffer atomics");
+        } else {
+            *mode = GDR_GPU_RASTER_FORWARD;
+            if (pipeline != GDR_PIPELINE_MESH)
+                snprintf(reason, reason_size, "default: the %s pipeline draws forward", gdr_pipeline_name(pipeline));
+            else
+                snprintf(reason, reason_size, "default: no visibility buffer (%s)", v->missing);
+        }
+        return GDR_OK;
+    case GDR_RASTER_FORWARD:
+        *mode = GDR_GPU_RASTER_FORWARD;
+        snprintf(reason, reason_size, "asked for");
+        return GDR_OK;
+    case GDR_RASTER_HYBRID:
+    case GDR_RASTER_HW:
+    case GDR_RASTER_SW:
+        if (pipeline != GDR_PIPELINE_MESH)
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "raster %s: needs the mesh pipeline (not %s)",
+                                 gdr_raster_name(frame->raster), gdr_pipeline_name(pipeline));
+        if (!v->supported)
+            return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "raster %s: not available on '%s': %s",
+                                 gdr_raster_name(frame->raster), r->ctx->properties.deviceName, v->missing);
+        *mode = frame->raster == GDR_RASTER_HYBRID ? GDR_GPU_RASTER_HYBRID
+                : frame->raster == GDR_RASTER_HW   ? GDR_GPU_RASTER_HW
+                                                   : GDR_GPU_RASTER_SW;
+        snprintf(reason, reason_size, "asked for");
+        return GDR_OK;
+    }
+    return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: unknown raster %d", (int)frame->raster);
+}
+
+/* Adds the timings of the slot's last frame (summed over its raster phases), if it was timed and
+ * has finished (its fence was waited for before this is called). */
+static void collect_timings(gdr_renderer *r, uint32_t slot_index)
+{
+    gdr_visbuffer *v = &r->vis;
+    uint32_t phases = v->slot_phases[slot_index];
+    if (phases == 0)
+        return;
+    v->slot_phases[slot_index] = 0;
+    uint64_t ticks[2 * GDR_VISBUFFER_TS_COUNT];
+    VkResult result = vkGetQueryPoolResults(r->ctx->device, v->timestamps, slot_index * 2 * GDR_VISBUFFER_TS_COUNT,
+                                            phases * GDR_VISBUFFER_TS_COUNT, sizeof ticks, ticks, sizeof ticks[0],
+                                            VK_QUERY_RESULT_64_BIT);
+    if (result != VK_SUCCESS)
+        return; /* timings only: a frame without them is left out of the means */
+    double period_ms = r->ctx->properties.limits.timestampPeriod * 1e-6;
+    for (uint32_t p = 0; p < phases; p++)
+        for (int i = 0; i < 3; i++)
+            v->pass_ms[i] += (double)(ticks[p * GDR_VISBUFFER_TS_COUNT + i + 1] - ticks[p * GDR_VISBUFFER_TS_COUNT + i]) *
+                             period_ms;
+    v->timed_frames++;
+}
+
+void gdr_visbuffer_begin_render(gdr_renderer *r)
+{
+    gdr_visbuffer *v = &r->vis;
+    for (uint32_t i = 0; i < GDR_FRAMES_IN_FLIGHT; i++)
+        v->slot_phases[i] = 0;
+    memset(v->pass_ms, 0, sizeof v->pass_ms);
+    v->timed_frames = 0;
+}
+
+void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_frame_desc *frame, uint32_t mode,
+                               VkCommandBuffer cmd)
+{
+    gdr_visbuffer *v = &r->vis;
+    v->slot_mode[slot_index] = mode;
+    if (!v->params[slot_index].mapped)
+        return; /* no mesh pipeline */
+    collect_timings(r, slot_index);
+    gdr_mat4 projection, view;
+    gdr_frame_matrices(r, &frame->camera, &projection, &view);
+    GdrGpuRasterParams params = {
+        .clusters = v->clusters.address,
+        .counters = v->counters.address,
+        .mode = mode,
+        .capacity = v->capacity,
+        .sw_threshold_px = gdr_visbuffer_threshold(frame),
+        .ndc_scale = {fabsf(projection.m[0]), fabsf(projection.m[5])},
+    };
+    memcpy(v->params[slot_index].mapped, &params, sizeof params);
+    if (mode != GDR_GPU_RASTER_FORWARD) {
+        vkCmdFillBuffer(cmd, v->counters.buffer, 0, VK_WHOLE_SIZE, 0);
+        vkCmdFillBuffer(cmd, v->pixels.buffer, 0, VK_WHOLE_SIZE, 0);
+        vkCmdResetQueryPool(cmd, v->timestamps, slot_index * 2 * GDR_VISBUFFER_TS_COUNT, 2 * GDR_VISBUFFER_TS_COUNT);
+    }
+}
+
+static void timestamp(gdr_renderer *r, VkCommandBuffer cmd, uint32_t slot_index, enum gdr_visbuffer_timestamp which)
+{
+    uint32_t phase = r->vis.slot_phases[slot_index];
+    vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, r->vis.timestamps,
+                         (slot_index * 2 + phase) * GDR_VISBUFFER_TS_COUNT + which);
+}
+
+static void set_viewport(gdr_renderer *r, VkCommandBuffer cmd)
+{
+    gdr_viewport flipped = gdr_viewport_flip_y((float)r->width, (float)r->height);
+    VkViewport viewport = {flipped.x, flipped.y, flipped.width, flipped.height, 0.0f, 1.0f};
+    VkRect2D scissor = {{0, 0}, {r->width, r->height}};
+    vkCmdSetViewport(cmd, 0, 1, &viewport);
+    vkCmdSetScissor(cmd, 0, 1, &scissor);
+}
+
+/* The mesh-shader pass: the task shaders bin, the fragments write the visibility buffer. */
+static void record_hw(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer cmd, int phase, VkDeviceSize launch)
+{
+    VkRenderingInfo rendering = {.sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
+                                 .renderArea = {{0, 0}, {r->width, r->height}}, .layerCount = 1};
+    vkCmdBeginRendering(cmd, &rendering);
+    set_viewport(r, cmd);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->vis.hw_pipelines[phase]);
+    r->ctx->cmd_draw_mesh_tasks_indirect(cmd, slot->draw_stats.buffer, launch, 1,
+                                         sizeof(VkDrawMeshTasksIndirectCommandEXT));
+    vkCmdEndRendering(cmd);
+}
+
+/* The compute rasteriser over the clusters the task shaders appended. */
+static void record_sw(gdr_renderer *r, VkCommandBuffer cmd)
+{
+    const VkPipelineStageFlags2 mesh_stages = VK_PIPELINE_STAGE_2_TASK_SHADER_BIT_EXT | VK_PIPELINE_STAGE_2_MESH_SHADER_BIT_EXT;
+    memory_barrier(cmd, mesh_stages | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->vis.submit_pipeline);
+    vkCmdDispatch(cmd, 1, 1, 1);
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                   VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_SHADER_READ_BIT);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->vis.sw_pipeline);
+    vkCmdDispatchIndirect(cmd, r->vis.counters.buffer, offsetof(GdrGpuRasterCounters, dispatch_x));
+}
+
+/* The resolve: shades every pixel into the colour image, writes its depth into the depth image. */
+static void record_resolve(gdr_renderer *r, VkCommandBuffer cmd)
+{
+    const VkPipelineStageFlags2 mesh_stages = VK_PIPELINE_STAGE_2_TASK_SHADER_BIT_EXT | VK_PIPELINE_STAGE_2_MESH_SHADER_BIT_EXT;
+    memory_barrier(cmd, mesh_stages | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                   VK_ACCESS_2_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                   VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
+    gdr_vk_image_barrier(cmd, r->color.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                         VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT, 0,
+                         VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+    gdr_vk_image_barrier(cmd, r->depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                         VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                         VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_COPY_BIT, 0,
+                         VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                         VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+    VkRenderingAttachmentInfo color = {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+                                       .imageView = r->color.view, .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                                       .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR, .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+                                       .clearValue.color = GDR_CLEAR_COLOR};
+    VkRenderingAttachmentInfo depth = {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+                                       .imageView = r->depth.view, .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                                       .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR, .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+                                       .clearValue.depthStencil = {0.0f, 0}};
+    VkRenderingInfo rendering = {.sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
+                                 .renderArea = {{0, 0}, {r->width, r->height}}, .layerCount = 1,
+                                 .colorAttachmentCount = 1, .pColorAttachments = &color, .pDepthAttachment = &depth};
+    vkCmdBeginRendering(cmd, &rendering);
+    set_viewport(r, cmd);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->vis.resolve_pipeline);
+    vkCmdDraw(cmd, 3, 1, 0, 0);
+    vkCmdEndRendering(cmd);
+}
+
+void gdr_visbuffer_record_raster(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer cmd, int phase,
+                                 VkDeviceSize launch)
+{
+    uint32_t slot_index = (uint32_t)(slot - r->slots);
+    timestamp(r, cmd, slot_index, GDR_VISBUFFER_TS_BEGIN);
+    record_hw(r, slot, cmd, phase, launch);
+    timestamp(r, cmd, slot_index, GDR_VISBUFFER_TS_AFTER_HW);
+    record_sw(r, cmd);
+    timestamp(r, cmd, slot_index, GDR_VISBUFFER_TS_AFTER_SW);
+    record_resolve(r, cmd);
+    timestamp(r, cmd, slot_index, GDR_VISBUFFER_TS_AFTER_RESOLVE);
+    r->vis.slot_phases[slot_index]++;
+}
+
+void gdr_visbuffer_record_readback(gdr_renderer *r, uint32_t slot_index, VkCommandBuffer cmd)
+{
+    if (!r->vis.supported)
+        return;
+    VkBufferCopy copy = {0, 0, sizeof(GdrGpuRasterCounters)};
+    vkCmdCopyBuffer(cmd, r->vis.counters.buffer, r->vis.counters_readback[slot_index].buffer, 1, &copy);
+}
+
+void gdr_visbuffer_stats(gdr_renderer *r, uint32_t slot_index, gdr_frame_stats *stats)
+{
+    gdr_visbuffer *v = &r->vis;
+    for (uint32_t i = 0; i < GDR_FRAMES_IN_FLIGHT; i++)
+        collect_timings(r, i); /* every frame has finished: the renderer drained its slots */
+    uint32_t mode = v->slot_mode[slot_index];
+    stats->raster = gdr_visbuffer_public_mode(mode);
+    if (mode == GDR_GPU_RASTER_FORWARD || !v->supported)
+        return;
+    GdrGpuRasterCounters counters;
+    memcpy(&counters, v->counters_readback[slot_index].mapped, sizeof counters);
+    GdrGpuRasterParams params;
+    memcpy(&params, v->params[slot_index].mapped, sizeof params);
+    stats->sw_threshold_px = params.sw_threshold_px;
+    stats->raster_sw_clusters = counters.sw_clusters;
+    stats->raster_hw_clusters = counters.hw_clusters;
+    stats->raster_sw_triangles = counters.sw_triangles;
+    stats->raster_hw_triangles = counters.hw_triangles;
+    stats->raster_overflow = counters.overflow;
+    if (v->timed_frames > 0) {
+        stats->raster_hw_ms = v->pass_ms[0] / v->timed_frames;
+        stats->raster_sw_ms = v->pass_ms[1] / v->timed_frames;
+        stats->raster_resolve_ms = v->pass_ms[2] / v->timed_frames;
+    }
+}
+
+/* --- readbacks for tests and tools ------------------------------------------------------------ */
+
+/* A host-visible copy of `size` bytes of `source` (a buffer) or of the depth image (source NULL).
+ * Test/debug path: the memory goes back with the renderer (linear allocator). */
+static gdr_status read_back(gdr_renderer *r, VkBuffer source, VkDeviceSize size, gdr_vk_buffer *out, gdr_error *err)
+{
+    gdr_status status = gdr_vk_buffer_create(&r->allocator, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                             GDR_VK_BUFFER_READBACK, out, err);
+    VkCommandBuffer cmd;
+    if (status == GDR_OK)
+        status = gdr_vk_begin_one_time(r->ctx, &cmd, err);
+    if (status != GDR_OK)
+        return status;
+    if (source) {
+        VkBufferCopy region = {0, 0, size};
+        vkCmdCopyBuffer(cmd, source, out->buffer, 1, &region);
+    } else {
+        gdr_vk_image_barrier(cmd, r->depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                             VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                             VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
+                             VK_ACCESS_2_TRANSFER_READ_BIT);
+        VkBufferImageCopy region = {.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1},
+                                    .imageExtent = {r->width, r->height, 1}};
+        vkCmdCopyImageToBuffer(cmd, r->depth.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, out->buffer, 1, &region);
+        gdr_vk_image_barrier(cmd, r->depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                             VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT, 0,
+                             VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT, 0);
+    }
+    return gdr_vk_end_one_time(r->ctx, cmd, err);
+}
+
+static gdr_status check_frame(gdr_renderer *r, bool needs_visbuffer, gdr_error *err)
+{
+    if (r->last_slot < 0)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "visibility buffer: no frame rendered yet");
+    if (needs_visbuffer && r->vis.slot_mode[r->last_slot] == GDR_GPU_RASTER_FORWARD)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "visibility buffer: the last frame drew forward");
+    return GDR_OK;
+}
+
+gdr_status gdr_visbuffer_read_pixels(gdr_renderer *r, gdr_visbuffer_pixel *pixels, gdr_error *err)
+{
+    gdr_visbuffer *v = &r->vis;
+    gdr_vk_buffer values = {0}, clusters = {0};
+    size_t count = (size_t)r->width * r->height;
+    gdr_status status = check_frame(r, true, err);
+    if (status == GDR_OK)
+        status = read_back(r, v->pixels.buffer, count * sizeof(uint64_t), &values, err);
+    if (status == GDR_OK)
+        status = read_back(r, v->clusters.buffer, v->clusters.size, &clusters, err);
+    for (size_t p = 0; status == GDR_OK && p < count; p++) {
+        uint64_t value = ((const uint64_t *)values.mapped)[p];
+        uint32_t depth_bits = (uint32_t)(value >> 32), id = (uint32_t)value;
+        uint32_t slot = id >> GDR_VISBUFFER_TRIANGLE_BITS;
+        pixels[p] = (gdr_visbuffer_pixel){0.0f, UINT32_MAX, 0, 0};
+        if (depth_bits == 0)
+            continue;
+        if (slot >= v->capacity) {
+            status = gdr_error_set(err, GDR_ERROR_VULKAN, "visibility buffer: pixel %zu names slot %u of %u", p, slot,
+                                   v->capacity);
+            break;
+        }
+        const GdrGpuRasterCluster *entry = (const GdrGpuRasterCluster *)clusters.mapped + slot;
+        memcpy(&pixels[p].depth, &depth_bits, sizeof depth_bits);
+        pixels[p].instance = entry->instance;
+        pixels[p].meshlet = entry->meshlet;
+        pixels[p].triangle = id & ((1u << GDR_VISBUFFER_TRIANGLE_BITS) - 1u);
+    }
+    gdr_vk_buffer_destroy(r->ctx, &values);
+    gdr_vk_buffer_destroy(r->ctx, &clusters);
+    return status;
+}
+
+gdr_status gdr_visbuffer_read_depth(gdr_renderer *r, float *depth, gdr_error *err)
+{
+    gdr_vk_buffer copy = {0};
+    size_t bytes = (size_t)r->width * r->height * sizeof(float);
+    gdr_status status = check_frame(r, false, err);
+    if (status == GDR_OK)
+        status = read_back(r, VK_NULL_HANDLE, bytes, &copy, err);
+    if (status == GDR_OK)
+        memcpy(depth, copy.mapped, bytes);
+    gdr_vk_buffer_destroy(r->ctx, &copy);
+    return status;
+}
+
+gdr_status gdr_visbuffer_read_overdraw(gdr_renderer *r, uint32_t *counts, gdr_error *err)
+{
+    gdr_vk_buffer copy = {0};
+    size_t bytes = (size_t)r->width * r->height * sizeof(uint32_t);
+    gdr_status status = check_frame(r, false, err);
+    if (status == GDR_OK)
+        status = read_back(r, r->overdraw.buffer, bytes, &copy, err);
+    if (status == GDR_OK)
+        memcpy(counts, copy.mapped, bytes);
+    gdr_vk_buffer_destroy(r->ctx, &copy);
+    return status;
+}
