@@ -70,7 +70,7 @@ typedef enum gdr_raster {
 
 /* The hybrid threshold when gdr_frame_desc.sw_threshold_px is 0 (docs/PIPELINE.md says how it was
  * chosen). */
-#define GDR_DEFAULT_SW_THRESHOLD_PX 8.0f
+#define GDR_DEFAULT_SW_THRESHOLD_PX 12.0f
 
 typedef struct gdr_frame_desc {
     gdr_camera camera;  /* aspect 0: width / height; zfar 0: infinite reverse-Z projection */
