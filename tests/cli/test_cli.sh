@@ -62,6 +62,13 @@ grep -q '^occlusion late' "$work/stdout" || { echo "FAIL: render printed no occl
 expect 0 "occlusion off" "$gdr" render occlusion $small --occlusion off --pipeline indirect --validate
 grep -q '^occlusion' "$work/stdout" && { echo "FAIL: occlusion statistics with occlusion off"; failures=$((failures + 1)); }
 expect 0 "bench, lod and occlusion side by side" "$gdr" bench --scene demo:instances=30 --lod-errors 0,2 --occlusion on,off --frames 2 --width 64 --height 48 --validate
+for raster in hw sw forward hybrid; do
+    expect 0 "raster $raster" "$gdr" render demo:instances=50 $small --raster $raster --sw-threshold 4 --validate
+done
+grep -q '^raster_clusters' "$work/stdout" || { echo "FAIL: render printed no raster statistics"; failures=$((failures + 1)); }
+expect 1 "raster sw needs the mesh pipeline" "$gdr" render demo:instances=50 $small --raster sw --pipeline indirect
+expect 2 "raster unknown" "$gdr" render demo --raster soft
+expect 2 "sw threshold zero" "$gdr" render demo --sw-threshold 0
 expect 2 "lod error negative" "$gdr" render demo --lod-error -1
 expect 2 "lod error not a number" "$gdr" render demo --lod-error 1px
 expect 2 "lod depth too deep" "$gdr" render demo --lod-depth 65
