@@ -164,7 +164,7 @@ typedef struct gdr_frame_stats {
     float sw_threshold_px;
     uint32_t raster_sw_clusters, raster_hw_clusters;
     uint64_t raster_sw_triangles, raster_hw_triangles;
-    uint32_t raster_overflow;             /* clusters lost for want of room in the list: always 0 */
+    uint32_t raster_overflow;             /* clusters lost for want of room in the list: 0 below 2^25 */
     double raster_hw_ms, raster_sw_ms, raster_resolve_ms;
     /* The LOD cut (mesh pipeline), last frame: whether it was applied, the clusters it left out,
      * and the clusters and triangles drawn per DAG depth (the last entry: that depth or deeper;
