@@ -314,6 +314,21 @@ static gdr_status resolve_pipeline(const gdr_renderer *r, const gdr_frame_desc *
     return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: unknown pipeline %d", (int)frame->pipeline);
 }
 
+/* Waits for the slot's previous frame, if any, and adds its pass timings to pass_ms. */
+static gdr_status wait_slot_and_time(gdr_renderer *r, gdr_frame_slot *slot, double pass_ms[GDR_TS_COUNT - 1],
+                                     uint32_t *timed_frames, gdr_error *err)
+{
+    double ms[GDR_TS_COUNT - 1];
+    bool had_frame = slot->submitted;
+    gdr_status status = gdr_frame_slot_wait(r, slot, ms, err);
+    if (status == GDR_OK && had_frame) {
+        for (int i = 0; i < GDR_TS_COUNT - 1; i++)
+            pass_ms[i] += ms[i];
+        (*timed_frames)++;
+    }
+    return status;
+}
+
 gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uint32_t frames, gdr_frame_stats *stats,
                                gdr_error *err)
 {
@@ -361,17 +376,10 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
     r->color_read_back = false;
     for (uint32_t f = 0; f < frames; f++) {
         gdr_frame_slot *slot = &r->slots[r->frame_index % GDR_FRAMES_IN_FLIGHT];
-        double ms[GDR_TS_COUNT - 1];
-        bool had_frame = slot->submitted;
-        gdr_status status = gdr_frame_slot_wait(r, slot, ms, err);
+        gdr_status status = wait_slot_and_time(r, slot, pass_ms, &timed_frames, err);
         if (status != GDR_OK) {
             free(frame_cpu_ms);
             return status;
-        }
-        if (had_frame) {
-            for (int i = 0; i < GDR_TS_COUNT - 1; i++)
-                pass_ms[i] += ms[i];
-            timed_frames++;
         }
         double start = gdr_now_ms();
         bool last = f + 1 == frames;
@@ -393,17 +401,10 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
     }
     /* Drain every slot so the last frame's results are on the host. */
     for (uint32_t i = 0; i < GDR_FRAMES_IN_FLIGHT; i++) {
-        double ms[GDR_TS_COUNT - 1];
-        bool had_frame = r->slots[i].submitted;
-        gdr_status status = gdr_frame_slot_wait(r, &r->slots[i], ms, err);
+        gdr_status status = wait_slot_and_time(r, &r->slots[i], pass_ms, &timed_frames, err);
         if (status != GDR_OK) {
             free(frame_cpu_ms);
             return status;
-        }
-        if (had_frame) {
-            for (int p = 0; p < GDR_TS_COUNT - 1; p++)
-                pass_ms[p] += ms[p];
-            timed_frames++;
         }
     }
     r->color_read_back = frame->read_back;

@@ -41,6 +41,23 @@ static inline int cpu_instance_visibility(const gdr_scene *scene, uint32_t index
     return surely_visible ? 1 : maybe_visible ? 0 : -1;
 }
 
+/* A camera at `position` turned by `yaw` about +Y, then `pitch` about +X. */
+static inline gdr_camera test_look(gdr_vec3 position, float yaw, float pitch, float yfov, float znear)
+{
+    gdr_quat qy = gdr_quat_from_axis_angle((gdr_vec3){0, 1, 0}, yaw);
+    gdr_quat qp = gdr_quat_from_axis_angle((gdr_vec3){1, 0, 0}, pitch);
+    return (gdr_camera){.position = position, .rotation = gdr_quat_mul(qy, qp), .yfov = yfov, .znear = znear};
+}
+
+/* qsort order of gdr_visible_meshlet: by instance, then cluster. */
+static inline int compare_visible_meshlets(const void *a, const void *b)
+{
+    const gdr_visible_meshlet *x = a, *y = b;
+    if (x->instance != y->instance)
+        return x->instance < y->instance ? -1 : 1;
+    return x->meshlet < y->meshlet ? -1 : x->meshlet > y->meshlet;
+}
+
 static inline int compare_u32(const void *a, const void *b)
 {
     uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;

@@ -30,21 +30,6 @@ static bool render(const gdr_frame_desc *frame, uint8_t *pixels, gdr_frame_stats
     return true;
 }
 
-static gdr_camera look(gdr_vec3 position, float yaw, float pitch, float yfov, float znear)
-{
-    gdr_quat qy = gdr_quat_from_axis_angle((gdr_vec3){0, 1, 0}, yaw);
-    gdr_quat qp = gdr_quat_from_axis_angle((gdr_vec3){1, 0, 0}, pitch);
-    return (gdr_camera){.position = position, .rotation = gdr_quat_mul(qy, qp), .yfov = yfov, .znear = znear};
-}
-
-static int compare_pairs(const void *a, const void *b)
-{
-    const gdr_visible_meshlet *x = a, *y = b;
-    if (x->instance != y->instance)
-        return x->instance < y->instance ? -1 : 1;
-    return x->meshlet < y->meshlet ? -1 : x->meshlet > y->meshlet;
-}
-
 /* A scene of `count` instances of one closed dense mesh (an icosphere blob subdivided `levels`
  * times), in a row going away from the origin along -Z, with varied rotations and scales. */
 static gdr_scene *blob_scene(uint32_t levels, uint32_t count)
@@ -114,7 +99,7 @@ static uint32_t check_cut(const gdr_scene *scene, const gdr_frame_desc *frame, c
     CHECK(drawn && gdr_renderer_read_visible_meshlets(renderer, drawn, (uint32_t)capacity, &count, &err) == GDR_OK);
     if (!drawn)
         return 0;
-    qsort(drawn, count, sizeof *drawn, compare_pairs);
+    qsort(drawn, count, sizeof *drawn, compare_visible_meshlets);
     CHECK(stats.lod_applied == (frame->lod_fixed_depth ? frame->lod_depth > 0 : frame->lod_error_px > 0.0f));
     CHECK(count == stats.meshlets_visible);
     CHECK(stats.meshlets_lod_culled + stats.meshlets_visible == stats.meshlets_tested);
@@ -185,7 +170,7 @@ static void check_cuts(void)
         char what[96];
         const float thresholds[4] = {0.3f, 1.0f, 4.0f, 25.0f};
         for (int n = 0; n < 8; n++) {
-            gdr_camera camera = look((gdr_vec3){test_random_range(&rng, -20, 20), test_random_range(&rng, 0.5f, 15),
+            gdr_camera camera = test_look((gdr_vec3){test_random_range(&rng, -20, 20), test_random_range(&rng, 0.5f, 15),
                                                 test_random_range(&rng, -20, 30)},
                                      test_random_range(&rng, -PI_F, PI_F), test_random_range(&rng, -0.8f, 0.3f),
                                      test_random_range(&rng, 0.4f, 1.4f), test_random_range(&rng, 0.05f, 0.5f));
@@ -199,7 +184,7 @@ static void check_cuts(void)
             check_cut(scene, &frame, what);
         }
         /* Far away: every instance takes the root shortcut, which draws the root groups. */
-        gdr_frame_desc far = {.camera = look((gdr_vec3){0, 0, 4000}, 0, 0, 0.8f, 0.1f), .cull = GDR_CULL_OFF,
+        gdr_frame_desc far = {.camera = test_look((gdr_vec3){0, 0, 4000}, 0, 0, 0.8f, 0.1f), .cull = GDR_CULL_OFF,
                               .pipeline = GDR_PIPELINE_MESH, .record_visible_meshlets = true, .lod_error_px = 1.0f};
         snprintf(what, sizeof what, "%s far away", names[s]);
         check_cut(scene, &far, what);
@@ -260,7 +245,7 @@ static void check_cracks_and_quality(void)
     const float distances[3] = {2.6f, 5.0f, 12.0f};
     const float thresholds[6] = {8.0f, 4.0f, 2.0f, 1.0f, 0.5f, 0.25f};
     for (int d = 0; d < 3; d++) {
-        gdr_camera camera = look((gdr_vec3){0.3f, 0.4f, distances[d]}, 0.0f, 0.0f, 0.9f, 0.05f);
+        gdr_camera camera = test_look((gdr_vec3){0.3f, 0.4f, distances[d]}, 0.0f, 0.0f, 0.9f, 0.05f);
         gdr_frame_desc frame = {.camera = camera, .read_back = true, .pipeline = GDR_PIPELINE_MESH};
         gdr_frame_stats stats;
         CHECK(render(&frame, image_full, &stats));
@@ -292,7 +277,7 @@ static void check_cracks_and_quality(void)
     printf("triangles drawn at 1 px by distance:");
     for (int d = 0; d < 7; d++) {
         float distance = 3.0f * (float)(1 << d);
-        gdr_frame_desc frame = {.camera = look((gdr_vec3){0, 0, distance}, 0, 0, 0.9f, 0.05f), .cull = GDR_CULL_OFF,
+        gdr_frame_desc frame = {.camera = test_look((gdr_vec3){0, 0, distance}, 0, 0, 0.9f, 0.05f), .cull = GDR_CULL_OFF,
                                 .pipeline = GDR_PIPELINE_MESH, .lod_error_px = 1.0f};
         gdr_frame_stats stats;
         CHECK(render(&frame, NULL, &stats));

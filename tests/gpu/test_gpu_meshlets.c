@@ -71,14 +71,6 @@ static int cpu_cluster_visibility(const gdr_scene *scene, uint32_t index, uint32
     return surely_in && !maybe_back ? 1 : 0;
 }
 
-static int compare_pairs(const void *a, const void *b)
-{
-    const gdr_visible_meshlet *x = a, *y = b;
-    if (x->instance != y->instance)
-        return x->instance < y->instance ? -1 : 1;
-    return x->meshlet < y->meshlet ? -1 : x->meshlet > y->meshlet;
-}
-
 /* Pixels whose winner depends on rounding alone: they change in the indirect pipeline when the
  * camera moves by a millionth of its distance from the origin (far below a pixel on screen).
  * Overlapping coincident surfaces (CAD models are full of them) z-fight in a speckle pattern set
@@ -113,7 +105,7 @@ static void check_camera(const gdr_scene *scene, const gdr_camera *camera, const
     gdr_visible_meshlet *drawn = malloc(sizeof *drawn * capacity);
     uint32_t count = 0;
     CHECK(drawn && gdr_renderer_read_visible_meshlets(renderer, drawn, (uint32_t)capacity, &count, &err) == GDR_OK);
-    qsort(drawn, count, sizeof *drawn, compare_pairs);
+    qsort(drawn, count, sizeof *drawn, compare_visible_meshlets);
     CHECK(count == culled.meshlets_visible);
     CHECK(culled.meshlets_frustum_culled + culled.meshlets_cone_culled + culled.meshlets_visible == culled.meshlets_tested);
     CHECK(culled.task_overflow == 0);
@@ -180,13 +172,6 @@ static void check_camera(const gdr_scene *scene, const gdr_camera *camera, const
     }
 }
 
-static gdr_camera look(gdr_vec3 position, float yaw, float pitch, float yfov, float znear)
-{
-    gdr_quat qy = gdr_quat_from_axis_angle((gdr_vec3){0, 1, 0}, yaw);
-    gdr_quat qp = gdr_quat_from_axis_angle((gdr_vec3){1, 0, 0}, pitch);
-    return (gdr_camera){.position = position, .rotation = gdr_quat_mul(qy, qp), .yfov = yfov, .znear = znear};
-}
-
 static void check_demo(void)
 {
     gdr_error err = {0};
@@ -202,7 +187,7 @@ static void check_demo(void)
     char what[64];
     unsigned rng = 4242;
     for (int n = 0; n < 16; n++) { /* anywhere, any direction */
-        gdr_camera camera = look((gdr_vec3){test_random_range(&rng, -30, 30), test_random_range(&rng, 0.3f, 20),
+        gdr_camera camera = test_look((gdr_vec3){test_random_range(&rng, -30, 30), test_random_range(&rng, 0.3f, 20),
                                             test_random_range(&rng, -30, 30)},
                                  test_random_range(&rng, -PI_F, PI_F), test_random_range(&rng, -1.2f, 0.3f),
                                  test_random_range(&rng, 0.4f, 1.6f), test_random_range(&rng, 0.05f, 1.0f));
@@ -213,7 +198,7 @@ static void check_demo(void)
         const gdr_instance *instance = &scene->instances[(n * 37) % scene->instance_count];
         gdr_vec4 b = scene->meshes[instance->mesh].bounds;
         gdr_vec3 center = gdr_mat4_transform_point(instance->transform, (gdr_vec3){b.x, b.y, b.z});
-        gdr_camera camera = look(center, (float)n * 1.1f, -0.2f, 1.2f, 0.02f);
+        gdr_camera camera = test_look(center, (float)n * 1.1f, -0.2f, 1.2f, 0.02f);
         snprintf(what, sizeof what, "demo camera inside instance %u", (n * 37) % scene->instance_count);
         check_camera(scene, &camera, what);
     }
@@ -222,8 +207,8 @@ static void check_demo(void)
         gdr_vec4 b = scene->meshes[instance->mesh].bounds;
         gdr_vec3 center = gdr_mat4_transform_point(instance->transform, (gdr_vec3){b.x, b.y, b.z});
         float r = b.w * gdr_mat4_max_axis_scale(instance->transform);
-        gdr_camera camera = n < 2 ? look((gdr_vec3){center.x, 0.02f, center.z}, (float)n * 2.0f, 0.0f, 0.9f, 0.01f)
-                                  : look((gdr_vec3){center.x + r * 1.01f, center.y, center.z + 3.0f * r}, 0.0f,
+        gdr_camera camera = n < 2 ? test_look((gdr_vec3){center.x, 0.02f, center.z}, (float)n * 2.0f, 0.0f, 0.9f, 0.01f)
+                                  : test_look((gdr_vec3){center.x + r * 1.01f, center.y, center.z + 3.0f * r}, 0.0f,
                                          0.0f, 0.5f, 0.05f);
         snprintf(what, sizeof what, "demo grazing camera %d", n);
         check_camera(scene, &camera, what);
@@ -291,7 +276,7 @@ static void check_gltf(void)
         float yaw = (float)n * 1.3f, pitch = -0.35f + 0.15f * (float)n;
         gdr_vec3 back = {sinf(yaw) * cosf(pitch), -sinf(pitch), cosf(yaw) * cosf(pitch)}; /* camera +Z in world */
         gdr_vec3 position = gdr_vec3_add(center, gdr_vec3_scale(back, distances[n] * radius));
-        gdr_camera camera = look(position, yaw, pitch, 1.0f, 0.002f * radius);
+        gdr_camera camera = test_look(position, yaw, pitch, 1.0f, 0.002f * radius);
         snprintf(what, sizeof what, "2CylinderEngine camera %d", n);
         check_camera(scene, &camera, what);
     }

@@ -145,13 +145,6 @@ static void check_camera(const gdr_frame_desc *base, const char *what)
     }
 }
 
-static gdr_camera look(gdr_vec3 position, float yaw, float pitch, float yfov, float znear)
-{
-    gdr_quat qy = gdr_quat_from_axis_angle((gdr_vec3){0, 1, 0}, yaw);
-    gdr_quat qp = gdr_quat_from_axis_angle((gdr_vec3){1, 0, 0}, pitch);
-    return (gdr_camera){.position = position, .rotation = gdr_quat_mul(qy, qp), .yfov = yfov, .znear = znear};
-}
-
 static gdr_scene *load(const char *spec)
 {
     gdr_error err = {0};
@@ -179,7 +172,7 @@ static void check_demo(void)
     unsigned rng = 99;
     char what[64];
     for (int n = 0; n < 3; n++) {
-        frame.camera = look((gdr_vec3){test_random_range(&rng, -20, 20), test_random_range(&rng, 0.5f, 8),
+        frame.camera = test_look((gdr_vec3){test_random_range(&rng, -20, 20), test_random_range(&rng, 0.5f, 8),
                                        test_random_range(&rng, -20, 20)},
                             test_random_range(&rng, -PI_F, PI_F), test_random_range(&rng, -0.6f, 0.1f), 1.0f, 0.05f);
         snprintf(what, sizeof what, "demo random camera %d", n);
