@@ -4,9 +4,9 @@
  *    filling the view (2 * (W / S) * (H / S) triangles), for each S of --sizes, drawn by the mesh
  *    shaders forward (no visibility buffer), by the mesh shaders into the visibility buffer (hw)
  *    and by the compute rasteriser (sw). Triangles per second = triangles / the rasteriser's GPU
- *    time (timestamps: the "draw" pass forward; the mesh-shader pass for hw; the compute dispatch,
- *    with its one-thread submit pass, for sw). The resolve is timed apart: it costs the same for
- *    every field.
+ *    time (timestamps: the "draw" pass forward; the mesh-shader pass for hw; the compute dispatch
+ *    for sw). The cluster cull (tests, binning and launches) and the resolve are timed apart: they
+ *    cost the same for every rasteriser.
  * 2. A scene: the lod-field scene (--instances copies of a --triangles mesh with a LOD DAG, cut at
  *    --lod-error pixels) at W x H, GPU ms per frame for hw and for hybrid at each --thresholds.
  * Occlusion culling is off (one raster phase per frame). Prints a table and JSON (--json FILE).
@@ -38,13 +38,13 @@ typedef struct options {
 typedef struct field_result {
     float size_px;
     uint64_t triangles;
-    double forward_ms, hw_ms, sw_ms, resolve_ms, sw_binning_ms;
+    double forward_ms, cull_ms, hw_ms, sw_ms, resolve_ms;
 } field_result;
 
 typedef struct scene_result {
     const char *raster;
     float threshold;
-    double gpu_ms, hw_ms, sw_ms, resolve_ms;
+    double gpu_ms, cull_ms, hw_ms, sw_ms, resolve_ms;
     uint32_t sw_clusters, hw_clusters;
     uint64_t sw_triangles, hw_triangles;
 } scene_result;
@@ -228,12 +228,12 @@ static gdr_status run_field(const options *o, float size_px, field_result *out, 
     }
     if (status == GDR_OK) {
         out->hw_ms = stats.raster_hw_ms;
+        out->cull_ms = stats.raster_cull_ms;
         out->resolve_ms = stats.raster_resolve_ms;
         status = render(o, r, frame, GDR_RASTER_SW, 0.0f, &stats, err);
     }
     if (status == GDR_OK) {
         out->sw_ms = stats.raster_sw_ms;
-        out->sw_binning_ms = stats.raster_hw_ms; /* the task shaders alone: binning, no mesh work */
         if (stats.raster_hw_clusters > 0)
             fprintf(stderr, "raster_bench: %u clusters of the %g px field went to the mesh shaders in sw mode "
                             "(their spheres leave the guard band)\n", stats.raster_hw_clusters, (double)size_px);
@@ -264,7 +264,7 @@ static gdr_status run_scene(const options *o, scene_result *results, uint32_t *c
         status = render(o, r, frame, raster, threshold, &stats, err);
         if (status == GDR_OK)
             results[(*count)++] = (scene_result){gdr_raster_name(raster), threshold, stats.gpu_ms_per_frame,
-                                                 stats.raster_hw_ms, stats.raster_sw_ms, stats.raster_resolve_ms,
+                                                 stats.raster_cull_ms, stats.raster_hw_ms, stats.raster_sw_ms, stats.raster_resolve_ms,
                                                  stats.raster_sw_clusters, stats.raster_hw_clusters,
                                                  stats.raster_sw_triangles, stats.raster_hw_triangles};
     }
@@ -286,21 +286,21 @@ static void write_json(FILE *f, const options *o, const field_result *fields, co
     for (uint32_t i = 0; i < o->size_count; i++) {
         const field_result *r = &fields[i];
         fprintf(f, "    {\"size_px\": %g, \"triangles\": %llu, \"forward_ms\": %.4f, \"hw_ms\": %.4f, \"sw_ms\": %.4f, "
-                   "\"resolve_ms\": %.4f, \"sw_binning_ms\": %.4f, \"forward_tris_per_s\": %.4g, "
+                   "\"resolve_ms\": %.4f, \"cull_ms\": %.4f, \"forward_tris_per_s\": %.4g, "
                    "\"hw_tris_per_s\": %.4g, \"sw_tris_per_s\": %.4g}%s\n",
                 (double)r->size_px, (unsigned long long)r->triangles, r->forward_ms, r->hw_ms, r->sw_ms, r->resolve_ms,
-                r->sw_binning_ms, per_second(r->triangles, r->forward_ms), per_second(r->triangles, r->hw_ms),
+                r->cull_ms, per_second(r->triangles, r->forward_ms), per_second(r->triangles, r->hw_ms),
                 per_second(r->triangles, r->sw_ms), i + 1 < o->size_count ? "," : "");
     }
     fprintf(f, "  ],\n  \"scene\": {\"instances\": %u, \"triangles\": %u, \"lod_error_px\": %g, \"runs\": [\n",
             o->instances, o->triangles, (double)o->lod_error);
     for (uint32_t i = 0; i < scene_count; i++) {
         const scene_result *s = &scenes[i];
-        fprintf(f, "    {\"raster\": \"%s\", \"sw_threshold_px\": %g, \"gpu_ms_per_frame\": %.4f, \"hw_ms\": %.4f, "
+        fprintf(f, "    {\"raster\": \"%s\", \"sw_threshold_px\": %g, \"gpu_ms_per_frame\": %.4f, \"cull_ms\": %.4f, \"hw_ms\": %.4f, "
                    "\"sw_ms\": %.4f, \"resolve_ms\": %.4f, \"sw_clusters\": %u, \"hw_clusters\": %u, "
                    "\"sw_triangles\": %llu, \"hw_triangles\": %llu}%s\n",
-                s->raster, (double)s->threshold, s->gpu_ms, s->hw_ms, s->sw_ms, s->resolve_ms, s->sw_clusters,
-                s->hw_clusters, (unsigned long long)s->sw_triangles, (unsigned long long)s->hw_triangles,
+                s->raster, (double)s->threshold, s->gpu_ms, s->cull_ms, s->hw_ms, s->sw_ms, s->resolve_ms,
+                s->sw_clusters, s->hw_clusters, (unsigned long long)s->sw_triangles, (unsigned long long)s->hw_triangles,
                 i + 1 < scene_count ? "," : "");
     }
     fprintf(f, "  ]}\n}\n");
@@ -340,15 +340,15 @@ int main(int argc, char **argv)
         fprintf(stderr, "raster_bench: lod-field: %s\n", err.message);
         return 1;
     }
-    printf("%8s %10s %10s %10s %10s %10s %22s %22s\n", "raster", "threshold", "frame", "hw", "sw", "resolve",
-           "sw clusters/triangles", "hw clusters/triangles");
+    printf("%8s %10s %10s %10s %10s %10s %10s %22s %22s\n", "raster", "threshold", "frame", "cull", "hw", "sw",
+           "resolve", "sw clusters/triangles", "hw clusters/triangles");
     for (uint32_t i = 0; i < scene_count; i++) {
         const scene_result *s = &scenes[i];
         char sw[32], hw[32];
         snprintf(sw, sizeof sw, "%u/%llu", s->sw_clusters, (unsigned long long)s->sw_triangles);
         snprintf(hw, sizeof hw, "%u/%llu", s->hw_clusters, (unsigned long long)s->hw_triangles);
-        printf("%8s %10g %10.3f %10.3f %10.3f %10.3f %22s %22s\n", s->raster, (double)s->threshold, s->gpu_ms, s->hw_ms,
-               s->sw_ms, s->resolve_ms, sw, hw);
+        printf("%8s %10g %10.3f %10.3f %10.3f %10.3f %10.3f %22s %22s\n", s->raster, (double)s->threshold, s->gpu_ms,
+               s->cull_ms, s->hw_ms, s->sw_ms, s->resolve_ms, sw, hw);
     }
     if (scene_count > 1)
         printf("hybrid (%g px) vs hw: %.2fx faster per frame\n", (double)scenes[1].threshold,

@@ -156,16 +156,17 @@ typedef struct gdr_frame_stats {
     uint32_t overdraw_max;                /* overdraw view: the most fragments one pixel received */
     /* Rasterisation (issue 8): the path that rasterised (never DEFAULT; FORWARD off the mesh
      * pipeline) and why; the threshold HYBRID used; the last frame's visible clusters and their
-     * triangles (before back-face culling) per rasteriser; the GPU time of the mesh-shader pass, of
-     * the compute rasteriser (with its submit pass) and of the resolve, means over the frames (the
-     * three are part of the "draw" pass). */
+     * triangles (before back-face culling) per rasteriser; the GPU time of the cluster cull (the
+     * per-cluster tests and binning, with the launches), of the mesh-shader pass, of the compute
+     * rasteriser and of the resolve, means over the frames (the four are part of the "draw" pass). */
     gdr_raster raster;
     char raster_reason[128];
     float sw_threshold_px;
     uint32_t raster_sw_clusters, raster_hw_clusters;
     uint64_t raster_sw_triangles, raster_hw_triangles;
-    uint32_t raster_overflow;             /* clusters lost for want of room in the list: 0 below 2^25 */
-    double raster_hw_ms, raster_sw_ms, raster_resolve_ms;
+    uint32_t raster_overflow;             /* clusters lost for want of room in the list (0 below 2^25) or
+                                             beyond the device's mesh launch limit (0 below 2^22) */
+    double raster_cull_ms, raster_hw_ms, raster_sw_ms, raster_resolve_ms;
     /* The LOD cut (mesh pipeline), last frame: whether it was applied, the clusters it left out,
      * and the clusters and triangles drawn per DAG depth (the last entry: that depth or deeper;
      * triangles before triangle culling). */

@@ -40,9 +40,13 @@ _Static_assert(sizeof(GdrGpuPushConstants) == 120 && offsetof(GdrGpuPushConstant
                "GdrGpuPushConstants");
 _Static_assert(sizeof(GdrGpuPushConstants) <= 128, "push constants must fit the guaranteed 128 bytes");
 _Static_assert(sizeof(GdrGpuRasterCluster) == 8, "GdrGpuRasterCluster");
-_Static_assert(sizeof(GdrGpuRasterCounters) == 48 && offsetof(GdrGpuRasterCounters, dispatch_z) == 8 &&
+_Static_assert(sizeof(GdrGpuRasterCounters) == 72 && offsetof(GdrGpuRasterCounters, dispatch_z) == 8 &&
                    offsetof(GdrGpuRasterCounters, dispatch_x) == offsetof(VkDispatchIndirectCommand, x),
                "GdrGpuRasterCounters starts with a VkDispatchIndirectCommand");
+_Static_assert(offsetof(GdrGpuRasterCounters, draw_y) == offsetof(GdrGpuRasterCounters, draw_x) + 4 &&
+                   offsetof(GdrGpuRasterCounters, draw_z) == offsetof(GdrGpuRasterCounters, draw_x) + 8 &&
+                   offsetof(GdrGpuRasterCounters, draw_x) % 4 == 0,
+               "GdrGpuRasterCounters.draw_x..z is a VkDrawMeshTasksIndirectCommandEXT");
 _Static_assert(sizeof(GdrGpuRasterParams) == 48 && offsetof(GdrGpuRasterParams, mode) == 16 &&
                    offsetof(GdrGpuRasterParams, ndc_scale) == 32, "GdrGpuRasterParams");
 _Static_assert(GDR_MESH_MAX_TRIANGLES <= (1u << GDR_VISBUFFER_TRIANGLE_BITS) &&

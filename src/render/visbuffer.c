@@ -22,18 +22,17 @@ static gdr_status create_pipelines(gdr_renderer *r, gdr_error *err)
 {
     gdr_visbuffer *v = &r->vis;
     gdr_status status = GDR_OK;
-    /* The mesh-shader pass: no attachments, the atomic is the depth test. One per occlusion-culling
-     * phase of the task shader (its constant 0: none, early, late). */
-    for (uint32_t phase = 0; phase < 3 && status == GDR_OK; phase++) {
-        VkSpecializationMapEntry entry = {0, 0, sizeof(uint32_t)};
-        VkSpecializationInfo constants = {1, &entry, sizeof phase, &phase};
-        gdr_vk_graphics_pipeline_desc hw = {
-            .layout = r->layout, .task_shader = &gdr_shader_meshlet_task, .task_specialization = &constants,
-            .mesh_shader = &gdr_shader_meshlet_mesh, .fragment_shader = &gdr_shader_meshlet_visbuffer_frag,
-            .color_format = VK_FORMAT_UNDEFINED, .depth_format = VK_FORMAT_UNDEFINED,
-            .cull_mode = VK_CULL_MODE_BACK_BIT, .no_depth_test = true};
-        status = gdr_vk_graphics_pipeline_create(r->ctx, &hw, &v->hw_pipelines[phase], err);
-    }
+    /* The cluster cull, one per occlusion-culling phase (its constant 0: none, early, late). */
+    for (uint32_t phase = 0; phase < 3 && status == GDR_OK; phase++)
+        status = gdr_vk_compute_pipeline_create_specialized(r->ctx, r->layout, &gdr_shader_clustercull_comp, &phase, 1,
+                                                            &v->cull_pipelines[phase], err);
+    /* The mesh-shader pass: no task shader, no attachments, the atomic is the depth test. */
+    gdr_vk_graphics_pipeline_desc hw = {
+        .layout = r->layout, .mesh_shader = &gdr_shader_meshlet_list_mesh,
+        .fragment_shader = &gdr_shader_meshlet_visbuffer_frag, .color_format = VK_FORMAT_UNDEFINED,
+        .depth_format = VK_FORMAT_UNDEFINED, .cull_mode = VK_CULL_MODE_BACK_BIT, .no_depth_test = true};
+    if (status == GDR_OK)
+        status = gdr_vk_graphics_pipeline_create(r->ctx, &hw, &v->hw_pipeline, err);
     if (status == GDR_OK)
         status = gdr_vk_compute_pipeline_create(r->ctx, r->layout, &gdr_shader_raster_sw_comp, &v->sw_pipeline, err);
     if (status == GDR_OK)
@@ -110,8 +109,8 @@ void gdr_visbuffer_destroy(gdr_renderer *r)
 {
     gdr_visbuffer *v = &r->vis;
     VkDevice device = r->ctx->device;
-    VkPipeline pipelines[] = {v->hw_pipelines[0], v->hw_pipelines[1], v->hw_pipelines[2], v->sw_pipeline,
-                              v->submit_pipeline, v->resolve_pipeline};
+    VkPipeline pipelines[] = {v->cull_pipelines[0], v->cull_pipelines[1], v->cull_pipelines[2], v->hw_pipeline,
+                              v->sw_pipeline, v->submit_pipeline, v->resolve_pipeline};
     for (size_t i = 0; i < sizeof pipelines / sizeof pipelines[0]; i++)
         if (pipelines[i])
             vkDestroyPipeline(device, pipelines[i], NULL);
@@ -201,7 +200,7 @@ static void collect_timings(gdr_renderer *r, uint32_t slot_index)
         return; /* timings only: a frame without them is left out of the means */
     double period_ms = r->ctx->properties.limits.timestampPeriod * 1e-6;
     for (uint32_t p = 0; p < phases; p++)
-        for (int i = 0; i < 3; i++)
+        for (int i = 0; i + 1 < GDR_VISBUFFER_TS_COUNT; i++)
             v->pass_ms[i] += (double)(ticks[p * GDR_VISBUFFER_TS_COUNT + i + 1] - ticks[p * GDR_VISBUFFER_TS_COUNT + i]) *
                              period_ms;
     v->timed_frames++;
@@ -226,6 +225,11 @@ void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_f
     collect_timings(r, slot_index);
     gdr_mat4 projection, view;
     gdr_frame_matrices(r, &frame->camera, &projection, &view);
+    /* Launches of whole rows (raster_submit.comp) within the device's mesh launch limits. */
+    const VkPhysicalDeviceMeshShaderPropertiesEXT *mesh = &r->ctx->mesh_shader_properties;
+    uint64_t rows = mesh->maxMeshWorkGroupTotalCount / GDR_MESH_GROUPS_PER_ROW;
+    if (rows > mesh->maxMeshWorkGroupCount[1])
+        rows = mesh->maxMeshWorkGroupCount[1];
     GdrGpuRasterParams params = {
         .clusters = v->clusters.address,
         .counters = v->counters.address,
@@ -233,6 +237,7 @@ void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_f
         .capacity = v->capacity,
         .sw_threshold_px = gdr_visbuffer_threshold(frame),
         .ndc_scale = {fabsf(projection.m[0]), fabsf(projection.m[5])},
+        .hw_launch_limit = (uint32_t)(rows * GDR_MESH_GROUPS_PER_ROW),
     };
     memcpy(v->params[slot_index].mapped, &params, sizeof params);
     if (mode != GDR_GPU_RASTER_FORWARD) {
@@ -258,30 +263,43 @@ static void set_viewport(gdr_renderer *r, VkCommandBuffer cmd)
     vkCmdSetScissor(cmd, 0, 1, &scissor);
 }
 
-/* The mesh-shader pass: the task shaders bin, the fragments write the visibility buffer. */
-static void record_hw(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer cmd, int phase, VkDeviceSize launch)
+/* The cluster cull over the phase's task commands (launched like the task shader would be, from
+ * `launch` in the slot's draw stats), then the launches of both rasterisers. */
+static void record_cull(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer cmd, int phase, VkDeviceSize launch)
+{
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->vis.cull_pipelines[phase]);
+    vkCmdDispatchIndirect(cmd, slot->draw_stats.buffer, launch);
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->vis.submit_pipeline);
+    vkCmdDispatch(cmd, 1, 1, 1);
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_MESH_SHADER_BIT_EXT |
+                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                   VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_SHADER_READ_BIT);
+}
+
+/* The mesh-shader pass: one mesh workgroup per cluster at the back of the list; the fragments write
+ * the visibility buffer. */
+static void record_hw(gdr_renderer *r, VkCommandBuffer cmd)
 {
     VkRenderingInfo rendering = {.sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
                                  .renderArea = {{0, 0}, {r->width, r->height}}, .layerCount = 1};
     vkCmdBeginRendering(cmd, &rendering);
     set_viewport(r, cmd);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->vis.hw_pipelines[phase]);
-    r->ctx->cmd_draw_mesh_tasks_indirect(cmd, slot->draw_stats.buffer, launch, 1,
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->vis.hw_pipeline);
+    r->ctx->cmd_draw_mesh_tasks_indirect(cmd, r->vis.counters.buffer, offsetof(GdrGpuRasterCounters, draw_x), 1,
                                          sizeof(VkDrawMeshTasksIndirectCommandEXT));
     vkCmdEndRendering(cmd);
 }
 
-/* The compute rasteriser over the clusters the task shaders appended. */
+/* The compute rasteriser over the clusters at the front of the list. (After the mesh-shader pass:
+ * both write the visibility buffer, with atomics, but a barrier keeps the timings apart.) */
 static void record_sw(gdr_renderer *r, VkCommandBuffer cmd)
 {
-    const VkPipelineStageFlags2 mesh_stages = VK_PIPELINE_STAGE_2_TASK_SHADER_BIT_EXT | VK_PIPELINE_STAGE_2_MESH_SHADER_BIT_EXT;
-    memory_barrier(cmd, mesh_stages | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
-                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->vis.submit_pipeline);
-    vkCmdDispatch(cmd, 1, 1, 1);
-    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
-                   VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                   VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_2_SHADER_READ_BIT);
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_MESH_SHADER_BIT_EXT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                   VK_ACCESS_2_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                   VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->vis.sw_pipeline);
     vkCmdDispatchIndirect(cmd, r->vis.counters.buffer, offsetof(GdrGpuRasterCounters, dispatch_x));
 }
@@ -325,7 +343,9 @@ void gdr_visbuffer_record_raster(gdr_renderer *r, gdr_frame_slot *slot, VkComman
 {
     uint32_t slot_index = (uint32_t)(slot - r->slots);
     timestamp(r, cmd, slot_index, GDR_VISBUFFER_TS_BEGIN);
-    record_hw(r, slot, cmd, phase, launch);
+    record_cull(r, slot, cmd, phase, launch);
+    timestamp(r, cmd, slot_index, GDR_VISBUFFER_TS_AFTER_CULL);
+    record_hw(r, cmd);
     timestamp(r, cmd, slot_index, GDR_VISBUFFER_TS_AFTER_HW);
     record_sw(r, cmd);
     timestamp(r, cmd, slot_index, GDR_VISBUFFER_TS_AFTER_SW);
@@ -362,9 +382,10 @@ void gdr_visbuffer_stats(gdr_renderer *r, uint32_t slot_index, gdr_frame_stats *
     stats->raster_hw_triangles = counters.hw_triangles;
     stats->raster_overflow = counters.overflow;
     if (v->timed_frames > 0) {
-        stats->raster_hw_ms = v->pass_ms[0] / v->timed_frames;
-        stats->raster_sw_ms = v->pass_ms[1] / v->timed_frames;
-        stats->raster_resolve_ms = v->pass_ms[2] / v->timed_frames;
+        stats->raster_cull_ms = v->pass_ms[0] / v->timed_frames;
+        stats->raster_hw_ms = v->pass_ms[1] / v->timed_frames;
+        stats->raster_sw_ms = v->pass_ms[2] / v->timed_frames;
+        stats->raster_resolve_ms = v->pass_ms[3] / v->timed_frames;
     }
 }
 

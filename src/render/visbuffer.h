@@ -2,15 +2,19 @@
  *
  * Per frame, in the visibility-buffer modes:
  *  1. fills: the counters and the visibility buffer to zero (gdr_visbuffer_begin_frame);
- *  2. the mesh-shader pass: the task shaders bin each visible cluster (shared/raster_bin.h), append
- *     the compute rasteriser's to the front of the frame's visible-cluster list and reserve their
- *     own at the back; the mesh shaders' fragments write (depth, id) with a 64-bit atomicMax
+ *  2. the cluster cull (clustercull.comp), launched indirectly over the instance cull's task
+ *     commands: the per-cluster tests of the task shader (shared/cluster_cull.h), then each visible
+ *     cluster binned (shared/raster_bin.h) and appended to the frame's visible-cluster list, the
+ *     compute rasteriser's at the front and the mesh shaders' at the back;
+ *  3. raster_submit.comp writes both launches: the compute rasteriser's VkDispatchIndirectCommand
+ *     and the mesh shaders' VkDrawMeshTasksIndirectCommandEXT;
+ *  4. the mesh-shader pass without a task shader (meshlet_list.mesh), one workgroup per cluster at
+ *     the back of the list; its fragments write (depth, id) with a 64-bit atomicMax
  *     (meshlet_visbuffer.frag), no attachments;
- *  3. raster_submit.comp writes the compute rasteriser's VkDispatchIndirectCommand;
- *  4. raster_sw.comp, one workgroup per cluster, writes the same atomics;
- *  5. the resolve (visbuffer_resolve.frag) shades every pixel into the colour image and writes its
+ *  5. raster_sw.comp, one workgroup per cluster at the front, writes the same atomics;
+ *  6. the resolve (visbuffer_resolve.frag) shades every pixel into the colour image and writes its
  *     depth into the depth image.
- * Steps 2 to 5 are gdr_visbuffer_record_raster; the CPU records the same commands whatever the scene.
+ * Steps 2 to 6 are gdr_visbuffer_record_raster; the CPU records the same commands whatever the scene.
  *
  * The list holds every cluster of every instance's DAG (at most GDR_RASTER_MAX_CLUSTERS entries),
  * so it cannot overflow below that size; beyond it, clusters that do not fit are dropped and counted
@@ -25,7 +29,8 @@
 struct gdr_frame_slot;
 
 enum gdr_visbuffer_timestamp {
-    GDR_VISBUFFER_TS_BEGIN,     /* before the mesh-shader pass */
+    GDR_VISBUFFER_TS_BEGIN,     /* before the cluster cull */
+    GDR_VISBUFFER_TS_AFTER_CULL,
     GDR_VISBUFFER_TS_AFTER_HW,
     GDR_VISBUFFER_TS_AFTER_SW,
     GDR_VISBUFFER_TS_AFTER_RESOLVE,
@@ -43,12 +48,14 @@ typedef struct gdr_visbuffer {
     uint32_t capacity;
     uint32_t mode;               /* GDR_GPU_RASTER_* of the frames of the current render call */
     char reason[128];            /* why that mode */
-    VkPipeline hw_pipelines[3];  /* mesh-shader pass per occlusion phase: none, early, late */
+    VkPipeline cull_pipelines[3]; /* cluster cull per occlusion phase: none, early, late */
+    VkPipeline hw_pipeline;       /* mesh shaders (no task shader) into the visibility buffer */
     VkPipeline sw_pipeline, submit_pipeline, resolve_pipeline;
     VkQueryPool timestamps;      /* GDR_VISBUFFER_TS_COUNT per raster phase, two phases per frame slot */
     uint32_t slot_mode[GDR_FRAMES_IN_FLIGHT]; /* GDR_GPU_RASTER_* of the slot's last frame */
     uint32_t slot_phases[GDR_FRAMES_IN_FLIGHT]; /* raster phases timed in it, yet to be read */
-    double pass_ms[3];           /* hw, sw, resolve, summed over the timed frames of one render call */
+    double pass_ms[GDR_VISBUFFER_TS_COUNT - 1]; /* cull, hw, sw, resolve, summed over the timed frames
+                                                    of one render call */
     uint32_t timed_frames;
 } gdr_visbuffer;
 
@@ -74,9 +81,10 @@ void gdr_visbuffer_begin_render(gdr_renderer *r);
  * frame must have finished (its timings are gathered here). */
 void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_frame_desc *frame, uint32_t mode,
                                VkCommandBuffer cmd);
-/* Steps 2 to 5 above for one raster phase (0: the only one, 1: occlusion culling's early phase,
- * 2: its late phase, which adds to what the early one wrote), after the cull's barrier; `launch`:
- * the offset of the phase's VkDrawMeshTasksIndirectCommandEXT in the slot's draw stats. Leaves the
+/* Steps 2 to 6 above for one raster phase (0: the only one, 1: occlusion culling's early phase,
+ * 2: its late phase, which adds to what the early one wrote), after the instance cull's barrier
+ * (which must make its writes visible to compute shaders and indirect reads); `launch`: the offset
+ * of the phase's task launch (x, y, z: one workgroup per task command) in the slot's draw stats. Leaves the
  * colour image in COLOR_ATTACHMENT_OPTIMAL and the depth image in DEPTH_ATTACHMENT_OPTIMAL with the
  * depth of everything rasterised so far (for the depth pyramid), their writes and the overdraw
  * counts visible to fragment and compute shaders. */

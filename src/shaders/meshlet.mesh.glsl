@@ -3,6 +3,10 @@
 // back-face test and the "covers no sample" test (seed 000) mark triangles culled before raster.
 // Both tests are conservative against the rasteriser: a triangle is culled only when its 8-bit
 // sub-pixel snapped form (Vulkan's minimum precision) could not produce a fragment either.
+// Two variants (src/shaders/CMakeLists.txt): the forward one draws the clusters its task workgroup
+// hands over in the payload; the visibility-buffer one (GDR_MESH_FROM_LIST, issue 8) is launched
+// without a task shader, one workgroup per mesh-shader entry that clustercull.comp appended to the
+// frame's visible-cluster list, and its fragments write the visibility buffer.
 #extension GL_EXT_mesh_shader : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 
@@ -14,7 +18,9 @@
 layout(local_size_x = GDR_MESH_WORKGROUP_SIZE) in;
 layout(triangles, max_vertices = GDR_MESH_MAX_VERTICES, max_primitives = GDR_MESH_MAX_TRIANGLES) out;
 
+#ifndef GDR_MESH_FROM_LIST
 taskPayloadSharedEXT GdrTaskPayload payload;
+#endif
 
 // Only the built-ins used: the implicit blocks would also declare the shading-rate built-in, whose
 // capability the device does not enable.
@@ -24,7 +30,9 @@ out gl_MeshPerPrimitiveEXT { perprimitiveEXT bool gl_CullPrimitiveEXT; } gl_Mesh
 layout(location = 0) out vec3 out_normal[];
 layout(location = 1) out vec3 out_world_position[];
 layout(location = 2) perprimitiveEXT flat out vec4 out_color[];
-layout(location = 3) perprimitiveEXT flat out uint out_visibility_id[]; // visibility buffer (issue 8)
+#ifdef GDR_MESH_FROM_LIST
+layout(location = 3) perprimitiveEXT flat out uint out_visibility_id[]; // list slot and triangle (issue 8)
+#endif
 
 shared vec3 screen[GDR_MESH_MAX_VERTICES]; // pixels (y up) and clip w
 
@@ -54,22 +62,25 @@ uint triangle_culled(vec3 a, vec3 b, vec3 c)
 void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
-    uint meshlet_index = payload.meshlets[gl_WorkGroupID.x];
-    GdrGpuMeshlet meshlet = MeshletsRef(push.meshlets).items[meshlet_index];
-    GdrGpuInstance instance = InstancesRef(push.instances).items[payload.instance];
     uint lane = gl_LocalInvocationIndex;
-    // Visibility buffer (issue 8): the cluster's entry in the frame's list (reserved by the task
-    // shader; none when the list was full), and an id per triangle.
+#ifdef GDR_MESH_FROM_LIST
+    // This launch's entries: [hw_first, hw_first + hw_count) (raster_submit.comp), in rows.
     GdrGpuRasterParams raster = RasterParamsRef(push.raster).value;
-    bool visbuffer = raster.mode != GDR_GPU_RASTER_FORWARD;
-    uint slot = payload.raster_first + gl_WorkGroupID.x;
-    if (visbuffer && payload.raster_first == GDR_RASTER_NO_SLOT) {
-        SetMeshOutputsEXT(0u, 0u);
+    RasterCountersRef counters = RasterCountersRef(raster.counters);
+    uint launched = gl_WorkGroupID.x + gl_WorkGroupID.y * GDR_MESH_GROUPS_PER_ROW;
+    if (launched >= counters.value.hw_count) {
+        SetMeshOutputsEXT(0u, 0u); // the tail of the last row
         return;
     }
+    uint slot = counters.value.hw_first + launched;
+    GdrGpuRasterCluster entry = RasterClustersRef(raster.clusters).items[slot];
+    uint instance_index = entry.instance, meshlet_index = entry.meshlet;
+#else
+    uint instance_index = payload.instance, meshlet_index = payload.meshlets[gl_WorkGroupID.x];
+#endif
+    GdrGpuMeshlet meshlet = MeshletsRef(push.meshlets).items[meshlet_index];
+    GdrGpuInstance instance = InstancesRef(push.instances).items[instance_index];
     SetMeshOutputsEXT(meshlet.vertex_count, meshlet.triangle_count);
-    if (visbuffer && lane == 0u)
-        RasterClustersRef(raster.clusters).items[slot] = GdrGpuRasterCluster(payload.instance, meshlet_index);
 
     mat3 m = mat3(instance.model);
     mat3 cofactor = mat3(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1]));
@@ -98,13 +109,15 @@ void main()
         if (g.view_mode == GDR_VIEW_MESHLETS)
             albedo = gdr_id_color(meshlet_index);
         else if (g.view_mode == GDR_VIEW_INSTANCES)
-            albedo = gdr_id_color(payload.instance);
+            albedo = gdr_id_color(instance_index);
         else if (g.view_mode == GDR_VIEW_TRIANGLES)
             albedo = gdr_id_color(meshlet_index * 128u + t);
         else if (g.view_mode == GDR_VIEW_LOD)
             albedo = gdr_depth_color(meshlet.group_depth);
         out_color[t] = vec4(albedo, 1.0);
+#ifdef GDR_MESH_FROM_LIST
         out_visibility_id[t] = gdr_visbuffer_id(slot, t);
+#endif
         emitted += why == 0u ? 1u : 0u;
         backfacing += why == 1u ? 1u : 0u;
         small += why == 2u ? 1u : 0u;

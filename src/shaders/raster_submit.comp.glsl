@@ -1,8 +1,9 @@
 #version 460
-// The compute rasteriser's "submit" pass (issue 8): one thread turns the number of clusters the
-// task shaders binned to it since the last launch into the VkDispatchIndirectCommand that launches
-// one workgroup each. Launches wider than GDR_SW_GROUPS_PER_ROW use rows (y); the rasteriser skips
-// the tail of the last row.
+// The launches of one raster phase (issue 8), one thread: from the clusters the cluster cull
+// appended since the last phase, the compute rasteriser's VkDispatchIndirectCommand (front of the
+// list) and the mesh shaders' VkDrawMeshTasksIndirectCommandEXT (back of the list), one workgroup per
+// cluster. Launches wider than a row use y; the shaders skip the tail of the last row. Mesh-shader
+// clusters beyond the device's launch limit are dropped and counted as overflow.
 #include "shared/glsl_buffers.h"
 #include "shared/visbuffer.h"
 
@@ -10,8 +11,8 @@ layout(local_size_x = 1) in;
 
 void main()
 {
-    RasterCountersRef counters = RasterCountersRef(RasterParamsRef(push.raster).value.counters);
-    // The clusters appended since the last dispatch of the frame (one per raster phase).
+    GdrGpuRasterParams params = RasterParamsRef(push.raster).value;
+    RasterCountersRef counters = RasterCountersRef(params.counters);
     uint first = counters.value.sw_dispatched;
     uint count = counters.value.sw_clusters - first;
     counters.value.sw_first = first;
@@ -20,4 +21,17 @@ void main()
     counters.value.dispatch_x = rows > 1u ? GDR_SW_GROUPS_PER_ROW : count;
     counters.value.dispatch_y = rows;
     counters.value.dispatch_z = 1u;
+
+    uint hw_total = counters.value.hw_clusters;
+    uint hw_new = hw_total - counters.value.hw_dispatched;
+    uint hw_count = min(hw_new, params.hw_launch_limit);
+    if (hw_count < hw_new)
+        counters.value.overflow += hw_new - hw_count;
+    counters.value.hw_first = params.capacity - hw_total;
+    counters.value.hw_count = hw_count;
+    counters.value.hw_dispatched = hw_total;
+    rows = (hw_count + GDR_MESH_GROUPS_PER_ROW - 1u) / GDR_MESH_GROUPS_PER_ROW;
+    counters.value.draw_x = rows > 1u ? GDR_MESH_GROUPS_PER_ROW : hw_count;
+    counters.value.draw_y = rows;
+    counters.value.draw_z = 1u;
 }

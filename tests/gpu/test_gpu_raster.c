@@ -86,13 +86,30 @@ static uint32_t differing_pixels(const frame_result *a, const frame_result *b)
 static void check_camera(const gdr_frame_desc *base, const char *what)
 {
     frame_result *forward = &result_a, *hw = &result_b, *sw = &result_c, *hybrid = &result_d;
-    if (!render(base, GDR_RASTER_FORWARD, forward) || !render(base, GDR_RASTER_HW, hw) ||
+    /* Forward and hw without occlusion history (the last frame saw another camera), so that their
+     * cluster statistics can be compared. */
+    gdr_frame_desc fresh = *base;
+    fresh.occlusion_camera_cut = true;
+    if (!render(&fresh, GDR_RASTER_FORWARD, forward) || !render(&fresh, GDR_RASTER_HW, hw) ||
         !render(base, GDR_RASTER_SW, sw)) {
         CHECK(false);
         return;
     }
     CHECK(hw->stats.raster == GDR_RASTER_HW && hw->stats.raster_sw_clusters == 0);
     CHECK(sw->stats.raster == GDR_RASTER_SW && sw->stats.raster_overflow == 0);
+    /* The forward path tests clusters in the task shader, the visibility-buffer paths in the
+     * cluster-cull compute pass: the same tests (shared/cluster_cull.h), the same decisions. */
+    const gdr_frame_stats *f = &forward->stats, *h = &hw->stats;
+    CHECK(f->meshlets_tested == h->meshlets_tested && f->meshlets_visible == h->meshlets_visible &&
+          f->meshlets_frustum_culled == h->meshlets_frustum_culled &&
+          f->meshlets_cone_culled == h->meshlets_cone_culled && f->meshlets_lod_culled == h->meshlets_lod_culled);
+    if (f->meshlets_visible != h->meshlets_visible)
+        fprintf(stderr, "%s: forward tested %u visible %u frustum %u cone %u lod %u; hw tested %u visible %u frustum "
+                "%u cone %u lod %u\n", what, f->meshlets_tested, f->meshlets_visible, f->meshlets_frustum_culled,
+                f->meshlets_cone_culled, f->meshlets_lod_culled, h->meshlets_tested, h->meshlets_visible,
+                h->meshlets_frustum_culled, h->meshlets_cone_culled, h->meshlets_lod_culled);
+    CHECK(h->raster_hw_clusters == h->meshlets_visible);
+    CHECK(sw->stats.raster_sw_clusters + sw->stats.raster_hw_clusters == sw->stats.meshlets_visible);
 
     /* The mesh-shader path stores gl_FragCoord.z: the depth buffer of the forward path, bit for
      * bit, wherever either drew (a tie between two triangles has one depth either way). */

@@ -34,8 +34,8 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
             if (s->raster == GDR_RASTER_HYBRID)
                 fprintf(out, "; threshold %g px", (double)s->sw_threshold_px);
             fprintf(out, s->raster_overflow ? "; %u lost to overflow\n" : "\n", s->raster_overflow);
-            fprintf(out, "raster_gpu_ms       mesh shaders %.4f, compute %.4f, resolve %.4f (part of draw)\n",
-                    s->raster_hw_ms, s->raster_sw_ms, s->raster_resolve_ms);
+            fprintf(out, "raster_gpu_ms       cluster cull %.4f, mesh shaders %.4f, compute %.4f, resolve %.4f "
+                         "(part of draw)\n", s->raster_cull_ms, s->raster_hw_ms, s->raster_sw_ms, s->raster_resolve_ms);
         }
         if (s->lod_applied) {
             fprintf(out, "meshlets_lod_culled %u (not in the LOD cut)\n", s->meshlets_lod_culled);
@@ -92,6 +92,7 @@ void stats_add_meshlet_json(cJSON *object, const gdr_frame_stats *s)
         cJSON_AddNumberToObject(object, "raster_sw_triangles", (double)s->raster_sw_triangles);
         cJSON_AddNumberToObject(object, "raster_hw_triangles", (double)s->raster_hw_triangles);
         cJSON_AddNumberToObject(object, "raster_overflow", s->raster_overflow);
+        cJSON_AddNumberToObject(object, "raster_cull_ms", s->raster_cull_ms);
         cJSON_AddNumberToObject(object, "raster_hw_ms", s->raster_hw_ms);
         cJSON_AddNumberToObject(object, "raster_sw_ms", s->raster_sw_ms);
         cJSON_AddNumberToObject(object, "raster_resolve_ms", s->raster_resolve_ms);

@@ -28,5 +28,8 @@
 #define GDR_RASTER_MAX_CLUSTERS (1u << 25)
 #define GDR_SW_SUBPIXEL_BITS 8
 #define GDR_SW_GROUPS_PER_ROW 65535
+/* Mesh workgroups launched without a task shader (the visibility-buffer modes): maxMeshWorkGroupCount
+ * is at least this in x and y on every device with mesh shaders. */
+#define GDR_MESH_GROUPS_PER_ROW 65535
 
 #endif

@@ -221,9 +221,9 @@ GDR_STRUCT_END(GdrGpuPushConstants)
  *
  * A visibility-buffer pixel is 64 bits: the high word the depth as float bits (reverse-Z, so
  * atomicMax keeps the nearest; 0 is empty), the low word (slot << GDR_VISBUFFER_TRIANGLE_BITS) |
- * triangle, where slot indexes the frame's list of visible clusters (GdrGpuRasterCluster). The task
- * shader appends software-rasterised clusters from the front of that list and reserves the mesh
- * shader's from the back. */
+ * triangle, where slot indexes the frame's list of visible clusters (GdrGpuRasterCluster). The
+ * cluster cull (clustercull.comp) appends software-rasterised clusters from the front of that list
+ * and mesh-shader clusters from the back. */
 #define GDR_GPU_RASTER_FORWARD 0u /* the mesh shaders shade (issue 4); no visibility buffer */
 #define GDR_GPU_RASTER_HW 1u      /* every cluster through the mesh shaders into the visibility buffer */
 #define GDR_GPU_RASTER_SW 2u      /* every cluster the compute rasteriser can take (see raster_bin.h) */
@@ -236,7 +236,8 @@ GDR_STRUCT_BEGIN(GdrGpuRasterCluster)
 GDR_STRUCT_END(GdrGpuRasterCluster)
 
 /* Counters of a frame, zeroed before the cull. The first three words are the
- * VkDispatchIndirectCommand of the software rasteriser, written by raster_submit.comp. */
+ * VkDispatchIndirectCommand of the software rasteriser, draw_x..z the VkDrawMeshTasksIndirectCommandEXT
+ * of the mesh-shader clusters, both written by raster_submit.comp once per raster phase. */
 GDR_STRUCT_BEGIN(GdrGpuRasterCounters)
     gdr_uint dispatch_x;
     gdr_uint dispatch_y;
@@ -249,6 +250,12 @@ GDR_STRUCT_BEGIN(GdrGpuRasterCounters)
     gdr_uint overflow;     /* visible clusters dropped for want of room (never expected, see visbuffer.c) */
     gdr_uint sw_first;     /* first entry of the current software dispatch (raster_submit.comp) */
     gdr_uint sw_dispatched; /* entries launched by earlier dispatches of the frame (one per raster phase) */
+    gdr_uint hw_first;      /* first entry of the current mesh-shader launch (the back grows down) */
+    gdr_uint hw_count;      /* entries in it */
+    gdr_uint hw_dispatched; /* back entries launched by earlier launches of the frame */
+    gdr_uint draw_x;        /* VkDrawMeshTasksIndirectCommandEXT: one mesh workgroup per entry, in rows */
+    gdr_uint draw_y;
+    gdr_uint draw_z;
     gdr_uint reserved0;
 GDR_STRUCT_END(GdrGpuRasterCounters)
 
@@ -259,7 +266,7 @@ GDR_STRUCT_BEGIN(GdrGpuRasterParams)
     gdr_uint mode;          /* GDR_GPU_RASTER_* */
     gdr_uint capacity;      /* entries of the cluster list, <= GDR_RASTER_MAX_CLUSTERS */
     float sw_threshold_px;  /* hybrid: clusters whose triangles are smaller go to the compute rasteriser */
-    gdr_uint reserved0;
+    gdr_uint hw_launch_limit; /* the most mesh workgroups one launch may have (maxMeshWorkGroupTotalCount) */
     gdr_vec2 ndc_scale;     /* the projection's P[0][0] and P[1][1] (x and y from view space to NDC) */
     gdr_vec2 reserved1;
 GDR_STRUCT_END(GdrGpuRasterParams)

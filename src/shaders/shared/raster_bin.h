@@ -1,5 +1,5 @@
 /* Hybrid rasterisation (issue 8): which rasteriser draws a visible cluster. The decision is shared
- * by C (tests, tools) and GLSL; the task shader's appends to the frame's visible-cluster list are
+ * by C (tests, tools) and GLSL; the cluster cull's appends to the frame's visible-cluster list are
  * GLSL only (below). */
 #ifndef GDR_RASTER_BIN_H
 #define GDR_RASTER_BIN_H
@@ -49,15 +49,14 @@ GDR_SHARED_FN bool gdr_raster_bin_sw(gdr_uint mode, float threshold_px, gdr_vec3
 #ifdef GDR_GLSL
 #include "visbuffer.h"
 
-/* Task shader, every invocation in uniform control flow, after culling: bins the invocation's
- * cluster (when visible) and appends compute-rasterised ones at the front of the frame's
- * visible-cluster list (one atomic per subgroup). Returns true for those: the caller leaves them out
- * of its mesh tasks. Needs MeshletsRef and InstancesRef (meshlet_payload.h, glsl_buffers.h). */
-bool gdr_raster_bin(GdrGpuFrameGlobals g, bool visible, uint instance, uint meshlet_index)
+/* The cluster cull (clustercull.comp), every invocation in uniform control flow, after the tests:
+ * bins the invocation's cluster when visible and appends it to the frame's visible-cluster list,
+ * compute-rasterised clusters at the front and mesh-shader clusters at the back (one atomic per end
+ * and subgroup). Entries that do not fit are dropped and counted. Needs MeshletsRef and InstancesRef
+ * (meshlet_payload.h, glsl_buffers.h). */
+void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint meshlet_index)
 {
     GdrGpuRasterParams params = RasterParamsRef(push.raster).value;
-    if (params.mode == GDR_GPU_RASTER_FORWARD)
-        return false;
     bool sw = false;
     uint triangles = 0u;
     if (visible) {
@@ -69,49 +68,43 @@ bool gdr_raster_bin(GdrGpuFrameGlobals g, bool visible, uint instance, uint mesh
         sw = gdr_raster_bin_sw(params.mode, params.sw_threshold_px, center, radius, float(triangles), g.znear,
                                g.zfar, params.ndc_scale, g.viewport.y);
     }
+    bool hw = visible && !sw;
     RasterCountersRef counters = RasterCountersRef(params.counters);
-    uvec4 ballot = subgroupBallot(sw);
-    uint count = subgroupBallotBitCount(ballot);
+    uvec4 sw_ballot = subgroupBallot(sw), hw_ballot = subgroupBallot(hw);
+    uint sw_count = subgroupBallotBitCount(sw_ballot), hw_count = subgroupBallotBitCount(hw_ballot);
     uint sw_triangles = subgroupAdd(sw ? triangles : 0u);
-    uint hw_triangles = subgroupAdd(visible && !sw ? triangles : 0u);
-    uint base = 0u;
-    bool fits = true;
+    uint hw_triangles = subgroupAdd(hw ? triangles : 0u);
+    uint sw_base = 0u, hw_base = 0u;
+    bool sw_fits = true, hw_fits = true;
     if (subgroupElect()) {
-        if (count > 0u) {
-            fits = atomicAdd(counters.value.used, count) + count <= params.capacity;
-            if (fits)
-                base = atomicAdd(counters.value.sw_clusters, count);
+        if (sw_count > 0u) {
+            sw_fits = atomicAdd(counters.value.used, sw_count) + sw_count <= params.capacity;
+            if (sw_fits)
+                sw_base = atomicAdd(counters.value.sw_clusters, sw_count);
             else
-                atomicAdd(counters.value.overflow, count);
+                atomicAdd(counters.value.overflow, sw_count);
+        }
+        if (hw_count > 0u) {
+            hw_fits = atomicAdd(counters.value.used, hw_count) + hw_count <= params.capacity;
+            if (hw_fits)
+                hw_base = params.capacity - atomicAdd(counters.value.hw_clusters, hw_count) - hw_count;
+            else
+                atomicAdd(counters.value.overflow, hw_count);
         }
         if (sw_triangles > 0u)
             atomicAdd(counters.value.sw_triangles, sw_triangles);
         if (hw_triangles > 0u)
             atomicAdd(counters.value.hw_triangles, hw_triangles);
     }
-    base = subgroupBroadcastFirst(base);
-    fits = subgroupBroadcastFirst(fits);
-    if (sw && fits)
-        RasterClustersRef(params.clusters).items[base + subgroupBallotExclusiveBitCount(ballot)] =
-            GdrGpuRasterCluster(instance, meshlet_index);
-    return sw;
-}
-
-/* Task shader, one invocation: reserves `count` entries at the back of the list for the
- * workgroup's mesh-shader clusters. Returns the slot of the first (the mesh shaders write the
- * entries: slot + gl_WorkGroupID.x), or GDR_RASTER_NO_SLOT when they do not fit (the mesh shaders
- * then draw nothing). */
-uint gdr_raster_reserve_hw(uint count)
-{
-    GdrGpuRasterParams params = RasterParamsRef(push.raster).value;
-    if (params.mode == GDR_GPU_RASTER_FORWARD || count == 0u)
-        return 0u;
-    RasterCountersRef counters = RasterCountersRef(params.counters);
-    if (atomicAdd(counters.value.used, count) + count > params.capacity) {
-        atomicAdd(counters.value.overflow, count);
-        return GDR_RASTER_NO_SLOT;
-    }
-    return params.capacity - atomicAdd(counters.value.hw_clusters, count) - count;
+    sw_base = subgroupBroadcastFirst(sw_base);
+    hw_base = subgroupBroadcastFirst(hw_base);
+    sw_fits = subgroupBroadcastFirst(sw_fits);
+    hw_fits = subgroupBroadcastFirst(hw_fits);
+    RasterClustersRef list = RasterClustersRef(params.clusters);
+    if (sw && sw_fits)
+        list.items[sw_base + subgroupBallotExclusiveBitCount(sw_ballot)] = GdrGpuRasterCluster(instance, meshlet_index);
+    if (hw && hw_fits)
+        list.items[hw_base + subgroupBallotExclusiveBitCount(hw_ballot)] = GdrGpuRasterCluster(instance, meshlet_index);
 }
 #endif
 

@@ -1,0 +1,192 @@
+/* GLSL only: the per-cluster tests of the mesh pipeline, shared by the task shader (forward raster)
+ * and the cluster-cull compute pass (visibility-buffer raster, issue 8). One invocation per cluster
+ * of a task command (up to GDR_TASK_WORKGROUP_SIZE clusters of one visible instance):
+ *  - the LOD cut (issue 5): is the cluster part of the cut this view needs?
+ *  - its sphere against the frustum (the instance test's math), then its normal cone against the
+ *    camera;
+ *  - two-phase occlusion culling (issue 6).
+ * Include after glsl_buffers.h, cull_math.h, lod_math.h, occlusion_test.h and meshlet_payload.h. */
+#ifndef GDR_CLUSTER_CULL_H
+#define GDR_CLUSTER_CULL_H
+
+// Occlusion culling phases (the shaders' specialisation constant 0): none, early, late.
+#define GDR_PHASE_NONE 0u
+#define GDR_PHASE_EARLY 1u
+#define GDR_PHASE_LATE 2u
+
+layout(buffer_reference, scalar) writeonly buffer VisibleMeshletsRef { uvec2 items[]; };
+
+// What the tests decided for one invocation's cluster.
+struct GdrClusterResult {
+    bool in_task;        // the invocation has a cluster
+    bool visible;        // draw it
+    bool lod_culled, frustum_culled, cone_culled;
+    bool late_tested;    // late phase: passed the other tests, so tested against the pyramid
+    bool occluded;
+    uint instance;
+    uint meshlet;        // global GdrGpuMeshlet index
+    uint flags;          // the task command's GDR_TASK_* flags
+    int depth;           // DAG depth of the cluster's group
+    uint triangles;
+};
+
+// passes(group) of the cut rule (gdr/geometry.h): projected error within the threshold, or for the
+// discrete debug cut, depth below N and not the root. Without a group the fields make "refined"
+// always pass (error 0, depth -1) and "group" never (error INFINITY).
+bool gdr_lod_passes(GdrGpuFrameGlobals g, vec4 sphere, float error, int depth, mat4 model)
+{
+    if ((g.flags & GDR_FRAME_LOD_DEPTH) != 0u)
+        return depth < g.lod_depth && !isinf(error);
+    return gdr_lod_group_projected_error(sphere, error, model[0].xyz, model[1].xyz, model[2].xyz, model[3].xyz,
+                                         g.camera_position.xyz, g.znear, g.lod_projection_scale) <= g.lod_threshold;
+}
+
+// Two-phase occlusion culling of one cluster that passed the other tests (`candidate`), with one
+// visibility bit per cluster of every instance. Early: draw it if it was visible at the end of the
+// last frame. Late: test it against this frame's pyramid, record the result for the next frame and
+// draw it if visible and not drawn early. (Clusters are not tested against last frame's pyramid in
+// the early phase: the late phase could then not tell which ones the early phase drew.)
+bool gdr_cluster_occlusion_phase(GdrGpuFrameGlobals g, uint phase, GdrGpuInstance instance, GdrGpuTaskCommand task,
+                                 uint lane, bool candidate, vec3 center, float radius, out bool occluded)
+{
+    uint mesh_first = MeshesRef(push.meshes).items[instance.mesh].meshlet_offset;
+    uint bit = instance.meshlet_visibility_offset + (task.meshlet_first + lane - mesh_first);
+    VisibilityRef bits = VisibilityRef(g.meshlet_visibility);
+    bool was_visible = (bits.items[bit >> 5] & (1u << (bit & 31u))) != 0u;
+    occluded = false;
+    if (phase == GDR_PHASE_EARLY)
+        return candidate && was_visible;
+    occluded = candidate && gdr_sphere_occluded(g, center, radius);
+    bool visible = candidate && !occluded;
+    if (visible != was_visible) {
+        if (visible)
+            atomicOr(bits.items[bit >> 5], 1u << (bit & 31u));
+        else
+            atomicAnd(bits.items[bit >> 5], ~(1u << (bit & 31u)));
+    }
+    bool drawn_early = (task.flags & GDR_TASK_DRAWN_EARLY) != 0u && was_visible && candidate;
+    return visible && !drawn_early;
+}
+
+// The tests for cluster `lane` of task command `task_index` of `phase`'s region of the task list.
+GdrClusterResult gdr_cluster_test(GdrGpuFrameGlobals g, uint phase, uint task_index, uint lane)
+{
+    GdrClusterResult result;
+    result.in_task = false;
+    result.visible = false;
+    result.lod_culled = false;
+    result.frustum_culled = false;
+    result.cone_culled = false;
+    result.late_tested = false;
+    result.occluded = false;
+    result.instance = 0u;
+    result.meshlet = 0u;
+    result.flags = 0u;
+    result.depth = 0;
+    result.triangles = 0u;
+    DrawStatsRef stats = DrawStatsRef(push.draw_stats);
+    uint task_count = min(phase == GDR_PHASE_LATE ? stats.value.late_task_count : stats.value.task_count,
+                          g.task_capacity);
+    if (task_index >= task_count)
+        return result;
+    // The late phase's commands follow the early phase's region (drawcull.comp).
+    GdrGpuTaskCommand task =
+        TaskCommandsRef(push.tasks + (phase == GDR_PHASE_LATE ? uint64_t(g.task_capacity) * 16ul : 0ul)).items[task_index];
+    result.instance = task.instance;
+    result.flags = task.flags;
+    result.meshlet = task.meshlet_first + lane;
+    if (lane >= task.meshlet_count)
+        return result;
+    result.in_task = true;
+
+    GdrGpuMeshlet meshlet = MeshletsRef(push.meshlets).items[result.meshlet];
+    GdrGpuInstance instance = InstancesRef(push.instances).items[task.instance];
+    mat4 model = instance.model;
+    vec3 center = (g.view * (model * vec4(meshlet.sphere.xyz, 1.0))).xyz;
+    float radius = meshlet.sphere.w * gdr_max_axis_scale(model[0].xyz, model[1].xyz, model[2].xyz);
+    result.depth = meshlet.group_depth;
+    result.triangles = meshlet.triangle_count;
+    bool visible = true;
+    if ((g.flags & GDR_FRAME_LOD) != 0u && (task.flags & GDR_TASK_LOD_ACCEPTED) == 0u) {
+        visible = gdr_lod_passes(g, meshlet.refined_sphere, meshlet.refined_error, meshlet.refined_depth, model) &&
+                  !gdr_lod_passes(g, meshlet.group_sphere, meshlet.group_error, meshlet.group_depth, model);
+        result.lod_culled = !visible;
+    }
+    bool cull = g.cull_enabled != 0u;
+    if (visible && cull && (g.flags & GDR_FRAME_MESHLET_FRUSTUM) != 0u) {
+        visible = gdr_sphere_visible(g.frustum, center, radius, g.znear, g.zfar);
+        result.frustum_culled = !visible;
+    }
+    mat3 linear = mat3(model);
+    if (visible && cull && (g.flags & GDR_FRAME_MESHLET_CONE) != 0u && determinant(linear) > 0.0) {
+        vec3 camera = inverse(linear) * (g.camera_position.xyz - model[3].xyz);
+        result.cone_culled = gdr_cone_backfacing(meshlet.cone_apex, meshlet.cone_axis, meshlet.cone_cutoff, camera);
+        visible = !result.cone_culled;
+    }
+    result.late_tested = phase == GDR_PHASE_LATE && visible;
+    if (phase != GDR_PHASE_NONE)
+        visible = gdr_cluster_occlusion_phase(g, phase, instance, task, lane, visible, center, radius, result.occluded);
+    result.visible = visible;
+    return result;
+}
+
+// Clusters and triangles drawn per DAG depth: one atomic per distinct depth in the subgroup.
+void gdr_count_lod_depths(DrawStatsRef stats, bool visible, int depth, uint triangles)
+{
+    uint bucket = uint(clamp(depth, 0, GDR_LOD_STATS_DEPTHS - 1));
+    bool pending = visible;
+    for (;;) {
+        uint current = subgroupMin(pending ? bucket : 0xffffffffu);
+        if (current == 0xffffffffu)
+            break;
+        bool mine = pending && bucket == current;
+        uint clusters = subgroupAdd(mine ? 1u : 0u);
+        uint tris = subgroupAdd(mine ? triangles : 0u);
+        if (subgroupElect()) {
+            atomicAdd(stats.value.lod_clusters[current], clusters);
+            atomicAdd(stats.value.lod_triangles[current], tris);
+        }
+        pending = pending && !mine;
+    }
+}
+
+// Every invocation, in uniform control flow: the frame's statistics of the tests (one atomic per
+// counter and subgroup), and for tests the visible clusters' list when the frame asks for it.
+void gdr_cluster_count(GdrGpuFrameGlobals g, uint phase, GdrClusterResult r)
+{
+    DrawStatsRef stats = DrawStatsRef(push.draw_stats);
+    if ((g.flags & GDR_FRAME_RECORD_MESHLETS) != 0u && r.visible) {
+        uint at = atomicAdd(stats.value.meshlets_recorded, 1u);
+        VisibleMeshletsRef(push.visible_meshlets).items[at] = uvec2(r.instance, r.meshlet);
+    }
+    gdr_count_lod_depths(stats, r.visible, r.depth, r.triangles);
+    if (phase == GDR_PHASE_EARLY) {
+        uint n = subgroupAdd(r.visible ? 1u : 0u);
+        if (subgroupElect() && n > 0u)
+            atomicAdd(stats.value.meshlets_early_drawn, n);
+    } else if (phase == GDR_PHASE_LATE) {
+        uint n = subgroupAdd(r.visible ? 1u : 0u);
+        uint t = subgroupAdd(r.late_tested ? 1u : 0u);
+        uint o = subgroupAdd(r.occluded ? 1u : 0u);
+        if (subgroupElect() && t > 0u) {
+            atomicAdd(stats.value.meshlets_late_drawn, n);
+            atomicAdd(stats.value.meshlets_late_tested, t);
+            atomicAdd(stats.value.meshlets_late_occluded, o);
+        }
+    }
+    uint tested = subgroupAdd(r.in_task ? 1u : 0u);
+    uint lod = subgroupAdd(r.lod_culled ? 1u : 0u);
+    uint frustum = subgroupAdd(r.frustum_culled ? 1u : 0u);
+    uint cone = subgroupAdd(r.cone_culled ? 1u : 0u);
+    uint drawn = subgroupAdd(r.visible ? 1u : 0u);
+    if (subgroupElect() && tested > 0u) {
+        atomicAdd(stats.value.meshlets_tested, tested);
+        atomicAdd(stats.value.meshlets_frustum_culled, frustum);
+        atomicAdd(stats.value.meshlets_cone_culled, cone);
+        atomicAdd(stats.value.meshlets_visible, drawn);
+        if (lod > 0u)
+            atomicAdd(stats.value.meshlets_lod_culled, lod);
+    }
+}
+
+#endif
