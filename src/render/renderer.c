@@ -100,12 +100,14 @@ static gdr_status create_pipelines(gdr_renderer *r, gdr_error *err)
 static gdr_status create_targets(gdr_renderer *r, gdr_error *err)
 {
     gdr_status status = gdr_vk_image_create(&r->allocator, r->width, r->height, GDR_COLOR_FORMAT,
-                                            VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                                            VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+                                                VK_IMAGE_USAGE_TRANSFER_DST_BIT, /* the visibility buffer's resolve */
                                             VK_IMAGE_ASPECT_COLOR_BIT, &r->color, err);
     if (status == GDR_OK)
         status = gdr_vk_image_create(&r->allocator, r->width, r->height, GDR_DEPTH_FORMAT,
                                      VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
-                                         VK_IMAGE_USAGE_TRANSFER_SRC_BIT, /* tests read it back */
+                                         VK_IMAGE_USAGE_TRANSFER_SRC_BIT | /* tests read it back */
+                                         VK_IMAGE_USAGE_TRANSFER_DST_BIT, /* the visibility buffer's resolve */
                                      VK_IMAGE_ASPECT_DEPTH_BIT, &r->depth, err); /* sampled: the depth pyramid */
     if (status == GDR_OK)
         status = gdr_vk_buffer_create(&r->allocator, (VkDeviceSize)r->width * r->height * 4,

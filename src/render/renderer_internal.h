@@ -110,7 +110,7 @@ struct gdr_renderer {
 
 #define GDR_COLOR_FORMAT VK_FORMAT_R8G8B8A8_UNORM
 #define GDR_DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
-#define GDR_CLEAR_COLOR {{0.42f, 0.55f, 0.72f, 1.0f}} /* the background */
+#define GDR_CLEAR_COLOR {{GDR_BACKGROUND_R, GDR_BACKGROUND_G, GDR_BACKGROUND_B, 1.0f}} /* the background */
 
 gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_error *err);
 void gdr_gpu_scene_destroy(gdr_renderer *r);

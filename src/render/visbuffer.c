@@ -38,13 +38,9 @@ static gdr_status create_pipelines(gdr_renderer *r, gdr_error *err)
     if (status == GDR_OK)
         status = gdr_vk_compute_pipeline_create(r->ctx, r->layout, &gdr_shader_raster_submit_comp,
                                                 &v->submit_pipeline, err);
-    if (status == GDR_OK) { /* a full-screen triangle; the fragment shader writes the depth */
-        gdr_vk_graphics_pipeline_desc resolve = {
-            .layout = r->layout, .vertex_shader = &gdr_shader_overdraw_paint_vert,
-            .fragment_shader = &gdr_shader_visbuffer_resolve_frag, .color_format = GDR_COLOR_FORMAT,
-            .depth_format = GDR_DEPTH_FORMAT, .cull_mode = VK_CULL_MODE_NONE, .depth_always = true};
-        status = gdr_vk_graphics_pipeline_create(r->ctx, &resolve, &v->resolve_pipeline, err);
-    }
+    if (status == GDR_OK)
+        status = gdr_vk_compute_pipeline_create(r->ctx, r->layout, &gdr_shader_visbuffer_resolve_comp,
+                                                &v->resolve_pipeline, err);
     return status;
 }
 
@@ -75,6 +71,10 @@ gdr_status gdr_visbuffer_create(gdr_renderer *r, bool disabled, gdr_error *err)
                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
                                           VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                       GDR_VK_BUFFER_DEVICE, &v->pixels, err);
+    if (status == GDR_OK) /* the resolve's colour and depth, copied into the images */
+        status = gdr_vk_buffer_create(&r->allocator, (VkDeviceSize)r->width * r->height * 2 * sizeof(uint32_t),
+                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                      GDR_VK_BUFFER_DEVICE, &v->resolved, err);
     if (status == GDR_OK)
         status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuRasterCounters),
                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
@@ -117,6 +117,7 @@ void gdr_visbuffer_destroy(gdr_renderer *r)
     if (v->timestamps)
         vkDestroyQueryPool(device, v->timestamps, NULL);
     gdr_vk_buffer_destroy(r->ctx, &v->pixels);
+    gdr_vk_buffer_destroy(r->ctx, &v->resolved);
     gdr_vk_buffer_destroy(r->ctx, &v->clusters);
     gdr_vk_buffer_destroy(r->ctx, &v->counters);
     for (uint32_t i = 0; i < GDR_FRAMES_IN_FLIGHT; i++) {
@@ -238,6 +239,7 @@ void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_f
         .sw_threshold_px = gdr_visbuffer_threshold(frame),
         .ndc_scale = {fabsf(projection.m[0]), fabsf(projection.m[5])},
         .hw_launch_limit = (uint32_t)(rows * GDR_MESH_GROUPS_PER_ROW),
+        .resolved = v->resolved.address,
     };
     memcpy(v->params[slot_index].mapped, &params, sizeof params);
     if (mode != GDR_GPU_RASTER_FORWARD) {
@@ -304,38 +306,50 @@ static void record_sw(gdr_renderer *r, VkCommandBuffer cmd)
     vkCmdDispatchIndirect(cmd, r->vis.counters.buffer, offsetof(GdrGpuRasterCounters, dispatch_x));
 }
 
-/* The resolve: shades every pixel into the colour image, writes its depth into the depth image. */
+/* The resolve: a compute pass shades every pixel and writes its depth into the resolved buffer;
+ * copies take them into the colour image and the depth image (for the depth pyramid), which are
+ * then left as attachments. */
 static void record_resolve(gdr_renderer *r, VkCommandBuffer cmd)
 {
-    const VkPipelineStageFlags2 mesh_stages = VK_PIPELINE_STAGE_2_TASK_SHADER_BIT_EXT | VK_PIPELINE_STAGE_2_MESH_SHADER_BIT_EXT;
+    const VkPipelineStageFlags2 mesh_stages = VK_PIPELINE_STAGE_2_MESH_SHADER_BIT_EXT;
     memory_barrier(cmd, mesh_stages | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                   VK_ACCESS_2_SHADER_WRITE_BIT,
-                   VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                   VK_ACCESS_2_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                    VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->vis.resolve_pipeline);
+    vkCmdDispatch(cmd, (r->width + GDR_RESOLVE_TILE - 1) / GDR_RESOLVE_TILE,
+                  (r->height + GDR_RESOLVE_TILE - 1) / GDR_RESOLVE_TILE, 1);
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    /* Earlier users of the images: the last frame's readback copy and the previous raster phase's
+     * depth pyramid (which returned the depth image to an attachment). */
     gdr_vk_image_barrier(cmd, r->color.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                         VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT, 0,
-                         VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+                         VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                         VK_PIPELINE_STAGE_2_COPY_BIT | VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                         VK_ACCESS_2_TRANSFER_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                         VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
     gdr_vk_image_barrier(cmd, r->depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                         VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                         VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_COPY_BIT, 0,
+                         VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                         VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT |
+                             VK_PIPELINE_STAGE_2_COPY_BIT,
+                         VK_ACCESS_2_TRANSFER_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                         VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
+    VkBufferImageCopy color = {.bufferOffset = 0, .imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+                               .imageExtent = {r->width, r->height, 1}};
+    VkBufferImageCopy depth = {.bufferOffset = pixels * sizeof(uint32_t),
+                               .imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1},
+                               .imageExtent = {r->width, r->height, 1}};
+    vkCmdCopyBufferToImage(cmd, r->vis.resolved.buffer, r->color.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &color);
+    vkCmdCopyBufferToImage(cmd, r->vis.resolved.buffer, r->depth.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &depth);
+    gdr_vk_image_barrier(cmd, r->color.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                         VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
+                         VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                         VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+    gdr_vk_image_barrier(cmd, r->depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                         VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
+                         VK_ACCESS_2_TRANSFER_WRITE_BIT,
                          VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
                          VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
-    VkRenderingAttachmentInfo color = {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-                                       .imageView = r->color.view, .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                                       .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR, .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
-                                       .clearValue.color = GDR_CLEAR_COLOR};
-    VkRenderingAttachmentInfo depth = {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-                                       .imageView = r->depth.view, .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                                       .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR, .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
-                                       .clearValue.depthStencil = {0.0f, 0}};
-    VkRenderingInfo rendering = {.sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
-                                 .renderArea = {{0, 0}, {r->width, r->height}}, .layerCount = 1,
-                                 .colorAttachmentCount = 1, .pColorAttachments = &color, .pDepthAttachment = &depth};
-    vkCmdBeginRendering(cmd, &rendering);
-    set_viewport(r, cmd);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->vis.resolve_pipeline);
-    vkCmdDraw(cmd, 3, 1, 0, 0);
-    vkCmdEndRendering(cmd);
 }
 
 void gdr_visbuffer_record_raster(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer cmd, int phase,

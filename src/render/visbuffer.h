@@ -12,8 +12,8 @@
  *     the back of the list; its fragments write (depth, id) with a 64-bit atomicMax
  *     (meshlet_visbuffer.frag), no attachments;
  *  5. raster_sw.comp, one workgroup per cluster at the front, writes the same atomics;
- *  6. the resolve (visbuffer_resolve.frag) shades every pixel into the colour image and writes its
- *     depth into the depth image.
+ *  6. the resolve (visbuffer_resolve.comp) shades every pixel and writes its colour and depth into
+ *     a buffer, copied into the colour and depth images.
  * Steps 2 to 6 are gdr_visbuffer_record_raster; the CPU records the same commands whatever the scene.
  *
  * The list holds every cluster of every instance's DAG (at most GDR_RASTER_MAX_CLUSTERS entries),
@@ -41,6 +41,7 @@ typedef struct gdr_visbuffer {
     bool supported;              /* mesh shaders and 64-bit buffer atomics */
     char missing[160];           /* why not, when not */
     gdr_vk_buffer pixels;        /* uint64 per pixel */
+    gdr_vk_buffer resolved;      /* the resolve's output: RGBA8 per pixel, then float depth per pixel */
     gdr_vk_buffer clusters;      /* GdrGpuRasterCluster[capacity], made with the scene */
     gdr_vk_buffer counters;      /* GdrGpuRasterCounters */
     gdr_vk_buffer params[GDR_FRAMES_IN_FLIGHT];            /* GdrGpuRasterParams, host-written */

@@ -18,5 +18,5 @@ void main()
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
     if (g.view_mode == GDR_VIEW_OVERDRAW) // fragments that passed the depth test, per pixel
         atomicAdd(OverdrawRef(push.overdraw).items[uint(gl_FragCoord.y) * uint(g.viewport.x) + uint(gl_FragCoord.x)], 1u);
-    out_color = gdr_shade(g, in_normal, in_world_position, in_color.rgb);
+    out_color = gdr_shade(g.light_direction.xyz, in_normal, in_world_position, in_color.rgb);
 }

@@ -31,5 +31,11 @@
 /* Mesh workgroups launched without a task shader (the visibility-buffer modes): maxMeshWorkGroupCount
  * is at least this in x and y on every device with mesh shaders. */
 #define GDR_MESH_GROUPS_PER_ROW 65535
+/* The visibility buffer's resolve: one workgroup per square tile of this many pixels a side. */
+#define GDR_RESOLVE_TILE 8
+/* The background colour, written as is into the UNORM colour target. */
+#define GDR_BACKGROUND_R 0.42f
+#define GDR_BACKGROUND_G 0.55f
+#define GDR_BACKGROUND_B 0.72f
 
 #endif

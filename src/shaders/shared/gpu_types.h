@@ -268,7 +268,7 @@ GDR_STRUCT_BEGIN(GdrGpuRasterParams)
     float sw_threshold_px;  /* hybrid: clusters whose triangles are smaller go to the compute rasteriser */
     gdr_uint hw_launch_limit; /* the most mesh workgroups one launch may have (maxMeshWorkGroupTotalCount) */
     gdr_vec2 ndc_scale;     /* the projection's P[0][0] and P[1][1] (x and y from view space to NDC) */
-    gdr_vec2 reserved1;
+    gdr_uint64 resolved;    /* the resolve's output: RGBA8 per pixel, then the depth bits per pixel */
 GDR_STRUCT_END(GdrGpuRasterParams)
 
 #endif

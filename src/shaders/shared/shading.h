@@ -2,11 +2,12 @@
 #ifndef GDR_SHADING_H
 #define GDR_SHADING_H
 
-/* A directional light, a sky/ground ambient term and a faint world grid; returns sRGB-encoded colour. */
-vec4 gdr_shade(GdrGpuFrameGlobals g, vec3 normal, vec3 world_position, vec3 albedo)
+/* A directional light (the frame's light_direction), a sky/ground ambient term and a faint world
+ * grid; returns sRGB-encoded colour. */
+vec4 gdr_shade(vec3 light_direction, vec3 normal, vec3 world_position, vec3 albedo)
 {
     vec3 n = normalize(normal);
-    float diffuse = max(dot(n, g.light_direction.xyz), 0.0);
+    float diffuse = max(dot(n, light_direction), 0.0);
     float sky = 0.5 + 0.5 * n.y;
     vec3 checker = vec3(0.92 + 0.08 * mod(floor(world_position.x) + floor(world_position.z), 2.0));
     vec3 color = albedo * checker * (0.18 + 0.17 * sky + 0.7 * diffuse);

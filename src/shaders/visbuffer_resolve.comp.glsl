@@ -1,0 +1,89 @@
+#version 460
+// The visibility buffer's resolve (issue 8), one invocation per pixel in GDR_RESOLVE_TILE-square
+// workgroups. Each pixel's id names a cluster of the frame's list and a triangle; the triangle's
+// three vertices are fetched and transformed as the mesh shader does, the perspective-correct
+// barycentrics of the pixel centre are recomputed, and the interpolated normal and position are
+// shaded by gdr_shade, as the forward path shades them. Writes every pixel's colour (RGBA8) and
+// depth into the resolved buffer, which the CPU's commands then copy into the colour and depth
+// images (the depth for the depth pyramid); empty pixels get the background and depth 0.
+// A compute pass rather than a full-screen fragment pass: on the Hopper GPUs a fragment pass that
+// writes depth costs about 1 ms at 1440p before any shading (docs/PERFORMANCE.md).
+#include "shared/glsl_buffers.h"
+#include "shared/meshlet_payload.h"
+#include "shared/shading.h"
+#include "shared/visbuffer.h"
+
+layout(local_size_x = GDR_RESOLVE_TILE, local_size_y = GDR_RESOLVE_TILE) in;
+layout(buffer_reference, scalar) writeonly buffer ResolvedRef { uint items[]; };
+
+uint triangle_byte(uint at)
+{
+    return (UintsRef(push.meshlet_triangles).items[at >> 2] >> ((at & 3u) * 8u)) & 255u;
+}
+
+// Shades the pixel whose centre is `centre` (framebuffer pixels, y down) from its id.
+vec4 shade_pixel(FrameGlobalsRef globals, vec2 viewport, vec2 centre, uint id)
+{
+    uint triangle = id & GDR_VISBUFFER_TRIANGLE_MASK;
+    GdrGpuRasterCluster entry =
+        RasterClustersRef(RasterParamsRef(push.raster).value.clusters).items[id >> GDR_VISBUFFER_TRIANGLE_BITS];
+    MeshletsRef meshlets = MeshletsRef(push.meshlets);
+    uint vertex_offset = meshlets.items[entry.meshlet].vertex_offset;
+    uint at = meshlets.items[entry.meshlet].triangle_offset + triangle * 3u;
+    mat4 model = InstancesRef(push.instances).items[entry.instance].model;
+    mat4 view_projection = globals.value.view_projection;
+    uvec3 corners = uvec3(triangle_byte(at), triangle_byte(at + 1u), triangle_byte(at + 2u));
+
+    // Perspective-correct barycentrics from clip space, valid for vertices behind the camera too:
+    // the point b0 V0 + b1 V1 + b2 V2 (b summing to 1) projects to the pixel centre p when
+    // sum b_i (x_i - p.x w_i) = 0 and sum b_i (y_i - p.y w_i) = 0, so b is parallel to X x Y.
+    vec2 p = vec2(centre.x / (0.5 * viewport.x) - 1.0, 1.0 - centre.y / (0.5 * viewport.y));
+    vec3 world[3], normal[3], x_row, y_row;
+    for (int i = 0; i < 3; i++) {
+        uint vertex_index = UintsRef(push.meshlet_vertices).items[vertex_offset + corners[i]];
+        vec3 position = VerticesRef(push.vertices).items[vertex_index].position;
+        normal[i] = VerticesRef(push.vertices).items[vertex_index].normal;
+        vec4 w = model * vec4(position, 1.0);
+        vec4 clip = view_projection * w;
+        world[i] = w.xyz;
+        x_row[i] = clip.x - p.x * clip.w;
+        y_row[i] = clip.y - p.y * clip.w;
+    }
+    vec3 b = cross(x_row, y_row);
+    b /= b.x + b.y + b.z;
+
+    mat3 m = mat3(model);
+    mat3 cofactor = mat3(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1]));
+    vec3 n = cofactor * (b.x * normal[0] + b.y * normal[1] + b.z * normal[2]);
+    vec3 position = b.x * world[0] + b.y * world[1] + b.z * world[2];
+    vec3 albedo = InstancesRef(push.instances).items[entry.instance].color.rgb;
+    uint view_mode = globals.value.view_mode;
+    if (view_mode == GDR_VIEW_MESHLETS)
+        albedo = gdr_id_color(entry.meshlet);
+    else if (view_mode == GDR_VIEW_INSTANCES)
+        albedo = gdr_id_color(entry.instance);
+    else if (view_mode == GDR_VIEW_TRIANGLES)
+        albedo = gdr_id_color(entry.meshlet * 128u + triangle);
+    else if (view_mode == GDR_VIEW_LOD)
+        albedo = gdr_depth_color(meshlets.items[entry.meshlet].group_depth);
+    return gdr_shade(globals.value.light_direction.xyz, n, position, albedo);
+}
+
+void main()
+{
+    FrameGlobalsRef globals = FrameGlobalsRef(push.globals);
+    vec2 viewport = globals.value.viewport;
+    uvec2 size = uvec2(viewport);
+    uvec2 pixel = gl_GlobalInvocationID.xy;
+    if (any(greaterThanEqual(pixel, size)))
+        return;
+    uint index = pixel.y * size.x + pixel.x;
+    uint64_t value = VisbufferRef(push.visbuffer).items[index];
+    uint depth_bits = uint(value >> 32);
+    vec4 color = vec4(GDR_BACKGROUND_R, GDR_BACKGROUND_G, GDR_BACKGROUND_B, 1.0);
+    if (depth_bits != 0u)
+        color = shade_pixel(globals, viewport, vec2(pixel) + 0.5, uint(value));
+    ResolvedRef resolved = ResolvedRef(RasterParamsRef(push.raster).value.resolved);
+    resolved.items[index] = packUnorm4x8(color);
+    resolved.items[size.x * size.y + index] = depth_bits;
+}
