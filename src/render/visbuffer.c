@@ -38,9 +38,10 @@ static gdr_status create_pipelines(gdr_renderer *r, gdr_error *err)
     if (status == GDR_OK)
         status = gdr_vk_compute_pipeline_create(r->ctx, r->layout, &gdr_shader_raster_submit_comp,
                                                 &v->submit_pipeline, err);
-    if (status == GDR_OK)
-        status = gdr_vk_compute_pipeline_create(r->ctx, r->layout, &gdr_shader_visbuffer_resolve_comp,
-                                                &v->resolve_pipeline, err);
+    /* The resolve, shading or (constant 0) depth only. */
+    for (uint32_t depth_only = 0; depth_only < 2 && status == GDR_OK; depth_only++)
+        status = gdr_vk_compute_pipeline_create_specialized(r->ctx, r->layout, &gdr_shader_visbuffer_resolve_comp,
+                                                            &depth_only, 1, &v->resolve_pipelines[depth_only], err);
     return status;
 }
 
@@ -110,7 +111,7 @@ void gdr_visbuffer_destroy(gdr_renderer *r)
     gdr_visbuffer *v = &r->vis;
     VkDevice device = r->ctx->device;
     VkPipeline pipelines[] = {v->cull_pipelines[0], v->cull_pipelines[1], v->cull_pipelines[2], v->hw_pipeline,
-                              v->sw_pipeline, v->submit_pipeline, v->resolve_pipeline};
+                              v->sw_pipeline, v->submit_pipeline, v->resolve_pipelines[0], v->resolve_pipelines[1]};
     for (size_t i = 0; i < sizeof pipelines / sizeof pipelines[0]; i++)
         if (pipelines[i])
             vkDestroyPipeline(device, pipelines[i], NULL);
@@ -308,43 +309,46 @@ static void record_sw(gdr_renderer *r, VkCommandBuffer cmd)
 
 /* The resolve: a compute pass shades every pixel and writes its depth into the resolved buffer;
  * copies take them into the colour image and the depth image (for the depth pyramid), which are
- * then left as attachments. */
-static void record_resolve(gdr_renderer *r, VkCommandBuffer cmd)
+ * then left as attachments. `depth_only`: the depth alone (the colour image is left as it was). */
+static void record_resolve(gdr_renderer *r, VkCommandBuffer cmd, bool depth_only)
 {
-    const VkPipelineStageFlags2 mesh_stages = VK_PIPELINE_STAGE_2_MESH_SHADER_BIT_EXT;
-    memory_barrier(cmd, mesh_stages | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_MESH_SHADER_BIT_EXT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT |
+                            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                    VK_ACCESS_2_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                    VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_SHADER_WRITE_BIT);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->vis.resolve_pipeline);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->vis.resolve_pipelines[depth_only]);
     vkCmdDispatch(cmd, (r->width + GDR_RESOLVE_TILE - 1) / GDR_RESOLVE_TILE,
                   (r->height + GDR_RESOLVE_TILE - 1) / GDR_RESOLVE_TILE, 1);
     memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
                    VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
-    /* Earlier users of the images: the last frame's readback copy and the previous raster phase's
-     * depth pyramid (which returned the depth image to an attachment). */
-    gdr_vk_image_barrier(cmd, r->color.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                         VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                         VK_PIPELINE_STAGE_2_COPY_BIT | VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                         VK_ACCESS_2_TRANSFER_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-                         VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
+    /* Earlier users of the images: the last frame's readback copy, the previous raster phase's
+     * copies and its depth pyramid (which returned the depth image to an attachment). */
+    if (!depth_only) {
+        gdr_vk_image_barrier(cmd, r->color.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                             VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                             VK_PIPELINE_STAGE_2_COPY_BIT | VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                             VK_ACCESS_2_TRANSFER_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                             VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+        VkBufferImageCopy color = {.bufferOffset = 0, .imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+                                   .imageExtent = {r->width, r->height, 1}};
+        vkCmdCopyBufferToImage(cmd, r->vis.resolved.buffer, r->color.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                               &color);
+        gdr_vk_image_barrier(cmd, r->color.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                             VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
+                             VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                             VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+    }
     gdr_vk_image_barrier(cmd, r->depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                          VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                          VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT |
                              VK_PIPELINE_STAGE_2_COPY_BIT,
                          VK_ACCESS_2_TRANSFER_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
                          VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
-    VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
-    VkBufferImageCopy color = {.bufferOffset = 0, .imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
-                               .imageExtent = {r->width, r->height, 1}};
     VkBufferImageCopy depth = {.bufferOffset = pixels * sizeof(uint32_t),
                                .imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1},
                                .imageExtent = {r->width, r->height, 1}};
-    vkCmdCopyBufferToImage(cmd, r->vis.resolved.buffer, r->color.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &color);
     vkCmdCopyBufferToImage(cmd, r->vis.resolved.buffer, r->depth.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &depth);
-    gdr_vk_image_barrier(cmd, r->color.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                         VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
-                         VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                         VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
     gdr_vk_image_barrier(cmd, r->depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                          VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
                          VK_ACCESS_2_TRANSFER_WRITE_BIT,
@@ -363,7 +367,7 @@ void gdr_visbuffer_record_raster(gdr_renderer *r, gdr_frame_slot *slot, VkComman
     timestamp(r, cmd, slot_index, GDR_VISBUFFER_TS_AFTER_HW);
     record_sw(r, cmd);
     timestamp(r, cmd, slot_index, GDR_VISBUFFER_TS_AFTER_SW);
-    record_resolve(r, cmd);
+    record_resolve(r, cmd, phase == 1); /* the late phase shades what both phases drew */
     timestamp(r, cmd, slot_index, GDR_VISBUFFER_TS_AFTER_RESOLVE);
     r->vis.slot_phases[slot_index]++;
 }

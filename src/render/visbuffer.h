@@ -51,7 +51,8 @@ typedef struct gdr_visbuffer {
     char reason[128];            /* why that mode */
     VkPipeline cull_pipelines[3]; /* cluster cull per occlusion phase: none, early, late */
     VkPipeline hw_pipeline;       /* mesh shaders (no task shader) into the visibility buffer */
-    VkPipeline sw_pipeline, submit_pipeline, resolve_pipeline;
+    VkPipeline sw_pipeline, submit_pipeline;
+    VkPipeline resolve_pipelines[2]; /* shading; depth only (occlusion culling's early phase) */
     VkQueryPool timestamps;      /* GDR_VISBUFFER_TS_COUNT per raster phase, two phases per frame slot */
     uint32_t slot_mode[GDR_FRAMES_IN_FLIGHT]; /* GDR_GPU_RASTER_* of the slot's last frame */
     uint32_t slot_phases[GDR_FRAMES_IN_FLIGHT]; /* raster phases timed in it, yet to be read */
@@ -85,9 +86,10 @@ void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_f
 /* Steps 2 to 6 above for one raster phase (0: the only one, 1: occlusion culling's early phase,
  * 2: its late phase, which adds to what the early one wrote), after the instance cull's barrier
  * (which must make its writes visible to compute shaders and indirect reads); `launch`: the offset
- * of the phase's task launch (x, y, z: one workgroup per task command) in the slot's draw stats. Leaves the
- * colour image in COLOR_ATTACHMENT_OPTIMAL and the depth image in DEPTH_ATTACHMENT_OPTIMAL with the
- * depth of everything rasterised so far (for the depth pyramid), their writes and the overdraw
+ * of the phase's task launch (x, y, z: one workgroup per task command) in the slot's draw stats.
+ * Leaves the depth image in DEPTH_ATTACHMENT_OPTIMAL with the depth of everything rasterised so far
+ * (for the depth pyramid) and, except in the early phase (depth only: the late phase shades
+ * everything), the colour image shaded in COLOR_ATTACHMENT_OPTIMAL; their writes and the overdraw
  * counts visible to fragment and compute shaders. */
 void gdr_visbuffer_record_raster(gdr_renderer *r, struct gdr_frame_slot *slot, VkCommandBuffer cmd, int phase,
                                  VkDeviceSize launch);
