@@ -188,8 +188,8 @@ static void cull_and_draw(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer
     if (pipeline == GDR_PIPELINE_MESH && r->vis.slot_mode[slot - r->slots] != GDR_GPU_RASTER_FORWARD) {
         /* issue 8: the visibility buffer, then the resolve */
         gdr_visbuffer_record_raster(r, slot, cmd, phase,
-                                    phase == 2 ? offsetof(GdrGpuDrawStats, late_task_groups_x)
-                                               : offsetof(GdrGpuDrawStats, task_groups_x));
+                                    phase == 2 ? offsetof(GdrGpuDrawStats, late_cull_groups_x)
+                                               : offsetof(GdrGpuDrawStats, cull_groups_x));
         return;
     }
     begin_rendering(r, cmd, phase != 2);

@@ -27,7 +27,7 @@ _Static_assert(offsetof(GdrGpuDrawCommand, vertex_offset) == offsetof(VkDrawInde
                    offsetof(GdrGpuDrawCommand, first_instance) == offsetof(VkDrawIndexedIndirectCommand, firstInstance),
                "GdrGpuDrawCommand offsets");
 _Static_assert(GDR_LOD_STATS_DEPTHS == GDR_LOD_STATS_DEPTH_COUNT, "LOD statistics: shaders and gdr/renderer.h");
-_Static_assert(sizeof(GdrGpuDrawStats) == 64 + 8 * GDR_LOD_STATS_DEPTHS + 64 && offsetof(GdrGpuDrawStats, draw_count) == 0 &&
+_Static_assert(sizeof(GdrGpuDrawStats) == 64 + 8 * GDR_LOD_STATS_DEPTHS + 96 && offsetof(GdrGpuDrawStats, draw_count) == 0 &&
                    offsetof(GdrGpuDrawStats, task_groups_x) == 16, "GdrGpuDrawStats");
 _Static_assert(offsetof(GdrGpuDrawStats, task_groups_z) - offsetof(GdrGpuDrawStats, task_groups_x) ==
                    offsetof(VkDrawMeshTasksIndirectCommandEXT, groupCountZ), "the mesh tasks command inside GdrGpuDrawStats");

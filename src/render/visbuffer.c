@@ -266,7 +266,7 @@ static void set_viewport(gdr_renderer *r, VkCommandBuffer cmd)
     vkCmdSetScissor(cmd, 0, 1, &scissor);
 }
 
-/* The cluster cull over the phase's task commands (launched like the task shader would be, from
+/* The cluster cull over the phase's task commands (its launch written by tasksubmit.comp at
  * `launch` in the slot's draw stats), then the launches of both rasterisers. */
 static void record_cull(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer cmd, int phase, VkDeviceSize launch)
 {

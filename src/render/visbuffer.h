@@ -86,7 +86,7 @@ void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_f
 /* Steps 2 to 6 above for one raster phase (0: the only one, 1: occlusion culling's early phase,
  * 2: its late phase, which adds to what the early one wrote), after the instance cull's barrier
  * (which must make its writes visible to compute shaders and indirect reads); `launch`: the offset
- * of the phase's task launch (x, y, z: one workgroup per task command) in the slot's draw stats.
+ * of the phase's cluster-cull launch (a VkDispatchIndirectCommand) in the slot's draw stats.
  * Leaves the depth image in DEPTH_ATTACHMENT_OPTIMAL with the depth of everything rasterised so far
  * (for the depth pyramid) and, except in the early phase (depth only: the late phase shades
  * everything), the colour image shaded in COLOR_ATTACHMENT_OPTIMAL; their writes and the overdraw

@@ -15,6 +15,9 @@
 #define GDR_MESH_MAX_TRIANGLES 124
 /* maxTaskWorkGroupCount[0] is at least this on every device: larger launches use y too. */
 #define GDR_TASK_GROUPS_PER_ROW 65535
+/* The cluster cull of the visibility-buffer modes (clustercull.comp) takes this many task commands
+ * per workgroup (GDR_TASK_WORKGROUP_SIZE invocations each). */
+#define GDR_CLUSTER_CULL_TASKS 8
 /* LOD statistics: clusters and triangles drawn per DAG depth, the last bucket for deeper ones. */
 #define GDR_LOD_STATS_DEPTHS 32
 /* Instance records the CPU can send per frame through the update ring. */

@@ -150,6 +150,16 @@ GDR_STRUCT_BEGIN(GdrGpuDrawStats)
     gdr_uint meshlets_late_drawn;      /* visible and not drawn early */
     gdr_uint reserved_occlusion0;
     gdr_uint reserved_occlusion1;
+    /* The cluster cull's launches (visibility-buffer modes, issue 8): one workgroup per
+     * GDR_CLUSTER_CULL_TASKS task commands, early (or only) and late phase. */
+    gdr_uint cull_groups_x;
+    gdr_uint cull_groups_y;
+    gdr_uint cull_groups_z;
+    gdr_uint late_cull_groups_x;
+    gdr_uint late_cull_groups_y;
+    gdr_uint late_cull_groups_z;
+    gdr_uint reserved_cull0;
+    gdr_uint reserved_cull1;
 GDR_STRUCT_END(GdrGpuDrawStats)
 
 /* Per-frame constants, written by the CPU into its frame's slot. */
