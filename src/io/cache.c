@@ -438,6 +438,49 @@ static void fourcc_text(uint32_t id, char out[5])
     out[4] = 0;
 }
 
+typedef struct byte_range {
+    uint64_t offset, length;
+    uint32_t id;
+} byte_range;
+
+static int compare_ranges(const void *a, const void *b)
+{
+    const byte_range *x = a, *y = b;
+    return x->offset < y->offset ? -1 : x->offset > y->offset;
+}
+
+/* Every byte after the table must belong to a section or be zero alignment padding (under 8 bytes
+ * before each section and at the end): no byte of the file escapes the checksums. */
+static gdr_status check_coverage(const char *name, const uint8_t *data, size_t size, uint64_t table_end,
+                                 byte_range *ranges, uint32_t count, gdr_error *err)
+{
+    qsort(ranges, count, sizeof *ranges, compare_ranges);
+    uint64_t cursor = table_end;
+    char after[32] = "the section table"; /* what the bytes at cursor follow */
+    for (uint32_t i = 0; i <= count; i++) {
+        uint64_t next = i < count ? ranges[i].offset : size;
+        if (next < cursor)
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: sections overlap at offset %llu (after %s)",
+                                 name, (unsigned long long)next, after);
+        if (next - cursor >= 8)
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: %llu bytes at offset %llu, after %s, lie "
+                                 "outside every section", name, (unsigned long long)(next - cursor),
+                                 (unsigned long long)cursor, after);
+        for (uint64_t at = cursor; at < next; at++)
+            if (data[at] != 0)
+                return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: padding byte at offset %llu, after %s, is "
+                                     "not zero", name, (unsigned long long)at, after);
+        if (i < count) {
+            char text[5];
+            fourcc_text(ranges[i].id, text);
+            snprintf(after, sizeof after, "section '%s'", text);
+        }
+        if (i < count)
+            cursor = ranges[i].offset + ranges[i].length;
+    }
+    return GDR_OK;
+}
+
 static gdr_status parse_container(const char *name, const uint8_t *data, size_t size, cache_view *v, gdr_error *err)
 {
     memset(v, 0, sizeof *v);
@@ -465,7 +508,11 @@ static gdr_status parse_container(const char *name, const uint8_t *data, size_t 
     const uint8_t *table = data + CACHE_HEADER_SIZE;
     if (table_hash != gdr_io_hash(table, (size_t)count * CACHE_ENTRY_SIZE))
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: section table checksum mismatch", name);
+    for (unsigned i = 48; i < CACHE_HEADER_SIZE; i++)
+        if (data[i] != 0)
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: reserved header byte %u is not zero", name, i);
     uint64_t table_end = CACHE_HEADER_SIZE + (uint64_t)count * CACHE_ENTRY_SIZE;
+    byte_range ranges[CACHE_MAX_SECTIONS];
     reader t = {table, (size_t)count * CACHE_ENTRY_SIZE, 0, 0};
     for (uint32_t i = 0; i < count; i++) {
         uint32_t id = get_u32(&t), flags = get_u32(&t);
@@ -475,6 +522,7 @@ static gdr_status parse_container(const char *name, const uint8_t *data, size_t 
         if (offset < table_end || offset > size || length > size - offset)
             return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section %u '%s' (offset %llu, %llu bytes) lies outside "
                                  "the file", name, i, text, (unsigned long long)offset, (unsigned long long)length);
+        ranges[i] = (byte_range){offset, length, id};
         if (checksum != gdr_io_hash(data + offset, (size_t)length))
             return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: section '%s' checksum mismatch", name, text);
         int known = -1;
@@ -492,6 +540,9 @@ static gdr_status parse_container(const char *name, const uint8_t *data, size_t 
         v->present[known] = 1;
         v->sections[known] = (reader){data + offset, (size_t)length, 0, 0};
     }
+    gdr_status coverage = check_coverage(name, data, size, table_end, ranges, count, err);
+    if (coverage != GDR_OK)
+        return coverage;
     for (int k = 0; k < K_COUNT; k++)
         if (!v->present[k] && !optional_section(k)) {
             char text[5];

@@ -435,6 +435,20 @@ static void test_pvs_section(void)
     unsigned truncations = 0;
     for (size_t cut = 0; cut < size; cut += cut < offset ? 97 : 1, truncations++)
         expect_refused(data, cut, NULL, NULL);
+    /* Every alignment padding byte between sections flipped: no byte escapes the checks. */
+    uint32_t section_count, paddings = 0;
+    memcpy(&section_count, data + 16, 4);
+    for (uint32_t i = 0; i < section_count; i++) {
+        uint64_t at, n;
+        memcpy(&at, data + 64 + (size_t)i * 32 + 8, 8);
+        memcpy(&n, data + 64 + (size_t)i * 32 + 16, 8);
+        for (uint64_t p = at + n; p % 8 != 0 && p < size; p++, paddings++) {
+            memcpy(bad, data, size);
+            bad[p] ^= 0x20;
+            expect_refused(bad, size, "is not zero", NULL);
+        }
+    }
+    CHECK(paddings > 0);
     /* Every byte of the section flipped: the section checksum names it. */
     for (uint64_t i = offset; i < size; i++) {
         memcpy(bad, data, size);
