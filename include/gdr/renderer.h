@@ -28,6 +28,11 @@ typedef struct gdr_renderer_desc {
     bool busy_wait;
     bool disable_mesh_shaders; /* behave as a device without VK_EXT_mesh_shader (tests the fallback) */
     bool disable_visibility_buffer; /* behave as a device without 64-bit buffer atomics (issue 8) */
+    /* The GPU-driven pipelines record a frame slot's commands once and submit them again while
+     * nothing they depend on changes (pipeline, raster mode, occlusion culling, overdraw view, the
+     * image read back, the number of instance updates). true: record every frame (to measure what
+     * recording costs). The CPU pipeline always records. */
+    bool record_every_frame;
 } gdr_renderer_desc;
 
 typedef enum gdr_cull_mode {
@@ -133,6 +138,8 @@ typedef struct gdr_frame_stats {
     double cpu_ms_per_frame;    /* recording + submission, mean over the frames */
     double cpu_submit_ms_per_frame; /* the vkQueueSubmit2 part of it */
     double cpu_ms_per_frame_median; /* recording + submission, median over the frames */
+    uint32_t frames_recorded;   /* frames whose commands the CPU recorded; the others were submitted
+                                   again as recorded (gdr_renderer_desc.record_every_frame) */
     double gpu_ms_per_frame;    /* first to last timestamp, mean over the frames */
     gdr_pass_timing passes[GDR_MAX_PASSES];
     uint32_t pass_count;

@@ -1,6 +1,7 @@
 /* The CPU-driven baseline (issue 7, seed 003's "before"): every frame the CPU culls the instances
- * with the gdr/cull.h library (octree, frustum planes) and records, per visible instance, its own
- * binds (vertex buffer, index buffer, push constants) and one vkCmdDrawIndexed. It exists to be
+ * with the gdr/cull.h library (octree, frustum planes) and records, per visible instance, seed 003's
+ * six commands: its own binds (pipeline, vertex buffer, index buffer, descriptor set, push
+ * constants) and one vkCmdDrawIndexed. It exists to be
  * measured against the GPU-driven pipelines on the same scene and camera, and to draw the same image. */
 #include <math.h>
 #include <stdlib.h>
@@ -80,11 +81,15 @@ gdr_status gdr_cpu_path_cull(gdr_renderer *r, const gdr_frame_desc *frame, gdr_e
 void gdr_cpu_path_record_draws(gdr_renderer *r, VkCommandBuffer cmd, const GdrGpuPushConstants *push)
 {
     const gdr_gpu_scene *g = &r->scene;
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->draw_pipeline);
     for (uint32_t v = 0; v < r->cpu.visible_count; v++) {
         uint32_t i = r->cpu.visible[v];
         const GdrGpuMesh *mesh = &g->cpu_meshes[g->cpu_instances[i].mesh];
-        /* As a renderer with a buffer pair and constants per object would: bind, push, draw. */
+        /* As seed 003's renderer does for every object: bindPipeline, bindVertexBuffers,
+         * bindIndexBuffer, bindDescriptorSets, pushConstants, drawIndexed. gdr's scenes draw with
+         * one pipeline and one descriptor set (the frame's set 0), so those two binds name the same
+         * objects each time, as in an engine that binds per object without sorting. */
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->draw_pipeline);
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->layout, 0, 1, &r->occlusion.set, 0, NULL);
         VkDeviceSize vertex_offset = (VkDeviceSize)mesh->vertex_offset * sizeof(GdrGpuVertex);
         vkCmdBindVertexBuffers(cmd, 0, 1, &g->vertices.buffer, &vertex_offset);
         vkCmdBindIndexBuffer(cmd, g->indices.buffer, (VkDeviceSize)mesh->first_index * sizeof(uint32_t),

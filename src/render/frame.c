@@ -238,10 +238,50 @@ static void bind_frame_state(gdr_renderer *r, VkCommandBuffer cmd, const GdrGpuP
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->layout, 0, 1, &r->occlusion.set, 0, NULL);
 }
 
+gdr_status gdr_frame_record_color_readback(gdr_renderer *r, VkCommandBuffer cmd, gdr_error *err)
+{
+    VkCommandBufferBeginInfo begin = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    GDR_VK_TRY(err, vkBeginCommandBuffer(cmd, &begin));
+    gdr_vk_image_barrier(cmd, r->color.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                         VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                         VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
+                         VK_ACCESS_2_TRANSFER_READ_BIT);
+    VkBufferImageCopy region = {.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+                                .imageExtent = {r->width, r->height, 1}};
+    vkCmdCopyImageToBuffer(cmd, r->color.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, r->color_readback.buffer, 1,
+                           &region);
+    memory_barrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                   VK_ACCESS_2_HOST_READ_BIT);
+    GDR_VK_TRY(err, vkEndCommandBuffer(cmd));
+    return GDR_OK;
+}
+
+/* Submits the slot's frame and, when `copy_color`, the colour readback after it. */
+static gdr_status submit(gdr_renderer *r, gdr_frame_slot *slot, bool copy_color, double *submit_ms, gdr_error *err)
+{
+    VkCommandBufferSubmitInfo cmd_info[2] = {
+        {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO, .commandBuffer = slot->cmd},
+        {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO, .commandBuffer = slot->readback_cmd}};
+    VkSubmitInfo2 submit = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2, .commandBufferInfoCount = copy_color ? 2 : 1,
+                            .pCommandBufferInfos = cmd_info};
+    double start = gdr_now_ms();
+    GDR_VK_TRY(err, vkQueueSubmit2(r->ctx->queue, 1, &submit, slot->fence));
+    *submit_ms += gdr_now_ms() - start;
+    slot->submitted = true;
+    return GDR_OK;
+}
+
+static bool same_recording(const gdr_recorded_frame *a, const gdr_recorded_frame *b)
+{
+    return a->valid && b->valid && a->pipeline == b->pipeline && a->raster_mode == b->raster_mode &&
+           a->occlusion == b->occlusion && a->overdraw == b->overdraw && a->updates == b->updates && memcmp(&a->push, &b->push, sizeof a->push) == 0;
+}
+
 gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame,
                                        gdr_pipeline pipeline, bool copy_color, double *submit_ms, gdr_error *err)
 {
     VkCommandBuffer cmd = slot->cmd;
+    uint32_t slot_index = (uint32_t)(slot - r->slots);
     uint32_t update_count = take_updates(r, slot);
     /* Occlusion culling (issue 6) with its history when the last frame left a usable one. */
     bool occlusion = pipeline != GDR_PIPELINE_CPU && frame->cull != GDR_CULL_OFF && frame->occlusion != GDR_CULL_OFF;
@@ -265,35 +305,52 @@ gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, co
         .overdraw = r->overdraw.address,
         .visible_meshlets = r->visible_meshlets.address,
         .visbuffer = r->vis.pixels.address,
-        .raster = r->vis.params[slot - r->slots].address,
+        .raster = r->vis.params[slot_index].address,
     };
     bool overdraw = frame->view == GDR_VIEW_MODE_OVERDRAW;
+    uint32_t raster_mode = pipeline == GDR_PIPELINE_MESH ? r->vis.mode : GDR_GPU_RASTER_FORWARD;
+    gdr_visbuffer_begin_frame(r, slot_index, frame, raster_mode);
+    uint32_t query_base = slot_index * GDR_TS_COUNT;
+    vkResetQueryPool(r->ctx->device, r->timestamps, query_base, GDR_TS_COUNT);
+    slot->timestamps_written = true;
+    slot->pipeline = pipeline;
+
+    /* A GPU-driven frame whose commands are already in the slot: submit them again. */
+    gdr_recorded_frame key = {.valid = pipeline != GDR_PIPELINE_CPU && !r->record_every_frame, .pipeline = pipeline,
+                              .raster_mode = raster_mode, .occlusion = occlusion, .overdraw = overdraw,
+                              .updates = update_count > 0, .push = push};
+    if (same_recording(&slot->recorded, &key)) {
+        r->vis.slot_phases[slot_index] = slot->recorded.raster_phases;
+        slot->resubmitted = true;
+        return submit(r, slot, copy_color, submit_ms, err);
+    }
+    slot->recorded.valid = false;
+    slot->resubmitted = false;
     /* Task and mesh stages may only be named where the device has them enabled. */
     const VkPipelineStageFlags2 mesh_stages =
         r->ctx->has_mesh_shader ? VK_PIPELINE_STAGE_2_TASK_SHADER_BIT_EXT | VK_PIPELINE_STAGE_2_MESH_SHADER_BIT_EXT : 0;
 
     GDR_VK_TRY(err, vkResetCommandBuffer(cmd, 0));
-    VkCommandBufferBeginInfo begin = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
-                                      .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
+    VkCommandBufferBeginInfo begin = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     GDR_VK_TRY(err, vkBeginCommandBuffer(cmd, &begin));
-    uint32_t query_base = (uint32_t)(slot - r->slots) * GDR_TS_COUNT;
-    vkResetQueryPool(r->ctx->device, r->timestamps, query_base, GDR_TS_COUNT);
     /* The previous frame shares the instance buffer and the render targets: let it finish with them. */
     memory_barrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
                    VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
     timestamp(r, cmd, slot, GDR_TS_BEGIN);
     bind_frame_state(r, cmd, &push);
 
-    /* 1. Instance updates from the ring; counters (and overdraw counts) to zero. */
+    /* 1. Instance updates from the ring (sized for a full ring slot, so that frames with any number
+     * of updates share one recording; the shader reads the count); counters (and overdraw counts)
+     * to zero. */
     if (update_count > 0) {
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->scatter_pipeline);
-        vkCmdDispatch(cmd, (update_count + GDR_SCATTER_WORKGROUP_SIZE - 1) / GDR_SCATTER_WORKGROUP_SIZE, 1, 1);
+        vkCmdDispatch(cmd, (GDR_INSTANCE_UPDATES_PER_FRAME + GDR_SCATTER_WORKGROUP_SIZE - 1) / GDR_SCATTER_WORKGROUP_SIZE,
+                      1, 1);
     }
     vkCmdFillBuffer(cmd, slot->draw_stats.buffer, 0, VK_WHOLE_SIZE, 0);
     if (overdraw)
         vkCmdFillBuffer(cmd, r->overdraw.buffer, 0, VK_WHOLE_SIZE, 0);
-    gdr_visbuffer_begin_frame(r, (uint32_t)(slot - r->slots), frame,
-                              pipeline == GDR_PIPELINE_MESH ? r->vis.mode : GDR_GPU_RASTER_FORWARD, cmd);
+    gdr_visbuffer_record_fills(r, slot_index, cmd);
     /* (vkCmdFillBuffer is a transfer: COPY or CLEAR stage depending on the implementation.) */
     memory_barrier(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
                    VK_ACCESS_2_SHADER_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT,
@@ -345,31 +402,14 @@ gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, co
     VkBufferCopy stats_copy = {0, 0, sizeof(GdrGpuDrawStats)};
     vkCmdCopyBuffer(cmd, slot->draw_stats.buffer, slot->stats_readback.buffer, 1, &stats_copy);
     gdr_visbuffer_record_readback(r, (uint32_t)(slot - r->slots), cmd);
-    if (copy_color) {
-        gdr_vk_image_barrier(cmd, r->color.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                             VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                             VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
-                             VK_ACCESS_2_TRANSFER_READ_BIT);
-        VkBufferImageCopy region = {.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
-                                    .imageExtent = {r->width, r->height, 1}};
-        vkCmdCopyImageToBuffer(cmd, r->color.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, r->color_readback.buffer, 1,
-                               &region);
-    }
     memory_barrier(cmd, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
                    VK_ACCESS_2_HOST_READ_BIT);
     timestamp(r, cmd, slot, GDR_TS_END);
     GDR_VK_TRY(err, vkEndCommandBuffer(cmd));
 
-    VkCommandBufferSubmitInfo cmd_info = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO, .commandBuffer = cmd};
-    VkSubmitInfo2 submit = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2, .commandBufferInfoCount = 1,
-                            .pCommandBufferInfos = &cmd_info};
-    double start = gdr_now_ms();
-    GDR_VK_TRY(err, vkQueueSubmit2(r->ctx->queue, 1, &submit, slot->fence));
-    *submit_ms += gdr_now_ms() - start;
-    slot->submitted = true;
-    slot->timestamps_written = true;
-    slot->pipeline = pipeline;
-    return GDR_OK;
+    key.raster_phases = r->vis.slot_phases[slot_index];
+    slot->recorded = key;
+    return submit(r, slot, copy_color, submit_ms, err);
 }
 
 gdr_status gdr_frame_slot_wait(gdr_renderer *r, gdr_frame_slot *slot, double gpu_ms[GDR_TS_COUNT - 1], gdr_error *err)

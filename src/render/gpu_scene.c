@@ -290,6 +290,10 @@ gdr_status gdr_frame_slots_create(gdr_renderer *r, gdr_error *err)
                                              .commandPool = r->ctx->command_pool,
                                              .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY, .commandBufferCount = 1};
         GDR_VK_TRY(err, vkAllocateCommandBuffers(r->ctx->device, &alloc, &slot->cmd));
+        GDR_VK_TRY(err, vkAllocateCommandBuffers(r->ctx->device, &alloc, &slot->readback_cmd));
+        gdr_status recorded = gdr_frame_record_color_readback(r, slot->readback_cmd, err);
+        if (recorded != GDR_OK)
+            return recorded;
         VkFenceCreateInfo fence = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
         GDR_VK_TRY(err, vkCreateFence(r->ctx->device, &fence, NULL, &slot->fence));
         gdr_status status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuFrameGlobals),
@@ -330,6 +334,8 @@ void gdr_frame_slots_destroy(gdr_renderer *r)
             vkDestroyFence(r->ctx->device, slot->fence, NULL);
         if (slot->cmd)
             vkFreeCommandBuffers(r->ctx->device, r->ctx->command_pool, 1, &slot->cmd);
+        if (slot->readback_cmd)
+            vkFreeCommandBuffers(r->ctx->device, r->ctx->command_pool, 1, &slot->readback_cmd);
         gdr_vk_buffer_destroy(r->ctx, &slot->globals);
         gdr_vk_buffer_destroy(r->ctx, &slot->updates);
         gdr_vk_buffer_destroy(r->ctx, &slot->draws);

@@ -142,6 +142,7 @@ gdr_status gdr_renderer_create(const gdr_renderer_desc *desc_in, gdr_renderer **
     r->height = desc.height;
     r->last_slot = -1;
     r->busy_wait = desc.busy_wait;
+    r->record_every_frame = desc.record_every_frame;
     gdr_vk_context_desc context_desc = {.device = desc.device, .validate = desc.validate,
                                         .synchronization_validation = desc.synchronization_validation,
                                         .disable_mesh_shaders = desc.disable_mesh_shaders};
@@ -374,7 +375,7 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
     double *frame_cpu_ms = malloc(sizeof(double) * frames);
     if (!frame_cpu_ms)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "render: out of memory");
-    uint32_t timed_frames = 0;
+    uint32_t timed_frames = 0, recorded = 0;
     r->color_read_back = false;
     for (uint32_t f = 0; f < frames; f++) {
         gdr_frame_slot *slot = &r->slots[r->frame_index % GDR_FRAMES_IN_FLIGHT];
@@ -394,6 +395,7 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
         }
         frame_cpu_ms[f] = gdr_now_ms() - start;
         cpu_ms += frame_cpu_ms[f];
+        recorded += status == GDR_OK && !slot->resubmitted;
         if (status != GDR_OK) {
             free(frame_cpu_ms);
             return status;
@@ -475,6 +477,7 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
     }
     stats->cpu_ms_per_frame = cpu_ms / frames;
     stats->cpu_submit_ms_per_frame = submit_ms / frames;
+    stats->frames_recorded = recorded;
     stats->cpu_ms_per_frame_median = median;
     stats->pass_count = GDR_TS_COUNT - 1;
     for (int p = 0; p < GDR_TS_COUNT - 1; p++) {

@@ -60,8 +60,25 @@ typedef struct gdr_gpu_scene {
 } gdr_gpu_scene;
 
 /* What one frame in flight owns. */
+/* What a GPU-driven frame's commands depend on. A slot whose command buffer was recorded for the
+ * same key submits it again as it is: everything else a frame changes (camera, options read by the
+ * shaders, instance updates) lives in buffers the CPU rewrites before each submit. */
+typedef struct gdr_recorded_frame {
+    bool valid;
+    gdr_pipeline pipeline;
+    uint32_t raster_mode;        /* GDR_GPU_RASTER_* */
+    bool occlusion, overdraw;
+    bool updates;                /* the scatter pass runs (instance updates in the ring) */
+    uint32_t raster_phases;      /* visibility-buffer phases timed (host bookkeeping) */
+    GdrGpuPushConstants push;
+} gdr_recorded_frame;
+
 typedef struct gdr_frame_slot {
     VkCommandBuffer cmd;
+    VkCommandBuffer readback_cmd; /* copies the colour image for the CPU; recorded once, submitted after
+                                     `cmd` in frames that read the image back */
+    gdr_recorded_frame recorded; /* what `cmd` holds (GPU-driven frames only) */
+    bool resubmitted;            /* the last frame submitted `cmd` again without recording */
     VkFence fence;
     bool submitted;
     bool timestamps_written;
@@ -105,6 +122,7 @@ struct gdr_renderer {
     bool has_scene;
     gdr_frame_slot slots[GDR_FRAMES_IN_FLIGHT];
     uint32_t frame_index;
+    bool record_every_frame;      /* gdr_renderer_desc.record_every_frame: never resubmit */
     int last_slot; /* slot of the last submitted frame, -1 before the first */
 };
 
@@ -120,6 +138,9 @@ void gdr_frame_slots_destroy(gdr_renderer *r);
 /* Waits for the slot's previous frame (if any) and gathers its timings into `gpu_ms` (may be NULL). */
 gdr_status gdr_frame_slot_wait(gdr_renderer *r, gdr_frame_slot *slot, double gpu_ms[GDR_TS_COUNT - 1], gdr_error *err);
 /* Records and submits one frame into `slot`; adds the time spent in vkQueueSubmit2 to *submit_ms. */
+/* Records the commands that copy the colour image (left COLOR_ATTACHMENT_OPTIMAL by every frame)
+ * into color_readback for the host. */
+gdr_status gdr_frame_record_color_readback(gdr_renderer *r, VkCommandBuffer cmd, gdr_error *err);
 gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame,
                                        gdr_pipeline pipeline, bool copy_color, double *submit_ms, gdr_error *err);
 

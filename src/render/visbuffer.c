@@ -217,8 +217,7 @@ void gdr_visbuffer_begin_render(gdr_renderer *r)
     v->timed_frames = 0;
 }
 
-void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_frame_desc *frame, uint32_t mode,
-                               VkCommandBuffer cmd)
+void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_frame_desc *frame, uint32_t mode)
 {
     gdr_visbuffer *v = &r->vis;
     v->slot_mode[slot_index] = mode;
@@ -243,7 +242,12 @@ void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_f
         .resolved = v->resolved.address,
     };
     memcpy(v->params[slot_index].mapped, &params, sizeof params);
-    if (mode != GDR_GPU_RASTER_FORWARD) {
+}
+
+void gdr_visbuffer_record_fills(gdr_renderer *r, uint32_t slot_index, VkCommandBuffer cmd)
+{
+    gdr_visbuffer *v = &r->vis;
+    if (v->slot_mode[slot_index] != GDR_GPU_RASTER_FORWARD) {
         vkCmdFillBuffer(cmd, v->counters.buffer, 0, VK_WHOLE_SIZE, 0);
         vkCmdFillBuffer(cmd, v->pixels.buffer, 0, VK_WHOLE_SIZE, 0);
         vkCmdResetQueryPool(cmd, v->timestamps, slot_index * 2 * GDR_VISBUFFER_TS_COUNT, 2 * GDR_VISBUFFER_TS_COUNT);

@@ -78,11 +78,12 @@ float gdr_visbuffer_threshold(const gdr_frame_desc *frame);
 
 /* Start of a gdr_renderer_render call: timings restart. */
 void gdr_visbuffer_begin_render(gdr_renderer *r);
-/* Writes the slot's parameters and records the fills (before the barrier that follows the frame's
- * other fills: transfer writes -> task, mesh, fragment and compute shaders). The slot's previous
- * frame must have finished (its timings are gathered here). */
-void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_frame_desc *frame, uint32_t mode,
-                               VkCommandBuffer cmd);
+/* Writes the slot's parameters for a frame in `mode`. The slot's previous frame must have finished
+ * (its timings are gathered here). */
+void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_frame_desc *frame, uint32_t mode);
+/* Records the frame's fills (before the barrier that follows the frame's other fills: transfer
+ * writes -> task, mesh, fragment and compute shaders). */
+void gdr_visbuffer_record_fills(gdr_renderer *r, uint32_t slot_index, VkCommandBuffer cmd);
 /* Steps 2 to 6 above for one raster phase (0: the only one, 1: occlusion culling's early phase,
  * 2: its late phase, which adds to what the early one wrote), after the instance cull's barrier
  * (which must make its writes visible to compute shaders and indirect reads); `launch`: the offset

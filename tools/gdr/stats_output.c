@@ -58,8 +58,8 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
                 "%u drawn\n", s->instances_late_tested, s->instances_late_occluded, s->instances_late_drawn,
                 s->meshlets_late_tested, s->meshlets_late_occluded, s->meshlets_late_drawn);
     }
-    fprintf(out, "cpu_ms_per_frame    %.4f (of which vkQueueSubmit2 %.4f)\n", s->cpu_ms_per_frame,
-            s->cpu_submit_ms_per_frame);
+    fprintf(out, "cpu_ms_per_frame    %.4f (of which vkQueueSubmit2 %.4f; commands recorded in %u of the frames, "
+            "the others submitted again)\n", s->cpu_ms_per_frame, s->cpu_submit_ms_per_frame, s->frames_recorded);
     fprintf(out, "gpu_ms_per_frame    %.4f\n", s->gpu_ms_per_frame);
     for (uint32_t p = 0; p < s->pass_count; p++)
         fprintf(out, "  gpu_ms.%-16s %.4f\n", s->passes[p].name, s->passes[p].gpu_ms);
@@ -145,6 +145,7 @@ char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
     stats_add_occlusion_json(root, s);
     cJSON_AddNumberToObject(root, "cpu_ms_per_frame", s->cpu_ms_per_frame);
     cJSON_AddNumberToObject(root, "cpu_submit_ms_per_frame", s->cpu_submit_ms_per_frame);
+    cJSON_AddNumberToObject(root, "frames_recorded", s->frames_recorded);
     cJSON_AddNumberToObject(root, "cpu_ms_per_frame_median", s->cpu_ms_per_frame_median);
     cJSON_AddNumberToObject(root, "gpu_ms_per_frame", s->gpu_ms_per_frame);
     cJSON *passes = cJSON_AddObjectToObject(root, "gpu_ms");
