@@ -426,6 +426,7 @@ gdr_status gdr_frame_slot_wait(gdr_renderer *r, gdr_frame_slot *slot, double gpu
     }
     GDR_VK_TRY(err, vkResetFences(r->ctx->device, 1, &slot->fence));
     slot->submitted = false;
+    gdr_visbuffer_collect_timings(r, (uint32_t)(slot - r->slots));
     if (gpu_ms && slot->timestamps_written) {
         uint64_t ticks[GDR_TS_COUNT];
         uint32_t base = (uint32_t)(slot - r->slots) * GDR_TS_COUNT;

@@ -185,9 +185,7 @@ gdr_status gdr_visbuffer_resolve_mode(const gdr_renderer *r, const gdr_frame_des
     return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: unknown raster %d", (int)frame->raster);
 }
 
-/* Adds the timings of the slot's last frame (summed over its raster phases), if it was timed and
- * has finished (its fence was waited for before this is called). */
-static void collect_timings(gdr_renderer *r, uint32_t slot_index)
+void gdr_visbuffer_collect_timings(gdr_renderer *r, uint32_t slot_index)
 {
     gdr_visbuffer *v = &r->vis;
     uint32_t phases = v->slot_phases[slot_index];
@@ -223,7 +221,7 @@ void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_f
     v->slot_mode[slot_index] = mode;
     if (!v->params[slot_index].mapped)
         return; /* no mesh pipeline */
-    collect_timings(r, slot_index);
+    gdr_visbuffer_collect_timings(r, slot_index);
     gdr_mat4 projection, view;
     gdr_frame_matrices(r, &frame->camera, &projection, &view);
     /* Launches of whole rows (raster_submit.comp) within the device's mesh launch limits. */
@@ -388,7 +386,7 @@ void gdr_visbuffer_stats(gdr_renderer *r, uint32_t slot_index, gdr_frame_stats *
 {
     gdr_visbuffer *v = &r->vis;
     for (uint32_t i = 0; i < GDR_FRAMES_IN_FLIGHT; i++)
-        collect_timings(r, i); /* every frame has finished: the renderer drained its slots */
+        gdr_visbuffer_collect_timings(r, i); /* every frame has finished: the renderer drained its slots */
     uint32_t mode = v->slot_mode[slot_index];
     stats->raster = gdr_visbuffer_public_mode(mode);
     if (mode == GDR_GPU_RASTER_FORWARD || !v->supported)

@@ -78,6 +78,9 @@ float gdr_visbuffer_threshold(const gdr_frame_desc *frame);
 
 /* Start of a gdr_renderer_render call: timings restart. */
 void gdr_visbuffer_begin_render(gdr_renderer *r);
+/* Adds the timings of the slot's last frame (summed over its raster phases), if it was timed and
+ * has finished (its fence was waited for before this is called); a no-op once collected. */
+void gdr_visbuffer_collect_timings(gdr_renderer *r, uint32_t slot_index);
 /* Writes the slot's parameters for a frame in `mode`. The slot's previous frame must have finished
  * (its timings are gathered here). */
 void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_frame_desc *frame, uint32_t mode);

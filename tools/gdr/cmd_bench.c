@@ -64,7 +64,7 @@ int gdr_cmd_bench(int argc, char **argv)
     uint32_t lod_error_count = 1;
     bool occlusion_modes[2] = {true, false};
     uint32_t occlusion_count = 1;
-    bool validate = false, has_camera = false;
+    bool validate = false, has_camera = false, record_every_frame = false;
     gdr_pipeline pipelines[3] = {GDR_PIPELINE_DEFAULT};
     uint32_t pipeline_count = 1;
     gdr_vec3 camera_position;
@@ -73,6 +73,10 @@ int gdr_cmd_bench(int argc, char **argv)
         const char *arg = argv[i], *value;
         if (strcmp(arg, "--validate") == 0) {
             validate = true;
+            continue;
+        }
+        if (strcmp(arg, "--record-every-frame") == 0) {
+            record_every_frame = true;
             continue;
         }
         if (!(value = cli_value(argc, argv, &i)))
@@ -141,7 +145,7 @@ int gdr_cmd_bench(int argc, char **argv)
         gdr_frame_stats stats;
         gdr_demo_desc demo = {.instances = sizes[s]};
         gdr_renderer_desc desc = {.width = width, .height = height, .device = device, .validate = validate,
-                                  .busy_wait = true};
+                                  .busy_wait = true, .record_every_frame = record_every_frame};
         gdr_status loaded = scene_spec ? gdr_scene_load(scene_spec, &scene, &err) : gdr_scene_create_demo(&demo, &scene, &err);
         if (loaded != GDR_OK || gdr_renderer_create(&desc, &renderer, &err) != GDR_OK ||
             gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK) {

@@ -64,6 +64,8 @@ static void print_help(FILE *out)
           "  --frames N              frames per size (default 20)\n"
           "  --width W --height H    render target size (default 1920x1080)\n"
           "  --camera px,py,pz,qx,qy,qz,qw   instead of the demo camera\n"
+          "  --record-every-frame    record the GPU-driven frames' commands every frame (default:\n"
+          "                          once, then submitted again while nothing they depend on changes)\n"
           "  --device N|NAME, --validate, --json FILE\n"
           "\n"
           "exit status: 0 success, 1 failure, 2 bad usage, 3 validation messages\n",
