@@ -29,9 +29,9 @@ typedef struct gdr_renderer_desc {
     bool disable_mesh_shaders; /* behave as a device without VK_EXT_mesh_shader (tests the fallback) */
     bool disable_visibility_buffer; /* behave as a device without 64-bit buffer atomics (issue 8) */
     /* The GPU-driven pipelines record a frame slot's commands once and submit them again while
-     * nothing they depend on changes (pipeline, raster mode, occlusion culling, overdraw view, the
-     * image read back, the number of instance updates). true: record every frame (to measure what
-     * recording costs). The CPU pipeline always records. */
+     * nothing they depend on changes (pipeline, raster mode, occlusion culling, overdraw view,
+     * whether instance updates are pending). true: record every frame (to measure what recording
+     * costs). The CPU pipeline always records. */
     bool record_every_frame;
 } gdr_renderer_desc;
 

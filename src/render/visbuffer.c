@@ -221,7 +221,6 @@ void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_f
     v->slot_mode[slot_index] = mode;
     if (!v->params[slot_index].mapped)
         return; /* no mesh pipeline */
-    gdr_visbuffer_collect_timings(r, slot_index);
     gdr_mat4 projection, view;
     gdr_frame_matrices(r, &frame->camera, &projection, &view);
     /* Launches of whole rows (raster_submit.comp) within the device's mesh launch limits. */

@@ -82,7 +82,7 @@ void gdr_visbuffer_begin_render(gdr_renderer *r);
  * has finished (its fence was waited for before this is called); a no-op once collected. */
 void gdr_visbuffer_collect_timings(gdr_renderer *r, uint32_t slot_index);
 /* Writes the slot's parameters for a frame in `mode`. The slot's previous frame must have finished
- * (its timings are gathered here). */
+ * and its timings been collected (gdr_frame_slot_wait does both). */
 void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_frame_desc *frame, uint32_t mode);
 /* Records the frame's fills (before the barrier that follows the frame's other fills: transfer
  * writes -> task, mesh, fragment and compute shaders). */

@@ -105,16 +105,8 @@ void main()
         gl_PrimitiveTriangleIndicesEXT[t] = corners;
         uint why = cull ? triangle_culled(screen[corners.x], screen[corners.y], screen[corners.z]) : 0u;
         gl_MeshPrimitivesEXT[t].gl_CullPrimitiveEXT = why != 0u;
-        vec3 albedo = instance.color.rgb;
-        if (g.view_mode == GDR_VIEW_MESHLETS)
-            albedo = gdr_id_color(meshlet_index);
-        else if (g.view_mode == GDR_VIEW_INSTANCES)
-            albedo = gdr_id_color(instance_index);
-        else if (g.view_mode == GDR_VIEW_TRIANGLES)
-            albedo = gdr_id_color(meshlet_index * 128u + t);
-        else if (g.view_mode == GDR_VIEW_LOD)
-            albedo = gdr_depth_color(meshlet.group_depth);
-        out_color[t] = vec4(albedo, 1.0);
+        out_color[t] = vec4(gdr_view_albedo(g.view_mode, instance.color.rgb, instance_index, meshlet_index, t,
+                                            meshlet.group_depth), 1.0);
 #ifdef GDR_MESH_FROM_LIST
         out_visibility_id[t] = gdr_visbuffer_id(slot, t);
 #endif

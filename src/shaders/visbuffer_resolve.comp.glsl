@@ -59,16 +59,8 @@ vec4 shade_pixel(FrameGlobalsRef globals, vec2 viewport, vec2 centre, uint id)
     mat3 cofactor = mat3(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1]));
     vec3 n = cofactor * (b.x * normal[0] + b.y * normal[1] + b.z * normal[2]);
     vec3 position = b.x * world[0] + b.y * world[1] + b.z * world[2];
-    vec3 albedo = InstancesRef(push.instances).items[entry.instance].color.rgb;
-    uint view_mode = globals.value.view_mode;
-    if (view_mode == GDR_VIEW_MESHLETS)
-        albedo = gdr_id_color(entry.meshlet);
-    else if (view_mode == GDR_VIEW_INSTANCES)
-        albedo = gdr_id_color(entry.instance);
-    else if (view_mode == GDR_VIEW_TRIANGLES)
-        albedo = gdr_id_color(entry.meshlet * 128u + triangle);
-    else if (view_mode == GDR_VIEW_LOD)
-        albedo = gdr_depth_color(meshlets.items[entry.meshlet].group_depth);
+    vec3 albedo = gdr_view_albedo(globals.value.view_mode, InstancesRef(push.instances).items[entry.instance].color.rgb,
+                                  entry.instance, entry.meshlet, triangle, meshlets.items[entry.meshlet].group_depth);
     return gdr_shade(globals.value.light_direction.xyz, n, position, albedo);
 }
 

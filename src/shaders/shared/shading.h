@@ -41,4 +41,20 @@ vec3 gdr_depth_color(int depth)
     return (depth & 1) == 0 ? ramp : ramp * 0.75;
 }
 
+/* The colour a triangle is shaded with under `view_mode` (GDR_VIEW_*): its instance's own colour,
+ * or the debug views' colour of its cluster, instance, triangle or DAG depth. One definition for
+ * the forward mesh shader and the visibility buffer's resolve. */
+vec3 gdr_view_albedo(uint view_mode, vec3 instance_color, uint instance, uint meshlet, uint triangle, int group_depth)
+{
+    if (view_mode == GDR_VIEW_MESHLETS)
+        return gdr_id_color(meshlet);
+    if (view_mode == GDR_VIEW_INSTANCES)
+        return gdr_id_color(instance);
+    if (view_mode == GDR_VIEW_TRIANGLES)
+        return gdr_id_color(meshlet * 128u + triangle);
+    if (view_mode == GDR_VIEW_LOD)
+        return gdr_depth_color(group_depth);
+    return instance_color;
+}
+
 #endif
