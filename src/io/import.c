@@ -77,7 +77,13 @@ static void warn(const gdr_load_options *o, const char *format, ...)
 static gdr_status finish_cache_read(const char *path, gdr_scene **out, gdr_pvs *pvs, gdr_pvs **out_pvs,
                                     gdr_error *err)
 {
-    gdr_status status = build_clusters(path, out, 0, 1, err);
+    gdr_status status = gdr_io_clean_unclustered_meshes(*out, path, err);
+    if (status != GDR_OK) {
+        gdr_scene_destroy(*out);
+        *out = NULL;
+    } else {
+        status = build_clusters(path, out, 0, 1, err);
+    }
     if (status == GDR_OK && out_pvs)
         *out_pvs = pvs;
     else
