@@ -17,6 +17,9 @@ extern "C" {
 
 #define GDR_NAME_MAX 64
 #define GDR_NO_INDEX UINT32_MAX
+/* Largest magnitude of a mesh-space coordinate (metres) gdr accepts anywhere: far beyond any real
+ * scene, small enough that squared distances and areas stay finite in float. */
+#define GDR_MAX_COORDINATE 1e12f
 
 typedef struct gdr_mesh {
     char name[GDR_NAME_MAX];
@@ -91,7 +94,8 @@ GDR_API gdr_status gdr_scene_create(gdr_scene **out, gdr_error *err);
 GDR_API void gdr_scene_destroy(gdr_scene *scene);
 
 /* Adds a mesh whose arrays are copied; normals may be NULL (generated from the faces), uvs may
- * be NULL (zeros). Computes the bounding sphere. Checks every index against vertex_count. */
+ * be NULL (zeros). Computes the bounding sphere. Checks every index against vertex_count and every
+ * position (finite, within GDR_MAX_COORDINATE). */
 GDR_API gdr_status gdr_scene_add_mesh(gdr_scene *scene, const char *name, const gdr_vec3 *positions,
                                       const gdr_vec3 *normals, const gdr_vec2 *uvs,
                                       uint32_t vertex_count, const uint32_t *indices,

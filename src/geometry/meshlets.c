@@ -66,9 +66,12 @@ static gdr_status check_mesh(const gdr_mesh *mesh, gdr_error *err)
                                  mesh->indices[i], i, mesh->vertex_count);
     for (uint32_t v = 0; v < mesh->vertex_count; v++) {
         const gdr_vec3 p = mesh->positions[v];
-        if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
-            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "mesh '%s': position %u is not finite",
-                                 mesh->name, v);
+        /* meshoptimizer's own asserts fire on coordinates near sqrt(FLT_MAX) */
+        if (!(fabsf(p.x) <= GDR_MAX_COORDINATE) || !(fabsf(p.y) <= GDR_MAX_COORDINATE) ||
+            !(fabsf(p.z) <= GDR_MAX_COORDINATE))
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
+                                 "mesh '%s': position %u is not finite or beyond the %g limit on coordinates",
+                                 mesh->name, v, GDR_MAX_COORDINATE);
     }
     return GDR_OK;
 }
@@ -256,7 +259,13 @@ gdr_status gdr_meshlets_build(const gdr_mesh *mesh, const gdr_meshlet_options *o
     size_t count = meshopt_buildMeshlets(meshlets, vertices, triangles, mesh->indices, mesh->index_count,
                                          &mesh->positions[0].x, mesh->vertex_count, sizeof(gdr_vec3),
                                          o.max_vertices, o.max_triangles, o.cone_weight);
-    assert(count > 0 && count <= bound);
+    if (count == 0 || count > bound) {
+        free(meshlets);
+        free(vertices);
+        free(triangles);
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "mesh '%s': meshoptimizer made %zu meshlets from %u "
+                             "triangles", mesh->name, count, mesh->index_count / 3);
+    }
     /* Each meshlet's triangles start on a 4-byte boundary (meshoptimizer pads them): kept, so a
      * shader can read them as 32-bit words. Every offset fits in 32 bits: no meshlet is empty, so
      * there are at most index_count vertex entries and index_count + 3 * count triangle bytes. */

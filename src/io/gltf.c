@@ -456,7 +456,8 @@ static gdr_status clean_triangles(gltf_ctx *c, const char *place, prim_arrays *a
                                               *index_count, &added);
     if (status != GDR_OK)
         return gltf_fail(c, status, "%s: out of memory", place);
-    if (degenerate || duplicate)
+    /* Zero-area triangles draw nothing and are common in real files: dropped silently. */
+    if (duplicate || (degenerate && *index_count == 0))
         gdr_io_warn(&c->warnings, "%s: %s: %u of %u triangles dropped (%u degenerate, %u duplicate)%s", c->name,
                     place, degenerate + duplicate, before, degenerate, duplicate,
                     *index_count ? "" : "; no triangles left, skipped");
@@ -996,6 +997,28 @@ static gdr_status load_scene(gltf_ctx *c)
 
 /* --- entry points ---------------------------------------------------------------------------- */
 
+/* How deeply arrays and objects are nested at byte `end` of JSON text (strings skipped). */
+static int json_depth(const char *json, size_t end)
+{
+    int depth = 0, in_string = 0;
+    for (size_t i = 0; i < end; i++) {
+        char ch = json[i];
+        if (in_string) {
+            if (ch == '\\')
+                i++;
+            else if (ch == '"')
+                in_string = 0;
+        } else if (ch == '"') {
+            in_string = 1;
+        } else if (ch == '[' || ch == '{') {
+            depth++;
+        } else if ((ch == ']' || ch == '}') && depth > 0) {
+            depth--;
+        }
+    }
+    return depth;
+}
+
 static gdr_status import_document(gltf_ctx *c, const uint8_t *data, size_t size)
 {
     const char *json = (const char *)data;
@@ -1013,6 +1036,9 @@ static gdr_status import_document(gltf_ctx *c, const uint8_t *data, size_t size)
         uint32_t line = 1;
         for (size_t i = 0; i < offset; i++)
             line += json[i] == '\n';
+        if (json_depth(json, offset) >= CJSON_NESTING_LIMIT)
+            return gltf_fail(c, GDR_ERROR_PARSE, "JSON nested deeper than %d arrays and objects at line %u (byte %zu)",
+                             CJSON_NESTING_LIMIT, line, offset);
         return gltf_fail(c, GDR_ERROR_PARSE, "JSON syntax error at line %u (byte %zu)", line, offset);
     }
     if (!cJSON_IsObject(c->root))

@@ -148,7 +148,7 @@ static gdr_status confine_to_folder(gltf_ctx *c, const char *place, const char *
     if (!realpath(c->base_dir[0] ? c->base_dir : ".", folder))
         return gltf_fail(c, GDR_ERROR_IO, "%s.uri: the scene's folder cannot be resolved: %s", place, strerror(errno));
     if (!realpath(*path, resolved))
-        return gltf_fail(c, GDR_ERROR_IO, "%s.uri: '%.64s': %s", place, uri, strerror(errno));
+        return GDR_OK; /* nothing there to read: opening it says so */
     size_t length = strlen(folder);
     int inside = strncmp(resolved, folder, length) == 0 && (resolved[length] == '/' || strcmp(folder, "/") == 0);
     if (!inside)
@@ -214,10 +214,11 @@ gdr_status gltf_load_uri(gltf_ctx *c, const char *uri, const char *place, uint8_
     path[n] = 0;
     gdr_error file_err;
     gdr_status status = c->allow_outside_files ? GDR_OK : confine_to_folder(c, place, uri, &path);
-    if (status == GDR_OK)
-        status = gdr_io_read_file(path, out, size, c->sources, &file_err);
-    else
-        file_err = *c->err;
+    if (status != GDR_OK) {
+        free(path);
+        return status;
+    }
+    status = gdr_io_read_file(path, out, size, c->sources, &file_err);
     free(path);
     if (status != GDR_OK)
         return gltf_fail(c, status, "%s.uri: %s", place, file_err.message);

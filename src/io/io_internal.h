@@ -14,9 +14,8 @@
 /* Largest element count of an accessor that no buffer data backs (it would be all zeros). */
 #define GDR_IO_MAX_UNBACKED_ELEMENTS (1u << 24)
 
-/* Largest magnitude of a vertex coordinate an importer accepts (mesh space, metres): far beyond any
- * real scene, small enough that squared distances and areas stay finite in float. */
-#define GDR_IO_MAX_COORDINATE 1e12
+/* Largest magnitude of a vertex coordinate an importer accepts (gdr/scene.h). */
+#define GDR_IO_MAX_COORDINATE GDR_MAX_COORDINATE
 /* A vertex used by more triangles than this is split into copies (gdr_io_split_shared_vertices). */
 #define GDR_IO_MAX_VERTEX_VALENCE 128u
 
@@ -80,6 +79,12 @@ gdr_status gdr_io_clean_unclustered_meshes(gdr_scene *scene, const char *name, g
  * refused when a side exceeds the decoder's limit. */
 gdr_status gdr_io_image_size(const void *data, size_t size, const char *name, uint32_t *width, uint32_t *height,
                              gdr_error *err);
+
+/* gdr_cache_read_ex for the cache of `source` (NULL: a cache read on its own): the cache must
+ * record that file as the first of its sources, with the same size and contents (its folder may
+ * have moved: the other sources are then looked for under the new folder), else it is stale. */
+gdr_status gdr_io_cache_read_for(const char *path, const char *source, const char *build_options, gdr_scene **out,
+                                 gdr_pvs **out_pvs, gdr_error *err);
 
 /* Warning sink of one import. */
 typedef struct gdr_io_warnings {

@@ -262,7 +262,8 @@ static gdr_status clean_group(obj_ctx *c, gdr_vec3 **positions, gdr_vec3 **norma
                                               &added);
     if (status != GDR_OK)
         return obj_fail(c, status, "out of memory");
-    if (degenerate || duplicate)
+    /* Zero-area faces draw nothing and are common in real files: dropped silently. */
+    if (duplicate || (degenerate && m->index_count == 0))
         gdr_io_warn(&c->warnings, "%s: group '%s' ending at line %u: %u of %u faces dropped (%u degenerate, %u "
                     "duplicate)", c->name, m->name[0] ? m->name : "obj", c->line, degenerate + duplicate, before,
                     degenerate, duplicate);

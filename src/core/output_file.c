@@ -1,0 +1,93 @@
+/* Output files: links followed, regular files replaced atomically, devices and FIFOs written in
+ * place (output_file.h). */
+#define _XOPEN_SOURCE 700 /* realpath, fsync */
+#include "core/output_file.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+/* A device, FIFO or socket: opened for writing as it is (no O_CREAT, no O_TRUNC). */
+static gdr_status open_direct(const char *path, gdr_output_file *out, gdr_error *err)
+{
+    int fd = open(path, O_WRONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+    if (fd < 0)
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: cannot write: %s", path,
+                             errno == ENXIO ? "a FIFO with no reader" : strerror(errno));
+    int flags = fcntl(fd, F_GETFL);
+    if (flags < 0 || fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0 || !(out->file = fdopen(fd, "wb"))) {
+        close(fd);
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: cannot write: %s", path, strerror(errno));
+    }
+    return GDR_OK;
+}
+
+gdr_status gdr_output_open(const char *path, gdr_output_file *out, gdr_error *err)
+{
+    *out = (gdr_output_file){0};
+    struct stat st;
+    char resolved[PATH_MAX];
+    const char *target = path;
+    if (lstat(path, &st) == 0 && S_ISLNK(st.st_mode)) {
+        if (!realpath(path, resolved))
+            return gdr_error_set(err, GDR_ERROR_IO, "%s: a symbolic link whose target cannot be written: %s", path,
+                                 strerror(errno));
+        target = resolved;
+    }
+    int exists = stat(target, &st) == 0;
+    if (exists && S_ISDIR(st.st_mode))
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: is a directory", path);
+    out->target = strdup(target);
+    if (!out->target)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+    if (exists && !S_ISREG(st.st_mode)) {
+        gdr_status status = open_direct(target, out, err);
+        if (status != GDR_OK)
+            free(out->target), out->target = NULL;
+        return status;
+    }
+    size_t length = strlen(target) + 32;
+    out->temporary = malloc(length);
+    if (!out->temporary) {
+        free(out->target), out->target = NULL;
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+    }
+    snprintf(out->temporary, length, "%s.tmp.%ld", target, (long)getpid());
+    int fd = open(out->temporary, O_WRONLY | O_CREAT | O_TRUNC | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd < 0 && errno == EEXIST && unlink(out->temporary) == 0) /* left by a crashed run of this pid */
+        fd = open(out->temporary, O_WRONLY | O_CREAT | O_TRUNC | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd < 0 || !(out->file = fdopen(fd, "wb"))) {
+        gdr_status status = gdr_error_set(err, GDR_ERROR_IO, "%s: cannot create: %s", out->temporary, strerror(errno));
+        if (fd >= 0)
+            close(fd), unlink(out->temporary);
+        free(out->temporary), free(out->target);
+        *out = (gdr_output_file){0};
+        return status;
+    }
+    return GDR_OK;
+}
+
+gdr_status gdr_output_close(gdr_output_file *out, bool ok, const char *path, gdr_error *err)
+{
+    gdr_status status = GDR_OK;
+    int saved = errno;
+    if (ok && (fflush(out->file) != 0 || (out->temporary && fsync(fileno(out->file)) != 0)))
+        ok = false, saved = errno;
+    if (fclose(out->file) != 0 && ok)
+        ok = false, saved = errno;
+    if (ok && out->temporary && rename(out->temporary, out->target) != 0)
+        ok = false, saved = errno;
+    if (!ok) {
+        if (out->temporary)
+            unlink(out->temporary);
+        status = gdr_error_set(err, GDR_ERROR_IO, "%s: cannot write (%s)", path, strerror(saved));
+    }
+    free(out->temporary);
+    free(out->target);
+    *out = (gdr_output_file){0};
+    return status;
+}
