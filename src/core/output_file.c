@@ -26,6 +26,41 @@ static gdr_status open_direct(const char *path, gdr_output_file *out, gdr_error 
     return GDR_OK;
 }
 
+/* The file a chain of symbolic links ends at, which need not exist yet (its folder must). */
+static bool resolve_link(const char *path, char *out)
+{
+    char current[PATH_MAX], next[PATH_MAX];
+    snprintf(current, sizeof current, "%s", path);
+    for (int hops = 0; hops < 16; hops++) {
+        struct stat st;
+        if (lstat(current, &st) != 0 || !S_ISLNK(st.st_mode))
+            break;
+        ssize_t n = readlink(current, next, sizeof next - 1);
+        if (n <= 0)
+            return false;
+        next[n] = 0;
+        if (next[0] != '/') { /* relative to the link's folder */
+            const char *slash = strrchr(current, '/');
+            int length = slash ? (int)(slash - current) + 1 : 0;
+            char joined[PATH_MAX];
+            if (snprintf(joined, sizeof joined, "%.*s%s", length, current, next) >= (int)sizeof joined)
+                return false;
+            snprintf(next, sizeof next, "%s", joined);
+        }
+        snprintf(current, sizeof current, "%s", next);
+    }
+    if (realpath(current, out))
+        return true;
+    /* Not there yet: its folder resolved, its name kept. */
+    char folder[PATH_MAX], resolved[PATH_MAX];
+    const char *slash = strrchr(current, '/');
+    snprintf(folder, sizeof folder, "%.*s", slash ? (int)(slash - current) + (slash == current) : 1,
+             slash ? current : ".");
+    if (errno != ENOENT || !realpath(folder, resolved))
+        return false;
+    return snprintf(out, PATH_MAX, "%s/%s", resolved, slash ? slash + 1 : current) < PATH_MAX;
+}
+
 gdr_status gdr_output_open(const char *path, gdr_output_file *out, gdr_error *err)
 {
     *out = (gdr_output_file){0};
@@ -33,7 +68,7 @@ gdr_status gdr_output_open(const char *path, gdr_output_file *out, gdr_error *er
     char resolved[PATH_MAX];
     const char *target = path;
     if (lstat(path, &st) == 0 && S_ISLNK(st.st_mode)) {
-        if (!realpath(path, resolved))
+        if (!resolve_link(path, resolved))
             return gdr_error_set(err, GDR_ERROR_IO, "%s: a symbolic link whose target cannot be written: %s", path,
                                  strerror(errno));
         target = resolved;
