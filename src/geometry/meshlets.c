@@ -10,6 +10,7 @@
 
 #include "core/thread_pool.h"
 #include "geometry/cluster_bounds.h"
+#include "geometry/meshlet_chunks.h"
 #include "gdr/geometry.h"
 #include "gdr/scene.h"
 
@@ -245,7 +246,10 @@ gdr_status gdr_meshlets_build(const gdr_mesh *mesh, const gdr_meshlet_options *o
     if (status != GDR_OK)
         return status;
 
-    size_t bound = meshopt_buildMeshletsBound(mesh->index_count, o.max_vertices, o.max_triangles);
+    /* Hostile meshes (meshlet_chunks.h) are built in chunks: sound ones exactly as before. */
+    int chunked = gdr_meshlet_needs_chunks(mesh);
+    size_t bound = chunked ? gdr_meshlet_chunks_bound(mesh, o.max_vertices, o.max_triangles)
+                           : meshopt_buildMeshletsBound(mesh->index_count, o.max_vertices, o.max_triangles);
     struct meshopt_Meshlet *meshlets = malloc(bound * sizeof *meshlets);
     unsigned int *vertices = malloc(bound * o.max_vertices * sizeof *vertices);
     unsigned char *triangles = malloc(bound * o.max_triangles * 3);
@@ -256,9 +260,11 @@ gdr_status gdr_meshlets_build(const gdr_mesh *mesh, const gdr_meshlet_options *o
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for %zu meshlets", mesh->name,
                              bound);
     }
-    size_t count = meshopt_buildMeshlets(meshlets, vertices, triangles, mesh->indices, mesh->index_count,
-                                         &mesh->positions[0].x, mesh->vertex_count, sizeof(gdr_vec3),
-                                         o.max_vertices, o.max_triangles, o.cone_weight);
+    size_t count = chunked ? gdr_meshlet_build_chunks(mesh, o.max_vertices, o.max_triangles, o.cone_weight, meshlets,
+                                                      vertices, triangles)
+                           : meshopt_buildMeshlets(meshlets, vertices, triangles, mesh->indices, mesh->index_count,
+                                                   &mesh->positions[0].x, mesh->vertex_count, sizeof(gdr_vec3),
+                                                   o.max_vertices, o.max_triangles, o.cone_weight);
     if (count == 0 || count > bound) {
         free(meshlets);
         free(vertices);

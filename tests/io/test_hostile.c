@@ -13,6 +13,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "geometry/cluster_checks.h"
 #include "gdr/geometry.h"
 #include "gdr/io.h"
 #include "io/io_test_helpers.h"
@@ -155,6 +156,37 @@ static void test_fan_split(void)
         free(uses);
     }
     gdr_scene_destroy(s);
+}
+
+/* A soup of separate triangles and one far away: meshoptimizer's kd-tree cannot split them, so
+ * meshlets are built in chunks; they must still follow the whole cluster contract. */
+static void test_soup_with_outlier(void)
+{
+    enum { N = 9000 };
+    gdr_vec3 *p = malloc(sizeof(gdr_vec3) * 3 * (N + 1));
+    uint32_t *idx = malloc(sizeof(uint32_t) * 3 * (N + 1));
+    unsigned state = 3;
+    for (uint32_t i = 0; i < N; i++) {
+        gdr_vec3 a = {test_random(&state), test_random(&state), test_random(&state)};
+        p[3 * i] = a;
+        p[3 * i + 1] = (gdr_vec3){a.x + 0.01f, a.y, a.z};
+        p[3 * i + 2] = (gdr_vec3){a.x, a.y + 0.01f, a.z};
+    }
+    p[3 * N] = (gdr_vec3){1e9f, 0, 0};
+    p[3 * N + 1] = (gdr_vec3){1e9f, 1, 0};
+    p[3 * N + 2] = (gdr_vec3){1e9f, 0, 1};
+    for (uint32_t i = 0; i < 3 * (N + 1); i++)
+        idx[i] = i;
+    gdr_mesh mesh = {.name = "soup", .vertex_count = 3 * (N + 1), .positions = p, .index_count = 3 * (N + 1),
+                     .indices = idx};
+    gdr_mesh_clusters mc = {0};
+    CHECK(gdr_meshlets_build(&mesh, NULL, &mc, &err) == GDR_OK);
+    CHECK(check_cluster_layout(&mesh, &mc, GDR_CLUSTER_MAX_VERTICES, GDR_CLUSTER_MAX_TRIANGLES));
+    CHECK(check_cluster_coverage(&mesh, &mc));
+    CHECK(check_cluster_spheres(&mesh, &mc));
+    gdr_mesh_clusters_free(&mc);
+    free(p);
+    free(idx);
 }
 
 /* URIs leaving the scene's folder are refused unless allowed. */
@@ -503,6 +535,7 @@ int main(void)
     test_huge_coordinates();
     test_degenerate_and_duplicate();
     test_fan_split();
+    test_soup_with_outlier();
     test_uri_confinement();
     test_fifo();
     test_source_list_repeats();

@@ -1,6 +1,6 @@
 /* Work proportional to input: for every dimension of a scene file that drives a loop or an
  * allocation (triangles, repeated and degenerate faces, shared vertices, groups, nodes, meshes,
- * materials, images, instances), the file is generated at size N and 4N and taken through import,
+ * materials, images, instances, a soup with an outlier), the file is generated at size N and 4N and taken through import,
  * meshlets and the LOD DAG; the CPU time must grow less than 8-fold (linear: 4, n log n: about
  * 4.5, quadratic: 16). Times are the best of three runs, measured side by side. */
 #define _POSIX_C_SOURCE 200809L
@@ -81,6 +81,20 @@ static void obj_grid(text *t, uint32_t n)
             uint32_t a = y * (side + 1) + x + 1, b = a + 1, c = a + side + 1, d = c + 1;
             put(t, "f %u %u %u\nf %u %u %u\n", a, b, d, a, d, c);
         }
+}
+
+static void obj_soup_and_outlier(text *t, uint32_t n)
+{
+    /* Separate triangles in a unit cube and one far away: meshoptimizer's kd-tree cannot split the
+     * centroids (meshlet_chunks.c). */
+    unsigned state = 7;
+    for (uint32_t i = 0; i < n; i++) {
+        float x = test_random(&state), y = test_random(&state), z = test_random(&state);
+        put(t, "v %g %g %g\nv %g %g %g\nv %g %g %g\n", x, y, z, x + 0.01f, y, z, x, y + 0.01f, z);
+    }
+    put(t, "v 1e9 0 0\nv 1e9 1 0\nv 1e9 0 1\n");
+    for (uint32_t i = 0; i <= n; i++)
+        put(t, "f %u %u %u\n", 3 * i + 1, 3 * i + 2, 3 * i + 3);
 }
 
 static const char *gltf_head = "{\"asset\":{\"version\":\"2.0\"},";
@@ -212,6 +226,7 @@ int main(void)
         {"obj: fan around one vertex", 0, 10000, obj_fan},
         {"obj: groups after a large one", 0, 20000, obj_groups},
         {"obj: grid (triangles)", 0, 20000, obj_grid},
+        {"obj: soup and one far triangle", 0, 8000, obj_soup_and_outlier},
         {"gltf: zero positions", 1, 20000, gltf_zero_positions},
         {"gltf: node list", 1, 5000, gltf_node_list},
         {"gltf: node chain", 1, 5000, gltf_node_chain},
