@@ -61,10 +61,65 @@ static bool resolve_link(const char *path, char *out)
     return snprintf(out, PATH_MAX, "%s/%s", resolved, slash ? slash + 1 : current) < PATH_MAX;
 }
 
+/* N when the path, or a link on the way from it, names this process's descriptor N (/dev/stdout,
+ * /dev/fd/N, /proc/self/fd/N); -1 otherwise. */
+static int own_descriptor(const char *path)
+{
+    char current[PATH_MAX], next[PATH_MAX];
+    snprintf(current, sizeof current, "%s", path);
+    for (int hops = 0; hops < 16; hops++) {
+        if (strcmp(current, "/dev/stdout") == 0)
+            return 1;
+        if (strcmp(current, "/dev/stderr") == 0)
+            return 2;
+        const char *number = strncmp(current, "/dev/fd/", 8) == 0 ? current + 8
+                             : strncmp(current, "/proc/self/fd/", 14) == 0 ? current + 14 : NULL;
+        if (number && number[0] >= '0' && number[0] <= '9' && strspn(number, "0123456789") == strlen(number))
+            return atoi(number);
+        ssize_t n = readlink(current, next, sizeof next - 1);
+        if (n <= 0 || next[0] != '/')
+            return -1;
+        next[n] = 0;
+        snprintf(current, sizeof current, "%s", next);
+    }
+    return -1;
+}
+
 gdr_status gdr_output_open(const char *path, gdr_output_file *out, gdr_error *err)
 {
     *out = (gdr_output_file){0};
     struct stat st;
+    /* The process's own output (gdr ... --stats /dev/stdout > file): written through the descriptor
+     * it has, after what is buffered for it, never replacing the file behind it. */
+    int own = own_descriptor(path);
+    if (own >= 0) {
+        fflush(own == 1 ? stdout : own == 2 ? stderr : NULL);
+        int fd = dup(own);
+        if (fd < 0 || !(out->file = fdopen(fd, "wb"))) {
+            if (fd >= 0)
+                close(fd);
+            return gdr_error_set(err, GDR_ERROR_IO, "%s: cannot write: %s", path, strerror(errno));
+        }
+        if (!(out->target = strdup(path))) {
+            fclose(out->file);
+            out->file = NULL;
+            return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+        }
+        return GDR_OK;
+    }
+    /* What the path names, links followed: a device, FIFO or socket is written where it is (through
+     * the path itself, so that /dev/stdout reaches a pipe). */
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: is a directory", path);
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        if (!(out->target = strdup(path)))
+            return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+        gdr_status status = open_direct(path, out, err);
+        if (status != GDR_OK)
+            free(out->target), out->target = NULL;
+        return status;
+    }
+    /* A regular file, or none yet: replaced atomically, at the end of any chain of links. */
     char resolved[PATH_MAX];
     const char *target = path;
     if (lstat(path, &st) == 0 && S_ISLNK(st.st_mode)) {
@@ -73,18 +128,9 @@ gdr_status gdr_output_open(const char *path, gdr_output_file *out, gdr_error *er
                                  strerror(errno));
         target = resolved;
     }
-    int exists = stat(target, &st) == 0;
-    if (exists && S_ISDIR(st.st_mode))
-        return gdr_error_set(err, GDR_ERROR_IO, "%s: is a directory", path);
     out->target = strdup(target);
     if (!out->target)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
-    if (exists && !S_ISREG(st.st_mode)) {
-        gdr_status status = open_direct(target, out, err);
-        if (status != GDR_OK)
-            free(out->target), out->target = NULL;
-        return status;
-    }
     size_t length = strlen(target) + 32;
     out->temporary = malloc(length);
     if (!out->temporary) {

@@ -4,8 +4,11 @@
  *  - an existing regular file, or a new one, is replaced atomically: written to a temporary file
  *    in the same folder, flushed, then renamed over it, so a crash, a full disk or an error never
  *    leaves a half-written file;
- *  - an existing device, FIFO or socket (/dev/stdout, /dev/null, a pipe) is written directly, never
- *    replaced; a FIFO without a reader is refused at once instead of waiting for one;
+ *  - the process's own descriptors (/dev/stdout, /dev/stderr, /dev/fd/N, /proc/self/fd/N, or a link
+ *    to one) are written through the descriptor, after what stdio has buffered for it, whatever it
+ *    is (a terminal, a pipe, a file the shell redirected);
+ *  - an existing device, FIFO or socket (/dev/null, a pipe) is written directly, never replaced; a
+ *    FIFO without a reader is refused at once instead of waiting for one;
  *  - a directory is refused. */
 #ifndef GDR_CORE_OUTPUT_FILE_H
 #define GDR_CORE_OUTPUT_FILE_H

@@ -27,19 +27,25 @@ check() { # check DESCRIPTION CONDITION...
 
 tiny="--width 32 --height 24"
 # Output targets: links followed, devices written in place, never replaced.
+# What /dev/stdout is, as a link of the test's own (a regression must not replace /dev/stdout).
+ln -s /proc/self/fd/1 "$work/stdout-link"
 # shellcheck disable=SC2086
-expect 0 "stats to stdout" "" "$gdr" render demo:instances=4 $tiny --stats /dev/stdout
+expect 0 "stats to stdout" "" "$gdr" render demo:instances=4 $tiny --stats "$work/stdout-link"
 check "stats JSON on stdout" grep -q '"instances_total"' "$work/stdout"
+check "the stdout link is still a link" test -L "$work/stdout-link"
 echo old > "$work/target.json" && ln -s target.json "$work/link.json"
 # shellcheck disable=SC2086
-expect 0 "stats to a symlink" "" "$gdr" render demo:instances=4 $tiny --stats "$work/link.json" --out /dev/null
+expect 0 "stats to a symlink" "" "$gdr" render demo:instances=4 $tiny --stats "$work/link.json"
 check "the link is still a link" test -L "$work/link.json"
 check "its target holds the statistics" grep -q '"instances_total"' "$work/target.json"
-check "/dev/null is still a device" test -c /dev/null
-if [ -w /dev/full ]; then
+# Devices of the test's own (root can make them), so that a regression cannot replace /dev/null.
+if mknod "$work/null" c 1 3 2>/dev/null && mknod "$work/full" c 1 7 2>/dev/null; then
     # shellcheck disable=SC2086
-    expect 1 "stats to a full device" "cannot write" "$gdr" render demo:instances=4 $tiny --stats /dev/full
-    check "/dev/full is still a device" test -c /dev/full
+    expect 0 "image to a null device" "" "$gdr" render demo:instances=4 $tiny --out "$work/null"
+    check "the null device is still a device" test -c "$work/null"
+    # shellcheck disable=SC2086
+    expect 1 "stats to a full device" "cannot write" "$gdr" render demo:instances=4 $tiny --stats "$work/full"
+    check "the full device is still a device" test -c "$work/full"
 fi
 mkfifo "$work/fifo"
 expect 1 "cache to a FIFO without a reader" "no reader" "$gdr" build demo:instances=4 -o "$work/fifo"
