@@ -148,3 +148,18 @@ void gdr_frame_plan_describe(const gdr_frame_plan *plan, FILE *out)
     print_barrier(out, &plan->end_barrier, false);
     fprintf(out, " | |\n\n");
 }
+
+void gdr_describe_frame_passes(FILE *out)
+{
+    static const gdr_frame_config configs[] = {
+        {GDR_PIPELINE_INDIRECT, false, false, false, true}, {GDR_PIPELINE_INDIRECT, false, true, false, true},
+        {GDR_PIPELINE_CPU, false, false, false, true},      {GDR_PIPELINE_MESH, false, false, false, true},
+        {GDR_PIPELINE_MESH, false, true, false, true},      {GDR_PIPELINE_MESH, true, false, false, true},
+        {GDR_PIPELINE_MESH, true, true, false, true},       {GDR_PIPELINE_MESH, true, true, true, true},
+    };
+    for (size_t i = 0; i < sizeof configs / sizeof configs[0]; i++) {
+        gdr_frame_plan plan;
+        gdr_frame_plan_build(&configs[i], &plan);
+        gdr_frame_plan_describe(&plan, out);
+    }
+}

@@ -45,6 +45,7 @@ typedef struct resource_state {
     gdr_vk_scope visible;              /* whom a barrier has made that write visible to */
     VkPipelineStageFlags2 read_stages; /* reads since the last write (a later write waits for them) */
     VkImageLayout layout;
+    bool untouched;                    /* not used yet in this frame */
 } resource_state;
 
 static VkImageLayout home_layout(gdr_frame_resource resource)
@@ -77,9 +78,7 @@ static void add_hazards(const resource_state *s, const gdr_resource_use *use, gd
         gdr_image_transition *t = &b->images[b->image_count++];
         *t = (gdr_image_transition){.resource = use->resource, .from = use->discard ? VK_IMAGE_LAYOUT_UNDEFINED : s->layout,
                                     .to = use->layout, .src = s->write, .dst = dst};
-        t->src.stages |= s->read_stages;
-        if (!t->src.stages)
-            t->src.stages = VK_PIPELINE_STAGE_2_NONE;
+        t->src.stages |= s->read_stages | (s->untouched ? VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT : 0);
         return;
     }
     if (use->access == 0)
@@ -113,6 +112,7 @@ static void apply_uses(resource_state *s, const gdr_frame_pass *p, gdr_frame_res
     }
     if (!used)
         return;
+    s->untouched = false;
     if (written.stages || transitioned) { /* a layout transition counts as a write in its stages */
         s->write = written.stages ? written : (gdr_vk_scope){read.stages, 0};
         s->visible = transitioned && !written.stages ? read : (gdr_vk_scope){0};
@@ -155,11 +155,12 @@ static void derive_timestamps(gdr_frame_plan *plan)
 
 void gdr_frame_plan_derive(gdr_frame_plan *plan)
 {
-    /* Nothing is known of what came before the frame: its first barrier waits for all of it, and
-     * leaves every resource in its home layout with nothing pending. */
+    /* Nothing is known of what came before the frame: its first barrier waits for all of it. After
+     * it every resource is in its home layout and nothing is left to make visible; every later
+     * command runs after that barrier, and a layout transition chains through it (untouched). */
     resource_state states[GDR_RES_COUNT];
     for (uint32_t r = 0; r < GDR_RES_COUNT; r++)
-        states[r] = (resource_state){.layout = home_layout((gdr_frame_resource)r)};
+        states[r] = (resource_state){.layout = home_layout((gdr_frame_resource)r), .untouched = true};
     for (uint32_t i = 0; i < plan->pass_count; i++) {
         gdr_frame_pass *p = &plan->passes[i];
         derive_pass(states, p);
