@@ -16,7 +16,7 @@ void gdr_frame_matrices(const gdr_renderer *r, const gdr_camera *camera, gdr_mat
 GdrGpuPushConstants gdr_frame_push_constants(const gdr_renderer *r, const gdr_frame_slot *slot)
 {
     return (GdrGpuPushConstants){.globals = slot->globals.address, .frame = slot->frame_buffers.address,
-                                 .scene = r->scene.refs.address};
+                                 .scene = r->scene.refs.address, .visbuffer = r->vis.pixels.address};
 }
 
 static GdrGpuFrameBuffers frame_buffers(const gdr_renderer *r, const gdr_frame_slot *slot)
@@ -24,7 +24,7 @@ static GdrGpuFrameBuffers frame_buffers(const gdr_renderer *r, const gdr_frame_s
     return (GdrGpuFrameBuffers){
         .draws = slot->draws.address, .draw_stats = slot->draw_stats.address, .updates = slot->updates.address,
         .tasks = slot->tasks.address, .overdraw = r->overdraw.address, .visible_meshlets = r->visible_meshlets.address,
-        .visbuffer = r->vis.pixels.address, .raster = r->vis.params[slot - r->slots].address};
+        .raster = r->vis.params[slot - r->slots].address};
 }
 
 static uint32_t frame_flags(const gdr_frame_desc *frame, bool lod, bool occlusion, bool history)

@@ -31,10 +31,9 @@ shared ivec2 corner_fixed[GDR_MESH_MAX_VERTICES]; // framebuffer position in sub
 shared vec3 corner_float[GDR_MESH_MAX_VERTICES];  // framebuffer position and depth, unsnapped
 
 // Per invocation, read once (a reference reloaded after every atomic would cost a load per pixel):
-// where covered pixels go, and the triangles' bytes.
+// the target's width, the overdraw counts and the triangles' bytes.
 uint target_width;
 bool count_overdraw;
-VisbufferRef target_pixels;
 OverdrawRef target_overdraw;
 UintsRef triangle_bytes;
 // The depth plane of the current triangle: depth = x + y * (px - ax) + z * (py - ay), in pixels.
@@ -51,7 +50,7 @@ void write_pixel(int x, int y, uint id)
     vec2 centre = vec2(x, y) + 0.5 - depth_origin;
     float depth = clamp(depth_plane.x + depth_plane.y * centre.x + depth_plane.z * centre.y, 0.0, 1.0);
     uint pixel = uint(y) * target_width + uint(x);
-    atomicMax(target_pixels.items[pixel], gdr_visbuffer_pack(depth, id));
+    atomicMax(push.visbuffer.items[pixel], gdr_visbuffer_pack(depth, id));
     if (count_overdraw)
         atomicAdd(target_overdraw.items[pixel], 1u);
 }
@@ -142,7 +141,6 @@ void main()
     InstancesRef instances = GDR_SCENE.instances;
     UintsRef vertex_refs = GDR_SCENE.meshlet_vertices;
     VerticesRef vertices = GDR_SCENE.vertices;
-    target_pixels = GDR_FRAME.visbuffer;
     target_overdraw = GDR_FRAME.overdraw;
     triangle_bytes = GDR_SCENE.meshlet_triangles;
     RasterCountersRef counters = RasterCountersRef(params.value.counters);

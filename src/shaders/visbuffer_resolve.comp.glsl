@@ -72,7 +72,7 @@ void main()
     if (any(greaterThanEqual(pixel, size)))
         return;
     uint index = pixel.y * size.x + pixel.x;
-    uint64_t value = VisbufferRef(GDR_FRAME.visbuffer).items[index];
+    uint64_t value = push.visbuffer.items[index];
     uint depth_bits = uint(value >> 32);
     ResolvedRef resolved = ResolvedRef(RasterParamsRef(GDR_FRAME.raster).value.resolved);
     resolved.items[size.x * size.y + index] = depth_bits;
