@@ -67,6 +67,34 @@ GDR_STRUCT_BEGIN(GdrGpuMeshlet)
     gdr_uint reserved2;
 GDR_STRUCT_END(GdrGpuMeshlet)
 
+/* One node of a mesh's LOD hierarchy: gdr_lod_node of gdr/geometry.h, whose contract it shares
+ * (the CPU array is uploaded as it is). Indices are mesh-local: an inner node's children are nodes
+ * [first, first + count) of its mesh, a leaf's clusters are the mesh's clusters
+ * [first, first + count). The node test is gdr_lod_node_may_draw (lod_math.h). */
+GDR_STRUCT_BEGIN(GdrGpuLodNode)
+    gdr_vec4 sphere;         /* mesh space: contains every group, refined group and cluster sphere below */
+    float max_error;         /* largest group error below (INFINITY when the root group is below) */
+    float min_refined_error; /* smallest refined-group error below; 0 when a cluster below has none */
+    gdr_uint first;          /* inner: first child node; leaf: first cluster */
+    gdr_uint count;          /* inner: children (1 .. GDR_GPU_LOD_NODE_MAX_CHILDREN); leaf: clusters */
+    gdr_uint group;          /* leaf: its group (GDR_GPU_NO_GROUP without a DAG); inner: GDR_GPU_NO_GROUP */
+    gdr_uint flags;          /* GDR_GPU_LOD_NODE_LEAF */
+    gdr_uint reserved0;
+    gdr_uint reserved1;
+GDR_STRUCT_END(GdrGpuLodNode)
+
+#define GDR_GPU_LOD_NODE_LEAF 1u
+#define GDR_GPU_LOD_NODE_MAX_CHILDREN 8u
+
+#ifndef GDR_GLSL
+#include <stddef.h>
+_Static_assert(sizeof(GdrGpuLodNode) == 48 && offsetof(GdrGpuLodNode, max_error) == 16 &&
+                   offsetof(GdrGpuLodNode, min_refined_error) == 20 && offsetof(GdrGpuLodNode, first) == 24 &&
+                   offsetof(GdrGpuLodNode, count) == 28 && offsetof(GdrGpuLodNode, group) == 32 &&
+                   offsetof(GdrGpuLodNode, flags) == 36,
+               "GdrGpuLodNode: scalar layout, 48 bytes");
+#endif
+
 /* Task-shader work written by the instance cull of the meshlet pipeline: one task workgroup tests
  * clusters [meshlet_first, meshlet_first + meshlet_count) of one instance. */
 GDR_STRUCT_BEGIN(GdrGpuTaskCommand)
