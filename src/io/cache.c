@@ -65,15 +65,18 @@ gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_c
 gdr_status gdr_cache_write_ex(const char *path, const gdr_scene *scene, const gdr_cache_source *source,
                               const gdr_pvs *pvs, gdr_error *err)
 {
-    if (pvs && gdr_pvs_object_count(pvs) != scene->instance_count)
-        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
-                             "%s: the precomputed visibility was baked for %u objects, the scene has %u instances",
-                             path, gdr_pvs_object_count(pvs), scene->instance_count);
     /* The table has exactly one entry per section: no byte of the file lies outside a checksum. */
     cache_write_input in = {scene, source, pvs};
     uint32_t expected = 0;
-    for (uint32_t k = 0; k < CACHE_SECTION_COUNT; k++)
-        expected += !gdr_cache_sections[k].present || gdr_cache_sections[k].present(&in);
+    for (uint32_t k = 0; k < CACHE_SECTION_COUNT; k++) {
+        const cache_section *sec = &gdr_cache_sections[k];
+        if (sec->present && !sec->present(&in))
+            continue;
+        gdr_status status = sec->check ? sec->check(&in, path, err) : GDR_OK;
+        if (status != GDR_OK)
+            return status;
+        expected++;
+    }
     section_entry entries[CACHE_SECTION_COUNT];
     uint32_t count = 0;
     writer w = {0};

@@ -145,7 +145,8 @@ static inline void fourcc_text(uint32_t id, char out[5])
  * the ones before it read). */
 enum {
     CACHE_SOURCE, CACHE_SCENE, CACHE_TEXTURES, CACHE_PIXELS, CACHE_MESHES, CACHE_GEOMETRY, CACHE_CLUSTERS,
-    CACHE_CLUSTER_DATA, CACHE_MATERIALS, CACHE_INSTANCES, CACHE_CAMERAS, CACHE_PVS, CACHE_SECTION_COUNT
+    CACHE_CLUSTER_DATA, CACHE_HIERARCHY, CACHE_MATERIALS, CACHE_INSTANCES, CACHE_CAMERAS, CACHE_PVS,
+    CACHE_SECTION_COUNT
 };
 
 /* What a file is written from. */
@@ -163,6 +164,8 @@ typedef struct cache_section {
     uint32_t flags; /* CACHE_SECTION_REQUIRED */
     int optional;   /* a file may leave it out */
     int (*present)(const cache_write_input *in); /* NULL: always written */
+    /* What the input must satisfy to be written (NULL: anything); refuses naming `path`. */
+    gdr_status (*check)(const cache_write_input *in, const char *path, gdr_error *err);
     void (*write)(writer *w, const cache_write_input *in);
     /* Reads and checks the whole section into the scene being built; NULL: the container reads it
      * (SRCE, for staleness). */

@@ -17,7 +17,8 @@
 
 enum { MESH_RECORD = 64 + 8 + 16, MATERIAL_RECORD = 64 + 16 + 12 + 12 + 8, INSTANCE_RECORD = 64 + 8 + 16,
        CAMERA_RECORD = 64 + 12 + 16 + 16, TEXTURE_RECORD = 64 + 12, CLUSTERS_RECORD = 6 * 4,
-       CLUSTER_RECORD = 4 * 4 + 16 + 12 + 12 + 4 + 3 * 4, GROUP_RECORD = 16 + 4 + 3 * 4 };
+       CLUSTER_RECORD = 4 * 4 + 16 + 12 + 12 + 4 + 3 * 4, GROUP_RECORD = 16 + 4 + 3 * 4,
+       NODE_RECORD = 16 + 4 + 4 + 4 * 4 + 2 * 4 };
 
 /* What the sections read so far hand to the ones after them. */
 struct cache_read_state {
@@ -426,6 +427,88 @@ static gdr_status read_cluster_data(cache_read_state *st, reader *data, gdr_erro
     return expect_end(st, data, "CLDT", err);
 }
 
+/* --- LODH: per mesh, the LOD hierarchy over its clusters ---------------------------------------- */
+
+/* Clusters come with their hierarchy (gdr_meshlets_build, gdr_mesh_build_lod_dag). */
+static gdr_status check_hierarchy_present(const cache_write_input *in, const char *path, gdr_error *err)
+{
+    for (uint32_t i = 0; i < in->scene->mesh_count; i++) {
+        const gdr_mesh *m = &in->scene->meshes[i];
+        if (m->clusters.cluster_count > 0 && m->clusters.lod_node_count == 0)
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: mesh %u ('%s') has clusters without their LOD "
+                                 "hierarchy (gdr_mesh_clusters_build_hierarchy)", path, i, m->name);
+    }
+    return GDR_OK;
+}
+
+static void write_hierarchy(writer *w, const cache_write_input *in)
+{
+    const gdr_scene *s = in->scene;
+    for (uint32_t i = 0; i < s->mesh_count; i++) {
+        const gdr_mesh_clusters *c = &s->meshes[i].clusters;
+        put_u32(w, c->lod_node_count);
+        put_u32(w, c->lod_node_levels);
+        for (uint32_t k = 0; k < c->lod_node_count; k++) {
+            const gdr_lod_node *n = &c->lod_nodes[k];
+            put_f32s(w, &n->sphere.x, 4);
+            put_f32s(w, &n->max_error, 1);
+            put_f32s(w, &n->min_refined_error, 1);
+            put_u32(w, n->first);
+            put_u32(w, n->count);
+            put_u32(w, n->group);
+            put_u32(w, n->flags);
+            put_u32(w, n->reserved[0]);
+            put_u32(w, n->reserved[1]);
+        }
+    }
+}
+
+static gdr_status read_mesh_hierarchy(cache_read_state *st, reader *r, uint32_t m, gdr_error *err)
+{
+    gdr_mesh_clusters *c = &st->scene->meshes[m].clusters;
+    uint32_t node_count = get_u32(r), levels = get_u32(r);
+    if (r->failed || (c->cluster_count == 0) != (node_count == 0) ||
+        (uint64_t)node_count * NODE_RECORD > r->size - r->at)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'LODH': mesh %u: %u nodes for %u clusters "
+                             "(the section holds %zu more bytes)", st->name, m, node_count, c->cluster_count,
+                             r->failed ? (size_t)0 : r->size - r->at);
+    if (node_count == 0)
+        return GDR_OK;
+    c->lod_nodes = malloc(sizeof *c->lod_nodes * node_count); /* owned by the scene from here */
+    if (!c->lod_nodes)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: mesh %u: out of memory for %u hierarchy nodes",
+                             st->name, m, node_count);
+    c->lod_node_count = node_count;
+    c->lod_node_levels = levels;
+    for (uint32_t k = 0; k < node_count; k++) {
+        gdr_lod_node *n = &c->lod_nodes[k];
+        get_f32s(r, &n->sphere.x, 4);
+        get_f32s(r, &n->max_error, 1);
+        get_f32s(r, &n->min_refined_error, 1);
+        n->first = get_u32(r);
+        n->count = get_u32(r);
+        n->group = get_u32(r);
+        n->flags = get_u32(r);
+        n->reserved[0] = get_u32(r);
+        n->reserved[1] = get_u32(r);
+    }
+    char what[192];
+    if (!gdr_mesh_clusters_check_hierarchy(c, what, sizeof what))
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'LODH': mesh %u: %s", st->name, m, what);
+    return GDR_OK;
+}
+
+/* Every hierarchy is checked whole (gdr_mesh_clusters_check_hierarchy) against the clusters read. */
+static gdr_status read_hierarchy(cache_read_state *st, reader *r, gdr_error *err)
+{
+    for (uint32_t m = 0; m < st->mesh_count; m++) {
+        gdr_status status = read_mesh_hierarchy(st, r, m, err);
+        if (status != GDR_OK)
+            return status;
+    }
+    return expect_end(st, r, "LODH", err);
+}
+
 /* --- MATL: materials --------------------------------------------------------------------------- */
 
 static void write_materials(writer *w, const cache_write_input *in)
@@ -547,6 +630,15 @@ static gdr_status read_cameras(cache_read_state *st, reader *ca, gdr_error *err)
 
 static int has_pvs(const cache_write_input *in) { return in->pvs != NULL; }
 
+static gdr_status check_pvs_objects(const cache_write_input *in, const char *path, gdr_error *err)
+{
+    if (gdr_pvs_object_count(in->pvs) == in->scene->instance_count)
+        return GDR_OK;
+    return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
+                         "%s: the precomputed visibility was baked for %u objects, the scene has %u instances", path,
+                         gdr_pvs_object_count(in->pvs), in->scene->instance_count);
+}
+
 static void write_pvs(writer *w, const cache_write_input *in)
 {
     size_t size = gdr_pvs_serialized_size(in->pvs);
@@ -582,19 +674,21 @@ static gdr_status read_pvs(cache_read_state *st, reader *r, gdr_error *err)
 
 #define REQUIRED CACHE_SECTION_REQUIRED
 const cache_section gdr_cache_sections[CACHE_SECTION_COUNT] = {
-    [CACHE_SOURCE] = {FOURCC('S', 'R', 'C', 'E'), 0, 1, NULL, write_source, NULL},
-    [CACHE_SCENE] = {FOURCC('S', 'C', 'N', 'E'), REQUIRED, 0, NULL, write_scene, read_scene},
-    [CACHE_TEXTURES] = {FOURCC('T', 'E', 'X', 'R'), REQUIRED, 0, NULL, write_textures, read_textures},
-    [CACHE_PIXELS] = {FOURCC('T', 'X', 'P', 'X'), REQUIRED, 0, NULL, write_pixels, read_pixels},
-    [CACHE_MESHES] = {FOURCC('M', 'E', 'S', 'H'), REQUIRED, 0, NULL, write_meshes, read_meshes},
-    [CACHE_GEOMETRY] = {FOURCC('G', 'E', 'O', 'M'), REQUIRED, 0, NULL, write_geometry, read_geometry},
-    [CACHE_CLUSTERS] = {FOURCC('C', 'L', 'U', 'S'), REQUIRED, 0, NULL, write_cluster_counts, read_cluster_counts},
-    [CACHE_CLUSTER_DATA] = {FOURCC('C', 'L', 'D', 'T'), REQUIRED, 0, NULL, write_cluster_data, read_cluster_data},
-    [CACHE_MATERIALS] = {FOURCC('M', 'A', 'T', 'L'), REQUIRED, 0, NULL, write_materials, read_materials},
-    [CACHE_INSTANCES] = {FOURCC('I', 'N', 'S', 'T'), REQUIRED, 0, NULL, write_instances, read_instances},
-    [CACHE_CAMERAS] = {FOURCC('C', 'A', 'M', 'R'), REQUIRED, 0, NULL, write_cameras, read_cameras},
+    [CACHE_SOURCE] = {FOURCC('S', 'R', 'C', 'E'), 0, 1, NULL, NULL, write_source, NULL},
+    [CACHE_SCENE] = {FOURCC('S', 'C', 'N', 'E'), REQUIRED, 0, NULL, NULL, write_scene, read_scene},
+    [CACHE_TEXTURES] = {FOURCC('T', 'E', 'X', 'R'), REQUIRED, 0, NULL, NULL, write_textures, read_textures},
+    [CACHE_PIXELS] = {FOURCC('T', 'X', 'P', 'X'), REQUIRED, 0, NULL, NULL, write_pixels, read_pixels},
+    [CACHE_MESHES] = {FOURCC('M', 'E', 'S', 'H'), REQUIRED, 0, NULL, NULL, write_meshes, read_meshes},
+    [CACHE_GEOMETRY] = {FOURCC('G', 'E', 'O', 'M'), REQUIRED, 0, NULL, NULL, write_geometry, read_geometry},
+    [CACHE_CLUSTERS] = {FOURCC('C', 'L', 'U', 'S'), REQUIRED, 0, NULL, NULL, write_cluster_counts, read_cluster_counts},
+    [CACHE_CLUSTER_DATA] = {FOURCC('C', 'L', 'D', 'T'), REQUIRED, 0, NULL, NULL, write_cluster_data, read_cluster_data},
+    [CACHE_HIERARCHY] = {FOURCC('L', 'O', 'D', 'H'), REQUIRED, 0, NULL, check_hierarchy_present, write_hierarchy,
+                         read_hierarchy},
+    [CACHE_MATERIALS] = {FOURCC('M', 'A', 'T', 'L'), REQUIRED, 0, NULL, NULL, write_materials, read_materials},
+    [CACHE_INSTANCES] = {FOURCC('I', 'N', 'S', 'T'), REQUIRED, 0, NULL, NULL, write_instances, read_instances},
+    [CACHE_CAMERAS] = {FOURCC('C', 'A', 'M', 'R'), REQUIRED, 0, NULL, NULL, write_cameras, read_cameras},
     /* optional: readers that predate it skip it */
-    [CACHE_PVS] = {FOURCC('P', 'V', 'I', 'S'), 0, 1, has_pvs, write_pvs, read_pvs},
+    [CACHE_PVS] = {FOURCC('P', 'V', 'I', 'S'), 0, 1, has_pvs, check_pvs_objects, write_pvs, read_pvs},
 };
 #undef REQUIRED
 

@@ -4,6 +4,7 @@
  * work it saves. Broken hierarchies (a shrunken sphere, a lowered error bound) must be refused by
  * the check and change some cut, so the comparison can fail. */
 #include <math.h>
+#include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -31,15 +32,15 @@ static void check_ok(gdr_status status, const gdr_error *err, const char *what)
 }
 
 /* A view of one instance: a random rotation, scale (sometimes tiny or huge) and translation (up to
- * far from the origin, where float rounding is coarse), a camera from inside the mesh to far away,
- * a threshold from 0 to large. */
-static gdr_lod_view random_view(const gdr_mesh *mesh, unsigned *rng)
+ * far from the origin, where float rounding is coarse, unless near_origin), sometimes a shear, a camera from inside the
+ * mesh to far away, a threshold from 0 to large. */
+static gdr_lod_view random_view(const gdr_mesh *mesh, unsigned *rng, int near_origin)
 {
     gdr_vec3 axis = gdr_vec3_normalize((gdr_vec3){test_random_range(rng, -1, 1), test_random_range(rng, -1, 1),
                                                   test_random_range(rng, -1, 1) + 0.01f});
     float s = powf(10.0f, test_random_range(rng, -2.0f, 2.0f));
     gdr_vec3 scale = {s, s * test_random_range(rng, 0.5f, 1.5f), s};
-    float far = powf(10.0f, test_random_range(rng, 0.0f, 4.0f));
+    float far = near_origin ? 0.0f : powf(10.0f, test_random_range(rng, 0.0f, 4.0f));
     gdr_vec3 t = {test_random_range(rng, -far, far), test_random_range(rng, -far, far), test_random_range(rng, -far, far)};
     float thresholds[4] = {0.0f, test_random_range(rng, 0.05f, 2.0f), test_random_range(rng, 0.5f, 40.0f), 1e6f};
     uint32_t pick = (uint32_t)(test_random(rng) * 8.0f);
@@ -48,6 +49,12 @@ static gdr_lod_view random_view(const gdr_mesh *mesh, unsigned *rng)
                       .viewport_height = test_random_range(rng, 240.0f, 2160.0f),
                       .znear = test_random_range(rng, 0.01f, 0.5f),
                       .threshold = thresholds[pick < 4 ? pick : (pick < 6 ? 1 : 2)]};
+    if (test_random(rng) < (near_origin ? 0.5f : 0.25f)) { /* a shear, as nested glTF transforms make: the stretch bound matters */
+        gdr_mat4 shear = gdr_mat4_identity();
+        shear.m[4] = test_random_range(rng, -1.5f, 1.5f);
+        shear.m[9] = test_random_range(rng, -1.5f, 1.5f);
+        v.transform = gdr_mat4_mul(v.transform, shear);
+    }
     gdr_vec3 dir = gdr_vec3_normalize((gdr_vec3){test_random_range(rng, -1, 1), test_random_range(rng, -1, 1),
                                                  test_random_range(rng, -1, 1) + 0.01f});
     float distance = mesh->bounds.w * s * powf(10.0f, test_random_range(rng, -1.5f, 2.5f));
@@ -63,7 +70,7 @@ static uint32_t compare_cuts(const gdr_mesh *mesh, unsigned seed, uint32_t views
     uint8_t *flat = malloc(c->cluster_count), *tree = malloc(c->cluster_count);
     uint32_t differ = 0;
     for (uint32_t v = 0; v < views; v++) {
-        gdr_lod_view view = random_view(mesh, &seed);
+        gdr_lod_view view = random_view(mesh, &seed, 0);
         gdr_lod_traversal_stats st = {0};
         uint32_t a = gdr_lod_cut_select(c, &view, flat);
         uint32_t b = gdr_lod_cut_select_hierarchical(c, &view, tree, &st);
@@ -82,6 +89,67 @@ static uint32_t compare_cuts(const gdr_mesh *mesh, unsigned seed, uint32_t views
     return differ;
 }
 
+static float group_error_px(const gdr_mesh_clusters *c, uint32_t g, const gdr_lod_view *v)
+{
+    const float *m = v->transform.m;
+    gdr_vec3 c0 = {m[0], m[1], m[2]}, c1 = {m[4], m[5], m[6]}, c2 = {m[8], m[9], m[10]}, c3 = {m[12], m[13], m[14]};
+    return gdr_lod_group_projected_error(c->groups[g].sphere, c->groups[g].error, c0, c1, c2, c3, v->camera_position,
+                                         v->znear, gdr_lod_projection_scale(v));
+}
+
+static bool node_test(const gdr_lod_node *n, float max_error, float min_refined_error, const gdr_lod_view *v,
+                      float threshold)
+{
+    const float *m = v->transform.m;
+    gdr_vec3 c0 = {m[0], m[1], m[2]}, c1 = {m[4], m[5], m[6]}, c2 = {m[8], m[9], m[10]}, c3 = {m[12], m[13], m[14]};
+    return gdr_lod_node_may_draw(n->sphere, max_error, min_refined_error, c0, c1, c2, c3, v->camera_position,
+                                 v->znear, gdr_lod_projection_scale(v), threshold);
+}
+
+/* Each side of the node test at the threshold where it is tightest: just below the largest
+ * projected group error under the node (a group fails: the node must not be skipped as "every
+ * group passes"), and at the smallest projected refined-group error (that group passes: the node
+ * must not be skipped as "no refined group passes"). The errors are the float values the flat
+ * cut computes, so this checks the rounding slack too. Returns the number of violations. */
+static uint32_t check_node_bounds(const gdr_mesh *mesh, unsigned seed, uint32_t views)
+{
+    const gdr_mesh_clusters *c = &mesh->clusters;
+    if (c->group_count == 0)
+        return 0;
+    float *own = malloc(sizeof *own * c->lod_node_count), *refined = malloc(sizeof *refined * c->lod_node_count);
+    uint32_t violations = 0;
+    for (uint32_t v = 0; v < views; v++) {
+        gdr_lod_view view = random_view(mesh, &seed, (int)(v & 1));
+        for (uint32_t i = c->lod_node_count; i-- > 0;) { /* children come after their parent */
+            const gdr_lod_node *n = &c->lod_nodes[i];
+            own[i] = -INFINITY;
+            refined[i] = INFINITY; /* stays so when a cluster below has no refined group */
+            int level0 = 0;
+            for (uint32_t k = n->first; k < n->first + n->count; k++) {
+                if (n->flags & GDR_LOD_NODE_LEAF) {
+                    uint32_t r = c->clusters[k].refined_group;
+                    level0 |= r == GDR_NO_INDEX;
+                    if (r != GDR_NO_INDEX)
+                        refined[i] = fminf(refined[i], group_error_px(c, r, &view));
+                } else {
+                    own[i] = fmaxf(own[i], own[k]);
+                    refined[i] = fminf(refined[i], refined[k]);
+                    level0 |= c->lod_nodes[k].min_refined_error == 0.0f;
+                }
+            }
+            if (n->flags & GDR_LOD_NODE_LEAF)
+                own[i] = group_error_px(c, n->group, &view);
+            if (isfinite(own[i]) && !node_test(n, n->max_error, 0.0f, &view, nextafterf(own[i], -INFINITY)))
+                violations++;
+            if (!level0 && isfinite(refined[i]) && !node_test(n, INFINITY, n->min_refined_error, &view, refined[i]))
+                violations++;
+        }
+    }
+    free(own);
+    free(refined);
+    return violations;
+}
+
 static void check_mesh(const char *what, const gdr_mesh *mesh, cut_totals *totals, uint32_t views)
 {
     char why[256] = "";
@@ -95,6 +163,11 @@ static void check_mesh(const char *what, const gdr_mesh *mesh, cut_totals *total
         printf("%s: mesh '%s': %u of %u views cut differently through the hierarchy\n", what, mesh->name, differ,
                views);
     CHECK(differ == 0);
+    uint32_t violations = check_node_bounds(mesh, 77u + mesh->vertex_count, views / 4 + 1);
+    if (violations)
+        printf("%s: mesh '%s': %u node tests skipped a node at the threshold where one of its groups decides\n",
+               what, mesh->name, violations);
+    CHECK(violations == 0);
 }
 
 static void report(const char *what, const cut_totals *t)
