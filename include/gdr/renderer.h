@@ -7,6 +7,7 @@
 #define GDR_RENDERER_H
 
 #include <stdbool.h>
+#include <stdio.h>
 #include <stdint.h>
 
 #include "gdr/core.h"
@@ -237,6 +238,11 @@ GDR_API gdr_status gdr_renderer_read_visible_meshlets(gdr_renderer *renderer, gd
                                                       uint32_t capacity, uint32_t *count, gdr_error *err);
 
 GDR_API void gdr_renderer_size(const gdr_renderer *renderer, uint32_t *width, uint32_t *height);
+
+/* Writes, as Markdown, the passes of the frame of every configuration (pipeline, raster, occlusion
+ * culling, overdraw view): per pass the resources it reads and writes and the barrier derived
+ * before it. docs/PIPELINE.md holds this output (`gdr info --passes`). Needs no device. */
+GDR_API void gdr_describe_frame_passes(FILE *out);
 
 /* Writes RGBA8 pixels as a PNG through a temporary file and a rename: never a half-written file. */
 GDR_API gdr_status gdr_write_png(const char *path, const uint8_t *rgba, uint32_t width, uint32_t height,

@@ -88,7 +88,7 @@ void gdr_cpu_path_record_draws(gdr_renderer *r, VkCommandBuffer cmd, const GdrGp
          * bindIndexBuffer, bindDescriptorSets, pushConstants, drawIndexed. gdr's scenes draw with
          * one pipeline and one descriptor set (the frame's set 0), so those two binds name the same
          * objects each time, as in an engine that binds per object without sorting. */
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->draw_pipeline);
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pipelines[GDR_PIPE_DRAW_INDEXED]);
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->layout, 0, 1, &r->occlusion.set, 0, NULL);
         VkDeviceSize vertex_offset = (VkDeviceSize)mesh->vertex_offset * sizeof(GdrGpuVertex);
         vkCmdBindVertexBuffers(cmd, 0, 1, &g->vertices.buffer, &vertex_offset);

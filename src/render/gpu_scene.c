@@ -264,6 +264,23 @@ gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
     return status;
 }
 
+gdr_status gdr_gpu_scene_write_refs(gdr_renderer *r, gdr_error *err)
+{
+    gdr_gpu_scene *g = &r->scene;
+    GdrGpuScene refs = {.instances = g->instances.address, .meshes = g->meshes.address,
+                        .vertices = g->vertices.address, .meshlets = g->meshlets.address,
+                        .meshlet_vertices = g->meshlet_vertices.address,
+                        .meshlet_triangles = g->meshlet_triangles.address,
+                        .instance_visibility = r->occlusion.instance_visibility.address,
+                        .meshlet_visibility = r->occlusion.meshlet_visibility.address};
+    gdr_status status = gdr_vk_buffer_create(&r->allocator, sizeof refs,
+                                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                             GDR_VK_BUFFER_DEVICE, &g->refs, err);
+    if (status == GDR_OK)
+        status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->refs, 0, &refs, sizeof refs, err);
+    return status;
+}
+
 void gdr_gpu_scene_destroy(gdr_renderer *r)
 {
     gdr_gpu_scene *g = &r->scene;
@@ -274,6 +291,7 @@ void gdr_gpu_scene_destroy(gdr_renderer *r)
     gdr_vk_buffer_destroy(r->ctx, &g->meshlets);
     gdr_vk_buffer_destroy(r->ctx, &g->meshlet_vertices);
     gdr_vk_buffer_destroy(r->ctx, &g->meshlet_triangles);
+    gdr_vk_buffer_destroy(r->ctx, &g->refs);
     free(g->cpu_meshlets);
     free(g->cpu_meshes);
     free(g->cpu_instances);
@@ -299,6 +317,9 @@ gdr_status gdr_frame_slots_create(gdr_renderer *r, gdr_error *err)
         gdr_status status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuFrameGlobals),
                                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GDR_VK_BUFFER_UPLOAD,
                                                  &slot->globals, err);
+        if (status == GDR_OK)
+            status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuFrameBuffers), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                          GDR_VK_BUFFER_UPLOAD, &slot->frame_buffers, err);
         if (status == GDR_OK)
             status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuInstanceUpdate) * GDR_INSTANCE_UPDATES_PER_FRAME,
                                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GDR_VK_BUFFER_UPLOAD, &slot->updates, err);
@@ -337,6 +358,7 @@ void gdr_frame_slots_destroy(gdr_renderer *r)
         if (slot->readback_cmd)
             vkFreeCommandBuffers(r->ctx->device, r->ctx->command_pool, 1, &slot->readback_cmd);
         gdr_vk_buffer_destroy(r->ctx, &slot->globals);
+        gdr_vk_buffer_destroy(r->ctx, &slot->frame_buffers);
         gdr_vk_buffer_destroy(r->ctx, &slot->updates);
         gdr_vk_buffer_destroy(r->ctx, &slot->draws);
         gdr_vk_buffer_destroy(r->ctx, &slot->draw_stats);

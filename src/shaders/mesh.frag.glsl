@@ -10,12 +10,11 @@ layout(location = 1) in vec3 in_world_position;
 layout(location = 2) flat in vec4 in_color;
 
 layout(location = 0) out vec4 out_color;
-layout(buffer_reference, scalar) buffer OverdrawRef { uint items[]; };
 
 void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
     if (g.view_mode == GDR_VIEW_OVERDRAW) // fragments that passed the depth test, per pixel
-        atomicAdd(OverdrawRef(push.overdraw).items[uint(gl_FragCoord.y) * uint(g.viewport.x) + uint(gl_FragCoord.x)], 1u);
+        atomicAdd(OverdrawRef(GDR_FRAME.overdraw).items[uint(gl_FragCoord.y) * uint(g.viewport.x) + uint(gl_FragCoord.x)], 1u);
     out_color = gdr_shade(g.light_direction.xyz, in_normal, in_world_position, in_color.rgb);
 }
