@@ -117,18 +117,16 @@ GDR_STRUCT_BEGIN(GdrGpuLodNode)
     gdr_uint reserved0;
     gdr_uint reserved1;
 GDR_STRUCT_END(GdrGpuLodNode)
+GDR_ASSERT_SIZE(GdrGpuLodNode, 48);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, max_error, 16);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, min_refined_error, 20);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, first, 24);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, count, 28);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, group, 32);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, flags, 36);
 
 #define GDR_GPU_LOD_NODE_LEAF 1u
 #define GDR_GPU_LOD_NODE_MAX_CHILDREN 8u
-
-#ifndef GDR_GLSL
-#include <stddef.h>
-_Static_assert(sizeof(GdrGpuLodNode) == 48 && offsetof(GdrGpuLodNode, max_error) == 16 &&
-                   offsetof(GdrGpuLodNode, min_refined_error) == 20 && offsetof(GdrGpuLodNode, first) == 24 &&
-                   offsetof(GdrGpuLodNode, count) == 28 && offsetof(GdrGpuLodNode, group) == 32 &&
-                   offsetof(GdrGpuLodNode, flags) == 36,
-               "GdrGpuLodNode: scalar layout, 48 bytes");
-#endif
 
 /* Task-shader work written by the instance cull of the meshlet pipeline: one task workgroup tests
  * clusters [meshlet_first, meshlet_first + meshlet_count) of one instance. */
