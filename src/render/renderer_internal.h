@@ -43,6 +43,7 @@ typedef struct gdr_gpu_scene {
     gdr_vk_buffer meshlets;          /* GdrGpuMeshlet[], all meshes' clusters */
     gdr_vk_buffer meshlet_vertices;  /* uint32[]: global vertex index per cluster-local vertex */
     gdr_vk_buffer meshlet_triangles; /* uint32[] holding 3 bytes per cluster triangle */
+    gdr_vk_buffer lod_nodes;         /* GdrGpuLodNode[]: every mesh's LOD hierarchy, as gdr_lod_node */
     gdr_vk_buffer refs;              /* GdrGpuScene: the addresses above, for the push constants */
     uint32_t mesh_count;
     uint32_t instance_count;
