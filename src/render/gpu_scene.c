@@ -318,6 +318,12 @@ gdr_status gdr_gpu_scene_write_refs(gdr_renderer *r, gdr_error *err)
                                              GDR_VK_BUFFER_DEVICE, &g->refs, err);
     if (status == GDR_OK)
         status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->refs, 0, &refs, sizeof refs, err);
+    const gdr_vk_buffer *buffers[] = {&g->vertices, &g->indices, &g->meshes, &g->instances, &g->meshlets,
+                                      &g->meshlet_vertices, &g->meshlet_triangles, &g->refs,
+                                      &r->occlusion.instance_visibility, &r->occlusion.meshlet_visibility};
+    g->bytes = 0;
+    for (size_t i = 0; i < sizeof buffers / sizeof buffers[0]; i++)
+        g->bytes += buffers[i]->size;
     return status;
 }
 

@@ -177,12 +177,6 @@ gdr_status gdr_renderer_update_instance(gdr_renderer *r, uint32_t index, const g
     return gdr_cpu_path_update_instance(r, index, err);
 }
 
-static int compare_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
 const char *gdr_pipeline_name(gdr_pipeline pipeline)
 {
     switch (pipeline) {
@@ -238,8 +232,9 @@ static gdr_status resolve_pipeline(const gdr_renderer *r, const gdr_frame_desc *
     return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: unknown pipeline %d", (int)frame->pipeline);
 }
 
-gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uint32_t frames, gdr_frame_stats *stats,
-                               gdr_error *err)
+/* The frame description's checks; the pipeline and raster mode it asks for on this device. */
+static gdr_status check_frame(gdr_renderer *r, const gdr_frame_desc *frame, uint32_t frames, gdr_pipeline *pipeline,
+                              char *reason, size_t reason_size, gdr_error *err)
 {
     if (!r->has_scene)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: no scene (call gdr_renderer_set_scene first)");
@@ -252,149 +247,79 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
                              "render: camera needs 0 < yfov < pi, znear > 0 and zfar = 0 or > znear "
                              "(yfov %g, znear %g, zfar %g)", (double)camera->yfov, (double)camera->znear,
                              (double)camera->zfar);
-
     if ((unsigned)frame->view > GDR_VIEW_MODE_LOD)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: unknown view %d", (int)frame->view);
     if (!(frame->lod_error_px >= 0.0f && frame->lod_error_px <= 1e30f))
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: lod_error_px must be finite and >= 0 (%g)",
                              (double)frame->lod_error_px);
-    gdr_pipeline pipeline = GDR_PIPELINE_INDIRECT;
-    char reason[160] = "";
-    gdr_status resolved = resolve_pipeline(r, frame, &pipeline, reason, sizeof reason, err);
-    if (resolved == GDR_OK)
-        resolved = gdr_visbuffer_resolve_mode(r, frame, pipeline, &r->vis.mode, r->vis.reason, sizeof r->vis.reason, err);
-    if (resolved != GDR_OK)
-        return resolved;
-    r->timings = (gdr_frame_timings){0};
-    r->cpu.cull_ms = 0.0;
-    if (frame->record_visible_meshlets && !r->visible_meshlets.buffer) {
+    gdr_status status = resolve_pipeline(r, frame, pipeline, reason, reason_size, err);
+    if (status == GDR_OK)
+        status = gdr_visbuffer_resolve_mode(r, frame, *pipeline, &r->vis.mode, r->vis.reason, sizeof r->vis.reason, err);
+    if (status == GDR_OK && frame->record_visible_meshlets && !r->visible_meshlets.buffer) {
         /* Every cluster of every instance's DAG at most: cannot overflow. */
         uint64_t total = r->scene.instance_lod_cluster_count;
-        gdr_status status = gdr_vk_buffer_create(&r->allocator, 8 * (total ? total : 1),
-                                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                                                 GDR_VK_BUFFER_DEVICE, &r->visible_meshlets, err);
-        if (status != GDR_OK)
-            return status;
+        status = gdr_vk_buffer_create(&r->allocator, 8 * (total ? total : 1),
+                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                      GDR_VK_BUFFER_DEVICE, &r->visible_meshlets, err);
     }
+    return status;
+}
 
-    double cpu_ms = 0.0, submit_ms = 0.0;
+/* One frame: its slot's previous frame waited for, culled on the CPU where the pipeline does, and
+ * recorded or resubmitted. Adds its CPU time to frame_cpu_ms. */
+static gdr_status run_frame(gdr_renderer *r, const gdr_frame_desc *frame, gdr_pipeline pipeline, bool read_back,
+                            double *frame_cpu_ms, double *submit_ms, uint32_t *recorded, gdr_error *err)
+{
+    gdr_frame_slot *slot = &r->slots[r->frame_index % GDR_FRAMES_IN_FLIGHT];
+    gdr_status status = gdr_frame_slot_wait(r, slot, err);
+    if (status != GDR_OK)
+        return status;
+    double start = gdr_now_ms();
+    if (pipeline == GDR_PIPELINE_CPU)
+        status = gdr_cpu_path_cull(r, frame, err);
+    if (status == GDR_OK) {
+        slot->cpu_visible_count = r->cpu.visible_count;
+        slot->cpu_triangles = r->cpu.triangles;
+        status = gdr_frame_record_and_submit(r, slot, frame, pipeline, read_back, submit_ms, err);
+    }
+    *frame_cpu_ms = gdr_now_ms() - start;
+    if (status != GDR_OK)
+        return status;
+    *recorded += !slot->resubmitted;
+    r->last_slot = (int)(slot - r->slots);
+    r->frame_index++;
+    return GDR_OK;
+}
+
+gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uint32_t frames, gdr_frame_stats *stats,
+                               gdr_error *err)
+{
+    gdr_pipeline pipeline = GDR_PIPELINE_INDIRECT;
+    char reason[160] = "";
+    gdr_status status = check_frame(r, frame, frames, &pipeline, reason, sizeof reason, err);
+    if (status != GDR_OK)
+        return status;
     double *frame_cpu_ms = malloc(sizeof(double) * frames);
     if (!frame_cpu_ms)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "render: out of memory");
-    uint32_t recorded = 0;
+    r->timings = (gdr_frame_timings){0};
+    r->cpu.cull_ms = 0.0;
     r->color_read_back = false;
-    for (uint32_t f = 0; f < frames; f++) {
-        gdr_frame_slot *slot = &r->slots[r->frame_index % GDR_FRAMES_IN_FLIGHT];
-        gdr_status status = gdr_frame_slot_wait(r, slot, err);
-        if (status != GDR_OK) {
-            free(frame_cpu_ms);
-            return status;
-        }
-        double start = gdr_now_ms();
-        bool last = f + 1 == frames;
-        if (pipeline == GDR_PIPELINE_CPU)
-            status = gdr_cpu_path_cull(r, frame, err);
-        if (status == GDR_OK) {
-            slot->cpu_visible_count = r->cpu.visible_count;
-            slot->cpu_triangles = r->cpu.triangles;
-            status = gdr_frame_record_and_submit(r, slot, frame, pipeline, last && frame->read_back, &submit_ms, err);
-        }
-        frame_cpu_ms[f] = gdr_now_ms() - start;
-        cpu_ms += frame_cpu_ms[f];
-        recorded += status == GDR_OK && !slot->resubmitted;
-        if (status != GDR_OK) {
-            free(frame_cpu_ms);
-            return status;
-        }
-        r->last_slot = (int)(slot - r->slots);
-        r->frame_index++;
-    }
+    double submit_ms = 0.0;
+    uint32_t recorded = 0;
+    for (uint32_t f = 0; f < frames && status == GDR_OK; f++)
+        status = run_frame(r, frame, pipeline, f + 1 == frames && frame->read_back, &frame_cpu_ms[f], &submit_ms,
+                           &recorded, err);
     /* Drain every slot so the last frame's results are on the host. */
-    for (uint32_t i = 0; i < GDR_FRAMES_IN_FLIGHT; i++) {
-        gdr_status status = gdr_frame_slot_wait(r, &r->slots[i], err);
-        if (status != GDR_OK) {
-            free(frame_cpu_ms);
-            return status;
-        }
+    for (uint32_t i = 0; i < GDR_FRAMES_IN_FLIGHT && status == GDR_OK; i++)
+        status = gdr_frame_slot_wait(r, &r->slots[i], err);
+    if (status == GDR_OK) {
+        r->color_read_back = frame->read_back;
+        if (stats)
+            gdr_frame_stats_fill(r, pipeline, reason, frame_cpu_ms, frames, submit_ms, recorded, stats);
     }
-    r->color_read_back = frame->read_back;
-    if (!stats) {
-        free(frame_cpu_ms);
-        return GDR_OK;
-    }
-    qsort(frame_cpu_ms, frames, sizeof *frame_cpu_ms, compare_double);
-    double median = frames % 2 ? frame_cpu_ms[frames / 2] : 0.5 * (frame_cpu_ms[frames / 2 - 1] + frame_cpu_ms[frames / 2]);
     free(frame_cpu_ms);
-
-    memset(stats, 0, sizeof *stats);
-    const gdr_frame_slot *last_slot = &r->slots[r->last_slot];
-    GdrGpuDrawStats gpu;
-    memcpy(&gpu, last_slot->stats_readback.mapped, sizeof gpu);
-    stats->frames = frames;
-    stats->instances_total = r->scene.instance_count;
-    stats->pipeline = pipeline;
-    snprintf(stats->pipeline_reason, sizeof stats->pipeline_reason, "%s", reason);
-    gdr_visbuffer_stats(r, (uint32_t)r->last_slot, stats);
-    snprintf(stats->raster_reason, sizeof stats->raster_reason, "%s", r->vis.reason);
-    if (pipeline == GDR_PIPELINE_CPU) {
-        stats->instances_visible = last_slot->cpu_visible_count;
-        stats->draws = last_slot->cpu_visible_count;
-        stats->draw_calls = last_slot->cpu_visible_count;
-        stats->triangles = last_slot->cpu_triangles;
-        stats->cpu_cull_ms_per_frame = r->cpu.cull_ms / frames;
-    } else {
-        bool occlusion = last_slot->occlusion_applied;
-        stats->instances_visible = gpu.draw_count + (occlusion ? gpu.instances_late_drawn : 0);
-        stats->draws = pipeline == GDR_PIPELINE_MESH
-                           ? gpu.task_groups_x * gpu.task_groups_y + gpu.late_task_groups_x * gpu.late_task_groups_y
-                           : gpu.draw_count + gpu.late_draw_count;
-        stats->draw_calls = occlusion ? 2 : 1;
-        stats->occlusion_applied = occlusion;
-        stats->instances_early_drawn = gpu.instances_early_drawn;
-        stats->instances_early_occluded = gpu.instances_early_occluded;
-        stats->instances_late_tested = gpu.instances_late_tested;
-        stats->instances_late_occluded = gpu.instances_late_occluded;
-        stats->instances_late_drawn = gpu.instances_late_drawn;
-        stats->meshlets_early_drawn = gpu.meshlets_early_drawn;
-        stats->meshlets_late_tested = gpu.meshlets_late_tested;
-        stats->meshlets_late_occluded = gpu.meshlets_late_occluded;
-        stats->meshlets_late_drawn = gpu.meshlets_late_drawn;
-        stats->triangles = ((uint64_t)gpu.triangles_high << 32) | gpu.triangles_low;
-        stats->triangles += stats->raster_sw_triangles; /* the mesh shaders count only their own */
-    }
-    if (pipeline == GDR_PIPELINE_MESH) {
-        stats->meshlets_total = r->scene.instance_meshlet_count;
-        stats->meshlets_tested = gpu.meshlets_tested;
-        stats->meshlets_frustum_culled = gpu.meshlets_frustum_culled;
-        stats->meshlets_cone_culled = gpu.meshlets_cone_culled;
-        stats->meshlets_visible = gpu.meshlets_visible;
-        stats->triangles_backface_culled = gpu.triangles_backface_culled;
-        stats->triangles_small_culled = gpu.triangles_small_culled;
-        stats->task_workgroups = gpu.task_count + gpu.late_task_count;
-        stats->task_overflow = gpu.task_overflow;
-        stats->lod_applied = last_slot->lod_applied;
-        stats->meshlets_lod_culled = gpu.meshlets_lod_culled;
-        for (uint32_t d = 0; d < GDR_LOD_STATS_DEPTH_COUNT; d++) {
-            stats->lod_clusters_per_depth[d] = gpu.lod_clusters[d];
-            stats->lod_triangles_per_depth[d] = gpu.lod_triangles[d];
-            if (gpu.lod_clusters[d] > 0)
-                stats->lod_depth_count = d + 1;
-        }
-    }
-    stats->cpu_ms_per_frame = cpu_ms / frames;
-    stats->cpu_submit_ms_per_frame = submit_ms / frames;
-    stats->frames_recorded = recorded;
-    stats->cpu_ms_per_frame_median = median;
-    stats->pass_count = GDR_SECTION_COUNT;
-    for (uint32_t p = 0; p < GDR_SECTION_COUNT; p++) {
-        stats->passes[p].name = gdr_frame_section_name((gdr_frame_section)p);
-        stats->passes[p].gpu_ms = r->timings.frames ? r->timings.section_ms[p] / r->timings.frames : 0.0;
-        stats->gpu_ms_per_frame += stats->passes[p].gpu_ms;
-    }
-    snprintf(stats->device, sizeof stats->device, "%s", r->ctx->properties.deviceName);
-    snprintf(stats->driver, sizeof stats->driver, "%s", r->ctx->driver_info);
-    stats->validation_messages = r->ctx->validation_messages;
-    return GDR_OK;
+    return status;
 }
 
 gdr_status gdr_renderer_read_color(gdr_renderer *r, uint8_t *rgba, gdr_error *err)

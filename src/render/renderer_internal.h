@@ -51,6 +51,7 @@ typedef struct gdr_gpu_scene {
     uint32_t task_capacity;        /* task commands of all instances: the task buffer's size */
     uint64_t instance_meshlet_count; /* level-0 clusters summed over the instances (meshlets_total) */
     uint64_t instance_lod_cluster_count; /* every DAG cluster summed over the instances */
+    uint64_t bytes;                /* device memory of the buffers above and the occlusion history */
     GdrGpuMesh *cpu_meshes;        /* host copies, for references and statistics */
     GdrGpuMeshlet *cpu_meshlets;
     GdrGpuInstance *cpu_instances;
@@ -153,6 +154,10 @@ void gdr_pass_record_overdraw_paint(gdr_renderer *r, gdr_frame_slot *slot, const
                                     VkCommandBuffer cmd);
 void gdr_pass_record_cpu_draws(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass, VkCommandBuffer cmd);
 void gdr_pass_record_readback(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass, VkCommandBuffer cmd);
+/* The statistics of a render call (frame_stats.c) after its last frame has finished; sorts
+ * frame_cpu_ms. */
+void gdr_frame_stats_fill(gdr_renderer *r, gdr_pipeline pipeline, const char *reason, double *frame_cpu_ms,
+                          uint32_t frames, double submit_ms, uint32_t recorded, gdr_frame_stats *stats);
 /* The frame's viewport and scissor: the Vulkan Y flip (seed 000) for the scene, none for
  * full-screen passes. */
 void gdr_frame_set_viewport(gdr_renderer *r, VkCommandBuffer cmd, bool flip_y);

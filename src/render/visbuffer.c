@@ -240,25 +240,25 @@ void gdr_visbuffer_stats(gdr_renderer *r, uint32_t slot_index, gdr_frame_stats *
 {
     gdr_visbuffer *v = &r->vis;
     uint32_t mode = v->slot_mode[slot_index];
-    stats->raster = gdr_visbuffer_public_mode(mode);
+    stats->raster.mode = gdr_visbuffer_public_mode(mode);
     if (mode == GDR_GPU_RASTER_FORWARD || !v->supported)
         return;
     GdrGpuRasterCounters counters;
     memcpy(&counters, v->counters_readback[slot_index].mapped, sizeof counters);
     GdrGpuRasterParams params;
     memcpy(&params, v->params[slot_index].mapped, sizeof params);
-    stats->sw_threshold_px = params.sw_threshold_px;
-    stats->raster_sw_clusters = counters.sw_clusters;
-    stats->raster_hw_clusters = counters.hw_clusters;
-    stats->raster_sw_triangles = counters.sw_triangles;
-    stats->raster_hw_triangles = counters.hw_triangles;
-    stats->raster_overflow = counters.overflow;
+    stats->raster.sw_threshold_px = params.sw_threshold_px;
+    stats->raster.sw_clusters = counters.sw_clusters;
+    stats->raster.hw_clusters = counters.hw_clusters;
+    stats->raster.sw_triangles = counters.sw_triangles;
+    stats->raster.hw_triangles = counters.hw_triangles;
+    stats->raster.overflow = counters.overflow;
     const gdr_frame_timings *t = &r->timings;
     if (t->raster_frames > 0) {
-        stats->raster_cull_ms = t->raster_ms[GDR_RASTER_TIMER_CULL] / t->raster_frames;
-        stats->raster_hw_ms = t->raster_ms[GDR_RASTER_TIMER_HW] / t->raster_frames;
-        stats->raster_sw_ms = t->raster_ms[GDR_RASTER_TIMER_SW] / t->raster_frames;
-        stats->raster_resolve_ms = t->raster_ms[GDR_RASTER_TIMER_RESOLVE] / t->raster_frames;
+        stats->raster.cull_ms = t->raster_ms[GDR_RASTER_TIMER_CULL] / t->raster_frames;
+        stats->raster.hw_ms = t->raster_ms[GDR_RASTER_TIMER_HW] / t->raster_frames;
+        stats->raster.sw_ms = t->raster_ms[GDR_RASTER_TIMER_SW] / t->raster_frames;
+        stats->raster.resolve_ms = t->raster_ms[GDR_RASTER_TIMER_RESOLVE] / t->raster_frames;
     }
 }
 

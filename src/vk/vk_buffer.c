@@ -78,14 +78,20 @@ static const gdr_vk_scope copy_read = {VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2
 static const gdr_vk_scope copy_write = {VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT};
 static const gdr_vk_scope host_read = {VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT};
 
-gdr_status gdr_vk_buffer_read_back(gdr_vk_allocator *allocator, VkBuffer source, VkDeviceSize offset,
-                                   VkDeviceSize size, gdr_vk_buffer *out, gdr_error *err)
+/* A host-visible buffer of `size` bytes for a read-back, and a one-time command buffer begun for it. */
+static gdr_status begin_read_back(gdr_vk_allocator *allocator, VkDeviceSize size, gdr_vk_buffer *out,
+                                  VkCommandBuffer *cmd, gdr_error *err)
 {
     gdr_status status = gdr_vk_buffer_create(allocator, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, GDR_VK_BUFFER_READBACK,
                                              out, err);
+    return status == GDR_OK ? gdr_vk_begin_one_time(allocator->ctx, cmd, err) : status;
+}
+
+gdr_status gdr_vk_buffer_read_back(gdr_vk_allocator *allocator, VkBuffer source, VkDeviceSize offset,
+                                   VkDeviceSize size, gdr_vk_buffer *out, gdr_error *err)
+{
     VkCommandBuffer cmd;
-    if (status == GDR_OK)
-        status = gdr_vk_begin_one_time(allocator->ctx, &cmd, err);
+    gdr_status status = begin_read_back(allocator, size, out, &cmd, err);
     if (status != GDR_OK)
         return status;
     gdr_vk_memory_barrier(cmd, everything_before, copy_read);
@@ -99,11 +105,8 @@ gdr_status gdr_vk_image_read_back(gdr_vk_allocator *allocator, const gdr_vk_imag
                                   VkImageLayout layout, uint32_t texel_size, gdr_vk_buffer *out, gdr_error *err)
 {
     VkDeviceSize size = (VkDeviceSize)image->width * image->height * texel_size;
-    gdr_status status = gdr_vk_buffer_create(allocator, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, GDR_VK_BUFFER_READBACK,
-                                             out, err);
     VkCommandBuffer cmd;
-    if (status == GDR_OK)
-        status = gdr_vk_begin_one_time(allocator->ctx, &cmd, err);
+    gdr_status status = begin_read_back(allocator, size, out, &cmd, err);
     if (status != GDR_OK)
         return status;
     gdr_vk_image_transition to_copy = {.image = image->image, .aspect = aspect, .from = layout,
