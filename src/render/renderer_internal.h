@@ -24,7 +24,9 @@ typedef struct gdr_frame_timings {
 /* The CPU-driven baseline (seed 003's "before"): the gdr/cull.h library culls on the CPU, then
  * one vkCmdDrawIndexed with its own binds per visible instance. */
 typedef struct gdr_cpu_path {
-    struct gdr_cull_scene *cull_scene;
+    struct gdr_cull_mesh_bounds *mesh_bounds; /* per mesh, from gdr_cpu_path_create */
+    uint32_t mesh_count;
+    struct gdr_cull_scene *cull_scene;        /* built when the pipeline is first used */
     uint32_t *visible_bits;   /* gdr_cull_word_count(instances) words */
     uint32_t *visible;        /* indices of the visible instances of the last culled frame */
     uint32_t visible_count;
@@ -41,6 +43,7 @@ typedef struct gdr_gpu_scene {
     gdr_vk_buffer meshlets;          /* GdrGpuMeshlet[], all meshes' clusters */
     gdr_vk_buffer meshlet_vertices;  /* uint32[]: global vertex index per cluster-local vertex */
     gdr_vk_buffer meshlet_triangles; /* uint32[] holding 3 bytes per cluster triangle */
+    gdr_vk_buffer lod_nodes;         /* GdrGpuLodNode[]: every mesh's LOD hierarchy, as gdr_lod_node */
     gdr_vk_buffer refs;              /* GdrGpuScene: the addresses above, for the push constants */
     uint32_t mesh_count;
     uint32_t instance_count;

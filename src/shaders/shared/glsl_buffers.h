@@ -16,6 +16,7 @@ layout(buffer_reference, scalar) buffer InstancesRef { GdrGpuInstance items[]; }
 layout(buffer_reference, scalar) readonly buffer MeshesRef { GdrGpuMesh items[]; };
 layout(buffer_reference, scalar) readonly buffer VerticesRef { GdrGpuVertex items[]; };
 layout(buffer_reference, scalar) readonly buffer MeshletsRef { GdrGpuMeshlet items[]; };
+layout(buffer_reference, scalar) readonly buffer LodNodesRef { GdrGpuLodNode items[]; };
 layout(buffer_reference, scalar) readonly buffer UintsRef { uint items[]; };
 layout(buffer_reference, scalar) buffer VisibilityRef { uint items[]; };
 layout(buffer_reference, scalar) writeonly buffer DrawCommandsRef { GdrGpuDrawCommand items[]; };

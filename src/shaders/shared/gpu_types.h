@@ -15,6 +15,7 @@ GDR_DECLARE_REF(InstancesRef)
 GDR_DECLARE_REF(MeshesRef)
 GDR_DECLARE_REF(VerticesRef)
 GDR_DECLARE_REF(MeshletsRef)
+GDR_DECLARE_REF(LodNodesRef)
 GDR_DECLARE_REF(UintsRef)
 GDR_DECLARE_REF(VisibilityRef)
 GDR_DECLARE_REF(DrawCommandsRef)
@@ -55,14 +56,14 @@ GDR_STRUCT_BEGIN(GdrGpuMesh)
     gdr_uint root_first;        /* first cluster of the root group, relative to meshlet_offset */
     gdr_uint root_cluster_count; /* 0 without a DAG: no root shortcut */
     gdr_uint root_task_count;
-    gdr_uint reserved0;
+    gdr_uint lod_node_offset;   /* the mesh's LOD hierarchy: GdrGpuLodNode[lod_node_offset .. + lod_node_count) */
     /* The root shortcut: a sphere containing, and the largest error of, the groups the root
      * group's clusters were made from. When it passes, each of them passes (errors and spheres
      * are monotonic up the DAG), so the cut is exactly the root group's clusters. */
     gdr_vec4 root_refined_sphere;
     float root_refined_error;
-    gdr_uint reserved1;
-    gdr_uint reserved2;
+    gdr_uint lod_node_count;    /* >= 1 for a mesh with clusters; node 0 of the mesh is its root */
+    gdr_uint lod_node_levels;   /* levels of the mesh's hierarchy (a traversal level by level needs this many steps) */
     gdr_uint reserved3;
 GDR_STRUCT_END(GdrGpuMesh)
 GDR_ASSERT_SIZE(GdrGpuMesh, 96);
@@ -101,6 +102,32 @@ GDR_ASSERT_OFFSET(GdrGpuMeshlet, cone_cutoff, 44);
 GDR_ASSERT_OFFSET(GdrGpuMeshlet, group, 60);
 GDR_ASSERT_OFFSET(GdrGpuMeshlet, group_sphere, 80);
 GDR_ASSERT_OFFSET(GdrGpuMeshlet, group_error, 112);
+
+/* One node of a mesh's LOD hierarchy: gdr_lod_node of gdr/geometry.h, whose contract it shares
+ * (the CPU array is uploaded as it is). Indices are mesh-local: an inner node's children are nodes
+ * [first, first + count) of its mesh, a leaf's clusters are the mesh's clusters
+ * [first, first + count). The node test is gdr_lod_node_may_draw (lod_math.h). */
+GDR_STRUCT_BEGIN(GdrGpuLodNode)
+    gdr_vec4 sphere;         /* mesh space: contains every group, refined group and cluster sphere below */
+    float max_error;         /* largest group error below (INFINITY when the root group is below) */
+    float min_refined_error; /* smallest refined-group error below; 0 when a cluster below has none */
+    gdr_uint first;          /* inner: first child node; leaf: first cluster */
+    gdr_uint count;          /* inner: children (1 .. GDR_GPU_LOD_NODE_MAX_CHILDREN); leaf: clusters */
+    gdr_uint group;          /* leaf: its group (GDR_GPU_NO_GROUP without a DAG); inner: GDR_GPU_NO_GROUP */
+    gdr_uint flags;          /* GDR_GPU_LOD_NODE_LEAF */
+    gdr_uint reserved0;
+    gdr_uint reserved1;
+GDR_STRUCT_END(GdrGpuLodNode)
+GDR_ASSERT_SIZE(GdrGpuLodNode, 48);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, max_error, 16);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, min_refined_error, 20);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, first, 24);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, count, 28);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, group, 32);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, flags, 36);
+
+#define GDR_GPU_LOD_NODE_LEAF 1u
+#define GDR_GPU_LOD_NODE_MAX_CHILDREN 8u
 
 /* Task-shader work written by the instance cull of the meshlet pipeline: one task workgroup tests
  * clusters [meshlet_first, meshlet_first + meshlet_count) of one instance. */
@@ -217,8 +244,9 @@ GDR_STRUCT_BEGIN(GdrGpuScene)
     GDR_REF(UintsRef) meshlet_triangles;      /* the bytes of the cluster-local triangles */
     GDR_REF(VisibilityRef) instance_visibility; /* occlusion history: GDR_INSTANCE_VISIBLE_* per instance */
     GDR_REF(VisibilityRef) meshlet_visibility;  /* occlusion history: a bit per cluster of every instance */
+    GDR_REF(LodNodesRef) lod_nodes;           /* GdrGpuLodNode[], every mesh's LOD hierarchy (GdrGpuMesh.lod_node_*) */
 GDR_STRUCT_END(GdrGpuScene)
-GDR_ASSERT_SIZE(GdrGpuScene, 64);
+GDR_ASSERT_SIZE(GdrGpuScene, 72);
 
 /* A frame slot's buffers: written once, when the slot is made (and when a buffer made on first use
  * appears). Shaders read it and GdrGpuScene in place (GDR_SCENE, GDR_FRAME), never as a local
