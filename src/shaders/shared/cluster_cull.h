@@ -9,10 +9,7 @@
 #ifndef GDR_CLUSTER_CULL_H
 #define GDR_CLUSTER_CULL_H
 
-// Occlusion culling phases (the shaders' specialisation constant 0): none, early, late.
-#define GDR_PHASE_NONE 0u
-#define GDR_PHASE_EARLY 1u
-#define GDR_PHASE_LATE 2u
+#include "task_queue.h" // the occlusion culling phases
 
 
 // What the tests decided for one invocation's cluster.
