@@ -7,6 +7,7 @@
 #define GDR_RENDERER_H
 
 #include <stdbool.h>
+#include <stdio.h>
 #include <stdint.h>
 
 #include "gdr/core.h"
@@ -33,6 +34,13 @@ typedef struct gdr_renderer_desc {
      * whether instance updates are pending). true: record every frame (to measure what recording
      * costs). The CPU pipeline always records. */
     bool record_every_frame;
+    /* Tests only: the task list's and the LOD traversal's capacities per frame phase (0: sized from
+     * the scene), to provoke their overflow, which the statistics report. */
+    uint32_t debug_task_capacity;
+    uint32_t debug_traversal_capacity;
+    /* Tests only: a deliberately wrong LOD hierarchy (node spheres shrunk), to show that the image
+     * tests catch a node test that is not conservative. */
+    bool debug_shrink_lod_nodes;
 } gdr_renderer_desc;
 
 typedef enum gdr_cull_mode {
@@ -102,6 +110,10 @@ typedef struct gdr_frame_desc {
     float lod_error_px;
     bool lod_fixed_depth;
     uint32_t lod_depth;
+    /* With the LOD cut by error: find each instance's clusters by traversing the hierarchy over its
+     * DAG (gdr/geometry.h, "LOD hierarchy"), testing nodes by LOD error, frustum and (late phase)
+     * occlusion, instead of testing every cluster of the DAG (OFF). DEFAULT: on. The cut is the same. */
+    gdr_cull_mode lod_hierarchy;
     /* Two-phase occlusion culling against the depth pyramid (issue 6; indirect pipeline: instances,
      * mesh pipeline: instances and clusters; DEFAULT: on; off when cull is off). Conservative: the
      * image is the same with it off. The history it keeps between frames is discarded when the
@@ -127,6 +139,73 @@ typedef struct gdr_pass_timing {
     const char *name;
     double gpu_ms; /* mean over the frames */
 } gdr_pass_timing;
+
+/* Rasterisation: the path that rasterised (never DEFAULT; FORWARD off the mesh pipeline) and why;
+ * the threshold HYBRID used; the last frame's visible clusters and their triangles (before
+ * back-face culling) per rasteriser; the GPU time of the cluster cull (the per-cluster tests and
+ * binning, with the launches), of the mesh-shader pass, of the compute rasteriser and of the
+ * resolve, means over the frames (the four are part of the "draw" passes). */
+typedef struct gdr_raster_stats {
+    gdr_raster mode;
+    char reason[128];
+    float sw_threshold_px;
+    uint32_t sw_clusters, hw_clusters;
+    uint64_t sw_triangles, hw_triangles;
+    uint32_t overflow; /* clusters lost for want of room in the list (0 below 2^25) or beyond the
+                          device's mesh launch limit (0 below 2^22) */
+    double cull_ms, hw_ms, sw_ms, resolve_ms;
+} gdr_raster_stats;
+
+/* The LOD cut (mesh pipeline), last frame: whether it was applied, the clusters it left out, and
+ * the clusters and triangles drawn per DAG depth (the last entry: that depth or deeper; triangles
+ * before triangle culling). */
+typedef struct gdr_lod_stats_frame {
+    bool applied;
+    uint32_t meshlets_culled;
+    uint32_t depth_count; /* entries used below: deepest depth drawn + 1 */
+    uint32_t clusters_per_depth[GDR_LOD_STATS_DEPTH_COUNT];
+    uint64_t triangles_per_depth[GDR_LOD_STATS_DEPTH_COUNT];
+} gdr_lod_stats_frame;
+
+/* Occlusion culling, last frame, per phase (early: what was visible last frame; late: the rest of
+ * what is in the frustum, against this frame's pyramid). Clusters: mesh pipeline. */
+typedef struct gdr_occlusion_stats {
+    bool applied;
+    uint32_t instances_early_drawn;
+    uint32_t instances_early_occluded; /* visible last frame, hidden behind last frame's pyramid */
+    uint32_t instances_late_tested;
+    uint32_t instances_late_occluded;
+    uint32_t instances_late_drawn;     /* not drawn early */
+    uint32_t meshlets_early_drawn;
+    uint32_t meshlets_late_tested;
+    uint32_t meshlets_late_occluded;
+    uint32_t meshlets_late_drawn;
+} gdr_occlusion_stats;
+
+/* The LOD hierarchy traversal (mesh pipeline, LOD cut by error), last frame, both phases: node
+ * visits, those whose subtree cannot hold a cluster of the cut, those outside the frustum, those
+ * behind the depth pyramid (late phase), the late phase's visits, and visits that did not fit the
+ * traversal's queue (their subtrees were not drawn; 0 unless the scene outgrows
+ * GDR_TRAVERSE_MAX_VISITS visits per level). */
+typedef struct gdr_traversal_stats {
+    bool applied;
+    uint32_t levels;
+    uint32_t nodes_tested;
+    uint32_t nodes_lod_culled;
+    uint32_t nodes_frustum_culled;
+    uint32_t nodes_occluded;
+    uint32_t late_nodes_tested;
+    uint32_t overflow;
+} gdr_traversal_stats;
+
+/* GPU memory: what the renderer holds from the device (whole blocks), and of what it placed in
+ * them, the scene's part (geometry, clusters, instances, occlusion history) and the rest (render
+ * targets, frame slots, visibility buffer, read-backs). */
+typedef struct gdr_memory_stats {
+    uint64_t device_bytes;
+    uint64_t scene_bytes;
+    uint64_t frame_bytes;
+} gdr_memory_stats;
 
 typedef struct gdr_frame_stats {
     uint32_t frames;
@@ -159,41 +238,14 @@ typedef struct gdr_frame_stats {
     uint32_t triangles_backface_culled;   /* by the mesh shader */
     uint32_t triangles_small_culled;      /* covering no sample */
     uint32_t task_workgroups;
-    uint32_t task_overflow;               /* task commands lost for want of room: always 0 (sized from the scene) */
+    uint32_t task_overflow;               /* task commands lost for want of room: 0 unless a frame phase needs more
+                                             than GDR_MAX_TASK_COMMANDS (16 M) */
     uint32_t overdraw_max;                /* overdraw view: the most fragments one pixel received */
-    /* Rasterisation (issue 8): the path that rasterised (never DEFAULT; FORWARD off the mesh
-     * pipeline) and why; the threshold HYBRID used; the last frame's visible clusters and their
-     * triangles (before back-face culling) per rasteriser; the GPU time of the cluster cull (the
-     * per-cluster tests and binning, with the launches), of the mesh-shader pass, of the compute
-     * rasteriser and of the resolve, means over the frames (the four are part of the "draw" pass). */
-    gdr_raster raster;
-    char raster_reason[128];
-    float sw_threshold_px;
-    uint32_t raster_sw_clusters, raster_hw_clusters;
-    uint64_t raster_sw_triangles, raster_hw_triangles;
-    uint32_t raster_overflow;             /* clusters lost for want of room in the list (0 below 2^25) or
-                                             beyond the device's mesh launch limit (0 below 2^22) */
-    double raster_cull_ms, raster_hw_ms, raster_sw_ms, raster_resolve_ms;
-    /* The LOD cut (mesh pipeline), last frame: whether it was applied, the clusters it left out,
-     * and the clusters and triangles drawn per DAG depth (the last entry: that depth or deeper;
-     * triangles before triangle culling). */
-    bool lod_applied;
-    uint32_t meshlets_lod_culled;
-    uint32_t lod_depth_count;             /* entries used below: deepest depth drawn + 1 */
-    uint32_t lod_clusters_per_depth[GDR_LOD_STATS_DEPTH_COUNT];
-    uint64_t lod_triangles_per_depth[GDR_LOD_STATS_DEPTH_COUNT];
-    /* Occlusion culling, last frame, per phase (early: what was visible last frame; late: the
-     * rest of what is in the frustum, against this frame's pyramid). Clusters: mesh pipeline. */
-    bool occlusion_applied;
-    uint32_t instances_early_drawn;
-    uint32_t instances_early_occluded; /* visible last frame, hidden behind last frame's pyramid */
-    uint32_t instances_late_tested;
-    uint32_t instances_late_occluded;
-    uint32_t instances_late_drawn;     /* not drawn early */
-    uint32_t meshlets_early_drawn;
-    uint32_t meshlets_late_tested;
-    uint32_t meshlets_late_occluded;
-    uint32_t meshlets_late_drawn;
+    gdr_raster_stats raster;
+    gdr_lod_stats_frame lod;
+    gdr_occlusion_stats occlusion;
+    gdr_traversal_stats traversal;
+    gdr_memory_stats memory;
 } gdr_frame_stats;
 
 GDR_API gdr_status gdr_renderer_create(const gdr_renderer_desc *desc, gdr_renderer **out, gdr_error *err);
@@ -237,6 +289,11 @@ GDR_API gdr_status gdr_renderer_read_visible_meshlets(gdr_renderer *renderer, gd
                                                       uint32_t capacity, uint32_t *count, gdr_error *err);
 
 GDR_API void gdr_renderer_size(const gdr_renderer *renderer, uint32_t *width, uint32_t *height);
+
+/* Writes, as Markdown, the passes of the frame of every configuration (pipeline, raster, occlusion
+ * culling, overdraw view): per pass the resources it reads and writes and the barrier derived
+ * before it. docs/PIPELINE.md holds this output (`gdr info --passes`). Needs no device. */
+GDR_API void gdr_describe_frame_passes(FILE *out);
 
 /* Writes RGBA8 pixels as a PNG through a temporary file and a rename: never a half-written file. */
 GDR_API gdr_status gdr_write_png(const char *path, const uint8_t *rgba, uint32_t width, uint32_t height,

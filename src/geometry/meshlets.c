@@ -311,6 +311,11 @@ gdr_status gdr_meshlets_build(const gdr_mesh *mesh, const gdr_meshlet_options *o
     free(meshlets);
     free(vertices);
     free(triangles);
+    status = gdr_mesh_clusters_build_hierarchy(&c, err);
+    if (status != GDR_OK) {
+        gdr_mesh_clusters_free(&c);
+        return status;
+    }
     *out = c;
     return GDR_OK;
 }
