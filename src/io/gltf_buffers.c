@@ -260,9 +260,13 @@ gdr_status gltf_buffer_get(gltf_ctx *c, uint32_t index, const char *place, const
             return gltf_fail(c, GDR_ERROR_PARSE, "%s: has no uri%s", here,
                              c->is_glb ? " and is not the GLB binary chunk" : "");
         }
-        if (available < byte_length)
+        if (available < byte_length) {
+            /* An image's failure is only a warning: the buffer may be asked for again. */
+            free(b->owned);
+            b->owned = NULL;
             return gltf_fail(c, GDR_ERROR_PARSE, "%s.byteLength: %u, but only %zu bytes are there", here,
                              byte_length, available);
+        }
         b->data = bytes;
         b->size = byte_length;
         b->state = 1;
