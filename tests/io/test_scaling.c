@@ -1,7 +1,8 @@
 /* Work proportional to input: for every dimension of a scene file that drives a loop or an
  * allocation (triangles, repeated and degenerate faces, shared vertices, groups, nodes, meshes,
- * materials, images, instances, a soup with an outlier; meshes and triangles of a cache), the file is generated at size N and 4N and taken through import,
- * meshlets and the LOD DAG; the CPU time must grow less than 8-fold (linear: 4, n log n: about
+ * materials, images, instances, a soup with an outlier), the file is generated at size N and 4N
+ * and taken through import, meshlets and the LOD DAG; for a cache's meshes and triangles, the
+ * cache of such a file is read. The CPU time must grow less than 8-fold (linear: 4, n log n: about
  * 4.5, quadratic: 16). Times are the best of three runs, measured side by side. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdarg.h>
