@@ -35,21 +35,26 @@ static int kdtree_degenerates(const float *centroids, uint32_t count, uint32_t *
     while (top > 0) {
         kd_range r = stack[--top];
         uint32_t n = r.end - r.begin;
-        if (n <= 8)
+        if (n <= LARGEST_SOUND_LEAF) /* nothing below can make a larger leaf */
             continue;
         if ((work += n) > work_limit)
             return 1;
-        double mean[3] = {0, 0, 0}, m2[3] = {0, 0, 0};
-        for (uint32_t i = 0; i < n; i++) {
-            const float *p = centroids + 3 * (size_t)order[r.begin + i];
+        /* Sums about the range's first point (no division per point; the spread decides the axis). */
+        const float *origin = centroids + 3 * (size_t)order[r.begin];
+        double sum[3] = {0, 0, 0}, squares[3] = {0, 0, 0};
+        for (uint32_t i = r.begin; i < r.end; i++) {
+            const float *p = centroids + 3 * (size_t)order[i];
             for (int k = 0; k < 3; k++) {
-                double delta = p[k] - mean[k];
-                mean[k] += delta / (i + 1);
-                m2[k] += delta * (p[k] - mean[k]);
+                double d = (double)p[k] - origin[k];
+                sum[k] += d;
+                squares[k] += d * d;
             }
         }
-        int axis = m2[0] >= m2[1] && m2[0] >= m2[2] ? 0 : m2[1] >= m2[2] ? 1 : 2;
-        float split = (float)mean[axis];
+        double spread[3];
+        for (int k = 0; k < 3; k++)
+            spread[k] = squares[k] - sum[k] * sum[k] / n;
+        int axis = spread[0] >= spread[1] && spread[0] >= spread[2] ? 0 : spread[1] >= spread[2] ? 1 : 2;
+        float split = (float)(origin[axis] + sum[axis] / n);
         uint32_t middle = r.begin;
         for (uint32_t i = r.begin; i < r.end; i++)
             if (centroids[3 * (size_t)order[i] + axis] < split) {
@@ -58,11 +63,8 @@ static int kdtree_degenerates(const float *centroids, uint32_t count, uint32_t *
                 order[i] = t;
             }
         uint32_t left = middle - r.begin;
-        if (left <= 4 || left >= n - 4) {
-            if (n > LARGEST_SOUND_LEAF)
-                return 1;
-            continue;
-        }
+        if (left <= 4 || left >= n - 4)
+            return 1; /* a leaf of n > LARGEST_SOUND_LEAF triangles */
         stack[top++] = (kd_range){r.begin, middle};
         stack[top++] = (kd_range){middle, r.end};
     }
