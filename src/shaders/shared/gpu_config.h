@@ -16,8 +16,11 @@
 /* maxTaskWorkGroupCount[0] is at least this on every device: larger launches use y too. */
 #define GDR_TASK_GROUPS_PER_ROW 65535
 /* The cluster cull of the visibility-buffer modes (clustercull.comp) takes this many task commands
- * per workgroup (GDR_TASK_WORKGROUP_SIZE invocations each). */
-#define GDR_CLUSTER_CULL_TASKS 8
+ * per workgroup, GDR_CLUSTER_CULL_LANES invocations each, which step through a command's clusters
+ * as far as the workgroup's largest command needs: most commands of a large field are a distant
+ * instance's root group, one or two clusters. */
+#define GDR_CLUSTER_CULL_TASKS 32
+#define GDR_CLUSTER_CULL_LANES 8
 /* LOD statistics: clusters and triangles drawn per DAG depth, the last bucket for deeper ones. */
 #define GDR_LOD_STATS_DEPTHS 32
 /* The LOD hierarchy traversal (lodtraverse.comp): one invocation per node visit, one dispatch per
