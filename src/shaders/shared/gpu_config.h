@@ -27,6 +27,9 @@
  * level of the hierarchies (at most GDR_LOD_TREE_LEVELS, gdr/geometry.h's GDR_LOD_NODE_MAX_LEVELS);
  * a level holds at most GDR_TRAVERSE_MAX_VISITS visits (a one-dimensional indirect dispatch). */
 #define GDR_TRAVERSE_WORKGROUP_SIZE 64
+/* Meshes of at most this many task commands of clusters are tested whole: their few commands cost
+ * less than the traversal's levels (the same cut either way). */
+#define GDR_TRAVERSE_MIN_TASKS 8
 #define GDR_LOD_TREE_LEVELS 32
 #define GDR_TRAVERSE_MAX_VISITS (65535u * GDR_TRAVERSE_WORKGROUP_SIZE)
 /* Task commands a frame phase can hold at most (16 bytes each); a scene that could need more gets
