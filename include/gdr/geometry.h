@@ -79,8 +79,9 @@ typedef struct gdr_meshlet_options {
     uint32_t max_triangles; /* 0: GDR_CLUSTER_MAX_TRIANGLES; at most that, a multiple of 4 */
     float cone_weight;      /* 0: the default (0.25); in (0, 1]; favours clusters with tight normal
                                cones over small ones */
-    uint32_t thread_count;  /* gdr_scene_build_clusters: workers including the caller, at most 256;
-                               0: one per processor. The result does not depend on it. */
+    uint32_t thread_count;  /* workers including the caller, at most 256; 0: one per processor. A mesh
+                               is built in chunks of 65,536 triangles, side by side; a scene's meshes
+                               side by side. The result does not depend on it. */
 } gdr_meshlet_options;
 
 typedef struct gdr_mesh gdr_mesh;   /* gdr/scene.h */

@@ -66,7 +66,7 @@ static int push_cluster(lod_build *b, gdr_cluster c)
 }
 
 /* Appends a formed group's clusters, made from group `group`. */
-static int append_result(lod_build *b, const group_result *r, uint32_t group, uint32_t *frontier,
+static int append_result(lod_build *b, const group_result *r, uint32_t result, uint32_t group, uint32_t *frontier,
                          uint32_t *frontier_count)
 {
     if (!gdr_lod_reserve(&b->vertices, &b->vertex_cap, b->vertex_count + r->vertex_count, sizeof *b->vertices) ||
@@ -79,7 +79,7 @@ static int append_result(lod_build *b, const group_result *r, uint32_t group, ui
         c.triangle_offset += (uint32_t)b->triangle_bytes;
         c.refined_group = group;
         frontier[(*frontier_count)++] = (uint32_t)b->cluster_count;
-        if (!push_cluster(b, c))
+        if (!gdr_lod_error_adopt(b, (uint32_t)b->cluster_count, result, r, i) || !push_cluster(b, c))
             return 0;
     }
     memcpy(b->vertices + b->vertex_count, r->vertices, (size_t)r->vertex_count * sizeof *b->vertices);
@@ -178,7 +178,7 @@ static int take_results(lod_build *b, uint32_t depth, uint32_t groups, uint32_t 
         for (uint32_t i = first; i < end; i++)
             b->clusters[b->members[i]].group = id;
         if (r->formed) {
-            if (!append_result(b, r, id, next, next_count))
+            if (!append_result(b, r, g, id, next, next_count))
                 return 0;
             continue;
         }
@@ -189,7 +189,7 @@ static int take_results(lod_build *b, uint32_t depth, uint32_t groups, uint32_t 
             c.group = GDR_NO_INDEX;
             c.refined_group = id;
             next[(*next_count)++] = (uint32_t)b->cluster_count;
-            if (!push_cluster(b, c))
+            if (!gdr_lod_error_inherit(b, (uint32_t)b->cluster_count, b->members[i]) || !push_cluster(b, c))
                 return 0;
         }
         b->stats.passthrough_clusters += end - first;
@@ -230,7 +230,7 @@ static gdr_status lod_step(lod_build *b, uint32_t depth, uint32_t *next, uint32_
         b->stats.stuck_groups += !b->results[g].formed;
         b->stats.border_rejects += (uint64_t)b->results[g].border_reject;
     }
-    if (*progress && !take_results(b, depth, groups, next, next_count))
+    if (*progress && (!take_results(b, depth, groups, next, next_count) || !gdr_lod_error_gather(b, next, *next_count)))
         goto oom;
     goto done;
 oom:
@@ -399,6 +399,8 @@ static int setup(lod_build *b)
     if (!b->owner)
         return 0;
     memset(b->owner, 0xff, (size_t)b->position_count * sizeof *b->owner);
+    if (!gdr_lod_error_setup(b))
+        return 0;
     for (uint32_t w = 0; w < b->scratch_count; w++) {
         b->scratch[w].map = malloc((size_t)mesh->vertex_count * sizeof *b->scratch[w].map);
         if (!b->scratch[w].map)
@@ -534,6 +536,7 @@ static gdr_status build_mesh(lod_build *b, gdr_error *err)
         give_back_level0(b);
     }
     free(frontier);
+    gdr_lod_error_free(b);
     free(b->position_id);
     free(b->owner);
     if (b->scratch)

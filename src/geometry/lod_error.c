@@ -1,0 +1,507 @@
+/* A group's error, measured against the full-detail surface (docs/GEOMETRY.md, "The error").
+ *
+ * Every distinct level-0 position is a *sample* of the full-detail surface S0, owned by exactly one
+ * cluster of the frontier (at first the first level-0 cluster that uses it). When a group is
+ * simplified into new clusters, each of its members' samples passes to the new cluster whose
+ * triangle is nearest to it. The group's deviation is the larger of
+ *  - the distance from each of its samples to the simplified triangles (S0 -> simplified), and
+ *  - the distance from points of the simplified triangles (corners, edge midpoints, centroid) to
+ *    S0, measured against the level-0 triangles around the nearest sample (simplified -> S0);
+ * both are upper bounds of the distances they stand for (distance to a subset of the triangles).
+ * The group's error is the larger of its deviation and the errors of the groups its members came
+ * from. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "geometry/lod_internal.h"
+
+#define NO_SOURCE UINT32_MAX
+
+/* Squared distance from p to triangle (a, b, c), by the region of the closest point. */
+static float point_triangle_d2(gdr_vec3 P, gdr_vec3 A, gdr_vec3 B, gdr_vec3 C)
+{
+    const float p[3] = {P.x, P.y, P.z}, a[3] = {A.x, A.y, A.z}, b[3] = {B.x, B.y, B.z}, c[3] = {C.x, C.y, C.z};
+    float ab[3], ac[3], ap[3], q[3];
+    for (int k = 0; k < 3; k++) {
+        ab[k] = b[k] - a[k];
+        ac[k] = c[k] - a[k];
+        ap[k] = p[k] - a[k];
+    }
+#define DOT(x, y) ((x)[0] * (y)[0] + (x)[1] * (y)[1] + (x)[2] * (y)[2])
+    float d1 = DOT(ab, ap), d2 = DOT(ac, ap);
+    float bp[3] = {p[0] - b[0], p[1] - b[1], p[2] - b[2]}, cp[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+    float d3 = DOT(ab, bp), d4 = DOT(ac, bp), d5 = DOT(ab, cp), d6 = DOT(ac, cp);
+#undef DOT
+    float va = d3 * d6 - d5 * d4, vb = d5 * d2 - d1 * d6, vc = d1 * d4 - d3 * d2;
+    if (d1 <= 0.0f && d2 <= 0.0f) {
+        memcpy(q, a, sizeof q);
+    } else if (d3 >= 0.0f && d4 <= d3) {
+        memcpy(q, b, sizeof q);
+    } else if (d6 >= 0.0f && d5 <= d6) {
+        memcpy(q, c, sizeof q);
+    } else if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) {
+        float v = d1 / (d1 - d3);
+        for (int k = 0; k < 3; k++)
+            q[k] = a[k] + v * ab[k];
+    } else if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) {
+        float w = d2 / (d2 - d6);
+        for (int k = 0; k < 3; k++)
+            q[k] = a[k] + w * ac[k];
+    } else if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f) {
+        float w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        for (int k = 0; k < 3; k++)
+            q[k] = b[k] + w * (c[k] - b[k]);
+    } else {
+        float denom = va + vb + vc;
+        float v = vb / denom, w = vc / denom;
+        if (!(denom > 0.0f)) /* degenerate: nearest corner */
+            v = w = 0.0f;
+        for (int k = 0; k < 3; k++)
+            q[k] = a[k] + ab[k] * v + ac[k] * w;
+    }
+    float dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+    float d = dx * dx + dy * dy + dz * dz;
+    /* Any corner bounds the distance too: guards the degenerate cases above. */
+    float da = (p[0] - a[0]) * (p[0] - a[0]) + (p[1] - a[1]) * (p[1] - a[1]) + (p[2] - a[2]) * (p[2] - a[2]);
+    return d < da ? d : da;
+}
+
+static gdr_vec3 load3(const float *f) { return (gdr_vec3){f[0], f[1], f[2]}; }
+
+/* --- setup ------------------------------------------------------------------------------------- */
+
+static int reserve_cluster_samples(lod_build *b, size_t need)
+{
+    if (need <= b->cluster_sample_cap)
+        return 1;
+    size_t n = b->cluster_sample_cap ? b->cluster_sample_cap : 64;
+    while (n < need)
+        n *= 2;
+    uint32_t *first = realloc(b->cluster_sample_first, n * sizeof *first);
+    if (!first)
+        return 0;
+    b->cluster_sample_first = first;
+    uint32_t *count = realloc(b->cluster_sample_count, n * sizeof *count);
+    if (!count)
+        return 0;
+    b->cluster_sample_count = count;
+    uint32_t *source = realloc(b->cluster_sample_source, n * sizeof *source);
+    if (!source)
+        return 0;
+    b->cluster_sample_source = source;
+    b->cluster_sample_cap = n;
+    return 1;
+}
+
+/* Level-0 triangles around each position (by position id), as (cluster << 7 | triangle). */
+static int build_adjacency(lod_build *b, uint32_t level0)
+{
+    size_t corners = 0;
+    for (uint32_t c = 0; c < level0; c++)
+        corners += (size_t)b->clusters[c].triangle_count * 3;
+    b->adjacency_start = calloc((size_t)b->position_count + 1, sizeof *b->adjacency_start);
+    b->adjacency = malloc((corners ? corners : 1) * sizeof *b->adjacency);
+    if (!b->adjacency_start || !b->adjacency || corners > UINT32_MAX)
+        return 0;
+    for (uint32_t c = 0; c < level0; c++) {
+        const gdr_cluster *k = &b->clusters[c];
+        const uint8_t *t = gdr_lod_cluster_triangles(b, k);
+        const uint32_t *v = gdr_lod_cluster_vertices(b, k);
+        for (uint32_t i = 0; i < k->triangle_count * 3; i++)
+            b->adjacency_start[b->position_id[v[t[i]]] + 1]++;
+    }
+    for (uint32_t p = 0; p < b->position_count; p++)
+        b->adjacency_start[p + 1] += b->adjacency_start[p];
+    for (uint32_t c = 0; c < level0; c++) {
+        const gdr_cluster *k = &b->clusters[c];
+        const uint8_t *t = gdr_lod_cluster_triangles(b, k);
+        const uint32_t *v = gdr_lod_cluster_vertices(b, k);
+        for (uint32_t i = 0; i < k->triangle_count * 3; i++)
+            b->adjacency[b->adjacency_start[b->position_id[v[t[i]]]]++] = c << 7 | (i / 3);
+    }
+    for (uint32_t p = b->position_count; p > 0; p--) /* start[p] now holds the end of p: shift back */
+        b->adjacency_start[p] = b->adjacency_start[p - 1];
+    b->adjacency_start[0] = 0;
+    return 1;
+}
+
+/* Each position used by level 0 is owned by the first level-0 cluster that uses it. */
+static int assign_level0_samples(lod_build *b, uint32_t level0)
+{
+    uint32_t *owner = b->owner; /* free until the first step: borrowed, then reset */
+    b->samples = malloc(((size_t)b->position_count + 1) * sizeof *b->samples);
+    if (!b->samples || !reserve_cluster_samples(b, level0))
+        return 0;
+    for (uint32_t c = 0; c < level0; c++) {
+        const gdr_cluster *k = &b->clusters[c];
+        const uint32_t *v = gdr_lod_cluster_vertices(b, k);
+        b->cluster_sample_first[c] = b->sample_count;
+        for (uint32_t j = 0; j < k->vertex_count; j++) {
+            uint32_t p = b->position_id[v[j]];
+            if (owner[p] != OWNER_NONE)
+                continue;
+            owner[p] = c;
+            b->sample_vertex[p] = v[j];
+            b->samples[b->sample_count++] = p;
+        }
+        b->cluster_sample_count[c] = b->sample_count - b->cluster_sample_first[c];
+        b->cluster_sample_source[c] = NO_SOURCE;
+    }
+    memset(owner, 0xff, (size_t)b->position_count * sizeof *owner);
+    return 1;
+}
+
+int gdr_lod_error_setup(lod_build *b)
+{
+    uint32_t level0 = b->mesh->clusters.level0_cluster_count;
+    b->sample_vertex = malloc(((size_t)b->position_count + 1) * sizeof *b->sample_vertex);
+    if (!b->sample_vertex || level0 >= (1u << 25))
+        return 0;
+    return build_adjacency(b, level0) && assign_level0_samples(b, level0);
+}
+
+void gdr_lod_error_free(lod_build *b)
+{
+    free(b->sample_vertex);
+    free(b->adjacency_start);
+    free(b->adjacency);
+    free(b->samples);
+    free(b->cluster_sample_first);
+    free(b->cluster_sample_count);
+    free(b->cluster_sample_source);
+}
+
+/* --- following the frontier -------------------------------------------------------------------- */
+
+int gdr_lod_error_inherit(lod_build *b, uint32_t cluster, uint32_t from)
+{
+    if (!reserve_cluster_samples(b, (size_t)cluster + 1))
+        return 0;
+    b->cluster_sample_first[cluster] = b->cluster_sample_first[from];
+    b->cluster_sample_count[cluster] = b->cluster_sample_count[from];
+    b->cluster_sample_source[cluster] = b->cluster_sample_source[from];
+    return 1;
+}
+
+int gdr_lod_error_adopt(lod_build *b, uint32_t cluster, uint32_t group, const group_result *r, uint32_t index)
+{
+    if (!reserve_cluster_samples(b, (size_t)cluster + 1))
+        return 0;
+    b->cluster_sample_first[cluster] = r->cluster_sample_first[index];
+    b->cluster_sample_count[cluster] = r->cluster_sample_first[index + 1] - r->cluster_sample_first[index];
+    b->cluster_sample_source[cluster] = group;
+    return 1;
+}
+
+int gdr_lod_error_gather(lod_build *b, const uint32_t *frontier, uint32_t count)
+{
+    uint32_t *next = malloc(((size_t)b->position_count + 1) * sizeof *next);
+    if (!next)
+        return 0;
+    uint32_t n = 0;
+    for (uint32_t f = 0; f < count; f++) {
+        uint32_t c = frontier[f], src = b->cluster_sample_source[c];
+        const uint32_t *from = src == NO_SOURCE ? b->samples : b->results[src].samples;
+        memcpy(next + n, from + b->cluster_sample_first[c], b->cluster_sample_count[c] * sizeof *next);
+        b->cluster_sample_first[c] = n;
+        b->cluster_sample_source[c] = NO_SOURCE;
+        n += b->cluster_sample_count[c];
+    }
+    free(b->samples);
+    b->samples = next;
+    b->sample_count = n;
+    return 1;
+}
+
+/* --- one group ----------------------------------------------------------------------------------- */
+
+/* The simplified triangles (group-local vertex ids) in cluster order, the cluster of each, and the
+ * triangles around each local vertex. */
+static int output_triangles(lod_scratch *s, const group_result *r, uint32_t local_count)
+{
+    uint32_t t = 0;
+    for (uint32_t i = 0; i < r->cluster_count; i++)
+        t += s->meshlets[i].triangle_count;
+    if (!LOD_RESERVE(s, out_corners, (size_t)t * 3) || !LOD_RESERVE(s, out_cluster, t) ||
+        !LOD_RESERVE(s, ring_start, (size_t)local_count + 1) || !LOD_RESERVE(s, ring, (size_t)t * 3))
+        return 0;
+    t = 0;
+    for (uint32_t i = 0; i < r->cluster_count; i++) {
+        const struct meshopt_Meshlet *m = &s->meshlets[i];
+        for (uint32_t j = 0; j < m->triangle_count * 3; j++)
+            s->out_corners[(size_t)t * 3 + j] = s->meshlet_vertices[m->vertex_offset +
+                                                                     s->meshlet_triangles[m->triangle_offset + j]];
+        for (uint32_t j = 0; j < m->triangle_count; j++)
+            s->out_cluster[t + j] = i;
+        t += m->triangle_count;
+    }
+    s->out_triangle_count = t;
+    memset(s->ring_start, 0, ((size_t)local_count + 1) * sizeof *s->ring_start);
+    for (size_t i = 0; i < (size_t)t * 3; i++)
+        s->ring_start[s->out_corners[i] + 1]++;
+    for (uint32_t l = 0; l < local_count; l++)
+        s->ring_start[l + 1] += s->ring_start[l];
+    for (size_t i = 0; i < (size_t)t * 3; i++)
+        s->ring[s->ring_start[s->out_corners[i]]++] = (uint32_t)(i / 3);
+    for (uint32_t l = local_count; l > 0; l--)
+        s->ring_start[l] = s->ring_start[l - 1];
+    s->ring_start[0] = 0;
+    return 1;
+}
+
+/* The members' samples, gathered in member order, with their coordinates. */
+static int gather_samples(lod_build *b, lod_scratch *s, uint32_t first, uint32_t count)
+{
+    size_t n = 0;
+    for (uint32_t i = 0; i < count; i++)
+        n += b->cluster_sample_count[b->members[first + i]];
+    if (!LOD_RESERVE(s, sample_ids, n + 1) || !LOD_RESERVE(s, sample_points, n + 1) ||
+        !LOD_RESERVE(s, sample_cluster, n + 1) || !LOD_RESERVE(s, sample_d2, n + 1) ||
+        !LOD_RESERVE(s, sample_order, n + 1))
+        return 0;
+    n = 0;
+    for (uint32_t i = 0; i < count; i++) {
+        uint32_t c = b->members[first + i];
+        const uint32_t *ids = b->samples + b->cluster_sample_first[c];
+        for (uint32_t j = 0; j < b->cluster_sample_count[c]; j++) {
+            s->sample_ids[n] = ids[j];
+            s->sample_points[n++] = b->mesh->positions[b->sample_vertex[ids[j]]];
+        }
+    }
+    s->gathered = (uint32_t)n;
+    return 1;
+}
+
+/* Distance (squared) from p to the triangles around local vertex l, and the nearest of them. */
+static float ring_d2(const lod_scratch *s, uint32_t l, gdr_vec3 p, uint32_t *nearest)
+{
+    float best = INFINITY;
+    *nearest = s->ring[s->ring_start[l]];
+    for (uint32_t k = s->ring_start[l]; k < s->ring_start[l + 1]; k++) {
+        const uint32_t *t = s->out_corners + (size_t)s->ring[k] * 3;
+        float d = point_triangle_d2(p, load3(s->positions + (size_t)t[0] * 3), load3(s->positions + (size_t)t[1] * 3),
+                                    load3(s->positions + (size_t)t[2] * 3));
+        if (d < best) {
+            best = d;
+            *nearest = s->ring[k];
+        }
+    }
+    return best;
+}
+
+/* Largest distance from a sample to the simplified triangles; each sample's nearest cluster. The
+ * triangles around the nearest simplified vertex give an upper bound quickly; only a sample whose
+ * bound exceeds the largest distance so far is measured exactly (grid of the triangles), so the
+ * result is the exact maximum and every sample lies within it of the cluster it passes to. */
+static float samples_to_simplified(lod_scratch *s, uint32_t local_count)
+{
+    uint32_t used = 0;
+    if (!LOD_RESERVE(s, vertex_points, local_count) || !LOD_RESERVE(s, vertex_local, local_count))
+        return -1.0f;
+    for (uint32_t l = 0; l < local_count; l++)
+        if (s->ring_start[l + 1] > s->ring_start[l]) {
+            memcpy(&s->vertex_points[used], s->positions + (size_t)l * 3, sizeof(gdr_vec3));
+            s->vertex_local[used++] = l;
+        }
+    if (!lod_grid_build(&s->grid, s->vertex_points, used) ||
+        !lod_triangle_grid_build(&s->triangle_grid, s->positions, s->out_corners, s->out_triangle_count))
+        return -1.0f;
+    float worst = 0.0f;
+    for (uint32_t i = 0; i < s->gathered; i++) {
+        float d2;
+        uint32_t l = s->vertex_local[lod_grid_nearest(&s->grid, s->sample_points[i], &d2)], nearest;
+        float d = ring_d2(s, l, s->sample_points[i], &nearest);
+        if (d > worst)
+            nearest = lod_triangle_grid_nearest(&s->triangle_grid, s->sample_points[i], point_triangle_d2, &d);
+        s->sample_cluster[i] = s->out_cluster[nearest];
+        s->sample_d2[i] = d;
+        worst = d > worst ? d : worst;
+    }
+    return sqrtf(worst);
+}
+
+/* Distance (squared) from p to the level-0 triangles around position `position`; with `rings` 2,
+ * also to those around their corners. An upper bound of the distance from p to S0. */
+static float to_full_detail_d2(const lod_build *b, uint32_t position, gdr_vec3 p, int rings)
+{
+    float best = INFINITY;
+    const gdr_vec3 *x = b->mesh->positions;
+    for (uint32_t k = b->adjacency_start[position]; k < b->adjacency_start[position + 1]; k++) {
+        const gdr_cluster *c = &b->clusters[b->adjacency[k] >> 7];
+        const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(b->adjacency[k] & 127) * 3;
+        const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+        float d = point_triangle_d2(p, x[v[t[0]]], x[v[t[1]]], x[v[t[2]]]);
+        best = d < best ? d : best;
+        for (int j = 0; j < 3 && rings > 1; j++) {
+            uint32_t other = b->position_id[v[t[j]]];
+            if (other != position) {
+                d = to_full_detail_d2(b, other, p, 1);
+                best = d < best ? d : best;
+            }
+        }
+    }
+    return best;
+}
+
+/* Squared distance between p and the position of position id `position`. */
+static float position_d2(const lod_build *b, uint32_t position, gdr_vec3 p)
+{
+    gdr_vec3 q = b->mesh->positions[b->sample_vertex[position]];
+    float dx = q.x - p.x, dy = q.y - p.y, dz = q.z - p.z;
+    return dx * dx + dy * dy + dz * dz;
+}
+
+/* Walks over level-0 positions from `start`, to a neighbour nearer to p while there is one: the
+ * walk ends at a position nearest to p among its neighbours (on a surface, next to p's foot). */
+static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p)
+{
+    uint32_t at = start;
+    float best = position_d2(b, at, p);
+    for (;;) {
+        uint32_t from = at;
+        for (uint32_t k = b->adjacency_start[from]; k < b->adjacency_start[from + 1]; k++) {
+            const gdr_cluster *c = &b->clusters[b->adjacency[k] >> 7];
+            const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(b->adjacency[k] & 127) * 3;
+            const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+            for (int j = 0; j < 3; j++) {
+                uint32_t q = b->position_id[v[t[j]]];
+                float d = position_d2(b, q, p);
+                if (d < best) { /* strictly nearer: the walk ends */
+                    best = d;
+                    at = q;
+                }
+            }
+        }
+        if (at == from)
+            return at;
+    }
+}
+
+/* Upper bound (squared) of the distance from p to S0: the level-0 triangles around the position a
+ * walk from `start` ends at, and where that exceeds `worst`, around their corners too. *at
+ * receives where the walk ended (the next probe of the triangle starts there). */
+static float probe_d2(const lod_build *b, uint32_t *at, gdr_vec3 p, float worst)
+{
+    *at = walk_towards(b, *at, p);
+    float d = to_full_detail_d2(b, *at, p, 1);
+    float d2 = position_d2(b, *at, p);
+    d = d < d2 ? d : d2; /* the position itself is a point of S0 */
+    if (d > worst) {
+        float wider = to_full_detail_d2(b, *at, p, 2);
+        d = wider < d ? wider : d;
+    }
+    return d;
+}
+
+/* The largest probe distance over the points of a barycentric grid of n steps on triangle v, corners
+ * left out (they are level-0 vertices: distance 0); walks start at *at. */
+static float probe_triangle(const lod_build *b, uint32_t *at, const gdr_vec3 v[3], int n, float worst)
+{
+    float largest = 0.0f;
+    for (int i = 0; i <= n; i++)
+        for (int j = 0; i + j <= n; j++) {
+            if (i == n || j == n || i + j == 0)
+                continue;
+            float u = (float)i / (float)n, w = (float)j / (float)n, z = 1.0f - u - w;
+            gdr_vec3 p = {z * v[0].x + u * v[1].x + w * v[2].x, z * v[0].y + u * v[1].y + w * v[2].y,
+                          z * v[0].z + u * v[1].z + w * v[2].z};
+            float d = probe_d2(b, at, p, worst > largest ? worst : largest);
+            largest = d > largest ? d : largest;
+        }
+    return largest;
+}
+
+/* Largest distance from the simplified triangles to S0: probed at the edge midpoints and the
+ * centroid, and on a finer grid (4 steps an edge) where those come within 80% of the largest
+ * distance so far. */
+static float simplified_to_full(const lod_build *b, lod_scratch *s)
+{
+    float worst = 0.0f;
+    for (uint32_t t = 0; t < s->out_triangle_count; t++) {
+        gdr_vec3 v[3];
+        for (int k = 0; k < 3; k++)
+            v[k] = load3(s->positions + (size_t)s->out_corners[(size_t)t * 3 + k] * 3);
+        uint32_t at = b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]];
+        gdr_vec3 centroid = {(v[0].x + v[1].x + v[2].x) * (1.0f / 3.0f), (v[0].y + v[1].y + v[2].y) * (1.0f / 3.0f),
+                             (v[0].z + v[1].z + v[2].z) * (1.0f / 3.0f)};
+        float d = probe_triangle(b, &at, v, 2, worst), c = probe_d2(b, &at, centroid, worst);
+        d = c > d ? c : d;
+        if (d >= 0.64f * worst) /* squared: within 80% */
+            d = fmaxf(d, probe_triangle(b, &at, v, 4, worst));
+        worst = d > worst ? d : worst;
+    }
+    return sqrtf(worst);
+}
+
+static int farther_first(const void *x, const void *y)
+{
+    const sample_rank *a = x, *b = y;
+    if (a->d2 != b->d2)
+        return a->d2 > b->d2 ? -1 : 1;
+    return a->id < b->id ? -1 : a->id > b->id;
+}
+
+/* Keeps at most LOD_SAMPLES_PER_CLUSTER of the samples out[0 .. n): half of them the farthest from
+ * the simplified surface (where the next levels are likely to deviate most), the other half spread
+ * evenly over the rest (in the order gathered, which follows the surface). Returns the count kept. */
+static uint32_t thin_samples(lod_scratch *s, uint32_t *out, const uint32_t *index, uint32_t n)
+{
+    if (n <= LOD_SAMPLES_PER_CLUSTER) {
+        for (uint32_t i = 0; i < n; i++)
+            out[i] = s->sample_ids[index[i]];
+        return n;
+    }
+    sample_rank *rank = s->sample_order;
+    for (uint32_t i = 0; i < n; i++)
+        rank[i] = (sample_rank){.d2 = s->sample_d2[index[i]], .id = index[i]};
+    qsort(rank, n, sizeof *rank, farther_first);
+    const uint32_t far = LOD_SAMPLES_PER_CLUSTER / 2, spread = LOD_SAMPLES_PER_CLUSTER - far;
+    for (uint32_t i = far; i < n; i++) /* the rest, back in gathered order */
+        rank[i].d2 = 0.0f;
+    qsort(rank + far, n - far, sizeof *rank, farther_first);
+    uint32_t kept = 0;
+    for (uint32_t i = 0; i < far; i++)
+        out[kept++] = s->sample_ids[rank[i].id];
+    for (uint32_t j = 0; j < spread; j++)
+        out[kept++] = s->sample_ids[rank[far + (uint32_t)((uint64_t)j * (n - far) / spread)].id];
+    return kept;
+}
+
+/* The samples in order of the new cluster they pass to (thinned), into r. */
+static int hand_samples_to_clusters(lod_scratch *s, group_result *r)
+{
+    r->samples = malloc(((size_t)s->gathered + 1) * sizeof *r->samples);
+    r->cluster_sample_first = calloc((size_t)r->cluster_count + 1, sizeof *r->cluster_sample_first);
+    uint32_t *start = r->cluster_sample_first, *index = s->sample_cluster;
+    if (!r->samples || !start || !LOD_RESERVE(s, sample_index, (size_t)s->gathered + 1))
+        return 0;
+    for (uint32_t i = 0; i < s->gathered; i++)
+        start[index[i] + 1]++;
+    for (uint32_t c = 0; c < r->cluster_count; c++)
+        start[c + 1] += start[c];
+    for (uint32_t i = 0; i < s->gathered; i++) /* sample indices by cluster, in gathered order */
+        s->sample_index[start[index[i]]++] = i;
+    uint32_t kept = 0, from = 0;
+    for (uint32_t c = 0; c < r->cluster_count; c++) {
+        uint32_t end = start[c];
+        start[c] = kept;
+        kept += thin_samples(s, r->samples + kept, s->sample_index + from, end - from);
+        from = end;
+    }
+    start[r->cluster_count] = kept;
+    return 1;
+}
+
+int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, uint32_t first, uint32_t count, uint32_t local_count,
+                            group_result *r)
+{
+    if (!output_triangles(s, r, local_count) || !gather_samples(b, s, first, count))
+        return 0;
+    float to_simplified = s->gathered ? samples_to_simplified(s, local_count) : 0.0f;
+    float to_full = simplified_to_full(b, s);
+    if (to_simplified < 0.0f || to_full < 0.0f || !hand_samples_to_clusters(s, r))
+        return 0;
+    r->deviation = to_simplified > to_full ? to_simplified : to_full;
+    return 1;
+}
