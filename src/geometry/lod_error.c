@@ -321,9 +321,9 @@ static float samples_to_simplified(lod_scratch *s, uint32_t local_count)
     return sqrtf(worst);
 }
 
-/* Distance (squared) from p to the level-0 triangles around position `position`; with `rings` 2,
- * also to those around their corners. An upper bound of the distance from p to S0. */
-static float to_full_detail_d2(const lod_build *b, uint32_t position, gdr_vec3 p, int rings)
+/* Distance (squared) from p to the level-0 triangles around position `position`: an upper bound of
+ * the distance from p to S0. */
+static float to_full_detail_d2(const lod_build *b, uint32_t position, gdr_vec3 p)
 {
     float best = INFINITY;
     const gdr_vec3 *x = b->mesh->positions;
@@ -333,13 +333,6 @@ static float to_full_detail_d2(const lod_build *b, uint32_t position, gdr_vec3 p
         const uint32_t *v = gdr_lod_cluster_vertices(b, c);
         float d = point_triangle_d2(p, x[v[t[0]]], x[v[t[1]]], x[v[t[2]]]);
         best = d < best ? d : best;
-        for (int j = 0; j < 3 && rings > 1; j++) {
-            uint32_t other = b->position_id[v[t[j]]];
-            if (other != position) {
-                d = to_full_detail_d2(b, other, p, 1);
-                best = d < best ? d : best;
-            }
-        }
     }
     return best;
 }
@@ -378,25 +371,19 @@ static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p)
     }
 }
 
-/* Upper bound (squared) of the distance from p to S0: the level-0 triangles around the position a
- * walk from `start` ends at, and where that exceeds `worst`, around their corners too. *at
- * receives where the walk ended (the next probe of the triangle starts there). */
-static float probe_d2(const lod_build *b, uint32_t *at, gdr_vec3 p, float worst)
+/* Upper bound (squared) of the distance from p to S0: to the level-0 triangles around the position
+ * a walk from *at ends at (the position nearest to p among its neighbours; on a surface the
+ * triangle nearest to p is almost always among these, and where it is not the bound is only
+ * looser). *at receives where the walk ended (the next probe of the triangle starts there). */
+static float probe_d2(const lod_build *b, uint32_t *at, gdr_vec3 p)
 {
     *at = walk_towards(b, *at, p);
-    float d = to_full_detail_d2(b, *at, p, 1);
-    float d2 = position_d2(b, *at, p);
-    d = d < d2 ? d : d2; /* the position itself is a point of S0 */
-    if (d > worst) {
-        float wider = to_full_detail_d2(b, *at, p, 2);
-        d = wider < d ? wider : d;
-    }
-    return d;
+    return to_full_detail_d2(b, *at, p);
 }
 
 /* The largest probe distance over the points of a barycentric grid of n steps on triangle v, corners
  * left out (they are level-0 vertices: distance 0); walks start at *at. */
-static float probe_triangle(const lod_build *b, uint32_t *at, const gdr_vec3 v[3], int n, float worst)
+static float probe_triangle(const lod_build *b, uint32_t *at, const gdr_vec3 v[3], int n)
 {
     float largest = 0.0f;
     for (int i = 0; i <= n; i++)
@@ -406,15 +393,15 @@ static float probe_triangle(const lod_build *b, uint32_t *at, const gdr_vec3 v[3
             float u = (float)i / (float)n, w = (float)j / (float)n, z = 1.0f - u - w;
             gdr_vec3 p = {z * v[0].x + u * v[1].x + w * v[2].x, z * v[0].y + u * v[1].y + w * v[2].y,
                           z * v[0].z + u * v[1].z + w * v[2].z};
-            float d = probe_d2(b, at, p, worst > largest ? worst : largest);
+            float d = probe_d2(b, at, p);
             largest = d > largest ? d : largest;
         }
     return largest;
 }
 
-/* Largest distance from the simplified triangles to S0: probed at the edge midpoints and the
- * centroid, and on a finer grid (4 steps an edge) where those come within 80% of the largest
- * distance so far. */
+/* Largest distance from the simplified triangles to S0: probed on a barycentric grid of 3 steps an
+ * edge (6 points on the edges, the centroid), and of 6 steps where those come within 90% of the
+ * largest distance so far (the deviation of a simplified triangle peaks inside it or on an edge). */
 static float simplified_to_full(const lod_build *b, lod_scratch *s)
 {
     float worst = 0.0f;
@@ -423,12 +410,9 @@ static float simplified_to_full(const lod_build *b, lod_scratch *s)
         for (int k = 0; k < 3; k++)
             v[k] = load3(s->positions + (size_t)s->out_corners[(size_t)t * 3 + k] * 3);
         uint32_t at = b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]];
-        gdr_vec3 centroid = {(v[0].x + v[1].x + v[2].x) * (1.0f / 3.0f), (v[0].y + v[1].y + v[2].y) * (1.0f / 3.0f),
-                             (v[0].z + v[1].z + v[2].z) * (1.0f / 3.0f)};
-        float d = probe_triangle(b, &at, v, 2, worst), c = probe_d2(b, &at, centroid, worst);
-        d = c > d ? c : d;
-        if (d >= 0.64f * worst) /* squared: within 80% */
-            d = fmaxf(d, probe_triangle(b, &at, v, 4, worst));
+        float d = probe_triangle(b, &at, v, 3);
+        if (d >= 0.81f * worst) /* squared: within 90% */
+            d = fmaxf(d, probe_triangle(b, &at, v, 6));
         worst = d > worst ? d : worst;
     }
     return sqrtf(worst);

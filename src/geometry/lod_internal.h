@@ -39,7 +39,7 @@ typedef struct lod_progress {
 } lod_progress;
 
 /* Samples of the full-detail surface a new cluster keeps (lod_error.c). */
-#define LOD_SAMPLES_PER_CLUSTER 64u
+#define LOD_SAMPLES_PER_CLUSTER 100000u
 
 typedef struct sample_rank {
     float d2;

@@ -228,7 +228,7 @@ void gdr_cluster_compute_bounds(gdr_cluster *c, const uint32_t *vertices, const 
 /* Meshes are split into chunks of this many triangles, built independently (in parallel when
  * asked) and concatenated in order: a fixed size, so the clusters do not depend on the thread
  * count. Each chunk ends with at most one partly filled cluster. */
-#define MESHLET_CHUNK_TRIANGLES 65536u
+#define MESHLET_CHUNK_TRIANGLES 32768u
 
 /* The clusters of one chunk: offsets relative to its own arrays, vertices as mesh indices. */
 typedef struct chunk_result {
@@ -273,6 +273,11 @@ static gdr_status meshlets_of(const gdr_mesh *mesh, const gdr_meshlet_options *o
     r->vertex_count = last->vertex_offset + last->vertex_count;
     r->triangle_bytes = last->triangle_offset + (last->triangle_count * 3 + 3) / 4 * 4;
     r->cluster_count = (uint32_t)count;
+    /* meshoptimizer wanted room for the worst case: keep only what was used. */
+    uint32_t *vertices = realloc(r->vertices, (size_t)r->vertex_count * sizeof *vertices);
+    uint8_t *triangles = realloc(r->triangles, r->triangle_bytes);
+    r->vertices = vertices ? vertices : r->vertices;
+    r->triangles = triangles ? triangles : r->triangles;
     if (local_to_mesh)
         for (uint32_t i = 0; i < r->vertex_count; i++)
             r->vertices[i] = local_to_mesh[r->vertices[i]];
@@ -300,26 +305,31 @@ static void chunk_task(void *user, uint32_t c, uint32_t worker)
     const gdr_mesh *mesh = job->mesh;
     size_t first = (size_t)c * MESHLET_CHUNK_TRIANGLES * 3, n = mesh->index_count - first;
     n = n > (size_t)MESHLET_CHUNK_TRIANGLES * 3 ? (size_t)MESHLET_CHUNK_TRIANGLES * 3 : n;
-    uint32_t *map = job->maps[worker];
-    uint32_t *local = malloc(n * sizeof *local), *local_to_mesh = malloc(n * sizeof *local_to_mesh);
-    float *positions = malloc(n * 3 * sizeof *positions);
+    uint32_t *map = job->maps[worker], count = 0;
+    uint32_t *local = malloc(n * sizeof *local), *local_to_mesh = NULL;
+    float *positions = NULL;
     job->results[c].status = GDR_ERROR_OUT_OF_MEMORY;
-    if (local && local_to_mesh && positions) {
-        uint32_t count = 0;
-        for (size_t i = 0; i < n; i++) {
-            uint32_t v = mesh->indices[first + i];
-            if (map[v] == UINT32_MAX) {
-                map[v] = count;
-                memcpy(positions + (size_t)count * 3, &mesh->positions[v], sizeof(float) * 3);
-                local_to_mesh[count++] = v;
-            }
-            local[i] = map[v];
+    if (!local)
+        return;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t v = mesh->indices[first + i];
+        if (map[v] == UINT32_MAX)
+            map[v] = count++;
+        local[i] = map[v];
+    }
+    local_to_mesh = malloc((size_t)count * sizeof *local_to_mesh);
+    positions = malloc((size_t)count * 3 * sizeof *positions);
+    for (size_t i = 0; i < n; i++) {
+        uint32_t v = mesh->indices[first + i];
+        map[v] = UINT32_MAX;
+        if (local_to_mesh && positions) {
+            local_to_mesh[local[i]] = v;
+            memcpy(positions + (size_t)local[i] * 3, &mesh->positions[v], sizeof(float) * 3);
         }
-        for (uint32_t i = 0; i < count; i++)
-            map[local_to_mesh[i]] = UINT32_MAX;
+    }
+    if (local_to_mesh && positions)
         job->results[c].status = meshlets_of(mesh, job->o, local, n, positions, count, local_to_mesh,
                                              &job->results[c]);
-    }
     free(local);
     free(local_to_mesh);
     free(positions);
