@@ -99,10 +99,10 @@ static gdr_status bench_size(gdr_vk_context *ctx, uint32_t width, uint32_t heigh
     double *ms = calloc(runs, sizeof *ms);
     gdr_status status = ms ? GDR_OK : gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "out of memory");
     if (status == GDR_OK)
-        status = gdr_vk_image_create(&allocator, width, height, VK_FORMAT_D32_SFLOAT,
-                                     VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
-                                         VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                                     VK_IMAGE_ASPECT_DEPTH_BIT, &depth, err);
+        status = gdr_vk_image_create(&allocator, &(gdr_vk_image_desc){.width = width, .height = height, .format = VK_FORMAT_D32_SFLOAT,
+                                  .usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                                           VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                                  .aspect = VK_IMAGE_ASPECT_DEPTH_BIT}, &depth, err);
     if (status == GDR_OK)
         status = gdr_vk_buffer_create(&allocator, (VkDeviceSize)width * height * sizeof(float),
                                       VK_BUFFER_USAGE_TRANSFER_SRC_BIT, GDR_VK_BUFFER_UPLOAD, &upload, err);

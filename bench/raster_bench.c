@@ -227,16 +227,16 @@ static gdr_status run_field(const options *o, float size_px, field_result *out, 
         status = render(o, r, frame, GDR_RASTER_HW, 0.0f, &stats, err);
     }
     if (status == GDR_OK) {
-        out->hw_ms = stats.raster_hw_ms;
-        out->cull_ms = stats.raster_cull_ms;
-        out->resolve_ms = stats.raster_resolve_ms;
+        out->hw_ms = stats.raster.hw_ms;
+        out->cull_ms = stats.raster.cull_ms;
+        out->resolve_ms = stats.raster.resolve_ms;
         status = render(o, r, frame, GDR_RASTER_SW, 0.0f, &stats, err);
     }
     if (status == GDR_OK) {
-        out->sw_ms = stats.raster_sw_ms;
-        if (stats.raster_hw_clusters > 0)
+        out->sw_ms = stats.raster.sw_ms;
+        if (stats.raster.hw_clusters > 0)
             fprintf(stderr, "raster_bench: %u clusters of the %g px field went to the mesh shaders in sw mode "
-                            "(their spheres leave the guard band)\n", stats.raster_hw_clusters, (double)size_px);
+                            "(their spheres leave the guard band)\n", stats.raster.hw_clusters, (double)size_px);
     }
     gdr_renderer_destroy(r);
     gdr_scene_destroy(scene);
@@ -264,9 +264,9 @@ static gdr_status run_scene(const options *o, scene_result *results, uint32_t *c
         status = render(o, r, frame, raster, threshold, &stats, err);
         if (status == GDR_OK)
             results[(*count)++] = (scene_result){gdr_raster_name(raster), threshold, stats.gpu_ms_per_frame,
-                                                 stats.raster_cull_ms, stats.raster_hw_ms, stats.raster_sw_ms, stats.raster_resolve_ms,
-                                                 stats.raster_sw_clusters, stats.raster_hw_clusters,
-                                                 stats.raster_sw_triangles, stats.raster_hw_triangles};
+                                                 stats.raster.cull_ms, stats.raster.hw_ms, stats.raster.sw_ms, stats.raster.resolve_ms,
+                                                 stats.raster.sw_clusters, stats.raster.hw_clusters,
+                                                 stats.raster.sw_triangles, stats.raster.hw_triangles};
     }
     gdr_renderer_destroy(r);
     gdr_scene_destroy(scene);

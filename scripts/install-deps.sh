@@ -7,7 +7,7 @@ set -eu
 PACKAGES="build-essential cmake pkg-config clang \
 libvulkan-dev glslc vulkan-validationlayers \
 libmeshoptimizer-dev libmetis-dev libcjson-dev libstb-dev libzstd-dev \
-libxxhash-dev libclang-rt-14-dev assimp-testmodels"
+libxxhash-dev libclang-rt-14-dev assimp-testmodels valgrind"
 BACKPORTS_PACKAGES="mesa-vulkan-drivers"
 
 missing=""

@@ -109,11 +109,24 @@ GDR_API uint32_t gdr_cull_scene_node_count(const gdr_cull_scene *scene);
  * when many objects have moved). Not concurrent with gdr_cull_execute on the same scene. */
 GDR_API gdr_status gdr_cull_scene_update(gdr_cull_scene *scene, uint32_t first, uint32_t count,
                                          const gdr_cull_object *objects, gdr_error *err);
-/* Bounds of every instance of a gdr_scene: the world box of the mesh's transformed corners, and
+/* What the bounds of a mesh's instances are made from: its box in mesh space (the range of its
+ * vertices; lo > hi for a mesh without vertices) and its bounding sphere. Computed once per mesh
+ * (one pass over its vertices) by gdr_cull_mesh_bounds_of, so that each instance costs O(1). */
+typedef struct gdr_cull_mesh_bounds {
+    gdr_vec3 lo, hi;
+    gdr_vec4 sphere; /* gdr_mesh.bounds: centre xyz, radius w */
+} gdr_cull_mesh_bounds;
+
+GDR_API gdr_cull_mesh_bounds gdr_cull_mesh_bounds_of(const gdr_mesh *mesh);
+/* The bounds of one instance of a mesh: the world box of the mesh box's transformed corners, and
  * the smaller of two spheres about the box centre that hold the mesh (the box's own, and one
- * around the transformed mesh sphere). Fills objects[0, scene->instance_count); flags and
- * limits are zero. */
-GDR_API void gdr_cull_objects_from_scene(gdr_cull_object *objects, const gdr_scene *scene);
+ * around the transformed mesh sphere). An empty mesh gives an invalid object (radius -1): nothing
+ * to draw. Flags and limits are zero. */
+GDR_API gdr_cull_object gdr_cull_object_from_mesh_bounds(const gdr_cull_mesh_bounds *bounds, const gdr_mat4 *transform);
+/* gdr_cull_object_from_mesh_bounds for every instance of a gdr_scene, each mesh's bounds computed
+ * once: O(vertices + instances). Fills objects[0, scene->instance_count); an instance of a mesh
+ * that does not exist gets an invalid object. Fails only when out of memory. */
+GDR_API gdr_status gdr_cull_objects_from_scene(gdr_cull_object *objects, const gdr_scene *scene, gdr_error *err);
 
 /* --- precomputed visibility (declared early: the view refers to it) ------------------------ */
 

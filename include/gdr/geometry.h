@@ -12,6 +12,7 @@
 #ifndef GDR_GEOMETRY_H
 #define GDR_GEOMETRY_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "gdr/core.h"
@@ -60,6 +61,28 @@ typedef struct gdr_cluster_group {
     uint32_t cluster_count;
 } gdr_cluster_group;
 
+/* One node of a mesh's LOD hierarchy (below, "LOD hierarchy"). The GPU reads the same bytes as
+ * GdrGpuLodNode (src/shaders/shared/gpu_types.h; the layouts are checked to agree). */
+typedef struct gdr_lod_node {
+    gdr_vec4 sphere;         /* mesh space; contains the sphere of every group, refined group and
+                                cluster below the node */
+    float max_error;         /* the largest error of a group below (INFINITY when the root group is) */
+    float min_refined_error; /* the smallest error of a refined group of a cluster below; 0 when a
+                                cluster below has none (level 0) */
+    uint32_t first;          /* inner node: its first child (children are [first, first + count));
+                                leaf: its first cluster (clusters [first, first + count)) */
+    uint32_t count;          /* inner node: 1 .. GDR_LOD_NODE_MAX_CHILDREN; leaf: >= 1 */
+    uint32_t group;          /* leaf: the group whose clusters it names, GDR_NO_INDEX without a DAG;
+                                inner node: GDR_NO_INDEX */
+    uint32_t flags;          /* GDR_LOD_NODE_LEAF */
+    uint32_t reserved[2];    /* zero */
+} gdr_lod_node;
+
+#define GDR_LOD_NODE_LEAF 1u
+#define GDR_LOD_NODE_MAX_CHILDREN 8u
+#define GDR_LOD_NODE_MAX_LEVELS 32u
+#define GDR_LOD_LEAF_CLUSTERS_NO_DAG 4u /* clusters per leaf of a mesh without a DAG */
+
 typedef struct gdr_mesh_clusters {
     gdr_cluster *clusters;
     uint32_t cluster_count;
@@ -71,6 +94,10 @@ typedef struct gdr_mesh_clusters {
     gdr_cluster_group *groups;     /* empty (NULL, 0) until the LOD DAG is built */
     uint32_t group_count;
     uint32_t dag_depth;            /* number of DAG levels above level 0; 0 without a DAG */
+    gdr_lod_node *lod_nodes;       /* the hierarchy over the clusters (below, "LOD hierarchy"); empty
+                                      (NULL, 0) only where a build failed */
+    uint32_t lod_node_count;
+    uint32_t lod_node_levels;      /* levels of lod_nodes: 1 for a root alone, at most GDR_LOD_NODE_MAX_LEVELS */
 } gdr_mesh_clusters;
 
 /* Options of the meshlet builder; zero-initialise, every field has a default. */
@@ -201,6 +228,45 @@ GDR_API gdr_status gdr_mesh_build_lod_dag(gdr_mesh *mesh, const gdr_lod_options 
  * ("meshes[3]: mesh 'rock': ...") and no mesh keeps a DAG from this call. */
 GDR_API gdr_status gdr_scene_build_lod(gdr_scene *scene, const gdr_lod_options *options, gdr_lod_stats *stats,
                                        gdr_error *err);
+
+/* --- LOD hierarchy -----------------------------------------------------------------------------
+ *
+ * A bounding-volume hierarchy over the DAG's groups, so that a traversal from the root visits only
+ * the parts of a mesh where the cut can lie (docs/GEOMETRY.md, "LOD hierarchy"). The leaves are
+ * the groups, one leaf per group, naming the group's clusters (contiguous: see the DAG above);
+ * level 0 is covered by the groups of depth 0, whose clusters have no refined group. A mesh
+ * without a DAG gets leaves of up to GDR_LOD_LEAF_CLUSTERS_NO_DAG consecutive clusters, without a
+ * group (max_error INFINITY, min_refined_error 0: the LOD test never skips them, only frustum and
+ * occlusion tests can). Each DAG depth gets its own subtree (the groups of one depth have errors of
+ * one scale, so a node's error bounds stay tight), built top-down by splitting the groups at the
+ * median of their centres along the longest axis, three times per node: up to
+ * GDR_LOD_NODE_MAX_CHILDREN children. The subtrees' roots, deepest first, are joined under a top
+ * tree. Nodes are stored breadth first: the root is node 0, every node's children are contiguous
+ * and come after it, and each level of the tree is a contiguous range, so a GPU can traverse level
+ * by level or from a work queue.
+ *
+ * A node may be skipped (no cluster below it is in the cut) when gdr_lod_node_may_draw
+ * (src/shaders/shared/lod_math.h) says so: either every group below passes (its max_error, seen
+ * from the nearest point of its sphere, projects within the threshold) or no refined group below
+ * passes (min_refined_error, seen from the farthest point, projects above it). The proof that this
+ * never skips a cluster the flat cut draws, with float rounding, is in docs/GEOMETRY.md.
+ *
+ * gdr_meshlets_build and gdr_mesh_build_lod_dag build the hierarchy of what they build (and so the
+ * scene-wide builds and gdr_cache_read), so clusters come with their hierarchy. */
+
+/* (Re)builds clusters->lod_nodes over clusters' groups (or over its clusters without a DAG).
+ * Needs the DAG's contract above (or clusters without groups). Fails only when out of memory, or
+ * with more than GDR_LOD_NODE_MAX_LEVELS levels (never for 32-bit counts); on failure the
+ * hierarchy is empty. */
+GDR_API gdr_status gdr_mesh_clusters_build_hierarchy(gdr_mesh_clusters *clusters, gdr_error *err);
+
+/* Checks that clusters->lod_nodes is a hierarchy of the contract above: a tree stored breadth first
+ * whose leaves name each group exactly once (each cluster exactly once without a DAG), whose
+ * spheres contain their children's spheres (and a leaf's the spheres of its group, its clusters and
+ * their refined groups), and whose error bounds contain their children's (in double precision on
+ * the stored floats). On a violation writes what and where
+ * to `what` (at most what_size bytes) and returns 0. */
+GDR_API int gdr_mesh_clusters_check_hierarchy(const gdr_mesh_clusters *clusters, char *what, size_t what_size);
 
 #ifdef __cplusplus
 }

@@ -7,6 +7,7 @@
 #define GDR_RENDERER_H
 
 #include <stdbool.h>
+#include <stdio.h>
 #include <stdint.h>
 
 #include "gdr/core.h"
@@ -128,6 +129,57 @@ typedef struct gdr_pass_timing {
     double gpu_ms; /* mean over the frames */
 } gdr_pass_timing;
 
+/* Rasterisation: the path that rasterised (never DEFAULT; FORWARD off the mesh pipeline) and why;
+ * the threshold HYBRID used; the last frame's visible clusters and their triangles (before
+ * back-face culling) per rasteriser; the GPU time of the cluster cull (the per-cluster tests and
+ * binning, with the launches), of the mesh-shader pass, of the compute rasteriser and of the
+ * resolve, means over the frames (the four are part of the "draw" passes). */
+typedef struct gdr_raster_stats {
+    gdr_raster mode;
+    char reason[128];
+    float sw_threshold_px;
+    uint32_t sw_clusters, hw_clusters;
+    uint64_t sw_triangles, hw_triangles;
+    uint32_t overflow; /* clusters lost for want of room in the list (0 below 2^25) or beyond the
+                          device's mesh launch limit (0 below 2^22) */
+    double cull_ms, hw_ms, sw_ms, resolve_ms;
+} gdr_raster_stats;
+
+/* The LOD cut (mesh pipeline), last frame: whether it was applied, the clusters it left out, and
+ * the clusters and triangles drawn per DAG depth (the last entry: that depth or deeper; triangles
+ * before triangle culling). */
+typedef struct gdr_lod_stats_frame {
+    bool applied;
+    uint32_t meshlets_culled;
+    uint32_t depth_count; /* entries used below: deepest depth drawn + 1 */
+    uint32_t clusters_per_depth[GDR_LOD_STATS_DEPTH_COUNT];
+    uint64_t triangles_per_depth[GDR_LOD_STATS_DEPTH_COUNT];
+} gdr_lod_stats_frame;
+
+/* Occlusion culling, last frame, per phase (early: what was visible last frame; late: the rest of
+ * what is in the frustum, against this frame's pyramid). Clusters: mesh pipeline. */
+typedef struct gdr_occlusion_stats {
+    bool applied;
+    uint32_t instances_early_drawn;
+    uint32_t instances_early_occluded; /* visible last frame, hidden behind last frame's pyramid */
+    uint32_t instances_late_tested;
+    uint32_t instances_late_occluded;
+    uint32_t instances_late_drawn;     /* not drawn early */
+    uint32_t meshlets_early_drawn;
+    uint32_t meshlets_late_tested;
+    uint32_t meshlets_late_occluded;
+    uint32_t meshlets_late_drawn;
+} gdr_occlusion_stats;
+
+/* GPU memory: what the renderer holds from the device (whole blocks), and of what it placed in
+ * them, the scene's part (geometry, clusters, instances, occlusion history) and the rest (render
+ * targets, frame slots, visibility buffer, read-backs). */
+typedef struct gdr_memory_stats {
+    uint64_t device_bytes;
+    uint64_t scene_bytes;
+    uint64_t frame_bytes;
+} gdr_memory_stats;
+
 typedef struct gdr_frame_stats {
     uint32_t frames;
     uint32_t instances_total;
@@ -161,39 +213,10 @@ typedef struct gdr_frame_stats {
     uint32_t task_workgroups;
     uint32_t task_overflow;               /* task commands lost for want of room: always 0 (sized from the scene) */
     uint32_t overdraw_max;                /* overdraw view: the most fragments one pixel received */
-    /* Rasterisation (issue 8): the path that rasterised (never DEFAULT; FORWARD off the mesh
-     * pipeline) and why; the threshold HYBRID used; the last frame's visible clusters and their
-     * triangles (before back-face culling) per rasteriser; the GPU time of the cluster cull (the
-     * per-cluster tests and binning, with the launches), of the mesh-shader pass, of the compute
-     * rasteriser and of the resolve, means over the frames (the four are part of the "draw" pass). */
-    gdr_raster raster;
-    char raster_reason[128];
-    float sw_threshold_px;
-    uint32_t raster_sw_clusters, raster_hw_clusters;
-    uint64_t raster_sw_triangles, raster_hw_triangles;
-    uint32_t raster_overflow;             /* clusters lost for want of room in the list (0 below 2^25) or
-                                             beyond the device's mesh launch limit (0 below 2^22) */
-    double raster_cull_ms, raster_hw_ms, raster_sw_ms, raster_resolve_ms;
-    /* The LOD cut (mesh pipeline), last frame: whether it was applied, the clusters it left out,
-     * and the clusters and triangles drawn per DAG depth (the last entry: that depth or deeper;
-     * triangles before triangle culling). */
-    bool lod_applied;
-    uint32_t meshlets_lod_culled;
-    uint32_t lod_depth_count;             /* entries used below: deepest depth drawn + 1 */
-    uint32_t lod_clusters_per_depth[GDR_LOD_STATS_DEPTH_COUNT];
-    uint64_t lod_triangles_per_depth[GDR_LOD_STATS_DEPTH_COUNT];
-    /* Occlusion culling, last frame, per phase (early: what was visible last frame; late: the
-     * rest of what is in the frustum, against this frame's pyramid). Clusters: mesh pipeline. */
-    bool occlusion_applied;
-    uint32_t instances_early_drawn;
-    uint32_t instances_early_occluded; /* visible last frame, hidden behind last frame's pyramid */
-    uint32_t instances_late_tested;
-    uint32_t instances_late_occluded;
-    uint32_t instances_late_drawn;     /* not drawn early */
-    uint32_t meshlets_early_drawn;
-    uint32_t meshlets_late_tested;
-    uint32_t meshlets_late_occluded;
-    uint32_t meshlets_late_drawn;
+    gdr_raster_stats raster;
+    gdr_lod_stats_frame lod;
+    gdr_occlusion_stats occlusion;
+    gdr_memory_stats memory;
 } gdr_frame_stats;
 
 GDR_API gdr_status gdr_renderer_create(const gdr_renderer_desc *desc, gdr_renderer **out, gdr_error *err);
@@ -237,6 +260,11 @@ GDR_API gdr_status gdr_renderer_read_visible_meshlets(gdr_renderer *renderer, gd
                                                       uint32_t capacity, uint32_t *count, gdr_error *err);
 
 GDR_API void gdr_renderer_size(const gdr_renderer *renderer, uint32_t *width, uint32_t *height);
+
+/* Writes, as Markdown, the passes of the frame of every configuration (pipeline, raster, occlusion
+ * culling, overdraw view): per pass the resources it reads and writes and the barrier derived
+ * before it. docs/PIPELINE.md holds this output (`gdr info --passes`). Needs no device. */
+GDR_API void gdr_describe_frame_passes(FILE *out);
 
 /* Writes RGBA8 pixels as a PNG through a temporary file and a rename: never a half-written file. */
 GDR_API gdr_status gdr_write_png(const char *path, const uint8_t *rgba, uint32_t width, uint32_t height,

@@ -79,37 +79,55 @@ gdr_status gdr_cull_scene_update(gdr_cull_scene *s, uint32_t first, uint32_t cou
     return GDR_OK;
 }
 
-void gdr_cull_objects_from_scene(gdr_cull_object *objects, const gdr_scene *scene)
+gdr_cull_mesh_bounds gdr_cull_mesh_bounds_of(const gdr_mesh *mesh)
 {
+    gdr_cull_mesh_bounds b = {.lo = {INFINITY, INFINITY, INFINITY}, .hi = {-INFINITY, -INFINITY, -INFINITY},
+                              .sphere = mesh->bounds};
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        gdr_vec3 p = mesh->positions[v];
+        b.lo = (gdr_vec3){fminf(b.lo.x, p.x), fminf(b.lo.y, p.y), fminf(b.lo.z, p.z)};
+        b.hi = (gdr_vec3){fmaxf(b.hi.x, p.x), fmaxf(b.hi.y, p.y), fmaxf(b.hi.z, p.z)};
+    }
+    return b;
+}
+
+gdr_cull_object gdr_cull_object_from_mesh_bounds(const gdr_cull_mesh_bounds *b, const gdr_mat4 *transform)
+{
+    gdr_cull_object o = {0};
+    if (!(b->lo.x <= b->hi.x)) {
+        o.radius = -1.0f; /* invalid: nothing to draw */
+        return o;
+    }
+    gdr_vec3 wlo = {INFINITY, INFINITY, INFINITY}, whi = {-INFINITY, -INFINITY, -INFINITY};
+    for (int c = 0; c < 8; c++) {
+        gdr_vec3 corner = {(c & 1) ? b->hi.x : b->lo.x, (c & 2) ? b->hi.y : b->lo.y, (c & 4) ? b->hi.z : b->lo.z};
+        gdr_vec3 p = gdr_mat4_transform_point(*transform, corner);
+        wlo = (gdr_vec3){fminf(wlo.x, p.x), fminf(wlo.y, p.y), fminf(wlo.z, p.z)};
+        whi = (gdr_vec3){fmaxf(whi.x, p.x), fmaxf(whi.y, p.y), fmaxf(whi.z, p.z)};
+    }
+    o.center = gdr_vec3_scale(gdr_vec3_add(wlo, whi), 0.5f);
+    o.extent = gdr_vec3_scale(gdr_vec3_sub(whi, wlo), 0.5f);
+    gdr_vec3 sphere_center = gdr_mat4_transform_point(*transform, (gdr_vec3){b->sphere.x, b->sphere.y, b->sphere.z});
+    float sphere_radius = b->sphere.w * gdr_mat4_max_axis_scale(*transform);
+    float around_sphere = gdr_vec3_length(gdr_vec3_sub(sphere_center, o.center)) + sphere_radius;
+    o.radius = fminf(gdr_vec3_length(o.extent), around_sphere);
+    return o;
+}
+
+gdr_status gdr_cull_objects_from_scene(gdr_cull_object *objects, const gdr_scene *scene, gdr_error *err)
+{
+    gdr_cull_mesh_bounds *meshes = malloc(sizeof *meshes * (scene->mesh_count ? scene->mesh_count : 1));
+    if (!meshes)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "cull objects: out of memory for %u meshes",
+                             scene->mesh_count);
+    for (uint32_t m = 0; m < scene->mesh_count; m++)
+        meshes[m] = gdr_cull_mesh_bounds_of(&scene->meshes[m]);
+    const gdr_cull_mesh_bounds missing = {.lo = {1, 1, 1}, .hi = {0, 0, 0}}; /* empty: an invalid object */
     for (uint32_t i = 0; i < scene->instance_count; i++) {
         const gdr_instance *inst = &scene->instances[i];
-        gdr_cull_object o = {0};
-        if (inst->mesh >= scene->mesh_count || scene->meshes[inst->mesh].vertex_count == 0) {
-            o.radius = -1.0f; /* invalid: nothing to draw */
-            objects[i] = o;
-            continue;
-        }
-        const gdr_mesh *mesh = &scene->meshes[inst->mesh];
-        gdr_vec3 lo = mesh->positions[0], hi = mesh->positions[0];
-        for (uint32_t v = 1; v < mesh->vertex_count; v++) {
-            gdr_vec3 p = mesh->positions[v];
-            lo = (gdr_vec3){fminf(lo.x, p.x), fminf(lo.y, p.y), fminf(lo.z, p.z)};
-            hi = (gdr_vec3){fmaxf(hi.x, p.x), fmaxf(hi.y, p.y), fmaxf(hi.z, p.z)};
-        }
-        gdr_vec3 wlo = {INFINITY, INFINITY, INFINITY}, whi = {-INFINITY, -INFINITY, -INFINITY};
-        for (int c = 0; c < 8; c++) {
-            gdr_vec3 corner = {(c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z};
-            gdr_vec3 p = gdr_mat4_transform_point(inst->transform, corner);
-            wlo = (gdr_vec3){fminf(wlo.x, p.x), fminf(wlo.y, p.y), fminf(wlo.z, p.z)};
-            whi = (gdr_vec3){fmaxf(whi.x, p.x), fmaxf(whi.y, p.y), fmaxf(whi.z, p.z)};
-        }
-        o.center = gdr_vec3_scale(gdr_vec3_add(wlo, whi), 0.5f);
-        o.extent = gdr_vec3_scale(gdr_vec3_sub(whi, wlo), 0.5f);
-        gdr_vec3 sphere_center = gdr_mat4_transform_point(inst->transform,
-                                                          (gdr_vec3){mesh->bounds.x, mesh->bounds.y, mesh->bounds.z});
-        float sphere_radius = mesh->bounds.w * gdr_mat4_max_axis_scale(inst->transform);
-        float around_sphere = gdr_vec3_length(gdr_vec3_sub(sphere_center, o.center)) + sphere_radius;
-        o.radius = fminf(gdr_vec3_length(o.extent), around_sphere);
-        objects[i] = o;
+        objects[i] = gdr_cull_object_from_mesh_bounds(inst->mesh < scene->mesh_count ? &meshes[inst->mesh] : &missing,
+                                                      &inst->transform);
     }
+    free(meshes);
+    return GDR_OK;
 }

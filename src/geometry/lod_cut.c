@@ -3,6 +3,8 @@
 
 #include <math.h>
 
+#include <string.h>
+
 #include "gdr/scene.h"
 
 float gdr_lod_projection_scale(const gdr_lod_view *view)
@@ -20,15 +22,64 @@ bool gdr_lod_group_passes(const gdr_mesh_clusters *clusters, uint32_t group, con
     return e <= view->threshold;
 }
 
+static uint32_t select_cluster(const gdr_mesh_clusters *clusters, uint32_t i, const gdr_lod_view *view,
+                               uint8_t *selected)
+{
+    const gdr_cluster *c = &clusters->clusters[i];
+    bool refined = c->refined_group == GDR_NO_INDEX || gdr_lod_group_passes(clusters, c->refined_group, view);
+    bool group = c->group != GDR_NO_INDEX && gdr_lod_group_passes(clusters, c->group, view);
+    selected[i] = gdr_lod_cluster_drawn(refined, group);
+    return selected[i];
+}
+
 uint32_t gdr_lod_cut_select(const gdr_mesh_clusters *clusters, const gdr_lod_view *view, uint8_t *selected)
 {
     uint32_t count = 0;
-    for (uint32_t i = 0; i < clusters->cluster_count; i++) {
-        const gdr_cluster *c = &clusters->clusters[i];
-        bool refined = c->refined_group == GDR_NO_INDEX || gdr_lod_group_passes(clusters, c->refined_group, view);
-        bool group = c->group != GDR_NO_INDEX && gdr_lod_group_passes(clusters, c->group, view);
-        selected[i] = gdr_lod_cluster_drawn(refined, group);
-        count += selected[i];
+    for (uint32_t i = 0; i < clusters->cluster_count; i++)
+        count += select_cluster(clusters, i, view, selected);
+    return count;
+}
+
+static bool node_may_draw(const gdr_lod_node *n, const gdr_lod_view *view)
+{
+    const float *m = view->transform.m;
+    gdr_vec3 c0 = {m[0], m[1], m[2]}, c1 = {m[4], m[5], m[6]}, c2 = {m[8], m[9], m[10]}, c3 = {m[12], m[13], m[14]};
+    return gdr_lod_node_may_draw(n->sphere, n->max_error, n->min_refined_error, c0, c1, c2, c3, view->camera_position,
+                                 view->znear, gdr_lod_projection_scale(view), view->threshold);
+}
+
+uint32_t gdr_lod_cut_select_hierarchical(const gdr_mesh_clusters *clusters, const gdr_lod_view *view,
+                                         uint8_t *selected, gdr_lod_traversal_stats *stats)
+{
+    if (clusters->lod_node_count == 0) {
+        if (stats)
+            stats->clusters_tested += clusters->cluster_count;
+        return gdr_lod_cut_select(clusters, view, selected);
+    }
+    memset(selected, 0, clusters->cluster_count);
+    /* Depth first; a node's children wait on the stack: at most (MAX_CHILDREN - 1) per level. */
+    uint32_t stack[GDR_LOD_NODE_MAX_CHILDREN * GDR_LOD_NODE_MAX_LEVELS], top = 0, count = 0;
+    gdr_lod_traversal_stats local = {0};
+    stack[top++] = 0;
+    while (top > 0) {
+        const gdr_lod_node *n = &clusters->lod_nodes[stack[--top]];
+        local.nodes_tested++;
+        if (!node_may_draw(n, view))
+            continue;
+        if (!(n->flags & GDR_LOD_NODE_LEAF)) {
+            for (uint32_t k = n->count; k-- > 0;)
+                stack[top++] = n->first + k;
+            continue;
+        }
+        local.leaves_accepted++;
+        local.clusters_tested += n->count;
+        for (uint32_t i = n->first; i < n->first + n->count; i++)
+            count += select_cluster(clusters, i, view, selected);
+    }
+    if (stats) {
+        stats->nodes_tested += local.nodes_tested;
+        stats->leaves_accepted += local.leaves_accepted;
+        stats->clusters_tested += local.clusters_tested;
     }
     return count;
 }

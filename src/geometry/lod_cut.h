@@ -32,6 +32,20 @@ bool gdr_lod_group_passes(const gdr_mesh_clusters *clusters, uint32_t group, con
  * Returns the number of clusters selected. */
 uint32_t gdr_lod_cut_select(const gdr_mesh_clusters *clusters, const gdr_lod_view *view, uint8_t *selected);
 
+/* What a hierarchical cut did: the work a traversal of the LOD hierarchy saves. */
+typedef struct gdr_lod_traversal_stats {
+    uint64_t nodes_tested;    /* nodes whose test ran (the root and the children of nodes that passed) */
+    uint64_t leaves_accepted; /* leaves that passed: their clusters were tested */
+    uint64_t clusters_tested; /* clusters of those leaves, each tested by the cut rule */
+} gdr_lod_traversal_stats;
+
+/* The same cut as gdr_lod_cut_select (the same bytes in `selected`, cluster_count of them), found
+ * by walking clusters->lod_nodes from the root with gdr_lod_node_may_draw (the test a GPU
+ * traversal uses) and testing only the clusters of the leaves reached. A mesh without a hierarchy
+ * falls back to the flat cut (every cluster tested). stats (may be NULL) are added to. */
+uint32_t gdr_lod_cut_select_hierarchical(const gdr_mesh_clusters *clusters, const gdr_lod_view *view,
+                                         uint8_t *selected, gdr_lod_traversal_stats *stats);
+
 /* The discrete debug cut at DAG depth N (gdr/geometry.h): the same rule with
  * passes(g) = (depth(g) < depth and g is not the root). */
 uint32_t gdr_lod_cut_select_depth(const gdr_mesh_clusters *clusters, uint32_t depth, uint8_t *selected);

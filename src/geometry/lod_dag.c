@@ -284,6 +284,9 @@ static void truncate_to_level0(gdr_mesh_clusters *c)
     free(c->groups);
     c->groups = NULL;
     c->group_count = 0;
+    free(c->lod_nodes); /* the hierarchy of what was there; rebuilt by build_one */
+    c->lod_nodes = NULL;
+    c->lod_node_count = c->lod_node_levels = 0;
     c->dag_depth = 0;
 }
 
@@ -581,6 +584,10 @@ static gdr_status build_one(gdr_mesh *mesh, const gdr_lod_options *o, gdr_thread
     lod_build b = {.mesh = mesh, .opt = *o, .pool = pool, .worker_base = worker, .progress = progress,
                    .scratch_count = gdr_thread_pool_thread_count(pool)};
     status = build_mesh(&b, err);
+    if (status == GDR_OK && (status = gdr_mesh_clusters_build_hierarchy(&mesh->clusters, err)) != GDR_OK)
+        truncate_to_level0(&mesh->clusters);
+    if (status != GDR_OK) /* level 0 is back: its own hierarchy, when memory allows */
+        gdr_mesh_clusters_build_hierarchy(&mesh->clusters, NULL);
     if (status == GDR_OK && stats)
         *stats = b.stats;
     return status;
@@ -692,10 +699,12 @@ gdr_status gdr_scene_build_lod(gdr_scene *scene, const gdr_lod_options *options,
     for (uint32_t m = 0; m < n; m++) {
         if (!built[m])
             continue;
-        if (status != GDR_OK)
+        if (status != GDR_OK) {
             truncate_to_level0(&scene->meshes[m].clusters);
-        else if (stats)
+            gdr_mesh_clusters_build_hierarchy(&scene->meshes[m].clusters, NULL);
+        } else if (stats) {
             stats_add(stats, &mesh_stats[m]);
+        }
     }
 done:
     gdr_thread_pool_destroy(pool);

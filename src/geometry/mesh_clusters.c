@@ -12,5 +12,6 @@ void gdr_mesh_clusters_free(gdr_mesh_clusters *clusters)
     free(clusters->vertices);
     free(clusters->triangles);
     free(clusters->groups);
+    free(clusters->lod_nodes);
     memset(clusters, 0, sizeof *clusters);
 }

@@ -441,6 +441,11 @@ gdr_status gdr_meshlets_build(const gdr_mesh *mesh, const gdr_meshlet_options *o
         return gdr_error_set(err, status, "mesh '%s': meshoptimizer made no meshlets", mesh->name);
     if (status != GDR_OK)
         return gdr_error_set(err, status, "mesh '%s': out of memory for meshlets", mesh->name);
+    status = gdr_mesh_clusters_build_hierarchy(out, err);
+    if (status != GDR_OK) {
+        gdr_mesh_clusters_free(out);
+        return status;
+    }
     return GDR_OK;
 }
 

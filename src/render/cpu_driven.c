@@ -19,19 +19,43 @@ static gdr_cull_object object_from_instance(const GdrGpuInstance *instance, cons
     return (gdr_cull_object){.center = center, .radius = radius, .extent = {radius, radius, radius}};
 }
 
+/* Keeps only what the instances' bounds need of the scene, per mesh (the renderer holds no pointer
+ * into it; the instances' transforms are in r->scene.cpu_instances): the culling structures are
+ * built when the pipeline is first used, so a renderer that never draws with it pays O(meshes). */
 gdr_status gdr_cpu_path_create(gdr_renderer *r, const gdr_scene *scene, gdr_error *err)
 {
     gdr_cpu_path *cpu = &r->cpu;
-    uint32_t count = scene->instance_count;
+    cpu->mesh_bounds = malloc(sizeof *cpu->mesh_bounds * (scene->mesh_count ? scene->mesh_count : 1));
+    if (!cpu->mesh_bounds)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "CPU pipeline: out of memory for %u meshes",
+                             scene->mesh_count);
+    cpu->mesh_count = scene->mesh_count;
+    for (uint32_t m = 0; m < scene->mesh_count; m++)
+        cpu->mesh_bounds[m] = gdr_cull_mesh_bounds_of(&scene->meshes[m]);
+    return GDR_OK;
+}
+
+/* The library's own bounds of every instance (a box and a sphere from the transformed mesh box),
+ * from the instances' current transforms, and the cull scene over them. */
+static gdr_status build_cull_scene(gdr_renderer *r, gdr_error *err)
+{
+    gdr_cpu_path *cpu = &r->cpu;
+    uint32_t count = r->scene.instance_count;
     gdr_cull_object *objects = malloc(sizeof *objects * (count ? count : 1));
+    free(cpu->visible_bits); /* from an attempt that ran out of memory */
+    free(cpu->visible);
     cpu->visible_bits = calloc(gdr_cull_word_count(count) + 1, sizeof(uint32_t));
     cpu->visible = malloc(sizeof(uint32_t) * (count ? count : 1));
     if (!objects || !cpu->visible_bits || !cpu->visible) {
         free(objects);
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "CPU pipeline: out of memory");
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "CPU pipeline: out of memory for %u instances", count);
     }
-    /* The library's own bounds: a box and a sphere from the transformed mesh. */
-    gdr_cull_objects_from_scene(objects, scene);
+    const gdr_cull_mesh_bounds none = {.lo = {1, 1, 1}, .hi = {0, 0, 0}};
+    for (uint32_t i = 0; i < count; i++) {
+        const GdrGpuInstance *instance = &r->scene.cpu_instances[i];
+        const gdr_cull_mesh_bounds *b = instance->mesh < cpu->mesh_count ? &cpu->mesh_bounds[instance->mesh] : &none;
+        objects[i] = gdr_cull_object_from_mesh_bounds(b, &instance->model);
+    }
     gdr_cull_scene_desc desc = {.objects = objects, .object_count = count};
     gdr_status status = gdr_cull_scene_create(&desc, &cpu->cull_scene, err);
     free(objects);
@@ -40,6 +64,7 @@ gdr_status gdr_cpu_path_create(gdr_renderer *r, const gdr_scene *scene, gdr_erro
 
 void gdr_cpu_path_destroy(gdr_renderer *r)
 {
+    free(r->cpu.mesh_bounds);
     gdr_cull_scene_destroy(r->cpu.cull_scene);
     free(r->cpu.visible_bits);
     free(r->cpu.visible);
@@ -48,6 +73,8 @@ void gdr_cpu_path_destroy(gdr_renderer *r)
 
 gdr_status gdr_cpu_path_update_instance(gdr_renderer *r, uint32_t index, gdr_error *err)
 {
+    if (!r->cpu.cull_scene)
+        return GDR_OK; /* built from the current transforms when first used */
     const GdrGpuInstance *instance = &r->scene.cpu_instances[index];
     gdr_cull_object object = object_from_instance(instance, &r->scene.cpu_meshes[instance->mesh]);
     return gdr_cull_scene_update(r->cpu.cull_scene, index, 1, &object, err);
@@ -56,6 +83,11 @@ gdr_status gdr_cpu_path_update_instance(gdr_renderer *r, uint32_t index, gdr_err
 gdr_status gdr_cpu_path_cull(gdr_renderer *r, const gdr_frame_desc *frame, gdr_error *err)
 {
     gdr_cpu_path *cpu = &r->cpu;
+    if (!cpu->cull_scene) { /* first use: not part of the frame's culling time */
+        gdr_status built = build_cull_scene(r, err);
+        if (built != GDR_OK)
+            return built;
+    }
     double start = gdr_now_ms();
     gdr_cull_view view = {.skip_frustum = frame->cull == GDR_CULL_OFF};
     gdr_frame_matrices(r, &frame->camera, &view.projection, &view.view);
@@ -88,7 +120,7 @@ void gdr_cpu_path_record_draws(gdr_renderer *r, VkCommandBuffer cmd, const GdrGp
          * bindIndexBuffer, bindDescriptorSets, pushConstants, drawIndexed. gdr's scenes draw with
          * one pipeline and one descriptor set (the frame's set 0), so those two binds name the same
          * objects each time, as in an engine that binds per object without sorting. */
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->draw_pipeline);
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pipelines[GDR_PIPE_DRAW_INDEXED]);
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->layout, 0, 1, &r->occlusion.set, 0, NULL);
         VkDeviceSize vertex_offset = (VkDeviceSize)mesh->vertex_offset * sizeof(GdrGpuVertex);
         vkCmdBindVertexBuffers(cmd, 0, 1, &g->vertices.buffer, &vertex_offset);

@@ -186,6 +186,43 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
     return status;
 }
 
+/* The LOD hierarchy pool: every mesh's gdr_lod_node array as it is (the bytes of GdrGpuLodNode,
+ * mesh-local indices), one after another. Fills the meshes' lod_node fields. */
+static gdr_status upload_lod_nodes(gdr_renderer *r, const gdr_scene *scene, const gdr_mesh_clusters *const *clusters,
+                                   gdr_error *err)
+{
+    gdr_gpu_scene *g = &r->scene;
+    uint64_t total = 0;
+    for (uint32_t m = 0; m < scene->mesh_count; m++)
+        total += clusters[m]->lod_node_count;
+    if (total > UINT32_MAX / 2)
+        return gdr_error_set(err, GDR_ERROR_CAPACITY, "scene: %llu LOD hierarchy nodes exceed 32-bit offsets",
+                             (unsigned long long)total);
+    GdrGpuLodNode *nodes = malloc(sizeof *nodes * (total ? total : 1));
+    if (!nodes)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory for %llu LOD nodes",
+                             (unsigned long long)total);
+    uint32_t cursor = 0;
+    for (uint32_t m = 0; m < scene->mesh_count; m++) {
+        const gdr_mesh_clusters *c = clusters[m];
+        g->cpu_meshes[m].lod_node_offset = cursor;
+        g->cpu_meshes[m].lod_node_count = c->lod_node_count;
+        g->cpu_meshes[m].lod_node_levels = c->lod_node_levels;
+        if (c->lod_node_count)
+            memcpy(nodes + cursor, c->lod_nodes, sizeof *nodes * c->lod_node_count);
+        cursor += c->lod_node_count;
+    }
+    /* TRANSFER_SRC: tests read the pool back. */
+    const VkBufferUsageFlags usage =
+        VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    gdr_status status = gdr_vk_buffer_create(&r->allocator, sizeof *nodes * (total ? total : 1), usage,
+                                             GDR_VK_BUFFER_DEVICE, &g->lod_nodes, err);
+    if (status == GDR_OK)
+        status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->lod_nodes, 0, nodes, sizeof *nodes * total, err);
+    free(nodes);
+    return status;
+}
+
 gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_error *err)
 {
     gdr_gpu_scene *g = &r->scene;
@@ -240,6 +277,8 @@ gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
         status = gather_clusters(scene, clusters, built, err);
     if (status == GDR_OK)
         status = upload_clusters(r, scene, clusters, err);
+    if (status == GDR_OK)
+        status = upload_lod_nodes(r, scene, clusters, err);
     for (uint32_t m = 0; built && m < scene->mesh_count; m++)
         gdr_mesh_clusters_free(&built[m]);
     free(built);
@@ -264,6 +303,30 @@ gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
     return status;
 }
 
+gdr_status gdr_gpu_scene_write_refs(gdr_renderer *r, gdr_error *err)
+{
+    gdr_gpu_scene *g = &r->scene;
+    GdrGpuScene refs = {.instances = g->instances.address, .meshes = g->meshes.address,
+                        .vertices = g->vertices.address, .meshlets = g->meshlets.address,
+                        .meshlet_vertices = g->meshlet_vertices.address,
+                        .meshlet_triangles = g->meshlet_triangles.address,
+                        .instance_visibility = r->occlusion.instance_visibility.address,
+                        .meshlet_visibility = r->occlusion.meshlet_visibility.address,
+                        .lod_nodes = g->lod_nodes.address};
+    gdr_status status = gdr_vk_buffer_create(&r->allocator, sizeof refs,
+                                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                             GDR_VK_BUFFER_DEVICE, &g->refs, err);
+    if (status == GDR_OK)
+        status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->refs, 0, &refs, sizeof refs, err);
+    const gdr_vk_buffer *buffers[] = {&g->vertices, &g->indices, &g->meshes, &g->instances, &g->meshlets,
+                                      &g->meshlet_vertices, &g->meshlet_triangles, &g->refs,
+                                      &r->occlusion.instance_visibility, &r->occlusion.meshlet_visibility};
+    g->bytes = 0;
+    for (size_t i = 0; i < sizeof buffers / sizeof buffers[0]; i++)
+        g->bytes += buffers[i]->size;
+    return status;
+}
+
 void gdr_gpu_scene_destroy(gdr_renderer *r)
 {
     gdr_gpu_scene *g = &r->scene;
@@ -274,6 +337,8 @@ void gdr_gpu_scene_destroy(gdr_renderer *r)
     gdr_vk_buffer_destroy(r->ctx, &g->meshlets);
     gdr_vk_buffer_destroy(r->ctx, &g->meshlet_vertices);
     gdr_vk_buffer_destroy(r->ctx, &g->meshlet_triangles);
+    gdr_vk_buffer_destroy(r->ctx, &g->lod_nodes);
+    gdr_vk_buffer_destroy(r->ctx, &g->refs);
     free(g->cpu_meshlets);
     free(g->cpu_meshes);
     free(g->cpu_instances);
@@ -299,6 +364,9 @@ gdr_status gdr_frame_slots_create(gdr_renderer *r, gdr_error *err)
         gdr_status status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuFrameGlobals),
                                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GDR_VK_BUFFER_UPLOAD,
                                                  &slot->globals, err);
+        if (status == GDR_OK)
+            status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuFrameBuffers), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                          GDR_VK_BUFFER_UPLOAD, &slot->frame_buffers, err);
         if (status == GDR_OK)
             status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuInstanceUpdate) * GDR_INSTANCE_UPDATES_PER_FRAME,
                                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GDR_VK_BUFFER_UPLOAD, &slot->updates, err);
@@ -337,6 +405,7 @@ void gdr_frame_slots_destroy(gdr_renderer *r)
         if (slot->readback_cmd)
             vkFreeCommandBuffers(r->ctx->device, r->ctx->command_pool, 1, &slot->readback_cmd);
         gdr_vk_buffer_destroy(r->ctx, &slot->globals);
+        gdr_vk_buffer_destroy(r->ctx, &slot->frame_buffers);
         gdr_vk_buffer_destroy(r->ctx, &slot->updates);
         gdr_vk_buffer_destroy(r->ctx, &slot->draws);
         gdr_vk_buffer_destroy(r->ctx, &slot->draw_stats);

@@ -5,6 +5,7 @@
 
 #include "shaders/embedded_shaders.h"
 #include "vk/vk_descriptors.h"
+#include "vk/vk_image.h"
 
 /* Workgroup size of depthreduce.comp.glsl, given to it as specialization constants 0 and 1. */
 #define HZB_GROUP_SIZE 8u
@@ -51,31 +52,22 @@ static gdr_status check_format(gdr_vk_context *ctx, gdr_error *err)
 
 static gdr_status create_image(gdr_hzb *hzb, gdr_vk_allocator *allocator, gdr_error *err)
 {
-    VkDevice device = hzb->ctx->device;
-    VkImageCreateInfo info = {.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO, .imageType = VK_IMAGE_TYPE_2D,
-                              .format = GDR_HZB_FORMAT, .extent = {hzb->width, hzb->height, 1},
-                              .mipLevels = hzb->level_count, .arrayLayers = 1, .samples = VK_SAMPLE_COUNT_1_BIT,
-                              .tiling = VK_IMAGE_TILING_OPTIMAL,
-                              /* transfer source: tests and debug views read levels back */
+    /* transfer source: tests and debug views read levels back */
+    gdr_vk_image_desc desc = {.width = hzb->width, .height = hzb->height, .format = GDR_HZB_FORMAT,
                               .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
                                        VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                              .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED};
-    GDR_VK_TRY(err, vkCreateImage(device, &info, NULL, &hzb->image));
-    VkMemoryRequirements requirements;
-    vkGetImageMemoryRequirements(device, hzb->image, &requirements);
-    gdr_vk_allocation allocation;
-    gdr_status status = gdr_vk_allocate(allocator, requirements, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, &allocation, err);
+                              .mip_levels = hzb->level_count};
+    gdr_status status = gdr_vk_image_create(allocator, &desc, &hzb->pyramid, err);
     if (status != GDR_OK)
         return status;
-    GDR_VK_TRY(err, vkBindImageMemory(device, hzb->image, allocation.memory, allocation.offset));
+    hzb->image = hzb->pyramid.image;
+    hzb->view = hzb->pyramid.view;
     VkImageViewCreateInfo view = {.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, .image = hzb->image,
                                   .viewType = VK_IMAGE_VIEW_TYPE_2D, .format = GDR_HZB_FORMAT,
-                                  .subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, hzb->level_count, 0, 1}};
-    GDR_VK_TRY(err, vkCreateImageView(device, &view, NULL, &hzb->view));
+                                  .subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1}};
     for (uint32_t level = 0; level < hzb->level_count; level++) {
         view.subresourceRange.baseMipLevel = level;
-        view.subresourceRange.levelCount = 1;
-        GDR_VK_TRY(err, vkCreateImageView(device, &view, NULL, &hzb->level_views[level]));
+        GDR_VK_TRY(err, vkCreateImageView(hzb->ctx->device, &view, NULL, &hzb->level_views[level]));
     }
     return GDR_OK;
 }
@@ -195,10 +187,7 @@ void gdr_hzb_destroy(gdr_hzb *hzb)
     for (uint32_t level = 0; level < GDR_HZB_MAX_LEVELS; level++)
         if (hzb->level_views[level])
             vkDestroyImageView(device, hzb->level_views[level], NULL);
-    if (hzb->view)
-        vkDestroyImageView(device, hzb->view, NULL);
-    if (hzb->image)
-        vkDestroyImage(device, hzb->image, NULL);
+    gdr_vk_image_destroy(hzb->ctx, &hzb->pyramid);
     memset(hzb, 0, sizeof *hzb);
 }
 
@@ -206,15 +195,10 @@ static void pyramid_barrier(VkCommandBuffer cmd, const gdr_hzb *hzb, uint32_t fi
                             VkImageLayout from, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                             VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access)
 {
-    VkImageMemoryBarrier2 barrier = {.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2, .srcStageMask = src_stage,
-                                     .srcAccessMask = src_access, .dstStageMask = dst_stage,
-                                     .dstAccessMask = dst_access, .oldLayout = from, .newLayout = GDR_HZB_LAYOUT,
-                                     .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-                                     .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .image = hzb->image,
-                                     .subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, first_level, level_count, 0, 1}};
-    VkDependencyInfo dependency = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .imageMemoryBarrierCount = 1,
-                                   .pImageMemoryBarriers = &barrier};
-    vkCmdPipelineBarrier2(cmd, &dependency);
+    gdr_vk_image_transition t = {.image = hzb->image, .aspect = VK_IMAGE_ASPECT_COLOR_BIT, .from = from,
+                                 .to = GDR_HZB_LAYOUT, .src = {src_stage, src_access}, .dst = {dst_stage, dst_access},
+                                 .first_mip = first_level, .mip_count = level_count};
+    gdr_vk_barrier(cmd, &(gdr_vk_barrier_desc){.images = &t, .image_count = 1});
 }
 
 void gdr_hzb_record_build(const gdr_hzb *hzb, VkCommandBuffer cmd)
@@ -246,33 +230,20 @@ void gdr_hzb_record_build(const gdr_hzb *hzb, VkCommandBuffer cmd)
                     hzb->reader_stages, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
 }
 
-static void depth_barrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayout to,
-                          VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage,
-                          VkAccessFlags2 dst_access)
-{
-    VkImageMemoryBarrier2 barrier = {.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2, .srcStageMask = src_stage,
-                                     .srcAccessMask = src_access, .dstStageMask = dst_stage,
-                                     .dstAccessMask = dst_access, .oldLayout = from, .newLayout = to,
-                                     .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-                                     .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .image = image,
-                                     .subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1}};
-    VkDependencyInfo dependency = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .imageMemoryBarrierCount = 1,
-                                   .pImageMemoryBarriers = &barrier};
-    vkCmdPipelineBarrier2(cmd, &dependency);
-}
-
 void gdr_hzb_record_depth_to_read(const gdr_hzb *hzb, VkCommandBuffer cmd, VkImage depth_image, VkImageLayout from)
 {
-    depth_barrier(cmd, depth_image, from, hzb->depth_layout,
-                  VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, GDR_HZB_DEPTH_READ_STAGE, GDR_HZB_DEPTH_READ_ACCESS);
+    gdr_vk_image_barrier(cmd, depth_image, VK_IMAGE_ASPECT_DEPTH_BIT, from, hzb->depth_layout,
+                         VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                         VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, GDR_HZB_DEPTH_READ_STAGE,
+                         GDR_HZB_DEPTH_READ_ACCESS);
 }
 
 void gdr_hzb_record_depth_to_attachment(const gdr_hzb *hzb, VkCommandBuffer cmd, VkImage depth_image, VkImageLayout to)
 {
-    depth_barrier(cmd, depth_image, hzb->depth_layout, to, GDR_HZB_DEPTH_READ_STAGE, VK_ACCESS_2_NONE,
-                  VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+    gdr_vk_image_barrier(cmd, depth_image, VK_IMAGE_ASPECT_DEPTH_BIT, hzb->depth_layout, to, GDR_HZB_DEPTH_READ_STAGE,
+                         VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                                               VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                         VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
 }
 
 void gdr_hzb_occlusion_params(const gdr_hzb *hzb, GdrOcclusionParams *params)

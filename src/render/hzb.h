@@ -24,7 +24,7 @@
 #define GDR_HZB_H
 
 #include "shaders/shared/occlusion_math.h"
-#include "vk/vk_memory.h"
+#include "vk/vk_image.h"
 
 #define GDR_HZB_FORMAT VK_FORMAT_R32_SFLOAT
 #define GDR_HZB_LAYOUT VK_IMAGE_LAYOUT_GENERAL
@@ -52,8 +52,9 @@ typedef struct gdr_hzb {
     uint32_t depth_width, depth_height;
     uint32_t width, height;  /* level 0: powers of two, <= the depth size */
     uint32_t level_count;    /* floor(log2(max(width, height))) + 1; the last level is 1x1 */
-    VkImage image;
-    VkImageView view;        /* every level, for sampling: pair it with min_sampler */
+    gdr_vk_image pyramid;
+    VkImage image;           /* pyramid.image */
+    VkImageView view;        /* pyramid.view: every level, for sampling: pair it with min_sampler */
     VkImageView level_views[GDR_HZB_MAX_LEVELS];
     /* Linear filter with VK_SAMPLER_REDUCTION_MODE_MIN, nearest mip, clamp to edge: one fetch gives
      * the minimum of the 2x2 texels around the coordinate that have a non-zero weight. */

@@ -15,100 +15,34 @@ double gdr_now_ms(void)
     return (double)t.tv_sec * 1e3 + (double)t.tv_nsec * 1e-6;
 }
 
-/* The early and late phases of occlusion culling (issue 6): the culling shaders with their PHASE
- * constant, and the late phase's launch of its task commands. */
-static gdr_status create_phase_pipelines(gdr_renderer *r, gdr_error *err)
-{
-    gdr_status status = GDR_OK;
-    for (uint32_t phase = 1; phase <= 2 && status == GDR_OK; phase++) {
-        const uint32_t indirect[2] = {0, phase}, tasks[2] = {1, phase};
-        status = gdr_vk_compute_pipeline_create_specialized(r->ctx, r->layout, &gdr_shader_drawcull_comp, indirect, 2,
-                                                            &r->cull_phase_pipelines[phase - 1], err);
-        if (status != GDR_OK || !r->ctx->has_mesh_shader)
-            continue;
-        status = gdr_vk_compute_pipeline_create_specialized(r->ctx, r->layout, &gdr_shader_drawcull_comp, tasks, 2,
-                                                            &r->cull_tasks_phase_pipelines[phase - 1], err);
-        VkSpecializationMapEntry entry = {0, 0, sizeof(uint32_t)};
-        VkSpecializationInfo constants = {1, &entry, sizeof phase, &phase};
-        gdr_vk_graphics_pipeline_desc mesh = {
-            .layout = r->layout, .task_shader = &gdr_shader_meshlet_task, .task_specialization = &constants,
-            .mesh_shader = &gdr_shader_meshlet_mesh, .fragment_shader = &gdr_shader_meshlet_frag,
-            .color_format = GDR_COLOR_FORMAT, .depth_format = GDR_DEPTH_FORMAT, .cull_mode = VK_CULL_MODE_BACK_BIT};
-        if (status == GDR_OK)
-            status = gdr_vk_graphics_pipeline_create(r->ctx, &mesh, &r->mesh_phase_pipelines[phase - 1], err);
-    }
-    if (status == GDR_OK && r->ctx->has_mesh_shader) {
-        const uint32_t late = 1;
-        status = gdr_vk_compute_pipeline_create_specialized(r->ctx, r->layout, &gdr_shader_tasksubmit_comp, &late, 1,
-                                                            &r->task_submit_late_pipeline, err);
-    }
-    return status;
-}
-
+/* The frame pipelines' layout (the push-constant block, and set 0 for the depth pyramid), then the
+ * registry's pipelines that the device can run. */
 static gdr_status create_pipelines(gdr_renderer *r, gdr_error *err)
 {
-    /* Every frame pipeline: the push-constant block, and set 0 for the depth pyramid. */
     gdr_status status = gdr_vk_pipeline_layout_create_with_sets(r->ctx, &r->occlusion.set_layout, 1, VK_SHADER_STAGE_ALL,
                                                                 sizeof(GdrGpuPushConstants), &r->layout, err);
+    const bool available[3] = {[GDR_NEEDS_CORE] = true,
+                               [GDR_NEEDS_MESH_SHADER] = r->ctx->has_mesh_shader,
+                               [GDR_NEEDS_VISIBILITY_BUFFER] = r->vis.supported};
     if (status == GDR_OK)
-        status = create_phase_pipelines(r, err);
-    if (status == GDR_OK)
-        status = gdr_vk_compute_pipeline_create(r->ctx, r->layout, &gdr_shader_drawcull_comp, &r->cull_pipeline, err);
-    if (status == GDR_OK)
-        status = gdr_vk_compute_pipeline_create(r->ctx, r->layout, &gdr_shader_instance_scatter_comp,
-                                                &r->scatter_pipeline, err);
-    if (status == GDR_OK) {
-        const uint32_t emit_tasks = 1;
-        status = gdr_vk_compute_pipeline_create_specialized(r->ctx, r->layout, &gdr_shader_drawcull_comp, &emit_tasks, 1,
-                                                            &r->cull_tasks_pipeline, err);
-    }
-    if (status == GDR_OK)
-        status = gdr_vk_compute_pipeline_create(r->ctx, r->layout, &gdr_shader_tasksubmit_comp, &r->task_submit_pipeline,
-                                                err);
-    if (status == GDR_OK)
-        status = gdr_vk_compute_pipeline_create(r->ctx, r->layout, &gdr_shader_overdraw_max_comp,
-                                                &r->overdraw_max_pipeline, err);
-    if (status == GDR_OK) {
-        gdr_vk_graphics_pipeline_desc paint = {
-            .layout = r->layout, .vertex_shader = &gdr_shader_overdraw_paint_vert,
-            .fragment_shader = &gdr_shader_overdraw_paint_frag, .color_format = GDR_COLOR_FORMAT,
-            .depth_format = VK_FORMAT_UNDEFINED, .cull_mode = VK_CULL_MODE_NONE, .no_depth_test = true};
-        status = gdr_vk_graphics_pipeline_create(r->ctx, &paint, &r->overdraw_paint_pipeline, err);
-    }
-    if (status == GDR_OK && r->ctx->has_mesh_shader) {
-        gdr_vk_graphics_pipeline_desc mesh = {
-            .layout = r->layout, .task_shader = &gdr_shader_meshlet_task, .mesh_shader = &gdr_shader_meshlet_mesh,
-            .fragment_shader = &gdr_shader_meshlet_frag, .color_format = GDR_COLOR_FORMAT,
-            .depth_format = GDR_DEPTH_FORMAT, .cull_mode = VK_CULL_MODE_BACK_BIT};
-        status = gdr_vk_graphics_pipeline_create(r->ctx, &mesh, &r->mesh_pipeline, err);
-    }
-    if (status != GDR_OK)
-        return status;
-    VkVertexInputBindingDescription binding = {0, sizeof(GdrGpuVertex), VK_VERTEX_INPUT_RATE_VERTEX};
-    /* uv stays in the vertex (for textures later) but the forward shading does not read it yet. */
-    VkVertexInputAttributeDescription attributes[2] = {
-        {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(GdrGpuVertex, position)},
-        {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(GdrGpuVertex, normal)},
-    };
-    gdr_vk_graphics_pipeline_desc desc = {
-        .layout = r->layout, .vertex_shader = &gdr_shader_mesh_vert, .fragment_shader = &gdr_shader_mesh_frag,
-        .vertex_binding = &binding, .vertex_attributes = attributes, .vertex_attribute_count = 2,
-        .color_format = GDR_COLOR_FORMAT, .depth_format = GDR_DEPTH_FORMAT, .cull_mode = VK_CULL_MODE_BACK_BIT};
-    return gdr_vk_graphics_pipeline_create(r->ctx, &desc, &r->draw_pipeline, err);
+        status = gdr_pipelines_create(r->ctx, r->layout, available, r->pipelines, err);
+    return status;
 }
 
 static gdr_status create_targets(gdr_renderer *r, gdr_error *err)
 {
-    gdr_status status = gdr_vk_image_create(&r->allocator, r->width, r->height, GDR_COLOR_FORMAT,
-                                            VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-                                                VK_IMAGE_USAGE_TRANSFER_DST_BIT, /* the visibility buffer's resolve */
-                                            VK_IMAGE_ASPECT_COLOR_BIT, &r->color, err);
+    gdr_vk_image_desc color = {.width = r->width, .height = r->height, .format = GDR_COLOR_FORMAT,
+                               .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+                                        VK_IMAGE_USAGE_TRANSFER_DST_BIT}; /* the visibility buffer's resolve */
+    gdr_vk_image_desc depth = {.width = r->width, .height = r->height, .format = GDR_DEPTH_FORMAT,
+                               .usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT |
+                                        VK_IMAGE_USAGE_SAMPLED_BIT |      /* the depth pyramid */
+                                        VK_IMAGE_USAGE_TRANSFER_SRC_BIT | /* tests read it back */
+                                        VK_IMAGE_USAGE_TRANSFER_DST_BIT,  /* the visibility buffer's resolve */
+                               .aspect = VK_IMAGE_ASPECT_DEPTH_BIT};
+    gdr_status status = gdr_vk_image_create(&r->allocator, &color, &r->color, err);
     if (status == GDR_OK)
-        status = gdr_vk_image_create(&r->allocator, r->width, r->height, GDR_DEPTH_FORMAT,
-                                     VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
-                                         VK_IMAGE_USAGE_TRANSFER_SRC_BIT | /* tests read it back */
-                                         VK_IMAGE_USAGE_TRANSFER_DST_BIT, /* the visibility buffer's resolve */
-                                     VK_IMAGE_ASPECT_DEPTH_BIT, &r->depth, err); /* sampled: the depth pyramid */
+        status = gdr_vk_image_create(&r->allocator, &depth, &r->depth, err);
     if (status == GDR_OK)
         status = gdr_vk_buffer_create(&r->allocator, (VkDeviceSize)r->width * r->height * 4,
                                       VK_BUFFER_USAGE_TRANSFER_DST_BIT, GDR_VK_BUFFER_READBACK, &r->color_readback, err);
@@ -120,7 +54,7 @@ static gdr_status create_targets(gdr_renderer *r, gdr_error *err)
     if (status != GDR_OK)
         return status;
     VkQueryPoolCreateInfo query = {.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO, .queryType = VK_QUERY_TYPE_TIMESTAMP,
-                                   .queryCount = GDR_FRAMES_IN_FLIGHT * GDR_TS_COUNT};
+                                   .queryCount = GDR_FRAMES_IN_FLIGHT * GDR_FRAME_MAX_TIMESTAMPS};
     GDR_VK_TRY(err, vkCreateQueryPool(r->ctx->device, &query, NULL, &r->timestamps));
     return GDR_OK;
 }
@@ -156,9 +90,9 @@ gdr_status gdr_renderer_create(const gdr_renderer_desc *desc_in, gdr_renderer **
     if (status == GDR_OK)
         status = gdr_occlusion_create(r, err);
     if (status == GDR_OK)
-        status = create_pipelines(r, err);
-    if (status == GDR_OK)
         status = gdr_visbuffer_create(r, desc.disable_visibility_buffer, err);
+    if (status == GDR_OK)
+        status = create_pipelines(r, err);
     if (status != GDR_OK) {
         gdr_renderer_destroy(r);
         return status;
@@ -180,18 +114,7 @@ void gdr_renderer_destroy(gdr_renderer *r)
         VkDevice device = r->ctx->device;
         if (r->timestamps)
             vkDestroyQueryPool(device, r->timestamps, NULL);
-        if (r->cull_pipeline)
-            vkDestroyPipeline(device, r->cull_pipeline, NULL);
-        if (r->scatter_pipeline)
-            vkDestroyPipeline(device, r->scatter_pipeline, NULL);
-        VkPipeline pipelines[] = {r->draw_pipeline, r->cull_tasks_pipeline, r->task_submit_pipeline, r->mesh_pipeline,
-                                  r->overdraw_max_pipeline, r->overdraw_paint_pipeline, r->cull_phase_pipelines[0],
-                                  r->cull_phase_pipelines[1], r->cull_tasks_phase_pipelines[0],
-                                  r->cull_tasks_phase_pipelines[1], r->mesh_phase_pipelines[0],
-                                  r->mesh_phase_pipelines[1], r->task_submit_late_pipeline};
-        for (size_t i = 0; i < sizeof pipelines / sizeof pipelines[0]; i++)
-            if (pipelines[i])
-                vkDestroyPipeline(device, pipelines[i], NULL);
+        gdr_pipelines_destroy(r->ctx, r->pipelines);
         if (r->layout)
             vkDestroyPipelineLayout(device, r->layout, NULL);
         gdr_occlusion_destroy(r);
@@ -223,6 +146,8 @@ gdr_status gdr_renderer_set_scene(gdr_renderer *r, const gdr_scene *scene, gdr_e
     if (status == GDR_OK)
         status = gdr_occlusion_scene_create(r, err);
     if (status == GDR_OK)
+        status = gdr_gpu_scene_write_refs(r, err);
+    if (status == GDR_OK)
         r->has_scene = true;
     return status;
 }
@@ -251,16 +176,6 @@ gdr_status gdr_renderer_update_instance(gdr_renderer *r, uint32_t index, const g
                                                             .instance = *instance};
     return gdr_cpu_path_update_instance(r, index, err);
 }
-
-static int compare_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static const char *const pass_names[GDR_TS_COUNT - 1] = {"instance_update", "cull",        "draw",
-                                                         "pyramid",         "late_cull",   "late_draw",
-                                                         "late_pyramid",    "readback"};
 
 const char *gdr_pipeline_name(gdr_pipeline pipeline)
 {
@@ -317,23 +232,9 @@ static gdr_status resolve_pipeline(const gdr_renderer *r, const gdr_frame_desc *
     return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: unknown pipeline %d", (int)frame->pipeline);
 }
 
-/* Waits for the slot's previous frame, if any, and adds its pass timings to pass_ms. */
-static gdr_status wait_slot_and_time(gdr_renderer *r, gdr_frame_slot *slot, double pass_ms[GDR_TS_COUNT - 1],
-                                     uint32_t *timed_frames, gdr_error *err)
-{
-    double ms[GDR_TS_COUNT - 1];
-    bool had_frame = slot->submitted;
-    gdr_status status = gdr_frame_slot_wait(r, slot, ms, err);
-    if (status == GDR_OK && had_frame) {
-        for (int i = 0; i < GDR_TS_COUNT - 1; i++)
-            pass_ms[i] += ms[i];
-        (*timed_frames)++;
-    }
-    return status;
-}
-
-gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uint32_t frames, gdr_frame_stats *stats,
-                               gdr_error *err)
+/* The frame description's checks; the pipeline and raster mode it asks for on this device. */
+static gdr_status check_frame(gdr_renderer *r, const gdr_frame_desc *frame, uint32_t frames, gdr_pipeline *pipeline,
+                              char *reason, size_t reason_size, gdr_error *err)
 {
     if (!r->has_scene)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: no scene (call gdr_renderer_set_scene first)");
@@ -346,149 +247,79 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
                              "render: camera needs 0 < yfov < pi, znear > 0 and zfar = 0 or > znear "
                              "(yfov %g, znear %g, zfar %g)", (double)camera->yfov, (double)camera->znear,
                              (double)camera->zfar);
-
     if ((unsigned)frame->view > GDR_VIEW_MODE_LOD)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: unknown view %d", (int)frame->view);
     if (!(frame->lod_error_px >= 0.0f && frame->lod_error_px <= 1e30f))
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: lod_error_px must be finite and >= 0 (%g)",
                              (double)frame->lod_error_px);
-    gdr_pipeline pipeline = GDR_PIPELINE_INDIRECT;
-    char reason[160] = "";
-    gdr_status resolved = resolve_pipeline(r, frame, &pipeline, reason, sizeof reason, err);
-    if (resolved == GDR_OK)
-        resolved = gdr_visbuffer_resolve_mode(r, frame, pipeline, &r->vis.mode, r->vis.reason, sizeof r->vis.reason, err);
-    if (resolved != GDR_OK)
-        return resolved;
-    gdr_visbuffer_begin_render(r);
-    r->cpu.cull_ms = 0.0;
-    if (frame->record_visible_meshlets && !r->visible_meshlets.buffer) {
+    gdr_status status = resolve_pipeline(r, frame, pipeline, reason, reason_size, err);
+    if (status == GDR_OK)
+        status = gdr_visbuffer_resolve_mode(r, frame, *pipeline, &r->vis.mode, r->vis.reason, sizeof r->vis.reason, err);
+    if (status == GDR_OK && frame->record_visible_meshlets && !r->visible_meshlets.buffer) {
         /* Every cluster of every instance's DAG at most: cannot overflow. */
         uint64_t total = r->scene.instance_lod_cluster_count;
-        gdr_status status = gdr_vk_buffer_create(&r->allocator, 8 * (total ? total : 1),
-                                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                                                 GDR_VK_BUFFER_DEVICE, &r->visible_meshlets, err);
-        if (status != GDR_OK)
-            return status;
+        status = gdr_vk_buffer_create(&r->allocator, 8 * (total ? total : 1),
+                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                      GDR_VK_BUFFER_DEVICE, &r->visible_meshlets, err);
     }
+    return status;
+}
 
-    double cpu_ms = 0.0, submit_ms = 0.0, pass_ms[GDR_TS_COUNT - 1] = {0};
+/* One frame: its slot's previous frame waited for, culled on the CPU where the pipeline does, and
+ * recorded or resubmitted. Adds its CPU time to frame_cpu_ms. */
+static gdr_status run_frame(gdr_renderer *r, const gdr_frame_desc *frame, gdr_pipeline pipeline, bool read_back,
+                            double *frame_cpu_ms, double *submit_ms, uint32_t *recorded, gdr_error *err)
+{
+    gdr_frame_slot *slot = &r->slots[r->frame_index % GDR_FRAMES_IN_FLIGHT];
+    gdr_status status = gdr_frame_slot_wait(r, slot, err);
+    if (status != GDR_OK)
+        return status;
+    double start = gdr_now_ms();
+    if (pipeline == GDR_PIPELINE_CPU)
+        status = gdr_cpu_path_cull(r, frame, err);
+    if (status == GDR_OK) {
+        slot->cpu_visible_count = r->cpu.visible_count;
+        slot->cpu_triangles = r->cpu.triangles;
+        status = gdr_frame_record_and_submit(r, slot, frame, pipeline, read_back, submit_ms, err);
+    }
+    *frame_cpu_ms = gdr_now_ms() - start;
+    if (status != GDR_OK)
+        return status;
+    *recorded += !slot->resubmitted;
+    r->last_slot = (int)(slot - r->slots);
+    r->frame_index++;
+    return GDR_OK;
+}
+
+gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uint32_t frames, gdr_frame_stats *stats,
+                               gdr_error *err)
+{
+    gdr_pipeline pipeline = GDR_PIPELINE_INDIRECT;
+    char reason[160] = "";
+    gdr_status status = check_frame(r, frame, frames, &pipeline, reason, sizeof reason, err);
+    if (status != GDR_OK)
+        return status;
     double *frame_cpu_ms = malloc(sizeof(double) * frames);
     if (!frame_cpu_ms)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "render: out of memory");
-    uint32_t timed_frames = 0, recorded = 0;
+    r->timings = (gdr_frame_timings){0};
+    r->cpu.cull_ms = 0.0;
     r->color_read_back = false;
-    for (uint32_t f = 0; f < frames; f++) {
-        gdr_frame_slot *slot = &r->slots[r->frame_index % GDR_FRAMES_IN_FLIGHT];
-        gdr_status status = wait_slot_and_time(r, slot, pass_ms, &timed_frames, err);
-        if (status != GDR_OK) {
-            free(frame_cpu_ms);
-            return status;
-        }
-        double start = gdr_now_ms();
-        bool last = f + 1 == frames;
-        if (pipeline == GDR_PIPELINE_CPU)
-            status = gdr_cpu_path_cull(r, frame, err);
-        if (status == GDR_OK) {
-            slot->cpu_visible_count = r->cpu.visible_count;
-            slot->cpu_triangles = r->cpu.triangles;
-            status = gdr_frame_record_and_submit(r, slot, frame, pipeline, last && frame->read_back, &submit_ms, err);
-        }
-        frame_cpu_ms[f] = gdr_now_ms() - start;
-        cpu_ms += frame_cpu_ms[f];
-        recorded += status == GDR_OK && !slot->resubmitted;
-        if (status != GDR_OK) {
-            free(frame_cpu_ms);
-            return status;
-        }
-        r->last_slot = (int)(slot - r->slots);
-        r->frame_index++;
-    }
+    double submit_ms = 0.0;
+    uint32_t recorded = 0;
+    for (uint32_t f = 0; f < frames && status == GDR_OK; f++)
+        status = run_frame(r, frame, pipeline, f + 1 == frames && frame->read_back, &frame_cpu_ms[f], &submit_ms,
+                           &recorded, err);
     /* Drain every slot so the last frame's results are on the host. */
-    for (uint32_t i = 0; i < GDR_FRAMES_IN_FLIGHT; i++) {
-        gdr_status status = wait_slot_and_time(r, &r->slots[i], pass_ms, &timed_frames, err);
-        if (status != GDR_OK) {
-            free(frame_cpu_ms);
-            return status;
-        }
+    for (uint32_t i = 0; i < GDR_FRAMES_IN_FLIGHT && status == GDR_OK; i++)
+        status = gdr_frame_slot_wait(r, &r->slots[i], err);
+    if (status == GDR_OK) {
+        r->color_read_back = frame->read_back;
+        if (stats)
+            gdr_frame_stats_fill(r, pipeline, reason, frame_cpu_ms, frames, submit_ms, recorded, stats);
     }
-    r->color_read_back = frame->read_back;
-    if (!stats) {
-        free(frame_cpu_ms);
-        return GDR_OK;
-    }
-    qsort(frame_cpu_ms, frames, sizeof *frame_cpu_ms, compare_double);
-    double median = frames % 2 ? frame_cpu_ms[frames / 2] : 0.5 * (frame_cpu_ms[frames / 2 - 1] + frame_cpu_ms[frames / 2]);
     free(frame_cpu_ms);
-
-    memset(stats, 0, sizeof *stats);
-    const gdr_frame_slot *last_slot = &r->slots[r->last_slot];
-    GdrGpuDrawStats gpu;
-    memcpy(&gpu, last_slot->stats_readback.mapped, sizeof gpu);
-    stats->frames = frames;
-    stats->instances_total = r->scene.instance_count;
-    stats->pipeline = pipeline;
-    snprintf(stats->pipeline_reason, sizeof stats->pipeline_reason, "%s", reason);
-    gdr_visbuffer_stats(r, (uint32_t)r->last_slot, stats);
-    snprintf(stats->raster_reason, sizeof stats->raster_reason, "%s", r->vis.reason);
-    if (pipeline == GDR_PIPELINE_CPU) {
-        stats->instances_visible = last_slot->cpu_visible_count;
-        stats->draws = last_slot->cpu_visible_count;
-        stats->draw_calls = last_slot->cpu_visible_count;
-        stats->triangles = last_slot->cpu_triangles;
-        stats->cpu_cull_ms_per_frame = r->cpu.cull_ms / frames;
-    } else {
-        bool occlusion = last_slot->occlusion_applied;
-        stats->instances_visible = gpu.draw_count + (occlusion ? gpu.instances_late_drawn : 0);
-        stats->draws = pipeline == GDR_PIPELINE_MESH
-                           ? gpu.task_groups_x * gpu.task_groups_y + gpu.late_task_groups_x * gpu.late_task_groups_y
-                           : gpu.draw_count + gpu.late_draw_count;
-        stats->draw_calls = occlusion ? 2 : 1;
-        stats->occlusion_applied = occlusion;
-        stats->instances_early_drawn = gpu.instances_early_drawn;
-        stats->instances_early_occluded = gpu.instances_early_occluded;
-        stats->instances_late_tested = gpu.instances_late_tested;
-        stats->instances_late_occluded = gpu.instances_late_occluded;
-        stats->instances_late_drawn = gpu.instances_late_drawn;
-        stats->meshlets_early_drawn = gpu.meshlets_early_drawn;
-        stats->meshlets_late_tested = gpu.meshlets_late_tested;
-        stats->meshlets_late_occluded = gpu.meshlets_late_occluded;
-        stats->meshlets_late_drawn = gpu.meshlets_late_drawn;
-        stats->triangles = ((uint64_t)gpu.triangles_high << 32) | gpu.triangles_low;
-        stats->triangles += stats->raster_sw_triangles; /* the mesh shaders count only their own */
-    }
-    if (pipeline == GDR_PIPELINE_MESH) {
-        stats->meshlets_total = r->scene.instance_meshlet_count;
-        stats->meshlets_tested = gpu.meshlets_tested;
-        stats->meshlets_frustum_culled = gpu.meshlets_frustum_culled;
-        stats->meshlets_cone_culled = gpu.meshlets_cone_culled;
-        stats->meshlets_visible = gpu.meshlets_visible;
-        stats->triangles_backface_culled = gpu.triangles_backface_culled;
-        stats->triangles_small_culled = gpu.triangles_small_culled;
-        stats->task_workgroups = gpu.task_count + gpu.late_task_count;
-        stats->task_overflow = gpu.task_overflow;
-        stats->lod_applied = last_slot->lod_applied;
-        stats->meshlets_lod_culled = gpu.meshlets_lod_culled;
-        for (uint32_t d = 0; d < GDR_LOD_STATS_DEPTH_COUNT; d++) {
-            stats->lod_clusters_per_depth[d] = gpu.lod_clusters[d];
-            stats->lod_triangles_per_depth[d] = gpu.lod_triangles[d];
-            if (gpu.lod_clusters[d] > 0)
-                stats->lod_depth_count = d + 1;
-        }
-    }
-    stats->cpu_ms_per_frame = cpu_ms / frames;
-    stats->cpu_submit_ms_per_frame = submit_ms / frames;
-    stats->frames_recorded = recorded;
-    stats->cpu_ms_per_frame_median = median;
-    stats->pass_count = GDR_TS_COUNT - 1;
-    for (int p = 0; p < GDR_TS_COUNT - 1; p++) {
-        stats->passes[p].name = pass_names[p];
-        stats->passes[p].gpu_ms = timed_frames ? pass_ms[p] / timed_frames : 0.0;
-        stats->gpu_ms_per_frame += stats->passes[p].gpu_ms;
-    }
-    snprintf(stats->device, sizeof stats->device, "%s", r->ctx->properties.deviceName);
-    snprintf(stats->driver, sizeof stats->driver, "%s", r->ctx->driver_info);
-    stats->validation_messages = r->ctx->validation_messages;
-    return GDR_OK;
+    return status;
 }
 
 gdr_status gdr_renderer_read_color(gdr_renderer *r, uint8_t *rgba, gdr_error *err)
@@ -497,24 +328,6 @@ gdr_status gdr_renderer_read_color(gdr_renderer *r, uint8_t *rgba, gdr_error *er
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "read_color: the last frame was not rendered with read_back");
     memcpy(rgba, r->color_readback.mapped, (size_t)r->width * r->height * 4);
     return GDR_OK;
-}
-
-/* Copies `size` bytes of a device buffer into a new host-visible buffer. A test/debug path: the
- * readback memory is only reclaimed with the renderer (linear allocator). */
-static gdr_status read_device_buffer(gdr_renderer *r, VkBuffer source, VkDeviceSize size, gdr_vk_buffer *readback,
-                                     gdr_error *err)
-{
-    gdr_status status = gdr_vk_buffer_create(&r->allocator, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                             GDR_VK_BUFFER_READBACK, readback, err);
-    VkCommandBuffer cmd;
-    if (status == GDR_OK)
-        status = gdr_vk_begin_one_time(r->ctx, &cmd, err);
-    if (status == GDR_OK) {
-        VkBufferCopy region = {0, 0, size};
-        vkCmdCopyBuffer(cmd, source, readback->buffer, 1, &region);
-        status = gdr_vk_end_one_time(r->ctx, cmd, err);
-    }
-    return status;
 }
 
 gdr_status gdr_renderer_read_visible(gdr_renderer *r, uint32_t *indices, uint32_t capacity, uint32_t *count,
@@ -547,8 +360,8 @@ gdr_status gdr_renderer_read_visible(gdr_renderer *r, uint32_t *indices, uint32_
         uint32_t capacity_tasks = r->scene.task_capacity;
         uint32_t early = gpu.task_count < capacity_tasks ? gpu.task_count : capacity_tasks;
         uint32_t late_count = late ? (gpu.late_task_count < capacity_tasks ? gpu.late_task_count : capacity_tasks) : 0;
-        status = read_device_buffer(r, slot->tasks.buffer, sizeof(GdrGpuTaskCommand) * 2 * (VkDeviceSize)capacity_tasks,
-                                    &readback, err);
+        status = gdr_vk_buffer_read_back(&r->allocator, slot->tasks.buffer, 0,
+                                         sizeof(GdrGpuTaskCommand) * 2 * (VkDeviceSize)capacity_tasks, &readback, err);
         const GdrGpuTaskCommand *tasks = readback.mapped;
         for (uint32_t i = 0; status == GDR_OK && i < early + late_count; i++) {
             const GdrGpuTaskCommand *task = i < early ? &tasks[i] : &tasks[capacity_tasks + (i - early)];
@@ -556,8 +369,9 @@ gdr_status gdr_renderer_read_visible(gdr_renderer *r, uint32_t *indices, uint32_
                 indices[n++] = task->instance;
         }
     } else {
-        status = read_device_buffer(r, slot->draws.buffer, sizeof(GdrGpuDrawCommand) * 2 * (VkDeviceSize)r->scene.instance_count,
-                                    &readback, err);
+        status = gdr_vk_buffer_read_back(&r->allocator, slot->draws.buffer, 0,
+                                         sizeof(GdrGpuDrawCommand) * 2 * (VkDeviceSize)r->scene.instance_count,
+                                         &readback, err);
         const GdrGpuDrawCommand *draws = readback.mapped;
         for (uint32_t i = 0; status == GDR_OK && i < gpu.draw_count && n < *count; i++)
             indices[n++] = draws[i].first_instance;
@@ -587,7 +401,8 @@ gdr_status gdr_renderer_read_visible_meshlets(gdr_renderer *r, gdr_visible_meshl
     if (*count == 0)
         return GDR_OK;
     gdr_vk_buffer readback = {0};
-    gdr_status status = read_device_buffer(r, r->visible_meshlets.buffer, 8 * (VkDeviceSize)*count, &readback, err);
+    gdr_status status = gdr_vk_buffer_read_back(&r->allocator, r->visible_meshlets.buffer, 0, 8 * (VkDeviceSize)*count,
+                                                &readback, err);
     for (uint32_t i = 0; status == GDR_OK && i < *count; i++) {
         const uint32_t *pair = (const uint32_t *)readback.mapped + 2 * i;
         uint32_t mesh = r->scene.cpu_instances[pair[0]].mesh;

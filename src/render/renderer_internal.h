@@ -3,7 +3,9 @@
 #define GDR_RENDERER_INTERNAL_H
 
 #include "gdr/renderer.h"
+#include "render/frame_plan.h"
 #include "render/occlusion.h"
+#include "render/pipelines.h"
 #include "shaders/shared/gpu_types.h"
 #include "vk/vk_buffer.h"
 #include "vk/vk_context.h"
@@ -11,25 +13,20 @@
 #include "vk/vk_memory.h"
 #include "render/visbuffer.h"
 
-/* Timestamps written per frame, in order; pass i lasts from timestamp i to i + 1. */
-enum gdr_timestamp {
-    GDR_TS_BEGIN,
-    GDR_TS_AFTER_UPDATE,
-    GDR_TS_AFTER_CULL,
-    GDR_TS_AFTER_DRAW,
-    /* Occlusion culling's late phase (issue 6); without it these follow each other at once. */
-    GDR_TS_AFTER_PYRAMID,
-    GDR_TS_AFTER_LATE_CULL,
-    GDR_TS_AFTER_LATE_DRAW,
-    GDR_TS_AFTER_LATE_PYRAMID,
-    GDR_TS_END,
-    GDR_TS_COUNT
-};
+/* GPU timings summed over the frames of one gdr_renderer_render call. */
+typedef struct gdr_frame_timings {
+    double section_ms[GDR_SECTION_COUNT];
+    double raster_ms[GDR_RASTER_TIMER_COUNT];
+    uint32_t frames;        /* frames timed */
+    uint32_t raster_frames; /* of those, frames with visibility-buffer passes */
+} gdr_frame_timings;
 
 /* The CPU-driven baseline (seed 003's "before"): the gdr/cull.h library culls on the CPU, then
  * one vkCmdDrawIndexed with its own binds per visible instance. */
 typedef struct gdr_cpu_path {
-    struct gdr_cull_scene *cull_scene;
+    struct gdr_cull_mesh_bounds *mesh_bounds; /* per mesh, from gdr_cpu_path_create */
+    uint32_t mesh_count;
+    struct gdr_cull_scene *cull_scene;        /* built when the pipeline is first used */
     uint32_t *visible_bits;   /* gdr_cull_word_count(instances) words */
     uint32_t *visible;        /* indices of the visible instances of the last culled frame */
     uint32_t visible_count;
@@ -46,12 +43,15 @@ typedef struct gdr_gpu_scene {
     gdr_vk_buffer meshlets;          /* GdrGpuMeshlet[], all meshes' clusters */
     gdr_vk_buffer meshlet_vertices;  /* uint32[]: global vertex index per cluster-local vertex */
     gdr_vk_buffer meshlet_triangles; /* uint32[] holding 3 bytes per cluster triangle */
+    gdr_vk_buffer lod_nodes;         /* GdrGpuLodNode[]: every mesh's LOD hierarchy, as gdr_lod_node */
+    gdr_vk_buffer refs;              /* GdrGpuScene: the addresses above, for the push constants */
     uint32_t mesh_count;
     uint32_t instance_count;
     uint32_t meshlet_count;
     uint32_t task_capacity;        /* task commands of all instances: the task buffer's size */
     uint64_t instance_meshlet_count; /* level-0 clusters summed over the instances (meshlets_total) */
     uint64_t instance_lod_cluster_count; /* every DAG cluster summed over the instances */
+    uint64_t bytes;                /* device memory of the buffers above and the occlusion history */
     GdrGpuMesh *cpu_meshes;        /* host copies, for references and statistics */
     GdrGpuMeshlet *cpu_meshlets;
     GdrGpuInstance *cpu_instances;
@@ -59,30 +59,22 @@ typedef struct gdr_gpu_scene {
     uint32_t pending_count, pending_capacity;
 } gdr_gpu_scene;
 
-/* What one frame in flight owns. */
-/* What a GPU-driven frame's commands depend on. A slot whose command buffer was recorded for the
- * same key submits it again as it is: everything else a frame changes (camera, options read by the
- * shaders, instance updates) lives in buffers the CPU rewrites before each submit. */
-typedef struct gdr_recorded_frame {
-    bool valid;
-    gdr_pipeline pipeline;
-    uint32_t raster_mode;        /* GDR_GPU_RASTER_* */
-    bool occlusion, overdraw;
-    bool updates;                /* the scatter pass runs (instance updates in the ring) */
-    uint32_t raster_phases;      /* visibility-buffer phases timed (host bookkeeping) */
-    GdrGpuPushConstants push;
-} gdr_recorded_frame;
-
+/* What one frame in flight owns. A GPU-driven slot keeps the plan its command buffer was recorded
+ * from and submits it again while the next frame's configuration is the same: everything else a
+ * frame changes (camera, options read by the shaders, instance updates) lives in buffers the CPU
+ * rewrites before each submit. */
 typedef struct gdr_frame_slot {
     VkCommandBuffer cmd;
     VkCommandBuffer readback_cmd; /* copies the colour image for the CPU; recorded once, submitted after
                                      `cmd` in frames that read the image back */
-    gdr_recorded_frame recorded; /* what `cmd` holds (GPU-driven frames only) */
+    gdr_frame_plan plan;         /* the passes of the frame last recorded into `cmd` */
+    bool recorded;               /* `cmd` holds `plan` and may be submitted again */
     bool resubmitted;            /* the last frame submitted `cmd` again without recording */
     VkFence fence;
     bool submitted;
-    bool timestamps_written;
+    bool timed;                  /* the submitted frame wrote its timestamps: read them after the fence */
     gdr_vk_buffer globals;       /* GdrGpuFrameGlobals, host-written */
+    gdr_vk_buffer frame_buffers; /* GdrGpuFrameBuffers, host-written */
     gdr_vk_buffer updates;       /* GdrGpuInstanceUpdate[GDR_INSTANCE_UPDATES_PER_FRAME], host-written ring slot */
     gdr_vk_buffer draws;         /* GdrGpuDrawCommand[2 * instance_count]: early (or only) phase, late phase */
     gdr_vk_buffer draw_stats;    /* GdrGpuDrawStats, device-local */
@@ -106,18 +98,14 @@ struct gdr_renderer {
     gdr_vk_buffer color_readback; /* width * height * 4 bytes */
     bool color_read_back;
     VkPipelineLayout layout;
-    VkPipeline cull_pipeline, scatter_pipeline, draw_pipeline;
-    VkPipeline cull_tasks_pipeline, task_submit_pipeline, mesh_pipeline; /* NULL without mesh shaders */
-    VkPipeline overdraw_max_pipeline, overdraw_paint_pipeline;
-    /* Two-phase occlusion culling (issue 6): [0] the early phase, [1] the late phase. */
-    VkPipeline cull_phase_pipelines[2], cull_tasks_phase_pipelines[2], mesh_phase_pipelines[2];
-    VkPipeline task_submit_late_pipeline;
+    VkPipeline pipelines[GDR_PIPE_COUNT]; /* the registry's (pipelines.h); NULL where the device cannot */
     gdr_occlusion occlusion;
     gdr_vk_buffer overdraw;       /* uint32 per pixel, then the maximum (overdraw view) */
     gdr_vk_buffer visible_meshlets; /* uint32 pairs, one per cluster of every instance; made on first use */
-    gdr_visbuffer vis;            /* the visibility buffer and the hybrid rasteriser (issue 8) */
+    gdr_visbuffer vis;            /* the visibility buffer and the hybrid rasteriser */
     gdr_cpu_path cpu;
-    VkQueryPool timestamps;
+    VkQueryPool timestamps;       /* GDR_FRAME_MAX_TIMESTAMPS per frame slot */
+    gdr_frame_timings timings;
     gdr_gpu_scene scene;
     bool has_scene;
     gdr_frame_slot slots[GDR_FRAMES_IN_FLIGHT];
@@ -131,18 +119,50 @@ struct gdr_renderer {
 #define GDR_CLEAR_COLOR {{GDR_BACKGROUND_R, GDR_BACKGROUND_G, GDR_BACKGROUND_B, 1.0f}} /* the background */
 
 gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_error *err);
+/* The scene's buffer addresses (GdrGpuScene) for the push constants; after the occlusion history. */
+gdr_status gdr_gpu_scene_write_refs(gdr_renderer *r, gdr_error *err);
 void gdr_gpu_scene_destroy(gdr_renderer *r);
 gdr_status gdr_frame_slots_create(gdr_renderer *r, gdr_error *err);
 void gdr_frame_slots_destroy(gdr_renderer *r);
 
-/* Waits for the slot's previous frame (if any) and gathers its timings into `gpu_ms` (may be NULL). */
-gdr_status gdr_frame_slot_wait(gdr_renderer *r, gdr_frame_slot *slot, double gpu_ms[GDR_TS_COUNT - 1], gdr_error *err);
-/* Records and submits one frame into `slot`; adds the time spent in vkQueueSubmit2 to *submit_ms. */
+/* Waits for the slot's previous frame (if any) and adds its GPU timings to r->timings. */
+gdr_status gdr_frame_slot_wait(gdr_renderer *r, gdr_frame_slot *slot, gdr_error *err);
 /* Records the commands that copy the colour image (left COLOR_ATTACHMENT_OPTIMAL by every frame)
  * into color_readback for the host. */
 gdr_status gdr_frame_record_color_readback(gdr_renderer *r, VkCommandBuffer cmd, gdr_error *err);
+/* Records (or reuses) and submits one frame into `slot`; adds the time spent in vkQueueSubmit2 to
+ * *submit_ms. */
 gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame,
                                        gdr_pipeline pipeline, bool copy_color, double *submit_ms, gdr_error *err);
+
+/* The recording functions of the frame's passes (frame_record.c; the visibility buffer's in
+ * visbuffer.c). */
+void gdr_pass_record_instance_scatter(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
+                                      VkCommandBuffer cmd);
+void gdr_pass_record_clear(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass, VkCommandBuffer cmd);
+void gdr_pass_record_instance_cull(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
+                                   VkCommandBuffer cmd);
+void gdr_pass_record_draw_indexed(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
+                                  VkCommandBuffer cmd);
+void gdr_pass_record_task_submit(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
+                                 VkCommandBuffer cmd);
+void gdr_pass_record_meshlets(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass, VkCommandBuffer cmd);
+void gdr_pass_record_pyramid(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass, VkCommandBuffer cmd);
+void gdr_pass_record_overdraw_max(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
+                                  VkCommandBuffer cmd);
+void gdr_pass_record_overdraw_paint(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
+                                    VkCommandBuffer cmd);
+void gdr_pass_record_cpu_draws(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass, VkCommandBuffer cmd);
+void gdr_pass_record_readback(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass, VkCommandBuffer cmd);
+/* The statistics of a render call (frame_stats.c) after its last frame has finished; sorts
+ * frame_cpu_ms. */
+void gdr_frame_stats_fill(gdr_renderer *r, gdr_pipeline pipeline, const char *reason, double *frame_cpu_ms,
+                          uint32_t frames, double submit_ms, uint32_t recorded, gdr_frame_stats *stats);
+/* The frame's viewport and scissor: the Vulkan Y flip (seed 000) for the scene, none for
+ * full-screen passes. */
+void gdr_frame_set_viewport(gdr_renderer *r, VkCommandBuffer cmd, bool flip_y);
+/* What every frame pipeline expects bound: the push constants and the depth pyramid (set 0). */
+void gdr_frame_bind_state(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer cmd);
 
 /* CPU pipeline (cpu_driven.c). */
 gdr_status gdr_cpu_path_create(gdr_renderer *r, const gdr_scene *scene, gdr_error *err);
@@ -153,6 +173,8 @@ gdr_status gdr_cpu_path_update_instance(gdr_renderer *r, uint32_t index, gdr_err
 gdr_status gdr_cpu_path_cull(gdr_renderer *r, const gdr_frame_desc *frame, gdr_error *err);
 /* One bind + draw sequence per visible instance, inside the render pass. */
 void gdr_cpu_path_record_draws(gdr_renderer *r, VkCommandBuffer cmd, const GdrGpuPushConstants *push);
+/* The push constants of the slot's frames. */
+GdrGpuPushConstants gdr_frame_push_constants(const gdr_renderer *r, const gdr_frame_slot *slot);
 /* The camera's projection and view for a frame (shared by the GPU globals and the CPU cull). */
 void gdr_frame_matrices(const gdr_renderer *r, const gdr_camera *camera, gdr_mat4 *projection, gdr_mat4 *view);
 double gdr_now_ms(void);

@@ -7,22 +7,12 @@
 #include <stdint.h>
 
 #include "gdr/math.h"
-
-/* A mix of multiply-xorshift rounds. */
-static inline uint32_t gdr_hash_u32(uint32_t x)
-{
-    x ^= x >> 16;
-    x *= 0x7feb352dU;
-    x ^= x >> 15;
-    x *= 0x846ca68bU;
-    x ^= x >> 16;
-    return x;
-}
+#include "shaders/shared/hash.h"
 
 /* A number in [0, 1) for object `index`, property `channel` (below 8). */
 static inline float gdr_hash_unit(uint32_t seed, uint32_t index, uint32_t channel)
 {
-    return (float)(gdr_hash_u32(seed * 0x9E3779B9U ^ gdr_hash_u32(index * 8U + channel)) >> 8) / 16777216.0f;
+    return (float)(gdr_hash(seed * 0x9E3779B9U ^ gdr_hash(index * 8U + channel)) >> 8) / 16777216.0f;
 }
 
 /* A saturated colour of the given hue in [0, 1), lifted so that shading stays readable. */

@@ -19,7 +19,6 @@ layout(constant_id = 1) const uint PHASE = 0u;
 #define PHASE_EARLY 1u
 #define PHASE_LATE 2u
 
-layout(buffer_reference, scalar) writeonly buffer TaskCommandsRef { GdrGpuTaskCommand items[]; };
 
 // The clusters an instance's task workgroups test: level 0; with the LOD cut, every cluster of
 // the DAG, or only the root group's when the root shortcut passes (issue 5).
@@ -45,7 +44,7 @@ TaskRange task_range(GdrGpuFrameGlobals g, GdrGpuMesh mesh, mat4 model)
 
 void append_tasks(GdrGpuFrameGlobals g, bool visible, uint instance, TaskRange range)
 {
-    DrawStatsRef stats = DrawStatsRef(push.draw_stats);
+    DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
     uint count = visible ? range.tasks : 0u;
     uint subgroup_total = subgroupAdd(count);
     uint base = 0u;
@@ -54,7 +53,7 @@ void append_tasks(GdrGpuFrameGlobals g, bool visible, uint instance, TaskRange r
                                    : atomicAdd(stats.value.task_count, subgroup_total);
     base = subgroupBroadcastFirst(base) + subgroupExclusiveAdd(count);
     // The late phase's commands follow the early phase's region (task_capacity entries).
-    TaskCommandsRef tasks = TaskCommandsRef(push.tasks + (PHASE == PHASE_LATE ? uint64_t(g.task_capacity) * 16ul : 0ul));
+    TaskCommandsRef tasks = TaskCommandsRef(uint64_t(GDR_FRAME.tasks) + (PHASE == PHASE_LATE ? uint64_t(g.task_capacity) * 16ul : 0ul));
     for (uint t = 0u; t < count; t++) {
         uint slot = base + t;
         uint first = t * GDR_TASK_WORKGROUP_SIZE;
@@ -78,7 +77,7 @@ void append_tasks(GdrGpuFrameGlobals g, bool visible, uint instance, TaskRange r
 void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
-    DrawStatsRef stats = DrawStatsRef(push.draw_stats);
+    DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
     uint id = gl_GlobalInvocationID.x;
     bool visible = false;
     GdrGpuMesh mesh;
@@ -86,8 +85,8 @@ void main()
     vec3 center = vec3(0.0);
     float radius = 0.0;
     if (id < g.instance_count) {
-        model = InstancesRef(push.instances).items[id].model;
-        mesh = MeshesRef(push.meshes).items[InstancesRef(push.instances).items[id].mesh];
+        model = InstancesRef(GDR_SCENE.instances).items[id].model;
+        mesh = MeshesRef(GDR_SCENE.meshes).items[InstancesRef(GDR_SCENE.instances).items[id].mesh];
         visible = mesh.index_count > 0u; // nothing to draw otherwise
         center = (g.view * (model * vec4(mesh.bounds.xyz, 1.0))).xyz;
         radius = mesh.bounds.w * gdr_max_axis_scale(model[0].xyz, model[1].xyz, model[2].xyz);
@@ -101,22 +100,22 @@ void main()
     // phase did not, and records what is visible for the next frame.
     bool drawn_early = false;
     if (PHASE == PHASE_EARLY && id < g.instance_count) {
-        uint state = VisibilityRef(g.instance_visibility).items[id];
+        uint state = VisibilityRef(GDR_SCENE.instance_visibility).items[id];
         bool candidate = visible && (g.flags & GDR_FRAME_HISTORY) != 0u && (state & GDR_INSTANCE_VISIBLE_LAST_FRAME) != 0u;
         bool occluded = candidate && gdr_sphere_occluded(g, center, radius);
         COUNT(instances_early_occluded, occluded);
         visible = candidate && !occluded;
         COUNT(instances_early_drawn, visible);
-        VisibilityRef(g.instance_visibility).items[id] = (state & GDR_INSTANCE_VISIBLE_LAST_FRAME) |
+        VisibilityRef(GDR_SCENE.instance_visibility).items[id] = (state & GDR_INSTANCE_VISIBLE_LAST_FRAME) |
                                                          (visible ? GDR_INSTANCE_DRAWN_EARLY : 0u);
     } else if (PHASE == PHASE_LATE && id < g.instance_count) {
-        uint state = VisibilityRef(g.instance_visibility).items[id];
+        uint state = VisibilityRef(GDR_SCENE.instance_visibility).items[id];
         drawn_early = (state & GDR_INSTANCE_DRAWN_EARLY) != 0u;
         COUNT(instances_late_tested, visible);
         bool occluded = visible && gdr_sphere_occluded(g, center, radius);
         COUNT(instances_late_occluded, occluded);
         visible = visible && !occluded;
-        VisibilityRef(g.instance_visibility).items[id] = visible ? GDR_INSTANCE_VISIBLE_LAST_FRAME : 0u;
+        VisibilityRef(GDR_SCENE.instance_visibility).items[id] = visible ? GDR_INSTANCE_VISIBLE_LAST_FRAME : 0u;
         // The meshlet pipeline goes on testing the clusters of instances drawn early (those not
         // drawn early may be visible now); the indirect pipeline has drawn them whole.
         if (!EMIT_TASKS)
@@ -147,7 +146,7 @@ void main()
     } else if (visible) {
         // The late phase's draws follow the early phase's region (instance_count entries).
         uint slot = base + subgroupBallotExclusiveBitCount(ballot) + (PHASE == PHASE_LATE ? g.instance_count : 0u);
-        DrawCommandsRef(push.draws).items[slot] =
+        DrawCommandsRef(GDR_FRAME.draws).items[slot] =
             GdrGpuDrawCommand(mesh.index_count, 1u, mesh.first_index, int(mesh.vertex_offset), id);
     }
 }

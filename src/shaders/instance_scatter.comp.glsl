@@ -10,7 +10,7 @@ void main()
     uint id = gl_GlobalInvocationID.x;
     if (id >= g.update_count)
         return;
-    GdrGpuInstanceUpdate update = InstanceUpdatesRef(push.updates).items[id];
+    GdrGpuInstanceUpdate update = InstanceUpdatesRef(GDR_FRAME.updates).items[id];
     if (update.tag == GDR_UPDATE_TAG_INSTANCE && update.index < g.instance_count)
-        InstancesRef(push.instances).items[update.index] = update.instance;
+        InstancesRef(GDR_SCENE.instances).items[update.index] = update.instance;
 }

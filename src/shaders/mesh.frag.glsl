@@ -1,5 +1,13 @@
 #version 460
-// Forward path shading (vertex pipelines): see shared/shading.h.
+// Forward shading (shared/shading.h) of the vertex pipeline and, compiled with
+// GDR_PER_PRIMITIVE_COLOR (meshlet.frag), of the mesh shaders, whose colour comes per primitive
+// (the debug views).
+#ifdef GDR_PER_PRIMITIVE_COLOR
+#extension GL_EXT_mesh_shader : require
+#define GDR_COLOR_INPUT perprimitiveEXT flat in
+#else
+#define GDR_COLOR_INPUT flat in
+#endif
 #include "shared/glsl_buffers.h"
 #include "shared/shading.h"
 
@@ -7,15 +15,14 @@ layout(early_fragment_tests) in;
 
 layout(location = 0) in vec3 in_normal;
 layout(location = 1) in vec3 in_world_position;
-layout(location = 2) flat in vec4 in_color;
+layout(location = 2) GDR_COLOR_INPUT vec4 in_color;
 
 layout(location = 0) out vec4 out_color;
-layout(buffer_reference, scalar) buffer OverdrawRef { uint items[]; };
 
 void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
     if (g.view_mode == GDR_VIEW_OVERDRAW) // fragments that passed the depth test, per pixel
-        atomicAdd(OverdrawRef(push.overdraw).items[uint(gl_FragCoord.y) * uint(g.viewport.x) + uint(gl_FragCoord.x)], 1u);
+        atomicAdd(OverdrawRef(GDR_FRAME.overdraw).items[uint(gl_FragCoord.y) * uint(g.viewport.x) + uint(gl_FragCoord.x)], 1u);
     out_color = gdr_shade(g.light_direction.xyz, in_normal, in_world_position, in_color.rgb);
 }

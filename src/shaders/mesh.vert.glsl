@@ -13,7 +13,7 @@ layout(location = 2) flat out vec4 out_color;
 void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
-    GdrGpuInstance instance = InstancesRef(push.instances).items[gl_InstanceIndex];
+    GdrGpuInstance instance = InstancesRef(GDR_SCENE.instances).items[gl_InstanceIndex];
     vec4 world = instance.model * vec4(in_position, 1.0);
     gl_Position = g.view_projection * world;
     // The cofactor matrix transforms normals correctly under non-uniform scale (up to length).

@@ -36,9 +36,11 @@ layout(location = 3) perprimitiveEXT flat out uint out_visibility_id[]; // list 
 
 shared vec3 screen[GDR_MESH_MAX_VERTICES]; // pixels (y up) and clip w
 
+UintsRef triangle_bytes; // read once per invocation
+
 uint triangle_byte(uint at)
 {
-    return (UintsRef(push.meshlet_triangles).items[at >> 2] >> ((at & 3u) * 8u)) & 255u;
+    return (triangle_bytes.items[at >> 2] >> ((at & 3u) * 8u)) & 255u;
 }
 
 // Non-zero when the triangle surely produces no fragment: 1 when back-facing beyond the snapping
@@ -63,30 +65,36 @@ void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
     uint lane = gl_LocalInvocationIndex;
+    // The scene's references at once, before the loads that depend on them.
+    MeshletsRef meshlets = GDR_SCENE.meshlets;
+    InstancesRef instances = GDR_SCENE.instances;
+    UintsRef vertex_refs = GDR_SCENE.meshlet_vertices;
+    VerticesRef vertices = GDR_SCENE.vertices;
+    triangle_bytes = GDR_SCENE.meshlet_triangles;
 #ifdef GDR_MESH_FROM_LIST
     // This launch's entries: [hw_first, hw_first + hw_count) (raster_submit.comp), in rows.
-    GdrGpuRasterParams raster = RasterParamsRef(push.raster).value;
-    RasterCountersRef counters = RasterCountersRef(raster.counters);
+    RasterParamsRef raster = GDR_FRAME.raster;
+    RasterCountersRef counters = RasterCountersRef(raster.value.counters);
     uint launched = gl_WorkGroupID.x + gl_WorkGroupID.y * GDR_MESH_GROUPS_PER_ROW;
     if (launched >= counters.value.hw_count) {
         SetMeshOutputsEXT(0u, 0u); // the tail of the last row
         return;
     }
     uint slot = counters.value.hw_first + launched;
-    GdrGpuRasterCluster entry = RasterClustersRef(raster.clusters).items[slot];
+    GdrGpuRasterCluster entry = RasterClustersRef(raster.value.clusters).items[slot];
     uint instance_index = entry.instance, meshlet_index = entry.meshlet;
 #else
     uint instance_index = payload.instance, meshlet_index = payload.meshlets[gl_WorkGroupID.x];
 #endif
-    GdrGpuMeshlet meshlet = MeshletsRef(push.meshlets).items[meshlet_index];
-    GdrGpuInstance instance = InstancesRef(push.instances).items[instance_index];
+    GdrGpuMeshlet meshlet = meshlets.items[meshlet_index];
+    GdrGpuInstance instance = instances.items[instance_index];
     SetMeshOutputsEXT(meshlet.vertex_count, meshlet.triangle_count);
 
     mat3 m = mat3(instance.model);
     mat3 cofactor = mat3(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1]));
     for (uint v = lane; v < meshlet.vertex_count; v += GDR_MESH_WORKGROUP_SIZE) {
-        uint vertex_index = UintsRef(push.meshlet_vertices).items[meshlet.vertex_offset + v];
-        GdrGpuVertex vertex = VerticesRef(push.vertices).items[vertex_index];
+        uint vertex_index = vertex_refs.items[meshlet.vertex_offset + v];
+        GdrGpuVertex vertex = vertices.items[vertex_index];
         vec4 world = instance.model * vec4(vertex.position, 1.0);
         vec4 clip = g.view_projection * world;
         gl_MeshVerticesEXT[v].gl_Position = clip;
@@ -118,7 +126,7 @@ void main()
     uint total_backfacing = subgroupAdd(backfacing);
     uint total_small = subgroupAdd(small);
     if (subgroupElect()) {
-        DrawStatsRef stats = DrawStatsRef(push.draw_stats);
+        DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
         uint old = atomicAdd(stats.value.triangles_low, total_emitted);
         if (old + total_emitted < old)
             atomicAdd(stats.value.triangles_high, 1u);

@@ -9,13 +9,12 @@
 #include "shared/visbuffer.h"
 
 layout(location = 3) perprimitiveEXT flat in uint in_visibility_id;
-layout(buffer_reference, scalar) buffer OverdrawRef { uint items[]; };
 
 void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
     uint pixel = uint(gl_FragCoord.y) * uint(g.viewport.x) + uint(gl_FragCoord.x);
-    atomicMax(VisbufferRef(push.visbuffer).items[pixel], gdr_visbuffer_pack(gl_FragCoord.z, in_visibility_id));
+    atomicMax(push.visbuffer.items[pixel], gdr_visbuffer_pack(gl_FragCoord.z, in_visibility_id));
     if (g.view_mode == GDR_VIEW_OVERDRAW) // on this path: every fragment rasterised, as the compute rasteriser counts
-        atomicAdd(OverdrawRef(push.overdraw).items[pixel], 1u);
+        atomicAdd(OverdrawRef(GDR_FRAME.overdraw).items[pixel], 1u);
 }

@@ -6,7 +6,6 @@
 #include "shared/glsl_buffers.h"
 
 layout(local_size_x = GDR_REDUCE_WORKGROUP_SIZE) in;
-layout(buffer_reference, scalar) buffer OverdrawRef { uint items[]; };
 
 shared uint workgroup_max;
 
@@ -14,7 +13,7 @@ void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
     uint pixels = uint(g.viewport.x) * uint(g.viewport.y);
-    OverdrawRef counts = OverdrawRef(push.overdraw);
+    OverdrawRef counts = OverdrawRef(GDR_FRAME.overdraw);
     if (gl_LocalInvocationIndex == 0u)
         workgroup_max = 0u;
     barrier();

@@ -3,7 +3,6 @@
 // white), normalised by the frame's maximum. Pixels no fragment reached keep the background.
 #include "shared/glsl_buffers.h"
 
-layout(buffer_reference, scalar) readonly buffer OverdrawRef { uint items[]; };
 layout(location = 0) out vec4 out_color;
 
 vec3 heat(float t)
@@ -19,7 +18,7 @@ void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
     uint width = uint(g.viewport.x), pixels = width * uint(g.viewport.y);
-    OverdrawRef counts = OverdrawRef(push.overdraw);
+    OverdrawRef counts = OverdrawRef(GDR_FRAME.overdraw);
     // gl_FragCoord is in framebuffer coordinates in every pass, whatever the viewport's flip.
     uint count = counts.items[uint(gl_FragCoord.y) * width + uint(gl_FragCoord.x)];
     uint maximum = max(counts.items[pixels], 1u);

@@ -11,8 +11,8 @@ layout(local_size_x = 1) in;
 
 void main()
 {
-    GdrGpuRasterParams params = RasterParamsRef(push.raster).value;
-    RasterCountersRef counters = RasterCountersRef(params.counters);
+    RasterParamsRef params = GDR_FRAME.raster;
+    RasterCountersRef counters = RasterCountersRef(params.value.counters);
     uint first = counters.value.sw_dispatched;
     uint count = counters.value.sw_clusters - first;
     counters.value.sw_first = first;
@@ -24,10 +24,10 @@ void main()
 
     uint hw_total = counters.value.hw_clusters;
     uint hw_new = hw_total - counters.value.hw_dispatched;
-    uint hw_count = min(hw_new, params.hw_launch_limit);
+    uint hw_count = min(hw_new, params.value.hw_launch_limit);
     if (hw_count < hw_new)
         counters.value.overflow += hw_new - hw_count;
-    counters.value.hw_first = params.capacity - hw_total;
+    counters.value.hw_first = params.value.capacity - hw_total;
     counters.value.hw_count = hw_count;
     counters.value.hw_dispatched = hw_total;
     rows = (hw_count + GDR_MESH_GROUPS_PER_ROW - 1u) / GDR_MESH_GROUPS_PER_ROW;

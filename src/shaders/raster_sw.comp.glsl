@@ -20,7 +20,6 @@
 #include "shared/visbuffer.h"
 
 layout(local_size_x = GDR_SW_RASTER_WORKGROUP_SIZE) in;
-layout(buffer_reference, scalar) buffer OverdrawRef { uint items[]; };
 
 const int SUBPIXEL = 1 << GDR_SW_SUBPIXEL_BITS;
 const int HALF_PIXEL = SUBPIXEL / 2;
@@ -31,16 +30,19 @@ const int SMALL_EXTENT = 64 * SUBPIXEL;
 shared ivec2 corner_fixed[GDR_MESH_MAX_VERTICES]; // framebuffer position in sub-pixel units
 shared vec3 corner_float[GDR_MESH_MAX_VERTICES];  // framebuffer position and depth, unsnapped
 
-// Per invocation: where covered pixels go.
+// Per invocation, read once (a reference reloaded after every atomic would cost a load per pixel):
+// the target's width, the overdraw counts and the triangles' bytes.
 uint target_width;
 bool count_overdraw;
+OverdrawRef target_overdraw;
+UintsRef triangle_bytes;
 // The depth plane of the current triangle: depth = x + y * (px - ax) + z * (py - ay), in pixels.
 vec3 depth_plane;
 vec2 depth_origin;
 
 uint triangle_byte(uint at)
 {
-    return (UintsRef(push.meshlet_triangles).items[at >> 2] >> ((at & 3u) * 8u)) & 255u;
+    return (triangle_bytes.items[at >> 2] >> ((at & 3u) * 8u)) & 255u;
 }
 
 void write_pixel(int x, int y, uint id)
@@ -48,9 +50,9 @@ void write_pixel(int x, int y, uint id)
     vec2 centre = vec2(x, y) + 0.5 - depth_origin;
     float depth = clamp(depth_plane.x + depth_plane.y * centre.x + depth_plane.z * centre.y, 0.0, 1.0);
     uint pixel = uint(y) * target_width + uint(x);
-    atomicMax(VisbufferRef(push.visbuffer).items[pixel], gdr_visbuffer_pack(depth, id));
+    atomicMax(push.visbuffer.items[pixel], gdr_visbuffer_pack(depth, id));
     if (count_overdraw)
-        atomicAdd(OverdrawRef(push.overdraw).items[pixel], 1u);
+        atomicAdd(target_overdraw.items[pixel], 1u);
 }
 
 // 0 for a top or left edge of a clockwise-as-seen triangle (framebuffer y down), else 1: the edge
@@ -133,14 +135,21 @@ void raster_triangle(uvec3 corners, uint id, ivec2 size)
 void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
-    GdrGpuRasterParams params = RasterParamsRef(push.raster).value;
-    RasterCountersRef counters = RasterCountersRef(params.counters);
+    // The references at once, before the loads that depend on them.
+    RasterParamsRef params = GDR_FRAME.raster;
+    MeshletsRef meshlets = GDR_SCENE.meshlets;
+    InstancesRef instances = GDR_SCENE.instances;
+    UintsRef vertex_refs = GDR_SCENE.meshlet_vertices;
+    VerticesRef vertices = GDR_SCENE.vertices;
+    target_overdraw = GDR_FRAME.overdraw;
+    triangle_bytes = GDR_SCENE.meshlet_triangles;
+    RasterCountersRef counters = RasterCountersRef(params.value.counters);
     uint index = counters.value.sw_first + gl_WorkGroupID.x + gl_WorkGroupID.y * GDR_SW_GROUPS_PER_ROW;
     if (index >= counters.value.sw_clusters)
         return; // the tail of the last row
-    GdrGpuRasterCluster entry = RasterClustersRef(params.clusters).items[index];
-    GdrGpuMeshlet meshlet = MeshletsRef(push.meshlets).items[entry.meshlet];
-    mat4 model = InstancesRef(push.instances).items[entry.instance].model;
+    GdrGpuRasterCluster entry = RasterClustersRef(params.value.clusters).items[index];
+    GdrGpuMeshlet meshlet = meshlets.items[entry.meshlet];
+    mat4 model = instances.items[entry.instance].model;
     uint lane = gl_LocalInvocationIndex;
     target_width = uint(g.viewport.x);
     count_overdraw = g.view_mode == GDR_VIEW_OVERDRAW;
@@ -148,8 +157,8 @@ void main()
     // The vertices, as the mesh shader transforms them, then the viewport transform.
     vec2 half_size = 0.5 * g.viewport;
     if (lane < meshlet.vertex_count) {
-        uint vertex_index = UintsRef(push.meshlet_vertices).items[meshlet.vertex_offset + lane];
-        vec3 position = VerticesRef(push.vertices).items[vertex_index].position;
+        uint vertex_index = vertex_refs.items[meshlet.vertex_offset + lane];
+        vec3 position = vertices.items[vertex_index].position;
         vec4 world = model * vec4(position, 1.0);
         vec4 clip = g.view_projection * world;
         vec3 ndc = clip.xyz / clip.w;

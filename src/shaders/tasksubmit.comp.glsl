@@ -13,7 +13,7 @@ layout(constant_id = 0) const bool LATE = false;
 void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
-    DrawStatsRef stats = DrawStatsRef(push.draw_stats);
+    DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
     uint count = min(LATE ? stats.value.late_task_count : stats.value.task_count, g.task_capacity);
     uint rows = (count + GDR_TASK_GROUPS_PER_ROW - 1u) / GDR_TASK_GROUPS_PER_ROW;
     uvec3 groups = uvec3(rows > 1u ? GDR_TASK_GROUPS_PER_ROW : count, rows, 1u);

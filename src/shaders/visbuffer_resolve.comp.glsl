@@ -17,11 +17,10 @@
 
 layout(local_size_x = GDR_RESOLVE_TILE, local_size_y = GDR_RESOLVE_TILE) in;
 layout(constant_id = 0) const bool DEPTH_ONLY = false;
-layout(buffer_reference, scalar) writeonly buffer ResolvedRef { uint items[]; };
 
 uint triangle_byte(uint at)
 {
-    return (UintsRef(push.meshlet_triangles).items[at >> 2] >> ((at & 3u) * 8u)) & 255u;
+    return (UintsRef(GDR_SCENE.meshlet_triangles).items[at >> 2] >> ((at & 3u) * 8u)) & 255u;
 }
 
 // Shades the pixel whose centre is `centre` (framebuffer pixels, y down) from its id.
@@ -29,11 +28,11 @@ vec4 shade_pixel(FrameGlobalsRef globals, vec2 viewport, vec2 centre, uint id)
 {
     uint triangle = id & GDR_VISBUFFER_TRIANGLE_MASK;
     GdrGpuRasterCluster entry =
-        RasterClustersRef(RasterParamsRef(push.raster).value.clusters).items[id >> GDR_VISBUFFER_TRIANGLE_BITS];
-    MeshletsRef meshlets = MeshletsRef(push.meshlets);
+        RasterClustersRef(RasterParamsRef(GDR_FRAME.raster).value.clusters).items[id >> GDR_VISBUFFER_TRIANGLE_BITS];
+    MeshletsRef meshlets = MeshletsRef(GDR_SCENE.meshlets);
     uint vertex_offset = meshlets.items[entry.meshlet].vertex_offset;
     uint at = meshlets.items[entry.meshlet].triangle_offset + triangle * 3u;
-    mat4 model = InstancesRef(push.instances).items[entry.instance].model;
+    mat4 model = InstancesRef(GDR_SCENE.instances).items[entry.instance].model;
     mat4 view_projection = globals.value.view_projection;
     uvec3 corners = uvec3(triangle_byte(at), triangle_byte(at + 1u), triangle_byte(at + 2u));
 
@@ -43,9 +42,9 @@ vec4 shade_pixel(FrameGlobalsRef globals, vec2 viewport, vec2 centre, uint id)
     vec2 p = vec2(centre.x / (0.5 * viewport.x) - 1.0, 1.0 - centre.y / (0.5 * viewport.y));
     vec3 world[3], normal[3], x_row, y_row;
     for (int i = 0; i < 3; i++) {
-        uint vertex_index = UintsRef(push.meshlet_vertices).items[vertex_offset + corners[i]];
-        vec3 position = VerticesRef(push.vertices).items[vertex_index].position;
-        normal[i] = VerticesRef(push.vertices).items[vertex_index].normal;
+        uint vertex_index = UintsRef(GDR_SCENE.meshlet_vertices).items[vertex_offset + corners[i]];
+        vec3 position = VerticesRef(GDR_SCENE.vertices).items[vertex_index].position;
+        normal[i] = VerticesRef(GDR_SCENE.vertices).items[vertex_index].normal;
         vec4 w = model * vec4(position, 1.0);
         vec4 clip = view_projection * w;
         world[i] = w.xyz;
@@ -59,7 +58,7 @@ vec4 shade_pixel(FrameGlobalsRef globals, vec2 viewport, vec2 centre, uint id)
     mat3 cofactor = mat3(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1]));
     vec3 n = cofactor * (b.x * normal[0] + b.y * normal[1] + b.z * normal[2]);
     vec3 position = b.x * world[0] + b.y * world[1] + b.z * world[2];
-    vec3 albedo = gdr_view_albedo(globals.value.view_mode, InstancesRef(push.instances).items[entry.instance].color.rgb,
+    vec3 albedo = gdr_view_albedo(globals.value.view_mode, InstancesRef(GDR_SCENE.instances).items[entry.instance].color.rgb,
                                   entry.instance, entry.meshlet, triangle, meshlets.items[entry.meshlet].group_depth);
     return gdr_shade(globals.value.light_direction.xyz, n, position, albedo);
 }
@@ -73,9 +72,9 @@ void main()
     if (any(greaterThanEqual(pixel, size)))
         return;
     uint index = pixel.y * size.x + pixel.x;
-    uint64_t value = VisbufferRef(push.visbuffer).items[index];
+    uint64_t value = push.visbuffer.items[index];
     uint depth_bits = uint(value >> 32);
-    ResolvedRef resolved = ResolvedRef(RasterParamsRef(push.raster).value.resolved);
+    ResolvedRef resolved = ResolvedRef(RasterParamsRef(GDR_FRAME.raster).value.resolved);
     resolved.items[size.x * size.y + index] = depth_bits;
     if (DEPTH_ONLY)
         return;

@@ -2,6 +2,8 @@
 
 #include <string.h>
 
+#include "vk/vk_image.h"
+
 gdr_status gdr_vk_buffer_create(gdr_vk_allocator *allocator, VkDeviceSize size, VkBufferUsageFlags usage,
                                 gdr_vk_buffer_memory memory, gdr_vk_buffer *out, gdr_error *err)
 {
@@ -69,4 +71,53 @@ gdr_status gdr_vk_buffer_upload(gdr_vk_context *ctx, gdr_vk_buffer *staging, gdr
         status = gdr_vk_end_one_time(ctx, cmd, err);
     }
     return status;
+}
+
+static const gdr_vk_scope everything_before = {VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT};
+static const gdr_vk_scope copy_read = {VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT};
+static const gdr_vk_scope copy_write = {VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT};
+static const gdr_vk_scope host_read = {VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT};
+
+/* A host-visible buffer of `size` bytes for a read-back, and a one-time command buffer begun for it. */
+static gdr_status begin_read_back(gdr_vk_allocator *allocator, VkDeviceSize size, gdr_vk_buffer *out,
+                                  VkCommandBuffer *cmd, gdr_error *err)
+{
+    gdr_status status = gdr_vk_buffer_create(allocator, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, GDR_VK_BUFFER_READBACK,
+                                             out, err);
+    return status == GDR_OK ? gdr_vk_begin_one_time(allocator->ctx, cmd, err) : status;
+}
+
+gdr_status gdr_vk_buffer_read_back(gdr_vk_allocator *allocator, VkBuffer source, VkDeviceSize offset,
+                                   VkDeviceSize size, gdr_vk_buffer *out, gdr_error *err)
+{
+    VkCommandBuffer cmd;
+    gdr_status status = begin_read_back(allocator, size, out, &cmd, err);
+    if (status != GDR_OK)
+        return status;
+    gdr_vk_memory_barrier(cmd, everything_before, copy_read);
+    VkBufferCopy region = {offset, 0, size};
+    vkCmdCopyBuffer(cmd, source, out->buffer, 1, &region);
+    gdr_vk_memory_barrier(cmd, copy_write, host_read);
+    return gdr_vk_end_one_time(allocator->ctx, cmd, err);
+}
+
+gdr_status gdr_vk_image_read_back(gdr_vk_allocator *allocator, const gdr_vk_image *image, VkImageAspectFlags aspect,
+                                  VkImageLayout layout, uint32_t texel_size, gdr_vk_buffer *out, gdr_error *err)
+{
+    VkDeviceSize size = (VkDeviceSize)image->width * image->height * texel_size;
+    VkCommandBuffer cmd;
+    gdr_status status = begin_read_back(allocator, size, out, &cmd, err);
+    if (status != GDR_OK)
+        return status;
+    gdr_vk_image_transition to_copy = {.image = image->image, .aspect = aspect, .from = layout,
+                                       .to = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, .src = everything_before,
+                                       .dst = copy_read};
+    gdr_vk_barrier(cmd, &(gdr_vk_barrier_desc){.images = &to_copy, .image_count = 1});
+    VkBufferImageCopy region = {.imageSubresource = {aspect, 0, 0, 1}, .imageExtent = {image->width, image->height, 1}};
+    vkCmdCopyImageToBuffer(cmd, image->image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, out->buffer, 1, &region);
+    gdr_vk_image_transition back = {.image = image->image, .aspect = aspect, .from = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                    .to = layout, .src = {VK_PIPELINE_STAGE_2_COPY_BIT, 0},
+                                    .dst = {VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0}};
+    gdr_vk_barrier(cmd, &(gdr_vk_barrier_desc){.src = copy_write, .dst = host_read, .images = &back, .image_count = 1});
+    return gdr_vk_end_one_time(allocator->ctx, cmd, err);
 }

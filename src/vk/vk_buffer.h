@@ -31,4 +31,17 @@ gdr_status gdr_vk_staging_create(gdr_vk_allocator *allocator, gdr_vk_buffer *out
 gdr_status gdr_vk_buffer_upload(gdr_vk_context *ctx, gdr_vk_buffer *staging, gdr_vk_buffer *dst,
                                 VkDeviceSize offset, const void *data, VkDeviceSize size, gdr_error *err);
 
+/* A new host-visible buffer (*out) holding a copy of `size` bytes of `source` from `offset`, made
+ * after every earlier submission's writes; waits for the copy. For tests and tools: the memory
+ * goes back with the allocator. */
+gdr_status gdr_vk_buffer_read_back(gdr_vk_allocator *allocator, VkBuffer source, VkDeviceSize offset,
+                                   VkDeviceSize size, gdr_vk_buffer *out, gdr_error *err);
+
+/* The same for mip level 0 of an image left in `layout` (tightly packed texels of `aspect`, whose
+ * texel is `texel_size` bytes); the image is given back in `layout`. */
+struct gdr_vk_image;
+gdr_status gdr_vk_image_read_back(gdr_vk_allocator *allocator, const struct gdr_vk_image *image,
+                                  VkImageAspectFlags aspect, VkImageLayout layout, uint32_t texel_size,
+                                  gdr_vk_buffer *out, gdr_error *err);
+
 #endif

@@ -270,11 +270,11 @@ static void test_culling(gdr_scene *scene, const gdr_pvs *pvs)
 {
     uint32_t n = scene->instance_count;
     gdr_cull_object *objects = malloc(n * sizeof(*objects));
-    gdr_cull_objects_from_scene(objects, scene);
+    gdr_error err;
+    CHECK(gdr_cull_objects_from_scene(objects, scene, &err) == GDR_OK);
     objects[5].flags |= GDR_CULL_OBJECT_DYNAMIC;
     gdr_cull_scene_desc sd = {objects, n, 0, 0};
     gdr_cull_scene *cs;
-    gdr_error err;
     CHECK(gdr_cull_scene_create(&sd, &cs, &err) == GDR_OK);
     gdr_pvs_cache *cache;
     CHECK(gdr_pvs_cache_create(pvs, &cache, &err) == GDR_OK);

@@ -17,7 +17,7 @@ static inline int same_bytes(const void *a, const void *b, size_t n)
     return n == 0 || (a && b && memcmp(a, b, n) == 0);
 }
 
-/* Bit for bit, every field and array (the DAG's groups included). */
+/* Bit for bit, every field and array (the DAG's groups and the LOD hierarchy included). */
 static inline int same_clusters(const gdr_mesh_clusters *x, const gdr_mesh_clusters *y)
 {
     return x->cluster_count == y->cluster_count && x->level0_cluster_count == y->level0_cluster_count &&
@@ -26,7 +26,9 @@ static inline int same_clusters(const gdr_mesh_clusters *x, const gdr_mesh_clust
            same_bytes(x->clusters, y->clusters, sizeof(gdr_cluster) * x->cluster_count) &&
            same_bytes(x->vertices, y->vertices, sizeof(uint32_t) * x->vertex_count) &&
            same_bytes(x->triangles, y->triangles, x->triangle_byte_count) &&
-           same_bytes(x->groups, y->groups, sizeof(gdr_cluster_group) * x->group_count);
+           same_bytes(x->groups, y->groups, sizeof(gdr_cluster_group) * x->group_count) &&
+           x->lod_node_count == y->lod_node_count && x->lod_node_levels == y->lod_node_levels &&
+           same_bytes(x->lod_nodes, y->lod_nodes, sizeof(gdr_lod_node) * x->lod_node_count);
 }
 
 /* Global corner k of triangle t of cluster c. */

@@ -52,6 +52,8 @@ static void add_fake_dag(gdr_mesh *mesh)
     c->groups[1] = (gdr_cluster_group){{0.0f, 0.5f, 0.0f, 4.0f}, INFINITY, 1, n, extra};
     c->group_count = 2;
     c->dag_depth = 1;
+    gdr_error err = {0};
+    CHECK(gdr_mesh_clusters_build_hierarchy(c, &err) == GDR_OK); /* of the made-up DAG */
 }
 
 static gdr_scene *make_scene(void)
@@ -152,6 +154,7 @@ static uint32_t get32(const uint8_t *p)
 }
 
 enum { CLUSTER_BYTES = 72 }; /* docs/CACHE_FORMAT.md: one cluster record in CLDT */
+#define NODE(i) (8 + 48 * (i))  /* LODH: node i of the first mesh */
 
 typedef struct corruption {
     const char *what;     /* expected in the message */
@@ -212,6 +215,17 @@ static void test_group_corruption(void)
         {"section 'CLDT': mesh 0 group 0: clusters 4294967295 (+22)", "CLDT", g + 24, UINT32_MAX, 0},
         {"section 'CLDT': mesh 0 cluster 23: group 2 / refined group 0 does not exist (2 groups)", "CLDT",
          23 * CLUSTER_BYTES + 60, 2, 0},
+        /* The hierarchy (docs/CACHE_FORMAT.md, LODH): node count, levels, then 48-byte nodes: the root
+         * (node 0) over the leaves of group 1 (node 1) and group 0 (node 2). */
+        {"section 'LODH': mesh 0: 1000000000 nodes for 24 clusters", "LODH", 0, 1000000000u, 0},
+        {"section 'LODH': mesh 0: 2 levels, the mesh says 5", "LODH", 4, 5, 0},
+        {"section 'LODH': mesh 0: node 0: does not contain child 1's sphere", "LODH", NODE(0) + 12, 0x3f800000u, 0},
+        {"section 'LODH': mesh 0: node 0: error bounds do not contain child 1's", "LODH", NODE(0) + 16, 0, 0},
+        {"section 'LODH': mesh 0: node 0: children 7 (+2) are not 1 to 8 nodes after it", "LODH", NODE(0) + 24, 7, 0},
+        {"section 'LODH': mesh 0: node 2: group 1 is missing or named twice", "LODH", NODE(2) + 32, 1, 0},
+        {"section 'LODH': mesh 0: node 2: does not contain its group 0's sphere or error", "LODH", NODE(2) + 16,
+         0x3c000000u, 0},
+        {"section 'LODH': mesh 0: node 0: bounds not finite", "LODH", NODE(0), 0x7fc00000u, 0},
     };
     CHECK(s->meshes[0].clusters.cluster_count == 24 && good && bad);
     if (good && bad)
@@ -285,7 +299,10 @@ static void test_corruption(void)
     put32(bad + 8, 1);
     fix_checksums(bad);
     CHECK(gdr_cache_read_memory(bad, size, "corrupt.gdrc", &out, &err) == GDR_ERROR_UNSUPPORTED);
-    CHECK(strstr(err.message, "cache format version 1, this build reads 2; rebuild it") != NULL);
+    char expected[96];
+    snprintf(expected, sizeof expected, "cache format version 1, this build reads %u; rebuild it",
+             GDR_CACHE_FORMAT_VERSION);
+    CHECK(strstr(err.message, expected) != NULL);
     /* The untouched file still reads, and the edits above really did go through the parser. */
     CHECK(gdr_cache_read_memory(good, size, "corrupt.gdrc", &out, &err) == GDR_OK);
     CHECK(out && same_clusters(&out->meshes[0].clusters, c));

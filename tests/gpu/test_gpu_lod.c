@@ -100,13 +100,13 @@ static uint32_t check_cut(const gdr_scene *scene, const gdr_frame_desc *frame, c
     if (!drawn)
         return 0;
     qsort(drawn, count, sizeof *drawn, compare_visible_meshlets);
-    CHECK(stats.lod_applied == (frame->lod_fixed_depth ? frame->lod_depth > 0 : frame->lod_error_px > 0.0f));
+    CHECK(stats.lod.applied == (frame->lod_fixed_depth ? frame->lod_depth > 0 : frame->lod_error_px > 0.0f));
     CHECK(count == stats.meshlets_visible);
-    CHECK(stats.meshlets_lod_culled + stats.meshlets_visible == stats.meshlets_tested);
+    CHECK(stats.lod.meshlets_culled + stats.meshlets_visible == stats.meshlets_tested);
     uint64_t per_depth_clusters = 0, per_depth_triangles = 0;
     for (uint32_t d = 0; d < GDR_LOD_STATS_DEPTH_COUNT; d++) {
-        per_depth_clusters += stats.lod_clusters_per_depth[d];
-        per_depth_triangles += stats.lod_triangles_per_depth[d];
+        per_depth_clusters += stats.lod.clusters_per_depth[d];
+        per_depth_triangles += stats.lod.triangles_per_depth[d];
     }
     CHECK(per_depth_clusters == stats.meshlets_visible);
     CHECK(per_depth_triangles == stats.triangles); /* culling off: every triangle of a drawn cluster */
@@ -191,7 +191,7 @@ static void check_cuts(void)
         /* The indirect pipeline draws full detail and says the cut was not applied. */
         gdr_frame_stats stats;
         gdr_frame_desc indirect = {.camera = far.camera, .pipeline = GDR_PIPELINE_INDIRECT, .lod_error_px = 1.0f};
-        CHECK(render(&indirect, NULL, &stats) && !stats.lod_applied);
+        CHECK(render(&indirect, NULL, &stats) && !stats.lod.applied);
         gdr_renderer_destroy(renderer);
         renderer = NULL;
         gdr_scene_destroy(scene);

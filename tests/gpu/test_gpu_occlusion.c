@@ -99,21 +99,21 @@ static void check_path(const gdr_scene *scene, uint32_t hidden, gdr_pipeline pip
                 fprintf(stderr, "%s frame %u%s: %u pixels differ with occlusion culling\n", name, f, cut ? " (cut)" : "",
                         differ);
         }
-        CHECK(on.occlusion_applied && !off.occlusion_applied);
+        CHECK(on.occlusion.applied && !off.occlusion.applied);
         CHECK(on.validation_messages == 0);
         /* The phases add up: what is drawn is drawn once, in one phase. */
-        CHECK(on.instances_visible == on.instances_early_drawn + on.instances_late_drawn);
-        CHECK(on.instances_late_occluded <= on.instances_late_tested);
+        CHECK(on.instances_visible == on.occlusion.instances_early_drawn + on.occlusion.instances_late_drawn);
+        CHECK(on.occlusion.instances_late_occluded <= on.occlusion.instances_late_tested);
         if (f == 0 || (announce_cuts && cut))
-            CHECK(on.instances_early_drawn == 0 && on.meshlets_early_drawn == 0); /* no history: all late */
+            CHECK(on.occlusion.instances_early_drawn == 0 && on.occlusion.meshlets_early_drawn == 0); /* no history: all late */
         if (pipeline == GDR_PIPELINE_MESH) {
-            CHECK(on.meshlets_visible == on.meshlets_early_drawn + on.meshlets_late_drawn);
-            CHECK(on.meshlets_late_occluded <= on.meshlets_late_tested);
+            CHECK(on.meshlets_visible == on.occlusion.meshlets_early_drawn + on.occlusion.meshlets_late_drawn);
+            CHECK(on.occlusion.meshlets_late_occluded <= on.occlusion.meshlets_late_tested);
         }
-        early_occluded += on.instances_early_occluded;
-        late_occluded += on.instances_late_occluded;
-        late_tested += on.instances_late_tested;
-        meshlets_occluded += on.meshlets_late_occluded;
+        early_occluded += on.occlusion.instances_early_occluded;
+        late_occluded += on.occlusion.instances_late_occluded;
+        late_tested += on.occlusion.instances_late_tested;
+        meshlets_occluded += on.occlusion.meshlets_late_occluded;
         if (f == 1) { /* the dolly towards the wall, with one frame of history */
             uint32_t inside = 0;
             double fraction = hidden_culled_fraction(with, scene, hidden, &camera, &inside);

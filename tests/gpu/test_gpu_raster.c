@@ -95,21 +95,21 @@ static void check_camera(const gdr_frame_desc *base, const char *what)
         CHECK(false);
         return;
     }
-    CHECK(hw->stats.raster == GDR_RASTER_HW && hw->stats.raster_sw_clusters == 0);
-    CHECK(sw->stats.raster == GDR_RASTER_SW && sw->stats.raster_overflow == 0);
+    CHECK(hw->stats.raster.mode == GDR_RASTER_HW && hw->stats.raster.sw_clusters == 0);
+    CHECK(sw->stats.raster.mode == GDR_RASTER_SW && sw->stats.raster.overflow == 0);
     /* The forward path tests clusters in the task shader, the visibility-buffer paths in the
      * cluster-cull compute pass: the same tests (shared/cluster_cull.h), the same decisions. */
     const gdr_frame_stats *f = &forward->stats, *h = &hw->stats;
     CHECK(f->meshlets_tested == h->meshlets_tested && f->meshlets_visible == h->meshlets_visible &&
           f->meshlets_frustum_culled == h->meshlets_frustum_culled &&
-          f->meshlets_cone_culled == h->meshlets_cone_culled && f->meshlets_lod_culled == h->meshlets_lod_culled);
+          f->meshlets_cone_culled == h->meshlets_cone_culled && f->lod.meshlets_culled == h->lod.meshlets_culled);
     if (f->meshlets_visible != h->meshlets_visible)
         fprintf(stderr, "%s: forward tested %u visible %u frustum %u cone %u lod %u; hw tested %u visible %u frustum "
                 "%u cone %u lod %u\n", what, f->meshlets_tested, f->meshlets_visible, f->meshlets_frustum_culled,
-                f->meshlets_cone_culled, f->meshlets_lod_culled, h->meshlets_tested, h->meshlets_visible,
-                h->meshlets_frustum_culled, h->meshlets_cone_culled, h->meshlets_lod_culled);
-    CHECK(h->raster_hw_clusters == h->meshlets_visible);
-    CHECK(sw->stats.raster_sw_clusters + sw->stats.raster_hw_clusters == sw->stats.meshlets_visible);
+                f->meshlets_cone_culled, f->lod.meshlets_culled, h->meshlets_tested, h->meshlets_visible,
+                h->meshlets_frustum_culled, h->meshlets_cone_culled, h->lod.meshlets_culled);
+    CHECK(h->raster.hw_clusters == h->meshlets_visible);
+    CHECK(sw->stats.raster.sw_clusters + sw->stats.raster.hw_clusters == sw->stats.meshlets_visible);
 
     /* The mesh-shader path stores gl_FragCoord.z: the depth buffer of the forward path, bit for
      * bit, wherever either drew (a tie between two triangles has one depth either way). */
@@ -126,7 +126,7 @@ static void check_camera(const gdr_frame_desc *base, const char *what)
     uint32_t sw_vs_hw = differing_triangles(sw, hw), sw_images = differing_pixels(sw, hw);
     printf("%s: sw vs hw: %u pixels name another triangle, %u differ in colour; %u of %u depths beyond "
            "tolerance; compute clusters %u of %u\n", what, sw_vs_hw, sw_images, sw_depth_far, compared,
-           sw->stats.raster_sw_clusters, sw->stats.raster_sw_clusters + sw->stats.raster_hw_clusters);
+           sw->stats.raster.sw_clusters, sw->stats.raster.sw_clusters + sw->stats.raster.hw_clusters);
     if (depth_mismatch) {
         fprintf(stderr, "%s: resolve depth differs from the hardware depth buffer at %u pixels\n", what, depth_mismatch);
         CHECK(false);
@@ -144,7 +144,7 @@ static void check_camera(const gdr_frame_desc *base, const char *what)
     }
     uint32_t hybrid_vs_hw = differing_triangles(hybrid, hw), hybrid_images = differing_pixels(hybrid, hw);
     printf("%s: hybrid (3 px: %u compute, %u mesh-shader clusters) vs hw: %u pixels name another triangle, %u differ "
-           "in colour\n", what, hybrid->stats.raster_sw_clusters, hybrid->stats.raster_hw_clusters, hybrid_vs_hw,
+           "in colour\n", what, hybrid->stats.raster.sw_clusters, hybrid->stats.raster.hw_clusters, hybrid_vs_hw,
            hybrid_images);
     CHECK(hybrid_vs_hw <= MAX_RASTER_DIFFERENCE);
     CHECK(hybrid_images <= MAX_RASTER_DIFFERENCE);
@@ -208,7 +208,7 @@ static void check_demo(void)
         frame = (gdr_frame_desc){.camera = scene->cameras[0]};
         gdr_frame_stats stats;
         CHECK(gdr_renderer_render(renderer, &frame, 1, &stats, &err) == GDR_OK);
-        CHECK(stats.raster == GDR_RASTER_FORWARD && strstr(stats.raster_reason, "no visibility buffer"));
+        CHECK(stats.raster.mode == GDR_RASTER_FORWARD && strstr(stats.raster.reason, "no visibility buffer"));
         frame.raster = GDR_RASTER_SW;
         CHECK(gdr_renderer_render(renderer, &frame, 1, &stats, &err) == GDR_ERROR_UNSUPPORTED &&
               strstr(err.message, "raster sw"));
@@ -386,7 +386,7 @@ static void check_crafted(void)
              gdr_visbuffer_read_pixels(renderer, vis[m], &err) == GDR_OK &&
              gdr_visbuffer_read_overdraw(renderer, counts[m], &err) == GDR_OK;
         CHECK(ok && stats.validation_messages == 0);
-        CHECK(!ok || (m == 0 ? stats.raster_sw_clusters == 0 : stats.raster_hw_clusters == 0));
+        CHECK(!ok || (m == 0 ? stats.raster.sw_clusters == 0 : stats.raster.hw_clusters == 0));
     }
     if (ok) {
         uint32_t differing = 0, twice = 0, holes = 0, covered = 0;

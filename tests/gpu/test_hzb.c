@@ -323,10 +323,10 @@ static void test_size(gdr_vk_context *ctx, const sample_pass *pass, uint32_t dw,
     gdr_hzb hzb = {0};
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
-    gdr_status status = gdr_vk_image_create(&allocator, dw, dh, VK_FORMAT_D32_SFLOAT,
-                                            VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
-                                                VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                                            VK_IMAGE_ASPECT_DEPTH_BIT, &depth, &err);
+    gdr_status status = gdr_vk_image_create(&allocator, &(gdr_vk_image_desc){.width = dw, .height = dh, .format = VK_FORMAT_D32_SFLOAT,
+                                  .usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                                           VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                                  .aspect = VK_IMAGE_ASPECT_DEPTH_BIT}, &depth, &err);
     for (int i = 0; i < 2 && status == GDR_OK; i++) {
         status = gdr_vk_buffer_create(&allocator, pixels * sizeof(float), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                       GDR_VK_BUFFER_UPLOAD, &upload[i], &err);

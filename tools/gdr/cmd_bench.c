@@ -175,7 +175,7 @@ int gdr_cmd_bench(int argc, char **argv)
                 first_cpu = stats.cpu_ms_per_frame_median;
             printf("%10u %9s %7.2f %4s %10u %12llu %10u %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f %10.4f\n",
                    stats.instances_total, gdr_pipeline_name(stats.pipeline),
-                   stats.lod_applied ? (double)frame.lod_error_px : 0.0, stats.occlusion_applied ? "on" : "off",
+                   stats.lod.applied ? (double)frame.lod_error_px : 0.0, stats.occlusion.applied ? "on" : "off",
                    stats.instances_visible,
                    (unsigned long long)stats.triangles,
                    stats.meshlets_visible, stats.cpu_ms_per_frame, stats.cpu_ms_per_frame_median,

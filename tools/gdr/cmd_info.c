@@ -6,6 +6,7 @@
 #include "commands.h"
 #include "gdr/cull.h"
 #include "gdr/io.h"
+#include "gdr/renderer.h"
 
 static void count_warning(void *user, const char *message)
 {
@@ -15,6 +16,10 @@ static void count_warning(void *user, const char *message)
 
 int gdr_cmd_info(int argc, char **argv)
 {
+    if (argc == 2 && strcmp(argv[1], "--passes") == 0) {
+        gdr_describe_frame_passes(stdout); /* docs/PIPELINE.md, "The frame, pass by pass" */
+        return fflush(stdout) == 0 && !ferror(stdout) ? 0 : 1;
+    }
     const char *input = NULL;
     gdr_load_options options = {0};
     unsigned warnings = 0;
@@ -26,7 +31,8 @@ int gdr_cmd_info(int argc, char **argv)
         } else if (strcmp(argv[i], "--cache-dir") == 0 && i + 1 < argc) {
             options.cache_dir = argv[++i];
         } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0 || argv[i][0] == '-' || input) {
-            fputs("usage: gdr info FILE|demo|lod-field|occlusion[:...] [--no-cache] [--cache-dir DIR]\n", stderr);
+            fputs("usage: gdr info FILE|demo|lod-field|occlusion[:...] [--no-cache] [--cache-dir DIR]\n"
+                  "       gdr info --passes\n", stderr);
             return strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0 ? 0 : 2;
         } else {
             input = argv[i];

@@ -15,6 +15,7 @@ static void print_help(FILE *out)
           "  gdr build INPUT -o OUT.gdrc [--pvs]   import INPUT and write the processed-scene cache\n"
           "                               (--pvs: bake the precomputed visibility into it)\n"
           "  gdr info FILE                summarise a scene: meshes, instances, triangles, materials, ...\n"
+          "  gdr info --passes            the passes, resources and barriers of every frame configuration\n"
           "  gdr --help | --version\n"
           "\n"
           "SCENE is a .gltf, .glb, .obj or .gdrc file, or a built-in procedural scene:\n"

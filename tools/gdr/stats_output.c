@@ -26,23 +26,23 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
                 s->triangles_small_culled);
         fprintf(out, "task_workgroups     %u (in 1 indirect mesh-tasks launch; %u lost to overflow)\n",
                 s->task_workgroups, s->task_overflow);
-        fprintf(out, "raster              %s (%s)\n", gdr_raster_name(s->raster), s->raster_reason);
-        if (s->raster != GDR_RASTER_FORWARD) {
+        fprintf(out, "raster              %s (%s)\n", gdr_raster_name(s->raster.mode), s->raster.reason);
+        if (s->raster.mode != GDR_RASTER_FORWARD) {
             fprintf(out, "raster_clusters     compute %u (%llu triangles), mesh shaders %u (%llu triangles)",
-                    s->raster_sw_clusters, (unsigned long long)s->raster_sw_triangles, s->raster_hw_clusters,
-                    (unsigned long long)s->raster_hw_triangles);
-            if (s->raster == GDR_RASTER_HYBRID)
-                fprintf(out, "; threshold %g px", (double)s->sw_threshold_px);
-            fprintf(out, s->raster_overflow ? "; %u lost to overflow\n" : "\n", s->raster_overflow);
+                    s->raster.sw_clusters, (unsigned long long)s->raster.sw_triangles, s->raster.hw_clusters,
+                    (unsigned long long)s->raster.hw_triangles);
+            if (s->raster.mode == GDR_RASTER_HYBRID)
+                fprintf(out, "; threshold %g px", (double)s->raster.sw_threshold_px);
+            fprintf(out, s->raster.overflow ? "; %u lost to overflow\n" : "\n", s->raster.overflow);
             fprintf(out, "raster_gpu_ms       cluster cull %.4f, mesh shaders %.4f, compute %.4f, resolve %.4f "
-                         "(part of draw)\n", s->raster_cull_ms, s->raster_hw_ms, s->raster_sw_ms, s->raster_resolve_ms);
+                         "(part of draw)\n", s->raster.cull_ms, s->raster.hw_ms, s->raster.sw_ms, s->raster.resolve_ms);
         }
-        if (s->lod_applied) {
-            fprintf(out, "meshlets_lod_culled %u (not in the LOD cut)\n", s->meshlets_lod_culled);
+        if (s->lod.applied) {
+            fprintf(out, "meshlets_lod_culled %u (not in the LOD cut)\n", s->lod.meshlets_culled);
             fprintf(out, "lod_depths          clusters/triangles drawn per DAG depth:");
-            for (uint32_t d = 0; d < s->lod_depth_count; d++)
-                fprintf(out, " %u:%u/%llu", d, s->lod_clusters_per_depth[d],
-                        (unsigned long long)s->lod_triangles_per_depth[d]);
+            for (uint32_t d = 0; d < s->lod.depth_count; d++)
+                fprintf(out, " %u:%u/%llu", d, s->lod.clusters_per_depth[d],
+                        (unsigned long long)s->lod.triangles_per_depth[d]);
             fputc('\n', out);
         }
     } else if (s->pipeline == GDR_PIPELINE_CPU) {
@@ -51,18 +51,20 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
     } else {
         fprintf(out, "draws               %u (in %u indirect draw call)\n", s->draws, s->draw_calls);
     }
-    if (s->occlusion_applied) {
+    if (s->occlusion.applied) {
         fprintf(out, "occlusion early     instances %u drawn, %u occluded (by last frame's pyramid); clusters %u drawn\n",
-                s->instances_early_drawn, s->instances_early_occluded, s->meshlets_early_drawn);
+                s->occlusion.instances_early_drawn, s->occlusion.instances_early_occluded, s->occlusion.meshlets_early_drawn);
         fprintf(out, "occlusion late      instances %u tested, %u occluded, %u drawn; clusters %u tested, %u occluded, "
-                "%u drawn\n", s->instances_late_tested, s->instances_late_occluded, s->instances_late_drawn,
-                s->meshlets_late_tested, s->meshlets_late_occluded, s->meshlets_late_drawn);
+                "%u drawn\n", s->occlusion.instances_late_tested, s->occlusion.instances_late_occluded, s->occlusion.instances_late_drawn,
+                s->occlusion.meshlets_late_tested, s->occlusion.meshlets_late_occluded, s->occlusion.meshlets_late_drawn);
     }
     fprintf(out, "cpu_ms_per_frame    %.4f (of which vkQueueSubmit2 %.4f; commands recorded in %u of the frames, "
             "the others submitted again)\n", s->cpu_ms_per_frame, s->cpu_submit_ms_per_frame, s->frames_recorded);
     fprintf(out, "gpu_ms_per_frame    %.4f\n", s->gpu_ms_per_frame);
     for (uint32_t p = 0; p < s->pass_count; p++)
         fprintf(out, "  gpu_ms.%-16s %.4f\n", s->passes[p].name, s->passes[p].gpu_ms);
+    fprintf(out, "gpu_memory_bytes    %llu (scene %llu, frame %llu)\n", (unsigned long long)s->memory.device_bytes,
+            (unsigned long long)s->memory.scene_bytes, (unsigned long long)s->memory.frame_bytes);
     fprintf(out, "validation_messages %u\n", s->validation_messages);
 }
 
@@ -75,44 +77,44 @@ void stats_add_meshlet_json(cJSON *object, const gdr_frame_stats *s)
     cJSON_AddNumberToObject(object, "meshlets_visible", s->meshlets_visible);
     cJSON_AddNumberToObject(object, "triangles_backface_culled", s->triangles_backface_culled);
     cJSON_AddNumberToObject(object, "triangles_small_culled", s->triangles_small_culled);
-    cJSON_AddBoolToObject(object, "lod_applied", s->lod_applied);
-    cJSON_AddNumberToObject(object, "meshlets_lod_culled", s->meshlets_lod_culled);
+    cJSON_AddBoolToObject(object, "lod_applied", s->lod.applied);
+    cJSON_AddNumberToObject(object, "meshlets_lod_culled", s->lod.meshlets_culled);
     cJSON *clusters = cJSON_AddArrayToObject(object, "lod_clusters_per_depth");
     cJSON *triangles = cJSON_AddArrayToObject(object, "lod_triangles_per_depth");
-    for (uint32_t d = 0; clusters && triangles && d < s->lod_depth_count; d++) {
-        cJSON_AddItemToArray(clusters, cJSON_CreateNumber(s->lod_clusters_per_depth[d]));
-        cJSON_AddItemToArray(triangles, cJSON_CreateNumber((double)s->lod_triangles_per_depth[d]));
+    for (uint32_t d = 0; clusters && triangles && d < s->lod.depth_count; d++) {
+        cJSON_AddItemToArray(clusters, cJSON_CreateNumber(s->lod.clusters_per_depth[d]));
+        cJSON_AddItemToArray(triangles, cJSON_CreateNumber((double)s->lod.triangles_per_depth[d]));
     }
-    cJSON_AddStringToObject(object, "raster", gdr_raster_name(s->raster));
-    cJSON_AddStringToObject(object, "raster_reason", s->raster_reason);
-    if (s->raster != GDR_RASTER_FORWARD) {
-        cJSON_AddNumberToObject(object, "sw_threshold_px", s->sw_threshold_px);
-        cJSON_AddNumberToObject(object, "raster_sw_clusters", s->raster_sw_clusters);
-        cJSON_AddNumberToObject(object, "raster_hw_clusters", s->raster_hw_clusters);
-        cJSON_AddNumberToObject(object, "raster_sw_triangles", (double)s->raster_sw_triangles);
-        cJSON_AddNumberToObject(object, "raster_hw_triangles", (double)s->raster_hw_triangles);
-        cJSON_AddNumberToObject(object, "raster_overflow", s->raster_overflow);
-        cJSON_AddNumberToObject(object, "raster_cull_ms", s->raster_cull_ms);
-        cJSON_AddNumberToObject(object, "raster_hw_ms", s->raster_hw_ms);
-        cJSON_AddNumberToObject(object, "raster_sw_ms", s->raster_sw_ms);
-        cJSON_AddNumberToObject(object, "raster_resolve_ms", s->raster_resolve_ms);
+    cJSON_AddStringToObject(object, "raster", gdr_raster_name(s->raster.mode));
+    cJSON_AddStringToObject(object, "raster_reason", s->raster.reason);
+    if (s->raster.mode != GDR_RASTER_FORWARD) {
+        cJSON_AddNumberToObject(object, "sw_threshold_px", s->raster.sw_threshold_px);
+        cJSON_AddNumberToObject(object, "raster_sw_clusters", s->raster.sw_clusters);
+        cJSON_AddNumberToObject(object, "raster_hw_clusters", s->raster.hw_clusters);
+        cJSON_AddNumberToObject(object, "raster_sw_triangles", (double)s->raster.sw_triangles);
+        cJSON_AddNumberToObject(object, "raster_hw_triangles", (double)s->raster.hw_triangles);
+        cJSON_AddNumberToObject(object, "raster_overflow", s->raster.overflow);
+        cJSON_AddNumberToObject(object, "raster_cull_ms", s->raster.cull_ms);
+        cJSON_AddNumberToObject(object, "raster_hw_ms", s->raster.hw_ms);
+        cJSON_AddNumberToObject(object, "raster_sw_ms", s->raster.sw_ms);
+        cJSON_AddNumberToObject(object, "raster_resolve_ms", s->raster.resolve_ms);
     }
 }
 
 void stats_add_occlusion_json(cJSON *object, const gdr_frame_stats *s)
 {
-    cJSON_AddBoolToObject(object, "occlusion_applied", s->occlusion_applied);
-    if (!s->occlusion_applied)
+    cJSON_AddBoolToObject(object, "occlusion_applied", s->occlusion.applied);
+    if (!s->occlusion.applied)
         return;
-    cJSON_AddNumberToObject(object, "instances_early_drawn", s->instances_early_drawn);
-    cJSON_AddNumberToObject(object, "instances_early_occluded", s->instances_early_occluded);
-    cJSON_AddNumberToObject(object, "instances_late_tested", s->instances_late_tested);
-    cJSON_AddNumberToObject(object, "instances_late_occluded", s->instances_late_occluded);
-    cJSON_AddNumberToObject(object, "instances_late_drawn", s->instances_late_drawn);
-    cJSON_AddNumberToObject(object, "meshlets_early_drawn", s->meshlets_early_drawn);
-    cJSON_AddNumberToObject(object, "meshlets_late_tested", s->meshlets_late_tested);
-    cJSON_AddNumberToObject(object, "meshlets_late_occluded", s->meshlets_late_occluded);
-    cJSON_AddNumberToObject(object, "meshlets_late_drawn", s->meshlets_late_drawn);
+    cJSON_AddNumberToObject(object, "instances_early_drawn", s->occlusion.instances_early_drawn);
+    cJSON_AddNumberToObject(object, "instances_early_occluded", s->occlusion.instances_early_occluded);
+    cJSON_AddNumberToObject(object, "instances_late_tested", s->occlusion.instances_late_tested);
+    cJSON_AddNumberToObject(object, "instances_late_occluded", s->occlusion.instances_late_occluded);
+    cJSON_AddNumberToObject(object, "instances_late_drawn", s->occlusion.instances_late_drawn);
+    cJSON_AddNumberToObject(object, "meshlets_early_drawn", s->occlusion.meshlets_early_drawn);
+    cJSON_AddNumberToObject(object, "meshlets_late_tested", s->occlusion.meshlets_late_tested);
+    cJSON_AddNumberToObject(object, "meshlets_late_occluded", s->occlusion.meshlets_late_occluded);
+    cJSON_AddNumberToObject(object, "meshlets_late_drawn", s->occlusion.meshlets_late_drawn);
 }
 
 char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
@@ -151,6 +153,9 @@ char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
     cJSON *passes = cJSON_AddObjectToObject(root, "gpu_ms");
     for (uint32_t p = 0; passes && p < s->pass_count; p++)
         cJSON_AddNumberToObject(passes, s->passes[p].name, s->passes[p].gpu_ms);
+    cJSON_AddNumberToObject(root, "gpu_memory_bytes", (double)s->memory.device_bytes);
+    cJSON_AddNumberToObject(root, "gpu_memory_scene_bytes", (double)s->memory.scene_bytes);
+    cJSON_AddNumberToObject(root, "gpu_memory_frame_bytes", (double)s->memory.frame_bytes);
     cJSON_AddNumberToObject(root, "validation_messages", s->validation_messages);
     char *text = cJSON_Print(root);
     cJSON_Delete(root);

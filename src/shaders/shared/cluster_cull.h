@@ -14,7 +14,6 @@
 #define GDR_PHASE_EARLY 1u
 #define GDR_PHASE_LATE 2u
 
-layout(buffer_reference, scalar) writeonly buffer VisibleMeshletsRef { uvec2 items[]; };
 
 // What the tests decided for one invocation's cluster.
 struct GdrClusterResult {
@@ -49,9 +48,9 @@ bool gdr_lod_passes(GdrGpuFrameGlobals g, vec4 sphere, float error, int depth, m
 bool gdr_cluster_occlusion_phase(GdrGpuFrameGlobals g, uint phase, GdrGpuInstance instance, GdrGpuTaskCommand task,
                                  uint lane, bool candidate, vec3 center, float radius, out bool occluded)
 {
-    uint mesh_first = MeshesRef(push.meshes).items[instance.mesh].meshlet_offset;
+    uint mesh_first = MeshesRef(GDR_SCENE.meshes).items[instance.mesh].meshlet_offset;
     uint bit = instance.meshlet_visibility_offset + (task.meshlet_first + lane - mesh_first);
-    VisibilityRef bits = VisibilityRef(g.meshlet_visibility);
+    VisibilityRef bits = VisibilityRef(GDR_SCENE.meshlet_visibility);
     bool was_visible = (bits.items[bit >> 5] & (1u << (bit & 31u))) != 0u;
     occluded = false;
     if (phase == GDR_PHASE_EARLY)
@@ -84,14 +83,14 @@ GdrClusterResult gdr_cluster_test(GdrGpuFrameGlobals g, uint phase, uint task_in
     result.flags = 0u;
     result.depth = 0;
     result.triangles = 0u;
-    DrawStatsRef stats = DrawStatsRef(push.draw_stats);
+    DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
     uint task_count = min(phase == GDR_PHASE_LATE ? stats.value.late_task_count : stats.value.task_count,
                           g.task_capacity);
     if (task_index >= task_count)
         return result;
     // The late phase's commands follow the early phase's region (drawcull.comp).
     GdrGpuTaskCommand task =
-        TaskCommandsRef(push.tasks + (phase == GDR_PHASE_LATE ? uint64_t(g.task_capacity) * 16ul : 0ul)).items[task_index];
+        TaskCommandsRef(uint64_t(GDR_FRAME.tasks) + (phase == GDR_PHASE_LATE ? uint64_t(g.task_capacity) * 16ul : 0ul)).items[task_index];
     result.instance = task.instance;
     result.flags = task.flags;
     result.meshlet = task.meshlet_first + lane;
@@ -99,8 +98,8 @@ GdrClusterResult gdr_cluster_test(GdrGpuFrameGlobals g, uint phase, uint task_in
         return result;
     result.in_task = true;
 
-    GdrGpuMeshlet meshlet = MeshletsRef(push.meshlets).items[result.meshlet];
-    GdrGpuInstance instance = InstancesRef(push.instances).items[task.instance];
+    GdrGpuMeshlet meshlet = MeshletsRef(GDR_SCENE.meshlets).items[result.meshlet];
+    GdrGpuInstance instance = InstancesRef(GDR_SCENE.instances).items[task.instance];
     mat4 model = instance.model;
     vec3 center = (g.view * (model * vec4(meshlet.sphere.xyz, 1.0))).xyz;
     float radius = meshlet.sphere.w * gdr_max_axis_scale(model[0].xyz, model[1].xyz, model[2].xyz);
@@ -154,10 +153,10 @@ void gdr_count_lod_depths(DrawStatsRef stats, bool visible, int depth, uint tria
 // counter and subgroup), and for tests the visible clusters' list when the frame asks for it.
 void gdr_cluster_count(GdrGpuFrameGlobals g, uint phase, GdrClusterResult r)
 {
-    DrawStatsRef stats = DrawStatsRef(push.draw_stats);
+    DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
     if ((g.flags & GDR_FRAME_RECORD_MESHLETS) != 0u && r.visible) {
         uint at = atomicAdd(stats.value.meshlets_recorded, 1u);
-        VisibleMeshletsRef(push.visible_meshlets).items[at] = uvec2(r.instance, r.meshlet);
+        VisibleMeshletsRef(GDR_FRAME.visible_meshlets).items[at] = uvec2(r.instance, r.meshlet);
     }
     gdr_count_lod_depths(stats, r.visible, r.depth, r.triangles);
     if (phase == GDR_PHASE_EARLY) {

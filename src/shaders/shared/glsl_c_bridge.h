@@ -17,6 +17,13 @@
 #define gdr_abs abs
 #define gdr_max max
 #define gdr_sqrt sqrt
+/* A typed GPU reference: in GLSL a buffer_reference type (declared with GDR_DECLARE_REF before
+ * the structs that hold it, defined in glsl_buffers.h), in C its 64-bit device address. */
+#define GDR_REF(reference_type) reference_type
+#define GDR_DECLARE_REF(reference_type) layout(buffer_reference) buffer reference_type;
+/* Layout checks are C's: GLSL ignores them. */
+#define GDR_ASSERT_SIZE(type, size)
+#define GDR_ASSERT_OFFSET(type, field, offset)
 #else
 #include <math.h>
 #include <stdbool.h>
@@ -32,6 +39,13 @@ typedef uint64_t gdr_uint64;
 #define gdr_abs fabsf
 #define gdr_max fmaxf
 #define gdr_sqrt sqrtf
+#include <stddef.h>
+#define GDR_REF(reference_type) uint64_t
+#define GDR_DECLARE_REF(reference_type)
+/* The scalar block layout GLSL uses, checked where each struct is declared. */
+#define GDR_ASSERT_SIZE(type, size) _Static_assert(sizeof(type) == (size), #type ": size")
+#define GDR_ASSERT_OFFSET(type, field, offset) \
+    _Static_assert(offsetof(type, field) == (offset), #type "." #field ": offset")
 #endif
 
 #endif

@@ -1,5 +1,5 @@
-/* Every struct the GPU reads or writes, declared once for C and GLSL (scalar block layout).
- * The C side checks sizes and offsets in src/render/gpu_types_check.c. */
+/* Every struct the GPU reads or writes, declared once for C and GLSL (scalar block layout), each
+ * followed by the C checks of its size and offsets. GPU pointers are typed references (GDR_REF). */
 #ifndef GDR_GPU_TYPES_H
 #define GDR_GPU_TYPES_H
 
@@ -7,12 +7,38 @@
 #include "gpu_config.h"
 #include "occlusion_math.h"
 
+/* The reference types the structs below hold (GLSL defines them in glsl_buffers.h). */
+GDR_DECLARE_REF(FrameGlobalsRef)
+GDR_DECLARE_REF(SceneRef)
+GDR_DECLARE_REF(FrameBuffersRef)
+GDR_DECLARE_REF(InstancesRef)
+GDR_DECLARE_REF(MeshesRef)
+GDR_DECLARE_REF(VerticesRef)
+GDR_DECLARE_REF(MeshletsRef)
+GDR_DECLARE_REF(LodNodesRef)
+GDR_DECLARE_REF(UintsRef)
+GDR_DECLARE_REF(VisibilityRef)
+GDR_DECLARE_REF(DrawCommandsRef)
+GDR_DECLARE_REF(DrawStatsRef)
+GDR_DECLARE_REF(InstanceUpdatesRef)
+GDR_DECLARE_REF(TaskCommandsRef)
+GDR_DECLARE_REF(OverdrawRef)
+GDR_DECLARE_REF(VisibleMeshletsRef)
+GDR_DECLARE_REF(VisbufferRef)
+GDR_DECLARE_REF(RasterParamsRef)
+GDR_DECLARE_REF(RasterCountersRef)
+GDR_DECLARE_REF(RasterClustersRef)
+GDR_DECLARE_REF(ResolvedRef)
+
 /* One vertex of the geometry pool (vertex input binding 0). */
 GDR_STRUCT_BEGIN(GdrGpuVertex)
     gdr_vec3 position;
     gdr_vec3 normal;
     gdr_vec2 uv;
 GDR_STRUCT_END(GdrGpuVertex)
+GDR_ASSERT_SIZE(GdrGpuVertex, 32);
+GDR_ASSERT_OFFSET(GdrGpuVertex, normal, 12);
+GDR_ASSERT_OFFSET(GdrGpuVertex, uv, 24);
 
 /* Where a mesh lives in the merged vertex, index and cluster buffers, and its bounds (seed 003, plan A).
  * The mesh's clusters are GdrGpuMeshlet[meshlet_offset .. + lod_cluster_count): level 0 first
@@ -30,16 +56,20 @@ GDR_STRUCT_BEGIN(GdrGpuMesh)
     gdr_uint root_first;        /* first cluster of the root group, relative to meshlet_offset */
     gdr_uint root_cluster_count; /* 0 without a DAG: no root shortcut */
     gdr_uint root_task_count;
-    gdr_uint reserved0;
+    gdr_uint lod_node_offset;   /* the mesh's LOD hierarchy: GdrGpuLodNode[lod_node_offset .. + lod_node_count) */
     /* The root shortcut: a sphere containing, and the largest error of, the groups the root
      * group's clusters were made from. When it passes, each of them passes (errors and spheres
      * are monotonic up the DAG), so the cut is exactly the root group's clusters. */
     gdr_vec4 root_refined_sphere;
     float root_refined_error;
-    gdr_uint reserved1;
-    gdr_uint reserved2;
+    gdr_uint lod_node_count;    /* >= 1 for a mesh with clusters; node 0 of the mesh is its root */
+    gdr_uint lod_node_levels;   /* levels of the mesh's hierarchy (a traversal level by level needs this many steps) */
     gdr_uint reserved3;
 GDR_STRUCT_END(GdrGpuMesh)
+GDR_ASSERT_SIZE(GdrGpuMesh, 96);
+GDR_ASSERT_OFFSET(GdrGpuMesh, bounds, 16);
+GDR_ASSERT_OFFSET(GdrGpuMesh, task_count, 36);
+GDR_ASSERT_OFFSET(GdrGpuMesh, root_refined_sphere, 64);
 
 /* One cluster of the geometry pool (gdr_cluster of gdr/geometry.h, with pool-global offsets), with
  * what the LOD cut (issue 5, gdr/geometry.h "The cut") needs of its two groups inline: the group it
@@ -66,6 +96,38 @@ GDR_STRUCT_BEGIN(GdrGpuMeshlet)
     gdr_uint reserved1;
     gdr_uint reserved2;
 GDR_STRUCT_END(GdrGpuMeshlet)
+GDR_ASSERT_SIZE(GdrGpuMeshlet, 128);
+GDR_ASSERT_OFFSET(GdrGpuMeshlet, sphere, 16);
+GDR_ASSERT_OFFSET(GdrGpuMeshlet, cone_cutoff, 44);
+GDR_ASSERT_OFFSET(GdrGpuMeshlet, group, 60);
+GDR_ASSERT_OFFSET(GdrGpuMeshlet, group_sphere, 80);
+GDR_ASSERT_OFFSET(GdrGpuMeshlet, group_error, 112);
+
+/* One node of a mesh's LOD hierarchy: gdr_lod_node of gdr/geometry.h, whose contract it shares
+ * (the CPU array is uploaded as it is). Indices are mesh-local: an inner node's children are nodes
+ * [first, first + count) of its mesh, a leaf's clusters are the mesh's clusters
+ * [first, first + count). The node test is gdr_lod_node_may_draw (lod_math.h). */
+GDR_STRUCT_BEGIN(GdrGpuLodNode)
+    gdr_vec4 sphere;         /* mesh space: contains every group, refined group and cluster sphere below */
+    float max_error;         /* largest group error below (INFINITY when the root group is below) */
+    float min_refined_error; /* smallest refined-group error below; 0 when a cluster below has none */
+    gdr_uint first;          /* inner: first child node; leaf: first cluster */
+    gdr_uint count;          /* inner: children (1 .. GDR_GPU_LOD_NODE_MAX_CHILDREN); leaf: clusters */
+    gdr_uint group;          /* leaf: its group (GDR_GPU_NO_GROUP without a DAG); inner: GDR_GPU_NO_GROUP */
+    gdr_uint flags;          /* GDR_GPU_LOD_NODE_LEAF */
+    gdr_uint reserved0;
+    gdr_uint reserved1;
+GDR_STRUCT_END(GdrGpuLodNode)
+GDR_ASSERT_SIZE(GdrGpuLodNode, 48);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, max_error, 16);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, min_refined_error, 20);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, first, 24);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, count, 28);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, group, 32);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, flags, 36);
+
+#define GDR_GPU_LOD_NODE_LEAF 1u
+#define GDR_GPU_LOD_NODE_MAX_CHILDREN 8u
 
 /* Task-shader work written by the instance cull of the meshlet pipeline: one task workgroup tests
  * clusters [meshlet_first, meshlet_first + meshlet_count) of one instance. */
@@ -75,6 +137,7 @@ GDR_STRUCT_BEGIN(GdrGpuTaskCommand)
     gdr_uint meshlet_count; /* 1 .. GDR_TASK_WORKGROUP_SIZE */
     gdr_uint flags;         /* GDR_TASK_* */
 GDR_STRUCT_END(GdrGpuTaskCommand)
+GDR_ASSERT_SIZE(GdrGpuTaskCommand, 16);
 
 #define GDR_TASK_LOD_ACCEPTED 1u /* the root shortcut chose these clusters: no LOD test */
 #define GDR_TASK_DRAWN_EARLY 2u  /* late phase (issue 6): the instance was drawn in the early phase */
@@ -90,6 +153,9 @@ GDR_STRUCT_BEGIN(GdrGpuInstance)
     gdr_uint meshlet_visibility_offset; /* first bit of this instance's clusters in the cluster visibility bits */
     gdr_uint reserved1;
 GDR_STRUCT_END(GdrGpuInstance)
+GDR_ASSERT_SIZE(GdrGpuInstance, 96);
+GDR_ASSERT_OFFSET(GdrGpuInstance, color, 64);
+GDR_ASSERT_OFFSET(GdrGpuInstance, mesh, 80);
 
 /* A fixed-size "tag + data" record of the per-frame instance ring (seed 000). */
 #define GDR_UPDATE_TAG_INSTANCE 1u /* replace instance `index` with `instance` */
@@ -100,6 +166,8 @@ GDR_STRUCT_BEGIN(GdrGpuInstanceUpdate)
     gdr_uint reserved1;
     GdrGpuInstance instance;
 GDR_STRUCT_END(GdrGpuInstanceUpdate)
+GDR_ASSERT_SIZE(GdrGpuInstanceUpdate, 112);
+GDR_ASSERT_OFFSET(GdrGpuInstanceUpdate, instance, 16);
 
 /* VkDrawIndexedIndirectCommand, written by the cull pass. first_instance carries the instance index. */
 GDR_STRUCT_BEGIN(GdrGpuDrawCommand)
@@ -109,6 +177,7 @@ GDR_STRUCT_BEGIN(GdrGpuDrawCommand)
     gdr_int vertex_offset;
     gdr_uint first_instance;
 GDR_STRUCT_END(GdrGpuDrawCommand)
+GDR_ASSERT_SIZE(GdrGpuDrawCommand, 20); /* VkDrawIndexedIndirectCommand: gpu_types_check.c */
 
 /* Counters of a frame, zeroed before the cull. draw_count (offset 0) is the count for
  * vkCmdDrawIndexedIndirectCount; task_groups (offset 16) is the VkDrawMeshTasksIndirectCommandEXT
@@ -161,6 +230,37 @@ GDR_STRUCT_BEGIN(GdrGpuDrawStats)
     gdr_uint reserved_cull0;
     gdr_uint reserved_cull1;
 GDR_STRUCT_END(GdrGpuDrawStats)
+GDR_ASSERT_SIZE(GdrGpuDrawStats, 64 + 8 * GDR_LOD_STATS_DEPTHS + 96);
+GDR_ASSERT_OFFSET(GdrGpuDrawStats, draw_count, 0);
+GDR_ASSERT_OFFSET(GdrGpuDrawStats, task_groups_x, 16);
+
+/* The scene's buffers: written once, when the scene is uploaded. */
+GDR_STRUCT_BEGIN(GdrGpuScene)
+    GDR_REF(InstancesRef) instances;          /* GdrGpuInstance[], persistent; the update ring changes it */
+    GDR_REF(MeshesRef) meshes;                /* GdrGpuMesh[] */
+    GDR_REF(VerticesRef) vertices;            /* GdrGpuVertex[], all meshes merged */
+    GDR_REF(MeshletsRef) meshlets;            /* GdrGpuMeshlet[], all meshes' clusters */
+    GDR_REF(UintsRef) meshlet_vertices;       /* global vertex index per cluster-local vertex */
+    GDR_REF(UintsRef) meshlet_triangles;      /* the bytes of the cluster-local triangles */
+    GDR_REF(VisibilityRef) instance_visibility; /* occlusion history: GDR_INSTANCE_VISIBLE_* per instance */
+    GDR_REF(VisibilityRef) meshlet_visibility;  /* occlusion history: a bit per cluster of every instance */
+    GDR_REF(LodNodesRef) lod_nodes;           /* GdrGpuLodNode[], every mesh's LOD hierarchy (GdrGpuMesh.lod_node_*) */
+GDR_STRUCT_END(GdrGpuScene)
+GDR_ASSERT_SIZE(GdrGpuScene, 72);
+
+/* A frame slot's buffers: written once, when the slot is made (and when a buffer made on first use
+ * appears). Shaders read it and GdrGpuScene in place (GDR_SCENE, GDR_FRAME), never as a local
+ * copy: a local struct holding references is invalid SPIR-V from glslang. */
+GDR_STRUCT_BEGIN(GdrGpuFrameBuffers)
+    GDR_REF(DrawCommandsRef) draws;           /* GdrGpuDrawCommand[2 * instances]: early (or only), late */
+    GDR_REF(DrawStatsRef) draw_stats;         /* GdrGpuDrawStats */
+    GDR_REF(InstanceUpdatesRef) updates;      /* this frame's segment of the instance update ring */
+    GDR_REF(TaskCommandsRef) tasks;           /* GdrGpuTaskCommand[2 * task_capacity]: early (or only), late */
+    GDR_REF(OverdrawRef) overdraw;            /* uint per pixel, then the maximum (overdraw view) */
+    GDR_REF(VisibleMeshletsRef) visible_meshlets; /* (instance, global cluster) pairs when recording */
+    GDR_REF(RasterParamsRef) raster;          /* GdrGpuRasterParams of the slot */
+GDR_STRUCT_END(GdrGpuFrameBuffers)
+GDR_ASSERT_SIZE(GdrGpuFrameBuffers, 56);
 
 /* Per-frame constants, written by the CPU into its frame's slot. */
 GDR_STRUCT_BEGIN(GdrGpuFrameGlobals)
@@ -185,9 +285,12 @@ GDR_STRUCT_BEGIN(GdrGpuFrameGlobals)
     gdr_uint reserved1;
     gdr_uint reserved2;
     GdrOcclusionParams occlusion; /* GDR_FRAME_OCCLUSION: the camera and the depth pyramid */
-    gdr_uint64 instance_visibility; /* uint[] per instance: GDR_INSTANCE_VISIBLE_* bits */
-    gdr_uint64 meshlet_visibility;  /* uint[] of bits, one per cluster of every instance */
 GDR_STRUCT_END(GdrGpuFrameGlobals)
+GDR_ASSERT_SIZE(GdrGpuFrameGlobals, 272);
+GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, frustum, 128);
+GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, znear, 176);
+GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, update_count, 192);
+GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, viewport, 208);
 
 #define GDR_FRAME_MESHLET_FRUSTUM 1u  /* task shader: cluster sphere vs frustum */
 #define GDR_FRAME_MESHLET_CONE 2u     /* task shader: cluster normal cone vs camera */
@@ -208,24 +311,16 @@ GDR_STRUCT_END(GdrGpuFrameGlobals)
 #define GDR_VIEW_OVERDRAW 4u  /* fragments per pixel, as a heat map */
 #define GDR_VIEW_LOD 5u       /* colour from the cluster's DAG depth */
 
-/* Push constants of every pass: device addresses of the buffers it uses. */
+/* Push constants of every frame pass: the frame's globals and buffers, the scene, and the
+ * visibility buffer, which every rasterised pixel writes (reading its address from memory per
+ * fragment cost 9% of the mesh-shader raster on the H100). */
 GDR_STRUCT_BEGIN(GdrGpuPushConstants)
-    gdr_uint64 globals;    /* GdrGpuFrameGlobals */
-    gdr_uint64 instances;  /* GdrGpuInstance[] */
-    gdr_uint64 meshes;     /* GdrGpuMesh[] */
-    gdr_uint64 draws;      /* GdrGpuDrawCommand[] */
-    gdr_uint64 draw_stats; /* GdrGpuDrawStats */
-    gdr_uint64 updates;    /* GdrGpuInstanceUpdate[] of this frame's ring slot */
-    gdr_uint64 vertices;   /* GdrGpuVertex[] */
-    gdr_uint64 meshlets;   /* GdrGpuMeshlet[] */
-    gdr_uint64 meshlet_vertices;  /* uint[]: global vertex index per cluster-local vertex */
-    gdr_uint64 meshlet_triangles; /* uint[] holding the bytes of the cluster-local triangles */
-    gdr_uint64 tasks;      /* GdrGpuTaskCommand[] */
-    gdr_uint64 overdraw;   /* uint[] per pixel (overdraw view) */
-    gdr_uint64 visible_meshlets; /* uvec2[] (instance, global cluster index) when recording */
-    gdr_uint64 visbuffer;  /* uint64[] per pixel: the visibility buffer (issue 8) */
-    gdr_uint64 raster;     /* GdrGpuRasterParams of this frame's slot (issue 8) */
+    GDR_REF(FrameGlobalsRef) globals; /* GdrGpuFrameGlobals of the frame's slot */
+    GDR_REF(FrameBuffersRef) frame;   /* GdrGpuFrameBuffers of the frame's slot */
+    GDR_REF(SceneRef) scene;          /* GdrGpuScene */
+    GDR_REF(VisbufferRef) visbuffer;  /* uint64 per pixel: the visibility buffer */
 GDR_STRUCT_END(GdrGpuPushConstants)
+GDR_ASSERT_SIZE(GdrGpuPushConstants, 32);
 
 /* --- Hybrid rasterisation (issue 8): the visibility buffer and the software rasteriser ----------
  *
@@ -244,6 +339,7 @@ GDR_STRUCT_BEGIN(GdrGpuRasterCluster)
     gdr_uint instance;
     gdr_uint meshlet; /* global GdrGpuMeshlet index */
 GDR_STRUCT_END(GdrGpuRasterCluster)
+GDR_ASSERT_SIZE(GdrGpuRasterCluster, 8);
 
 /* Counters of a frame, zeroed before the cull. The first three words are the
  * VkDispatchIndirectCommand of the software rasteriser, draw_x..z the VkDrawMeshTasksIndirectCommandEXT
@@ -268,17 +364,22 @@ GDR_STRUCT_BEGIN(GdrGpuRasterCounters)
     gdr_uint draw_z;
     gdr_uint reserved0;
 GDR_STRUCT_END(GdrGpuRasterCounters)
+GDR_ASSERT_SIZE(GdrGpuRasterCounters, 72);
+GDR_ASSERT_OFFSET(GdrGpuRasterCounters, dispatch_z, 8);
 
 /* Per-frame raster parameters, written by the CPU into its frame's slot. */
 GDR_STRUCT_BEGIN(GdrGpuRasterParams)
-    gdr_uint64 clusters;    /* GdrGpuRasterCluster[capacity] */
-    gdr_uint64 counters;    /* GdrGpuRasterCounters */
+    GDR_REF(RasterClustersRef) clusters; /* GdrGpuRasterCluster[capacity] */
+    GDR_REF(RasterCountersRef) counters; /* GdrGpuRasterCounters */
     gdr_uint mode;          /* GDR_GPU_RASTER_* */
     gdr_uint capacity;      /* entries of the cluster list, <= GDR_RASTER_MAX_CLUSTERS */
     float sw_threshold_px;  /* hybrid: clusters whose triangles are smaller go to the compute rasteriser */
     gdr_uint hw_launch_limit; /* the most mesh workgroups one launch may have (maxMeshWorkGroupTotalCount) */
     gdr_vec2 ndc_scale;     /* the projection's P[0][0] and P[1][1] (x and y from view space to NDC) */
-    gdr_uint64 resolved;    /* the resolve's output: RGBA8 per pixel, then the depth bits per pixel */
+    GDR_REF(ResolvedRef) resolved; /* the resolve's output: RGBA8 per pixel, then the depth bits per pixel */
 GDR_STRUCT_END(GdrGpuRasterParams)
+GDR_ASSERT_SIZE(GdrGpuRasterParams, 48);
+GDR_ASSERT_OFFSET(GdrGpuRasterParams, mode, 16);
+GDR_ASSERT_OFFSET(GdrGpuRasterParams, ndc_scale, 32);
 
 #endif

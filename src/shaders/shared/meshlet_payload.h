@@ -7,9 +7,5 @@ struct GdrTaskPayload {
     uint meshlets[GDR_TASK_WORKGROUP_SIZE]; /* global GdrGpuMeshlet indices of the visible clusters */
 };
 
-layout(buffer_reference, scalar) readonly buffer MeshletsRef { GdrGpuMeshlet items[]; };
-layout(buffer_reference, scalar) readonly buffer TaskCommandsRef { GdrGpuTaskCommand items[]; };
-layout(buffer_reference, scalar) readonly buffer UintsRef { uint items[]; };
-layout(buffer_reference, scalar) readonly buffer VerticesRef { GdrGpuVertex items[]; };
 
 #endif

@@ -56,20 +56,20 @@ GDR_SHARED_FN bool gdr_raster_bin_sw(gdr_uint mode, float threshold_px, gdr_vec3
  * (meshlet_payload.h, glsl_buffers.h). */
 void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint meshlet_index)
 {
-    GdrGpuRasterParams params = RasterParamsRef(push.raster).value;
+    RasterParamsRef params = GDR_FRAME.raster;
     bool sw = false;
     uint triangles = 0u;
     if (visible) {
-        GdrGpuMeshlet meshlet = MeshletsRef(push.meshlets).items[meshlet_index];
-        mat4 model = InstancesRef(push.instances).items[instance].model;
+        GdrGpuMeshlet meshlet = MeshletsRef(GDR_SCENE.meshlets).items[meshlet_index];
+        mat4 model = InstancesRef(GDR_SCENE.instances).items[instance].model;
         vec3 center = (g.view * (model * vec4(meshlet.sphere.xyz, 1.0))).xyz;
         float radius = meshlet.sphere.w * gdr_max_axis_scale(model[0].xyz, model[1].xyz, model[2].xyz);
         triangles = meshlet.triangle_count;
-        sw = gdr_raster_bin_sw(params.mode, params.sw_threshold_px, center, radius, float(triangles), g.znear,
-                               g.zfar, params.ndc_scale, g.viewport.y);
+        sw = gdr_raster_bin_sw(params.value.mode, params.value.sw_threshold_px, center, radius, float(triangles), g.znear,
+                               g.zfar, params.value.ndc_scale, g.viewport.y);
     }
     bool hw = visible && !sw;
-    RasterCountersRef counters = RasterCountersRef(params.counters);
+    RasterCountersRef counters = RasterCountersRef(params.value.counters);
     uvec4 sw_ballot = subgroupBallot(sw), hw_ballot = subgroupBallot(hw);
     uint sw_count = subgroupBallotBitCount(sw_ballot), hw_count = subgroupBallotBitCount(hw_ballot);
     uint sw_triangles = subgroupAdd(sw ? triangles : 0u);
@@ -78,16 +78,16 @@ void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint m
     bool sw_fits = true, hw_fits = true;
     if (subgroupElect()) {
         if (sw_count > 0u) {
-            sw_fits = atomicAdd(counters.value.used, sw_count) + sw_count <= params.capacity;
+            sw_fits = atomicAdd(counters.value.used, sw_count) + sw_count <= params.value.capacity;
             if (sw_fits)
                 sw_base = atomicAdd(counters.value.sw_clusters, sw_count);
             else
                 atomicAdd(counters.value.overflow, sw_count);
         }
         if (hw_count > 0u) {
-            hw_fits = atomicAdd(counters.value.used, hw_count) + hw_count <= params.capacity;
+            hw_fits = atomicAdd(counters.value.used, hw_count) + hw_count <= params.value.capacity;
             if (hw_fits)
-                hw_base = params.capacity - atomicAdd(counters.value.hw_clusters, hw_count) - hw_count;
+                hw_base = params.value.capacity - atomicAdd(counters.value.hw_clusters, hw_count) - hw_count;
             else
                 atomicAdd(counters.value.overflow, hw_count);
         }
@@ -100,7 +100,7 @@ void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint m
     hw_base = subgroupBroadcastFirst(hw_base);
     sw_fits = subgroupBroadcastFirst(sw_fits);
     hw_fits = subgroupBroadcastFirst(hw_fits);
-    RasterClustersRef list = RasterClustersRef(params.clusters);
+    RasterClustersRef list = RasterClustersRef(params.value.clusters);
     if (sw && sw_fits)
         list.items[sw_base + subgroupBallotExclusiveBitCount(sw_ballot)] = GdrGpuRasterCluster(instance, meshlet_index);
     if (hw && hw_fits)

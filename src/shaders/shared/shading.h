@@ -2,6 +2,8 @@
 #ifndef GDR_SHADING_H
 #define GDR_SHADING_H
 
+#include "hash.h"
+
 /* A directional light (the frame's light_direction), a sky/ground ambient term and a faint world
  * grid; returns sRGB-encoded colour. */
 vec4 gdr_shade(vec3 light_direction, vec3 normal, vec3 world_position, vec3 albedo)
@@ -12,17 +14,6 @@ vec4 gdr_shade(vec3 light_direction, vec3 normal, vec3 world_position, vec3 albe
     vec3 checker = vec3(0.92 + 0.08 * mod(floor(world_position.x) + floor(world_position.z), 2.0));
     vec3 color = albedo * checker * (0.18 + 0.17 * sky + 0.7 * diffuse);
     return vec4(pow(color, vec3(1.0 / 2.2)), 1.0);
-}
-
-/* A well-spread 32-bit hash (integer mix), for debug colours. */
-uint gdr_hash(uint x)
-{
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x;
 }
 
 /* A bright colour from an id: three bytes of its hash, lifted away from black. */

@@ -3,10 +3,6 @@
 #ifndef GDR_VISBUFFER_H
 #define GDR_VISBUFFER_H
 
-layout(buffer_reference, scalar) readonly buffer RasterParamsRef { GdrGpuRasterParams value; };
-layout(buffer_reference, scalar) buffer RasterCountersRef { GdrGpuRasterCounters value; };
-layout(buffer_reference, scalar) buffer RasterClustersRef { GdrGpuRasterCluster items[]; };
-layout(buffer_reference, scalar) buffer VisbufferRef { uint64_t items[]; };
 
 #define GDR_RASTER_NO_SLOT 0xffffffffu
 #define GDR_VISBUFFER_TRIANGLE_MASK ((1u << GDR_VISBUFFER_TRIANGLE_BITS) - 1u)

@@ -1,0 +1,713 @@
+/* What each section of the scene cache holds (docs/CACHE_FORMAT.md): one description per section,
+ * its writer and its reader side by side, in the order the file holds them. The container
+ * (cache.c) walks the same table to write the file and to read it back. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/cache_internal.h"
+#include "io/io_internal.h"
+
+#if !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
+#error "the cache reader and writer assume a little-endian host"
+#endif
+
+#define FOURCC(a, b, c, d) ((uint32_t)(a) | (uint32_t)(b) << 8 | (uint32_t)(c) << 16 | (uint32_t)(d) << 24)
+
+enum { MESH_RECORD = 64 + 8 + 16, MATERIAL_RECORD = 64 + 16 + 12 + 12 + 8, INSTANCE_RECORD = 64 + 8 + 16,
+       CAMERA_RECORD = 64 + 12 + 16 + 16, TEXTURE_RECORD = 64 + 12, CLUSTERS_RECORD = 6 * 4,
+       CLUSTER_RECORD = 4 * 4 + 16 + 12 + 12 + 4 + 3 * 4, GROUP_RECORD = 16 + 4 + 3 * 4,
+       NODE_RECORD = 16 + 4 + 4 + 4 * 4 + 2 * 4 };
+
+/* What the sections read so far hand to the ones after them. */
+struct cache_read_state {
+    const char *name; /* the file, for messages */
+    const uint8_t *file; /* its bytes, for offsets in messages */
+    gdr_scene *scene; /* being built */
+    gdr_pvs **out_pvs;
+    uint32_t mesh_count, material_count, instance_count, camera_count, texture_count; /* SCNE */
+    reader textures;  /* TEXR, read again with TXPX */
+    reader meshes;    /* MESH, read again with GEOM */
+    reader clusters;  /* CLUS, read again with CLDT */
+};
+
+static int all_finite(const float *v, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(v[i]))
+            return 0;
+    return 1;
+}
+
+/* A section of fixed-size records: its size must be count records exactly. */
+static gdr_status expect_records(const cache_read_state *st, const reader *r, uint32_t id, uint32_t count,
+                                 uint32_t record, gdr_error *err)
+{
+    if (r->size == (uint64_t)count * record)
+        return GDR_OK;
+    char text[5];
+    fourcc_text(id, text);
+    return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section '%s' holds %zu bytes, %u records need %llu", st->name,
+                         text, r->size, count, (unsigned long long)count * record);
+}
+
+/* A section read to its end. */
+static gdr_status expect_end(const cache_read_state *st, const reader *r, const char *id, gdr_error *err)
+{
+    if (r->at == r->size)
+        return GDR_OK;
+    return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section '%s' has %zu bytes left over", st->name, id,
+                         r->size - r->at);
+}
+
+/* --- SRCE: what the cache was built from (read by the container, for staleness) --------------- */
+
+static void write_source(writer *w, const cache_write_input *in)
+{
+    const gdr_cache_source *source = in->source;
+    put_string(w, source && source->build_options ? source->build_options : "");
+    uint32_t files = source && source->files ? source->files->count : 0;
+    put_u32(w, files);
+    for (uint32_t i = 0; i < files; i++) {
+        const gdr_source_file *f = &source->files->files[i];
+        put_string(w, f->path);
+        put_u64(w, f->size);
+        put_u64(w, (uint64_t)f->mtime_ns);
+        put_u64(w, f->hash);
+    }
+}
+
+/* --- SCNE: counts and extensions --------------------------------------------------------------- */
+
+static void write_scene(writer *w, const cache_write_input *in)
+{
+    const gdr_scene *s = in->scene;
+    put_u32(w, s->mesh_count);
+    put_u32(w, s->material_count);
+    put_u32(w, s->instance_count);
+    put_u32(w, s->camera_count);
+    put_u32(w, s->texture_count);
+    put_string(w, s->extensions);
+}
+
+static gdr_status read_scene(cache_read_state *st, reader *r, gdr_error *err)
+{
+    st->mesh_count = get_u32(r);
+    st->material_count = get_u32(r);
+    st->instance_count = get_u32(r);
+    st->camera_count = get_u32(r);
+    st->texture_count = get_u32(r);
+    uint32_t ext_length;
+    const char *ext = get_string(r, &ext_length);
+    if (r->failed || r->at != r->size)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'SCNE' has the wrong size", st->name);
+    if (!ext_length)
+        return GDR_OK;
+    char *copy = malloc(ext_length + 1);
+    if (!copy)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", st->name);
+    memcpy(copy, ext, ext_length);
+    copy[ext_length] = 0;
+    gdr_status status = gdr_scene_set_extensions(st->scene, copy, err);
+    free(copy);
+    return status;
+}
+
+/* --- TEXR (per texture: name, size, sRGB) and TXPX (their pixels) ------------------------------ */
+
+static void write_textures(writer *w, const cache_write_input *in)
+{
+    const gdr_scene *s = in->scene;
+    for (uint32_t i = 0; i < s->texture_count; i++) {
+        put_name(w, s->textures[i].name);
+        put_u32(w, s->textures[i].width);
+        put_u32(w, s->textures[i].height);
+        put_u32(w, s->textures[i].srgb);
+    }
+}
+
+static gdr_status read_textures(cache_read_state *st, reader *r, gdr_error *err)
+{
+    st->textures = *r;
+    return expect_records(st, r, FOURCC('T', 'E', 'X', 'R'), st->texture_count, TEXTURE_RECORD, err);
+}
+
+static void write_pixels(writer *w, const cache_write_input *in)
+{
+    const gdr_scene *s = in->scene;
+    for (uint32_t i = 0; i < s->texture_count; i++)
+        put(w, s->textures[i].rgba, (size_t)s->textures[i].width * s->textures[i].height * 4);
+}
+
+static gdr_status read_pixels(cache_read_state *st, reader *px, gdr_error *err)
+{
+    reader *tr = &st->textures;
+    for (uint32_t i = 0; i < st->texture_count; i++) {
+        char tname[GDR_NAME_MAX];
+        get_name(tr, tname);
+        uint32_t width = get_u32(tr), height = get_u32(tr), srgb = get_u32(tr);
+        if (width == 0 || height == 0 || width > 32768 || height > 32768 || srgb > 1)
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: texture %u: size %ux%u or flags are out of range",
+                                 st->name, i, width, height);
+        const uint8_t *pixels = take(px, (size_t)width * height * 4);
+        if (!pixels)
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: texture %u: pixel data runs past section 'TXPX'",
+                                 st->name, i);
+        gdr_status status = gdr_scene_add_texture(st->scene, tname, width, height, pixels, srgb, NULL, err);
+        if (status != GDR_OK)
+            return status;
+    }
+    return expect_end(st, px, "TXPX", err);
+}
+
+/* --- MESH (per mesh: name, counts, bounds) and GEOM (their vertices and indices) --------------- */
+
+static void write_meshes(writer *w, const cache_write_input *in)
+{
+    const gdr_scene *s = in->scene;
+    for (uint32_t i = 0; i < s->mesh_count; i++) {
+        const gdr_mesh *m = &s->meshes[i];
+        put_name(w, m->name);
+        put_u32(w, m->vertex_count);
+        put_u32(w, m->index_count);
+        put_f32s(w, &m->bounds.x, 4);
+    }
+}
+
+static gdr_status read_meshes(cache_read_state *st, reader *r, gdr_error *err)
+{
+    st->meshes = *r;
+    return expect_records(st, r, FOURCC('M', 'E', 'S', 'H'), st->mesh_count, MESH_RECORD, err);
+}
+
+static void write_geometry(writer *w, const cache_write_input *in)
+{
+    const gdr_scene *s = in->scene;
+    for (uint32_t i = 0; i < s->mesh_count; i++) {
+        const gdr_mesh *m = &s->meshes[i];
+        put(w, m->positions, sizeof(gdr_vec3) * m->vertex_count);
+        put(w, m->normals, sizeof(gdr_vec3) * m->vertex_count);
+        put(w, m->uvs, sizeof(gdr_vec2) * m->vertex_count);
+        put(w, m->indices, sizeof(uint32_t) * m->index_count);
+    }
+}
+
+/* One mesh: its arrays copied (aligned, so gdr_scene_add_mesh can read them as arrays) and added. */
+static gdr_status read_one_mesh(cache_read_state *st, reader *geo, uint32_t i, gdr_error *err)
+{
+    reader *mr = &st->meshes;
+    char mname[GDR_NAME_MAX];
+    get_name(mr, mname);
+    uint32_t vertex_count = get_u32(mr), index_count = get_u32(mr);
+    gdr_vec4 bounds;
+    get_f32s(mr, &bounds.x, 4);
+    uint64_t need = (uint64_t)vertex_count * 32 + (uint64_t)index_count * 4;
+    if (need > geo->size - geo->at)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: mesh %u: %u vertices and %u indices run past section 'GEOM'",
+                             st->name, i, vertex_count, index_count);
+    const void *positions = take(geo, (size_t)vertex_count * 12), *normals = take(geo, (size_t)vertex_count * 12);
+    const void *uvs = take(geo, (size_t)vertex_count * 8), *indices = take(geo, (size_t)index_count * 4);
+    gdr_vec3 *p = malloc((size_t)vertex_count * 12 + 1), *n = malloc((size_t)vertex_count * 12 + 1);
+    gdr_vec2 *t = malloc((size_t)vertex_count * 8 + 1);
+    uint32_t *idx = malloc((size_t)index_count * 4 + 1);
+    gdr_status status;
+    if (p && n && t && idx) {
+        memcpy(p, positions, (size_t)vertex_count * 12);
+        memcpy(n, normals, (size_t)vertex_count * 12);
+        memcpy(t, uvs, (size_t)vertex_count * 8);
+        memcpy(idx, indices, (size_t)index_count * 4);
+        if (!all_finite((const float *)n, (size_t)vertex_count * 3) ||
+            !all_finite((const float *)t, (size_t)vertex_count * 2) || !all_finite(&bounds.x, 4))
+            status = gdr_error_set(err, GDR_ERROR_PARSE, "%s: mesh %u: normals, uvs or bounds are not finite",
+                                   st->name, i);
+        else
+            status = gdr_scene_add_mesh(st->scene, mname, p, n, t, vertex_count, idx, index_count, NULL, err);
+    } else {
+        status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", st->name);
+    }
+    free(p);
+    free(n);
+    free(t);
+    free(idx);
+    if (status == GDR_OK)
+        st->scene->meshes[st->scene->mesh_count - 1].bounds = bounds;
+    return status;
+}
+
+static gdr_status read_geometry(cache_read_state *st, reader *geo, gdr_error *err)
+{
+    for (uint32_t i = 0; i < st->mesh_count; i++) {
+        gdr_status status = read_one_mesh(st, geo, i, err);
+        if (status != GDR_OK)
+            return status;
+    }
+    return expect_end(st, geo, "GEOM", err);
+}
+
+/* --- CLUS (per mesh: the counts of its clusters) and CLDT (their arrays) ----------------------- */
+
+static void write_cluster_counts(writer *w, const cache_write_input *in)
+{
+    const gdr_scene *s = in->scene;
+    for (uint32_t i = 0; i < s->mesh_count; i++) {
+        const gdr_mesh_clusters *c = &s->meshes[i].clusters;
+        put_u32(w, c->cluster_count);
+        put_u32(w, c->level0_cluster_count);
+        put_u32(w, c->vertex_count);
+        put_u32(w, c->triangle_byte_count);
+        put_u32(w, c->group_count);
+        put_u32(w, c->dag_depth);
+    }
+}
+
+static gdr_status read_cluster_counts(cache_read_state *st, reader *r, gdr_error *err)
+{
+    st->clusters = *r;
+    return expect_records(st, r, FOURCC('C', 'L', 'U', 'S'), st->mesh_count, CLUSTERS_RECORD, err);
+}
+
+static void write_cluster_data(writer *w, const cache_write_input *in)
+{
+    const gdr_scene *s = in->scene;
+    for (uint32_t i = 0; i < s->mesh_count; i++) {
+        const gdr_mesh_clusters *c = &s->meshes[i].clusters;
+        for (uint32_t k = 0; k < c->cluster_count; k++) {
+            const gdr_cluster *cl = &c->clusters[k];
+            put_u32(w, cl->vertex_offset);
+            put_u32(w, cl->triangle_offset);
+            put_u32(w, cl->vertex_count);
+            put_u32(w, cl->triangle_count);
+            put_f32s(w, &cl->sphere.x, 4);
+            put_f32s(w, &cl->cone_apex.x, 3);
+            put_f32s(w, &cl->cone_axis.x, 3);
+            put_f32s(w, &cl->cone_cutoff, 1);
+            put_u32(w, cl->group);
+            put_u32(w, cl->refined_group);
+            put_u32(w, cl->reserved);
+        }
+        for (uint32_t k = 0; k < c->group_count; k++) {
+            const gdr_cluster_group *g = &c->groups[k];
+            put_f32s(w, &g->sphere.x, 4);
+            put_f32s(w, &g->error, 1);
+            put_u32(w, g->depth);
+            put_u32(w, g->first_cluster);
+            put_u32(w, g->cluster_count);
+        }
+        put(w, c->vertices, sizeof(uint32_t) * c->vertex_count);
+        put(w, c->triangles, c->triangle_byte_count);
+        put_align(w, 4);
+    }
+}
+
+static int bad_sphere(const gdr_vec4 *sphere) { return !all_finite(&sphere->x, 4) || !(sphere->w >= 0.0f); }
+
+/* Reads the arrays of one mesh's clusters (counts already set in c, arrays allocated) and checks
+ * every offset, count and index against the limits, the arrays and the mesh. */
+static gdr_status read_mesh_clusters(const char *name, reader *r, uint32_t m, const gdr_mesh *mesh,
+                                     gdr_mesh_clusters *c, gdr_error *err)
+{
+#define CLDT(fmt, ...) gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLDT': mesh %u" fmt, name, m, __VA_ARGS__)
+    for (uint32_t k = 0; k < c->cluster_count; k++) {
+        gdr_cluster *cl = &c->clusters[k];
+        cl->vertex_offset = get_u32(r);
+        cl->triangle_offset = get_u32(r);
+        cl->vertex_count = get_u32(r);
+        cl->triangle_count = get_u32(r);
+        get_f32s(r, &cl->sphere.x, 4);
+        get_f32s(r, &cl->cone_apex.x, 3);
+        get_f32s(r, &cl->cone_axis.x, 3);
+        get_f32s(r, &cl->cone_cutoff, 1);
+        cl->group = get_u32(r);
+        cl->refined_group = get_u32(r);
+        cl->reserved = get_u32(r);
+        if (cl->vertex_count < 1 || cl->vertex_count > GDR_CLUSTER_MAX_VERTICES || cl->triangle_count < 1 ||
+            cl->triangle_count > GDR_CLUSTER_MAX_TRIANGLES)
+            return CLDT(" cluster %u: %u vertices and %u triangles (1 to %u and %u)", k, cl->vertex_count,
+                        cl->triangle_count, GDR_CLUSTER_MAX_VERTICES, GDR_CLUSTER_MAX_TRIANGLES);
+        if ((uint64_t)cl->vertex_offset + cl->vertex_count > c->vertex_count)
+            return CLDT(" cluster %u: vertices %u..%u lie outside the mesh's %u cluster vertices", k,
+                        cl->vertex_offset, cl->vertex_offset + (cl->vertex_count - 1), c->vertex_count);
+        if (cl->triangle_offset % 4 != 0 || (uint64_t)cl->triangle_offset + 3ull * cl->triangle_count >
+                                                c->triangle_byte_count)
+            return CLDT(" cluster %u: triangle bytes at %u (%u triangles) are unaligned or lie outside the mesh's %u",
+                        k, cl->triangle_offset, cl->triangle_count, c->triangle_byte_count);
+        if (bad_sphere(&cl->sphere) || !all_finite(&cl->cone_apex.x, 3) || !all_finite(&cl->cone_axis.x, 3) ||
+            !all_finite(&cl->cone_cutoff, 1))
+            return CLDT(" cluster %u: bounds are not finite (or a negative radius)", k);
+        if ((cl->group != GDR_NO_INDEX && cl->group >= c->group_count) ||
+            (cl->refined_group != GDR_NO_INDEX && cl->refined_group >= c->group_count))
+            return CLDT(" cluster %u: group %u / refined group %u does not exist (%u groups)", k, cl->group,
+                        cl->refined_group, c->group_count);
+    }
+    for (uint32_t k = 0; k < c->group_count; k++) {
+        gdr_cluster_group *g = &c->groups[k];
+        get_f32s(r, &g->sphere.x, 4);
+        get_f32s(r, &g->error, 1);
+        g->depth = get_u32(r);
+        g->first_cluster = get_u32(r);
+        g->cluster_count = get_u32(r);
+        if (bad_sphere(&g->sphere) || isnan(g->error))
+            return CLDT(" group %u: sphere or error is not a number", k);
+        if ((uint64_t)g->first_cluster + g->cluster_count > c->cluster_count)
+            return CLDT(" group %u: clusters %u (+%u) lie outside the mesh's %u", k, g->first_cluster,
+                        g->cluster_count, c->cluster_count);
+    }
+    const uint8_t *vertices = take(r, sizeof(uint32_t) * (size_t)c->vertex_count);
+    const uint8_t *triangles = take(r, c->triangle_byte_count);
+    take(r, (4 - c->triangle_byte_count % 4) % 4);
+    if (r->failed) /* the caller checked the sizes: only a programming error gets here */
+        return CLDT(" %s", "runs past the section");
+    memcpy(c->vertices, vertices, sizeof(uint32_t) * (size_t)c->vertex_count);
+    memcpy(c->triangles, triangles, c->triangle_byte_count);
+    for (uint32_t k = 0; k < c->vertex_count; k++)
+        if (c->vertices[k] >= mesh->vertex_count)
+            return CLDT(" cluster vertex %u: mesh vertex %u does not exist (%u vertices)", k, c->vertices[k],
+                        mesh->vertex_count);
+    uint64_t level0_triangles = 0;
+    for (uint32_t k = 0; k < c->cluster_count; k++) {
+        const gdr_cluster *cl = &c->clusters[k];
+        const uint8_t *local = c->triangles + cl->triangle_offset;
+        for (uint32_t t = 0; t < 3 * cl->triangle_count; t++)
+            if (local[t] >= cl->vertex_count)
+                return CLDT(" cluster %u triangle %u: local vertex %u, the cluster has %u", k, t / 3, local[t],
+                            cl->vertex_count);
+        if (k < c->level0_cluster_count)
+            level0_triangles += cl->triangle_count;
+    }
+    if (level0_triangles != mesh->index_count / 3)
+        return CLDT(": level-0 clusters hold %llu triangles, the mesh %u", (unsigned long long)level0_triangles,
+                    mesh->index_count / 3);
+#undef CLDT
+    return GDR_OK;
+}
+
+static gdr_status read_cluster_data(cache_read_state *st, reader *data, gdr_error *err)
+{
+    reader *counts = &st->clusters;
+    const char *name = st->name;
+    for (uint32_t m = 0; m < st->mesh_count; m++) {
+        gdr_mesh *mesh = &st->scene->meshes[m];
+        uint32_t cluster_count = get_u32(counts), level0 = get_u32(counts), vertex_count = get_u32(counts);
+        uint32_t triangle_bytes = get_u32(counts), group_count = get_u32(counts), dag_depth = get_u32(counts);
+        if (level0 > cluster_count || (cluster_count == 0 && (vertex_count || triangle_bytes || group_count ||
+                                                              dag_depth)) ||
+            (cluster_count > 0 && (level0 == 0 || mesh->index_count == 0)))
+            return gdr_error_set(err, GDR_ERROR_PARSE,
+                                 "%s: section 'CLUS': mesh %u: %u clusters (%u of level 0) for %u indices, %u cluster "
+                                 "vertices, %u triangle bytes, %u groups: inconsistent", name, m, cluster_count,
+                                 level0, mesh->index_count, vertex_count, triangle_bytes, group_count);
+        uint64_t need = (uint64_t)cluster_count * CLUSTER_RECORD + (uint64_t)group_count * GROUP_RECORD +
+                        (uint64_t)vertex_count * 4 + ((uint64_t)triangle_bytes + 3) / 4 * 4;
+        if (need > data->size - data->at)
+            return gdr_error_set(err, GDR_ERROR_PARSE,
+                                 "%s: section 'CLDT': mesh %u: %u clusters, %u groups, %u vertices and %u triangle "
+                                 "bytes run past the section", name, m, cluster_count, group_count, vertex_count,
+                                 triangle_bytes);
+        if (cluster_count == 0)
+            continue;
+        gdr_mesh_clusters *c = &mesh->clusters; /* owned by the scene from here: freed with it */
+        c->clusters = malloc(sizeof(gdr_cluster) * (size_t)cluster_count);
+        c->vertices = malloc(sizeof(uint32_t) * (size_t)vertex_count + 1);
+        c->triangles = malloc((size_t)triangle_bytes + 1);
+        c->groups = group_count ? malloc(sizeof(gdr_cluster_group) * (size_t)group_count) : NULL;
+        if (!c->clusters || !c->vertices || !c->triangles || (group_count && !c->groups))
+            return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: mesh %u: out of memory for %u clusters", name, m,
+                                 cluster_count);
+        c->cluster_count = cluster_count;
+        c->level0_cluster_count = level0;
+        c->vertex_count = vertex_count;
+        c->triangle_byte_count = triangle_bytes;
+        c->group_count = group_count;
+        c->dag_depth = dag_depth;
+        gdr_status status = read_mesh_clusters(name, data, m, mesh, c, err);
+        if (status != GDR_OK)
+            return status;
+    }
+    return expect_end(st, data, "CLDT", err);
+}
+
+/* --- LODH: per mesh, the LOD hierarchy over its clusters ---------------------------------------- */
+
+/* Clusters come with their hierarchy (gdr_meshlets_build, gdr_mesh_build_lod_dag). */
+static gdr_status check_hierarchy_present(const cache_write_input *in, const char *path, gdr_error *err)
+{
+    for (uint32_t i = 0; i < in->scene->mesh_count; i++) {
+        const gdr_mesh *m = &in->scene->meshes[i];
+        if (m->clusters.cluster_count > 0 && m->clusters.lod_node_count == 0)
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: mesh %u ('%s') has clusters without their LOD "
+                                 "hierarchy (gdr_mesh_clusters_build_hierarchy)", path, i, m->name);
+    }
+    return GDR_OK;
+}
+
+static void write_hierarchy(writer *w, const cache_write_input *in)
+{
+    const gdr_scene *s = in->scene;
+    for (uint32_t i = 0; i < s->mesh_count; i++) {
+        const gdr_mesh_clusters *c = &s->meshes[i].clusters;
+        put_u32(w, c->lod_node_count);
+        put_u32(w, c->lod_node_levels);
+        for (uint32_t k = 0; k < c->lod_node_count; k++) {
+            const gdr_lod_node *n = &c->lod_nodes[k];
+            put_f32s(w, &n->sphere.x, 4);
+            put_f32s(w, &n->max_error, 1);
+            put_f32s(w, &n->min_refined_error, 1);
+            put_u32(w, n->first);
+            put_u32(w, n->count);
+            put_u32(w, n->group);
+            put_u32(w, n->flags);
+            put_u32(w, n->reserved[0]);
+            put_u32(w, n->reserved[1]);
+        }
+    }
+}
+
+static gdr_status read_mesh_hierarchy(cache_read_state *st, reader *r, uint32_t m, gdr_error *err)
+{
+    gdr_mesh_clusters *c = &st->scene->meshes[m].clusters;
+    uint32_t node_count = get_u32(r), levels = get_u32(r);
+    if (r->failed || (c->cluster_count == 0) != (node_count == 0) ||
+        (uint64_t)node_count * NODE_RECORD > r->size - r->at)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'LODH': mesh %u: %u nodes for %u clusters "
+                             "(the section holds %zu more bytes)", st->name, m, node_count, c->cluster_count,
+                             r->failed ? (size_t)0 : r->size - r->at);
+    if (node_count == 0)
+        return GDR_OK;
+    c->lod_nodes = malloc(sizeof *c->lod_nodes * node_count); /* owned by the scene from here */
+    if (!c->lod_nodes)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: mesh %u: out of memory for %u hierarchy nodes",
+                             st->name, m, node_count);
+    c->lod_node_count = node_count;
+    c->lod_node_levels = levels;
+    for (uint32_t k = 0; k < node_count; k++) {
+        gdr_lod_node *n = &c->lod_nodes[k];
+        get_f32s(r, &n->sphere.x, 4);
+        get_f32s(r, &n->max_error, 1);
+        get_f32s(r, &n->min_refined_error, 1);
+        n->first = get_u32(r);
+        n->count = get_u32(r);
+        n->group = get_u32(r);
+        n->flags = get_u32(r);
+        n->reserved[0] = get_u32(r);
+        n->reserved[1] = get_u32(r);
+    }
+    char what[192];
+    if (!gdr_mesh_clusters_check_hierarchy(c, what, sizeof what))
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'LODH': mesh %u: %s", st->name, m, what);
+    return GDR_OK;
+}
+
+/* Every hierarchy is checked whole (gdr_mesh_clusters_check_hierarchy) against the clusters read. */
+static gdr_status read_hierarchy(cache_read_state *st, reader *r, gdr_error *err)
+{
+    for (uint32_t m = 0; m < st->mesh_count; m++) {
+        gdr_status status = read_mesh_hierarchy(st, r, m, err);
+        if (status != GDR_OK)
+            return status;
+    }
+    return expect_end(st, r, "LODH", err);
+}
+
+/* --- MATL: materials --------------------------------------------------------------------------- */
+
+static void write_materials(writer *w, const cache_write_input *in)
+{
+    const gdr_scene *s = in->scene;
+    for (uint32_t i = 0; i < s->material_count; i++) {
+        const gdr_material *m = &s->materials[i];
+        put_name(w, m->name);
+        put_f32s(w, &m->base_color.x, 4);
+        put_u32(w, m->base_color_texture);
+        put_u32(w, m->normal_texture);
+        put_u32(w, m->metallic_roughness_texture);
+        put_f32s(w, (const float[3]){m->metallic_factor, m->roughness_factor, m->alpha_cutoff}, 3);
+        put_u32(w, m->alpha_mode);
+        put_u32(w, m->double_sided);
+    }
+}
+
+static gdr_status read_one_material(cache_read_state *st, reader *ma, uint32_t i, gdr_error *err)
+{
+    gdr_material m;
+    float factors[3];
+    get_name(ma, m.name);
+    get_f32s(ma, &m.base_color.x, 4);
+    m.base_color_texture = get_u32(ma);
+    m.normal_texture = get_u32(ma);
+    m.metallic_roughness_texture = get_u32(ma);
+    get_f32s(ma, factors, 3);
+    m.metallic_factor = factors[0];
+    m.roughness_factor = factors[1];
+    m.alpha_cutoff = factors[2];
+    m.alpha_mode = get_u32(ma);
+    m.double_sided = get_u32(ma);
+    uint32_t textures[3] = {m.base_color_texture, m.normal_texture, m.metallic_roughness_texture};
+    for (int k = 0; k < 3; k++)
+        if (textures[k] != GDR_NO_INDEX && textures[k] >= st->texture_count)
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: material %u: texture %u does not exist (%u textures)",
+                                 st->name, i, textures[k], st->texture_count);
+    if (!all_finite(&m.base_color.x, 4) || !all_finite(factors, 3) || m.alpha_mode > GDR_ALPHA_BLEND ||
+        m.double_sided > 1)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: material %u: values out of range", st->name, i);
+    return gdr_scene_add_material(st->scene, &m, NULL, err);
+}
+
+static gdr_status read_materials(cache_read_state *st, reader *r, gdr_error *err)
+{
+    gdr_status status = expect_records(st, r, FOURCC('M', 'A', 'T', 'L'), st->material_count, MATERIAL_RECORD, err);
+    for (uint32_t i = 0; i < st->material_count && status == GDR_OK; i++)
+        status = read_one_material(st, r, i, err);
+    return status;
+}
+
+/* --- INST: instances ------------------------------------------------------------------------------ */
+
+static void write_instances(writer *w, const cache_write_input *in)
+{
+    const gdr_scene *s = in->scene;
+    for (uint32_t i = 0; i < s->instance_count; i++) {
+        const gdr_instance *inst = &s->instances[i];
+        put_f32s(w, inst->transform.m, 16);
+        put_u32(w, inst->mesh);
+        put_u32(w, inst->material);
+        put_f32s(w, &inst->color.x, 4);
+    }
+}
+
+static gdr_status read_instances(cache_read_state *st, reader *in, gdr_error *err)
+{
+    gdr_status status = expect_records(st, in, FOURCC('I', 'N', 'S', 'T'), st->instance_count, INSTANCE_RECORD, err);
+    for (uint32_t i = 0; i < st->instance_count && status == GDR_OK; i++) {
+        gdr_instance inst;
+        get_f32s(in, inst.transform.m, 16);
+        inst.mesh = get_u32(in);
+        inst.material = get_u32(in);
+        get_f32s(in, &inst.color.x, 4);
+        if (!all_finite(&inst.color.x, 4))
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: instance %u: colour is not finite", st->name, i);
+        status = gdr_scene_add_instance(st->scene, &inst, err);
+    }
+    return status;
+}
+
+/* --- CAMR: cameras ---------------------------------------------------------------------------------- */
+
+static void write_cameras(writer *w, const cache_write_input *in)
+{
+    const gdr_scene *s = in->scene;
+    for (uint32_t i = 0; i < s->camera_count; i++) {
+        const gdr_camera *cam = &s->cameras[i];
+        put_name(w, cam->name);
+        put_f32s(w, &cam->position.x, 3);
+        put_f32s(w, &cam->rotation.x, 4);
+        put_f32s(w, (const float[4]){cam->yfov, cam->znear, cam->zfar, cam->aspect}, 4);
+    }
+}
+
+static gdr_status read_cameras(cache_read_state *st, reader *ca, gdr_error *err)
+{
+    gdr_status status = expect_records(st, ca, FOURCC('C', 'A', 'M', 'R'), st->camera_count, CAMERA_RECORD, err);
+    for (uint32_t i = 0; i < st->camera_count && status == GDR_OK; i++) {
+        gdr_camera cam;
+        float lens[4];
+        get_name(ca, cam.name);
+        get_f32s(ca, &cam.position.x, 3);
+        get_f32s(ca, &cam.rotation.x, 4);
+        get_f32s(ca, lens, 4);
+        cam.yfov = lens[0];
+        cam.znear = lens[1];
+        cam.zfar = lens[2];
+        cam.aspect = lens[3];
+        if (!all_finite(&cam.position.x, 3) || !all_finite(&cam.rotation.x, 4) || !all_finite(lens, 4))
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: camera %u: values are not finite", st->name, i);
+        status = gdr_scene_add_camera(st->scene, &cam, err);
+    }
+    return status;
+}
+
+/* --- PVIS (optional): the precomputed-visibility blob --------------------------------------------- */
+
+static int has_pvs(const cache_write_input *in) { return in->pvs != NULL; }
+
+static gdr_status check_pvs_objects(const cache_write_input *in, const char *path, gdr_error *err)
+{
+    if (gdr_pvs_object_count(in->pvs) == in->scene->instance_count)
+        return GDR_OK;
+    return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
+                         "%s: the precomputed visibility was baked for %u objects, the scene has %u instances", path,
+                         gdr_pvs_object_count(in->pvs), in->scene->instance_count);
+}
+
+static void write_pvs(writer *w, const cache_write_input *in)
+{
+    size_t size = gdr_pvs_serialized_size(in->pvs);
+    uint8_t *blob = put_space(w, size);
+    if (blob && gdr_pvs_serialize(in->pvs, blob, size, NULL) != GDR_OK)
+        w->failed = 1;
+}
+
+/* gdr_pvs_load checks all of the blob, baked for this scene's instances. Checked whether or not the
+ * caller wants it (out_pvs may be NULL), like every section. */
+static gdr_status read_pvs(cache_read_state *st, reader *r, gdr_error *err)
+{
+    gdr_pvs *pvs = NULL;
+    gdr_error pvs_err = {0};
+    gdr_status status = gdr_pvs_load(r->data, r->size, &pvs, &pvs_err);
+    if (status != GDR_OK)
+        return gdr_error_set(err, status, "%s: section 'PVIS' (%zu bytes at offset %zu): %s", st->name, r->size,
+                             (size_t)(r->data - st->file), pvs_err.message);
+    if (gdr_pvs_object_count(pvs) != st->scene->instance_count) {
+        status = gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'PVIS': baked for %u objects, the scene has %u "
+                               "instances", st->name, gdr_pvs_object_count(pvs), st->scene->instance_count);
+        gdr_pvs_destroy(pvs);
+        return status;
+    }
+    if (st->out_pvs)
+        *st->out_pvs = pvs;
+    else
+        gdr_pvs_destroy(pvs);
+    return GDR_OK;
+}
+
+/* --- the table ------------------------------------------------------------------------------------- */
+
+#define REQUIRED CACHE_SECTION_REQUIRED
+const cache_section gdr_cache_sections[CACHE_SECTION_COUNT] = {
+    [CACHE_SOURCE] = {FOURCC('S', 'R', 'C', 'E'), 0, 1, NULL, NULL, write_source, NULL},
+    [CACHE_SCENE] = {FOURCC('S', 'C', 'N', 'E'), REQUIRED, 0, NULL, NULL, write_scene, read_scene},
+    [CACHE_TEXTURES] = {FOURCC('T', 'E', 'X', 'R'), REQUIRED, 0, NULL, NULL, write_textures, read_textures},
+    [CACHE_PIXELS] = {FOURCC('T', 'X', 'P', 'X'), REQUIRED, 0, NULL, NULL, write_pixels, read_pixels},
+    [CACHE_MESHES] = {FOURCC('M', 'E', 'S', 'H'), REQUIRED, 0, NULL, NULL, write_meshes, read_meshes},
+    [CACHE_GEOMETRY] = {FOURCC('G', 'E', 'O', 'M'), REQUIRED, 0, NULL, NULL, write_geometry, read_geometry},
+    [CACHE_CLUSTERS] = {FOURCC('C', 'L', 'U', 'S'), REQUIRED, 0, NULL, NULL, write_cluster_counts, read_cluster_counts},
+    [CACHE_CLUSTER_DATA] = {FOURCC('C', 'L', 'D', 'T'), REQUIRED, 0, NULL, NULL, write_cluster_data, read_cluster_data},
+    [CACHE_HIERARCHY] = {FOURCC('L', 'O', 'D', 'H'), REQUIRED, 0, NULL, check_hierarchy_present, write_hierarchy,
+                         read_hierarchy},
+    [CACHE_MATERIALS] = {FOURCC('M', 'A', 'T', 'L'), REQUIRED, 0, NULL, NULL, write_materials, read_materials},
+    [CACHE_INSTANCES] = {FOURCC('I', 'N', 'S', 'T'), REQUIRED, 0, NULL, NULL, write_instances, read_instances},
+    [CACHE_CAMERAS] = {FOURCC('C', 'A', 'M', 'R'), REQUIRED, 0, NULL, NULL, write_cameras, read_cameras},
+    /* optional: readers that predate it skip it */
+    [CACHE_PVS] = {FOURCC('P', 'V', 'I', 'S'), 0, 1, has_pvs, check_pvs_objects, write_pvs, read_pvs},
+};
+#undef REQUIRED
+
+gdr_status gdr_cache_read_sections(const char *name, cache_view *v, gdr_scene **out, gdr_pvs **out_pvs,
+                                   gdr_error *err)
+{
+    cache_read_state st = {.name = name, .file = v->data, .out_pvs = out_pvs};
+    gdr_status status = gdr_scene_create(&st.scene, err);
+    for (uint32_t k = 0; k < CACHE_SECTION_COUNT && status == GDR_OK; k++)
+        if (gdr_cache_sections[k].read && v->present[k])
+            status = gdr_cache_sections[k].read(&st, &v->sections[k], err);
+    if (status != GDR_OK) {
+        if (out_pvs && *out_pvs) {
+            gdr_pvs_destroy(*out_pvs);
+            *out_pvs = NULL;
+        }
+        gdr_scene_destroy(st.scene);
+        return status;
+    }
+    *out = st.scene;
+    return GDR_OK;
+}
