@@ -371,19 +371,77 @@ static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p)
     }
 }
 
-/* Upper bound (squared) of the distance from p to S0: to the level-0 triangles around the position
- * a walk from *at ends at (the position nearest to p among its neighbours; on a surface the
- * triangle nearest to p is almost always among these, and where it is not the bound is only
- * looser). *at receives where the walk ended (the next probe of the triangle starts there). */
-static float probe_d2(const lod_build *b, uint32_t *at, gdr_vec3 p)
+static int compare_u32(const void *x, const void *y)
 {
-    *at = walk_towards(b, *at, p);
-    return to_full_detail_d2(b, *at, p);
+    uint32_t a = *(const uint32_t *)x, b = *(const uint32_t *)y;
+    return a < b ? -1 : a > b;
+}
+
+/* A grid over the level-0 triangles around the group's samples (each once). Returns 0 when out of
+ * memory. */
+static int build_region(const lod_build *b, lod_scratch *s)
+{
+    size_t n = 0;
+    for (uint32_t i = 0; i < s->gathered; i++)
+        n += b->adjacency_start[s->sample_ids[i] + 1] - b->adjacency_start[s->sample_ids[i]];
+    if (!LOD_RESERVE(s, region_refs, n + 1))
+        return 0;
+    n = 0;
+    for (uint32_t i = 0; i < s->gathered; i++)
+        for (uint32_t k = b->adjacency_start[s->sample_ids[i]]; k < b->adjacency_start[s->sample_ids[i] + 1]; k++)
+            s->region_refs[n++] = b->adjacency[k];
+    qsort(s->region_refs, n, sizeof *s->region_refs, compare_u32);
+    size_t unique = 0;
+    for (size_t i = 0; i < n; i++)
+        if (i == 0 || s->region_refs[i] != s->region_refs[i - 1])
+            s->region_refs[unique++] = s->region_refs[i];
+    if (!LOD_RESERVE(s, region_positions, unique * 9 + 1) || !LOD_RESERVE(s, region_corners, unique * 3 + 1))
+        return 0;
+    for (size_t i = 0; i < unique; i++) {
+        const gdr_cluster *c = &b->clusters[s->region_refs[i] >> 7];
+        const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(s->region_refs[i] & 127) * 3;
+        const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+        for (int k = 0; k < 3; k++) {
+            memcpy(s->region_positions + i * 9 + (size_t)k * 3, &b->mesh->positions[v[t[k]]], sizeof(gdr_vec3));
+            s->region_corners[i * 3 + (size_t)k] = (uint32_t)(i * 3 + (size_t)k);
+        }
+    }
+    s->region_built = 1;
+    return lod_triangle_grid_build(&s->region_grid, s->region_positions, s->region_corners, (uint32_t)unique);
+}
+
+/* What probing a group's simplified triangles needs. */
+typedef struct probe_state {
+    const lod_build *b;
+    lod_scratch *s;
+    float worst;  /* squared: the largest distance so far (at least the samples' largest) */
+    int failed;   /* out of memory */
+} probe_state;
+
+/* Upper bound (squared) of the distance from p to S0: to the level-0 triangles around the position
+ * a walk from *at ends at (the position nearest to p among its neighbours; on a regular surface
+ * the triangle nearest to p is among these). Where that bound is more than twice the largest
+ * distance so far, the exact distance to the level-0 triangles around the group's samples is
+ * taken instead (the walk can stop far away on meshes of long thin triangles). *at receives where the
+ * walk ended (the next probe of the triangle starts there). */
+static float probe_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
+{
+    *at = walk_towards(ps->b, *at, p);
+    float d = to_full_detail_d2(ps->b, *at, p);
+    if (d <= 4.0f * ps->worst || ps->failed) /* squared: up to twice the largest so far */
+        return d;
+    if (!ps->s->region_built && !build_region(ps->b, ps->s)) {
+        ps->failed = 1;
+        return d;
+    }
+    float exact;
+    lod_triangle_grid_nearest(&ps->s->region_grid, p, point_triangle_d2, &exact);
+    return exact < d ? exact : d;
 }
 
 /* The largest probe distance over the points of a barycentric grid of n steps on triangle v, corners
  * left out (they are level-0 vertices: distance 0); walks start at *at. */
-static float probe_triangle(const lod_build *b, uint32_t *at, const gdr_vec3 v[3], int n)
+static float probe_triangle(probe_state *ps, uint32_t *at, const gdr_vec3 v[3], int n)
 {
     float largest = 0.0f;
     for (int i = 0; i <= n; i++)
@@ -393,29 +451,32 @@ static float probe_triangle(const lod_build *b, uint32_t *at, const gdr_vec3 v[3
             float u = (float)i / (float)n, w = (float)j / (float)n, z = 1.0f - u - w;
             gdr_vec3 p = {z * v[0].x + u * v[1].x + w * v[2].x, z * v[0].y + u * v[1].y + w * v[2].y,
                           z * v[0].z + u * v[1].z + w * v[2].z};
-            float d = probe_d2(b, at, p);
+            float d = probe_d2(ps, at, p);
             largest = d > largest ? d : largest;
+            ps->worst = d > ps->worst ? d : ps->worst;
         }
     return largest;
 }
 
-/* Largest distance from the simplified triangles to S0: probed on a barycentric grid of 3 steps an
- * edge (6 points on the edges, the centroid), and of 6 steps where those come within 90% of the
- * largest distance so far (the deviation of a simplified triangle peaks inside it or on an edge). */
-static float simplified_to_full(const lod_build *b, lod_scratch *s)
+/* Largest distance from the simplified triangles to S0, or `floor` when that is larger (the
+ * samples' largest distance: probes below it cannot change the group's deviation). Probed on a
+ * barycentric grid of 3 steps an edge (6 points on the edges, the centroid), and of 6 steps where
+ * those come within 90% of the largest distance so far (the deviation of a simplified triangle
+ * peaks inside it or on an edge). Returns -1 when out of memory. */
+static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor)
 {
-    float worst = 0.0f;
+    probe_state ps = {b, s, floor * floor, 0};
+    s->region_built = 0;
     for (uint32_t t = 0; t < s->out_triangle_count; t++) {
         gdr_vec3 v[3];
         for (int k = 0; k < 3; k++)
             v[k] = load3(s->positions + (size_t)s->out_corners[(size_t)t * 3 + k] * 3);
         uint32_t at = b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]];
-        float d = probe_triangle(b, &at, v, 3);
-        if (d >= 0.81f * worst) /* squared: within 90% */
-            d = fmaxf(d, probe_triangle(b, &at, v, 6));
-        worst = d > worst ? d : worst;
+        float before = ps.worst, d = probe_triangle(&ps, &at, v, 3);
+        if (d >= 0.81f * before) /* squared: within 90% */
+            probe_triangle(&ps, &at, v, 6);
     }
-    return sqrtf(worst);
+    return ps.failed ? -1.0f : sqrtf(ps.worst);
 }
 
 static int farther_first(const void *x, const void *y)
@@ -483,7 +544,7 @@ int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, uint32_t first, uint32
     if (!output_triangles(s, r, local_count) || !gather_samples(b, s, first, count))
         return 0;
     float to_simplified = s->gathered ? samples_to_simplified(s, local_count) : 0.0f;
-    float to_full = simplified_to_full(b, s);
+    float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified);
     if (to_simplified < 0.0f || to_full < 0.0f || !hand_samples_to_clusters(s, r))
         return 0;
     r->deviation = to_simplified > to_full ? to_simplified : to_full;

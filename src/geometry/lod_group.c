@@ -268,4 +268,8 @@ void gdr_lod_scratch_free(lod_scratch *s)
     free(s->vertex_points);
     lod_grid_free(&s->grid);
     lod_triangle_grid_free(&s->triangle_grid);
+    lod_triangle_grid_free(&s->region_grid);
+    free(s->region_refs);
+    free(s->region_corners);
+    free(s->region_positions);
 }

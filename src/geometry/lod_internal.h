@@ -82,6 +82,12 @@ typedef struct lod_scratch {
     uint32_t gathered;
     lod_grid grid;
     lod_triangle_grid triangle_grid;
+    uint32_t *region_refs, *region_corners; /* level-0 triangles around the group's samples */
+    size_t region_refs_cap, region_corners_cap;
+    float *region_positions;
+    size_t region_positions_cap;
+    lod_triangle_grid region_grid;
+    int region_built;
     uint8_t edge_count[64 * 64];
 } lod_scratch;
 
