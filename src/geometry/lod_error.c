@@ -4,12 +4,13 @@
  * cluster of the frontier (at first the first level-0 cluster that uses it). When a group is
  * simplified into new clusters, each of its members' samples passes to the new cluster whose
  * triangle is nearest to it. The group's deviation is the larger of
- *  - the distance from each of its samples to the simplified triangles (S0 -> simplified), and
- *  - the distance from points of the simplified triangles (corners, edge midpoints, centroid) to
- *    S0, measured against the level-0 triangles around the nearest sample (simplified -> S0);
- * both are upper bounds of the distances they stand for (distance to a subset of the triangles).
+ *  - the largest distance from one of its samples to the simplified triangles (exact), and
+ *  - an upper bound of the largest distance from probe points of the simplified triangles (grids
+ *    of 3 and 6 steps an edge) to S0: the distance to the level-0 triangles around the position a
+ *    walk ends at, or where that looks far off, to all level-0 triangles around the group's
+ *    samples (a distance to some triangles of S0 is never below the distance to S0).
  * The group's error is the larger of its deviation and the errors of the groups its members came
- * from. */
+ * from. Every level-0 position stays a sample at every step (that is what the proof needs). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -257,8 +258,7 @@ static int gather_samples(lod_build *b, lod_scratch *s, uint32_t first, uint32_t
     for (uint32_t i = 0; i < count; i++)
         n += b->cluster_sample_count[b->members[first + i]];
     if (!LOD_RESERVE(s, sample_ids, n + 1) || !LOD_RESERVE(s, sample_points, n + 1) ||
-        !LOD_RESERVE(s, sample_cluster, n + 1) || !LOD_RESERVE(s, sample_d2, n + 1) ||
-        !LOD_RESERVE(s, sample_order, n + 1))
+        !LOD_RESERVE(s, sample_cluster, n + 1))
         return 0;
     n = 0;
     for (uint32_t i = 0; i < count; i++) {
@@ -315,7 +315,6 @@ static float samples_to_simplified(lod_scratch *s, uint32_t local_count)
         if (d > worst)
             nearest = lod_triangle_grid_nearest(&s->triangle_grid, s->sample_points[i], point_triangle_d2, &d);
         s->sample_cluster[i] = s->out_cluster[nearest];
-        s->sample_d2[i] = d;
         worst = d > worst ? d : worst;
     }
     return sqrtf(worst);
@@ -479,62 +478,23 @@ static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor)
     return ps.failed ? -1.0f : sqrtf(ps.worst);
 }
 
-static int farther_first(const void *x, const void *y)
-{
-    const sample_rank *a = x, *b = y;
-    if (a->d2 != b->d2)
-        return a->d2 > b->d2 ? -1 : 1;
-    return a->id < b->id ? -1 : a->id > b->id;
-}
-
-/* Keeps at most LOD_SAMPLES_PER_CLUSTER of the samples out[0 .. n): half of them the farthest from
- * the simplified surface (where the next levels are likely to deviate most), the other half spread
- * evenly over the rest (in the order gathered, which follows the surface). Returns the count kept. */
-static uint32_t thin_samples(lod_scratch *s, uint32_t *out, const uint32_t *index, uint32_t n)
-{
-    if (n <= LOD_SAMPLES_PER_CLUSTER) {
-        for (uint32_t i = 0; i < n; i++)
-            out[i] = s->sample_ids[index[i]];
-        return n;
-    }
-    sample_rank *rank = s->sample_order;
-    for (uint32_t i = 0; i < n; i++)
-        rank[i] = (sample_rank){.d2 = s->sample_d2[index[i]], .id = index[i]};
-    qsort(rank, n, sizeof *rank, farther_first);
-    const uint32_t far = LOD_SAMPLES_PER_CLUSTER / 2, spread = LOD_SAMPLES_PER_CLUSTER - far;
-    for (uint32_t i = far; i < n; i++) /* the rest, back in gathered order */
-        rank[i].d2 = 0.0f;
-    qsort(rank + far, n - far, sizeof *rank, farther_first);
-    uint32_t kept = 0;
-    for (uint32_t i = 0; i < far; i++)
-        out[kept++] = s->sample_ids[rank[i].id];
-    for (uint32_t j = 0; j < spread; j++)
-        out[kept++] = s->sample_ids[rank[far + (uint32_t)((uint64_t)j * (n - far) / spread)].id];
-    return kept;
-}
-
-/* The samples in order of the new cluster they pass to (thinned), into r. */
+/* The samples in order of the new cluster they pass to, into r. */
 static int hand_samples_to_clusters(lod_scratch *s, group_result *r)
 {
     r->samples = malloc(((size_t)s->gathered + 1) * sizeof *r->samples);
     r->cluster_sample_first = calloc((size_t)r->cluster_count + 1, sizeof *r->cluster_sample_first);
-    uint32_t *start = r->cluster_sample_first, *index = s->sample_cluster;
-    if (!r->samples || !start || !LOD_RESERVE(s, sample_index, (size_t)s->gathered + 1))
+    uint32_t *start = r->cluster_sample_first;
+    if (!r->samples || !start)
         return 0;
     for (uint32_t i = 0; i < s->gathered; i++)
-        start[index[i] + 1]++;
+        start[s->sample_cluster[i] + 1]++;
     for (uint32_t c = 0; c < r->cluster_count; c++)
         start[c + 1] += start[c];
-    for (uint32_t i = 0; i < s->gathered; i++) /* sample indices by cluster, in gathered order */
-        s->sample_index[start[index[i]]++] = i;
-    uint32_t kept = 0, from = 0;
-    for (uint32_t c = 0; c < r->cluster_count; c++) {
-        uint32_t end = start[c];
-        start[c] = kept;
-        kept += thin_samples(s, r->samples + kept, s->sample_index + from, end - from);
-        from = end;
-    }
-    start[r->cluster_count] = kept;
+    for (uint32_t i = 0; i < s->gathered; i++)
+        r->samples[start[s->sample_cluster[i]]++] = s->sample_ids[i];
+    for (uint32_t c = r->cluster_count; c > 0; c--) /* start[c] now holds the end of c: shift back */
+        start[c] = start[c - 1];
+    start[0] = 0;
     return 1;
 }
 

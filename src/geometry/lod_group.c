@@ -260,9 +260,6 @@ void gdr_lod_scratch_free(lod_scratch *s)
     free(s->ring);
     free(s->sample_ids);
     free(s->sample_cluster);
-    free(s->sample_index);
-    free(s->sample_d2);
-    free(s->sample_order);
     free(s->vertex_local);
     free(s->sample_points);
     free(s->vertex_points);

@@ -38,14 +38,6 @@ typedef struct lod_progress {
     atomic_uint_fast64_t done;
 } lod_progress;
 
-/* Samples of the full-detail surface a new cluster keeps (lod_error.c). */
-#define LOD_SAMPLES_PER_CLUSTER 100000u
-
-typedef struct sample_rank {
-    float d2;
-    uint32_t id;
-} sample_rank;
-
 /* Per-worker scratch, reused from task to task. */
 typedef struct lod_scratch {
     uint32_t *map; /* mesh vertex -> local vertex, UINT32_MAX when unused (mesh vertex_count entries) */
@@ -71,12 +63,8 @@ typedef struct lod_scratch {
     uint32_t *out_corners, *out_cluster, *ring_start, *ring;
     size_t out_corners_cap, out_cluster_cap, ring_start_cap, ring_cap;
     uint32_t out_triangle_count;
-    uint32_t *sample_ids, *sample_cluster, *vertex_local, *sample_index;
-    size_t sample_ids_cap, sample_cluster_cap, vertex_local_cap, sample_index_cap;
-    float *sample_d2;
-    size_t sample_d2_cap;
-    sample_rank *sample_order;
-    size_t sample_order_cap;
+    uint32_t *sample_ids, *sample_cluster, *vertex_local;
+    size_t sample_ids_cap, sample_cluster_cap, vertex_local_cap;
     gdr_vec3 *sample_points, *vertex_points;
     size_t sample_points_cap, vertex_points_cap;
     uint32_t gathered;
