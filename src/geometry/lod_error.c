@@ -6,7 +6,7 @@
  * triangle is nearest to it. The group's deviation is the larger of
  *  - the largest distance from one of its samples to the simplified triangles (exact), and
  *  - an upper bound of the largest distance from probe points of the simplified triangles (grids
- *    of 3 and 6 steps an edge) to S0: the distance to the level-0 triangles around the position a
+ *    of 3 steps an edge, 8 where the deviation is largest) to S0: the distance to the level-0 triangles around the position a
  *    walk ends at, or where that looks far off, to all level-0 triangles around the group's
  *    samples (a distance to some triangles of S0 is never below the distance to S0).
  * The group's error is the larger of its deviation and the errors of the groups its members came
@@ -457,23 +457,38 @@ static float probe_triangle(probe_state *ps, uint32_t *at, const gdr_vec3 v[3], 
     return largest;
 }
 
+static void triangle_corners(const lod_scratch *s, uint32_t t, gdr_vec3 v[3])
+{
+    for (int k = 0; k < 3; k++)
+        v[k] = load3(s->positions + (size_t)s->out_corners[(size_t)t * 3 + k] * 3);
+}
+
 /* Largest distance from the simplified triangles to S0, or `floor` when that is larger (the
- * samples' largest distance: probes below it cannot change the group's deviation). Probed on a
- * barycentric grid of 3 steps an edge (6 points on the edges, the centroid), and of 6 steps where
- * those come within 90% of the largest distance so far (the deviation of a simplified triangle
- * peaks inside it or on an edge). Returns -1 when out of memory. */
+ * samples' largest distance: probes below it cannot change the group's deviation). Every triangle
+ * is probed on a barycentric grid of 3 steps an edge (6 points on the edges, the centroid); those
+ * whose probes come within 70% of the largest then, on a grid of 8 steps (the deviation of a
+ * simplified triangle peaks inside it or on an edge, between the coarse points). Returns -1 when
+ * out of memory. */
 static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor)
 {
     probe_state ps = {b, s, floor * floor, 0};
     s->region_built = 0;
+    if (!LOD_RESERVE(s, coarse_d2, (size_t)s->out_triangle_count + 1))
+        return -1.0f;
     for (uint32_t t = 0; t < s->out_triangle_count; t++) {
         gdr_vec3 v[3];
-        for (int k = 0; k < 3; k++)
-            v[k] = load3(s->positions + (size_t)s->out_corners[(size_t)t * 3 + k] * 3);
+        triangle_corners(s, t, v);
         uint32_t at = b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]];
-        float before = ps.worst, d = probe_triangle(&ps, &at, v, 3);
-        if (d >= 0.81f * before) /* squared: within 90% */
-            probe_triangle(&ps, &at, v, 6);
+        s->coarse_d2[t] = probe_triangle(&ps, &at, v, 3);
+    }
+    float coarse_worst = ps.worst;
+    for (uint32_t t = 0; t < s->out_triangle_count; t++) {
+        if (s->coarse_d2[t] < 0.49f * coarse_worst) /* squared: below 70% */
+            continue;
+        gdr_vec3 v[3];
+        triangle_corners(s, t, v);
+        uint32_t at = b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]];
+        probe_triangle(&ps, &at, v, 8);
     }
     return ps.failed ? -1.0f : sqrtf(ps.worst);
 }

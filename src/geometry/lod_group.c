@@ -269,4 +269,5 @@ void gdr_lod_scratch_free(lod_scratch *s)
     free(s->region_refs);
     free(s->region_corners);
     free(s->region_positions);
+    free(s->coarse_d2);
 }

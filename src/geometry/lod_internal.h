@@ -76,6 +76,8 @@ typedef struct lod_scratch {
     size_t region_positions_cap;
     lod_triangle_grid region_grid;
     int region_built;
+    float *coarse_d2; /* per simplified triangle: its largest coarse probe distance, squared */
+    size_t coarse_d2_cap;
     uint8_t edge_count[64 * 64];
 } lod_scratch;
 
