@@ -1,23 +1,19 @@
-/* meshopt_buildMeshlets with its worst case bounded (meshlet_chunks.h).
+/* Whether meshopt_buildMeshlets would be quadratic on a mesh (meshlet_chunks.h).
  *
  * meshoptimizer 0.18 finds the triangle that starts each meshlet in a kd-tree of triangle
  * centroids, split at the mean of the widest axis; a range it cannot split into two parts of more
  * than 4 becomes one leaf, scanned whole at every search. A triangle soup plus one triangle far
  * away (a legal file) makes that a single leaf of every triangle: quadratic. The same build is
  * simulated here first (linear work for sound meshes, capped otherwise); when it ends in a large
- * leaf, or is cut short, the triangles are given to meshoptimizer in chunks, so that no leaf and no
- * adjacency list holds more than a chunk. Sound meshes are built exactly as before. */
+ * leaf, or is cut short, meshlets.c gives the triangles to meshoptimizer in small chunks, so that
+ * no leaf holds more than a chunk. Sound meshes are built exactly as before. */
 #include "geometry/meshlet_chunks.h"
 
 #include <stdlib.h>
 #include <string.h>
 
-#include <meshoptimizer.h>
-
 /* Leaves up to this size are what sound meshes make (meshoptimizer's leaves hold 8). */
 #define LARGEST_SOUND_LEAF 256u
-/* Triangles per chunk when chunking. */
-#define CHUNK_TRIANGLES 4096u
 
 typedef struct kd_range {
     uint32_t begin, end;
@@ -71,16 +67,6 @@ static int kdtree_degenerates(const float *centroids, uint32_t count, uint32_t *
     return 0;
 }
 
-size_t gdr_meshlet_chunks_bound(const gdr_mesh *mesh, uint32_t max_vertices, uint32_t max_triangles)
-{
-    size_t bound = 0;
-    for (uint32_t first = 0; first < mesh->index_count; first += 3 * CHUNK_TRIANGLES) {
-        uint32_t n = mesh->index_count - first < 3 * CHUNK_TRIANGLES ? mesh->index_count - first : 3 * CHUNK_TRIANGLES;
-        bound += meshopt_buildMeshletsBound(n, max_vertices, max_triangles);
-    }
-    return bound;
-}
-
 int gdr_meshlet_needs_chunks(const gdr_mesh *mesh)
 {
     uint32_t count = mesh->index_count / 3;
@@ -104,57 +90,4 @@ int gdr_meshlet_needs_chunks(const gdr_mesh *mesh)
     free(order);
     free(stack);
     return degenerate;
-}
-
-size_t gdr_meshlet_build_chunks(const gdr_mesh *mesh, uint32_t max_vertices, uint32_t max_triangles,
-                                float cone_weight, struct meshopt_Meshlet *meshlets, unsigned int *vertices,
-                                unsigned char *triangles)
-{
-    uint32_t *local_of = malloc(sizeof(uint32_t) * (size_t)mesh->vertex_count);
-    uint32_t *global_of = malloc(sizeof(uint32_t) * 3 * CHUNK_TRIANGLES);
-    uint32_t *indices = malloc(sizeof(uint32_t) * 3 * CHUNK_TRIANGLES);
-    gdr_vec3 *positions = malloc(sizeof(gdr_vec3) * 3 * CHUNK_TRIANGLES);
-    size_t count = 0, vertex_end = 0, triangle_end = 0;
-    if (!local_of || !global_of || !indices || !positions)
-        goto done;
-    memset(local_of, 0xff, sizeof(uint32_t) * (size_t)mesh->vertex_count);
-    for (uint32_t first = 0; first < mesh->index_count; first += 3 * CHUNK_TRIANGLES) {
-        uint32_t n = mesh->index_count - first < 3 * CHUNK_TRIANGLES ? mesh->index_count - first : 3 * CHUNK_TRIANGLES;
-        uint32_t local_count = 0;
-        for (uint32_t i = 0; i < n; i++) {
-            uint32_t v = mesh->indices[first + i];
-            if (local_of[v] == UINT32_MAX) {
-                local_of[v] = local_count;
-                global_of[local_count] = v;
-                positions[local_count++] = mesh->positions[v];
-            }
-            indices[i] = local_of[v];
-        }
-        size_t made = meshopt_buildMeshlets(meshlets + count, vertices + vertex_end, triangles + triangle_end, indices,
-                                            n, &positions[0].x, local_count, sizeof(gdr_vec3), max_vertices,
-                                            max_triangles, cone_weight);
-        for (size_t m = count; m < count + made; m++) {
-            for (uint32_t k = 0; k < meshlets[m].vertex_count; k++)
-                vertices[vertex_end + meshlets[m].vertex_offset + k] =
-                    global_of[vertices[vertex_end + meshlets[m].vertex_offset + k]];
-            meshlets[m].vertex_offset += (unsigned)vertex_end;
-            meshlets[m].triangle_offset += (unsigned)triangle_end;
-        }
-        for (uint32_t k = 0; k < local_count; k++)
-            local_of[global_of[k]] = UINT32_MAX;
-        if (made == 0) {
-            count = 0;
-            goto done;
-        }
-        count += made;
-        const struct meshopt_Meshlet *last = &meshlets[count - 1];
-        vertex_end = (size_t)last->vertex_offset + last->vertex_count;
-        triangle_end = (size_t)last->triangle_offset + ((size_t)last->triangle_count * 3 + 3) / 4 * 4;
-    }
-done:
-    free(local_of);
-    free(global_of);
-    free(indices);
-    free(positions);
-    return count;
 }

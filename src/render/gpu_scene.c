@@ -239,7 +239,8 @@ static gdr_status upload_lod_nodes(gdr_renderer *r, const gdr_scene *scene, cons
         g->cpu_meshes[m].lod_node_offset = cursor;
         g->cpu_meshes[m].lod_node_count = c->lod_node_count;
         g->cpu_meshes[m].lod_node_levels = c->lod_node_levels;
-        if (c->lod_node_levels > g->traversal_levels)
+        bool traversed = g->cpu_meshes[m].lod_task_count > GDR_TRAVERSE_MIN_TASKS; /* as drawcull.comp decides */
+        if (traversed && c->lod_node_levels > g->traversal_levels)
             g->traversal_levels = c->lod_node_levels;
         if (c->lod_node_count)
             memcpy(nodes + cursor, c->lod_nodes, sizeof *nodes * c->lod_node_count);

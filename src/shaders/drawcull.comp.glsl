@@ -34,7 +34,8 @@ GdrTaskRange task_range(GdrGpuFrameGlobals g, GdrGpuMesh mesh, mat4 model, out b
                                       model[2].xyz, model[3].xyz, g.camera_position.xyz, g.znear,
                                       g.lod_projection_scale) <= g.lod_threshold)
         return gdr_task_range(mesh.meshlet_offset + mesh.root_first, mesh.root_cluster_count, GDR_TASK_LOD_ACCEPTED);
-    traverse = (g.flags & GDR_FRAME_LOD_HIERARCHY) != 0u && mesh.lod_node_count > 0u;
+    traverse = (g.flags & GDR_FRAME_LOD_HIERARCHY) != 0u && mesh.lod_node_count > 0u &&
+               mesh.lod_task_count > GDR_TRAVERSE_MIN_TASKS;
     return traverse ? GdrTaskRange(0u, 0u, 0u, 0u) : gdr_task_range(mesh.meshlet_offset, mesh.lod_cluster_count, 0u);
 }
 
