@@ -19,7 +19,8 @@ build: deps
 demo: build
 	$(BUILD_DIR)/tools/gdr/gdr render demo --out demo.png --stats demo.json
 
-# The whole suite: every test on lavapipe with validation on, then the unit tests under ASan+UBSan.
+# The whole suite: every test on lavapipe with validation on, then the unit tests and the GPU paths
+# (test_gpu_sanitized) under ASan+UBSan.
 check: build test test-asan
 
 test:
@@ -28,7 +29,7 @@ test:
 test-asan: deps
 	cmake -S . -B $(ASAN_DIR) -DCMAKE_BUILD_TYPE=Debug -DGDR_WERROR=ON -DGDR_SANITIZE=ON
 	cmake --build $(ASAN_DIR) -j $(JOBS)
-	cd $(ASAN_DIR) && ctest --output-on-failure -j $(JOBS) -L unit
+	cd $(ASAN_DIR) && ctest --output-on-failure -j $(JOBS) -L 'unit|sanitize'
 
 install: build
 	cmake --install $(BUILD_DIR)
