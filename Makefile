@@ -4,7 +4,7 @@ ASAN_DIR ?= build-asan
 JOBS ?= $(shell nproc)
 PREFIX ?= /usr/local
 
-.PHONY: all deps build demo check test test-asan install clean
+.PHONY: all deps build demo check test test-asan pipeline-doc install clean
 
 all: build
 
@@ -29,6 +29,10 @@ test-asan: deps
 	cmake -S . -B $(ASAN_DIR) -DCMAKE_BUILD_TYPE=Debug -DGDR_WERROR=ON -DGDR_SANITIZE=ON
 	cmake --build $(ASAN_DIR) -j $(JOBS)
 	cd $(ASAN_DIR) && ctest --output-on-failure -j $(JOBS) -L unit
+
+# docs/PIPELINE.md's printout of every frame configuration, regenerated from `gdr info --passes`.
+pipeline-doc: build
+	./scripts/update-pipeline-doc.sh $(BUILD_DIR)/tools/gdr/gdr
 
 install: build
 	cmake --install $(BUILD_DIR)
