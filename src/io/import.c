@@ -85,13 +85,8 @@ static gdr_status finish_cache_read(const char *path, gdr_scene **out, gdr_pvs *
     return status;
 }
 
-gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options, gdr_scene **out, gdr_error *err)
-{
-    return gdr_scene_load_file_ex(path, options, out, NULL, err);
-}
-
-gdr_status gdr_scene_load_file_ex(const char *path, const gdr_load_options *options, gdr_scene **out,
-                                  gdr_pvs **out_pvs, gdr_error *err)
+gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options, gdr_scene **out, gdr_pvs **out_pvs,
+                               gdr_error *err)
 {
     static const gdr_load_options defaults = {0};
     if (!options)
@@ -102,7 +97,7 @@ gdr_status gdr_scene_load_file_ex(const char *path, const gdr_load_options *opti
     const char *build_options = gdr_cache_build_options();
     gdr_pvs *pvs = NULL;
     if (gdr_io_has_extension(path, ".gdrc")) {
-        gdr_status status = gdr_cache_read_ex(path, build_options, out, out_pvs ? &pvs : NULL, err);
+        gdr_status status = gdr_cache_read(path, build_options, out, out_pvs ? &pvs : NULL, err);
         return status == GDR_OK ? finish_cache_read(path, out, pvs, out_pvs, err) : status;
     }
     gdr_import_options import = {.warning = options->warning, .warning_user = options->warning_user,
@@ -125,7 +120,7 @@ gdr_status gdr_scene_load_file_ex(const char *path, const gdr_load_options *opti
         if (access(candidates[i], F_OK) != 0)
             continue;
         gdr_error cache_err;
-        if (gdr_cache_read_ex(candidates[i], build_options, out, out_pvs ? &pvs : NULL, &cache_err) == GDR_OK)
+        if (gdr_cache_read(candidates[i], build_options, out, out_pvs ? &pvs : NULL, &cache_err) == GDR_OK)
             return finish_cache_read(candidates[i], out, pvs, out_pvs, err);
         if (!strstr(cache_err.message, ": stale: "))
             warn(options, "%s; rebuilding it", cache_err.message);
@@ -135,11 +130,11 @@ gdr_status gdr_scene_load_file_ex(const char *path, const gdr_load_options *opti
     import.sources = &sources;
     gdr_status status = gdr_import_file(path, &import, out, NULL, err);
     if (status == GDR_OK) {
-        gdr_cache_source source = {build_options, &sources};
+        gdr_cache_write_options write = {.source = {build_options, &sources}};
         int written = 0;
         gdr_error write_err = {0};
         for (int i = 0; i < count && !written; i++)
-            written = gdr_cache_write(candidates[i], *out, &source, &write_err) == GDR_OK;
+            written = gdr_cache_write(candidates[i], *out, &write, &write_err) == GDR_OK;
         if (!written && count)
             warn(options, "cache not written: %s", write_err.message);
     }

@@ -146,7 +146,7 @@ int gdr_cmd_bench(int argc, char **argv)
         gdr_demo_desc demo = {.instances = sizes[s]};
         gdr_renderer_desc desc = {.width = width, .height = height, .device = device, .validate = validate,
                                   .busy_wait = true, .record_every_frame = record_every_frame};
-        gdr_status loaded = scene_spec ? gdr_scene_load(scene_spec, &scene, &err) : gdr_scene_create_demo(&demo, &scene, &err);
+        gdr_status loaded = scene_spec ? gdr_scene_load(scene_spec, NULL, &scene, &err) : gdr_scene_create_demo(&demo, &scene, &err);
         if (loaded != GDR_OK || gdr_renderer_create(&desc, &renderer, &err) != GDR_OK ||
             gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK) {
             fprintf(stderr, "gdr: %s\n", err.message);
