@@ -594,7 +594,7 @@ gdr_status gdr_mesh_build_lod_dag(gdr_mesh *mesh, const gdr_lod_options *options
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "gdr_mesh_build_lod_dag: mesh must not be NULL");
     if (stats)
         *stats = (gdr_lod_stats){0};
-    gdr_lod_options o;
+    gdr_lod_options o = {0};
     gdr_status status = resolve_options(options, &o, err);
     if (status != GDR_OK)
         return status;
@@ -643,7 +643,7 @@ gdr_status gdr_scene_build_lod(gdr_scene *scene, const gdr_lod_options *options,
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "gdr_scene_build_lod: scene must not be NULL");
     if (stats)
         *stats = (gdr_lod_stats){0};
-    gdr_lod_options o;
+    gdr_lod_options o = {0};
     gdr_status status = resolve_options(options, &o, err);
     if (status != GDR_OK)
         return status;
