@@ -10,76 +10,24 @@
  *               (default: assimp-testmodels' 2CylinderEngine.glb when installed)
  *   --repeat R  builds per configuration, the fastest is reported (default 1)
  *
- * Peak memory is counted exactly: this program wraps malloc/calloc/realloc/free (glibc's
- * __libc_* entry points) to track the bytes in use across every library (meshoptimizer and METIS
- * included), and reports the most in use during a build minus what was in use when it started
+ * Peak memory is counted exactly (heap_count.c wraps the allocator in every library, meshoptimizer
+ * and METIS included), and the benchmark reports the most in use during a build minus what was in use when it started
  * ("heap B/t": per input triangle; the DAG's own arrays are part of it). Columns: meshlet_s is the
  * level-0 build (gdr_meshlets_build, one thread), dag_s the DAG build; Mtris/s counts input
  * triangles per second of the DAG build, "+meshlets" of both together. */
 #define _GNU_SOURCE
 #include <malloc.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
 #include <time.h>
 
+#include "heap_count.h"
 #include "gdr/geometry.h"
 #include "gdr/io.h"
 #include "gdr/scene.h"
 #include "scene/procedural_meshes.h"
-
-/* --- heap accounting ---------------------------------------------------------------------------- */
-
-extern void *__libc_malloc(size_t size);
-extern void *__libc_calloc(size_t count, size_t size);
-extern void *__libc_realloc(void *p, size_t size);
-extern void __libc_free(void *p);
-
-static atomic_llong heap_in_use, heap_peak;
-
-static void heap_add(long long bytes)
-{
-    long long now = atomic_fetch_add(&heap_in_use, bytes) + bytes;
-    long long peak = atomic_load(&heap_peak);
-    while (now > peak && !atomic_compare_exchange_weak(&heap_peak, &peak, now)) {
-    }
-}
-
-void *malloc(size_t size)
-{
-    void *p = __libc_malloc(size);
-    if (p)
-        heap_add((long long)malloc_usable_size(p));
-    return p;
-}
-
-void *calloc(size_t count, size_t size)
-{
-    void *p = __libc_calloc(count, size);
-    if (p)
-        heap_add((long long)malloc_usable_size(p));
-    return p;
-}
-
-void *realloc(void *old, size_t size)
-{
-    long long before = old ? (long long)malloc_usable_size(old) : 0;
-    void *p = __libc_realloc(old, size);
-    if (p)
-        heap_add((long long)malloc_usable_size(p) - before);
-    else if (size == 0 && old)
-        heap_add(-before);
-    return p;
-}
-
-void free(void *p)
-{
-    if (p)
-        heap_add(-(long long)malloc_usable_size(p));
-    __libc_free(p);
-}
 
 /* --- helpers -------------------------------------------------------------------------------------- */
 
@@ -143,14 +91,13 @@ static result run(const char *input, gdr_mesh *mesh, const gdr_mesh_clusters *le
         mesh->clusters = copy_level0(level0);
         gdr_error err = {0};
         gdr_lod_options o = {.thread_count = threads, .no_progress = 1};
-        long long heap_before = atomic_load(&heap_in_use);
-        atomic_store(&heap_peak, heap_before);
+        long long heap_before = heap_peak_reset();
         double t0 = now();
         if (gdr_mesh_build_lod_dag(mesh, &o, &r.stats, &err) != GDR_OK)
             die(input, &err);
         double t = now() - t0;
         r.dag_s = t < r.dag_s ? t : r.dag_s;
-        r.heap_bytes_per_triangle = (double)(atomic_load(&heap_peak) - heap_before) / (double)r.triangles;
+        r.heap_bytes_per_triangle = (double)(heap_peak() - heap_before) / (double)r.triangles;
     }
     return r;
 }
@@ -218,14 +165,13 @@ static result run_scene(const char *name, const char *file, uint32_t threads, in
         for (uint32_t m = 0; m < scene->mesh_count; m++)
             r.triangles += scene->meshes[m].index_count / 3;
         gdr_lod_options o = {.thread_count = threads, .no_progress = 1};
-        long long heap_before = atomic_load(&heap_in_use);
-        atomic_store(&heap_peak, heap_before);
+        long long heap_before = heap_peak_reset();
         t0 = now();
         if (gdr_scene_build_lod(scene, &o, &r.stats, &err) != GDR_OK)
             die(file, &err);
         double t = now() - t0;
         r.dag_s = t < r.dag_s ? t : r.dag_s;
-        r.heap_bytes_per_triangle = (double)(atomic_load(&heap_peak) - heap_before) / (double)r.triangles;
+        r.heap_bytes_per_triangle = (double)(heap_peak() - heap_before) / (double)r.triangles;
         gdr_scene_destroy(scene);
     }
     return r;

@@ -106,8 +106,9 @@ typedef struct gdr_meshlet_options {
     uint32_t max_triangles; /* 0: GDR_CLUSTER_MAX_TRIANGLES; at most that, a multiple of 4 */
     float cone_weight;      /* 0: the default (0.25); in (0, 1]; favours clusters with tight normal
                                cones over small ones */
-    uint32_t thread_count;  /* gdr_scene_build_clusters: workers including the caller, at most 256;
-                               0: one per processor. The result does not depend on it. */
+    uint32_t thread_count;  /* workers including the caller, at most 256; 0: one per processor. A mesh
+                               is built in chunks of 32,768 triangles, side by side; a scene's meshes
+                               side by side. The result does not depend on it. */
 } gdr_meshlet_options;
 
 typedef struct gdr_mesh gdr_mesh;   /* gdr/scene.h */
@@ -135,7 +136,7 @@ GDR_API void gdr_mesh_clusters_free(gdr_mesh_clusters *clusters);
 /* --- LOD DAG (issue 5) -----------------------------------------------------------------------
  *
  * gdr_mesh_build_lod_dag turns level 0 into a DAG (seed 004, Nanite): the current clusters are
- * partitioned into groups of neighbours holding about as many triangles as four level-0 clusters
+ * partitioned into groups of neighbours holding about as many triangles as sixteen level-0 clusters
  * (METIS over the graph of clusters that share edges, weighted by the number of shared edges);
  * each group's triangles are merged, simplified to about half (meshoptimizer) with every vertex
  * that the group shares with other groups locked, and split into new clusters; repeat until one
@@ -147,8 +148,10 @@ GDR_API void gdr_mesh_clusters_free(gdr_mesh_clusters *clusters);
  *  - the clusters of group g are clusters[groups[g].first_cluster .. + cluster_count), so the
  *    clusters are ordered by group; level 0 still comes first (level0_cluster_count of them,
  *    reordered by group), and clusters' data offsets need not increase with the cluster index;
- *  - errors are mesh-space distances; every group's error is > 0 (at least 1e-6 of the mesh's
- *    bounding radius) and at least the error of every group its clusters were made from; its
+ *  - errors are mesh-space distances; a group's error is the larger of its clusters' measured
+ *    deviation from the full-detail surface (level 0) they replace, both ways (docs/GEOMETRY.md,
+ *    "The error"), and the errors of the groups its clusters were made from; it is > 0 (at least
+ *    1e-6 of the mesh's bounding radius); its
  *    sphere contains their spheres and its clusters' spheres; the root group (the last one) has
  *    error INFINITY; groups[g].depth is the build step that formed the group (0 for groups of
  *    level-0 clusters), strictly greater than the depth of the groups its clusters were made from;
@@ -187,7 +190,7 @@ typedef enum gdr_lod_stop {
 /* Options of the DAG build; zero-initialise, every field has a default. */
 typedef struct gdr_lod_options {
     uint32_t group_size;   /* a group holds about as many triangles as this many level-0 clusters;
-                              0: 4; in [2, 32] */
+                              0: 16; in [2, 32] */
     float target_ratio;    /* share of a group's triangles that simplification aims to keep; 0: 0.5;
                               in (0, 0.85) */
     uint32_t thread_count; /* workers including the caller, at most 256; 0: one per processor. The

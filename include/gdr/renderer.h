@@ -34,6 +34,13 @@ typedef struct gdr_renderer_desc {
      * whether instance updates are pending). true: record every frame (to measure what recording
      * costs). The CPU pipeline always records. */
     bool record_every_frame;
+    /* Tests only: the task list's and the LOD traversal's capacities per frame phase (0: sized from
+     * the scene), to provoke their overflow, which the statistics report. */
+    uint32_t debug_task_capacity;
+    uint32_t debug_traversal_capacity;
+    /* Tests only: a deliberately wrong LOD hierarchy (node spheres shrunk), to show that the image
+     * tests catch a node test that is not conservative. */
+    bool debug_shrink_lod_nodes;
 } gdr_renderer_desc;
 
 typedef enum gdr_cull_mode {
@@ -103,6 +110,10 @@ typedef struct gdr_frame_desc {
     float lod_error_px;
     bool lod_fixed_depth;
     uint32_t lod_depth;
+    /* With the LOD cut by error: find each instance's clusters by traversing the hierarchy over its
+     * DAG (gdr/geometry.h, "LOD hierarchy"), testing nodes by LOD error, frustum and (late phase)
+     * occlusion, instead of testing every cluster of the DAG (OFF). DEFAULT: on. The cut is the same. */
+    gdr_cull_mode lod_hierarchy;
     /* Two-phase occlusion culling against the depth pyramid (issue 6; indirect pipeline: instances,
      * mesh pipeline: instances and clusters; DEFAULT: on; off when cull is off). Conservative: the
      * image is the same with it off. The history it keeps between frames is discarded when the
@@ -171,6 +182,22 @@ typedef struct gdr_occlusion_stats {
     uint32_t meshlets_late_drawn;
 } gdr_occlusion_stats;
 
+/* The LOD hierarchy traversal (mesh pipeline, LOD cut by error), last frame, both phases: node
+ * visits, those whose subtree cannot hold a cluster of the cut, those outside the frustum, those
+ * behind the depth pyramid (late phase), the late phase's visits, and visits that did not fit the
+ * traversal's queue (their subtrees were not drawn; 0 unless the scene outgrows
+ * GDR_TRAVERSE_MAX_VISITS visits per level). */
+typedef struct gdr_traversal_stats {
+    bool applied;
+    uint32_t levels;
+    uint32_t nodes_tested;
+    uint32_t nodes_lod_culled;
+    uint32_t nodes_frustum_culled;
+    uint32_t nodes_occluded;
+    uint32_t late_nodes_tested;
+    uint32_t overflow;
+} gdr_traversal_stats;
+
 /* GPU memory: what the renderer holds from the device (whole blocks), and of what it placed in
  * them, the scene's part (geometry, clusters, instances, occlusion history) and the rest (render
  * targets, frame slots, visibility buffer, read-backs). */
@@ -211,11 +238,13 @@ typedef struct gdr_frame_stats {
     uint32_t triangles_backface_culled;   /* by the mesh shader */
     uint32_t triangles_small_culled;      /* covering no sample */
     uint32_t task_workgroups;
-    uint32_t task_overflow;               /* task commands lost for want of room: always 0 (sized from the scene) */
+    uint32_t task_overflow;               /* task commands lost for want of room: 0 unless a frame phase needs more
+                                             than GDR_MAX_TASK_COMMANDS (16 M) */
     uint32_t overdraw_max;                /* overdraw view: the most fragments one pixel received */
     gdr_raster_stats raster;
     gdr_lod_stats_frame lod;
     gdr_occlusion_stats occlusion;
+    gdr_traversal_stats traversal;
     gdr_memory_stats memory;
 } gdr_frame_stats;
 

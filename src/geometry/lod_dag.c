@@ -17,6 +17,9 @@
  * selects level 0 even where simplification was exact (flat areas). */
 #define LOD_MIN_ERROR_SCALE 1e-6f
 #define LOD_MAX_GROUP_SIZE 32u
+/* Groups of about 16 level-0 clusters' worth of triangles: measured against 4 and 8 in
+ * docs/GEOMETRY.md (fewer half-empty clusters, fewer triangles at the same deviation). */
+#define LOD_DEFAULT_GROUP_SIZE 16u
 /* Meshes with fewer triangles are built side by side, one per task, by gdr_scene_build_lod. */
 #define LOD_SMALL_MESH_TRIANGLES 65536u
 
@@ -66,7 +69,7 @@ static int push_cluster(lod_build *b, gdr_cluster c)
 }
 
 /* Appends a formed group's clusters, made from group `group`. */
-static int append_result(lod_build *b, const group_result *r, uint32_t group, uint32_t *frontier,
+static int append_result(lod_build *b, const group_result *r, uint32_t result, uint32_t group, uint32_t *frontier,
                          uint32_t *frontier_count)
 {
     if (!gdr_lod_reserve(&b->vertices, &b->vertex_cap, b->vertex_count + r->vertex_count, sizeof *b->vertices) ||
@@ -79,7 +82,7 @@ static int append_result(lod_build *b, const group_result *r, uint32_t group, ui
         c.triangle_offset += (uint32_t)b->triangle_bytes;
         c.refined_group = group;
         frontier[(*frontier_count)++] = (uint32_t)b->cluster_count;
-        if (!push_cluster(b, c))
+        if (!gdr_lod_error_adopt(b, (uint32_t)b->cluster_count, result, r, i) || !push_cluster(b, c))
             return 0;
     }
     memcpy(b->vertices + b->vertex_count, r->vertices, (size_t)r->vertex_count * sizeof *b->vertices);
@@ -178,7 +181,7 @@ static int take_results(lod_build *b, uint32_t depth, uint32_t groups, uint32_t 
         for (uint32_t i = first; i < end; i++)
             b->clusters[b->members[i]].group = id;
         if (r->formed) {
-            if (!append_result(b, r, id, next, next_count))
+            if (!append_result(b, r, g, id, next, next_count))
                 return 0;
             continue;
         }
@@ -189,7 +192,7 @@ static int take_results(lod_build *b, uint32_t depth, uint32_t groups, uint32_t 
             c.group = GDR_NO_INDEX;
             c.refined_group = id;
             next[(*next_count)++] = (uint32_t)b->cluster_count;
-            if (!push_cluster(b, c))
+            if (!gdr_lod_error_inherit(b, (uint32_t)b->cluster_count, b->members[i]) || !push_cluster(b, c))
                 return 0;
         }
         b->stats.passthrough_clusters += end - first;
@@ -230,7 +233,7 @@ static gdr_status lod_step(lod_build *b, uint32_t depth, uint32_t *next, uint32_
         b->stats.stuck_groups += !b->results[g].formed;
         b->stats.border_rejects += (uint64_t)b->results[g].border_reject;
     }
-    if (*progress && !take_results(b, depth, groups, next, next_count))
+    if (*progress && (!take_results(b, depth, groups, next, next_count) || !gdr_lod_error_gather(b, next, *next_count)))
         goto oom;
     goto done;
 oom:
@@ -325,7 +328,7 @@ static gdr_status resolve_options(const gdr_lod_options *in, gdr_lod_options *ou
 {
     gdr_lod_options o = in ? *in : (gdr_lod_options){0};
     if (o.group_size == 0)
-        o.group_size = 4;
+        o.group_size = LOD_DEFAULT_GROUP_SIZE;
     if (o.target_ratio == 0.0f)
         o.target_ratio = 0.5f;
     if (o.group_size < 2 || o.group_size > LOD_MAX_GROUP_SIZE)
@@ -402,6 +405,8 @@ static int setup(lod_build *b)
     if (!b->owner)
         return 0;
     memset(b->owner, 0xff, (size_t)b->position_count * sizeof *b->owner);
+    if (!gdr_lod_error_setup(b))
+        return 0;
     for (uint32_t w = 0; w < b->scratch_count; w++) {
         b->scratch[w].map = malloc((size_t)mesh->vertex_count * sizeof *b->scratch[w].map);
         if (!b->scratch[w].map)
@@ -537,6 +542,7 @@ static gdr_status build_mesh(lod_build *b, gdr_error *err)
         give_back_level0(b);
     }
     free(frontier);
+    gdr_lod_error_free(b);
     free(b->position_id);
     free(b->owner);
     if (b->scratch)

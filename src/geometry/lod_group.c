@@ -221,12 +221,12 @@ void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker)
     gdr_lod_progress_add(b, triangles / 2, worker);
     if (!enough)
         return;
-    float scale = meshopt_simplifyScale(s->positions, local_count, sizeof(float) * 3);
-    r->error = r->error + relative_error * scale;
-    if (!split_into_clusters(b, s, out_count, local_count, r)) {
+    if (!split_into_clusters(b, s, out_count, local_count, r) ||
+        !gdr_lod_group_deviation(b, s, first, count, local_count, r)) {
         r->out_of_memory = 1;
         return;
     }
+    r->error = r->deviation > r->error ? r->deviation : r->error;
     r->formed = 1;
 }
 
@@ -235,6 +235,8 @@ void gdr_lod_result_free(group_result *r)
     free(r->clusters);
     free(r->vertices);
     free(r->triangles);
+    free(r->samples);
+    free(r->cluster_sample_first);
     memset(r, 0, sizeof *r);
 }
 
@@ -252,4 +254,20 @@ void gdr_lod_scratch_free(lod_scratch *s)
     free(s->meshlets);
     free(s->meshlet_vertices);
     free(s->meshlet_triangles);
+    free(s->out_corners);
+    free(s->out_cluster);
+    free(s->ring_start);
+    free(s->ring);
+    free(s->sample_ids);
+    free(s->sample_cluster);
+    free(s->vertex_local);
+    free(s->sample_points);
+    free(s->vertex_points);
+    lod_grid_free(&s->grid);
+    lod_triangle_grid_free(&s->triangle_grid);
+    lod_triangle_grid_free(&s->region_grid);
+    free(s->region_refs);
+    free(s->region_corners);
+    free(s->region_positions);
+    free(s->coarse_d2);
 }

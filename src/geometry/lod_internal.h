@@ -11,6 +11,7 @@
 
 #include "core/progress.h"
 #include "core/thread_pool.h"
+#include "geometry/lod_grid.h"
 #include "gdr/geometry.h"
 #include "gdr/scene.h"
 
@@ -58,6 +59,25 @@ typedef struct lod_scratch {
     size_t meshlet_vertices_cap;
     unsigned char *meshlet_triangles;
     size_t meshlet_triangles_cap;
+    /* measuring the group's deviation (lod_error.c) */
+    uint32_t *out_corners, *out_cluster, *ring_start, *ring;
+    size_t out_corners_cap, out_cluster_cap, ring_start_cap, ring_cap;
+    uint32_t out_triangle_count;
+    uint32_t *sample_ids, *sample_cluster, *vertex_local;
+    size_t sample_ids_cap, sample_cluster_cap, vertex_local_cap;
+    gdr_vec3 *sample_points, *vertex_points;
+    size_t sample_points_cap, vertex_points_cap;
+    uint32_t gathered;
+    lod_grid grid;
+    lod_triangle_grid triangle_grid;
+    uint32_t *region_refs, *region_corners; /* level-0 triangles around the group's samples */
+    size_t region_refs_cap, region_corners_cap;
+    float *region_positions;
+    size_t region_positions_cap;
+    lod_triangle_grid region_grid;
+    int region_built;
+    float *coarse_d2; /* per simplified triangle: its largest coarse probe distance, squared */
+    size_t coarse_d2_cap;
     uint8_t edge_count[64 * 64];
 } lod_scratch;
 
@@ -66,7 +86,8 @@ typedef struct group_result {
     int formed;        /* simplified enough: the group is formed and `clusters` replace its members */
     int border_reject; /* simplification moved a locked border */
     int out_of_memory;
-    float error;       /* own simplification error plus the largest error its members came with */
+    float error;       /* the larger of its deviation and the largest error its members came with */
+    float deviation;   /* measured against the full-detail surface (lod_error.c) */
     gdr_vec4 sphere;
     uint32_t input_triangles;
     gdr_cluster *clusters; /* offsets relative to the arrays below */
@@ -75,6 +96,8 @@ typedef struct group_result {
     uint32_t vertex_count;
     uint8_t *triangles;
     uint32_t triangle_bytes;
+    uint32_t *samples;              /* the group's samples, by the new cluster they pass to */
+    uint32_t *cluster_sample_first; /* new cluster i: samples[first[i] .. first[i + 1]) */
 } group_result;
 
 typedef struct lod_build {
@@ -87,6 +110,15 @@ typedef struct lod_build {
     uint32_t *position_id; /* mesh vertex -> id of its position (vertices with equal coordinates share it) */
     uint32_t position_count;
     uint32_t *owner;       /* position id -> group using it in this step, OWNER_SHARED or OWNER_NONE */
+    /* samples of the full-detail surface (lod_error.c): position ids, owned by frontier clusters */
+    uint32_t *sample_vertex;   /* position id -> a mesh vertex at that position */
+    uint32_t *adjacency_start; /* position id -> level-0 triangles around it: adjacency[start[p] .. start[p + 1]) */
+    uint32_t *adjacency;       /* level-0 triangles as cluster << 7 | triangle */
+    uint32_t *samples;         /* frontier cluster c owns samples[first[c] .. + count[c]) */
+    uint32_t sample_count;
+    uint32_t *cluster_sample_first, *cluster_sample_count;
+    uint32_t *cluster_sample_source; /* UINT32_MAX: in `samples`; else in results[source].samples */
+    size_t cluster_sample_cap;
     float min_error;
     uint64_t group_triangles; /* triangles a group aims at: group_size average level-0 clusters */
     lod_progress *progress;
@@ -138,6 +170,18 @@ gdr_status gdr_lod_partition(lod_build *b, int32_t *part, uint32_t *parts, gdr_e
 /* lod_group.c: a thread-pool task that simplifies group g of the step into b->results[g]. */
 void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker);
 void gdr_lod_result_free(group_result *r);
+
+/* lod_error.c: the samples of the full-detail surface and the groups' measured deviation. */
+int gdr_lod_error_setup(lod_build *b); /* after position ids and the owner table; 0: out of memory */
+void gdr_lod_error_free(lod_build *b);
+/* Sets r->deviation and r's samples by new cluster, after the split into clusters. */
+int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, uint32_t first, uint32_t count, uint32_t local_count,
+                            group_result *r);
+/* New cluster `cluster` owns the samples of `from` (pass-through) / of r's new cluster `index`. */
+int gdr_lod_error_inherit(lod_build *b, uint32_t cluster, uint32_t from);
+int gdr_lod_error_adopt(lod_build *b, uint32_t cluster, uint32_t group, const group_result *r, uint32_t index);
+/* Packs the samples of the next frontier into one array (before the step's results are freed). */
+int gdr_lod_error_gather(lod_build *b, const uint32_t *frontier, uint32_t count);
 void gdr_lod_scratch_free(lod_scratch *s);
 
 #endif

@@ -1,6 +1,5 @@
 /* Level-0 clusters (meshlets) of a mesh, built with meshoptimizer, and the scene-level build that
  * runs it over every mesh in parallel. See docs/GEOMETRY.md for the format and the limits. */
-#include <assert.h>
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -226,6 +225,190 @@ void gdr_cluster_compute_bounds(gdr_cluster *c, const uint32_t *vertices, const 
 
 /* --- one mesh ----------------------------------------------------------------------------- */
 
+/* Meshes are split into chunks of this many triangles, built independently (in parallel when
+ * asked) and concatenated in order: a fixed size, so the clusters do not depend on the thread
+ * count. Each chunk ends with at most one partly filled cluster. */
+#define MESHLET_CHUNK_TRIANGLES 32768u
+
+/* The clusters of one chunk: offsets relative to its own arrays, vertices as mesh indices. */
+typedef struct chunk_result {
+    gdr_cluster *clusters;
+    uint32_t cluster_count;
+    uint32_t *vertices;
+    uint32_t vertex_count;
+    uint8_t *triangles;
+    uint32_t triangle_bytes;
+    gdr_status status;
+} chunk_result;
+
+typedef struct chunk_job {
+    const gdr_mesh *mesh;
+    const gdr_meshlet_options *o;
+    chunk_result *results;
+    uint32_t **maps; /* per worker: mesh vertex -> chunk-local vertex (UINT32_MAX: unused) */
+} chunk_job;
+
+/* meshoptimizer's meshlets of indices[0 .. index_count) over `positions` (vertex_count), into r;
+ * local_to_mesh (NULL: the identity) turns their vertices into mesh indices. */
+static gdr_status meshlets_of(const gdr_mesh *mesh, const gdr_meshlet_options *o, const uint32_t *indices,
+                              size_t index_count, const float *positions, size_t vertex_count,
+                              const uint32_t *local_to_mesh, chunk_result *r)
+{
+    size_t bound = meshopt_buildMeshletsBound(index_count, o->max_vertices, o->max_triangles);
+    struct meshopt_Meshlet *meshlets = malloc(bound * sizeof *meshlets);
+    r->vertices = malloc(bound * o->max_vertices * sizeof *r->vertices);
+    r->triangles = malloc(bound * o->max_triangles * 3);
+    size_t count = 0;
+    if (meshlets && r->vertices && r->triangles)
+        count = meshopt_buildMeshlets(meshlets, r->vertices, r->triangles, indices, index_count, positions,
+                                      vertex_count, sizeof(float) * 3, o->max_vertices, o->max_triangles,
+                                      o->cone_weight);
+    r->clusters = count > 0 ? malloc(count * sizeof *r->clusters) : NULL;
+    if (!r->clusters) {
+        free(meshlets);
+        return meshlets && r->vertices && r->triangles && count == 0 ? GDR_ERROR_INVALID_ARGUMENT
+                                                                     : GDR_ERROR_OUT_OF_MEMORY;
+    }
+    const struct meshopt_Meshlet *last = &meshlets[count - 1];
+    r->vertex_count = last->vertex_offset + last->vertex_count;
+    r->triangle_bytes = last->triangle_offset + (last->triangle_count * 3 + 3) / 4 * 4;
+    r->cluster_count = (uint32_t)count;
+    /* meshoptimizer wanted room for the worst case: keep only what was used. */
+    uint32_t *vertices = realloc(r->vertices, (size_t)r->vertex_count * sizeof *vertices);
+    uint8_t *triangles = realloc(r->triangles, r->triangle_bytes);
+    r->vertices = vertices ? vertices : r->vertices;
+    r->triangles = triangles ? triangles : r->triangles;
+    if (local_to_mesh)
+        for (uint32_t i = 0; i < r->vertex_count; i++)
+            r->vertices[i] = local_to_mesh[r->vertices[i]];
+    for (size_t i = 0; i < count; i++) {
+        const struct meshopt_Meshlet *m = &meshlets[i];
+        gdr_cluster *cl = &r->clusters[i];
+        *cl = (gdr_cluster){.vertex_offset = m->vertex_offset, .triangle_offset = m->triangle_offset,
+                            .vertex_count = m->vertex_count, .triangle_count = m->triangle_count,
+                            .group = GDR_NO_INDEX, .refined_group = GDR_NO_INDEX};
+        /* Zero the padding: the output must not depend on what malloc returned. */
+        size_t used = (size_t)m->triangle_offset + (size_t)m->triangle_count * 3;
+        size_t end = i + 1 < count ? meshlets[i + 1].triangle_offset : r->triangle_bytes;
+        memset(r->triangles + used, 0, end - used);
+        cluster_bounds(cl, r->vertices + m->vertex_offset, r->triangles + m->triangle_offset, mesh);
+    }
+    free(meshlets);
+    return GDR_OK;
+}
+
+/* Chunk c over a compact local vertex list (meshoptimizer's cost grows with the vertex count it
+ * is given, so a chunk must not pass the whole mesh's). */
+static void chunk_task(void *user, uint32_t c, uint32_t worker)
+{
+    chunk_job *job = user;
+    const gdr_mesh *mesh = job->mesh;
+    size_t first = (size_t)c * MESHLET_CHUNK_TRIANGLES * 3, n = mesh->index_count - first;
+    n = n > (size_t)MESHLET_CHUNK_TRIANGLES * 3 ? (size_t)MESHLET_CHUNK_TRIANGLES * 3 : n;
+    uint32_t *map = job->maps[worker], count = 0;
+    uint32_t *local = malloc(n * sizeof *local), *local_to_mesh = NULL;
+    float *positions = NULL;
+    job->results[c].status = GDR_ERROR_OUT_OF_MEMORY;
+    if (!local)
+        return;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t v = mesh->indices[first + i];
+        if (map[v] == UINT32_MAX)
+            map[v] = count++;
+        local[i] = map[v];
+    }
+    local_to_mesh = malloc((size_t)count * sizeof *local_to_mesh);
+    positions = malloc((size_t)count * 3 * sizeof *positions);
+    for (size_t i = 0; i < n; i++) {
+        uint32_t v = mesh->indices[first + i];
+        map[v] = UINT32_MAX;
+        if (local_to_mesh && positions) {
+            local_to_mesh[local[i]] = v;
+            memcpy(positions + (size_t)local[i] * 3, &mesh->positions[v], sizeof(float) * 3);
+        }
+    }
+    if (local_to_mesh && positions)
+        job->results[c].status = meshlets_of(mesh, job->o, local, n, positions, count, local_to_mesh,
+                                             &job->results[c]);
+    free(local);
+    free(local_to_mesh);
+    free(positions);
+}
+
+/* The chunks' clusters, concatenated in order, into out. */
+static gdr_status concatenate(const chunk_result *r, uint32_t chunks, gdr_mesh_clusters *out)
+{
+    size_t clusters = 0, vertices = 0, bytes = 0;
+    for (uint32_t c = 0; c < chunks; c++) {
+        clusters += r[c].cluster_count;
+        vertices += r[c].vertex_count;
+        bytes += r[c].triangle_bytes;
+    }
+    if (clusters > UINT32_MAX || vertices > UINT32_MAX || bytes > UINT32_MAX)
+        return GDR_ERROR_OUT_OF_MEMORY;
+    gdr_mesh_clusters m = {.cluster_count = (uint32_t)clusters, .level0_cluster_count = (uint32_t)clusters,
+                           .vertex_count = (uint32_t)vertices, .triangle_byte_count = (uint32_t)bytes};
+    m.clusters = malloc(clusters * sizeof *m.clusters);
+    m.vertices = malloc(vertices * sizeof *m.vertices);
+    m.triangles = malloc(bytes);
+    if (!m.clusters || !m.vertices || !m.triangles) {
+        gdr_mesh_clusters_free(&m);
+        return GDR_ERROR_OUT_OF_MEMORY;
+    }
+    size_t k = 0, vo = 0, to = 0;
+    for (uint32_t c = 0; c < chunks; c++) {
+        for (uint32_t i = 0; i < r[c].cluster_count; i++, k++) {
+            m.clusters[k] = r[c].clusters[i];
+            m.clusters[k].vertex_offset += (uint32_t)vo;
+            m.clusters[k].triangle_offset += (uint32_t)to;
+        }
+        memcpy(m.vertices + vo, r[c].vertices, (size_t)r[c].vertex_count * sizeof *m.vertices);
+        memcpy(m.triangles + to, r[c].triangles, r[c].triangle_bytes);
+        vo += r[c].vertex_count;
+        to += r[c].triangle_bytes;
+    }
+    *out = m;
+    return GDR_OK;
+}
+
+/* Builds the chunks (with a pool when thread_count asks for one) and concatenates them. */
+static gdr_status build_chunks(const gdr_mesh *mesh, const gdr_meshlet_options *o, gdr_mesh_clusters *out)
+{
+    uint32_t chunks = (uint32_t)(((size_t)mesh->index_count / 3 + MESHLET_CHUNK_TRIANGLES - 1) /
+                                 MESHLET_CHUNK_TRIANGLES);
+    gdr_thread_pool *pool = NULL;
+    gdr_error ignored;
+    if (o->thread_count != 1 && gdr_thread_pool_create(o->thread_count, &pool, &ignored) != GDR_OK)
+        pool = NULL; /* one thread then: the result is the same */
+    uint32_t workers = gdr_thread_pool_thread_count(pool);
+    chunk_job job = {mesh, o, calloc(chunks, sizeof(chunk_result)), calloc(workers, sizeof(uint32_t *))};
+    gdr_status status = job.results && job.maps ? GDR_OK : GDR_ERROR_OUT_OF_MEMORY;
+    for (uint32_t w = 0; w < workers && status == GDR_OK; w++) {
+        job.maps[w] = malloc((size_t)mesh->vertex_count * sizeof *job.maps[w]);
+        if (!job.maps[w])
+            status = GDR_ERROR_OUT_OF_MEMORY;
+        else
+            memset(job.maps[w], 0xff, (size_t)mesh->vertex_count * sizeof *job.maps[w]);
+    }
+    if (status == GDR_OK)
+        gdr_thread_pool_run(pool, chunks, chunk_task, &job);
+    for (uint32_t c = 0; c < chunks && status == GDR_OK; c++)
+        status = job.results[c].status;
+    if (status == GDR_OK)
+        status = concatenate(job.results, chunks, out);
+    for (uint32_t c = 0; job.results && c < chunks; c++) {
+        free(job.results[c].clusters);
+        free(job.results[c].vertices);
+        free(job.results[c].triangles);
+    }
+    for (uint32_t w = 0; job.maps && w < workers; w++)
+        free(job.maps[w]);
+    free(job.results);
+    free(job.maps);
+    gdr_thread_pool_destroy(pool);
+    return status;
+}
+
 gdr_status gdr_meshlets_build(const gdr_mesh *mesh, const gdr_meshlet_options *options, gdr_mesh_clusters *out,
                               gdr_error *err)
 {
@@ -241,67 +424,28 @@ gdr_status gdr_meshlets_build(const gdr_mesh *mesh, const gdr_meshlet_options *o
         status = check_mesh(mesh, err);
     if (status != GDR_OK)
         return status;
-
-    size_t bound = meshopt_buildMeshletsBound(mesh->index_count, o.max_vertices, o.max_triangles);
-    struct meshopt_Meshlet *meshlets = malloc(bound * sizeof *meshlets);
-    unsigned int *vertices = malloc(bound * o.max_vertices * sizeof *vertices);
-    unsigned char *triangles = malloc(bound * o.max_triangles * 3);
-    if (!meshlets || !vertices || !triangles) {
-        free(meshlets);
-        free(vertices);
-        free(triangles);
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for %zu meshlets", mesh->name,
-                             bound);
+    if (mesh->index_count / 3 <= MESHLET_CHUNK_TRIANGLES) {
+        /* One chunk: straight over the mesh's own vertices. */
+        chunk_result r = {0};
+        status = meshlets_of(mesh, &o, mesh->indices, mesh->index_count, &mesh->positions[0].x, mesh->vertex_count,
+                             NULL, &r);
+        if (status == GDR_OK)
+            status = concatenate(&r, 1, out);
+        free(r.clusters);
+        free(r.vertices);
+        free(r.triangles);
+    } else {
+        status = build_chunks(mesh, &o, out);
     }
-    size_t count = meshopt_buildMeshlets(meshlets, vertices, triangles, mesh->indices, mesh->index_count,
-                                         &mesh->positions[0].x, mesh->vertex_count, sizeof(gdr_vec3),
-                                         o.max_vertices, o.max_triangles, o.cone_weight);
-    assert(count > 0 && count <= bound);
-    /* Each meshlet's triangles start on a 4-byte boundary (meshoptimizer pads them): kept, so a
-     * shader can read them as 32-bit words. Every offset fits in 32 bits: no meshlet is empty, so
-     * there are at most index_count vertex entries and index_count + 3 * count triangle bytes. */
-    const struct meshopt_Meshlet *last = &meshlets[count - 1];
-    size_t vertex_total = (size_t)last->vertex_offset + last->vertex_count;
-    size_t triangle_bytes = (size_t)last->triangle_offset + ((size_t)last->triangle_count * 3 + 3) / 4 * 4;
-
-    gdr_mesh_clusters c = {0};
-    c.clusters = malloc(count * sizeof *c.clusters);
-    c.vertices = malloc(vertex_total * sizeof *c.vertices);
-    c.triangles = malloc(triangle_bytes);
-    if (!c.clusters || !c.vertices || !c.triangles || count > UINT32_MAX || triangle_bytes > UINT32_MAX) {
-        gdr_mesh_clusters_free(&c);
-        free(meshlets);
-        free(vertices);
-        free(triangles);
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for %zu meshlets", mesh->name,
-                             count);
-    }
-    c.cluster_count = c.level0_cluster_count = (uint32_t)count;
-    c.vertex_count = (uint32_t)vertex_total;
-    c.triangle_byte_count = (uint32_t)triangle_bytes;
-    memcpy(c.vertices, vertices, vertex_total * sizeof *c.vertices);
-    memcpy(c.triangles, triangles, triangle_bytes);
-    for (size_t i = 0; i < count; i++) {
-        const struct meshopt_Meshlet *m = &meshlets[i];
-        gdr_cluster *cl = &c.clusters[i];
-        *cl = (gdr_cluster){.vertex_offset = m->vertex_offset, .triangle_offset = m->triangle_offset,
-                            .vertex_count = m->vertex_count, .triangle_count = m->triangle_count,
-                            .group = GDR_NO_INDEX, .refined_group = GDR_NO_INDEX};
-        /* Zero the padding: the output must not depend on what malloc returned. */
-        size_t used = (size_t)m->triangle_offset + (size_t)m->triangle_count * 3;
-        size_t end = i + 1 < count ? meshlets[i + 1].triangle_offset : triangle_bytes;
-        memset(c.triangles + used, 0, end - used);
-        cluster_bounds(cl, c.vertices + m->vertex_offset, c.triangles + m->triangle_offset, mesh);
-    }
-    free(meshlets);
-    free(vertices);
-    free(triangles);
-    status = gdr_mesh_clusters_build_hierarchy(&c, err);
+    if (status == GDR_ERROR_INVALID_ARGUMENT)
+        return gdr_error_set(err, status, "mesh '%s': meshoptimizer made no meshlets", mesh->name);
+    if (status != GDR_OK)
+        return gdr_error_set(err, status, "mesh '%s': out of memory for meshlets", mesh->name);
+    status = gdr_mesh_clusters_build_hierarchy(out, err);
     if (status != GDR_OK) {
-        gdr_mesh_clusters_free(&c);
+        gdr_mesh_clusters_free(out);
         return status;
     }
-    *out = c;
     return GDR_OK;
 }
 
@@ -364,6 +508,7 @@ typedef struct scene_build {
     gdr_scene *scene;
     const gdr_meshlet_options *options;
     const uint32_t *todo;   /* meshes to build, largest first (the longest tasks start first) */
+    uint32_t mesh_threads;  /* gdr_meshlets_build's thread_count for one mesh */
     uint32_t *failed_mesh;  /* per worker: the lowest mesh index that failed, or GDR_NO_INDEX */
     gdr_error *errors;      /* per worker: that mesh's error */
 } scene_build;
@@ -374,7 +519,10 @@ static void build_task(void *user, uint32_t task_index, uint32_t worker_index)
     uint32_t m = b->todo[task_index];
     gdr_mesh *mesh = &b->scene->meshes[m];
     gdr_error err;
-    gdr_status status = gdr_meshlets_build(mesh, b->options, &mesh->clusters, &err);
+    /* Meshes side by side, one thread each; a single mesh gets every thread. */
+    gdr_meshlet_options o = *b->options;
+    o.thread_count = b->mesh_threads;
+    gdr_status status = gdr_meshlets_build(mesh, &o, &mesh->clusters, &err);
     if (status == GDR_OK)
         status = reorder_vertices(mesh, &err);
     /* Keeping the lowest failing index per worker makes the reported error independent of the
@@ -433,7 +581,8 @@ gdr_status gdr_scene_build_clusters(gdr_scene *scene, const gdr_meshlet_options 
         }
     }
     uint32_t workers = gdr_thread_pool_thread_count(pool);
-    scene_build b = {scene, &o, todo, malloc(workers * sizeof(uint32_t)), malloc(workers * sizeof(gdr_error))};
+    scene_build b = {scene, &o, todo, todo_count == 1 ? o.thread_count : 1, malloc(workers * sizeof(uint32_t)),
+                     malloc(workers * sizeof(gdr_error))};
     if (!b.failed_mesh || !b.errors) {
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "out of memory");
     } else {

@@ -24,17 +24,26 @@ static GdrGpuFrameBuffers frame_buffers(const gdr_renderer *r, const gdr_frame_s
     return (GdrGpuFrameBuffers){
         .draws = slot->draws.address, .draw_stats = slot->draw_stats.address, .updates = slot->updates.address,
         .tasks = slot->tasks.address, .overdraw = r->overdraw.address, .visible_meshlets = r->visible_meshlets.address,
-        .raster = r->vis.params[slot - r->slots].address};
+        .raster = r->vis.params[slot - r->slots].address, .traversal = r->scene.traversal.address};
 }
 
-static uint32_t frame_flags(const gdr_frame_desc *frame, bool lod, bool occlusion, bool history)
+static uint32_t frame_flags(const gdr_frame_desc *frame, bool lod, bool occlusion, bool history, bool hierarchy)
 {
     return (frame->meshlet_frustum_cull != GDR_CULL_OFF ? GDR_FRAME_MESHLET_FRUSTUM : 0u) |
            (frame->meshlet_cone_cull != GDR_CULL_OFF ? GDR_FRAME_MESHLET_CONE : 0u) |
            (frame->triangle_cull != GDR_CULL_OFF ? GDR_FRAME_TRIANGLE_CULL : 0u) |
            (frame->record_visible_meshlets ? GDR_FRAME_RECORD_MESHLETS : 0u) | (lod ? GDR_FRAME_LOD : 0u) |
            (lod && frame->lod_fixed_depth ? GDR_FRAME_LOD_DEPTH : 0u) | (occlusion ? GDR_FRAME_OCCLUSION : 0u) |
-           (history ? GDR_FRAME_HISTORY : 0u);
+           (history ? GDR_FRAME_HISTORY : 0u) | (hierarchy ? GDR_FRAME_LOD_HIERARCHY : 0u);
+}
+
+/* The levels of the LOD hierarchy traversal a frame runs: the deepest hierarchy's, where the mesh
+ * pipeline selects the cut by error and the frame does not turn the traversal off. */
+static uint32_t traversal_levels(const gdr_renderer *r, const gdr_frame_desc *frame, gdr_pipeline pipeline)
+{
+    bool by_error = !frame->lod_fixed_depth && frame->lod_error_px > 0.0f;
+    return pipeline == GDR_PIPELINE_MESH && by_error && frame->lod_hierarchy != GDR_CULL_OFF ? r->scene.traversal_levels
+                                                                                             : 0;
 }
 
 static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame, gdr_pipeline pipeline,
@@ -59,13 +68,15 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .instance_count = r->scene.instance_count,
         .cull_enabled = frame->cull != GDR_CULL_OFF,
         .update_count = update_count,
-        .flags = frame_flags(frame, lod, occlusion, history),
+        .flags = frame_flags(frame, lod, occlusion, history, traversal_levels(r, frame, pipeline) > 0) |
+                 (r->debug_shrink_lod_nodes ? GDR_FRAME_DEBUG_SHRINK_NODES : 0u),
         .view_mode = (uint32_t)frame->view,
         .task_capacity = r->scene.task_capacity,
         .viewport = {(float)r->width, (float)r->height},
         .lod_threshold = frame->lod_error_px,
         .lod_projection_scale = fabsf(projection.m[5]) * 0.5f * (float)r->height,
         .lod_depth = frame->lod_depth > INT32_MAX ? INT32_MAX : (int32_t)frame->lod_depth,
+        .traversal_capacity = r->scene.traversal_capacity,
     };
     gdr_occlusion_params(r, &projection, camera->znear, &globals.occlusion);
     memcpy(slot->globals.mapped, &globals, sizeof globals);
@@ -182,7 +193,7 @@ static gdr_status submit(gdr_renderer *r, gdr_frame_slot *slot, bool copy_color,
 static bool same_config(const gdr_frame_config *a, const gdr_frame_config *b)
 {
     return a->pipeline == b->pipeline && a->visbuffer == b->visbuffer && a->occlusion == b->occlusion &&
-           a->overdraw == b->overdraw && a->updates == b->updates;
+           a->overdraw == b->overdraw && a->updates == b->updates && a->traversal_levels == b->traversal_levels;
 }
 
 gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame,
@@ -201,7 +212,8 @@ gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, co
     slot->pipeline = pipeline;
     gdr_frame_config config = {.pipeline = pipeline, .visbuffer = raster_mode != GDR_GPU_RASTER_FORWARD,
                                .occlusion = occlusion, .overdraw = frame->view == GDR_VIEW_MODE_OVERDRAW,
-                               .updates = update_count > 0};
+                               .updates = update_count > 0,
+                               .traversal_levels = traversal_levels(r, frame, pipeline)};
     /* A GPU-driven frame whose commands are already in the slot: submit them again. */
     slot->resubmitted = slot->recorded && same_config(&slot->plan.config, &config);
     if (slot->resubmitted)

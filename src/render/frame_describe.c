@@ -1,7 +1,7 @@
 /* The frame plans as Markdown: gdr info --passes, and docs/PIPELINE.md (a test keeps them equal). */
 #include <inttypes.h>
 
-#include "render/frame_plan.h"
+#include "render/renderer_internal.h"
 
 const char *gdr_frame_section_name(gdr_frame_section section)
 {
@@ -13,7 +13,7 @@ const char *gdr_frame_section_name(gdr_frame_section section)
 const char *gdr_frame_resource_name(gdr_frame_resource resource)
 {
     static const char *const names[GDR_RES_COUNT] = {
-        "instances", "visibility", "draw_stats", "draws", "tasks", "visible_meshlets", "overdraw", "raster_counters",
+        "instances", "visibility", "draw_stats", "draws", "tasks", "traversal", "visible_meshlets", "overdraw", "raster_counters",
         "raster_clusters", "visbuffer", "resolved", "readback", "color", "depth", "hzb"};
     return (unsigned)resource < GDR_RES_COUNT ? names[resource] : "?";
 }
@@ -137,8 +137,10 @@ void gdr_frame_plan_describe(const gdr_frame_plan *plan, FILE *out)
     fprintf(out, "| # | pass | phase | timing | barrier before it | uses |\n|---|---|---|---|---|---|\n");
     for (uint32_t i = 0; i < plan->pass_count; i++) {
         const gdr_frame_pass *p = &plan->passes[i];
-        fprintf(out, "| %u | %s | %s | %s | ", i + 1, p->template_->name, phase_name(p->phase),
-                gdr_frame_section_name(p->section));
+        fprintf(out, "| %u | %s", i + 1, p->template_->name);
+        if (p->template_->record == gdr_pass_record_lod_traverse)
+            fprintf(out, " (level %u)", p->step);
+        fprintf(out, " | %s | %s | ", phase_name(p->phase), gdr_frame_section_name(p->section));
         print_barrier(out, &p->barrier, p->begins_everything_before);
         fprintf(out, " | ");
         print_uses(out, p);
@@ -156,6 +158,8 @@ void gdr_describe_frame_passes(FILE *out)
         {GDR_PIPELINE_CPU, false, false, false, true},      {GDR_PIPELINE_MESH, false, false, false, true},
         {GDR_PIPELINE_MESH, false, true, false, true},      {GDR_PIPELINE_MESH, true, false, false, true},
         {GDR_PIPELINE_MESH, true, true, false, true},       {GDR_PIPELINE_MESH, true, true, true, true},
+        /* With the LOD cut: the traversal of hierarchies of 3 levels. */
+        {GDR_PIPELINE_MESH, true, true, false, true, 3},    {GDR_PIPELINE_MESH, false, true, false, false, 3},
     };
     for (size_t i = 0; i < sizeof configs / sizeof configs[0]; i++) {
         gdr_frame_plan plan;

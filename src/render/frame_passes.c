@@ -60,7 +60,15 @@ static const gdr_pass_template cull_tasks = {
     "instance_cull", gdr_pass_record_instance_cull,
     .what = "instances: frustum, occlusion, LOD root shortcut; appends task commands",
     .uses = {{GDR_RES_INSTANCES, COMPUTE, READ}, {GDR_RES_VISIBILITY, COMPUTE, READ_WRITE}, HZB_READ(COMPUTE),
-             {GDR_RES_TASKS, COMPUTE, WRITE}, {GDR_RES_DRAW_STATS, COMPUTE, READ_WRITE}}};
+             {GDR_RES_TASKS, COMPUTE, WRITE}, {GDR_RES_DRAW_STATS, COMPUTE, READ_WRITE},
+             {GDR_RES_DRAWS, COMPUTE, WRITE}, {GDR_RES_TRAVERSAL, COMPUTE, WRITE, .flags = GDR_USE_TRAVERSAL}}};
+
+static const gdr_pass_template lod_traverse = {
+    "lod_traverse", gdr_pass_record_lod_traverse,
+    .what = "one level of the LOD hierarchies: nodes by LOD error, frustum, occlusion (late); leaves append tasks",
+    .uses = {{GDR_RES_DRAW_STATS, INDIRECT, INDIRECT_READ}, {GDR_RES_DRAW_STATS, COMPUTE, READ_WRITE},
+             {GDR_RES_TRAVERSAL, COMPUTE, READ_WRITE}, {GDR_RES_INSTANCES, COMPUTE, READ}, HZB_READ(COMPUTE),
+             {GDR_RES_TASKS, COMPUTE, WRITE}}};
 
 static const gdr_pass_template task_submit = {
     "task_submit", gdr_pass_record_task_submit, .what = "the task commands' count into the launches",
@@ -153,6 +161,8 @@ static void add_phase(gdr_frame_plan *plan, gdr_occlusion_phase phase)
         gdr_frame_plan_add(plan, &draw_indexed, phase, draw);
     } else {
         gdr_frame_plan_add(plan, &cull_tasks, phase, cull);
+        for (uint32_t level = 0; level < c->traversal_levels; level++)
+            gdr_frame_plan_add_step(plan, &lod_traverse, phase, level, cull);
         gdr_frame_plan_add(plan, &task_submit, phase, cull);
         if (!c->visbuffer) {
             gdr_frame_plan_add(plan, &meshlets, phase, draw);

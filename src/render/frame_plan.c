@@ -17,16 +17,24 @@ static bool use_applies(const gdr_resource_use *use, const gdr_frame_config *con
         return false;
     if ((use->flags & GDR_USE_NOT_EARLY) && phase == GDR_PHASE_EARLY)
         return false;
+    if ((use->flags & GDR_USE_TRAVERSAL) && config->traversal_levels == 0)
+        return false;
     return use->stages != 0;
 }
 
 void gdr_frame_plan_add(gdr_frame_plan *plan, const gdr_pass_template *pass, gdr_occlusion_phase phase,
                         gdr_frame_section section)
 {
+    gdr_frame_plan_add_step(plan, pass, phase, 0, section);
+}
+
+void gdr_frame_plan_add_step(gdr_frame_plan *plan, const gdr_pass_template *pass, gdr_occlusion_phase phase,
+                             uint32_t step, gdr_frame_section section)
+{
     if (plan->pass_count == GDR_FRAME_MAX_PASSES)
         return; /* the builder's passes are counted: frame_passes.c asserts they fit */
     gdr_frame_pass *p = &plan->passes[plan->pass_count++];
-    *p = (gdr_frame_pass){.template_ = pass, .phase = phase, .section = section, .timestamp = -1};
+    *p = (gdr_frame_pass){.template_ = pass, .phase = phase, .step = step, .section = section, .timestamp = -1};
     for (uint32_t i = 0; i < GDR_PASS_MAX_USES; i++) {
         gdr_resource_use use = pass->uses[i];
         if (!use_applies(&use, &plan->config, phase))

@@ -12,6 +12,7 @@
 #include <stdio.h>
 
 #include "gdr/renderer.h"
+#include "shaders/shared/gpu_config.h"
 #include "vk/vk_image.h"
 
 /* Two-phase occlusion culling's phases; the culling shaders' specialisation constant PHASE. */
@@ -29,6 +30,7 @@ typedef enum gdr_frame_resource {
     GDR_RES_DRAW_STATS,       /* the frame's counters and indirect launches (GdrGpuDrawStats) */
     GDR_RES_DRAWS,            /* indirect draw commands */
     GDR_RES_TASKS,            /* task commands */
+    GDR_RES_TRAVERSAL,        /* the LOD hierarchy traversal's node visits */
     GDR_RES_VISIBLE_MESHLETS, /* the record of drawn clusters (tests, tools) */
     GDR_RES_OVERDRAW,         /* fragments per pixel (overdraw view) */
     GDR_RES_RASTER_COUNTERS,  /* GdrGpuRasterCounters with the rasterisers' launches */
@@ -75,6 +77,7 @@ typedef enum gdr_raster_timer {
 #define GDR_USE_CLEARS 4u         /* an attachment the pass clears in the frame's first raster phase
                                      (old contents discarded) and loads in the late phase */
 #define GDR_USE_NOT_EARLY 8u      /* not in the early phase */
+#define GDR_USE_TRAVERSAL 16u     /* only in frames that traverse the LOD hierarchy */
 
 typedef struct gdr_resource_use {
     gdr_frame_resource resource;
@@ -91,6 +94,7 @@ typedef struct gdr_frame_config {
     bool occlusion;         /* two phases against the depth pyramid */
     bool overdraw;          /* the overdraw view */
     bool updates;           /* instance updates in the ring: the scatter pass runs */
+    uint32_t traversal_levels; /* mesh pipeline: levels of the LOD hierarchy traversal (0: none) */
 } gdr_frame_config;
 
 struct gdr_renderer;
@@ -100,7 +104,7 @@ typedef void (*gdr_pass_record_fn)(struct gdr_renderer *r, struct gdr_frame_slot
                                    const struct gdr_frame_pass *pass, VkCommandBuffer cmd);
 
 #define GDR_PASS_MAX_USES 10
-#define GDR_FRAME_MAX_PASSES 32
+#define GDR_FRAME_MAX_PASSES (48 + 2 * GDR_LOD_TREE_LEVELS)
 #define GDR_FRAME_MAX_TIMESTAMPS (GDR_FRAME_MAX_PASSES + 1)
 
 /* A pass as written in the table. */
@@ -129,6 +133,7 @@ typedef struct gdr_frame_barrier {
 typedef struct gdr_frame_pass {
     const gdr_pass_template *template_;
     gdr_occlusion_phase phase;
+    uint32_t step;                 /* a repeated pass's step (the traversal's level) */
     gdr_frame_section section;
     uint32_t use_count;
     gdr_resource_use uses[GDR_PASS_MAX_USES];
@@ -154,6 +159,9 @@ void gdr_frame_plan_build(const gdr_frame_config *config, gdr_frame_plan *plan);
 /* Appends a pass from its template (the uses that apply to the configuration and phase). */
 void gdr_frame_plan_add(gdr_frame_plan *plan, const gdr_pass_template *pass, gdr_occlusion_phase phase,
                         gdr_frame_section section);
+/* The same for step `step` of a repeated pass. */
+void gdr_frame_plan_add_step(gdr_frame_plan *plan, const gdr_pass_template *pass, gdr_occlusion_phase phase,
+                             uint32_t step, gdr_frame_section section);
 /* Derives barriers and timestamps: what gdr_frame_plan_build ends with. */
 void gdr_frame_plan_derive(gdr_frame_plan *plan);
 

@@ -97,6 +97,18 @@ void gdr_pass_record_draw_indexed(gdr_renderer *r, gdr_frame_slot *slot, const g
     vkCmdEndRendering(cmd);
 }
 
+/* One level of the LOD hierarchy traversal, launched with what the level before queued. */
+void gdr_pass_record_lod_traverse(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
+                                  VkCommandBuffer cmd)
+{
+    bind_compute(r, cmd, GDR_PIPE_LOD_TRAVERSE + pass->phase);
+    uint32_t step = pass->step;
+    vkCmdPushConstants(cmd, r->layout, VK_SHADER_STAGE_ALL, offsetof(GdrGpuPushConstants, step), sizeof step, &step);
+    uint32_t level = (pass->phase == GDR_PHASE_LATE ? GDR_LOD_TREE_LEVELS : 0) + pass->step;
+    vkCmdDispatchIndirect(cmd, slot->draw_stats.buffer,
+                          offsetof(GdrGpuDrawStats, traversal) + sizeof(GdrGpuTraversalLevel) * level);
+}
+
 void gdr_pass_record_task_submit(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
                                  VkCommandBuffer cmd)
 {

@@ -42,6 +42,20 @@ static void fill_gpu_driven(const gdr_frame_slot *slot, const GdrGpuDrawStats *g
     stats->triangles += stats->raster.sw_triangles; /* the mesh shaders count only their own */
 }
 
+static void fill_traversal(const gdr_frame_slot *slot, const GdrGpuDrawStats *gpu, gdr_traversal_stats *t)
+{
+    *t = (gdr_traversal_stats){
+        .applied = slot->plan.config.traversal_levels > 0,
+        .levels = slot->plan.config.traversal_levels,
+        .nodes_tested = gpu->nodes_tested,
+        .nodes_lod_culled = gpu->nodes_lod_culled,
+        .nodes_frustum_culled = gpu->nodes_frustum_culled,
+        .nodes_occluded = gpu->nodes_occluded,
+        .late_nodes_tested = gpu->late_nodes_tested,
+        .overflow = gpu->traversal_overflow,
+    };
+}
+
 /* The mesh pipeline's clusters and LOD cut. */
 static void fill_mesh(const gdr_renderer *r, const gdr_frame_slot *slot, const GdrGpuDrawStats *gpu,
                       gdr_frame_stats *stats)
@@ -55,6 +69,7 @@ static void fill_mesh(const gdr_renderer *r, const gdr_frame_slot *slot, const G
     stats->triangles_small_culled = gpu->triangles_small_culled;
     stats->task_workgroups = gpu->task_count + gpu->late_task_count;
     stats->task_overflow = gpu->task_overflow;
+    fill_traversal(slot, gpu, &stats->traversal);
     stats->lod.applied = slot->lod_applied;
     stats->lod.meshlets_culled = gpu->meshlets_lod_culled;
     for (uint32_t d = 0; d < GDR_LOD_STATS_DEPTH_COUNT; d++) {

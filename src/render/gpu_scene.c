@@ -142,9 +142,8 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
         vertex_cursor += c->vertex_count;
         byte_cursor += c->triangle_byte_count;
     }
-    uint64_t tasks = 0, instance_meshlets = 0, instance_lod_clusters = 0;
+    uint64_t instance_meshlets = 0, instance_lod_clusters = 0;
     for (uint32_t i = 0; i < scene->instance_count; i++) {
-        tasks += g->cpu_meshes[scene->instances[i].mesh].lod_task_count; /* >= task_count and root_task_count */
         instance_meshlets += g->cpu_meshes[scene->instances[i].mesh].meshlet_count;
         g->cpu_instances[i].meshlet_visibility_offset = (uint32_t)instance_lod_clusters; /* checked below */
         instance_lod_clusters += g->cpu_meshes[scene->instances[i].mesh].lod_cluster_count;
@@ -154,10 +153,6 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
     if (status == GDR_OK && instance_lod_clusters > UINT32_MAX)
         status = gdr_error_set(err, GDR_ERROR_CAPACITY, "scene: %llu clusters over all instances exceed 32-bit indices",
                                (unsigned long long)instance_lod_clusters);
-    if (status == GDR_OK && tasks > UINT32_MAX / sizeof(GdrGpuTaskCommand) / 2)
-        status = gdr_error_set(err, GDR_ERROR_CAPACITY, "scene: %llu task workgroups per frame is too many",
-                               (unsigned long long)tasks);
-    g->task_capacity = (uint32_t)tasks;
     g->meshlet_count = (uint32_t)meshlet_total;
     const VkBufferUsageFlags usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     if (status == GDR_OK)
@@ -188,6 +183,42 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
 
 /* The LOD hierarchy pool: every mesh's gdr_lod_node array as it is (the bytes of GdrGpuLodNode,
  * mesh-local indices), one after another. Fills the meshes' lod_node fields. */
+/* Task commands one instance of mesh `c` can need in a phase: all its clusters (flat), or one run
+ * per hierarchy leaf the traversal reaches. */
+static uint64_t tasks_per_instance(const gdr_mesh_clusters *c, const GdrGpuMesh *mesh)
+{
+    uint64_t leaves = 0;
+    for (uint32_t n = 0; n < c->lod_node_count; n++)
+        if (c->lod_nodes[n].flags & GDR_GPU_LOD_NODE_LEAF)
+            leaves += (c->lod_nodes[n].count + GDR_TASK_WORKGROUP_SIZE - 1) / GDR_TASK_WORKGROUP_SIZE;
+    return leaves > mesh->lod_task_count ? leaves : mesh->lod_task_count; /* >= task_count, root_task_count */
+}
+
+/* The task list and the traversal's levels: what every instance could need, up to the limits of
+ * gpu_config.h (a frame that needs more counts what it drops); `debug_*` override for tests. */
+static void size_queues(gdr_renderer *r, const gdr_scene *scene, const gdr_mesh_clusters *const *clusters)
+{
+    gdr_gpu_scene *g = &r->scene;
+    uint64_t *per_mesh = calloc(scene->mesh_count ? scene->mesh_count : 1, sizeof *per_mesh);
+    uint64_t tasks = 0, visits = 0;
+    for (uint32_t m = 0; per_mesh && m < scene->mesh_count; m++)
+        per_mesh[m] = tasks_per_instance(clusters[m], &g->cpu_meshes[m]);
+    for (uint32_t i = 0; i < scene->instance_count; i++) {
+        uint32_t m = scene->instances[i].mesh;
+        tasks += per_mesh ? per_mesh[m] : GDR_MAX_TASK_COMMANDS;
+        visits += g->cpu_meshes[m].lod_node_count;
+    }
+    free(per_mesh);
+    g->task_capacity = (uint32_t)(tasks < GDR_MAX_TASK_COMMANDS ? tasks : GDR_MAX_TASK_COMMANDS);
+    g->traversal_capacity = (uint32_t)(visits < GDR_TRAVERSE_MAX_VISITS ? visits : GDR_TRAVERSE_MAX_VISITS);
+    if (r->debug_task_capacity)
+        g->task_capacity = r->debug_task_capacity;
+    if (r->debug_traversal_capacity)
+        g->traversal_capacity = r->debug_traversal_capacity;
+    g->task_capacity = g->task_capacity ? g->task_capacity : 1;
+    g->traversal_capacity = g->traversal_capacity ? g->traversal_capacity : 1;
+}
+
 static gdr_status upload_lod_nodes(gdr_renderer *r, const gdr_scene *scene, const gdr_mesh_clusters *const *clusters,
                                    gdr_error *err)
 {
@@ -208,6 +239,9 @@ static gdr_status upload_lod_nodes(gdr_renderer *r, const gdr_scene *scene, cons
         g->cpu_meshes[m].lod_node_offset = cursor;
         g->cpu_meshes[m].lod_node_count = c->lod_node_count;
         g->cpu_meshes[m].lod_node_levels = c->lod_node_levels;
+        bool traversed = g->cpu_meshes[m].lod_task_count > GDR_TRAVERSE_MIN_TASKS; /* as drawcull.comp decides */
+        if (traversed && c->lod_node_levels > g->traversal_levels)
+            g->traversal_levels = c->lod_node_levels;
         if (c->lod_node_count)
             memcpy(nodes + cursor, c->lod_nodes, sizeof *nodes * c->lod_node_count);
         cursor += c->lod_node_count;
@@ -279,6 +313,11 @@ gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
         status = upload_clusters(r, scene, clusters, err);
     if (status == GDR_OK)
         status = upload_lod_nodes(r, scene, clusters, err);
+    if (status == GDR_OK)
+        size_queues(r, scene, clusters);
+    if (status == GDR_OK) /* the traversal's visits: even levels, then odd levels */
+        status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuNodeVisit) * 2 * (VkDeviceSize)g->traversal_capacity,
+                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GDR_VK_BUFFER_DEVICE, &g->traversal, err);
     for (uint32_t m = 0; built && m < scene->mesh_count; m++)
         gdr_mesh_clusters_free(&built[m]);
     free(built);
@@ -338,6 +377,7 @@ void gdr_gpu_scene_destroy(gdr_renderer *r)
     gdr_vk_buffer_destroy(r->ctx, &g->meshlet_vertices);
     gdr_vk_buffer_destroy(r->ctx, &g->meshlet_triangles);
     gdr_vk_buffer_destroy(r->ctx, &g->lod_nodes);
+    gdr_vk_buffer_destroy(r->ctx, &g->traversal);
     gdr_vk_buffer_destroy(r->ctx, &g->refs);
     free(g->cpu_meshlets);
     free(g->cpu_meshes);

@@ -13,7 +13,8 @@ typedef enum gdr_pipeline_id {
     GDR_PIPE_INSTANCE_SCATTER,
     GDR_PIPE_CULL_DRAWS,        /* instance cull writing indirect draws, per phase */
     GDR_PIPE_CULL_TASKS = GDR_PIPE_CULL_DRAWS + 3, /* instance cull writing task commands, per phase */
-    GDR_PIPE_TASK_SUBMIT = GDR_PIPE_CULL_TASKS + 3,
+    GDR_PIPE_LOD_TRAVERSE = GDR_PIPE_CULL_TASKS + 3, /* one level of the LOD hierarchy traversal, per phase */
+    GDR_PIPE_TASK_SUBMIT = GDR_PIPE_LOD_TRAVERSE + 3,
     GDR_PIPE_TASK_SUBMIT_LATE,
     GDR_PIPE_DRAW_INDEXED,      /* the vertex pipeline of the indirect and CPU pipelines */
     GDR_PIPE_MESHLETS,          /* task + mesh + fragment shaders (forward raster), per phase */

@@ -82,6 +82,9 @@ gdr_status gdr_renderer_create(const gdr_renderer_desc *desc_in, gdr_renderer **
     r->last_slot = -1;
     r->busy_wait = desc.busy_wait;
     r->record_every_frame = desc.record_every_frame;
+    r->debug_task_capacity = desc.debug_task_capacity;
+    r->debug_traversal_capacity = desc.debug_traversal_capacity;
+    r->debug_shrink_lod_nodes = desc.debug_shrink_lod_nodes;
     gdr_vk_context_desc context_desc = {.device = desc.device, .validate = desc.validate,
                                         .synchronization_validation = desc.synchronization_validation,
                                         .disable_mesh_shaders = desc.disable_mesh_shaders};
@@ -360,19 +363,13 @@ gdr_status gdr_renderer_read_visible(gdr_renderer *r, uint32_t *indices, uint32_
     gdr_status status;
     uint32_t n = 0;
     if (slot->pipeline == GDR_PIPELINE_MESH) {
-        /* The task commands, each visible instance's run of commands in append order: the early
-         * (or only) phase's, then those of the late phase for instances it did not draw early. */
-        uint32_t capacity_tasks = r->scene.task_capacity;
-        uint32_t early = gpu.task_count < capacity_tasks ? gpu.task_count : capacity_tasks;
-        uint32_t late_count = late ? (gpu.late_task_count < capacity_tasks ? gpu.late_task_count : capacity_tasks) : 0;
-        status = gdr_vk_buffer_read_back(&r->allocator, slot->tasks.buffer, 0,
-                                         sizeof(GdrGpuTaskCommand) * 2 * (VkDeviceSize)capacity_tasks, &readback, err);
-        const GdrGpuTaskCommand *tasks = readback.mapped;
-        for (uint32_t i = 0; status == GDR_OK && i < early + late_count; i++) {
-            const GdrGpuTaskCommand *task = i < early ? &tasks[i] : &tasks[capacity_tasks + (i - early)];
-            if ((task->flags & GDR_TASK_FIRST) && !(task->flags & GDR_TASK_DRAWN_EARLY) && n < *count)
-                indices[n++] = task->instance;
-        }
+        /* The instance cull lists the visible instances in the draw-command list: the early (or
+         * only) phase's, then those of the late phase that it did not draw early. */
+        status = gdr_vk_buffer_read_back(&r->allocator, slot->draws.buffer, 0,
+                                         sizeof(GdrGpuDrawCommand) * (VkDeviceSize)*count, &readback, err);
+        const GdrGpuDrawCommand *draws = readback.mapped;
+        for (uint32_t i = 0; status == GDR_OK && i < gpu.instances_listed && n < *count; i++)
+            indices[n++] = draws[i].first_instance;
     } else {
         status = gdr_vk_buffer_read_back(&r->allocator, slot->draws.buffer, 0,
                                          sizeof(GdrGpuDrawCommand) * 2 * (VkDeviceSize)r->scene.instance_count,

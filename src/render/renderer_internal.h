@@ -43,12 +43,15 @@ typedef struct gdr_gpu_scene {
     gdr_vk_buffer meshlets;          /* GdrGpuMeshlet[], all meshes' clusters */
     gdr_vk_buffer meshlet_vertices;  /* uint32[]: global vertex index per cluster-local vertex */
     gdr_vk_buffer meshlet_triangles; /* uint32[] holding 3 bytes per cluster triangle */
+    gdr_vk_buffer traversal;         /* GdrGpuNodeVisit[2 * traversal_capacity]: the traversal's levels */
     gdr_vk_buffer lod_nodes;         /* GdrGpuLodNode[]: every mesh's LOD hierarchy, as gdr_lod_node */
     gdr_vk_buffer refs;              /* GdrGpuScene: the addresses above, for the push constants */
     uint32_t mesh_count;
     uint32_t instance_count;
     uint32_t meshlet_count;
-    uint32_t task_capacity;        /* task commands of all instances: the task buffer's size */
+    uint32_t task_capacity;        /* task commands of one phase: the task buffer holds two phases */
+    uint32_t traversal_capacity;   /* node visits of one traversal level */
+    uint32_t traversal_levels;     /* levels of the deepest mesh hierarchy */
     uint64_t instance_meshlet_count; /* level-0 clusters summed over the instances (meshlets_total) */
     uint64_t instance_lod_cluster_count; /* every DAG cluster summed over the instances */
     uint64_t bytes;                /* device memory of the buffers above and the occlusion history */
@@ -111,6 +114,8 @@ struct gdr_renderer {
     gdr_frame_slot slots[GDR_FRAMES_IN_FLIGHT];
     uint32_t frame_index;
     bool record_every_frame;      /* gdr_renderer_desc.record_every_frame: never resubmit */
+    uint32_t debug_task_capacity, debug_traversal_capacity; /* gdr_renderer_desc's test settings */
+    bool debug_shrink_lod_nodes;
     int last_slot; /* slot of the last submitted frame, -1 before the first */
 };
 
@@ -143,6 +148,8 @@ void gdr_pass_record_clear(gdr_renderer *r, gdr_frame_slot *slot, const gdr_fram
 void gdr_pass_record_instance_cull(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
                                    VkCommandBuffer cmd);
 void gdr_pass_record_draw_indexed(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
+                                  VkCommandBuffer cmd);
+void gdr_pass_record_lod_traverse(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
                                   VkCommandBuffer cmd);
 void gdr_pass_record_task_submit(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
                                  VkCommandBuffer cmd);

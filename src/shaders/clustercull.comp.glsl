@@ -1,7 +1,8 @@
 #version 460
-// The cluster cull of the visibility-buffer modes (issue 8): one workgroup per GDR_CLUSTER_CULL_TASKS
-// task commands (each up to GDR_TASK_WORKGROUP_SIZE clusters of one visible instance), one
-// invocation per cluster, launched indirectly (tasksubmit.comp). The tests are the task shader's
+// The cluster cull of the visibility-buffer modes: one workgroup per GDR_CLUSTER_CULL_TASKS task
+// commands (each up to GDR_TASK_WORKGROUP_SIZE clusters of one visible instance),
+// GDR_CLUSTER_CULL_LANES invocations per command stepping through its clusters, launched indirectly
+// (tasksubmit.comp). The tests are the task shader's
 // (shared/cluster_cull.h); each visible cluster is then binned and appended to the frame's
 // visible-cluster list (shared/raster_bin.h): small triangles to the compute rasteriser, the rest to
 // the mesh shaders, which raster_submit.comp launches without a task shader. A compute pass instead
@@ -18,17 +19,28 @@
 #include "shared/cluster_cull.h"
 #include "shared/raster_bin.h"
 
-layout(local_size_x = GDR_TASK_WORKGROUP_SIZE * GDR_CLUSTER_CULL_TASKS) in;
-// Occlusion culling phase (issue 6): GDR_PHASE_NONE, _EARLY or _LATE.
+layout(local_size_x = GDR_CLUSTER_CULL_LANES * GDR_CLUSTER_CULL_TASKS) in;
+// Occlusion culling phase: GDR_PHASE_NONE, _EARLY or _LATE.
 layout(constant_id = 0) const uint PHASE = GDR_PHASE_NONE;
+
+shared uint largest_task; // clusters in the workgroup's largest task command
 
 void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
     uint group = gl_WorkGroupID.x + gl_WorkGroupID.y * GDR_TASK_GROUPS_PER_ROW;
-    uint task_index = group * GDR_CLUSTER_CULL_TASKS + gl_LocalInvocationIndex / GDR_TASK_WORKGROUP_SIZE;
-    uint lane = gl_LocalInvocationIndex % GDR_TASK_WORKGROUP_SIZE;
-    GdrClusterResult cluster = gdr_cluster_test(g, PHASE, task_index, lane);
-    gdr_raster_append(g, cluster.visible, cluster.instance, cluster.meshlet);
-    gdr_cluster_count(g, PHASE, cluster);
+    uint task_index = group * GDR_CLUSTER_CULL_TASKS + gl_LocalInvocationIndex / GDR_CLUSTER_CULL_LANES;
+    uint lane = gl_LocalInvocationIndex % GDR_CLUSTER_CULL_LANES;
+    if (gl_LocalInvocationIndex == 0u)
+        largest_task = 0u;
+    barrier();
+    if (lane == 0u)
+        atomicMax(largest_task, gdr_cluster_task_size(g, PHASE, task_index));
+    barrier();
+    // Steps of GDR_CLUSTER_CULL_LANES clusters, as many as the largest command needs (uniform).
+    for (uint first = 0u; first < largest_task; first += GDR_CLUSTER_CULL_LANES) {
+        GdrClusterResult cluster = gdr_cluster_test(g, PHASE, task_index, first + lane);
+        gdr_raster_append(g, cluster.visible, cluster.instance, cluster.meshlet);
+        gdr_cluster_count(g, PHASE, cluster);
+    }
 }

@@ -3,7 +3,8 @@
 // compacted with subgroup ballots, as VkDrawIndexedIndirectCommands for one
 // vkCmdDrawIndexedIndirectCount (first_instance carries the instance index to the vertex shader),
 // or, for the meshlet pipeline (EMIT_TASKS), as task commands: one task workgroup per up to
-// GDR_TASK_WORKGROUP_SIZE clusters of the instance (level 0, or the LOD DAG's clusters).
+// GDR_TASK_WORKGROUP_SIZE clusters of the instance (level 0, the LOD DAG's clusters, the root
+// group's), or as the root of its LOD hierarchy queued for the traversal (lodtraverse.comp).
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 
@@ -11,59 +12,31 @@
 #include "shared/cull_math.h"
 #include "shared/lod_math.h"
 #include "shared/occlusion_test.h"
+#include "shared/task_queue.h"
 
 layout(local_size_x = GDR_CULL_WORKGROUP_SIZE) in;
 layout(constant_id = 0) const bool EMIT_TASKS = false;
-// Occlusion culling phase (issue 6): none, or the early / late phase of the two-phase scheme.
-layout(constant_id = 1) const uint PHASE = 0u;
-#define PHASE_EARLY 1u
-#define PHASE_LATE 2u
+// Occlusion culling phase: none, or the early / late phase of the two-phase scheme.
+layout(constant_id = 1) const uint PHASE = GDR_PHASE_NONE;
 
-
-// The clusters an instance's task workgroups test: level 0; with the LOD cut, every cluster of
-// the DAG, or only the root group's when the root shortcut passes (issue 5).
-struct TaskRange {
-    uint first;  // global cluster index
-    uint count;
-    uint tasks;
-    uint flags;  // GDR_TASK_*
-};
-
-TaskRange task_range(GdrGpuFrameGlobals g, GdrGpuMesh mesh, mat4 model)
+// The clusters an instance's task workgroups test: level 0; with the LOD cut, only the root
+// group's when the root shortcut passes, else those the traversal of its LOD hierarchy finds
+// (`traverse`: none here), or every cluster of the DAG (flat, or the discrete debug cut).
+GdrTaskRange task_range(GdrGpuFrameGlobals g, GdrGpuMesh mesh, mat4 model, out bool traverse)
 {
+    traverse = false;
     if ((g.flags & GDR_FRAME_LOD) == 0u)
-        return TaskRange(mesh.meshlet_offset, mesh.meshlet_count, mesh.task_count, 0u);
-    if ((g.flags & GDR_FRAME_LOD_DEPTH) == 0u && mesh.root_cluster_count > 0u &&
+        return gdr_task_range(mesh.meshlet_offset, mesh.meshlet_count, 0u);
+    if ((g.flags & GDR_FRAME_LOD_DEPTH) != 0u)
+        return gdr_task_range(mesh.meshlet_offset, mesh.lod_cluster_count, 0u);
+    if (mesh.root_cluster_count > 0u &&
         gdr_lod_group_projected_error(mesh.root_refined_sphere, mesh.root_refined_error, model[0].xyz, model[1].xyz,
                                       model[2].xyz, model[3].xyz, g.camera_position.xyz, g.znear,
                                       g.lod_projection_scale) <= g.lod_threshold)
-        return TaskRange(mesh.meshlet_offset + mesh.root_first, mesh.root_cluster_count, mesh.root_task_count,
-                         GDR_TASK_LOD_ACCEPTED);
-    return TaskRange(mesh.meshlet_offset, mesh.lod_cluster_count, mesh.lod_task_count, 0u);
-}
-
-void append_tasks(GdrGpuFrameGlobals g, bool visible, uint instance, TaskRange range)
-{
-    DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
-    uint count = visible ? range.tasks : 0u;
-    uint subgroup_total = subgroupAdd(count);
-    uint base = 0u;
-    if (subgroupElect() && subgroup_total > 0u)
-        base = PHASE == PHASE_LATE ? atomicAdd(stats.value.late_task_count, subgroup_total)
-                                   : atomicAdd(stats.value.task_count, subgroup_total);
-    base = subgroupBroadcastFirst(base) + subgroupExclusiveAdd(count);
-    // The late phase's commands follow the early phase's region (task_capacity entries).
-    TaskCommandsRef tasks = TaskCommandsRef(uint64_t(GDR_FRAME.tasks) + (PHASE == PHASE_LATE ? uint64_t(g.task_capacity) * 16ul : 0ul));
-    for (uint t = 0u; t < count; t++) {
-        uint slot = base + t;
-        uint first = t * GDR_TASK_WORKGROUP_SIZE;
-        if (slot < g.task_capacity)
-            tasks.items[slot] = GdrGpuTaskCommand(instance, range.first + first,
-                                                  min(range.count - first, GDR_TASK_WORKGROUP_SIZE),
-                                                  range.flags | (t == 0u ? GDR_TASK_FIRST : 0u));
-        else
-            atomicAdd(stats.value.task_overflow, 1u);
-    }
+        return gdr_task_range(mesh.meshlet_offset + mesh.root_first, mesh.root_cluster_count, GDR_TASK_LOD_ACCEPTED);
+    traverse = (g.flags & GDR_FRAME_LOD_HIERARCHY) != 0u && mesh.lod_node_count > 0u &&
+               mesh.lod_task_count > GDR_TRAVERSE_MIN_TASKS;
+    return traverse ? GdrTaskRange(0u, 0u, 0u, 0u) : gdr_task_range(mesh.meshlet_offset, mesh.lod_cluster_count, 0u);
 }
 
 // Adds each lane's 0/1 to a counter with one atomic per subgroup.
@@ -94,12 +67,12 @@ void main()
             visible = gdr_sphere_visible(g.frustum, center, radius, g.znear, g.zfar);
     }
 
-    // Two-phase occlusion culling (issue 6; seeds 000, 002). Early: what was visible at the end
+    // Two-phase occlusion culling (seeds 000, 002). Early: what was visible at the end
     // of the last frame, unless last frame's pyramid hides it. Late: everything in the frustum
     // against this frame's pyramid (built from the early phase's depth); draws what the early
     // phase did not, and records what is visible for the next frame.
     bool drawn_early = false;
-    if (PHASE == PHASE_EARLY && id < g.instance_count) {
+    if (PHASE == GDR_PHASE_EARLY && id < g.instance_count) {
         uint state = VisibilityRef(GDR_SCENE.instance_visibility).items[id];
         bool candidate = visible && (g.flags & GDR_FRAME_HISTORY) != 0u && (state & GDR_INSTANCE_VISIBLE_LAST_FRAME) != 0u;
         bool occluded = candidate && gdr_sphere_occluded(g, center, radius);
@@ -108,7 +81,7 @@ void main()
         COUNT(instances_early_drawn, visible);
         VisibilityRef(GDR_SCENE.instance_visibility).items[id] = (state & GDR_INSTANCE_VISIBLE_LAST_FRAME) |
                                                          (visible ? GDR_INSTANCE_DRAWN_EARLY : 0u);
-    } else if (PHASE == PHASE_LATE && id < g.instance_count) {
+    } else if (PHASE == GDR_PHASE_LATE && id < g.instance_count) {
         uint state = VisibilityRef(GDR_SCENE.instance_visibility).items[id];
         drawn_early = (state & GDR_INSTANCE_DRAWN_EARLY) != 0u;
         COUNT(instances_late_tested, visible);
@@ -129,7 +102,7 @@ void main()
     uint triangles = EMIT_TASKS ? 0u : subgroupAdd(visible ? mesh.index_count / 3u : 0u);
     uint base = 0u;
     if (subgroupElect() && subgroup_count > 0u) {
-        if (PHASE == PHASE_LATE)
+        if (PHASE == GDR_PHASE_LATE)
             base = atomicAdd(stats.value.late_draw_count, subgroup_count);
         else
             base = atomicAdd(stats.value.draw_count, subgroup_count);
@@ -139,13 +112,24 @@ void main()
     }
     base = subgroupBroadcastFirst(base);
     if (EMIT_TASKS) {
-        TaskRange range = visible ? task_range(g, mesh, model) : TaskRange(0u, 0u, 0u, 0u);
-        if (drawn_early)
-            range.flags |= GDR_TASK_DRAWN_EARLY;
-        append_tasks(g, visible, id, range);
+        bool traverse = false;
+        GdrTaskRange range = visible ? task_range(g, mesh, model, traverse) : GdrTaskRange(0u, 0u, 0u, 0u);
+        uint flags = drawn_early ? GDR_TASK_DRAWN_EARLY : 0u;
+        range.flags |= flags;
+        gdr_append_tasks(g, PHASE, visible, id, range);
+        gdr_queue_visits(g, PHASE, 0u, traverse && visible ? 1u : 0u, id, 0u, flags);
+        // The visible instances, for read-backs (the early phase's, then the late phase's others).
+        bool listed = visible && !drawn_early;
+        uvec4 listed_ballot = subgroupBallot(listed);
+        uint list_base = 0u;
+        if (subgroupElect() && subgroupBallotBitCount(listed_ballot) > 0u)
+            list_base = atomicAdd(stats.value.instances_listed, subgroupBallotBitCount(listed_ballot));
+        list_base = subgroupBroadcastFirst(list_base) + subgroupBallotExclusiveBitCount(listed_ballot);
+        if (listed)
+            DrawCommandsRef(GDR_FRAME.draws).items[list_base] = GdrGpuDrawCommand(0u, 0u, 0u, 0, id);
     } else if (visible) {
         // The late phase's draws follow the early phase's region (instance_count entries).
-        uint slot = base + subgroupBallotExclusiveBitCount(ballot) + (PHASE == PHASE_LATE ? g.instance_count : 0u);
+        uint slot = base + subgroupBallotExclusiveBitCount(ballot) + (PHASE == GDR_PHASE_LATE ? g.instance_count : 0u);
         DrawCommandsRef(GDR_FRAME.draws).items[slot] =
             GdrGpuDrawCommand(mesh.index_count, 1u, mesh.first_index, int(mesh.vertex_offset), id);
     }

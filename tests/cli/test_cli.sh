@@ -127,6 +127,8 @@ expect 0 "render occlusion" "$gdr" render occlusion $tiny --validate --out "$wor
 expect 0 "render occlusion from behind the wall" "$gdr" render occlusion:hidden=300,visible=40,seed=2 $tiny --camera-index 1 --validate
 expect 0 "info lod-field" "$gdr" info lod-field
 grep -q '^instances: *1000$' "$work/stdout" || { echo "FAIL: info lod-field: $(cat "$work/stdout")"; failures=$((failures + 1)); }
+grep -q '^lod nodes: *[1-9][0-9]* (hierarchies of up to [1-9][0-9]* levels)$' "$work/stdout" ||
+    { echo "FAIL: info lod-field hierarchy: $(cat "$work/stdout")"; failures=$((failures + 1)); }
 expect 0 "info occlusion" "$gdr" info occlusion:hidden=100,visible=10
 grep -q '^cameras: *6$' "$work/stdout" || { echo "FAIL: info occlusion: $(cat "$work/stdout")"; failures=$((failures + 1)); }
 expect 0 "build lod-field" "$gdr" build lod-field:instances=5,triangles=2000 -o "$work/field.gdrc" --no-progress

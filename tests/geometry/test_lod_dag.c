@@ -712,10 +712,129 @@ static void test_bad_input(void)
     gdr_scene_destroy(s);
 }
 
+/* --- the error bounds the deviation from full detail ------------------------------------------- */
+
+typedef struct dvec3 {
+    double x, y, z;
+} dvec3;
+
+static dvec3 d3(gdr_vec3 v) { return (dvec3){v.x, v.y, v.z}; }
+static dvec3 d3_sub(dvec3 a, dvec3 b) { return (dvec3){a.x - b.x, a.y - b.y, a.z - b.z}; }
+static double d3_dot(dvec3 a, dvec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+/* Distance from p to triangle abc, in double: the nearest of the plane's foot (when inside), the
+ * three edges' nearest points. */
+static double point_segment(dvec3 p, dvec3 a, dvec3 b)
+{
+    dvec3 ab = d3_sub(b, a), ap = d3_sub(p, a);
+    double t = d3_dot(ab, ab) > 0 ? d3_dot(ap, ab) / d3_dot(ab, ab) : 0;
+    t = t < 0 ? 0 : t > 1 ? 1 : t;
+    dvec3 d = d3_sub(ap, (dvec3){ab.x * t, ab.y * t, ab.z * t});
+    return sqrt(d3_dot(d, d));
+}
+
+static double point_triangle(dvec3 p, dvec3 a, dvec3 b, dvec3 c)
+{
+    dvec3 u = d3_sub(b, a), v = d3_sub(c, a), w = d3_sub(p, a);
+    dvec3 n = {u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x};
+    double nn = d3_dot(n, n), best = point_segment(p, a, b);
+    best = fmin(best, fmin(point_segment(p, b, c), point_segment(p, c, a)));
+    if (nn > 0) {
+        double uu = d3_dot(u, u), uv = d3_dot(u, v), vv = d3_dot(v, v), wu = d3_dot(w, u), wv = d3_dot(w, v);
+        double den = uv * uv - uu * vv, s = (uv * wv - vv * wu) / den, t = (uv * wu - uu * wv) / den;
+        if (s >= 0 && t >= 0 && s + t <= 1)
+            best = fmin(best, fabs(d3_dot(w, n)) / sqrt(nn));
+    }
+    return best;
+}
+
+/* Distance from p to the nearest triangle of a list of mesh-vertex corners. */
+static double point_surface(const gdr_mesh *m, dvec3 p, const uint32_t *corners, size_t triangles)
+{
+    double best = INFINITY;
+    for (size_t t = 0; t < triangles; t++)
+        best = fmin(best, point_triangle(p, d3(m->positions[corners[3 * t]]), d3(m->positions[corners[3 * t + 1]]),
+                                         d3(m->positions[corners[3 * t + 2]])));
+    return best;
+}
+
+/* The largest distance from the vertices and centroids of `from` to `to`. */
+static double one_sided(const gdr_mesh *m, const uint32_t *from, size_t from_count, const uint32_t *to,
+                        size_t to_count)
+{
+    double worst = 0;
+    for (size_t t = 0; t < from_count; t++) {
+        dvec3 c[3] = {d3(m->positions[from[3 * t]]), d3(m->positions[from[3 * t + 1]]), d3(m->positions[from[3 * t + 2]])};
+        dvec3 probes[4] = {c[0], c[1], c[2], {(c[0].x + c[1].x + c[2].x) / 3, (c[0].y + c[1].y + c[2].y) / 3,
+                                              (c[0].z + c[1].z + c[2].z) / 3}};
+        for (int k = 0; k < 4; k++)
+            worst = fmax(worst, point_surface(m, probes[k], to, to_count));
+    }
+    return worst;
+}
+
+/* Every cut at a range of thresholds deviates from full detail (both ways) by at most the largest
+ * error of the groups its clusters were made from. */
+static void check_error_bounds_cuts(const gdr_mesh *m)
+{
+    const gdr_mesh_clusters *mc = &m->clusters;
+    uint32_t *cut = malloc((size_t)m->index_count * 4 * sizeof *cut);
+    uint8_t *sel = malloc(mc->cluster_count);
+    double worst_ratio = 0;
+    for (int step = 0; step < 7; step++) {
+        float t = m->bounds.w * 1e-4f * powf(4.0f, (float)step);
+        size_t n = 0;
+        double stated = 0;
+        for (uint32_t i = 0; i < mc->cluster_count; i++) {
+            const gdr_cluster *c = &mc->clusters[i];
+            float refined = c->refined_group == GDR_NO_INDEX ? 0.0f : mc->groups[c->refined_group].error;
+            float own = c->group == GDR_NO_INDEX ? INFINITY : mc->groups[c->group].error;
+            if (!(refined <= t && !(own <= t)))
+                continue;
+            stated = fmax(stated, refined);
+            for (uint32_t j = 0; j < c->triangle_count * 3; j++)
+                cut[n++] = mc->vertices[c->vertex_offset + mc->triangles[c->triangle_offset + j]];
+        }
+        double a = one_sided(m, cut, n / 3, m->indices, m->index_count / 3);
+        double b = one_sided(m, m->indices, m->index_count / 3, cut, n / 3);
+        double deviation = fmax(a, b), slack = 1e-5 * m->bounds.w;
+        if (deviation > stated + slack)
+            fprintf(stderr, "mesh '%s': cut at %g deviates %g (to full %g, from full %g), states %g\n", m->name,
+                    (double)t, deviation, a, b, stated);
+        CHECK(deviation <= stated + slack);
+        if (stated > 0)
+            worst_ratio = fmax(worst_ratio, deviation / stated);
+    }
+    printf("%-8s cuts at 1e-4 .. 0.4 of the radius: true deviation / stated error at most %.3f\n", m->name,
+           worst_ratio);
+    free(cut);
+    free(sel);
+}
+
+static void test_error_bounds_deviation(void)
+{
+    gdr_scene *s = new_scene();
+    gdr_error err = {0};
+    uint32_t blob, torus;
+    check_ok(gdr_procedural_blob(s, 3, &blob, &err), &err, "blob");
+    check_ok(gdr_procedural_torus(s, 1.0f, 0.3f, 32, 16, &torus, &err), &err, "torus");
+    const uint32_t meshes[] = {blob, torus};
+    for (int i = 0; i < 2; i++) {
+        gdr_mesh *m = &s->meshes[meshes[i]];
+        build_level0(m);
+        gdr_lod_options o = {.group_size = 4, .thread_count = 1, .no_progress = 1};
+        check_ok(gdr_mesh_build_lod_dag(m, &o, NULL, &err), &err, m->name);
+        CHECK(m->clusters.dag_depth >= 2);
+        check_error_bounds_cuts(m);
+    }
+    gdr_scene_destroy(s);
+}
+
 int main(void)
 {
     test_meshes();
     test_determinism();
+    test_error_bounds_deviation();
     test_scene();
     test_bad_input();
     return test_finish("test_lod_dag");

@@ -64,7 +64,7 @@ int gdr_cmd_bench(int argc, char **argv)
     uint32_t lod_error_count = 1;
     bool occlusion_modes[2] = {true, false};
     uint32_t occlusion_count = 1;
-    bool validate = false, has_camera = false, record_every_frame = false;
+    bool validate = false, has_camera = false, record_every_frame = false, lod_hierarchy = true;
     gdr_pipeline pipelines[3] = {GDR_PIPELINE_DEFAULT};
     uint32_t pipeline_count = 1;
     gdr_vec3 camera_position;
@@ -98,6 +98,8 @@ int gdr_cmd_bench(int argc, char **argv)
             json_path = value;
         else if (strcmp(arg, "--scene") == 0)
             scene_spec = value;
+        else if (strcmp(arg, "--lod-hierarchy") == 0)
+            ok = cli_parse_on_off(arg, value, &lod_hierarchy);
         else if (strcmp(arg, "--lod-errors") == 0)
             ok = parse_lod_errors(value, lod_errors, &lod_error_count);
         else if (strcmp(arg, "--occlusion") == 0) {
@@ -159,7 +161,8 @@ int gdr_cmd_bench(int argc, char **argv)
             gdr_camera camera = scene->camera_count > 0 ? scene->cameras[0] : gdr_scene_framing_camera(scene);
             gdr_frame_desc frame = {.camera = camera, .cull = GDR_CULL_ON, .pipeline = pipelines[p],
                                     .lod_error_px = lod_errors[run / occlusion_count % lod_error_count],
-                                    .occlusion = occlusion ? GDR_CULL_ON : GDR_CULL_OFF};
+                                    .occlusion = occlusion ? GDR_CULL_ON : GDR_CULL_OFF,
+                                    .lod_hierarchy = lod_hierarchy ? GDR_CULL_ON : GDR_CULL_OFF};
             if (has_camera) {
                 frame.camera.position = camera_position;
                 frame.camera.rotation = camera_rotation;
@@ -190,6 +193,8 @@ int gdr_cmd_bench(int argc, char **argv)
             cJSON_AddNumberToObject(row, "cpu_cull_ms_per_frame", stats.cpu_cull_ms_per_frame);
             stats_add_meshlet_json(row, &stats);
             stats_add_occlusion_json(row, &stats);
+            stats_add_traversal_json(row, &stats);
+            stats_add_memory_json(row, &stats);
             cJSON_AddNumberToObject(row, "instances_total", stats.instances_total);
             cJSON_AddNumberToObject(row, "instances_visible", stats.instances_visible);
             cJSON_AddNumberToObject(row, "triangles", (double)stats.triangles);

@@ -53,9 +53,12 @@ int gdr_cmd_info(int argc, char **argv)
         return 1;
     }
     uint64_t vertices = 0, unique_triangles = 0, clusters = 0, level0 = 0, cluster_triangles = 0;
-    uint64_t cluster_vertices = 0;
+    uint64_t cluster_vertices = 0, nodes = 0;
+    uint32_t node_levels = 0;
     for (uint32_t i = 0; i < scene->mesh_count; i++) {
         const gdr_mesh_clusters *c = &scene->meshes[i].clusters;
+        nodes += c->lod_node_count;
+        node_levels = c->lod_node_levels > node_levels ? c->lod_node_levels : node_levels;
         vertices += scene->meshes[i].vertex_count;
         unique_triangles += scene->meshes[i].index_count / 3;
         clusters += c->cluster_count;
@@ -74,6 +77,7 @@ int gdr_cmd_info(int argc, char **argv)
     if (level0 != clusters)
         printf("; %llu at level 0", (unsigned long long)level0);
     printf(")\n");
+    printf("lod nodes:   %llu (hierarchies of up to %u levels)\n", (unsigned long long)nodes, node_levels);
     printf("instances:   %u\n", scene->instance_count);
     printf("triangles:   %llu (over all instances)\n", (unsigned long long)gdr_scene_triangle_count(scene));
     printf("materials:   %u\n", scene->material_count);

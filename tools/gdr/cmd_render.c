@@ -14,7 +14,7 @@ typedef struct render_options {
     const char *stats_json;
     uint32_t width, height, frames, camera_index;
     bool has_camera, has_camera_index, cull, validate;
-    bool meshlet_cull, cone_cull, triangle_cull, occlusion;
+    bool meshlet_cull, cone_cull, triangle_cull, occlusion, lod_hierarchy;
     gdr_pipeline pipeline;
     gdr_raster raster;
     float sw_threshold;
@@ -31,7 +31,8 @@ typedef struct render_options {
 static int parse_render_options(int argc, char **argv, render_options *o)
 {
     *o = (render_options){.width = 1280, .height = 720, .frames = 1, .cull = true, .meshlet_cull = true,
-                          .cone_cull = true, .triangle_cull = true, .lod_error = 1.0f, .occlusion = true};
+                          .cone_cull = true, .triangle_cull = true, .lod_error = 1.0f, .occlusion = true,
+                          .lod_hierarchy = true};
     static const char *const view_names[] = {"shaded", "meshlets", "instances", "triangles", "overdraw", "lod"};
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i], *value;
@@ -78,6 +79,8 @@ static int parse_render_options(int argc, char **argv, render_options *o)
             ok = cli_parse_on_off(arg, value, &o->triangle_cull);
         else if (strcmp(arg, "--occlusion") == 0)
             ok = cli_parse_on_off(arg, value, &o->occlusion);
+        else if (strcmp(arg, "--lod-hierarchy") == 0)
+            ok = cli_parse_on_off(arg, value, &o->lod_hierarchy);
         else if (strcmp(arg, "--pipeline") == 0)
             ok = cli_parse_pipeline(arg, value, &o->pipeline);
         else if (strcmp(arg, "--raster") == 0)
@@ -155,7 +158,8 @@ int gdr_cmd_render(int argc, char **argv)
                             .meshlet_cone_cull = o.cone_cull ? GDR_CULL_ON : GDR_CULL_OFF,
                             .triangle_cull = o.triangle_cull ? GDR_CULL_ON : GDR_CULL_OFF,
                             .lod_error_px = o.lod_error, .lod_fixed_depth = o.has_lod_depth, .lod_depth = o.lod_depth,
-                            .occlusion = o.occlusion ? GDR_CULL_ON : GDR_CULL_OFF};
+                            .occlusion = o.occlusion ? GDR_CULL_ON : GDR_CULL_OFF,
+                            .lod_hierarchy = o.lod_hierarchy ? GDR_CULL_ON : GDR_CULL_OFF};
     if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK || gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK ||
         gdr_renderer_render(renderer, &frame, o.frames, &stats, &err) != GDR_OK) {
         result = fail(&err);

@@ -37,6 +37,14 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
             fprintf(out, "raster_gpu_ms       cluster cull %.4f, mesh shaders %.4f, compute %.4f, resolve %.4f "
                          "(part of draw)\n", s->raster.cull_ms, s->raster.hw_ms, s->raster.sw_ms, s->raster.resolve_ms);
         }
+        if (s->traversal.applied)
+            fprintf(out, "lod_hierarchy       %u levels; nodes %u tested (%u late), %u LOD-culled, %u outside the frustum, "
+                         "%u occluded%s\n", s->traversal.levels, s->traversal.nodes_tested, s->traversal.late_nodes_tested,
+                    s->traversal.nodes_lod_culled, s->traversal.nodes_frustum_culled, s->traversal.nodes_occluded,
+                    s->traversal.overflow ? "; VISITS LOST TO OVERFLOW" : "");
+        if (s->traversal.overflow)
+            fprintf(out, "traversal_overflow  %u node visits did not fit (their clusters were not drawn)\n",
+                    s->traversal.overflow);
         if (s->lod.applied) {
             fprintf(out, "meshlets_lod_culled %u (not in the LOD cut)\n", s->lod.meshlets_culled);
             fprintf(out, "lod_depths          clusters/triangles drawn per DAG depth:");
@@ -117,6 +125,27 @@ void stats_add_occlusion_json(cJSON *object, const gdr_frame_stats *s)
     cJSON_AddNumberToObject(object, "meshlets_late_drawn", s->occlusion.meshlets_late_drawn);
 }
 
+void stats_add_traversal_json(cJSON *object, const gdr_frame_stats *s)
+{
+    cJSON_AddBoolToObject(object, "lod_hierarchy_applied", s->traversal.applied);
+    if (!s->traversal.applied)
+        return;
+    cJSON_AddNumberToObject(object, "lod_hierarchy_levels", s->traversal.levels);
+    cJSON_AddNumberToObject(object, "nodes_tested", s->traversal.nodes_tested);
+    cJSON_AddNumberToObject(object, "nodes_lod_culled", s->traversal.nodes_lod_culled);
+    cJSON_AddNumberToObject(object, "nodes_frustum_culled", s->traversal.nodes_frustum_culled);
+    cJSON_AddNumberToObject(object, "nodes_occluded", s->traversal.nodes_occluded);
+    cJSON_AddNumberToObject(object, "late_nodes_tested", s->traversal.late_nodes_tested);
+    cJSON_AddNumberToObject(object, "traversal_overflow", s->traversal.overflow);
+}
+
+void stats_add_memory_json(cJSON *object, const gdr_frame_stats *s)
+{
+    cJSON_AddNumberToObject(object, "gpu_memory_bytes", (double)s->memory.device_bytes);
+    cJSON_AddNumberToObject(object, "gpu_memory_scene_bytes", (double)s->memory.scene_bytes);
+    cJSON_AddNumberToObject(object, "gpu_memory_frame_bytes", (double)s->memory.frame_bytes);
+}
+
 char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
 {
     cJSON *root = cJSON_CreateObject();
@@ -145,6 +174,7 @@ char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
     if (s->pipeline == GDR_PIPELINE_CPU)
         cJSON_AddNumberToObject(root, "cpu_cull_ms_per_frame", s->cpu_cull_ms_per_frame);
     stats_add_occlusion_json(root, s);
+    stats_add_traversal_json(root, s);
     cJSON_AddNumberToObject(root, "cpu_ms_per_frame", s->cpu_ms_per_frame);
     cJSON_AddNumberToObject(root, "cpu_submit_ms_per_frame", s->cpu_submit_ms_per_frame);
     cJSON_AddNumberToObject(root, "frames_recorded", s->frames_recorded);
@@ -153,9 +183,7 @@ char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
     cJSON *passes = cJSON_AddObjectToObject(root, "gpu_ms");
     for (uint32_t p = 0; passes && p < s->pass_count; p++)
         cJSON_AddNumberToObject(passes, s->passes[p].name, s->passes[p].gpu_ms);
-    cJSON_AddNumberToObject(root, "gpu_memory_bytes", (double)s->memory.device_bytes);
-    cJSON_AddNumberToObject(root, "gpu_memory_scene_bytes", (double)s->memory.scene_bytes);
-    cJSON_AddNumberToObject(root, "gpu_memory_frame_bytes", (double)s->memory.frame_bytes);
+    stats_add_memory_json(root, s);
     cJSON_AddNumberToObject(root, "validation_messages", s->validation_messages);
     char *text = cJSON_Print(root);
     cJSON_Delete(root);

@@ -17,6 +17,8 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
 typedef struct cJSON cJSON;
 /* Adds the mesh pipeline's cluster and triangle counts (meshlets_*, triangles_*_culled). */
 /* The occlusion-culling statistics of a frame (per phase) into a JSON object. */
+void stats_add_traversal_json(cJSON *object, const gdr_frame_stats *s);
+void stats_add_memory_json(cJSON *object, const gdr_frame_stats *s);
 void stats_add_occlusion_json(cJSON *object, const gdr_frame_stats *s);
 void stats_add_meshlet_json(cJSON *object, const gdr_frame_stats *stats);
 /* Returns a malloc'ed JSON text, or NULL when out of memory. */

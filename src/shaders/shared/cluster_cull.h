@@ -9,10 +9,7 @@
 #ifndef GDR_CLUSTER_CULL_H
 #define GDR_CLUSTER_CULL_H
 
-// Occlusion culling phases (the shaders' specialisation constant 0): none, early, late.
-#define GDR_PHASE_NONE 0u
-#define GDR_PHASE_EARLY 1u
-#define GDR_PHASE_LATE 2u
+#include "task_queue.h" // the occlusion culling phases
 
 
 // What the tests decided for one invocation's cluster.
@@ -65,6 +62,18 @@ bool gdr_cluster_occlusion_phase(GdrGpuFrameGlobals g, uint phase, GdrGpuInstanc
     }
     bool drawn_early = (task.flags & GDR_TASK_DRAWN_EARLY) != 0u && was_visible && candidate;
     return visible && !drawn_early;
+}
+
+// The clusters of task command `task_index` of `phase`'s region of the task list (0 past its end).
+uint gdr_cluster_task_size(GdrGpuFrameGlobals g, uint phase, uint task_index)
+{
+    DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
+    uint task_count = min(phase == GDR_PHASE_LATE ? stats.value.late_task_count : stats.value.task_count,
+                          g.task_capacity);
+    if (task_index >= task_count)
+        return 0u;
+    return TaskCommandsRef(uint64_t(GDR_FRAME.tasks) + (phase == GDR_PHASE_LATE ? uint64_t(g.task_capacity) * 16ul : 0ul))
+        .items[task_index].meshlet_count;
 }
 
 // The tests for cluster `lane` of task command `task_index` of `phase`'s region of the task list.

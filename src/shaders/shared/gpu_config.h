@@ -16,10 +16,25 @@
 /* maxTaskWorkGroupCount[0] is at least this on every device: larger launches use y too. */
 #define GDR_TASK_GROUPS_PER_ROW 65535
 /* The cluster cull of the visibility-buffer modes (clustercull.comp) takes this many task commands
- * per workgroup (GDR_TASK_WORKGROUP_SIZE invocations each). */
-#define GDR_CLUSTER_CULL_TASKS 8
+ * per workgroup, GDR_CLUSTER_CULL_LANES invocations each, which step through a command's clusters
+ * as far as the workgroup's largest command needs: most commands of a large field are a distant
+ * instance's root group, one or two clusters. */
+#define GDR_CLUSTER_CULL_TASKS 32
+#define GDR_CLUSTER_CULL_LANES 8
 /* LOD statistics: clusters and triangles drawn per DAG depth, the last bucket for deeper ones. */
 #define GDR_LOD_STATS_DEPTHS 32
+/* The LOD hierarchy traversal (lodtraverse.comp): one invocation per node visit, one dispatch per
+ * level of the hierarchies (at most GDR_LOD_TREE_LEVELS, gdr/geometry.h's GDR_LOD_NODE_MAX_LEVELS);
+ * a level holds at most GDR_TRAVERSE_MAX_VISITS visits (a one-dimensional indirect dispatch). */
+#define GDR_TRAVERSE_WORKGROUP_SIZE 64
+/* Meshes of at most this many task commands of clusters are tested whole: their few commands cost
+ * less than the traversal's levels (the same cut either way). */
+#define GDR_TRAVERSE_MIN_TASKS 8
+#define GDR_LOD_TREE_LEVELS 32
+#define GDR_TRAVERSE_MAX_VISITS (65535u * GDR_TRAVERSE_WORKGROUP_SIZE)
+/* Task commands a frame phase can hold at most (16 bytes each); a scene that could need more gets
+ * this many, and a frame that needs more counts the excess (task_overflow). */
+#define GDR_MAX_TASK_COMMANDS (1u << 24)
 /* Instance records the CPU can send per frame through the update ring. */
 #define GDR_INSTANCE_UPDATES_PER_FRAME 4096
 /* Hybrid rasterisation (issue 8): one software-raster workgroup per cluster; a visibility-buffer id

@@ -29,6 +29,7 @@ GDR_DECLARE_REF(RasterParamsRef)
 GDR_DECLARE_REF(RasterCountersRef)
 GDR_DECLARE_REF(RasterClustersRef)
 GDR_DECLARE_REF(ResolvedRef)
+GDR_DECLARE_REF(NodeVisitsRef)
 
 /* One vertex of the geometry pool (vertex input binding 0). */
 GDR_STRUCT_BEGIN(GdrGpuVertex)
@@ -139,6 +140,25 @@ GDR_STRUCT_BEGIN(GdrGpuTaskCommand)
 GDR_STRUCT_END(GdrGpuTaskCommand)
 GDR_ASSERT_SIZE(GdrGpuTaskCommand, 16);
 
+/* One node visit of the LOD hierarchy traversal: node `node` (mesh-local GdrGpuLodNode index) of
+ * instance `instance`, with the task flags its clusters' commands will carry (GDR_TASK_DRAWN_EARLY). */
+GDR_STRUCT_BEGIN(GdrGpuNodeVisit)
+    gdr_uint instance;
+    gdr_uint node;
+    gdr_uint flags;
+GDR_STRUCT_END(GdrGpuNodeVisit)
+GDR_ASSERT_SIZE(GdrGpuNodeVisit, 12);
+
+/* A level of the traversal: its visits' count and the VkDispatchIndirectCommand that launches
+ * them (x = ceil(count / GDR_TRAVERSE_WORKGROUP_SIZE), y = z = 1 once a visit is queued). */
+GDR_STRUCT_BEGIN(GdrGpuTraversalLevel)
+    gdr_uint dispatch_x;
+    gdr_uint dispatch_y;
+    gdr_uint dispatch_z;
+    gdr_uint count;
+GDR_STRUCT_END(GdrGpuTraversalLevel)
+GDR_ASSERT_SIZE(GdrGpuTraversalLevel, 16);
+
 #define GDR_TASK_LOD_ACCEPTED 1u /* the root shortcut chose these clusters: no LOD test */
 #define GDR_TASK_DRAWN_EARLY 2u  /* late phase (issue 6): the instance was drawn in the early phase */
 #define GDR_TASK_FIRST 4u        /* the first command of its instance (for read-backs) */
@@ -229,8 +249,20 @@ GDR_STRUCT_BEGIN(GdrGpuDrawStats)
     gdr_uint late_cull_groups_z;
     gdr_uint reserved_cull0;
     gdr_uint reserved_cull1;
+    /* The LOD hierarchy traversal: per phase (early or only, then late) and level. Level 0 holds
+     * the roots the instance cull queues; the visits of level L + 1 the children of level L's. */
+    GdrGpuTraversalLevel traversal[2 * GDR_LOD_TREE_LEVELS];
+    gdr_uint nodes_tested;          /* node visits, both phases */
+    gdr_uint nodes_lod_culled;      /* no cluster below can be in the LOD cut */
+    gdr_uint nodes_frustum_culled;
+    gdr_uint nodes_occluded;        /* late phase: behind this frame's pyramid */
+    gdr_uint late_nodes_tested;
+    gdr_uint traversal_overflow;    /* visits that did not fit a level (GDR_TRAVERSE_MAX_VISITS or the
+                                       scene's capacity): their subtrees were not drawn */
+    gdr_uint instances_listed;      /* mesh pipeline: visible instances in the draw-command list (read-backs) */
+    gdr_uint reserved_traversal0;
 GDR_STRUCT_END(GdrGpuDrawStats)
-GDR_ASSERT_SIZE(GdrGpuDrawStats, 64 + 8 * GDR_LOD_STATS_DEPTHS + 96);
+GDR_ASSERT_SIZE(GdrGpuDrawStats, 64 + 8 * GDR_LOD_STATS_DEPTHS + 96 + 32 * GDR_LOD_TREE_LEVELS + 32);
 GDR_ASSERT_OFFSET(GdrGpuDrawStats, draw_count, 0);
 GDR_ASSERT_OFFSET(GdrGpuDrawStats, task_groups_x, 16);
 
@@ -259,8 +291,9 @@ GDR_STRUCT_BEGIN(GdrGpuFrameBuffers)
     GDR_REF(OverdrawRef) overdraw;            /* uint per pixel, then the maximum (overdraw view) */
     GDR_REF(VisibleMeshletsRef) visible_meshlets; /* (instance, global cluster) pairs when recording */
     GDR_REF(RasterParamsRef) raster;          /* GdrGpuRasterParams of the slot */
+    GDR_REF(NodeVisitsRef) traversal;         /* GdrGpuNodeVisit[2 * traversal_capacity]: even, odd levels */
 GDR_STRUCT_END(GdrGpuFrameBuffers)
-GDR_ASSERT_SIZE(GdrGpuFrameBuffers, 56);
+GDR_ASSERT_SIZE(GdrGpuFrameBuffers, 64);
 
 /* Per-frame constants, written by the CPU into its frame's slot. */
 GDR_STRUCT_BEGIN(GdrGpuFrameGlobals)
@@ -281,7 +314,7 @@ GDR_STRUCT_BEGIN(GdrGpuFrameGlobals)
     float lod_threshold;      /* pixels (GDR_FRAME_LOD) */
     float lod_projection_scale; /* P[1][1] * 0.5 * viewport height */
     gdr_int lod_depth;        /* GDR_FRAME_LOD_DEPTH: the discrete cut's depth */
-    gdr_uint reserved0;
+    gdr_uint traversal_capacity; /* node visits one traversal level holds (<= GDR_TRAVERSE_MAX_VISITS) */
     gdr_uint reserved1;
     gdr_uint reserved2;
     GdrOcclusionParams occlusion; /* GDR_FRAME_OCCLUSION: the camera and the depth pyramid */
@@ -300,6 +333,9 @@ GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, viewport, 208);
 #define GDR_FRAME_LOD_DEPTH 32u       /* with GDR_FRAME_LOD: the discrete cut at depth lod_depth */
 #define GDR_FRAME_OCCLUSION 64u       /* two-phase occlusion culling against the depth pyramid (issue 6) */
 #define GDR_FRAME_HISTORY 128u        /* with GDR_FRAME_OCCLUSION: last frame's visibility and pyramid are usable */
+#define GDR_FRAME_DEBUG_SHRINK_NODES 512u /* tests: a deliberately wrong node test (spheres a quarter of their size) */
+#define GDR_FRAME_LOD_HIERARCHY 256u  /* with GDR_FRAME_LOD: instances' clusters come from the traversal of
+                                         their LOD hierarchy (lodtraverse.comp) instead of all their clusters */
 
 #define GDR_INSTANCE_VISIBLE_LAST_FRAME 1u /* drawn and not occluded at the end of the last frame */
 #define GDR_INSTANCE_DRAWN_EARLY 2u        /* drawn by this frame's early phase */
@@ -319,8 +355,10 @@ GDR_STRUCT_BEGIN(GdrGpuPushConstants)
     GDR_REF(FrameBuffersRef) frame;   /* GdrGpuFrameBuffers of the frame's slot */
     GDR_REF(SceneRef) scene;          /* GdrGpuScene */
     GDR_REF(VisbufferRef) visbuffer;  /* uint64 per pixel: the visibility buffer */
+    gdr_uint step;                    /* a repeated pass's step (the traversal's level) */
+    gdr_uint reserved0;
 GDR_STRUCT_END(GdrGpuPushConstants)
-GDR_ASSERT_SIZE(GdrGpuPushConstants, 32);
+GDR_ASSERT_SIZE(GdrGpuPushConstants, 40);
 
 /* --- Hybrid rasterisation (issue 8): the visibility buffer and the software rasteriser ----------
  *

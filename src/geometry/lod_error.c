@@ -1,0 +1,527 @@
+/* A group's error, measured against the full-detail surface (docs/GEOMETRY.md, "The error").
+ *
+ * Every distinct level-0 position is a *sample* of the full-detail surface S0, owned by exactly one
+ * cluster of the frontier (at first the first level-0 cluster that uses it). When a group is
+ * simplified into new clusters, each of its members' samples passes to the new cluster whose
+ * triangle is nearest to it. The group's deviation is the larger of
+ *  - the largest distance from one of its samples to the simplified triangles (exact), and
+ *  - an upper bound of the largest distance from probe points of the simplified triangles (grids
+ *    of 3 steps an edge, 8 where the deviation is largest) to S0: the distance to the level-0 triangles around the position a
+ *    walk ends at, or where that looks far off, to all level-0 triangles around the group's
+ *    samples (a distance to some triangles of S0 is never below the distance to S0).
+ * The group's error is the larger of its deviation and the errors of the groups its members came
+ * from. Every level-0 position stays a sample at every step (that is what the proof needs). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "geometry/lod_internal.h"
+
+#define NO_SOURCE UINT32_MAX
+
+/* Squared distance from p to triangle (a, b, c), by the region of the closest point. */
+static float point_triangle_d2(gdr_vec3 P, gdr_vec3 A, gdr_vec3 B, gdr_vec3 C)
+{
+    const float p[3] = {P.x, P.y, P.z}, a[3] = {A.x, A.y, A.z}, b[3] = {B.x, B.y, B.z}, c[3] = {C.x, C.y, C.z};
+    float ab[3], ac[3], ap[3], q[3];
+    for (int k = 0; k < 3; k++) {
+        ab[k] = b[k] - a[k];
+        ac[k] = c[k] - a[k];
+        ap[k] = p[k] - a[k];
+    }
+#define DOT(x, y) ((x)[0] * (y)[0] + (x)[1] * (y)[1] + (x)[2] * (y)[2])
+    float d1 = DOT(ab, ap), d2 = DOT(ac, ap);
+    float bp[3] = {p[0] - b[0], p[1] - b[1], p[2] - b[2]}, cp[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+    float d3 = DOT(ab, bp), d4 = DOT(ac, bp), d5 = DOT(ab, cp), d6 = DOT(ac, cp);
+#undef DOT
+    float va = d3 * d6 - d5 * d4, vb = d5 * d2 - d1 * d6, vc = d1 * d4 - d3 * d2;
+    if (d1 <= 0.0f && d2 <= 0.0f) {
+        memcpy(q, a, sizeof q);
+    } else if (d3 >= 0.0f && d4 <= d3) {
+        memcpy(q, b, sizeof q);
+    } else if (d6 >= 0.0f && d5 <= d6) {
+        memcpy(q, c, sizeof q);
+    } else if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) {
+        float v = d1 / (d1 - d3);
+        for (int k = 0; k < 3; k++)
+            q[k] = a[k] + v * ab[k];
+    } else if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) {
+        float w = d2 / (d2 - d6);
+        for (int k = 0; k < 3; k++)
+            q[k] = a[k] + w * ac[k];
+    } else if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f) {
+        float w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        for (int k = 0; k < 3; k++)
+            q[k] = b[k] + w * (c[k] - b[k]);
+    } else {
+        float denom = va + vb + vc;
+        float v = vb / denom, w = vc / denom;
+        if (!(denom > 0.0f)) /* degenerate: nearest corner */
+            v = w = 0.0f;
+        for (int k = 0; k < 3; k++)
+            q[k] = a[k] + ab[k] * v + ac[k] * w;
+    }
+    float dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+    float d = dx * dx + dy * dy + dz * dz;
+    /* Any corner bounds the distance too: guards the degenerate cases above. */
+    float da = (p[0] - a[0]) * (p[0] - a[0]) + (p[1] - a[1]) * (p[1] - a[1]) + (p[2] - a[2]) * (p[2] - a[2]);
+    return d < da ? d : da;
+}
+
+static gdr_vec3 load3(const float *f) { return (gdr_vec3){f[0], f[1], f[2]}; }
+
+/* --- setup ------------------------------------------------------------------------------------- */
+
+static int reserve_cluster_samples(lod_build *b, size_t need)
+{
+    if (need <= b->cluster_sample_cap)
+        return 1;
+    size_t n = b->cluster_sample_cap ? b->cluster_sample_cap : 64;
+    while (n < need)
+        n *= 2;
+    uint32_t *first = realloc(b->cluster_sample_first, n * sizeof *first);
+    if (!first)
+        return 0;
+    b->cluster_sample_first = first;
+    uint32_t *count = realloc(b->cluster_sample_count, n * sizeof *count);
+    if (!count)
+        return 0;
+    b->cluster_sample_count = count;
+    uint32_t *source = realloc(b->cluster_sample_source, n * sizeof *source);
+    if (!source)
+        return 0;
+    b->cluster_sample_source = source;
+    b->cluster_sample_cap = n;
+    return 1;
+}
+
+/* Level-0 triangles around each position (by position id), as (cluster << 7 | triangle). */
+static int build_adjacency(lod_build *b, uint32_t level0)
+{
+    size_t corners = 0;
+    for (uint32_t c = 0; c < level0; c++)
+        corners += (size_t)b->clusters[c].triangle_count * 3;
+    b->adjacency_start = calloc((size_t)b->position_count + 1, sizeof *b->adjacency_start);
+    b->adjacency = malloc((corners ? corners : 1) * sizeof *b->adjacency);
+    if (!b->adjacency_start || !b->adjacency || corners > UINT32_MAX)
+        return 0;
+    for (uint32_t c = 0; c < level0; c++) {
+        const gdr_cluster *k = &b->clusters[c];
+        const uint8_t *t = gdr_lod_cluster_triangles(b, k);
+        const uint32_t *v = gdr_lod_cluster_vertices(b, k);
+        for (uint32_t i = 0; i < k->triangle_count * 3; i++)
+            b->adjacency_start[b->position_id[v[t[i]]] + 1]++;
+    }
+    for (uint32_t p = 0; p < b->position_count; p++)
+        b->adjacency_start[p + 1] += b->adjacency_start[p];
+    for (uint32_t c = 0; c < level0; c++) {
+        const gdr_cluster *k = &b->clusters[c];
+        const uint8_t *t = gdr_lod_cluster_triangles(b, k);
+        const uint32_t *v = gdr_lod_cluster_vertices(b, k);
+        for (uint32_t i = 0; i < k->triangle_count * 3; i++)
+            b->adjacency[b->adjacency_start[b->position_id[v[t[i]]]]++] = c << 7 | (i / 3);
+    }
+    for (uint32_t p = b->position_count; p > 0; p--) /* start[p] now holds the end of p: shift back */
+        b->adjacency_start[p] = b->adjacency_start[p - 1];
+    b->adjacency_start[0] = 0;
+    return 1;
+}
+
+/* Each position used by level 0 is owned by the first level-0 cluster that uses it. */
+static int assign_level0_samples(lod_build *b, uint32_t level0)
+{
+    uint32_t *owner = b->owner; /* free until the first step: borrowed, then reset */
+    b->samples = malloc(((size_t)b->position_count + 1) * sizeof *b->samples);
+    if (!b->samples || !reserve_cluster_samples(b, level0))
+        return 0;
+    for (uint32_t c = 0; c < level0; c++) {
+        const gdr_cluster *k = &b->clusters[c];
+        const uint32_t *v = gdr_lod_cluster_vertices(b, k);
+        b->cluster_sample_first[c] = b->sample_count;
+        for (uint32_t j = 0; j < k->vertex_count; j++) {
+            uint32_t p = b->position_id[v[j]];
+            if (owner[p] != OWNER_NONE)
+                continue;
+            owner[p] = c;
+            b->sample_vertex[p] = v[j];
+            b->samples[b->sample_count++] = p;
+        }
+        b->cluster_sample_count[c] = b->sample_count - b->cluster_sample_first[c];
+        b->cluster_sample_source[c] = NO_SOURCE;
+    }
+    memset(owner, 0xff, (size_t)b->position_count * sizeof *owner);
+    return 1;
+}
+
+int gdr_lod_error_setup(lod_build *b)
+{
+    uint32_t level0 = b->mesh->clusters.level0_cluster_count;
+    b->sample_vertex = malloc(((size_t)b->position_count + 1) * sizeof *b->sample_vertex);
+    if (!b->sample_vertex || level0 >= (1u << 25))
+        return 0;
+    return build_adjacency(b, level0) && assign_level0_samples(b, level0);
+}
+
+void gdr_lod_error_free(lod_build *b)
+{
+    free(b->sample_vertex);
+    free(b->adjacency_start);
+    free(b->adjacency);
+    free(b->samples);
+    free(b->cluster_sample_first);
+    free(b->cluster_sample_count);
+    free(b->cluster_sample_source);
+}
+
+/* --- following the frontier -------------------------------------------------------------------- */
+
+int gdr_lod_error_inherit(lod_build *b, uint32_t cluster, uint32_t from)
+{
+    if (!reserve_cluster_samples(b, (size_t)cluster + 1))
+        return 0;
+    b->cluster_sample_first[cluster] = b->cluster_sample_first[from];
+    b->cluster_sample_count[cluster] = b->cluster_sample_count[from];
+    b->cluster_sample_source[cluster] = b->cluster_sample_source[from];
+    return 1;
+}
+
+int gdr_lod_error_adopt(lod_build *b, uint32_t cluster, uint32_t group, const group_result *r, uint32_t index)
+{
+    if (!reserve_cluster_samples(b, (size_t)cluster + 1))
+        return 0;
+    b->cluster_sample_first[cluster] = r->cluster_sample_first[index];
+    b->cluster_sample_count[cluster] = r->cluster_sample_first[index + 1] - r->cluster_sample_first[index];
+    b->cluster_sample_source[cluster] = group;
+    return 1;
+}
+
+int gdr_lod_error_gather(lod_build *b, const uint32_t *frontier, uint32_t count)
+{
+    uint32_t *next = malloc(((size_t)b->position_count + 1) * sizeof *next);
+    if (!next)
+        return 0;
+    uint32_t n = 0;
+    for (uint32_t f = 0; f < count; f++) {
+        uint32_t c = frontier[f], src = b->cluster_sample_source[c];
+        const uint32_t *from = src == NO_SOURCE ? b->samples : b->results[src].samples;
+        memcpy(next + n, from + b->cluster_sample_first[c], b->cluster_sample_count[c] * sizeof *next);
+        b->cluster_sample_first[c] = n;
+        b->cluster_sample_source[c] = NO_SOURCE;
+        n += b->cluster_sample_count[c];
+    }
+    free(b->samples);
+    b->samples = next;
+    b->sample_count = n;
+    return 1;
+}
+
+/* --- one group ----------------------------------------------------------------------------------- */
+
+/* The simplified triangles (group-local vertex ids) in cluster order, the cluster of each, and the
+ * triangles around each local vertex. */
+static int output_triangles(lod_scratch *s, const group_result *r, uint32_t local_count)
+{
+    uint32_t t = 0;
+    for (uint32_t i = 0; i < r->cluster_count; i++)
+        t += s->meshlets[i].triangle_count;
+    if (!LOD_RESERVE(s, out_corners, (size_t)t * 3) || !LOD_RESERVE(s, out_cluster, t) ||
+        !LOD_RESERVE(s, ring_start, (size_t)local_count + 1) || !LOD_RESERVE(s, ring, (size_t)t * 3))
+        return 0;
+    t = 0;
+    for (uint32_t i = 0; i < r->cluster_count; i++) {
+        const struct meshopt_Meshlet *m = &s->meshlets[i];
+        for (uint32_t j = 0; j < m->triangle_count * 3; j++)
+            s->out_corners[(size_t)t * 3 + j] = s->meshlet_vertices[m->vertex_offset +
+                                                                     s->meshlet_triangles[m->triangle_offset + j]];
+        for (uint32_t j = 0; j < m->triangle_count; j++)
+            s->out_cluster[t + j] = i;
+        t += m->triangle_count;
+    }
+    s->out_triangle_count = t;
+    memset(s->ring_start, 0, ((size_t)local_count + 1) * sizeof *s->ring_start);
+    for (size_t i = 0; i < (size_t)t * 3; i++)
+        s->ring_start[s->out_corners[i] + 1]++;
+    for (uint32_t l = 0; l < local_count; l++)
+        s->ring_start[l + 1] += s->ring_start[l];
+    for (size_t i = 0; i < (size_t)t * 3; i++)
+        s->ring[s->ring_start[s->out_corners[i]]++] = (uint32_t)(i / 3);
+    for (uint32_t l = local_count; l > 0; l--)
+        s->ring_start[l] = s->ring_start[l - 1];
+    s->ring_start[0] = 0;
+    return 1;
+}
+
+/* The members' samples, gathered in member order, with their coordinates. */
+static int gather_samples(lod_build *b, lod_scratch *s, uint32_t first, uint32_t count)
+{
+    size_t n = 0;
+    for (uint32_t i = 0; i < count; i++)
+        n += b->cluster_sample_count[b->members[first + i]];
+    if (!LOD_RESERVE(s, sample_ids, n + 1) || !LOD_RESERVE(s, sample_points, n + 1) ||
+        !LOD_RESERVE(s, sample_cluster, n + 1))
+        return 0;
+    n = 0;
+    for (uint32_t i = 0; i < count; i++) {
+        uint32_t c = b->members[first + i];
+        const uint32_t *ids = b->samples + b->cluster_sample_first[c];
+        for (uint32_t j = 0; j < b->cluster_sample_count[c]; j++) {
+            s->sample_ids[n] = ids[j];
+            s->sample_points[n++] = b->mesh->positions[b->sample_vertex[ids[j]]];
+        }
+    }
+    s->gathered = (uint32_t)n;
+    return 1;
+}
+
+/* Distance (squared) from p to the triangles around local vertex l, and the nearest of them. */
+static float ring_d2(const lod_scratch *s, uint32_t l, gdr_vec3 p, uint32_t *nearest)
+{
+    float best = INFINITY;
+    *nearest = s->ring[s->ring_start[l]];
+    for (uint32_t k = s->ring_start[l]; k < s->ring_start[l + 1]; k++) {
+        const uint32_t *t = s->out_corners + (size_t)s->ring[k] * 3;
+        float d = point_triangle_d2(p, load3(s->positions + (size_t)t[0] * 3), load3(s->positions + (size_t)t[1] * 3),
+                                    load3(s->positions + (size_t)t[2] * 3));
+        if (d < best) {
+            best = d;
+            *nearest = s->ring[k];
+        }
+    }
+    return best;
+}
+
+/* Largest distance from a sample to the simplified triangles; each sample's nearest cluster. The
+ * triangles around the nearest simplified vertex give an upper bound quickly; only a sample whose
+ * bound exceeds the largest distance so far is measured exactly (grid of the triangles), so the
+ * result is the exact maximum and every sample lies within it of the cluster it passes to. */
+static float samples_to_simplified(lod_scratch *s, uint32_t local_count)
+{
+    uint32_t used = 0;
+    if (!LOD_RESERVE(s, vertex_points, local_count) || !LOD_RESERVE(s, vertex_local, local_count))
+        return -1.0f;
+    for (uint32_t l = 0; l < local_count; l++)
+        if (s->ring_start[l + 1] > s->ring_start[l]) {
+            memcpy(&s->vertex_points[used], s->positions + (size_t)l * 3, sizeof(gdr_vec3));
+            s->vertex_local[used++] = l;
+        }
+    if (!lod_grid_build(&s->grid, s->vertex_points, used) ||
+        !lod_triangle_grid_build(&s->triangle_grid, s->positions, s->out_corners, s->out_triangle_count))
+        return -1.0f;
+    float worst = 0.0f;
+    for (uint32_t i = 0; i < s->gathered; i++) {
+        float d2;
+        uint32_t l = s->vertex_local[lod_grid_nearest(&s->grid, s->sample_points[i], &d2)], nearest;
+        float d = ring_d2(s, l, s->sample_points[i], &nearest);
+        if (d > worst)
+            nearest = lod_triangle_grid_nearest(&s->triangle_grid, s->sample_points[i], point_triangle_d2, &d);
+        s->sample_cluster[i] = s->out_cluster[nearest];
+        worst = d > worst ? d : worst;
+    }
+    return sqrtf(worst);
+}
+
+/* Distance (squared) from p to the level-0 triangles around position `position`: an upper bound of
+ * the distance from p to S0. */
+static float to_full_detail_d2(const lod_build *b, uint32_t position, gdr_vec3 p)
+{
+    float best = INFINITY;
+    const gdr_vec3 *x = b->mesh->positions;
+    for (uint32_t k = b->adjacency_start[position]; k < b->adjacency_start[position + 1]; k++) {
+        const gdr_cluster *c = &b->clusters[b->adjacency[k] >> 7];
+        const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(b->adjacency[k] & 127) * 3;
+        const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+        float d = point_triangle_d2(p, x[v[t[0]]], x[v[t[1]]], x[v[t[2]]]);
+        best = d < best ? d : best;
+    }
+    return best;
+}
+
+/* Squared distance between p and the position of position id `position`. */
+static float position_d2(const lod_build *b, uint32_t position, gdr_vec3 p)
+{
+    gdr_vec3 q = b->mesh->positions[b->sample_vertex[position]];
+    float dx = q.x - p.x, dy = q.y - p.y, dz = q.z - p.z;
+    return dx * dx + dy * dy + dz * dz;
+}
+
+/* Walks over level-0 positions from `start`, to a neighbour nearer to p while there is one: the
+ * walk ends at a position nearest to p among its neighbours (on a surface, next to p's foot). */
+static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p)
+{
+    uint32_t at = start;
+    float best = position_d2(b, at, p);
+    for (;;) {
+        uint32_t from = at;
+        for (uint32_t k = b->adjacency_start[from]; k < b->adjacency_start[from + 1]; k++) {
+            const gdr_cluster *c = &b->clusters[b->adjacency[k] >> 7];
+            const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(b->adjacency[k] & 127) * 3;
+            const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+            for (int j = 0; j < 3; j++) {
+                uint32_t q = b->position_id[v[t[j]]];
+                float d = position_d2(b, q, p);
+                if (d < best) { /* strictly nearer: the walk ends */
+                    best = d;
+                    at = q;
+                }
+            }
+        }
+        if (at == from)
+            return at;
+    }
+}
+
+static int compare_u32(const void *x, const void *y)
+{
+    uint32_t a = *(const uint32_t *)x, b = *(const uint32_t *)y;
+    return a < b ? -1 : a > b;
+}
+
+/* A grid over the level-0 triangles around the group's samples (each once). Returns 0 when out of
+ * memory. */
+static int build_region(const lod_build *b, lod_scratch *s)
+{
+    size_t n = 0;
+    for (uint32_t i = 0; i < s->gathered; i++)
+        n += b->adjacency_start[s->sample_ids[i] + 1] - b->adjacency_start[s->sample_ids[i]];
+    if (!LOD_RESERVE(s, region_refs, n + 1))
+        return 0;
+    n = 0;
+    for (uint32_t i = 0; i < s->gathered; i++)
+        for (uint32_t k = b->adjacency_start[s->sample_ids[i]]; k < b->adjacency_start[s->sample_ids[i] + 1]; k++)
+            s->region_refs[n++] = b->adjacency[k];
+    qsort(s->region_refs, n, sizeof *s->region_refs, compare_u32);
+    size_t unique = 0;
+    for (size_t i = 0; i < n; i++)
+        if (i == 0 || s->region_refs[i] != s->region_refs[i - 1])
+            s->region_refs[unique++] = s->region_refs[i];
+    if (!LOD_RESERVE(s, region_positions, unique * 9 + 1) || !LOD_RESERVE(s, region_corners, unique * 3 + 1))
+        return 0;
+    for (size_t i = 0; i < unique; i++) {
+        const gdr_cluster *c = &b->clusters[s->region_refs[i] >> 7];
+        const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(s->region_refs[i] & 127) * 3;
+        const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+        for (int k = 0; k < 3; k++) {
+            memcpy(s->region_positions + i * 9 + (size_t)k * 3, &b->mesh->positions[v[t[k]]], sizeof(gdr_vec3));
+            s->region_corners[i * 3 + (size_t)k] = (uint32_t)(i * 3 + (size_t)k);
+        }
+    }
+    s->region_built = 1;
+    return lod_triangle_grid_build(&s->region_grid, s->region_positions, s->region_corners, (uint32_t)unique);
+}
+
+/* What probing a group's simplified triangles needs. */
+typedef struct probe_state {
+    const lod_build *b;
+    lod_scratch *s;
+    float worst;  /* squared: the largest distance so far (at least the samples' largest) */
+    int failed;   /* out of memory */
+} probe_state;
+
+/* Upper bound (squared) of the distance from p to S0: to the level-0 triangles around the position
+ * a walk from *at ends at (the position nearest to p among its neighbours; on a regular surface
+ * the triangle nearest to p is among these). Where that bound is more than twice the largest
+ * distance so far, the exact distance to the level-0 triangles around the group's samples is
+ * taken instead (the walk can stop far away on meshes of long thin triangles). *at receives where the
+ * walk ended (the next probe of the triangle starts there). */
+static float probe_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
+{
+    *at = walk_towards(ps->b, *at, p);
+    float d = to_full_detail_d2(ps->b, *at, p);
+    if (d <= 4.0f * ps->worst || ps->failed) /* squared: up to twice the largest so far */
+        return d;
+    if (!ps->s->region_built && !build_region(ps->b, ps->s)) {
+        ps->failed = 1;
+        return d;
+    }
+    float exact;
+    lod_triangle_grid_nearest(&ps->s->region_grid, p, point_triangle_d2, &exact);
+    return exact < d ? exact : d;
+}
+
+/* The largest probe distance over the points of a barycentric grid of n steps on triangle v, corners
+ * left out (they are level-0 vertices: distance 0); walks start at *at. */
+static float probe_triangle(probe_state *ps, uint32_t *at, const gdr_vec3 v[3], int n)
+{
+    float largest = 0.0f;
+    for (int i = 0; i <= n; i++)
+        for (int j = 0; i + j <= n; j++) {
+            if (i == n || j == n || i + j == 0)
+                continue;
+            float u = (float)i / (float)n, w = (float)j / (float)n, z = 1.0f - u - w;
+            gdr_vec3 p = {z * v[0].x + u * v[1].x + w * v[2].x, z * v[0].y + u * v[1].y + w * v[2].y,
+                          z * v[0].z + u * v[1].z + w * v[2].z};
+            float d = probe_d2(ps, at, p);
+            largest = d > largest ? d : largest;
+            ps->worst = d > ps->worst ? d : ps->worst;
+        }
+    return largest;
+}
+
+static void triangle_corners(const lod_scratch *s, uint32_t t, gdr_vec3 v[3])
+{
+    for (int k = 0; k < 3; k++)
+        v[k] = load3(s->positions + (size_t)s->out_corners[(size_t)t * 3 + k] * 3);
+}
+
+/* Largest distance from the simplified triangles to S0, or `floor` when that is larger (the
+ * samples' largest distance: probes below it cannot change the group's deviation). Every triangle
+ * is probed on a barycentric grid of 3 steps an edge (6 points on the edges, the centroid); those
+ * whose probes come within 70% of the largest then, on a grid of 8 steps (the deviation of a
+ * simplified triangle peaks inside it or on an edge, between the coarse points). Returns -1 when
+ * out of memory. */
+static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor)
+{
+    probe_state ps = {b, s, floor * floor, 0};
+    s->region_built = 0;
+    if (!LOD_RESERVE(s, coarse_d2, (size_t)s->out_triangle_count + 1))
+        return -1.0f;
+    for (uint32_t t = 0; t < s->out_triangle_count; t++) {
+        gdr_vec3 v[3];
+        triangle_corners(s, t, v);
+        uint32_t at = b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]];
+        s->coarse_d2[t] = probe_triangle(&ps, &at, v, 3);
+    }
+    float coarse_worst = ps.worst;
+    for (uint32_t t = 0; t < s->out_triangle_count; t++) {
+        if (s->coarse_d2[t] < 0.49f * coarse_worst) /* squared: below 70% */
+            continue;
+        gdr_vec3 v[3];
+        triangle_corners(s, t, v);
+        uint32_t at = b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]];
+        probe_triangle(&ps, &at, v, 8);
+    }
+    return ps.failed ? -1.0f : sqrtf(ps.worst);
+}
+
+/* The samples in order of the new cluster they pass to, into r. */
+static int hand_samples_to_clusters(lod_scratch *s, group_result *r)
+{
+    r->samples = malloc(((size_t)s->gathered + 1) * sizeof *r->samples);
+    r->cluster_sample_first = calloc((size_t)r->cluster_count + 1, sizeof *r->cluster_sample_first);
+    uint32_t *start = r->cluster_sample_first;
+    if (!r->samples || !start)
+        return 0;
+    for (uint32_t i = 0; i < s->gathered; i++)
+        start[s->sample_cluster[i] + 1]++;
+    for (uint32_t c = 0; c < r->cluster_count; c++)
+        start[c + 1] += start[c];
+    for (uint32_t i = 0; i < s->gathered; i++)
+        r->samples[start[s->sample_cluster[i]]++] = s->sample_ids[i];
+    for (uint32_t c = r->cluster_count; c > 0; c--) /* start[c] now holds the end of c: shift back */
+        start[c] = start[c - 1];
+    start[0] = 0;
+    return 1;
+}
+
+int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, uint32_t first, uint32_t count, uint32_t local_count,
+                            group_result *r)
+{
+    if (!output_triangles(s, r, local_count) || !gather_samples(b, s, first, count))
+        return 0;
+    float to_simplified = s->gathered ? samples_to_simplified(s, local_count) : 0.0f;
+    float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified);
+    if (to_simplified < 0.0f || to_full < 0.0f || !hand_samples_to_clusters(s, r))
+        return 0;
+    r->deviation = to_simplified > to_full ? to_simplified : to_full;
+    return 1;
+}

@@ -1,0 +1,301 @@
+/* A uniform grid over a point set for nearest-point queries (lod_grid.h). */
+#include "geometry/lod_grid.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define GRID_MAX_DIM 1024
+
+static int grid_reserve(uint32_t **p, size_t *cap, size_t need)
+{
+    if (need <= *cap)
+        return 1;
+    size_t n = *cap ? *cap : 64;
+    while (n < need)
+        n *= 2;
+    uint32_t *q = realloc(*p, n * sizeof *q);
+    if (!q)
+        return 0;
+    *p = q;
+    *cap = n;
+    return 1;
+}
+
+static uint32_t cell_coordinate(const lod_grid *g, float x, int k)
+{
+    float c = (x - g->lo[k]) * g->inv_cell;
+    if (!(c > 0.0f))
+        return 0;
+    return c >= (float)(g->dim[k] - 1) ? g->dim[k] - 1 : (uint32_t)c;
+}
+
+/* The points lie on a surface: about two per occupied cell when the cell edge is about twice the
+ * largest extent over the square root of the count (a sphere's or a square's spacing), with at
+ * most 4n + 64 cells in all (larger cells for the few groups that span most of a mesh). */
+static void choose_cells(lod_grid *g, const float hi[3], uint32_t n)
+{
+    float extent[3], largest = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        extent[k] = hi[k] - g->lo[k];
+        largest = extent[k] > largest ? extent[k] : largest;
+    }
+    float cell = 2.0f * largest / sqrtf((float)n + 1.0f);
+    if (!(cell > 0.0f))
+        cell = 1.0f;
+    for (int attempt = 0; attempt < 64; attempt++) {
+        double cells = 1.0;
+        for (int k = 0; k < 3; k++)
+            cells *= fmin(floor(extent[k] / cell) + 1.0, GRID_MAX_DIM);
+        if (cells <= 4.0 * n + 64.0)
+            break;
+        cell *= 1.25f;
+    }
+    for (int k = 0; k < 3; k++) {
+        double d = floor(extent[k] / cell) + 1.0;
+        g->dim[k] = d > GRID_MAX_DIM ? GRID_MAX_DIM : (uint32_t)d;
+    }
+    /* A capped axis: cells stretch along it; the search bound uses the largest cell edge. */
+    for (int k = 0; k < 3; k++)
+        if (extent[k] / (float)g->dim[k] > cell)
+            cell = extent[k] / (float)g->dim[k] * 1.0001f;
+    g->cell = cell;
+    g->inv_cell = 1.0f / cell;
+}
+
+int lod_grid_build(lod_grid *g, const gdr_vec3 *points, uint32_t n)
+{
+    g->points = points;
+    g->count = n;
+    float hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+    g->lo[0] = g->lo[1] = g->lo[2] = FLT_MAX;
+    for (uint32_t i = 0; i < n; i++) {
+        const float *p = &points[i].x;
+        for (int k = 0; k < 3; k++) {
+            g->lo[k] = p[k] < g->lo[k] ? p[k] : g->lo[k];
+            hi[k] = p[k] > hi[k] ? p[k] : hi[k];
+        }
+    }
+    choose_cells(g, hi, n);
+    size_t cells = (size_t)g->dim[0] * g->dim[1] * g->dim[2];
+    if (!grid_reserve(&g->start, &g->start_cap, cells + 1) || !grid_reserve(&g->items, &g->items_cap, n) ||
+        !grid_reserve(&g->cell_of, &g->cell_of_cap, n))
+        return 0;
+    memset(g->start, 0, (cells + 1) * sizeof *g->start);
+    for (uint32_t i = 0; i < n; i++) {
+        const float *p = &points[i].x;
+        uint32_t c = (cell_coordinate(g, p[2], 2) * g->dim[1] + cell_coordinate(g, p[1], 1)) * g->dim[0] +
+                     cell_coordinate(g, p[0], 0);
+        g->cell_of[i] = c;
+        g->start[c + 1]++;
+    }
+    for (size_t c = 0; c < cells; c++)
+        g->start[c + 1] += g->start[c];
+    for (uint32_t i = 0; i < n; i++)
+        g->items[g->start[g->cell_of[i]]++] = i;
+    for (size_t c = cells; c > 0; c--) /* start[c] now holds the end of cell c: shift back */
+        g->start[c] = g->start[c - 1];
+    g->start[0] = 0;
+    return 1;
+}
+
+static void visit_cell(const lod_grid *g, uint32_t x, uint32_t y, uint32_t z, const float q[3], uint32_t *best,
+                       float *best_d2)
+{
+    uint32_t c = (z * g->dim[1] + y) * g->dim[0] + x;
+    for (uint32_t i = g->start[c]; i < g->start[c + 1]; i++) {
+        const gdr_vec3 p = g->points[g->items[i]];
+        float dx = p.x - q[0], dy = p.y - q[1], dz = p.z - q[2];
+        float d2 = dx * dx + dy * dy + dz * dz;
+        if (d2 < *best_d2 || (d2 == *best_d2 && g->items[i] < *best)) {
+            *best_d2 = d2;
+            *best = g->items[i];
+        }
+    }
+}
+
+/* Cells at Chebyshev distance r from the query's cell are at least (r - 1) cell edges away, so
+ * the search stops once the best distance is within that. */
+uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squared)
+{
+    const float q[3] = {point.x, point.y, point.z};
+    int32_t at[3];
+    for (int k = 0; k < 3; k++)
+        at[k] = (int32_t)cell_coordinate(g, q[k], k);
+    uint32_t best = UINT32_MAX;
+    float best_d2 = INFINITY;
+    int32_t max_r = (int32_t)(g->dim[0] > g->dim[1] ? g->dim[0] : g->dim[1]);
+    max_r = (int32_t)g->dim[2] > max_r ? (int32_t)g->dim[2] : max_r;
+    for (int32_t r = 0; r <= max_r; r++) {
+        if (best != UINT32_MAX) {
+            float reach = (float)(r - 1) * g->cell;
+            if (r > 0 && reach * reach >= best_d2)
+                break;
+        }
+        for (int32_t z = at[2] - r; z <= at[2] + r; z++) {
+            if (z < 0 || z >= (int32_t)g->dim[2])
+                continue;
+            for (int32_t y = at[1] - r; y <= at[1] + r; y++) {
+                if (y < 0 || y >= (int32_t)g->dim[1])
+                    continue;
+                int shell = z == at[2] - r || z == at[2] + r || y == at[1] - r || y == at[1] + r;
+                for (int32_t x = at[0] - r; x <= at[0] + r; x += shell ? 1 : 2 * r) {
+                    if (x >= 0 && x < (int32_t)g->dim[0])
+                        visit_cell(g, (uint32_t)x, (uint32_t)y, (uint32_t)z, q, &best, &best_d2);
+                    if (r == 0)
+                        break;
+                }
+            }
+        }
+    }
+    *distance_squared = best_d2;
+    return best;
+}
+
+void lod_grid_free(lod_grid *g)
+{
+    free(g->start);
+    free(g->items);
+    free(g->cell_of);
+    memset(g, 0, sizeof *g);
+}
+
+/* --- triangles ------------------------------------------------------------------------------------ */
+
+static gdr_vec3 corner(const lod_triangle_grid *g, uint32_t t, int k)
+{
+    const float *p = g->positions + (size_t)g->corners[(size_t)t * 3 + k] * 3;
+    return (gdr_vec3){p[0], p[1], p[2]};
+}
+
+static uint32_t tri_cell(const lod_triangle_grid *g, float x, int k)
+{
+    float c = (x - g->lo[k]) * g->inv_cell;
+    if (!(c > 0.0f))
+        return 0;
+    return c >= (float)(g->dim[k] - 1) ? g->dim[k] - 1 : (uint32_t)c;
+}
+
+static void tri_box(const lod_triangle_grid *g, uint32_t t, uint32_t lo[3], uint32_t hi[3])
+{
+    for (int k = 0; k < 3; k++) {
+        lo[k] = UINT32_MAX;
+        hi[k] = 0;
+    }
+    for (int j = 0; j < 3; j++) {
+        gdr_vec3 p = corner(g, t, j);
+        const float *x = &p.x;
+        for (int k = 0; k < 3; k++) {
+            uint32_t c = tri_cell(g, x[k], k);
+            lo[k] = c < lo[k] ? c : lo[k];
+            hi[k] = c > hi[k] ? c : hi[k];
+        }
+    }
+}
+
+/* Cells about as large as the triangles: the grid of the corners' box with about n / 2 cells. */
+static void tri_choose_cells(lod_triangle_grid *g, uint32_t n)
+{
+    float hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+    g->lo[0] = g->lo[1] = g->lo[2] = FLT_MAX;
+    for (uint32_t t = 0; t < n; t++)
+        for (int j = 0; j < 3; j++) {
+            gdr_vec3 p = corner(g, t, j);
+            const float *x = &p.x;
+            for (int k = 0; k < 3; k++) {
+                g->lo[k] = x[k] < g->lo[k] ? x[k] : g->lo[k];
+                hi[k] = x[k] > hi[k] ? x[k] : hi[k];
+            }
+        }
+    lod_grid shape = {.lo = {g->lo[0], g->lo[1], g->lo[2]}};
+    choose_cells(&shape, hi, n);
+    g->cell = shape.cell;
+    g->inv_cell = shape.inv_cell;
+    memcpy(g->dim, shape.dim, sizeof g->dim);
+}
+
+int lod_triangle_grid_build(lod_triangle_grid *g, const float *positions, const uint32_t *corners, uint32_t n)
+{
+    g->positions = positions;
+    g->corners = corners;
+    tri_choose_cells(g, n);
+    size_t cells = (size_t)g->dim[0] * g->dim[1] * g->dim[2];
+    if (!grid_reserve(&g->start, &g->start_cap, cells + 1))
+        return 0;
+    memset(g->start, 0, (cells + 1) * sizeof *g->start);
+    for (int pass = 0; pass < 2; pass++) {
+        for (uint32_t t = 0; t < n; t++) {
+            uint32_t lo[3], hi[3];
+            tri_box(g, t, lo, hi);
+            for (uint32_t z = lo[2]; z <= hi[2]; z++)
+                for (uint32_t y = lo[1]; y <= hi[1]; y++)
+                    for (uint32_t x = lo[0]; x <= hi[0]; x++) {
+                        size_t c = ((size_t)z * g->dim[1] + y) * g->dim[0] + x;
+                        if (pass == 0)
+                            g->start[c + 1]++;
+                        else
+                            g->items[g->start[c]++] = t;
+                    }
+        }
+        if (pass == 0) {
+            for (size_t c = 0; c < cells; c++)
+                g->start[c + 1] += g->start[c];
+            if (!grid_reserve(&g->items, &g->items_cap, (size_t)g->start[cells] + 1))
+                return 0;
+        }
+    }
+    for (size_t c = cells; c > 0; c--)
+        g->start[c] = g->start[c - 1];
+    g->start[0] = 0;
+    return 1;
+}
+
+uint32_t lod_triangle_grid_nearest(const lod_triangle_grid *g, gdr_vec3 point, lod_point_triangle_fn *distance,
+                                   float *distance_squared)
+{
+    const float q[3] = {point.x, point.y, point.z};
+    int32_t at[3];
+    for (int k = 0; k < 3; k++)
+        at[k] = (int32_t)tri_cell(g, q[k], k);
+    uint32_t best = UINT32_MAX;
+    float best_d2 = INFINITY;
+    int32_t max_r = (int32_t)(g->dim[0] > g->dim[1] ? g->dim[0] : g->dim[1]);
+    max_r = (int32_t)g->dim[2] > max_r ? (int32_t)g->dim[2] : max_r;
+    for (int32_t r = 0; r <= max_r; r++) {
+        float reach = (float)(r - 1) * g->cell;
+        if (r > 0 && best != UINT32_MAX && reach * reach >= best_d2)
+            break;
+        for (int32_t z = at[2] - r; z <= at[2] + r; z++) {
+            if (z < 0 || z >= (int32_t)g->dim[2])
+                continue;
+            for (int32_t y = at[1] - r; y <= at[1] + r; y++) {
+                if (y < 0 || y >= (int32_t)g->dim[1])
+                    continue;
+                int shell = r == 0 || z == at[2] - r || z == at[2] + r || y == at[1] - r || y == at[1] + r;
+                for (int32_t x = at[0] - r; x <= at[0] + r; x += shell ? 1 : 2 * r) {
+                    if (x < 0 || x >= (int32_t)g->dim[0])
+                        continue;
+                    size_t c = ((size_t)z * g->dim[1] + (uint32_t)y) * g->dim[0] + (uint32_t)x;
+                    for (uint32_t i = g->start[c]; i < g->start[c + 1]; i++) {
+                        uint32_t t = g->items[i];
+                        float d = distance(point, corner(g, t, 0), corner(g, t, 1), corner(g, t, 2));
+                        if (d < best_d2 || (d == best_d2 && t < best)) {
+                            best_d2 = d;
+                            best = t;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    *distance_squared = best_d2;
+    return best;
+}
+
+void lod_triangle_grid_free(lod_triangle_grid *g)
+{
+    free(g->start);
+    free(g->items);
+    memset(g, 0, sizeof *g);
+}

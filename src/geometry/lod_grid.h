@@ -1,0 +1,47 @@
+/* A uniform grid over a point set, for nearest-point queries while measuring a group's deviation
+ * (lod_error.c). About two points per cell; the arrays are kept between builds. */
+#ifndef GDR_GEOMETRY_LOD_GRID_H
+#define GDR_GEOMETRY_LOD_GRID_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "gdr/math.h"
+
+typedef struct lod_grid {
+    const gdr_vec3 *points; /* not owned */
+    uint32_t count;
+    float lo[3];
+    float cell, inv_cell;
+    uint32_t dim[3];
+    uint32_t *start, *items, *cell_of; /* cell c holds items[start[c] .. start[c + 1]) */
+    size_t start_cap, items_cap, cell_of_cap;
+} lod_grid;
+
+/* Indexes points[0 .. n), n > 0 (kept by pointer until the next build). Returns 0 when out of
+ * memory. */
+int lod_grid_build(lod_grid *g, const gdr_vec3 *points, uint32_t n);
+/* The index of the point nearest to `point` (the lowest index on ties) and its squared distance. */
+uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squared);
+void lod_grid_free(lod_grid *g);
+
+/* A uniform grid over triangles (corner k of triangle t: positions[3 * corners[3t + k]] .. + 3),
+ * each listed in every cell its bounding box overlaps. */
+typedef struct lod_triangle_grid {
+    const float *positions; /* not owned */
+    const uint32_t *corners;
+    float lo[3];
+    float cell, inv_cell;
+    uint32_t dim[3];
+    uint32_t *start, *items;
+    size_t start_cap, items_cap;
+} lod_triangle_grid;
+
+int lod_triangle_grid_build(lod_triangle_grid *g, const float *positions, const uint32_t *corners, uint32_t n);
+/* The triangle nearest to `point` and its squared distance (computed by `distance`). */
+typedef float lod_point_triangle_fn(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3 c);
+uint32_t lod_triangle_grid_nearest(const lod_triangle_grid *g, gdr_vec3 point, lod_point_triangle_fn *distance,
+                                   float *distance_squared);
+void lod_triangle_grid_free(lod_triangle_grid *g);
+
+#endif

@@ -1,0 +1,87 @@
+/* GLSL only: what the instance cull and the LOD hierarchy traversal append for the cluster tests:
+ * task commands (one per up to GDR_TASK_WORKGROUP_SIZE clusters of one instance) and node visits
+ * (the traversal's next level). Every invocation of a subgroup calls these in uniform control flow
+ * (one atomic per subgroup). Include after glsl_buffers.h; needs the subgroup ballot and arithmetic
+ * extensions. */
+#ifndef GDR_TASK_QUEUE_H
+#define GDR_TASK_QUEUE_H
+
+// Occlusion culling phases (the culling shaders' specialisation constant PHASE): none, early, late.
+#define GDR_PHASE_NONE 0u
+#define GDR_PHASE_EARLY 1u
+#define GDR_PHASE_LATE 2u
+
+// A run of clusters of one instance: `tasks` commands of up to GDR_TASK_WORKGROUP_SIZE clusters.
+struct GdrTaskRange {
+    uint first;  // global cluster index
+    uint count;
+    uint tasks;
+    uint flags;  // GDR_TASK_*
+};
+
+GdrTaskRange gdr_task_range(uint first, uint count, uint flags)
+{
+    return GdrTaskRange(first, count, (count + GDR_TASK_WORKGROUP_SIZE - 1u) / GDR_TASK_WORKGROUP_SIZE, flags);
+}
+
+// Appends the commands of `range` (none when !append) to `phase`'s region of the task list (the
+// late phase's follows the early phase's task_capacity entries); what does not fit is counted.
+void gdr_append_tasks(GdrGpuFrameGlobals g, uint phase, bool append, uint instance, GdrTaskRange range)
+{
+    DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
+    uint count = append ? range.tasks : 0u;
+    uint subgroup_total = subgroupAdd(count);
+    uint base = 0u;
+    if (subgroupElect() && subgroup_total > 0u)
+        base = phase == GDR_PHASE_LATE ? atomicAdd(stats.value.late_task_count, subgroup_total)
+                                       : atomicAdd(stats.value.task_count, subgroup_total);
+    base = subgroupBroadcastFirst(base) + subgroupExclusiveAdd(count);
+    TaskCommandsRef tasks = TaskCommandsRef(uint64_t(GDR_FRAME.tasks) +
+                                            (phase == GDR_PHASE_LATE ? uint64_t(g.task_capacity) * 16ul : 0ul));
+    for (uint t = 0u; t < count; t++) {
+        uint slot = base + t;
+        uint first = t * GDR_TASK_WORKGROUP_SIZE;
+        if (slot < g.task_capacity)
+            tasks.items[slot] = GdrGpuTaskCommand(instance, range.first + first,
+                                                  min(range.count - first, GDR_TASK_WORKGROUP_SIZE),
+                                                  range.flags | (t == 0u ? GDR_TASK_FIRST : 0u));
+        else
+            atomicAdd(stats.value.task_overflow, 1u);
+    }
+}
+
+// Queues `count` visits of instance `instance`: nodes first_node .. + count (mesh-local) at traversal
+// level `level` of `phase`, with their launch; what does not fit the level is counted.
+void gdr_queue_visits(GdrGpuFrameGlobals g, uint phase, uint level, uint count, uint instance, uint first_node,
+                      uint flags)
+{
+    DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
+    if (level >= GDR_LOD_TREE_LEVELS) { // never: the deepest level of a hierarchy holds only leaves
+        if (count > 0u)
+            atomicAdd(stats.value.traversal_overflow, count);
+        count = 0u;
+    }
+    uint index = (phase == GDR_PHASE_LATE ? GDR_LOD_TREE_LEVELS : 0u) + min(level, GDR_LOD_TREE_LEVELS - 1u);
+    uint subgroup_total = subgroupAdd(count);
+    uint base = 0u;
+    if (subgroupElect() && subgroup_total > 0u) {
+        base = atomicAdd(stats.value.traversal[index].count, subgroup_total);
+        uint queued = min(base + subgroup_total, g.traversal_capacity);
+        atomicMax(stats.value.traversal[index].dispatch_x,
+                  (queued + GDR_TRAVERSE_WORKGROUP_SIZE - 1u) / GDR_TRAVERSE_WORKGROUP_SIZE);
+        atomicMax(stats.value.traversal[index].dispatch_y, 1u);
+        atomicMax(stats.value.traversal[index].dispatch_z, 1u);
+    }
+    base = subgroupBroadcastFirst(base) + subgroupExclusiveAdd(count);
+    // Even levels in the first half of the queue, odd ones in the second.
+    NodeVisitsRef visits = NodeVisitsRef(uint64_t(GDR_FRAME.traversal) +
+                                         uint64_t((level & 1u) * g.traversal_capacity) * 12ul);
+    for (uint c = 0u; c < count; c++) {
+        if (base + c < g.traversal_capacity)
+            visits.items[base + c] = GdrGpuNodeVisit(instance, first_node + c, flags);
+        else
+            atomicAdd(stats.value.traversal_overflow, 1u);
+    }
+}
+
+#endif
