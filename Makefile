@@ -20,8 +20,9 @@ build: deps
 demo: build
 	$(BUILD_DIR)/tools/gdr/gdr render demo --out demo.png --stats demo.json
 
-# The whole suite: every test on lavapipe with validation on, then the unit tests under ASan+UBSan,
-# then the Release configuration users build, compiled (about a minute on 2 cores).
+# The whole suite: every test on lavapipe with validation on, then the unit tests and the GPU paths
+# (test_gpu_sanitized) under ASan+UBSan, then the Release configuration users build, compiled
+# (about a minute on 2 cores).
 check: build test test-asan build-release
 
 test:
@@ -30,7 +31,7 @@ test:
 test-asan: deps
 	cmake -S . -B $(ASAN_DIR) -DCMAKE_BUILD_TYPE=Debug -DGDR_WERROR=ON -DGDR_SANITIZE=ON
 	cmake --build $(ASAN_DIR) -j $(JOBS)
-	cd $(ASAN_DIR) && ctest --output-on-failure -j $(JOBS) -L unit
+	cd $(ASAN_DIR) && ctest --output-on-failure -j $(JOBS) -L 'unit|sanitize'
 
 # docs/PIPELINE.md's printout of every frame configuration, regenerated from `gdr info --passes`.
 pipeline-doc: build

@@ -1,13 +1,29 @@
 #!/bin/sh
 # Installs what gdr needs to build, test and run, on Debian 12 (bookworm), as root.
 # Idempotent: packages already present are left alone; only missing ones are fetched.
-# Mesa (lavapipe >= 25, which has VK_EXT_mesh_shader) comes from bookworm-backports.
+# Mesa (lavapipe >= 25, which has VK_EXT_mesh_shader) comes from bookworm-backports. The tests'
+# glTF oracle, the Khronos validator, is the npm package gltf-validator (pinned) run by nodejs.
 set -eu
+
+GLTF_VALIDATOR="gltf-validator@2.0.0-dev.3.10"
+
+# The validator, into npm's global folder (where tests/io/gltf_validate.mjs looks for it).
+install_validator() {
+    if ! command -v npm >/dev/null 2>&1; then
+        apt-get install -y -q --no-install-recommends npm
+    fi
+    if [ ! -d "$(npm root -g 2>/dev/null)/gltf-validator" ]; then
+        npm install -g --no-fund --no-audit "$GLTF_VALIDATOR"
+    fi
+}
+validator_missing() {
+    ! command -v npm >/dev/null 2>&1 || [ ! -d "$(npm root -g 2>/dev/null)/gltf-validator" ]
+}
 
 PACKAGES="build-essential cmake pkg-config clang \
 libvulkan-dev glslc vulkan-validationlayers \
 libmeshoptimizer-dev libmetis-dev libcjson-dev libstb-dev libzstd-dev \
-libxxhash-dev libclang-rt-14-dev assimp-testmodels valgrind"
+libxxhash-dev libclang-rt-14-dev assimp-testmodels valgrind nodejs"
 BACKPORTS_PACKAGES="mesa-vulkan-drivers"
 
 missing=""
@@ -25,14 +41,20 @@ case "$mesa_version" in
     * ) if dpkg --compare-versions "$mesa_version" lt 25.0; then need_backports_mesa=1; fi ;;
 esac
 
-if [ -z "$missing" ] && [ "$need_backports_mesa" = 0 ]; then
+if [ -z "$missing" ] && [ "$need_backports_mesa" = 0 ] && ! validator_missing; then
     echo "install-deps: everything is installed"
     exit 0
 fi
 
 if [ "$(id -u)" != 0 ]; then
-    echo "install-deps: missing packages:$missing; run this script as root" >&2
+    echo "install-deps: missing packages:$missing (or npm's $GLTF_VALIDATOR); run this script as root" >&2
     exit 1
+fi
+
+if [ -z "$missing" ] && [ "$need_backports_mesa" = 0 ]; then
+    install_validator
+    echo "install-deps: done"
+    exit 0
 fi
 
 . /etc/os-release
@@ -57,4 +79,5 @@ if [ -n "$regular" ]; then
 fi
 # shellcheck disable=SC2086
 apt-get install -y -q --no-install-recommends -t bookworm-backports $BACKPORTS_PACKAGES
+install_validator
 echo "install-deps: done"

@@ -42,7 +42,10 @@ GDR_API gdr_status gdr_error_set(gdr_error *err, gdr_status status, const char *
     __attribute__((format(printf, 3, 4)));
 
 /* Writes a whole file through a temporary file in the same folder and a rename, so a crash or a
- * full disk never leaves a half-written file at `path`. */
+ * full disk never leaves a half-written file at `path`. A symbolic link is followed (its target
+ * is replaced; a dangling link is refused); /dev/stdout and the like go through the process's own
+ * descriptor; an existing device, FIFO or socket (a pipe) is written directly and never replaced, a FIFO without a reader refused at once; a
+ * directory is refused. */
 GDR_API gdr_status gdr_write_file_atomic(const char *path, const void *data, size_t size, gdr_error *err);
 
 /* Version string of the library, e.g. "0.1.0". */

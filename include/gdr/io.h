@@ -47,6 +47,9 @@ typedef struct gdr_import_options {
     int no_progress;          /* 1: no progress bar (default: shown on a terminal for long work) */
     gdr_source_list *sources; /* optional: receives every file read (the source and its buffers,
                                  images), for the cache's staleness check */
+    gdr_budget budget;        /* limits for untrusted files (gdr/scene.h); zero: the defaults */
+    int allow_outside_files;  /* 1: external URIs may leave the file's folder (absolute paths, '..',
+                                 symlinks pointing out); 0 (default): such a URI is refused */
 } gdr_import_options;
 
 typedef struct gdr_import_result {

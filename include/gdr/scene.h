@@ -17,6 +17,9 @@ extern "C" {
 
 #define GDR_NAME_MAX 64
 #define GDR_NO_INDEX UINT32_MAX
+/* Largest magnitude of a mesh-space coordinate (metres) gdr accepts anywhere: far beyond any real
+ * scene, small enough that squared distances and areas stay finite in float. */
+#define GDR_MAX_COORDINATE 1e12f
 
 typedef struct gdr_mesh {
     char name[GDR_NAME_MAX];
@@ -91,7 +94,8 @@ GDR_API gdr_status gdr_scene_create(gdr_scene **out, gdr_error *err);
 GDR_API void gdr_scene_destroy(gdr_scene *scene);
 
 /* Adds a mesh whose arrays are copied; normals may be NULL (generated from the faces), uvs may
- * be NULL (zeros). Computes the bounding sphere. Checks every index against vertex_count. */
+ * be NULL (zeros). Computes the bounding sphere. Checks every index against vertex_count and every
+ * position (finite, within GDR_MAX_COORDINATE). */
 GDR_API gdr_status gdr_scene_add_mesh(gdr_scene *scene, const char *name, const gdr_vec3 *positions,
                                       const gdr_vec3 *normals, const gdr_vec2 *uvs,
                                       uint32_t vertex_count, const uint32_t *indices,
@@ -206,6 +210,26 @@ GDR_API bool gdr_scene_spec_is_builtin(const char *spec);
  * file and the place, e.g. "box.gltf: meshes[0].primitives[1]: mode 1 (lines) skipped". */
 typedef void (*gdr_warning_fn)(void *user, const char *message);
 
+/* Limits on what one untrusted scene or cache file may make gdr do (docs/SECURITY.md). Each is
+ * checked before the memory it bounds is allocated; a file over one is refused with an error that
+ * names the budget and the option that raises it. Zero-initialise: 0 takes the default below. */
+typedef struct gdr_budget {
+    uint64_t triangles;      /* triangles over all meshes as read (before duplicates are dropped);
+                                0: GDR_DEFAULT_MAX_TRIANGLES */
+    uint64_t instances;      /* instances the file creates; 0: GDR_DEFAULT_MAX_INSTANCES */
+    uint64_t texture_pixels; /* pixels over all decoded images; 0: GDR_DEFAULT_MAX_TEXTURE_PIXELS */
+    uint64_t decoded_bytes;  /* bytes made by decoding (base64 data: URIs, EXT_meshopt_compression
+                                views, accessors without a bufferView); 0: GDR_DEFAULT_MAX_DECODED_BYTES */
+} gdr_budget;
+
+#define GDR_DEFAULT_MAX_TRIANGLES (1ull << 26)      /* 67,108,864 */
+#define GDR_DEFAULT_MAX_INSTANCES (1ull << 22)      /* 4,194,304 */
+#define GDR_DEFAULT_MAX_TEXTURE_PIXELS (1ull << 27) /* 134,217,728: 512 MiB of RGBA8 */
+#define GDR_DEFAULT_MAX_DECODED_BYTES (1ull << 31)  /* 2 GiB */
+
+/* The budget with every 0 replaced by its default. */
+GDR_API gdr_budget gdr_budget_resolve(const gdr_budget *budget);
+
 /* Options of gdr_scene_load; zero-initialise, every field has a default. */
 typedef struct gdr_load_options {
     int no_cache;          /* 1: import the source, never read or write a .gdrc cache */
@@ -214,6 +238,9 @@ typedef struct gdr_load_options {
     int no_progress;       /* 1: never draw a progress bar (default: on a terminal only) */
     gdr_warning_fn warning; /* NULL: warnings go to stderr as "gdr: warning: ..." */
     void *warning_user;
+    gdr_budget budget;      /* limits for untrusted files; zero: the defaults */
+    int allow_outside_files; /* 1: a glTF may name buffers and images outside its own folder
+                                (absolute paths, '..', symlinks out); 0: refused */
 } gdr_load_options;
 
 /* Loads a scene from a specification, a built-in scene with its level-0 clusters and LOD DAG:

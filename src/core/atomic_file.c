@@ -1,33 +1,11 @@
-#include "gdr/core.h"
-
-#include <errno.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <unistd.h>
+#include "core/output_file.h"
 
 gdr_status gdr_write_file_atomic(const char *path, const void *data, size_t size, gdr_error *err)
 {
-    size_t length = strlen(path);
-    char *temporary = malloc(length + 32);
-    if (!temporary)
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
-    snprintf(temporary, length + 32, "%s.tmp.%ld", path, (long)getpid());
-    FILE *file = fopen(temporary, "wb");
-    bool ok = file && fwrite(data, 1, size, file) == size;
-    int saved = errno;
-    if (file && fclose(file) != 0 && ok) {
-        ok = false;
-        saved = errno;
-    }
-    if (ok && rename(temporary, path) != 0) {
-        ok = false;
-        saved = errno;
-    }
-    if (!ok)
-        remove(temporary);
-    free(temporary);
-    if (!ok)
-        return gdr_error_set(err, GDR_ERROR_IO, "%s: cannot write (%s)", path, strerror(saved));
-    return GDR_OK;
+    gdr_output_file out;
+    gdr_status status = gdr_output_open(path, &out, err);
+    if (status != GDR_OK)
+        return status;
+    bool ok = fwrite(data, 1, size, out.file) == size;
+    return gdr_output_close(&out, ok, path, err);
 }

@@ -9,6 +9,7 @@
 
 #include "core/thread_pool.h"
 #include "geometry/cluster_bounds.h"
+#include "geometry/meshlet_chunks.h"
 #include "gdr/geometry.h"
 #include "gdr/scene.h"
 
@@ -65,9 +66,12 @@ static gdr_status check_mesh(const gdr_mesh *mesh, gdr_error *err)
                                  mesh->indices[i], i, mesh->vertex_count);
     for (uint32_t v = 0; v < mesh->vertex_count; v++) {
         const gdr_vec3 p = mesh->positions[v];
-        if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
-            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "mesh '%s': position %u is not finite",
-                                 mesh->name, v);
+        /* meshoptimizer's own asserts fire on coordinates near sqrt(FLT_MAX) */
+        if (!(fabsf(p.x) <= GDR_MAX_COORDINATE) || !(fabsf(p.y) <= GDR_MAX_COORDINATE) ||
+            !(fabsf(p.z) <= GDR_MAX_COORDINATE))
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
+                                 "mesh '%s': position %u is not finite or beyond the %g limit on coordinates",
+                                 mesh->name, v, GDR_MAX_COORDINATE);
     }
     return GDR_OK;
 }
@@ -409,6 +413,73 @@ static gdr_status build_chunks(const gdr_mesh *mesh, const gdr_meshlet_options *
     return status;
 }
 
+/* Meshes on which meshoptimizer's kd-tree of centroids degenerates (meshlet_chunks.h): built in
+ * small chunks so that the work stays linear. */
+static gdr_status build_hostile(const gdr_mesh *mesh, gdr_meshlet_options o, gdr_mesh_clusters *out, gdr_error *err)
+{
+    size_t bound = gdr_meshlet_chunks_bound(mesh, o.max_vertices, o.max_triangles);
+    struct meshopt_Meshlet *meshlets = malloc(bound * sizeof *meshlets);
+    unsigned int *vertices = malloc(bound * o.max_vertices * sizeof *vertices);
+    unsigned char *triangles = malloc(bound * o.max_triangles * 3);
+    if (!meshlets || !vertices || !triangles) {
+        free(meshlets);
+        free(vertices);
+        free(triangles);
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for %zu meshlets", mesh->name,
+                             bound);
+    }
+    size_t count = gdr_meshlet_build_chunks(mesh, o.max_vertices, o.max_triangles, o.cone_weight, meshlets, vertices,
+                                            triangles);
+    if (count == 0 || count > bound) {
+        free(meshlets);
+        free(vertices);
+        free(triangles);
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "mesh '%s': meshoptimizer made %zu meshlets from %u "
+                             "triangles", mesh->name, count, mesh->index_count / 3);
+    }
+    /* Each meshlet's triangles start on a 4-byte boundary (meshoptimizer pads them): kept, so a
+     * shader can read them as 32-bit words. Every offset fits in 32 bits: no meshlet is empty, so
+     * there are at most index_count vertex entries and index_count + 3 * count triangle bytes. */
+    const struct meshopt_Meshlet *last = &meshlets[count - 1];
+    size_t vertex_total = (size_t)last->vertex_offset + last->vertex_count;
+    size_t triangle_bytes = (size_t)last->triangle_offset + ((size_t)last->triangle_count * 3 + 3) / 4 * 4;
+
+    gdr_mesh_clusters c = {0};
+    c.clusters = malloc(count * sizeof *c.clusters);
+    c.vertices = malloc(vertex_total * sizeof *c.vertices);
+    c.triangles = malloc(triangle_bytes);
+    if (!c.clusters || !c.vertices || !c.triangles || count > UINT32_MAX || triangle_bytes > UINT32_MAX) {
+        gdr_mesh_clusters_free(&c);
+        free(meshlets);
+        free(vertices);
+        free(triangles);
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for %zu meshlets", mesh->name,
+                             count);
+    }
+    c.cluster_count = c.level0_cluster_count = (uint32_t)count;
+    c.vertex_count = (uint32_t)vertex_total;
+    c.triangle_byte_count = (uint32_t)triangle_bytes;
+    memcpy(c.vertices, vertices, vertex_total * sizeof *c.vertices);
+    memcpy(c.triangles, triangles, triangle_bytes);
+    for (size_t i = 0; i < count; i++) {
+        const struct meshopt_Meshlet *m = &meshlets[i];
+        gdr_cluster *cl = &c.clusters[i];
+        *cl = (gdr_cluster){.vertex_offset = m->vertex_offset, .triangle_offset = m->triangle_offset,
+                            .vertex_count = m->vertex_count, .triangle_count = m->triangle_count,
+                            .group = GDR_NO_INDEX, .refined_group = GDR_NO_INDEX};
+        /* Zero the padding: the output must not depend on what malloc returned. */
+        size_t used = (size_t)m->triangle_offset + (size_t)m->triangle_count * 3;
+        size_t end = i + 1 < count ? meshlets[i + 1].triangle_offset : triangle_bytes;
+        memset(c.triangles + used, 0, end - used);
+        cluster_bounds(cl, c.vertices + m->vertex_offset, c.triangles + m->triangle_offset, mesh);
+    }
+    free(meshlets);
+    free(vertices);
+    free(triangles);
+    *out = c;
+    return GDR_OK;
+}
+
 gdr_status gdr_meshlets_build(const gdr_mesh *mesh, const gdr_meshlet_options *options, gdr_mesh_clusters *out,
                               gdr_error *err)
 {
@@ -424,7 +495,11 @@ gdr_status gdr_meshlets_build(const gdr_mesh *mesh, const gdr_meshlet_options *o
         status = check_mesh(mesh, err);
     if (status != GDR_OK)
         return status;
-    if (mesh->index_count / 3 <= MESHLET_CHUNK_TRIANGLES) {
+    if (gdr_meshlet_needs_chunks(mesh)) {
+        status = build_hostile(mesh, o, out, err);
+        if (status != GDR_OK)
+            return status;
+    } else if (mesh->index_count / 3 <= MESHLET_CHUNK_TRIANGLES) {
         /* One chunk: straight over the mesh's own vertices. */
         chunk_result r = {0};
         status = meshlets_of(mesh, &o, mesh->indices, mesh->index_count, &mesh->positions[0].x, mesh->vertex_count,

@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "core/output_file.h"
 #include "gdr/cull.h"
 #include "io/cache_internal.h"
 #include "io/io_internal.h"
@@ -57,12 +58,36 @@ static void write_sections(writer *w, const cache_write_input *in, section_entry
 static void store_u32(uint8_t *p, uint32_t v) { memcpy(p, &v, 4); }
 static void store_u64(uint8_t *p, uint64_t v) { memcpy(p, &v, 8); }
 
+/* The writer refuses what the reader would refuse, before serialising: a file over the reader's
+ * size limit (counted here from the raw arrays alone, a lower bound of the file), and textures
+ * larger than it reads (the TEXR section's check). A cache that cannot be read back is never
+ * written. */
+static gdr_status check_reader_limits(const char *path, const gdr_scene *s, gdr_error *err)
+{
+    uint64_t bytes = CACHE_HEADER_SIZE;
+    for (uint32_t i = 0; i < s->texture_count; i++)
+        bytes += (uint64_t)s->textures[i].width * s->textures[i].height * 4;
+    for (uint32_t i = 0; i < s->mesh_count; i++) {
+        const gdr_mesh *m = &s->meshes[i];
+        bytes += (uint64_t)m->vertex_count * 32 + (uint64_t)m->index_count * 4 + (uint64_t)m->clusters.vertex_count * 4 +
+                 m->clusters.triangle_byte_count;
+    }
+    if (bytes > GDR_IO_MAX_FILE_SIZE)
+        return gdr_error_set(err, GDR_ERROR_CAPACITY, "%s: the scene needs at least %llu bytes, more than the %llu a "
+                             "cache may hold (the reader's limit)", path, (unsigned long long)bytes,
+                             (unsigned long long)GDR_IO_MAX_FILE_SIZE);
+    return GDR_OK;
+}
+
 gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_cache_write_options *options,
                            gdr_error *err)
 {
     static const gdr_cache_write_options defaults = {0};
     if (!options)
         options = &defaults;
+    gdr_status limits = check_reader_limits(path, scene, err);
+    if (limits != GDR_OK)
+        return limits;
     /* The table has exactly one entry per section: no byte of the file lies outside a checksum. */
     cache_write_input in = {scene, &options->source, options->pvs};
     uint32_t expected = 0;
@@ -87,6 +112,11 @@ gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_c
         free(w.data);
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory serialising the scene", path);
     }
+    if (w.size > GDR_IO_MAX_FILE_SIZE) {
+        free(w.data);
+        return gdr_error_set(err, GDR_ERROR_CAPACITY, "%s: %zu bytes, more than the %llu a cache may hold (the "
+                             "reader's limit)", path, w.size, (unsigned long long)GDR_IO_MAX_FILE_SIZE);
+    }
     uint8_t *table = w.data + CACHE_HEADER_SIZE;
     for (uint32_t i = 0; i < count; i++) {
         entries[i].checksum = gdr_io_hash(w.data + entries[i].offset, entries[i].size);
@@ -106,40 +136,24 @@ gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_c
     store_u64(w.data + 32, gdr_io_hash(table, (size_t)count * CACHE_ENTRY_SIZE));
     store_u64(w.data + 40, gdr_io_hash(w.data, 40));
 
-    /* A temporary file in the same folder, then rename: readers see the old file or the new one. */
-    size_t length = strlen(path);
-    char *temp = malloc(length + 32);
-    if (!temp) {
-        free(w.data);
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
-    }
-    snprintf(temp, length + 32, "%s.tmp.%ld", path, (long)getpid());
-    gdr_status status = GDR_OK;
-    FILE *file = fopen(temp, "wb");
-    if (!file) {
-        status = gdr_error_set(err, GDR_ERROR_IO, "%s: cannot create: %s", temp, strerror(errno));
-    } else {
+    /* A temporary file in the same folder, then rename: readers see the old file or the new one
+     * (core/output_file.h: links followed, devices and FIFOs written directly). */
+    gdr_output_file out;
+    gdr_status status = gdr_output_open(path, &out, err);
+    if (status == GDR_OK) {
         gdr_progress progress;
         gdr_progress_begin(&progress, "write cache", w.size, 0);
         size_t done = 0;
         while (done < w.size) {
             size_t chunk = w.size - done < (16u << 20) ? w.size - done : (16u << 20);
-            if (fwrite(w.data + done, 1, chunk, file) != chunk)
+            if (fwrite(w.data + done, 1, chunk, out.file) != chunk)
                 break;
             done += chunk;
             gdr_progress_update(&progress, done);
         }
         gdr_progress_end(&progress);
-        int flush_failed = fflush(file) != 0 || fsync(fileno(file)) != 0;
-        int close_failed = fclose(file) != 0;
-        if (done != w.size || flush_failed || close_failed)
-            status = gdr_error_set(err, GDR_ERROR_IO, "%s: write failed: %s", temp, strerror(errno));
-        else if (rename(temp, path) != 0)
-            status = gdr_error_set(err, GDR_ERROR_IO, "%s: cannot rename to %s: %s", temp, path, strerror(errno));
-        if (status != GDR_OK)
-            remove(temp);
+        status = gdr_output_close(&out, done == w.size, path, err);
     }
-    free(temp);
     free(w.data);
     return status;
 }
@@ -275,11 +289,126 @@ gdr_status gdr_cache_read_memory(const void *data, size_t size, const char *name
     return gdr_cache_read_sections(name ? name : "(memory)", &v, out, out_pvs, err);
 }
 
-/* Compares the SRCE section with the build options and the files on disk. */
-static gdr_status check_fresh(const char *name, cache_view *v, const char *build_options, gdr_error *err)
+/* One entry of section 'SRCE': a file the scene was built from, as it was then. */
+typedef struct source_entry {
+    char *path;    /* where to look for it now (malloc'ed) */
+    uint64_t size, mtime, hash;
+    uint64_t key;  /* hash of the path, to check each path once */
+    int moved;     /* its folder moved with the source: the mtime says nothing, compare contents */
+} source_entry;
+
+/* A file as it is now: looked at once however many entries name it. */
+typedef struct source_now {
+    int exists, hashed, unreadable;
+    uint64_t size, hash;
+    int64_t mtime;
+} source_now;
+
+static int compare_entries(const void *a, const void *b)
+{
+    const source_entry *x = a, *y = b;
+    if (x->key != y->key)
+        return x->key < y->key ? -1 : 1;
+    return strcmp(x->path, y->path);
+}
+
+static void free_entries(source_entry *entries, uint32_t count)
+{
+    for (uint32_t i = 0; entries && i < count; i++)
+        free(entries[i].path);
+    free(entries);
+}
+
+/* The entries of 'SRCE' after the build options. When the cache is read for `source` (the file it
+ * would be rebuilt from) and the first entry (the source it was built from) names another path,
+ * the source's folder has moved or been copied: entries under the old folder are looked for under
+ * the new one. */
+static gdr_status read_entries(const char *name, reader *r, const char *source, source_entry **out,
+                               uint32_t *out_count, gdr_error *err)
+{
+    uint32_t files = get_u32(r);
+    if (r->failed || files > (r->size - r->at) / 28) /* each entry is at least 28 bytes */
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'SRCE' is malformed", name);
+    source_entry *entries = calloc((size_t)files + 1, sizeof *entries);
+    if (!entries)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", name);
+    char old_dir[PATH_MAX] = "", new_dir[PATH_MAX] = "", absolute[PATH_MAX];
+    for (uint32_t i = 0; i < files; i++) {
+        uint32_t length;
+        const char *path = get_string(r, &length);
+        source_entry *e = &entries[i];
+        e->size = get_u64(r), e->mtime = get_u64(r), e->hash = get_u64(r);
+        if (r->failed || length == 0 || length >= PATH_MAX || memchr(path, 0, length)) {
+            free_entries(entries, files);
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'SRCE' is malformed", name);
+        }
+        size_t old_length = strlen(old_dir);
+        if (i == 0 && source && realpath(source, absolute) && (strlen(absolute) != length ||
+                                                               memcmp(absolute, path, length) != 0)) {
+            char recorded[PATH_MAX];
+            snprintf(recorded, sizeof recorded, "%.*s", (int)length, path);
+            gdr_io_dirname(recorded, old_dir, sizeof old_dir);
+            gdr_io_dirname(absolute, new_dir, sizeof new_dir);
+            old_length = strlen(old_dir);
+            e->path = strdup(absolute);
+            e->moved = 1;
+        } else if (old_length && length > old_length && memcmp(path, old_dir, old_length) == 0) {
+            size_t n = strlen(new_dir) + (length - old_length) + 1;
+            if ((e->path = malloc(n)))
+                snprintf(e->path, n, "%s%.*s", new_dir, (int)(length - old_length), path + old_length);
+            e->moved = 1;
+        } else if ((e->path = malloc((size_t)length + 1))) {
+            memcpy(e->path, path, length);
+            e->path[length] = 0;
+        }
+        if (!e->path) {
+            free_entries(entries, files);
+            return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", name);
+        }
+        e->key = gdr_io_hash(e->path, strlen(e->path));
+    }
+    *out = entries;
+    *out_count = files;
+    return GDR_OK;
+}
+
+/* Compares one entry with the file now (stat once, contents hashed at most once per path). */
+static gdr_status check_entry(const char *name, const source_entry *e, source_now *now, gdr_error *err)
+{
+    if (!now->exists)
+        return GDR_OK; /* the file is not here: the cache stands alone */
+    if (now->size != e->size)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: %s changed size (%llu -> %llu bytes)", name,
+                             e->path, (unsigned long long)e->size, (unsigned long long)now->size);
+    if ((uint64_t)now->mtime == e->mtime && !e->moved)
+        return GDR_OK;
+    if (!now->hashed && !now->unreadable) {
+        uint8_t *contents;
+        size_t contents_size;
+        gdr_error read_err;
+        if (gdr_io_read_file(e->path, &contents, &contents_size, NULL, &read_err) == GDR_OK) {
+            now->hash = gdr_io_hash(contents, contents_size);
+            now->hashed = 1;
+            free(contents);
+        } else {
+            now->unreadable = 1;
+        }
+    }
+    if (now->hashed && now->hash != e->hash)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: %s changed since the cache was built", name,
+                             e->path);
+    return GDR_OK;
+}
+
+/* Compares the SRCE section with the build options and the files on disk. With `source` (the file
+ * the cache stands for), the cache must record it as its first entry, with the same contents. */
+static gdr_status check_fresh(const char *name, cache_view *v, const char *build_options, const char *source,
+                              gdr_error *err)
 {
     if (!v->present[CACHE_SOURCE])
-        return GDR_OK;
+        return source ? gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: it does not record the source it "
+                                      "was built from", name)
+                      : GDR_OK;
     reader r = v->sections[CACHE_SOURCE];
     uint32_t length;
     const char *options = get_string(&r, &length);
@@ -288,40 +417,46 @@ static gdr_status check_fresh(const char *name, cache_view *v, const char *build
     if (build_options && (strlen(build_options) != length || memcmp(options, build_options, length) != 0))
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: built with options '%.*s', now '%s'", name,
                              (int)(length > 64 ? 64 : length), options, build_options);
-    uint32_t files = get_u32(&r);
-    for (uint32_t i = 0; i < files; i++) {
-        const char *path = get_string(&r, &length);
-        uint64_t size = get_u64(&r), mtime = get_u64(&r), hash = get_u64(&r);
-        if (r.failed || length == 0 || length >= PATH_MAX || memchr(path, 0, length))
-            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'SRCE' is malformed", name);
-        char file[PATH_MAX];
-        memcpy(file, path, length);
-        file[length] = 0;
-        uint64_t now_size;
-        int64_t now_mtime;
-        if (gdr_io_stat(file, &now_size, &now_mtime) != 0)
-            continue; /* the source is not here: the cache stands alone */
-        if (now_size != size)
-            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: %s changed size (%llu -> %llu bytes)",
-                                 name, file, (unsigned long long)size, (unsigned long long)now_size);
-        if ((uint64_t)now_mtime == mtime)
-            continue;
-        uint8_t *contents;
-        size_t contents_size;
-        gdr_error read_err;
-        if (gdr_io_read_file(file, &contents, &contents_size, NULL, &read_err) != GDR_OK)
-            continue;
-        uint64_t now_hash = gdr_io_hash(contents, contents_size);
-        free(contents);
-        if (now_hash != hash)
-            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: %s changed since the cache was built",
-                                 name, file);
+    source_entry *entries = NULL;
+    uint32_t count = 0;
+    gdr_status status = read_entries(name, &r, source, &entries, &count, err);
+    if (status != GDR_OK)
+        return status;
+    if (source && count == 0)
+        status = gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: it does not record the source it was "
+                               "built from", name);
+    if (source && status == GDR_OK) {
+        /* The source itself must be there, with the contents the cache was built from. */
+        source_now now = {0};
+        now.exists = gdr_io_stat(entries[0].path, &now.size, &now.mtime) == 0;
+        if (!now.exists)
+            status = gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: its source %s is not there", name,
+                                   entries[0].path);
+        else
+            status = check_entry(name, &entries[0], &now, err);
     }
-    return GDR_OK;
+    /* Every other path once, however often the list names it. */
+    qsort(entries, count, sizeof *entries, compare_entries);
+    source_now now = {0};
+    for (uint32_t i = 0; i < count && status == GDR_OK; i++) {
+        if (i == 0 || compare_entries(&entries[i - 1], &entries[i]) != 0) {
+            now = (source_now){0};
+            now.exists = gdr_io_stat(entries[i].path, &now.size, &now.mtime) == 0;
+        }
+        status = check_entry(name, &entries[i], &now, err);
+    }
+    free_entries(entries, count);
+    return status;
 }
 
 gdr_status gdr_cache_read(const char *path, const char *build_options, gdr_scene **out, gdr_pvs **out_pvs,
                           gdr_error *err)
+{
+    return gdr_io_cache_read_for(path, NULL, build_options, out, out_pvs, err);
+}
+
+gdr_status gdr_io_cache_read_for(const char *path, const char *source, const char *build_options, gdr_scene **out,
+                                 gdr_pvs **out_pvs, gdr_error *err)
 {
     *out = NULL;
     if (out_pvs)
@@ -334,7 +469,7 @@ gdr_status gdr_cache_read(const char *path, const char *build_options, gdr_scene
     cache_view v;
     status = parse_container(path, data, size, &v, err);
     if (status == GDR_OK)
-        status = check_fresh(path, &v, build_options, err);
+        status = check_fresh(path, &v, build_options, source, err);
     if (status == GDR_OK)
         status = gdr_cache_read_sections(path, &v, out, out_pvs, err);
     free(data);

@@ -13,6 +13,7 @@
 #include "gdr/io.h"
 
 #define CACHE_SECTION_REQUIRED 1u /* table flag: a reader that does not know the section must refuse the file */
+#define CACHE_MAX_TEXTURE_SIDE 32768u /* the largest texture side the reader accepts (and the writer writes) */
 
 /* --- writing: a growing buffer; `failed` once memory ran out ---------------------------------- */
 

@@ -116,6 +116,18 @@ static gdr_status read_scene(cache_read_state *st, reader *r, gdr_error *err)
 
 /* --- TEXR (per texture: name, size, sRGB) and TXPX (their pixels) ------------------------------ */
 
+/* The reader's limit on a texture's sides, enforced by the writer: no cache it cannot read back. */
+static gdr_status check_texture_sides(const cache_write_input *in, const char *path, gdr_error *err)
+{
+    for (uint32_t i = 0; i < in->scene->texture_count; i++) {
+        const gdr_texture *t = &in->scene->textures[i];
+        if (t->width == 0 || t->height == 0 || t->width > CACHE_MAX_TEXTURE_SIDE || t->height > CACHE_MAX_TEXTURE_SIDE)
+            return gdr_error_set(err, GDR_ERROR_CAPACITY, "%s: texture %u is %ux%u; a cache holds at most %ux%u", path,
+                                 i, t->width, t->height, CACHE_MAX_TEXTURE_SIDE, CACHE_MAX_TEXTURE_SIDE);
+    }
+    return GDR_OK;
+}
+
 static void write_textures(writer *w, const cache_write_input *in)
 {
     const gdr_scene *s = in->scene;
@@ -147,7 +159,8 @@ static gdr_status read_pixels(cache_read_state *st, reader *px, gdr_error *err)
         char tname[GDR_NAME_MAX];
         get_name(tr, tname);
         uint32_t width = get_u32(tr), height = get_u32(tr), srgb = get_u32(tr);
-        if (width == 0 || height == 0 || width > 32768 || height > 32768 || srgb > 1)
+        if (width == 0 || height == 0 || width > CACHE_MAX_TEXTURE_SIDE || height > CACHE_MAX_TEXTURE_SIDE ||
+            srgb > 1)
             return gdr_error_set(err, GDR_ERROR_PARSE, "%s: texture %u: size %ux%u or flags are out of range",
                                  st->name, i, width, height);
         const uint8_t *pixels = take(px, (size_t)width * height * 4);
@@ -676,7 +689,8 @@ static gdr_status read_pvs(cache_read_state *st, reader *r, gdr_error *err)
 const cache_section gdr_cache_sections[CACHE_SECTION_COUNT] = {
     [CACHE_SOURCE] = {FOURCC('S', 'R', 'C', 'E'), 0, 1, NULL, NULL, write_source, NULL},
     [CACHE_SCENE] = {FOURCC('S', 'C', 'N', 'E'), REQUIRED, 0, NULL, NULL, write_scene, read_scene},
-    [CACHE_TEXTURES] = {FOURCC('T', 'E', 'X', 'R'), REQUIRED, 0, NULL, NULL, write_textures, read_textures},
+    [CACHE_TEXTURES] = {FOURCC('T', 'E', 'X', 'R'), REQUIRED, 0, NULL, check_texture_sides, write_textures,
+                        read_textures},
     [CACHE_PIXELS] = {FOURCC('T', 'X', 'P', 'X'), REQUIRED, 0, NULL, NULL, write_pixels, read_pixels},
     [CACHE_MESHES] = {FOURCC('M', 'E', 'S', 'H'), REQUIRED, 0, NULL, NULL, write_meshes, read_meshes},
     [CACHE_GEOMETRY] = {FOURCC('G', 'E', 'O', 'M'), REQUIRED, 0, NULL, NULL, write_geometry, read_geometry},

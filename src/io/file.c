@@ -1,6 +1,7 @@
 /* File reading, file identities for the cache, warnings and base64. */
 #define _XOPEN_SOURCE 700 /* realpath */
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -59,14 +60,38 @@ void gdr_source_list_free(gdr_source_list *list)
     *list = (gdr_source_list){0};
 }
 
+gdr_status gdr_io_open_regular(const char *path, int *out_fd, gdr_error *err)
+{
+    *out_fd = -1;
+    /* O_NONBLOCK: opening a FIFO without a writer, or some devices, would otherwise wait forever
+     * before fstat could refuse them. */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+    if (fd < 0)
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
+    struct stat st;
+    int flags = fcntl(fd, F_GETFL);
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || flags < 0 || fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0) {
+        close(fd);
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: not a regular file", path);
+    }
+    *out_fd = fd;
+    return GDR_OK;
+}
+
 gdr_status gdr_io_read_file(const char *path, uint8_t **out_data, size_t *out_size, gdr_source_list *sources,
                             gdr_error *err)
 {
     *out_data = NULL;
     *out_size = 0;
-    FILE *file = fopen(path, "rb");
-    if (!file)
+    int fd;
+    gdr_status opened = gdr_io_open_regular(path, &fd, err);
+    if (opened != GDR_OK)
+        return opened;
+    FILE *file = fdopen(fd, "rb");
+    if (!file) {
+        close(fd);
         return gdr_error_set(err, GDR_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
+    }
     struct stat st;
     if (fstat(fileno(file), &st) != 0 || !S_ISREG(st.st_mode)) {
         fclose(file);

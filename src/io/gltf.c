@@ -92,17 +92,23 @@ static gdr_status check_extension_objects(gltf_ctx *c, const cJSON *node, char *
     return GDR_OK;
 }
 
-/* Top-level arrays: present ones must be arrays of objects. */
-static gdr_status get_top_array(gltf_ctx *c, const char *key, cJSON **out, uint32_t *count)
+/* Top-level arrays: present ones must be arrays of objects. Their elements are indexed once into
+ * *items (cJSON_GetArrayItem walks the list: a lookup per reference would be quadratic). */
+static gdr_status get_top_array(gltf_ctx *c, const char *key, cJSON **out, uint32_t *count, const cJSON ***items)
 {
     const cJSON *array = NULL;
     gdr_status status = gltf_get_array(c, c->root, key, "", &array, count);
     if (status != GDR_OK)
         return status;
+    *items = malloc(sizeof(const cJSON *) * ((size_t)*count + 1));
+    if (!*items)
+        return gltf_fail(c, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", key);
     uint32_t i = 0;
-    for (const cJSON *e = array ? array->child : NULL; e; e = e->next, i++)
+    for (const cJSON *e = array ? array->child : NULL; e && i < *count; e = e->next, i++) {
         if (!cJSON_IsObject(e))
             return gltf_fail(c, GDR_ERROR_PARSE, "%s[%u]: expected an object", key, i);
+        (*items)[i] = e;
+    }
     *out = (cJSON *)array;
     return GDR_OK;
 }
@@ -165,7 +171,7 @@ static gdr_status load_image(gltf_ctx *c, uint32_t image, int srgb, uint32_t *ou
     }
     char here[48];
     snprintf(here, sizeof here, "images[%u]", image);
-    const cJSON *json = cJSON_GetArrayItem(c->images, (int)image);
+    const cJSON *json = c->image_at[image];
     const char *uri = NULL, *name = NULL;
     uint32_t view_index = GDR_NO_INDEX;
     gdr_status status = gltf_get_string(c, json, "uri", here, &uri);
@@ -197,11 +203,18 @@ static gdr_status load_image(gltf_ctx *c, uint32_t image, int srgb, uint32_t *ou
     c->err = saved;
     uint8_t *rgba = NULL;
     uint32_t width = 0, height = 0;
-    if (status == GDR_OK) {
-        char label[96];
-        snprintf(label, sizeof label, "%s: %s", c->name, here);
-        status = gdr_image_decode(bytes, size, label, &rgba, &width, &height, &image_err);
+    char label[96];
+    snprintf(label, sizeof label, "%s: %s", c->name, here);
+    if (status == GDR_OK)
+        status = gdr_io_image_size(bytes, size, label, &width, &height, &image_err);
+    if (status == GDR_OK &&
+        gdr_io_budget_take(&c->budget, GDR_BUDGET_TEXTURE_PIXELS, (uint64_t)width * height, c->name, here, c->err) !=
+            GDR_OK) {
+        free(owned);
+        return c->err->status; /* over the budget: refused, not left out, so that the user learns why */
     }
+    if (status == GDR_OK)
+        status = gdr_image_decode(bytes, size, label, &rgba, &width, &height, &image_err);
     free(owned);
     if (status == GDR_OK) {
         char texture_name[GDR_NAME_MAX];
@@ -247,7 +260,7 @@ static gdr_status texture_ref(gltf_ctx *c, const cJSON *parent, const char *key,
                          c->texture_count);
     char tplace[48];
     snprintf(tplace, sizeof tplace, "textures[%u]", texture);
-    const cJSON *tjson = cJSON_GetArrayItem(c->textures, (int)texture);
+    const cJSON *tjson = c->texture_at[texture];
     uint32_t source = GDR_NO_INDEX;
     status = gltf_get_uint(c, tjson, "source", tplace, 0, UINT32_MAX - 1, &source);
     if (status == GDR_OK)
@@ -268,7 +281,7 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
 {
     char here[48];
     snprintf(here, sizeof here, "materials[%u]", index);
-    const cJSON *json = cJSON_GetArrayItem(c->materials, (int)index);
+    const cJSON *json = c->material_at[index];
     gdr_material m = {.base_color = {1, 1, 1, 1}, .metallic_factor = 1.0f, .roughness_factor = 1.0f,
                       .alpha_cutoff = 0.5f, .alpha_mode = GDR_ALPHA_OPAQUE};
     const char *name = NULL, *alpha_mode = NULL;
@@ -422,6 +435,35 @@ static gdr_status read_attribute(gltf_ctx *c, const cJSON *attributes, const cha
     return gltf_accessor_read_floats(c, accessor, use, components, *out);
 }
 
+/* The triangles `n` indices of topology `mode` make, from the budget, before anything is allocated
+ * for them. */
+static gdr_status take_triangles(gltf_ctx *c, uint32_t mode, uint32_t n, const char *place)
+{
+    uint64_t triangles = mode == 4 ? n / 3 : n > 2 ? n - 2 : 0;
+    return gdr_io_budget_take(&c->budget, GDR_BUDGET_TRIANGLES, triangles, c->name, place, c->err);
+}
+
+/* Degenerate and duplicate triangles dropped, vertices shared by too many triangles split: what
+ * meshlet building needs to stay linear (mesh_clean.c). */
+static gdr_status clean_triangles(gltf_ctx *c, const char *place, prim_arrays *a, uint32_t *vertex_count,
+                                  uint32_t *index_count)
+{
+    uint32_t before = *index_count / 3, degenerate, duplicate, added;
+    gdr_status status = gdr_io_drop_bad_triangles(a->positions, *vertex_count, a->triangles, index_count,
+                                                  &degenerate, &duplicate);
+    if (status == GDR_OK)
+        status = gdr_io_split_shared_vertices(&a->positions, &a->normals, &a->uvs, vertex_count, a->triangles,
+                                              *index_count, &added);
+    if (status != GDR_OK)
+        return gltf_fail(c, status, "%s: out of memory", place);
+    /* Zero-area triangles draw nothing and are common in real files: dropped silently. */
+    if (duplicate || (degenerate && *index_count == 0))
+        gdr_io_warn(&c->warnings, "%s: %s: %u of %u triangles dropped (%u degenerate, %u duplicate)%s", c->name,
+                    place, degenerate + duplicate, before, degenerate, duplicate,
+                    *index_count ? "" : "; no triangles left, skipped");
+    return GDR_OK;
+}
+
 /* One primitive -> one gdr mesh (or GDR_NO_INDEX when it has no triangles). */
 static gdr_status convert_primitive(gltf_ctx *c, const cJSON *prim, const char *place, const char *mesh_name,
                                     uint32_t *out_mesh, uint32_t *out_material)
@@ -469,12 +511,11 @@ static gdr_status convert_primitive(gltf_ctx *c, const cJSON *prim, const char *
     a.uvs = (gdr_vec2 *)uvs;
     if (status != GDR_OK)
         goto done;
-    for (uint32_t v = 0; v < vertex_count; v++)
-        if (!isfinite(a.positions[v].x) || !isfinite(a.positions[v].y) || !isfinite(a.positions[v].z)) {
-            status = gltf_fail(c, GDR_ERROR_PARSE, "%s.attributes.POSITION: vertex %u is not finite (%g, %g, %g)",
-                               place, v, a.positions[v].x, a.positions[v].y, a.positions[v].z);
-            goto done;
-        }
+    char positions_place[120];
+    snprintf(positions_place, sizeof positions_place, "%s.attributes.POSITION", place);
+    status = gdr_io_check_positions(a.positions, vertex_count, c->name, positions_place, c->err);
+    if (status != GDR_OK)
+        goto done;
     if (a.normals) {
         uint32_t bad = 0;
         for (uint32_t v = 0; v < vertex_count; v++) {
@@ -509,6 +550,9 @@ static gdr_status convert_primitive(gltf_ctx *c, const cJSON *prim, const char *
         if (status != GDR_OK)
             goto done;
         n = info.count;
+        status = take_triangles(c, mode, n, use);
+        if (status != GDR_OK)
+            goto done;
         a.indices = malloc(sizeof(uint32_t) * n);
         if (!a.indices) {
             status = gltf_fail(c, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", use);
@@ -525,6 +569,9 @@ static gdr_status convert_primitive(gltf_ctx *c, const cJSON *prim, const char *
             }
     } else {
         n = vertex_count;
+        status = take_triangles(c, mode, n, place);
+        if (status != GDR_OK)
+            goto done;
         a.indices = malloc(sizeof(uint32_t) * n);
         if (!a.indices) {
             status = gltf_fail(c, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", place);
@@ -546,6 +593,9 @@ static gdr_status convert_primitive(gltf_ctx *c, const cJSON *prim, const char *
         gdr_io_warn(&c->warnings, "%s: %s: no triangles; skipped", c->name, place);
         goto done;
     }
+    status = clean_triangles(c, place, &a, &vertex_count, &triangle_indices);
+    if (status != GDR_OK || triangle_indices == 0)
+        goto done;
     status = gdr_scene_add_mesh(c->scene, mesh_name, a.positions, a.normals, a.uvs, vertex_count, a.triangles,
                                 triangle_indices, out_mesh, c->err);
 done:
@@ -559,7 +609,7 @@ static gdr_status convert_mesh(gltf_ctx *c, uint32_t index, gdr_progress *progre
         return GDR_OK;
     char here[48];
     snprintf(here, sizeof here, "meshes[%u]", index);
-    const cJSON *json = cJSON_GetArrayItem(c->meshes, (int)index);
+    const cJSON *json = c->mesh_at[index];
     const cJSON *prims = NULL;
     const char *name = NULL;
     uint32_t count = 0;
@@ -624,11 +674,28 @@ static gdr_status node_local(gltf_ctx *c, const cJSON *node, const char *place, 
     return GDR_OK;
 }
 
-static gdr_status add_instances(gltf_ctx *c, uint32_t mesh, gdr_mat4 transform)
+/* The number of instances one placement of glTF mesh `mesh` makes (a converted mesh). */
+static uint32_t mesh_instance_count(gltf_ctx *c, uint32_t mesh)
+{
+    const cJSON *prims = cJSON_GetObjectItemCaseSensitive(c->mesh_at[mesh], "primitives");
+    uint32_t count = (uint32_t)cJSON_GetArraySize(prims), made = 0;
+    for (uint32_t p = 0; p < count; p++)
+        made += c->prim_mesh[c->mesh_first[mesh] + p] != GDR_NO_INDEX;
+    return made;
+}
+
+/* One placement of a mesh; `budgeted`: its instances were already taken from the budget. */
+static gdr_status add_instances(gltf_ctx *c, uint32_t mesh, gdr_mat4 transform, const char *place, int budgeted)
 {
     uint32_t first = c->mesh_first[mesh];
-    const cJSON *prims = cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(c->meshes, (int)mesh), "primitives");
+    const cJSON *prims = cJSON_GetObjectItemCaseSensitive(c->mesh_at[mesh], "primitives");
     uint32_t count = (uint32_t)cJSON_GetArraySize(prims);
+    if (!budgeted) {
+        gdr_status status = gdr_io_budget_take(&c->budget, GDR_BUDGET_INSTANCES, mesh_instance_count(c, mesh),
+                                               c->name, place, c->err);
+        if (status != GDR_OK)
+            return status;
+    }
     for (uint32_t p = 0; p < count; p++) {
         if (c->prim_mesh[first + p] == GDR_NO_INDEX)
             continue;
@@ -655,6 +722,22 @@ static gdr_status gpu_instancing(gltf_ctx *c, const cJSON *ext, const char *plac
     static const uint32_t components[3] = {3, 4, 3};
     float *data[3] = {NULL, NULL, NULL};
     uint32_t count = 0;
+    /* The instances are taken from the budget before their attributes are read. */
+    for (int k = 0; k < 3 && status == GDR_OK && count == 0; k++) {
+        uint32_t accessor = GDR_NO_INDEX;
+        gltf_accessor_info info = {0};
+        char use[160], in[140];
+        snprintf(in, sizeof in, "%s.attributes", here);
+        snprintf(use, sizeof use, "%s.%s", in, names[k]);
+        status = gltf_get_uint(c, attributes, names[k], in, 0, UINT32_MAX - 1, &accessor);
+        if (status == GDR_OK && accessor != GDR_NO_INDEX)
+            status = gltf_accessor_info_get(c, accessor, use, &info);
+        count = info.count;
+    }
+    if (status == GDR_OK)
+        status = gdr_io_budget_take(&c->budget, GDR_BUDGET_INSTANCES, (uint64_t)count * mesh_instance_count(c, mesh),
+                                    c->name, here, c->err);
+    count = 0;
     for (int k = 0; k < 3 && status == GDR_OK; k++)
         status = read_attribute(c, attributes, names[k], here, components[k], &count, &data[k]);
     for (uint32_t i = 0; status == GDR_OK && i < count; i++) {
@@ -678,7 +761,7 @@ static gdr_status gpu_instancing(gltf_ctx *c, const cJSON *ext, const char *plac
                 break;
             }
         if (status == GDR_OK)
-            status = add_instances(c, mesh, gdr_mat4_mul(global, local));
+            status = add_instances(c, mesh, gdr_mat4_mul(global, local), here, 1);
     }
     for (int k = 0; k < 3; k++)
         free(data[k]);
@@ -692,7 +775,7 @@ static gdr_status add_camera(gltf_ctx *c, uint32_t index, const char *place, gdr
                          c->camera_count);
     char here[48];
     snprintf(here, sizeof here, "cameras[%u]", index);
-    const cJSON *json = cJSON_GetArrayItem(c->cameras, (int)index);
+    const cJSON *json = c->camera_at[index];
     const char *type = NULL, *name = NULL;
     const cJSON *perspective = NULL;
     gdr_status status = gltf_get_string(c, json, "type", here, &type);
@@ -773,7 +856,7 @@ static gdr_status walk_nodes(gltf_ctx *c, const uint32_t *roots, uint32_t root_c
     uint32_t total_prims = 0, converted = 0;
     for (uint32_t m = 0; m < c->mesh_count; m++)
         total_prims += (uint32_t)cJSON_GetArraySize(
-            cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(c->meshes, (int)m), "primitives"));
+            cJSON_GetObjectItemCaseSensitive(c->mesh_at[m], "primitives"));
     gdr_progress progress;
     gdr_progress_begin(&progress, "import", total_prims, c->no_progress);
     for (uint32_t r = 0; r < root_count && status == GDR_OK; r++) {
@@ -793,7 +876,7 @@ static gdr_status walk_nodes(gltf_ctx *c, const uint32_t *roots, uint32_t root_c
             node_visit visit = stack[--top];
             char place[48];
             snprintf(place, sizeof place, "nodes[%u]", visit.node);
-            const cJSON *node = cJSON_GetArrayItem(c->nodes, (int)visit.node);
+            const cJSON *node = c->node_at[visit.node];
             gdr_mat4 local;
             uint32_t mesh = GDR_NO_INDEX, camera = GDR_NO_INDEX, child_count = 0;
             const cJSON *children = NULL;
@@ -820,7 +903,8 @@ static gdr_status walk_nodes(gltf_ctx *c, const uint32_t *roots, uint32_t root_c
                 if (status == GDR_OK)
                     status = convert_mesh(c, mesh, &progress, &converted);
                 if (status == GDR_OK)
-                    status = inst ? gpu_instancing(c, inst, place, mesh, global) : add_instances(c, mesh, global);
+                    status = inst ? gpu_instancing(c, inst, place, mesh, global)
+                                  : add_instances(c, mesh, global, place, 0);
             }
             if (status == GDR_OK && camera != GDR_NO_INDEX)
                 status = add_camera(c, camera, place, global);
@@ -872,7 +956,7 @@ static gdr_status load_scene(gltf_ctx *c)
             return gltf_fail(c, GDR_ERROR_OUT_OF_MEMORY, "out of memory");
         }
         for (uint32_t n = 0; n < c->node_count; n++) {
-            const cJSON *children = cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(c->nodes, (int)n), "children");
+            const cJSON *children = cJSON_GetObjectItemCaseSensitive(c->node_at[n], "children");
             for (const cJSON *ch = cJSON_IsArray(children) ? children->child : NULL; ch; ch = ch->next)
                 if (cJSON_IsNumber(ch) && ch->valuedouble >= 0 && ch->valuedouble < c->node_count)
                     is_child[(uint32_t)ch->valuedouble] = 1;
@@ -887,7 +971,7 @@ static gdr_status load_scene(gltf_ctx *c)
         if (scene == GDR_NO_INDEX)
             scene = 0;
         snprintf(place, sizeof place, "scenes[%u]", scene);
-        const cJSON *json = cJSON_GetArrayItem(c->scenes, (int)scene), *nodes = NULL;
+        const cJSON *json = c->scene_at[scene], *nodes = NULL;
         uint32_t count = 0;
         status = gltf_get_array(c, json, "nodes", place, &nodes, &count);
         if (status != GDR_OK)
@@ -913,6 +997,28 @@ static gdr_status load_scene(gltf_ctx *c)
 
 /* --- entry points ---------------------------------------------------------------------------- */
 
+/* How deeply arrays and objects are nested at byte `end` of JSON text (strings skipped). */
+static int json_depth(const char *json, size_t end)
+{
+    int depth = 0, in_string = 0;
+    for (size_t i = 0; i < end; i++) {
+        char ch = json[i];
+        if (in_string) {
+            if (ch == '\\')
+                i++;
+            else if (ch == '"')
+                in_string = 0;
+        } else if (ch == '"') {
+            in_string = 1;
+        } else if (ch == '[' || ch == '{') {
+            depth++;
+        } else if ((ch == ']' || ch == '}') && depth > 0) {
+            depth--;
+        }
+    }
+    return depth;
+}
+
 static gdr_status import_document(gltf_ctx *c, const uint8_t *data, size_t size)
 {
     const char *json = (const char *)data;
@@ -930,6 +1036,9 @@ static gdr_status import_document(gltf_ctx *c, const uint8_t *data, size_t size)
         uint32_t line = 1;
         for (size_t i = 0; i < offset; i++)
             line += json[i] == '\n';
+        if (json_depth(json, offset) >= CJSON_NESTING_LIMIT)
+            return gltf_fail(c, GDR_ERROR_PARSE, "JSON nested deeper than %d arrays and objects at line %u (byte %zu)",
+                             CJSON_NESTING_LIMIT, line, offset);
         return gltf_fail(c, GDR_ERROR_PARSE, "JSON syntax error at line %u (byte %zu)", line, offset);
     }
     if (!cJSON_IsObject(c->root))
@@ -938,15 +1047,20 @@ static gdr_status import_document(gltf_ctx *c, const uint8_t *data, size_t size)
     gdr_status status = check_asset_and_extensions(c);
     if (status == GDR_OK)
         status = check_extension_objects(c, c->root, place, 0, sizeof place);
-    struct { const char *key; cJSON **array; uint32_t *count; } tops[] = {
-        {"accessors", &c->accessors, &c->accessor_count},   {"bufferViews", &c->buffer_views, &c->view_count},
-        {"buffers", &c->buffers_json, &c->buffer_count},     {"meshes", &c->meshes, &c->mesh_count},
-        {"nodes", &c->nodes, &c->node_count},                {"materials", &c->materials, &c->material_count},
-        {"textures", &c->textures, &c->texture_count},       {"images", &c->images, &c->image_count},
-        {"cameras", &c->cameras, &c->camera_count},          {"scenes", &c->scenes, &c->scene_count},
+    struct { const char *key; cJSON **array; uint32_t *count; const cJSON ***items; } tops[] = {
+        {"accessors", &c->accessors, &c->accessor_count, &c->accessor_at},
+        {"bufferViews", &c->buffer_views, &c->view_count, &c->view_at},
+        {"buffers", &c->buffers_json, &c->buffer_count, &c->buffer_at},
+        {"meshes", &c->meshes, &c->mesh_count, &c->mesh_at},
+        {"nodes", &c->nodes, &c->node_count, &c->node_at},
+        {"materials", &c->materials, &c->material_count, &c->material_at},
+        {"textures", &c->textures, &c->texture_count, &c->texture_at},
+        {"images", &c->images, &c->image_count, &c->image_at},
+        {"cameras", &c->cameras, &c->camera_count, &c->camera_at},
+        {"scenes", &c->scenes, &c->scene_count, &c->scene_at},
     };
     for (size_t i = 0; i < sizeof tops / sizeof tops[0] && status == GDR_OK; i++)
-        status = get_top_array(c, tops[i].key, tops[i].array, tops[i].count);
+        status = get_top_array(c, tops[i].key, tops[i].array, tops[i].count, tops[i].items);
     if (status != GDR_OK)
         return status;
     c->buffers = calloc(c->buffer_count + 1, sizeof *c->buffers);
@@ -975,11 +1089,16 @@ gdr_status gdr_import_gltf_memory(const void *data, size_t size, const char *nam
     gdr_error local_err;
     gltf_ctx c = {.name = name ? name : "(memory)", .base_dir = base_dir, .err = err ? err : &local_err,
                   .warnings = {options->warning, options->warning_user, 0}, .sources = options->sources,
-                  .no_progress = options->no_progress};
+                  .no_progress = options->no_progress, .allow_outside_files = options->allow_outside_files};
+    gdr_io_budget_init(&c.budget, &options->budget);
     gdr_status status = gdr_scene_create(&c.scene, c.err);
     if (status == GDR_OK)
         status = import_document(&c, data, size);
     cJSON_Delete(c.root);
+    const cJSON **items[] = {c.accessor_at, c.view_at, c.buffer_at, c.mesh_at, c.node_at, c.material_at,
+                             c.texture_at, c.image_at, c.camera_at, c.scene_at};
+    for (size_t i = 0; i < sizeof items / sizeof items[0]; i++)
+        free(items[i]);
     gltf_buffers_free(&c);
     free(c.mesh_first);
     free(c.prim_mesh);

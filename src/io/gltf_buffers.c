@@ -1,5 +1,8 @@
 /* glTF buffers, buffer views (including EXT_meshopt_compression) and accessors, every offset
  * and length checked against what is really there before it is used. */
+#define _XOPEN_SOURCE 700 /* realpath, strdup */
+#include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -128,6 +131,37 @@ static int hex_value(char ch)
     return -1;
 }
 
+/* An external file must lie inside the scene's folder: the URI (percent-decoded, `path` is the
+ * folder joined with it) is relative, has no '..' part, and resolves (symlinks followed) to a path
+ * under the folder's own resolved path; *path becomes that resolved path, which is what is opened.
+ * Hostile scenes otherwise read any file the user can (its bytes would end up in the cache). */
+static gdr_status confine_to_folder(gltf_ctx *c, const char *place, const char *uri, char **path)
+{
+    const char *relative = *path + strlen(c->base_dir);
+    int escapes = relative[0] == '/';
+    for (const char *part = relative; *part && !escapes; part = strchr(part, '/') ? strchr(part, '/') + 1 : "")
+        escapes = strncmp(part, "..", 2) == 0 && (part[2] == '/' || part[2] == 0);
+    if (escapes)
+        return gltf_fail(c, GDR_ERROR_UNSUPPORTED, "%s.uri: '%.64s' leaves the scene's folder (absolute or '..'); "
+                         "allow it with --allow-outside-files", place, uri);
+    char folder[PATH_MAX], resolved[PATH_MAX];
+    if (!realpath(c->base_dir[0] ? c->base_dir : ".", folder))
+        return gltf_fail(c, GDR_ERROR_IO, "%s.uri: the scene's folder cannot be resolved: %s", place, strerror(errno));
+    if (!realpath(*path, resolved))
+        return GDR_OK; /* nothing there to read: opening it says so */
+    size_t length = strlen(folder);
+    int inside = strncmp(resolved, folder, length) == 0 && (resolved[length] == '/' || strcmp(folder, "/") == 0);
+    if (!inside)
+        return gltf_fail(c, GDR_ERROR_UNSUPPORTED, "%s.uri: '%.64s' resolves outside the scene's folder (a symbolic "
+                         "link); allow it with --allow-outside-files", place, uri);
+    char *copy = strdup(resolved);
+    if (!copy)
+        return gltf_fail(c, GDR_ERROR_OUT_OF_MEMORY, "%s.uri: out of memory", place);
+    free(*path);
+    *path = copy;
+    return GDR_OK;
+}
+
 gdr_status gltf_load_uri(gltf_ctx *c, const char *uri, const char *place, uint8_t **out, size_t *size)
 {
     *out = NULL;
@@ -138,6 +172,10 @@ gdr_status gltf_load_uri(gltf_ctx *c, const char *uri, const char *place, uint8_
         if (!comma || base64 != comma - 7)
             return gltf_fail(c, GDR_ERROR_UNSUPPORTED, "%s.uri: only base64 data: URIs are supported", place);
         size_t length = strlen(comma + 1);
+        gdr_status status = gdr_io_budget_take(&c->budget, GDR_BUDGET_DECODED_BYTES, gdr_base64_decoded_max(length),
+                                               c->name, place, c->err);
+        if (status != GDR_OK)
+            return status;
         uint8_t *data = malloc(gdr_base64_decoded_max(length) + 1);
         if (!data)
             return gltf_fail(c, GDR_ERROR_OUT_OF_MEMORY, "%s.uri: out of memory", place);
@@ -175,7 +213,12 @@ gdr_status gltf_load_uri(gltf_ctx *c, const char *uri, const char *place, uint8_
     }
     path[n] = 0;
     gdr_error file_err;
-    gdr_status status = gdr_io_read_file(path, out, size, c->sources, &file_err);
+    gdr_status status = c->allow_outside_files ? GDR_OK : confine_to_folder(c, place, uri, &path);
+    if (status != GDR_OK) {
+        free(path);
+        return status;
+    }
+    status = gdr_io_read_file(path, out, size, c->sources, &file_err);
     free(path);
     if (status != GDR_OK)
         return gltf_fail(c, status, "%s.uri: %s", place, file_err.message);
@@ -191,7 +234,7 @@ gdr_status gltf_buffer_get(gltf_ctx *c, uint32_t index, const char *place, const
     if (b->state == 0) {
         char here[48];
         snprintf(here, sizeof here, "buffers[%u]", index);
-        const cJSON *json = cJSON_GetArrayItem(c->buffers_json, (int)index);
+        const cJSON *json = c->buffer_at[index];
         uint32_t byte_length = 0;
         const char *uri = NULL;
         gdr_status status = gltf_get_uint(c, json, "byteLength", here, 1, UINT32_MAX, &byte_length);
@@ -217,9 +260,13 @@ gdr_status gltf_buffer_get(gltf_ctx *c, uint32_t index, const char *place, const
             return gltf_fail(c, GDR_ERROR_PARSE, "%s: has no uri%s", here,
                              c->is_glb ? " and is not the GLB binary chunk" : "");
         }
-        if (available < byte_length)
+        if (available < byte_length) {
+            /* An image's failure is only a warning: the buffer may be asked for again. */
+            free(b->owned);
+            b->owned = NULL;
             return gltf_fail(c, GDR_ERROR_PARSE, "%s.byteLength: %u, but only %zu bytes are there", here,
                              byte_length, available);
+        }
         b->data = bytes;
         b->size = byte_length;
         b->state = 1;
@@ -263,6 +310,9 @@ static gdr_status decode_meshopt(gltf_ctx *c, const cJSON *ext, const char *plac
         return gltf_fail(c, GDR_ERROR_PARSE, "%s.byteLength: %u bytes at offset %u exceed buffer %u length %zu",
                          here, length, offset, buffer, size);
     uint64_t decoded = (uint64_t)count * stride;
+    status = gdr_io_budget_take(&c->budget, GDR_BUDGET_DECODED_BYTES, decoded, c->name, here, c->err);
+    if (status != GDR_OK)
+        return status;
     if (decoded != byte_length)
         return gltf_fail(c, GDR_ERROR_PARSE, "%s: count %u x byteStride %u differs from the bufferView "
                          "byteLength %u", here, count, stride, byte_length);
@@ -322,7 +372,7 @@ gdr_status gltf_view_get(gltf_ctx *c, uint32_t index, const char *place, const g
     if (v->state == 0) {
         char here[48];
         snprintf(here, sizeof here, "bufferViews[%u]", index);
-        const cJSON *json = cJSON_GetArrayItem(c->buffer_views, (int)index);
+        const cJSON *json = c->view_at[index];
         uint32_t buffer = 0, offset = 0, length = 0, stride = 0;
         gdr_status status = gltf_get_uint(c, json, "buffer", here, 1, UINT32_MAX, &buffer);
         if (status == GDR_OK)
@@ -440,7 +490,7 @@ static gdr_status accessor_locate(gltf_ctx *c, uint32_t index, const char *use, 
                          c->accessor_count);
     char here[48];
     snprintf(here, sizeof here, "accessors[%u]", index);
-    const cJSON *json = cJSON_GetArrayItem(c->accessors, (int)index);
+    const cJSON *json = c->accessor_at[index];
     uint32_t view = GDR_NO_INDEX, offset = 0, count = 0, ctype = 0;
     const char *type = NULL;
     const cJSON *normalized = cJSON_GetObjectItemCaseSensitive(json, "normalized");
@@ -490,6 +540,10 @@ gdr_status gltf_accessor_info_get(gltf_ctx *c, uint32_t index, const char *use, 
 {
     accessor_source src = {0};
     gdr_status status = accessor_locate(c, index, use, &src);
+    /* Elements no buffer backs are made from nothing: the caller allocates them next. */
+    if (status == GDR_OK && !src.data)
+        status = gdr_io_budget_take(&c->budget, GDR_BUDGET_DECODED_BYTES,
+                                    (uint64_t)src.info.count * src.info.components * 4, c->name, use, c->err);
     if (status == GDR_OK)
         *info = src.info;
     return status;

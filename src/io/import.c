@@ -77,7 +77,13 @@ static void warn(const gdr_load_options *o, const char *format, ...)
 static gdr_status finish_cache_read(const char *path, gdr_scene **out, gdr_pvs *pvs, gdr_pvs **out_pvs,
                                     gdr_error *err)
 {
-    gdr_status status = build_clusters(path, out, 0, 1, err);
+    gdr_status status = gdr_io_clean_unclustered_meshes(*out, path, err);
+    if (status != GDR_OK) {
+        gdr_scene_destroy(*out);
+        *out = NULL;
+    } else {
+        status = build_clusters(path, out, 0, 1, err);
+    }
     if (status == GDR_OK && out_pvs)
         *out_pvs = pvs;
     else
@@ -101,7 +107,8 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
         return status == GDR_OK ? finish_cache_read(path, out, pvs, out_pvs, err) : status;
     }
     gdr_import_options import = {.warning = options->warning, .warning_user = options->warning_user,
-                                 .no_progress = options->no_progress};
+                                 .no_progress = options->no_progress, .budget = options->budget,
+                                 .allow_outside_files = options->allow_outside_files};
     if (options->no_cache)
         return gdr_import_file(path, &import, out, NULL, err);
 
@@ -120,7 +127,8 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
         if (access(candidates[i], F_OK) != 0)
             continue;
         gdr_error cache_err;
-        if (gdr_cache_read(candidates[i], build_options, out, out_pvs ? &pvs : NULL, &cache_err) == GDR_OK)
+        if (gdr_io_cache_read_for(candidates[i], path, build_options, out, out_pvs ? &pvs : NULL, &cache_err) ==
+            GDR_OK)
             return finish_cache_read(candidates[i], out, pvs, out_pvs, err);
         if (!strstr(cache_err.message, ": stale: "))
             warn(options, "%s; rebuilding it", cache_err.message);

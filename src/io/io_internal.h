@@ -14,6 +14,16 @@
 /* Largest element count of an accessor that no buffer data backs (it would be all zeros). */
 #define GDR_IO_MAX_UNBACKED_ELEMENTS (1u << 24)
 
+/* Largest magnitude of a vertex coordinate an importer accepts (gdr/scene.h). */
+#define GDR_IO_MAX_COORDINATE GDR_MAX_COORDINATE
+/* A vertex used by more triangles than this is split into copies (gdr_io_split_shared_vertices). */
+#define GDR_IO_MAX_VERTEX_VALENCE 128u
+
+/* Opens a file for reading without blocking on a FIFO or a device: refuses anything that is not a
+ * regular file ("not a regular file") before reading a byte. *out_fd is the descriptor (blocking
+ * again), or -1 on failure. */
+gdr_status gdr_io_open_regular(const char *path, int *out_fd, gdr_error *err);
+
 /* Reads a whole file into a malloc'ed buffer (one extra NUL byte after the data). When sources
  * is not NULL, the file's identity is appended to it. */
 gdr_status gdr_io_read_file(const char *path, uint8_t **out_data, size_t *out_size, gdr_source_list *sources,
@@ -27,6 +37,54 @@ gdr_status gdr_io_source_add(gdr_source_list *list, const char *path, uint64_t s
 int gdr_io_stat(const char *path, uint64_t *size, int64_t *mtime_ns);
 
 uint64_t gdr_io_hash(const void *data, size_t size);
+
+/* What one import has used of its budget (gdr_budget). */
+typedef enum gdr_io_budget_kind {
+    GDR_BUDGET_TRIANGLES, GDR_BUDGET_INSTANCES, GDR_BUDGET_TEXTURE_PIXELS, GDR_BUDGET_DECODED_BYTES,
+    GDR_BUDGET_KIND_COUNT
+} gdr_io_budget_kind;
+
+typedef struct gdr_io_budget {
+    uint64_t limit[GDR_BUDGET_KIND_COUNT];
+    uint64_t used[GDR_BUDGET_KIND_COUNT];
+} gdr_io_budget;
+
+void gdr_io_budget_init(gdr_io_budget *b, const gdr_budget *limits);
+/* Takes `amount` of a budget, before allocating for it; over the limit, an error naming the file,
+ * the place, the budget and how to raise it (GDR_ERROR_CAPACITY). */
+gdr_status gdr_io_budget_take(gdr_io_budget *b, gdr_io_budget_kind kind, uint64_t amount, const char *name,
+                              const char *place, gdr_error *err);
+
+/* mesh_clean.c: positions all finite and within GDR_IO_MAX_COORDINATE, else an error naming the
+ * file (`name`), the place and the vertex. */
+gdr_status gdr_io_check_positions(const gdr_vec3 *positions, uint32_t count, const char *name, const char *place,
+                                  gdr_error *err);
+/* Removes, in place and in order, triangles with two corners at one position or zero area
+ * (*degenerate) and triangles that repeat an earlier one, corners in the same rotation order, by
+ * position (*duplicate); *index_count shrinks. Linear. Returns GDR_ERROR_OUT_OF_MEMORY or GDR_OK. */
+gdr_status gdr_io_drop_bad_triangles(const gdr_vec3 *positions, uint32_t vertex_count, uint32_t *indices,
+                                     uint32_t *index_count, uint32_t *degenerate, uint32_t *duplicate);
+/* Gives every block of GDR_IO_MAX_VERTEX_VALENCE uses of a vertex (in index order) beyond the first
+ * its own copy (same position, normal, uv): the arrays (malloc'ed; normals and uvs may be NULL) grow,
+ * *added copies. Returns GDR_ERROR_OUT_OF_MEMORY or GDR_OK. */
+gdr_status gdr_io_split_shared_vertices(gdr_vec3 **positions, gdr_vec3 **normals, gdr_vec2 **uvs,
+                                        uint32_t *vertex_count, uint32_t *indices, uint32_t index_count,
+                                        uint32_t *added);
+
+/* The same two steps for every mesh of a scene that has triangles but no clusters (a cache read
+ * without them): what gdr_scene_build_clusters then gets is clean. */
+gdr_status gdr_io_clean_unclustered_meshes(gdr_scene *scene, const char *name, gdr_error *err);
+
+/* An image's size from its header (PNG, JPEG, anything stb_image reads), without decoding it;
+ * refused when a side exceeds the decoder's limit. */
+gdr_status gdr_io_image_size(const void *data, size_t size, const char *name, uint32_t *width, uint32_t *height,
+                             gdr_error *err);
+
+/* gdr_cache_read for the cache of `source` (NULL: a cache read on its own): the cache must
+ * record that file as the first of its sources, with the same size and contents (its folder may
+ * have moved: the other sources are then looked for under the new folder), else it is stale. */
+gdr_status gdr_io_cache_read_for(const char *path, const char *source, const char *build_options, gdr_scene **out,
+                                 gdr_pvs **out_pvs, gdr_error *err);
 
 /* Warning sink of one import. */
 typedef struct gdr_io_warnings {

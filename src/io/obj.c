@@ -36,6 +36,7 @@ typedef struct obj_ctx {
     gdr_scene *scene;
     float_array v, vt, vn;
     obj_mesh mesh;
+    gdr_io_budget budget;
     uint32_t line;
     int warned_lines, warned_unknown;
 } obj_ctx;
@@ -111,6 +112,9 @@ static gdr_status parse_floats(obj_ctx *c, const char *p, const char *end, uint3
             return obj_fail(c, GDR_ERROR_PARSE, "%s: '%s' is not a number", keyword, buffer);
         if (!isfinite(value))
             return obj_fail(c, GDR_ERROR_PARSE, "%s: '%s' is not finite", keyword, buffer);
+        if (out == &c->v && fabsf(value) > GDR_IO_MAX_COORDINATE)
+            return obj_fail(c, GDR_ERROR_PARSE, "v: '%s' is beyond the %g limit on coordinates", buffer,
+                            GDR_IO_MAX_COORDINATE);
         values[got++] = value;
         p += length;
     }
@@ -131,7 +135,7 @@ static gdr_status corner_index(obj_ctx *c, obj_corner k, uint32_t *out)
 {
     obj_mesh *m = &c->mesh;
     if ((uint64_t)(m->corner_count + 1) * 2 > m->table_size) {
-        uint32_t size = m->table_size ? m->table_size * 2 : 1024;
+        uint32_t size = m->table_size ? m->table_size * 2 : 64;
         if (size == 0 || size > (1u << 30))
             return obj_fail(c, GDR_ERROR_CAPACITY, "more than 2^29 distinct vertices in one group");
         uint32_t *table = calloc(size, sizeof(uint32_t));
@@ -226,6 +230,11 @@ static gdr_status parse_face(obj_ctx *c, const char *p, const char *end)
             first = index;
         else if (n >= 2) {
             obj_mesh *m = &c->mesh;
+            status = gdr_io_budget_take(&c->budget, GDR_BUDGET_TRIANGLES, 1, c->name, "f", c->err);
+            if (status != GDR_OK)
+                return obj_fail(c, status, "%u triangles exceed the budget of %llu; raise it with --budget "
+                                "triangles=N", (unsigned)(c->budget.used[GDR_BUDGET_TRIANGLES] + 1),
+                                (unsigned long long)c->budget.limit[GDR_BUDGET_TRIANGLES]);
             if (!grow32((void **)&m->indices, &m->index_capacity, (size_t)m->index_count + 3, sizeof(uint32_t)))
                 return obj_fail(c, GDR_ERROR_OUT_OF_MEMORY, "out of memory");
             m->indices[m->index_count++] = first;
@@ -237,6 +246,27 @@ static gdr_status parse_face(obj_ctx *c, const char *p, const char *end)
     }
     if (n < 3)
         gdr_io_warn(&c->warnings, "%s:%u: face with %u corners skipped", c->name, c->line, n);
+    return GDR_OK;
+}
+
+/* Degenerate and duplicate faces dropped, over-shared vertices split (mesh_clean.c). */
+static gdr_status clean_group(obj_ctx *c, gdr_vec3 **positions, gdr_vec3 **normals, gdr_vec2 **uvs,
+                              uint32_t *vertex_count)
+{
+    obj_mesh *m = &c->mesh;
+    uint32_t before = m->index_count / 3, degenerate, duplicate, added;
+    gdr_status status = gdr_io_drop_bad_triangles(*positions, *vertex_count, m->indices, &m->index_count,
+                                                  &degenerate, &duplicate);
+    if (status == GDR_OK)
+        status = gdr_io_split_shared_vertices(positions, normals, uvs, vertex_count, m->indices, m->index_count,
+                                              &added);
+    if (status != GDR_OK)
+        return obj_fail(c, status, "out of memory");
+    /* Zero-area faces draw nothing and are common in real files: dropped silently. */
+    if (duplicate || (degenerate && m->index_count == 0))
+        gdr_io_warn(&c->warnings, "%s: group '%s' ending at line %u: %u of %u faces dropped (%u degenerate, %u "
+                    "duplicate)", c->name, m->name[0] ? m->name : "obj", c->line, degenerate + duplicate, before,
+                    degenerate, duplicate);
     return GDR_OK;
 }
 
@@ -265,23 +295,37 @@ static gdr_status flush_mesh(obj_ctx *c)
                     normals[i] = length > 1e-12f ? gdr_vec3_scale(nv, 1.0f / length) : (gdr_vec3){0, 1, 0};
                 }
             }
-            uint32_t mesh_index;
-            status = gdr_scene_add_mesh(c->scene, m->name[0] ? m->name : "obj", positions, normals, uvs,
-                                        m->corner_count, m->indices, m->index_count, &mesh_index, c->err);
+            uint32_t mesh_index, vertex_count = m->corner_count;
+            status = clean_group(c, &positions, &normals, &uvs, &vertex_count);
+            if (status == GDR_OK && m->index_count == 0)
+                goto flushed;
+            if (status == GDR_OK)
+                status = gdr_io_budget_take(&c->budget, GDR_BUDGET_INSTANCES, 1, c->name, "g", c->err);
+            if (status == GDR_OK)
+                status = gdr_scene_add_mesh(c->scene, m->name[0] ? m->name : "obj", positions, normals, uvs,
+                                            vertex_count, m->indices, m->index_count, &mesh_index, c->err);
             if (status == GDR_OK) {
                 gdr_instance instance = {.transform = gdr_mat4_identity(), .mesh = mesh_index,
                                          .material = GDR_NO_INDEX, .color = {1, 1, 1, 1}};
                 status = gdr_scene_add_instance(c->scene, &instance, c->err);
             }
         }
+    flushed:
         free(positions);
         free(normals);
         free(uvs);
     }
+    /* Emptying the corner table costs its size: a table much larger than the group it served is
+     * dropped instead, so that many small groups after a large one stay linear. */
+    if (m->table && m->table_size > 8 * (uint64_t)m->corner_count + 1024) {
+        free(m->table);
+        m->table = NULL;
+        m->table_size = 0;
+    } else if (m->table) {
+        memset(m->table, 0, sizeof(uint32_t) * m->table_size);
+    }
     m->corner_count = m->index_count = 0;
     m->missing_normal = 0;
-    if (m->table)
-        memset(m->table, 0, sizeof(uint32_t) * m->table_size);
     return status;
 }
 
@@ -336,6 +380,7 @@ gdr_status gdr_import_obj_memory(const void *data, size_t size, const char *name
     gdr_error local_err;
     obj_ctx c = {.name = name ? name : "(memory)", .err = err ? err : &local_err,
                  .warnings = {options->warning, options->warning_user, 0}};
+    gdr_io_budget_init(&c.budget, &options->budget);
     const char *text = data, *end = text + size;
     gdr_status status = gdr_scene_create(&c.scene, c.err);
     if (status == GDR_OK && size >= 2 && ((text[0] == '\xfe' && text[1] == '\xff') ||

@@ -105,9 +105,11 @@ gdr_status gdr_scene_add_mesh(gdr_scene *scene, const char *name, const gdr_vec3
                                  "mesh '%s': index %u (at %u) is out of range (vertex count %u)", name,
                                  indices[i], i, vertex_count);
     for (uint32_t v = 0; v < vertex_count; v++)
-        if (!isfinite(positions[v].x) || !isfinite(positions[v].y) || !isfinite(positions[v].z))
-            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "mesh '%s': position %u is not finite",
-                                 name, v);
+        if (!(fabsf(positions[v].x) <= GDR_MAX_COORDINATE) || !(fabsf(positions[v].y) <= GDR_MAX_COORDINATE) ||
+            !(fabsf(positions[v].z) <= GDR_MAX_COORDINATE))
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "mesh '%s': position %u (%g, %g, %g) is not "
+                                 "finite or beyond the %g limit on coordinates", name, v, positions[v].x,
+                                 positions[v].y, positions[v].z, GDR_MAX_COORDINATE);
     gdr_status status = reserve_one((void **)&scene->meshes, &scene->mesh_capacity, scene->mesh_count,
                                     sizeof(gdr_mesh), err);
     if (status != GDR_OK)

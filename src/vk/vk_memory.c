@@ -61,10 +61,21 @@ gdr_status gdr_vk_allocate(gdr_vk_allocator *allocator, VkMemoryRequirements req
     VkMemoryAllocateInfo info = {.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, .pNext = &flags,
                                  .allocationSize = size, .memoryTypeIndex = (uint32_t)type};
     gdr_vk_memory_block block = {.size = size, .type_index = (uint32_t)type};
+    /* A scene or render target too large for the device: said before asking, and after a refusal,
+     * with what is already held, so that the user knows which way to make it smaller. */
+    uint32_t heap = ctx->memory_properties.memoryTypes[type].heapIndex;
+    VkDeviceSize heap_size = ctx->memory_properties.memoryHeaps[heap].size;
+    if (size > heap_size)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "device memory: %llu MiB in one piece exceed the %llu MiB "
+                             "of memory heap %u (the scene or the render target is too large for this device)",
+                             (unsigned long long)(size >> 20), (unsigned long long)(heap_size >> 20), heap);
     VkResult result = vkAllocateMemory(ctx->device, &info, NULL, &block.memory);
     if (result != VK_SUCCESS)
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "device memory: allocating a %llu MiB block failed: %s",
-                             (unsigned long long)(size >> 20), gdr_vk_result_name(result));
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "device memory: allocating a %llu MiB block failed with "
+                             "%llu MiB already allocated (heap %u: %llu MiB): %s; the scene or the render target is "
+                             "too large for this device", (unsigned long long)(size >> 20),
+                             (unsigned long long)(allocator->bytes_allocated >> 20), heap,
+                             (unsigned long long)(heap_size >> 20), gdr_vk_result_name(result));
     if (ctx->memory_properties.memoryTypes[type].propertyFlags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT) {
         result = vkMapMemory(ctx->device, block.memory, 0, VK_WHOLE_SIZE, 0, &block.mapped);
         if (result != VK_SUCCESS) {

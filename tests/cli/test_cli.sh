@@ -100,8 +100,8 @@ expect 2 "zero quaternion" "$gdr" render demo --camera 0,0,0,0,0,0,0
 expect 2 "missing value" "$gdr" render demo --width
 expect 2 "unknown option" "$gdr" render demo --colour red
 expect 2 "camera index out of range" "$gdr" render demo:instances=10 $small --camera-index 3
-expect 1 "zero instances" "$gdr" render demo:instances=0 $small
-expect 1 "unknown demo option" "$gdr" render demo:size=3 $small
+expect 2 "zero instances" "$gdr" render demo:instances=0 $small
+expect 2 "unknown demo option" "$gdr" render demo:size=3 $small
 expect 1 "missing scene file" "$gdr" render "$work/does-not-exist.gltf" $small
 expect 1 "no such device" "$gdr" render demo:instances=10 $small --device 99
 expect 1 "no such device name" "$gdr" render demo:instances=10 $small --device "no such gpu"
@@ -133,11 +133,11 @@ expect 0 "info occlusion" "$gdr" info occlusion:hidden=100,visible=10
 grep -q '^cameras: *6$' "$work/stdout" || { echo "FAIL: info occlusion: $(cat "$work/stdout")"; failures=$((failures + 1)); }
 expect 0 "build lod-field" "$gdr" build lod-field:instances=5,triangles=2000 -o "$work/field.gdrc" --no-progress
 expect 0 "render the built lod-field" "$gdr" render "$work/field.gdrc" $tiny --validate
-expect 1 "lod-field triangles too few" "$gdr" render lod-field:triangles=10 $tiny
-expect 1 "lod-field spacing too small" "$gdr" info lod-field:spacing=1
-expect 1 "occlusion unknown option" "$gdr" info occlusion:walls=3
+expect 2 "lod-field triangles too few" "$gdr" render lod-field:triangles=10 $tiny
+expect 2 "lod-field spacing too small" "$gdr" info lod-field:spacing=1
+expect 2 "occlusion unknown option" "$gdr" info occlusion:walls=3
 grep -q 'seed, hidden, visible' "$work/stderr" || { echo "FAIL: occlusion option message: $(cat "$work/stderr")"; failures=$((failures + 1)); }
-expect 1 "occlusion zero hidden" "$gdr" build occlusion:hidden=0 -o "$work/bad.gdrc"
+expect 2 "occlusion zero hidden" "$gdr" build occlusion:hidden=0 -o "$work/bad.gdrc"
 }
 [ ! -e "$work/bad.gdrc" ] || { echo "FAIL: a failed build left a cache"; failures=$((failures + 1)); }
 

@@ -14,6 +14,8 @@
 
 #include "gdr/cull.h"
 #include "gdr/io.h"
+#include "fuzz_geometry.h"
+#include "io/io_internal.h"
 
 /* FNV-1a 64 over a PVS blob with its checksum field (offset 72) taken as zero (docs/CULLING.md). */
 static void fix_pvs_checksum(uint8_t *blob, size_t size)
@@ -94,6 +96,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             free(again);
         }
         gdr_pvs_destroy(pvs);
+        /* What loading a cache does next (import.c), then the DAG as `gdr build` would. */
+        if (gdr_io_clean_unclustered_meshes(scene, "fuzz.gdrc", &err) == GDR_OK)
+            fuzz_build_geometry(scene);
         gdr_scene_destroy(scene);
     }
     free(copy);

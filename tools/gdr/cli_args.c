@@ -115,3 +115,45 @@ bool cli_parse_raster(const char *option, const char *text, gdr_raster *out)
     *out = values[index];
     return true;
 }
+
+bool cli_parse_budget(const char *option, const char *text, gdr_budget *out)
+{
+    static const char *const keys[] = {"triangles", "instances", "pixels", "bytes"};
+    uint64_t *fields[] = {&out->triangles, &out->instances, &out->texture_pixels, &out->decoded_bytes};
+    const char *p = text;
+    while (*p) {
+        const char *equals = strchr(p, '='), *comma = strchr(p, ',');
+        const char *end = comma ? comma : p + strlen(p);
+        int key = -1;
+        for (int k = 0; k < 4 && equals && equals < end; k++)
+            if ((size_t)(equals - p) == strlen(keys[k]) && strncmp(p, keys[k], strlen(keys[k])) == 0)
+                key = k;
+        char number[32];
+        char *stop = NULL;
+        unsigned long long value = 0;
+        if (key >= 0 && (size_t)(end - equals - 1) < sizeof number && end > equals + 1 && equals[1] != '-' &&
+            equals[1] != '+') {
+            snprintf(number, sizeof number, "%.*s", (int)(end - equals - 1), equals + 1);
+            errno = 0;
+            value = strtoull(number, &stop, 10);
+        }
+        if (key < 0 || !stop || *stop || errno || value == 0) {
+            fprintf(stderr, "gdr: %s %s: expected KEY=N[,KEY=N...] with KEY triangles, instances, pixels or bytes "
+                    "and N a positive integer\n", option, text);
+            return false;
+        }
+        *fields[key] = value;
+        p = comma ? comma + 1 : end;
+    }
+    if (p == text) {
+        fprintf(stderr, "gdr: %s: expected KEY=N[,KEY=N...]\n", option);
+        return false;
+    }
+    return true;
+}
+
+int cli_load_failed(const char *spec, const gdr_error *err)
+{
+    fprintf(stderr, "gdr: %s\n", err->message);
+    return gdr_scene_spec_is_builtin(spec) && err->status == GDR_ERROR_INVALID_ARGUMENT ? 2 : 1;
+}

@@ -21,6 +21,12 @@ bool cli_parse_pipeline(const char *option, const char *text, gdr_pipeline *out)
 bool cli_parse_raster(const char *option, const char *text, gdr_raster *out);
 /* "px,py,pz,qx,qy,qz,qw": position and rotation quaternion (normalised; must not be zero). */
 bool cli_parse_camera(const char *option, const char *text, gdr_vec3 *position, gdr_quat *rotation);
+/* --budget "triangles=N,instances=N,pixels=N,bytes=N" (any of them, each a positive integer): the
+ * limits on what one untrusted file may make gdr allocate (docs/SECURITY.md). */
+bool cli_parse_budget(const char *option, const char *text, gdr_budget *out);
+/* Prints "gdr: MESSAGE" for a scene that did not load and returns the exit status: 2 (bad usage)
+ * for a built-in scene's options out of range, 1 otherwise. */
+int cli_load_failed(const char *spec, const gdr_error *err);
 /* Returns the option's value (argv[*i + 1]) and advances *i, or prints an error and returns NULL. */
 const char *cli_value(int argc, char **argv, int *i);
 

@@ -121,7 +121,11 @@ int gdr_cmd_bench(int argc, char **argv)
                 }
                 ok = cli_parse_pipeline(arg, item, &pipelines[pipeline_count++]);
             }
-            ok = ok && pipeline_count > 0;
+            if (ok && pipeline_count == 0) {
+                fprintf(stderr, "gdr: --pipelines '%s': no pipeline named (expected mesh, indirect or cpu, "
+                        "comma-separated)\n", value);
+                ok = false;
+            }
         }
         else {
             fprintf(stderr, "gdr bench: unknown option '%s' (see gdr --help)\n", arg);
@@ -149,7 +153,9 @@ int gdr_cmd_bench(int argc, char **argv)
         gdr_renderer_desc desc = {.width = width, .height = height, .device = device, .validate = validate,
                                   .busy_wait = true, .record_every_frame = record_every_frame};
         gdr_status loaded = scene_spec ? gdr_scene_load(scene_spec, NULL, &scene, &err) : gdr_scene_create_demo(&demo, &scene, &err);
-        if (loaded != GDR_OK || gdr_renderer_create(&desc, &renderer, &err) != GDR_OK ||
+        if (loaded != GDR_OK) {
+            result = cli_load_failed(scene_spec ? scene_spec : "demo", &err);
+        } else if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK ||
             gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK) {
             fprintf(stderr, "gdr: %s\n", err.message);
             result = 1;

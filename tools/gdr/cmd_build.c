@@ -5,6 +5,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "cli_args.h"
 #include "commands.h"
 #include "core/thread_pool.h"
 #include "gdr/cull.h"
@@ -12,7 +13,7 @@
 
 static void build_usage(void)
 {
-    fputs("usage: gdr build INPUT -o OUTPUT.gdrc [--pvs] [--no-progress]\n"
+    fputs("usage: gdr build INPUT -o OUTPUT.gdrc [--pvs] [--no-progress] [--budget KEY=N,...] [--allow-outside-files]\n"
           "  INPUT: a .gltf, .glb or .obj file, a .gdrc cache, or a built-in scene: 'demo', 'lod-field'\n"
           "         or 'occlusion', each with optional ':key=value,...' (see gdr --help)\n"
           "  --pvs: bake precomputed visibility (default options, every processor) into the cache\n",
@@ -47,7 +48,8 @@ static gdr_status bake_pvs(const gdr_scene *scene, gdr_pvs **out, gdr_error *err
 int gdr_cmd_build(int argc, char **argv)
 {
     const char *input = NULL, *output = NULL;
-    int no_progress = 0, pvs_wanted = 0;
+    int no_progress = 0, pvs_wanted = 0, allow_outside_files = 0;
+    gdr_budget budget = {0};
     for (int i = 1; i < argc; i++) {
         if ((strcmp(argv[i], "-o") == 0 || strcmp(argv[i], "--out") == 0) && i + 1 < argc) {
             output = argv[++i];
@@ -55,6 +57,12 @@ int gdr_cmd_build(int argc, char **argv)
             no_progress = 1;
         } else if (strcmp(argv[i], "--pvs") == 0) {
             pvs_wanted = 1;
+        } else if (strcmp(argv[i], "--allow-outside-files") == 0) {
+            allow_outside_files = 1;
+        } else if (strcmp(argv[i], "--budget") == 0 && i + 1 < argc) {
+            if (!cli_parse_budget(argv[i], argv[i + 1], &budget))
+                return 2;
+            i++;
         } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             build_usage();
             return 0;
@@ -77,7 +85,8 @@ int gdr_cmd_build(int argc, char **argv)
     gdr_pvs *pvs = NULL; /* a .gdrc input's precomputed visibility is carried over unless rebaked */
     int is_builtin = gdr_scene_spec_is_builtin(input);
     size_t length = strlen(input);
-    gdr_load_options load = {.no_cache = 1, .no_progress = no_progress};
+    gdr_load_options load = {.no_cache = 1, .no_progress = no_progress, .budget = budget,
+                             .allow_outside_files = allow_outside_files};
     if (is_builtin) {
         status = gdr_scene_load(input, &load, &scene, &err);
     } else if (length > 5 && strcmp(input + length - 5, ".gdrc") == 0) {
@@ -86,7 +95,8 @@ int gdr_cmd_build(int argc, char **argv)
             printf("pvs: kept from %s (%u cells, %u objects)\n", input, gdr_pvs_cell_count(pvs),
                    gdr_pvs_object_count(pvs));
     } else {
-        gdr_import_options import = {.no_progress = no_progress, .sources = &sources};
+        gdr_import_options import = {.no_progress = no_progress, .sources = &sources, .budget = budget,
+                                     .allow_outside_files = allow_outside_files};
         status = gdr_import_file(input, &import, &scene, NULL, &err);
     }
     if (status == GDR_OK && pvs_wanted) {
@@ -102,10 +112,9 @@ int gdr_cmd_build(int argc, char **argv)
         printf("%s: %u meshes, %u instances, %llu triangles, %u materials, %u textures, %u cameras\n", output,
                scene->mesh_count, scene->instance_count, (unsigned long long)gdr_scene_triangle_count(scene),
                scene->material_count, scene->texture_count, scene->camera_count);
-    else
-        fprintf(stderr, "gdr: %s\n", err.message);
+    int result = status == GDR_OK ? 0 : cli_load_failed(input, &err);
     gdr_pvs_destroy(pvs);
     gdr_source_list_free(&sources);
     gdr_scene_destroy(scene);
-    return status == GDR_OK ? 0 : 1;
+    return result;
 }

@@ -3,10 +3,16 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "cli_args.h"
 #include "commands.h"
 #include "gdr/cull.h"
 #include "gdr/io.h"
 #include "gdr/renderer.h"
+
+#define INFO_USAGE                                                                                       \
+    "usage: gdr info FILE|demo|lod-field|occlusion[:...] [--no-cache] [--cache-dir DIR] [--budget KEY=N,...]\n" \
+    "       [--allow-outside-files]\n"                                                                 \
+    "       gdr info --passes\n"
 
 static void count_warning(void *user, const char *message)
 {
@@ -30,16 +36,21 @@ int gdr_cmd_info(int argc, char **argv)
             options.no_cache = 1;
         } else if (strcmp(argv[i], "--cache-dir") == 0 && i + 1 < argc) {
             options.cache_dir = argv[++i];
+        } else if (strcmp(argv[i], "--allow-outside-files") == 0) {
+            options.allow_outside_files = 1;
+        } else if (strcmp(argv[i], "--budget") == 0 && i + 1 < argc) {
+            if (!cli_parse_budget(argv[i], argv[i + 1], &options.budget))
+                return 2;
+            i++;
         } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0 || argv[i][0] == '-' || input) {
-            fputs("usage: gdr info FILE|demo|lod-field|occlusion[:...] [--no-cache] [--cache-dir DIR]\n"
-                  "       gdr info --passes\n", stderr);
+            fputs(INFO_USAGE, stderr);
             return strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0 ? 0 : 2;
         } else {
             input = argv[i];
         }
     }
     if (!input) {
-        fputs("usage: gdr info FILE|demo|lod-field|occlusion[:...] [--no-cache] [--cache-dir DIR]\n", stderr);
+        fputs(INFO_USAGE, stderr);
         return 2;
     }
     gdr_error err = {0};
@@ -48,10 +59,8 @@ int gdr_cmd_info(int argc, char **argv)
     /* Files go the way gdr_scene_load sends them, asking for their cache's PVS too. */
     gdr_status status = gdr_scene_spec_is_builtin(input) ? gdr_scene_load(input, &options, &scene, &err)
                                                          : gdr_scene_load_file(input, &options, &scene, &pvs, &err);
-    if (status != GDR_OK) {
-        fprintf(stderr, "gdr: %s\n", err.message);
-        return 1;
-    }
+    if (status != GDR_OK)
+        return cli_load_failed(input, &err);
     uint64_t vertices = 0, unique_triangles = 0, clusters = 0, level0 = 0, cluster_triangles = 0;
     uint64_t cluster_vertices = 0, nodes = 0;
     uint32_t node_levels = 0;

@@ -52,6 +52,10 @@ static int parse_render_options(int argc, char **argv, render_options *o)
             o->load.no_cache = 1;
             continue;
         }
+        if (strcmp(arg, "--allow-outside-files") == 0) {
+            o->load.allow_outside_files = 1;
+            continue;
+        }
         if (!(value = cli_value(argc, argv, &i)))
             return 2;
         bool ok = true;
@@ -100,6 +104,8 @@ static int parse_render_options(int argc, char **argv, render_options *o)
             o->device = value;
         else if (strcmp(arg, "--cache-dir") == 0)
             o->load.cache_dir = value;
+        else if (strcmp(arg, "--budget") == 0)
+            ok = cli_parse_budget(arg, value, &o->load.budget);
         else {
             fprintf(stderr, "gdr render: unknown option '%s' (see gdr --help)\n", arg);
             return 2;
@@ -140,7 +146,7 @@ int gdr_cmd_render(int argc, char **argv)
     gdr_error err = {0};
     gdr_scene *scene = NULL;
     if (gdr_scene_load(o.scene, &o.load, &scene, &err) != GDR_OK)
-        return fail(&err);
+        return cli_load_failed(o.scene, &err);
     if (o.has_camera_index && o.camera_index >= scene->camera_count) {
         fprintf(stderr, "gdr: --camera-index %u: the scene has %u camera(s)\n", o.camera_index, scene->camera_count);
         gdr_scene_destroy(scene);

@@ -1,0 +1,85 @@
+#!/bin/sh
+# The gdr program with hostile files and output paths (docs/SECURITY.md): refusals with a message
+# and the documented exit status; --out/--stats/-o onto links, devices and FIFOs.
+# usage: test_hostile_cli.sh GDR_BINARY WORK_DIR
+set -u
+gdr=$1
+work=$2
+rm -rf "$work" && mkdir -p "$work/scene" "$work/outside"
+failures=0
+
+# expect STATUS DESCRIPTION PATTERN -- COMMAND...: the exit status, and PATTERN (grep -E) in stderr.
+expect() {
+    want=$1 what=$2 pattern=$3
+    shift 3
+    timeout 20 "$@" >"$work/stdout" 2>"$work/stderr"
+    got=$?
+    if [ "$got" != "$want" ]; then
+        echo "FAIL ($what): exit $got, expected $want: $*"; cat "$work/stderr"; failures=$((failures + 1))
+    elif [ -n "$pattern" ] && ! grep -Eq "$pattern" "$work/stderr"; then
+        echo "FAIL ($what): stderr lacks /$pattern/: $*"; cat "$work/stderr"; failures=$((failures + 1))
+    fi
+}
+check() { # check DESCRIPTION CONDITION...
+    what=$1; shift
+    "$@" || { echo "FAIL ($what)"; failures=$((failures + 1)); }
+}
+
+tiny="--width 32 --height 24"
+# Output targets: links followed, devices written in place, never replaced.
+# What /dev/stdout is, as a link of the test's own (a regression must not replace /dev/stdout).
+ln -s /proc/self/fd/1 "$work/stdout-link"
+# shellcheck disable=SC2086
+expect 0 "stats to stdout" "" "$gdr" render demo:instances=4 $tiny --stats "$work/stdout-link"
+check "stats JSON on stdout" grep -q '"instances_total"' "$work/stdout"
+check "the stdout link is still a link" test -L "$work/stdout-link"
+echo old > "$work/target.json" && ln -s target.json "$work/link.json"
+# shellcheck disable=SC2086
+expect 0 "stats to a symlink" "" "$gdr" render demo:instances=4 $tiny --stats "$work/link.json"
+check "the link is still a link" test -L "$work/link.json"
+check "its target holds the statistics" grep -q '"instances_total"' "$work/target.json"
+# Devices of the test's own (root can make them), so that a regression cannot replace /dev/null.
+if mknod "$work/null" c 1 3 2>/dev/null && mknod "$work/full" c 1 7 2>/dev/null; then
+    # shellcheck disable=SC2086
+    expect 0 "image to a null device" "" "$gdr" render demo:instances=4 $tiny --out "$work/null"
+    check "the null device is still a device" test -c "$work/null"
+    # shellcheck disable=SC2086
+    expect 1 "stats to a full device" "cannot write" "$gdr" render demo:instances=4 $tiny --stats "$work/full"
+    check "the full device is still a device" test -c "$work/full"
+fi
+mkfifo "$work/fifo"
+expect 1 "cache to a FIFO without a reader" "no reader" "$gdr" build demo:instances=4 -o "$work/fifo"
+check "the FIFO is still a FIFO" test -p "$work/fifo"
+ln -s built.gdrc "$work/cache-link.gdrc"
+expect 0 "cache through a symlink" "" "$gdr" build demo:instances=4 -o "$work/cache-link.gdrc"
+check "the cache link is still a link" test -L "$work/cache-link.gdrc"
+expect 0 "the cache it wrote reads back" "" "$gdr" info "$work/built.gdrc"
+
+# Usage errors: exit 2 with a message.
+expect 2 "empty pipeline list" "no pipeline named" "$gdr" bench --pipelines ,
+expect 2 "a built-in scene's option out of range" "instances=0" "$gdr" info demo:instances=0
+expect 2 "budget of zero" "positive integer" "$gdr" info demo --budget triangles=0
+expect 2 "unknown budget" "KEY=N" "$gdr" info demo --budget widgets=3
+
+# Hostile files: exit 1 with a message naming the file and the place.
+printf 'v 0x1p127 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\n' > "$work/huge.obj"
+expect 1 "huge coordinate" "huge.obj:1: v: .* limit on coordinates" "$gdr" info "$work/huge.obj" --no-cache
+{
+    printf '{"asset":{"version":"2.0"},"extras":'
+    i=0; while [ $i -lt 1100 ]; do printf '['; i=$((i + 1)); done
+} > "$work/deep.gltf"
+expect 1 "deep JSON" "nested deeper than 1000" "$gdr" info "$work/deep.gltf" --no-cache
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n' > "$work/two.obj"
+expect 1 "triangle budget" "budget of 1.*--budget triangles=N" "$gdr" info "$work/two.obj" --no-cache --budget triangles=1
+expect 0 "triangle budget raised" "" "$gdr" info "$work/two.obj" --no-cache --budget triangles=2
+
+# A buffer outside the scene's folder: refused unless --allow-outside-files.
+printf 'AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA' | base64 -d > "$work/outside/secret.bin"
+printf '{"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":"../outside/secret.bin"}],"bufferViews":[{"buffer":0,"byteLength":36}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]}' > "$work/scene/escape.gltf"
+expect 1 "URI outside the folder" "leaves the scene's folder.*--allow-outside-files" "$gdr" info "$work/scene/escape.gltf"
+check "no cache written for the refused scene" test ! -e "$work/scene/escape.gltf.gdrc"
+expect 0 "URI outside the folder, allowed" "" "$gdr" info "$work/scene/escape.gltf" --allow-outside-files --no-cache
+check "one mesh" grep -q '^meshes: *1 ' "$work/stdout"
+
+echo "test_hostile_cli: $failures failure(s)"
+[ "$failures" = 0 ]

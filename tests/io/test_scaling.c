@@ -1,0 +1,261 @@
+/* Work proportional to input: for every dimension of a scene file that drives a loop or an
+ * allocation (triangles, repeated and degenerate faces, shared vertices, groups, nodes, meshes,
+ * materials, images, instances, a soup with an outlier), the file is generated at size N and 4N and taken through import,
+ * meshlets and the LOD DAG; the CPU time must grow less than 8-fold (linear: 4, n log n: about
+ * 4.5, quadratic: 16). Times are the best of three runs, measured side by side. */
+#define _POSIX_C_SOURCE 200809L
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "gdr/geometry.h"
+#include "gdr/io.h"
+#include "io/io_test_helpers.h"
+#include "test_util.h"
+
+typedef struct text {
+    char *data;
+    size_t size, capacity;
+} text;
+
+static void put(text *t, const char *format, ...) __attribute__((format(printf, 2, 3)));
+static void put(text *t, const char *format, ...)
+{
+    for (;;) {
+        va_list args;
+        va_start(args, format);
+        int n = vsnprintf(t->data + t->size, t->capacity - t->size, format, args);
+        va_end(args);
+        if (n >= 0 && (size_t)n < t->capacity - t->size) {
+            t->size += (size_t)n;
+            return;
+        }
+        t->capacity = t->capacity ? t->capacity * 2 : 1 << 16;
+        t->data = realloc(t->data, t->capacity);
+    }
+}
+
+/* --- generators: each writes a file of size n ---------------------------------------------------- */
+
+static void obj_duplicate_faces(text *t, uint32_t n)
+{
+    put(t, "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    for (uint32_t i = 0; i < n; i++)
+        put(t, "f 1 2 3\n");
+}
+
+static void obj_fan(text *t, uint32_t n)
+{
+    put(t, "v 0 0 0\n");
+    for (uint32_t i = 0; i <= n; i++)
+        put(t, "v %u 1 %u\n", i, i % 7);
+    for (uint32_t i = 0; i < n; i++)
+        put(t, "f 1 %u %u\n", i + 3, i + 2);
+}
+
+static void obj_groups(text *t, uint32_t n)
+{
+    /* A group of n faces first: its corner table must not be emptied again by each of the n small
+     * groups after it. */
+    for (uint32_t i = 0; i < n; i++)
+        put(t, "v %u 0 0\nv %u 1 0\nv %u 0 1\n", i, i, i);
+    for (uint32_t i = 0; i < n; i++)
+        put(t, "f %u %u %u\n", 3 * i + 1, 3 * i + 2, 3 * i + 3);
+    for (uint32_t i = 0; i < n; i++)
+        put(t, "g g%u\nf 1 2 3\n", i);
+}
+
+static void obj_grid(text *t, uint32_t n)
+{
+    uint32_t side = 2;
+    while (2 * side * side < n)
+        side++;
+    for (uint32_t y = 0; y <= side; y++)
+        for (uint32_t x = 0; x <= side; x++)
+            put(t, "v %u %u %u\n", x, y, (x * 7 + y * 13) % 5);
+    for (uint32_t y = 0; y < side; y++)
+        for (uint32_t x = 0; x < side; x++) {
+            uint32_t a = y * (side + 1) + x + 1, b = a + 1, c = a + side + 1, d = c + 1;
+            put(t, "f %u %u %u\nf %u %u %u\n", a, b, d, a, d, c);
+        }
+}
+
+static void obj_soup_and_outlier(text *t, uint32_t n)
+{
+    /* Separate triangles in a unit cube and one far away: meshoptimizer's kd-tree cannot split the
+     * centroids (meshlet_chunks.c). */
+    unsigned state = 7;
+    for (uint32_t i = 0; i < n; i++) {
+        float x = test_random(&state), y = test_random(&state), z = test_random(&state);
+        put(t, "v %g %g %g\nv %g %g %g\nv %g %g %g\n", x, y, z, x + 0.01f, y, z, x, y + 0.01f, z);
+    }
+    put(t, "v 1e9 0 0\nv 1e9 1 0\nv 1e9 0 1\n");
+    for (uint32_t i = 0; i <= n; i++)
+        put(t, "f %u %u %u\n", 3 * i + 1, 3 * i + 2, 3 * i + 3);
+}
+
+static const char *gltf_head = "{\"asset\":{\"version\":\"2.0\"},";
+/* One triangle: buffer 0, view 0, accessor 0 (positions). */
+static const char *gltf_triangle =
+    "\"buffers\":[{\"byteLength\":36,\"uri\":\"data:application/octet-stream;base64,"
+    "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],";
+
+static void gltf_zero_positions(text *t, uint32_t n)
+{
+    /* Every triangle's corners at the origin (an accessor without a bufferView), plus one real
+     * triangle so that there is a mesh. */
+    put(t, "%s%s\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+        "{\"componentType\":5126,\"count\":%u,\"type\":\"VEC3\"}],\"meshes\":[{\"primitives\":[{\"attributes\":"
+        "{\"POSITION\":0}},{\"attributes\":{\"POSITION\":1}}]}],\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]}",
+        gltf_head, gltf_triangle, 3 * n);
+}
+
+static void gltf_nodes(text *t, uint32_t n, int chain)
+{
+    put(t, "%s%s\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],\"nodes\":[", gltf_head, gltf_triangle);
+    for (uint32_t i = 0; i < n; i++) {
+        if (chain)
+            put(t, "%s{\"mesh\":0,\"translation\":[0,0,1]%s", i ? "," : "", i + 1 < n ? ",\"children\":[" : "}");
+        else
+            put(t, "%s{\"mesh\":0,\"translation\":[%u,0,0]}", i ? "," : "", i);
+        if (chain && i + 1 < n)
+            put(t, "%u]}", i + 1);
+    }
+    put(t, "],\"scenes\":[{\"nodes\":[");
+    for (uint32_t i = 0; i < (chain ? 1 : n); i++)
+        put(t, "%s%u", i ? "," : "", i);
+    put(t, "]}]}");
+}
+
+static void gltf_node_list(text *t, uint32_t n) { gltf_nodes(t, n, 0); }
+static void gltf_node_chain(text *t, uint32_t n) { gltf_nodes(t, n, 1); }
+
+static void gltf_unused_meshes_and_materials(text *t, uint32_t n)
+{
+    put(t, "%s%s\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}],"
+        "\"materials\":[", gltf_head, gltf_triangle);
+    for (uint32_t i = 0; i < n; i++)
+        put(t, "%s{}", i ? "," : "");
+    put(t, "],\"meshes\":[");
+    for (uint32_t i = 0; i < n; i++)
+        put(t, "%s{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":%u}]}", i ? "," : "", i);
+    put(t, "],\"nodes\":[{\"mesh\":%u}],\"scenes\":[{\"nodes\":[0]}]}", n - 1);
+}
+
+static void gltf_images(text *t, uint32_t n)
+{
+    /* n textures of one 1x1 PNG each, every one used by a material. */
+    static const uint8_t png[] = {
+        0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44, 0x52, 0x00,
+        0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x01, 0x08, 0x06, 0x00, 0x00, 0x00, 0x1f, 0x15, 0xc4, 0x89, 0x00,
+        0x00, 0x00, 0x0d, 0x49, 0x44, 0x41, 0x54, 0x78, 0x9c, 0x63, 0xf8, 0xcf, 0xc0, 0xf0, 0x1f, 0x00, 0x05,
+        0x00, 0x01, 0xff, 0x89, 0x99, 0x3d, 0x1d, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xae, 0x42,
+        0x60, 0x82};
+    char *uri = test_data_uri(png, sizeof png);
+    put(t, "%s\"images\":[", gltf_head);
+    for (uint32_t i = 0; i < n; i++)
+        put(t, "%s{\"uri\":\"%s\"}", i ? "," : "", uri);
+    put(t, "],\"textures\":[");
+    for (uint32_t i = 0; i < n; i++)
+        put(t, "%s{\"source\":%u}", i ? "," : "", i);
+    put(t, "],\"materials\":[");
+    for (uint32_t i = 0; i < n; i++)
+        put(t, "%s{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":%u}}}", i ? "," : "", i);
+    put(t, "]}");
+    free(uri);
+}
+
+static void gltf_gpu_instances(text *t, uint32_t n)
+{
+    put(t, "%s\"extensionsUsed\":[\"EXT_mesh_gpu_instancing\"],%s\"accessors\":[{\"bufferView\":0,"
+        "\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},{\"componentType\":5126,\"count\":%u,\"type\":"
+        "\"VEC3\"}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],\"nodes\":[{\"mesh\":0,"
+        "\"extensions\":{\"EXT_mesh_gpu_instancing\":{\"attributes\":{\"TRANSLATION\":1}}}}],"
+        "\"scenes\":[{\"nodes\":[0]}]}", gltf_head, gltf_triangle, n);
+}
+
+/* --- measurement ------------------------------------------------------------------------------ */
+
+typedef struct dimension {
+    const char *name;
+    int gltf;
+    uint32_t n; /* the smaller size; the larger is 4n */
+    void (*generate)(text *t, uint32_t n);
+} dimension;
+
+static double cpu_seconds(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static void ignore_warning(void *user, const char *message)
+{
+    (void)user;
+    (void)message;
+}
+
+/* Import, meshlets and DAG of one generated file; returns CPU seconds, or -1 on failure. */
+static double run(const dimension *d, const text *t)
+{
+    gdr_import_options o = {.warning = ignore_warning, .no_progress = 1};
+    gdr_lod_options lod = {.thread_count = 1, .no_progress = 1};
+    gdr_scene *s = NULL;
+    gdr_error err = {0};
+    double start = cpu_seconds();
+    gdr_status status = d->gltf ? gdr_import_gltf_memory(t->data, t->size, d->name, NULL, &o, &s, NULL, &err)
+                                : gdr_import_obj_memory(t->data, t->size, d->name, &o, &s, NULL, &err);
+    if (status == GDR_OK)
+        status = gdr_scene_build_lod(s, &lod, NULL, &err);
+    double seconds = cpu_seconds() - start;
+    gdr_scene_destroy(s);
+    if (status != GDR_OK)
+        fprintf(stderr, "%s: %s\n", d->name, err.message);
+    return status == GDR_OK ? seconds : -1.0;
+}
+
+int main(void)
+{
+    const dimension dimensions[] = {
+        {"obj: repeated face", 0, 20000, obj_duplicate_faces},
+        {"obj: fan around one vertex", 0, 10000, obj_fan},
+        {"obj: groups after a large one", 0, 20000, obj_groups},
+        {"obj: grid (triangles)", 0, 20000, obj_grid},
+        {"obj: soup and one far triangle", 0, 8000, obj_soup_and_outlier},
+        {"gltf: zero positions", 1, 20000, gltf_zero_positions},
+        {"gltf: node list", 1, 5000, gltf_node_list},
+        {"gltf: node chain", 1, 5000, gltf_node_chain},
+        {"gltf: meshes and materials", 1, 5000, gltf_unused_meshes_and_materials},
+        {"gltf: images", 1, 2000, gltf_images},
+        {"gltf: gpu instances", 1, 50000, gltf_gpu_instances},
+    };
+    printf("%-32s %10s %10s %10s %7s\n", "dimension", "n", "t(n) ms", "t(4n) ms", "ratio");
+    for (size_t i = 0; i < sizeof dimensions / sizeof dimensions[0]; i++) {
+        const dimension *d = &dimensions[i];
+        text small = {0}, large = {0};
+        d->generate(&small, d->n);
+        d->generate(&large, 4 * d->n);
+        double best[2] = {1e9, 1e9};
+        for (int repeat = 0; repeat < 3; repeat++)
+            for (int k = 0; k < 2; k++) {
+                double s = run(d, k ? &large : &small);
+                CHECK(s >= 0);
+                if (s >= 0 && s < best[k])
+                    best[k] = s;
+            }
+        /* A floor of 2 ms under the small run keeps timer noise out of the ratio. */
+        double ratio = best[1] / (best[0] > 0.002 ? best[0] : 0.002);
+        printf("%-32s %10u %10.2f %10.2f %7.2f\n", d->name, d->n, best[0] * 1e3, best[1] * 1e3, ratio);
+        if (!(ratio < 8.0))
+            fprintf(stderr, "%s: 4x the input took %.1fx the time (super-linear)\n", d->name, ratio);
+        CHECK(ratio < 8.0);
+        free(small.data);
+        free(large.data);
+    }
+    return test_finish("test_scaling");
+}
