@@ -153,7 +153,7 @@ int gdr_cmd_bench(int argc, char **argv)
         gdr_demo_desc demo = {.instances = sizes[s]};
         gdr_renderer_desc desc = {.width = width, .height = height, .device = device, .validate = validate,
                                   .busy_wait = true, .record_every_frame = record_every_frame};
-        gdr_status loaded = scene_spec ? gdr_scene_load(scene_spec, &scene, &err) : gdr_scene_create_demo(&demo, &scene, &err);
+        gdr_status loaded = scene_spec ? gdr_scene_load(scene_spec, NULL, &scene, &err) : gdr_scene_create_demo(&demo, &scene, &err);
         if (loaded != GDR_OK) {
             result = cli_load_failed(scene_spec ? scene_spec : "demo", &err);
         } else if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK ||

@@ -145,7 +145,7 @@ int gdr_cmd_render(int argc, char **argv)
         return usage;
     gdr_error err = {0};
     gdr_scene *scene = NULL;
-    if (gdr_scene_load_ex(o.scene, &o.load, &scene, &err) != GDR_OK)
+    if (gdr_scene_load(o.scene, &o.load, &scene, &err) != GDR_OK)
         return cli_load_failed(o.scene, &err);
     if (o.has_camera_index && o.camera_index >= scene->camera_count) {
         fprintf(stderr, "gdr: --camera-index %u: the scene has %u camera(s)\n", o.camera_index, scene->camera_count);
