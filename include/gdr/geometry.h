@@ -268,6 +268,12 @@ GDR_API gdr_status gdr_mesh_clusters_build_hierarchy(gdr_mesh_clusters *clusters
  * to `what` (at most what_size bytes) and returns 0. */
 GDR_API int gdr_mesh_clusters_check_hierarchy(const gdr_mesh_clusters *clusters, char *what, size_t what_size);
 
+/* A sphere (centre xyz, radius w) containing every sphere of the list: the centre of their bounding
+ * box, the radius computed in double and rounded up, with a relative slack of 1e-6, so that
+ * containment survives float evaluation of the distances. The LOD DAG's and the hierarchy's
+ * spheres are made with it; so are the renderer's bounds over several groups. count 0: all zero. */
+GDR_API gdr_vec4 gdr_lod_enclosing_sphere(const gdr_vec4 *spheres, size_t count);
+
 #ifdef __cplusplus
 }
 #endif

@@ -156,7 +156,7 @@ static void check_cuts(void)
 {
     gdr_error err = {0};
     gdr_scene *scenes[2] = {blob_scene(4, 24), NULL};
-    CHECK(gdr_scene_load("demo:instances=150,seed=11", &scenes[1], &err) == GDR_OK);
+    CHECK(gdr_scene_load("demo:instances=150,seed=11", NULL, &scenes[1], &err) == GDR_OK);
     const char *names[2] = {"blob row", "demo"};
     for (int s = 0; s < 2; s++) {
         gdr_scene *scene = scenes[s];

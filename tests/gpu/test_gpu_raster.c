@@ -167,7 +167,7 @@ static gdr_scene *load(const char *spec)
     gdr_error err = {0};
     gdr_scene *scene = NULL;
     gdr_load_options options = {.no_cache = 1, .no_progress = 1};
-    if (gdr_scene_load_ex(spec, &options, &scene, &err) != GDR_OK) {
+    if (gdr_scene_load(spec, &options, &scene, &err) != GDR_OK) {
         fprintf(stderr, "%s: %s\n", spec, err.message);
         CHECK(false);
         return NULL;
