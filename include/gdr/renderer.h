@@ -114,11 +114,13 @@ typedef struct gdr_frame_desc {
      * DAG (gdr/geometry.h, "LOD hierarchy"), testing nodes by LOD error, frustum and (late phase)
      * occlusion, instead of testing every cluster of the DAG (OFF). DEFAULT: on. The cut is the same. */
     gdr_cull_mode lod_hierarchy;
-    /* Two-phase occlusion culling against the depth pyramid (issue 6; indirect pipeline: instances,
-     * mesh pipeline: instances and clusters; DEFAULT: on; off when cull is off). Conservative: the
-     * image is the same with it off. The history it keeps between frames is discarded when the
-     * pipeline changes and on a camera cut (the caller says so: the frame after a jump, a teleport,
-     * a new shot); without history everything goes through the late phase's test. */
+    /* Two-phase occlusion culling against the depth pyramid (indirect pipeline: instances, mesh
+     * pipeline: instances, nodes and clusters; off when cull is off). DEFAULT: on for the indirect
+     * pipeline, off for the mesh pipeline, where the H100 measurements found it slower on every
+     * scene (docs/OCCLUSION.md). Conservative: the image is the same with it off. The history it
+     * keeps between frames is discarded when the pipeline changes and on a camera cut (the caller
+     * says so: the frame after a jump, a teleport, a new shot); without history everything goes
+     * through the late phase's test. */
     gdr_cull_mode occlusion;
     bool occlusion_camera_cut;
 } gdr_frame_desc;

@@ -322,11 +322,23 @@ static float samples_to_simplified(lod_scratch *s, uint32_t local_count)
 
 /* Distance (squared) from p to the level-0 triangles around position `position`: an upper bound of
  * the distance from p to S0. */
+/* A position's triangles are looked at up to this many: around a position of thousands (the centre
+ * of a fan) every probe would otherwise cost the whole fan. Fewer triangles only make a distance to
+ * them larger than the distance to the full-detail surface, so the bound stays a bound. */
+#define LOD_RING_LIMIT 64u
+#define LOD_WALK_LIMIT 32u
+
+static uint32_t ring_end(const lod_build *b, uint32_t position)
+{
+    uint32_t start = b->adjacency_start[position], end = b->adjacency_start[position + 1];
+    return end - start > LOD_RING_LIMIT ? start + LOD_RING_LIMIT : end;
+}
+
 static float to_full_detail_d2(const lod_build *b, uint32_t position, gdr_vec3 p)
 {
     float best = INFINITY;
     const gdr_vec3 *x = b->mesh->positions;
-    for (uint32_t k = b->adjacency_start[position]; k < b->adjacency_start[position + 1]; k++) {
+    for (uint32_t k = b->adjacency_start[position]; k < ring_end(b, position); k++) {
         const gdr_cluster *c = &b->clusters[b->adjacency[k] >> 7];
         const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(b->adjacency[k] & 127) * 3;
         const uint32_t *v = gdr_lod_cluster_vertices(b, c);
@@ -350,9 +362,12 @@ static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p)
 {
     uint32_t at = start;
     float best = position_d2(b, at, p);
-    for (;;) {
+    /* At most LOD_WALK_LIMIT steps: on a strip or a fan's rim a walk would cross the whole mesh one
+     * neighbour at a time. Where it stops short, the distance from there is only larger (a bound
+     * still), and a bound too loose sends the probe to the exact measure (probe_d2). */
+    for (uint32_t steps = 0; steps < LOD_WALK_LIMIT; steps++) {
         uint32_t from = at;
-        for (uint32_t k = b->adjacency_start[from]; k < b->adjacency_start[from + 1]; k++) {
+        for (uint32_t k = b->adjacency_start[from]; k < ring_end(b, from); k++) {
             const gdr_cluster *c = &b->clusters[b->adjacency[k] >> 7];
             const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(b->adjacency[k] & 127) * 3;
             const uint32_t *v = gdr_lod_cluster_vertices(b, c);
@@ -368,6 +383,7 @@ static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p)
         if (at == from)
             return at;
     }
+    return at;
 }
 
 static int compare_u32(const void *x, const void *y)
