@@ -227,7 +227,7 @@ static double run(const dimension *d, const text *t)
         s = NULL;
         start = cpu_seconds();
         if (status == GDR_OK)
-            status = gdr_cache_read(cache, NULL, &s, &err);
+            status = gdr_cache_read(cache, NULL, &s, NULL, &err);
     }
     double seconds = cpu_seconds() - start;
     gdr_scene_destroy(s);
