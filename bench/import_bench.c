@@ -1,4 +1,4 @@
-/* Import and cache benchmark (issue 3): import speed (MB/s, triangles/s) for large generated
+/* Import and cache benchmark: import speed (MB/s, triangles/s) for large generated
  * OBJ and GLB files and a real one, and cache load time against import time. Prints a table and
  * JSON. usage: import_bench [--grid N] [--dir DIR] [--repeat R] [--json FILE] */
 #include <stdio.h>

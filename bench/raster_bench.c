@@ -1,4 +1,4 @@
-/* Hybrid rasterisation (issue 8): throughput of each rasteriser and the frame time it buys.
+/* Hybrid rasterisation: throughput of each rasteriser and the frame time it buys.
  *
  * 1. Triangle fields: one grid of right triangles with legs of S pixels facing the camera and
  *    filling the view (2 * (W / S) * (H / S) triangles), for each S of --sizes, drawn by the mesh

@@ -39,7 +39,7 @@ typedef struct gdr_material {
     uint32_t base_color_texture;         /* texture index or GDR_NO_INDEX */
     uint32_t normal_texture;             /* recorded for later use, or GDR_NO_INDEX */
     uint32_t metallic_roughness_texture; /* recorded for later use, or GDR_NO_INDEX */
-    /* Additions (issue 3). A zero-initialised material keeps its old meaning: opaque,
+    /* Surface parameters the importers fill. A zero-initialised material means: opaque,
      * single-sided; metallic/roughness 0 unless an importer sets them. */
     float metallic_factor;
     float roughness_factor;
@@ -50,7 +50,7 @@ typedef struct gdr_material {
 
 typedef enum gdr_alpha_mode { GDR_ALPHA_OPAQUE = 0, GDR_ALPHA_MASK = 1, GDR_ALPHA_BLEND = 2 } gdr_alpha_mode;
 
-/* A decoded image: tightly packed RGBA8 rows, top row first (issue 3). */
+/* A decoded image: tightly packed RGBA8 rows, top row first. */
 typedef struct gdr_texture {
     char name[GDR_NAME_MAX];
     uint32_t width, height;
@@ -84,7 +84,7 @@ typedef struct gdr_scene {
     uint32_t instance_count, instance_capacity;
     gdr_camera *cameras;
     uint32_t camera_count, camera_capacity;
-    /* Additions (issue 3). */
+    /* Decoded images the materials index (base colour, normal, metallic-roughness). */
     gdr_texture *textures;
     uint32_t texture_count, texture_capacity;
     char *extensions; /* the source's extensionsUsed, comma-separated, or NULL */
@@ -128,7 +128,7 @@ typedef struct gdr_demo_desc {
 
 GDR_API gdr_status gdr_scene_create_demo(const gdr_demo_desc *desc, gdr_scene **out, gdr_error *err);
 
-/* --- LOD field (issue 5): many copies of one dense mesh, from near to far ---------------------
+/* --- LOD field: many copies of one dense mesh, from near to far -------------------------------
  *
  * One dense closed mesh, a bumpy (2, 3) torus knot named "torus_knot" (a welded tube: watertight,
  * every edge shared by exactly two triangles; bounding radius about 1 m), instanced `instances`
@@ -152,7 +152,7 @@ typedef struct gdr_lod_field_desc {
 
 GDR_API gdr_status gdr_scene_create_lod_field(const gdr_lod_field_desc *desc, gdr_scene **out, gdr_error *err);
 
-/* --- Occlusion scene (issue 6): a wall of buildings in front of many small objects -------------
+/* --- Occlusion scene: a wall of buildings in front of many small objects -----------------------
  *
  * Right-handed, Y up; the default camera stands at (0, 1.7, 0) looking down -Z. Instances, in
  * this order:

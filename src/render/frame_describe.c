@@ -131,9 +131,12 @@ static const char *phase_name(gdr_occlusion_phase phase)
 void gdr_frame_plan_describe(const gdr_frame_plan *plan, FILE *out)
 {
     const gdr_frame_config *c = &plan->config;
-    fprintf(out, "#### %s pipeline%s, occlusion %s%s%s\n\n", gdr_pipeline_name(c->pipeline),
+    fprintf(out, "#### %s pipeline%s, occlusion %s%s%s", gdr_pipeline_name(c->pipeline),
             c->pipeline != GDR_PIPELINE_MESH ? "" : c->visbuffer ? ", visibility buffer" : ", forward raster",
             c->occlusion ? "on" : "off", c->overdraw ? ", overdraw view" : "", c->updates ? ", instance updates" : "");
+    if (c->traversal_levels)
+        fprintf(out, ", LOD hierarchy of %u levels", c->traversal_levels);
+    fprintf(out, "\n\n");
     fprintf(out, "| # | pass | phase | timing | barrier before it | uses |\n|---|---|---|---|---|---|\n");
     for (uint32_t i = 0; i < plan->pass_count; i++) {
         const gdr_frame_pass *p = &plan->passes[i];

@@ -1,4 +1,4 @@
-/* The LOD field (issue 5): one dense closed mesh, copied from near to far in front of the camera,
+/* The LOD field: one dense closed mesh, copied from near to far in front of the camera,
  * so that one view needs every level of the LOD DAG. */
 #include <math.h>
 #include <stdlib.h>

@@ -1,4 +1,4 @@
-/* The occlusion scene (issue 6): a wall of buildings between the camera and thousands of small
+/* The occlusion scene: a wall of buildings between the camera and thousands of small
  * objects, with gaps, objects in front, and a camera path that cuts, turns and looks past the wall. */
 #include <math.h>
 #include <stdio.h>

@@ -295,7 +295,7 @@ static gdr_status create_device(gdr_vk_context *ctx, bool disable_mesh_shaders, 
                                             .drawIndirectCount = VK_TRUE, .bufferDeviceAddress = VK_TRUE,
                                             .scalarBlockLayout = VK_TRUE, .hostQueryReset = VK_TRUE,
                                             .samplerFilterMinmax = VK_TRUE,
-                                            /* the visibility buffer (issue 8), where the device has it */
+                                            /* the visibility buffer, where the device has it */
                                             .shaderBufferInt64Atomics = f12.shaderBufferInt64Atomics};
     ctx->has_buffer_int64_atomics = f12.shaderBufferInt64Atomics == VK_TRUE;
     VkPhysicalDeviceVulkan11Features e11 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES, .pNext = &e12,

@@ -1,4 +1,4 @@
-/* The LOD cut on the GPU (issue 5), on the default device (lavapipe in CI), validation on:
+/* The LOD cut on the GPU, on the default device (lavapipe in CI), validation on:
  *  - the clusters the task shaders select equal the CPU reference cut (geometry/lod_cut.h) for many
  *    cameras, thresholds and instance transforms, and the discrete depth cut exactly;
  *  - no cracks: a closed dense mesh rendered at several thresholds shows no background inside the

@@ -1,4 +1,4 @@
-/* The meshlet pipeline (issue 4) and the CPU-driven pipeline (issue 7) on the default device
+/* The meshlet pipeline and the CPU-driven pipeline on the default device
  * (lavapipe in CI), validation on:
  *  - culling at every level (instances, clusters by frustum and cone, triangles) never changes the
  *    image, for random cameras, cameras inside meshes and grazing views;

@@ -1,4 +1,4 @@
-/* Hybrid rasterisation (issue 8) on the default device (lavapipe in CI), validation on:
+/* Hybrid rasterisation on the default device (lavapipe in CI), validation on:
  *  - coverage rules: crafted triangles (edges through pixel centres, vertices on pixel centres, a
  *    fan around a sample, a jittered mesh with edges at every slope, slivers, sub-pixel triangles,
  *    back faces) are covered by the compute rasteriser exactly as by the hardware, pixel for pixel,

@@ -1,5 +1,5 @@
-/* The built-in scenes made for tests and benchmarks: "lod-field" (issue 5) and "occlusion"
- * (issue 6). Small sizes: the LOD DAG of the field's mesh costs about 0.2 s per 100k triangles. */
+/* The built-in scenes made for tests and benchmarks: "lod-field" and "occlusion".
+ * Small sizes: the LOD DAG of the field's mesh costs about 0.2 s per 100k triangles. */
 #include <stdlib.h>
 #include <string.h>
 
