@@ -1,10 +1,11 @@
 # The README's two commands: `make demo` and `make check`. CMake does the building underneath.
 BUILD_DIR ?= build
 ASAN_DIR ?= build-asan
+RELEASE_DIR ?= build-release
 JOBS ?= $(shell nproc)
 PREFIX ?= /usr/local
 
-.PHONY: all deps build demo check test test-asan install clean
+.PHONY: all deps build demo check test test-asan build-release build-release-clang pipeline-doc install clean
 
 all: build
 
@@ -20,8 +21,9 @@ demo: build
 	$(BUILD_DIR)/tools/gdr/gdr render demo --out demo.png --stats demo.json
 
 # The whole suite: every test on lavapipe with validation on, then the unit tests and the GPU paths
-# (test_gpu_sanitized) under ASan+UBSan.
-check: build test test-asan
+# (test_gpu_sanitized) under ASan+UBSan, then the Release configuration users build, compiled
+# (about a minute on 2 cores).
+check: build test test-asan build-release
 
 test:
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
@@ -31,8 +33,22 @@ test-asan: deps
 	cmake --build $(ASAN_DIR) -j $(JOBS)
 	cd $(ASAN_DIR) && ctest --output-on-failure -j $(JOBS) -L 'unit|sanitize'
 
+# docs/PIPELINE.md's printout of every frame configuration, regenerated from `gdr info --passes`.
+pipeline-doc: build
+	./scripts/update-pipeline-doc.sh $(BUILD_DIR)/tools/gdr/gdr
+
+# The Release build type with warnings as errors, compiled only: gcc warns at -O3 where it does not
+# at -O2. build-release-clang does the same with clang (CI runs both).
+build-release: deps
+	cmake -S . -B $(RELEASE_DIR) -DCMAKE_BUILD_TYPE=Release -DGDR_WERROR=ON -DGDR_BUILD_FUZZ=OFF
+	cmake --build $(RELEASE_DIR) -j $(JOBS)
+
+build-release-clang: deps
+	CC=clang cmake -S . -B $(RELEASE_DIR)-clang -DCMAKE_BUILD_TYPE=Release -DGDR_WERROR=ON -DGDR_BUILD_FUZZ=OFF
+	cmake --build $(RELEASE_DIR)-clang -j $(JOBS)
+
 install: build
 	cmake --install $(BUILD_DIR)
 
 clean:
-	rm -rf $(BUILD_DIR) $(ASAN_DIR)
+	rm -rf $(BUILD_DIR) $(ASAN_DIR) $(RELEASE_DIR) $(RELEASE_DIR)-clang

@@ -1,4 +1,4 @@
-/* CPU culling library benchmark (issue 7): 100k and 1M objects, octree vs brute force, 1 and 2
+/* CPU culling library benchmark: 100k and 1M objects, octree vs brute force, 1 and 2
  * threads. Prints a table and JSON. Usage: cull_bench [views] (default 24). */
 #include <stdio.h>
 #include <stdlib.h>

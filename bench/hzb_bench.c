@@ -1,4 +1,4 @@
-/* Depth pyramid (HZB) build time (issue 6), measured with timestamp queries around each build:
+/* Depth pyramid (HZB) build time, measured with timestamp queries around each build:
  * median, minimum and maximum of N builds per depth size, after warm-up builds, all in one command
  * buffer (each build waits for the previous one through its own barriers). Prints a table and JSON.
  * usage: hzb_bench [--device NAME|INDEX] [--runs N] [--sizes WxH,WxH,...] [--validate] [--json FILE]

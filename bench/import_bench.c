@@ -1,4 +1,4 @@
-/* Import and cache benchmark (issue 3): import speed (MB/s, triangles/s) for large generated
+/* Import and cache benchmark: import speed (MB/s, triangles/s) for large generated
  * OBJ and GLB files and a real one, and cache load time against import time. Prints a table and
  * JSON. usage: import_bench [--grid N] [--dir DIR] [--repeat R] [--json FILE] */
 #include <stdio.h>
@@ -118,8 +118,8 @@ static int measure(const char *label, const char *path, const char *dir, int rep
     char cache[4096];
     snprintf(cache, sizeof cache, "%s/%s.gdrc", dir, label);
     double t0 = now();
-    gdr_cache_source source = {gdr_cache_build_options(), NULL};
-    if (gdr_cache_write(cache, scene, &source, &err) != GDR_OK) {
+    gdr_cache_write_options plain_options = {.source = {gdr_cache_build_options(), NULL}};
+    if (gdr_cache_write(cache, scene, &plain_options, &err) != GDR_OK) {
         fprintf(stderr, "import_bench: %s\n", err.message);
         gdr_scene_destroy(scene);
         return 0;
@@ -130,7 +130,7 @@ static int measure(const char *label, const char *path, const char *dir, int rep
     r->cache_megabytes = (double)st.st_size / 1e6;
     for (int i = 0; i < repeat; i++) {
         t0 = now();
-        if (gdr_cache_read(cache, gdr_cache_build_options(), &scene, &err) != GDR_OK) {
+        if (gdr_cache_read(cache, gdr_cache_build_options(), &scene, NULL, &err) != GDR_OK) {
             fprintf(stderr, "import_bench: %s\n", err.message);
             return 0;
         }

@@ -45,7 +45,7 @@ int main(int argc, char **argv)
     gdr_scene *scene = NULL;
     gdr_renderer *renderer = NULL;
     double t0 = now_ms();
-    if (gdr_scene_load_ex(spec, &(gdr_load_options){.no_progress = 1}, &scene, &err) != GDR_OK) {
+    if (gdr_scene_load(spec, &(gdr_load_options){.no_progress = 1}, &scene, &err) != GDR_OK) {
         fprintf(stderr, "load_bench: %s\n", err.message);
         return 1;
     }

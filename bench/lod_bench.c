@@ -1,4 +1,4 @@
-/* LOD DAG build benchmark (issue 5): build throughput in input triangles per second with 1 and 2
+/* LOD DAG build benchmark: build throughput in input triangles per second with 1 and 2
  * threads, peak heap memory per input triangle and DAG triangles / input triangles, for a dense
  * procedural mesh (the displaced icosphere of the demo scene), the largest mesh of a real file and
  * that file's whole scene (gdr_scene_build_lod: small meshes are built side by side). Prints a

@@ -95,7 +95,7 @@ int main(int argc, char **argv)
     }
     gdr_scene *scene = NULL;
     gdr_error err = {0};
-    if (gdr_scene_load(spec, &scene, &err) != GDR_OK) {
+    if (gdr_scene_load(spec, NULL, &scene, &err) != GDR_OK) {
         fprintf(stderr, "lod_hierarchy_bench: %s\n", err.message);
         return 1;
     }

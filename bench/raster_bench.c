@@ -1,4 +1,4 @@
-/* Hybrid rasterisation (issue 8): throughput of each rasteriser and the frame time it buys.
+/* Hybrid rasterisation: throughput of each rasteriser and the frame time it buys.
  *
  * 1. Triangle fields: one grid of right triangles with legs of S pixels facing the camera and
  *    filling the view (2 * (W / S) * (H / S) triangles), for each S of --sizes, drawn by the mesh
@@ -250,7 +250,7 @@ static gdr_status run_scene(const options *o, scene_result *results, uint32_t *c
     gdr_load_options load = {.no_progress = 1};
     gdr_scene *scene = NULL;
     gdr_renderer *r = NULL;
-    gdr_status status = gdr_scene_load_ex(spec, &load, &scene, err);
+    gdr_status status = gdr_scene_load(spec, &load, &scene, err);
     if (status == GDR_OK)
         status = make_renderer(o, scene, &r, err);
     gdr_frame_desc frame = {.lod_error_px = o->lod_error};

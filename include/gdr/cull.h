@@ -1,4 +1,4 @@
-/* gdr cull: the CPU culling library (issue 7), in the style of UE5's scene visibility code.
+/* gdr cull: the CPU culling library, in the style of UE5's scene visibility code.
  *
  * No Vulkan here. Sections (grep for "--- "):
  *   --- frustum         planes from a view-projection matrix; sphere and box tests

@@ -1,4 +1,4 @@
-/* gdr geometry: a mesh as clusters (meshlets, issue 4) and the cluster LOD DAG over them (issue 5).
+/* gdr geometry: a mesh as clusters (meshlets) and the cluster LOD DAG over them.
  *
  * A cluster is a small piece of a mesh: at most GDR_CLUSTER_MAX_VERTICES vertices and
  * GDR_CLUSTER_MAX_TRIANGLES triangles whose corners are uint8 indices into the cluster's own
@@ -52,7 +52,7 @@ typedef struct gdr_cluster {
     uint32_t reserved;
 } gdr_cluster;
 
-/* A group of clusters of the LOD DAG (issue 5). */
+/* A group of clusters of the LOD DAG. */
 typedef struct gdr_cluster_group {
     gdr_vec4 sphere;        /* mesh space; contains the spheres of the groups its clusters came from */
     float error;            /* simplification error in mesh-space units; INFINITY for the root */
@@ -133,7 +133,7 @@ GDR_API gdr_status gdr_scene_build_clusters(gdr_scene *scene, const gdr_meshlet_
 
 GDR_API void gdr_mesh_clusters_free(gdr_mesh_clusters *clusters);
 
-/* --- LOD DAG (issue 5) -----------------------------------------------------------------------
+/* --- LOD DAG ---------------------------------------------------------------------------------
  *
  * gdr_mesh_build_lod_dag turns level 0 into a DAG (seed 004, Nanite): the current clusters are
  * partitioned into groups of neighbours holding about as many triangles as sixteen level-0 clusters
@@ -267,6 +267,12 @@ GDR_API gdr_status gdr_mesh_clusters_build_hierarchy(gdr_mesh_clusters *clusters
  * the stored floats). On a violation writes what and where
  * to `what` (at most what_size bytes) and returns 0. */
 GDR_API int gdr_mesh_clusters_check_hierarchy(const gdr_mesh_clusters *clusters, char *what, size_t what_size);
+
+/* A sphere (centre xyz, radius w) containing every sphere of the list: the centre of their bounding
+ * box, the radius computed in double and rounded up, with a relative slack of 1e-6, so that
+ * containment survives float evaluation of the distances. The LOD DAG's and the hierarchy's
+ * spheres are made with it; so are the renderer's bounds over several groups. count 0: all zero. */
+GDR_API gdr_vec4 gdr_lod_enclosing_sphere(const gdr_vec4 *spheres, size_t count);
 
 #ifdef __cplusplus
 }

@@ -92,36 +92,40 @@ typedef struct gdr_cache_source {
 
 /* Precomputed visibility (include/gdr/cull.h): baked offline for a scene's instances (object i =
  * instance i), it is stored in the cache next to the scene, not in gdr_scene (which stays plain
- * arrays with no culling dependency). Write it with gdr_cache_write_ex, get it back with
- * gdr_cache_read_ex or gdr_scene_load_file_ex. */
+ * arrays with no culling dependency). Write it with gdr_cache_write (options->pvs), get it back with
+ * gdr_cache_read or gdr_scene_load_file (out_pvs). */
 typedef struct gdr_pvs gdr_pvs;
 
-/* Writes scene to path through a temporary file in the same folder and a rename. */
-GDR_API gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_cache_source *source,
+/* What gdr_cache_write stores next to the scene; zero-initialise (or pass NULL): every field has a
+ * default. */
+typedef struct gdr_cache_write_options {
+    gdr_cache_source source; /* build options and source files; empty: none recorded, never stale */
+    const gdr_pvs *pvs;      /* NULL: no precomputed visibility. Otherwise its serialised form in the
+                                optional section 'PVIS'; it must have been baked for this scene
+                                (gdr_pvs_object_count(pvs) == scene->instance_count), else
+                                GDR_ERROR_INVALID_ARGUMENT and nothing is written */
+} gdr_cache_write_options;
+
+/* Writes scene to path through a temporary file in the same folder and a rename. options: NULL for
+ * the defaults. */
+GDR_API gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_cache_write_options *options,
                                    gdr_error *err);
-/* The same, and when pvs is not NULL its serialised form in the optional section 'PVIS'. pvs must
- * have been baked for this scene: gdr_pvs_object_count(pvs) == scene->instance_count, else
- * GDR_ERROR_INVALID_ARGUMENT and nothing is written. */
-GDR_API gdr_status gdr_cache_write_ex(const char *path, const gdr_scene *scene, const gdr_cache_source *source,
-                                      const gdr_pvs *pvs, gdr_error *err);
 
 /* Reads a cache. Checks magic, version, every size, offset and checksum. When build_options is
  * not NULL, a cache built with different options is refused (stale); each recorded source file
  * that exists with a different size or contents makes it stale too (a missing one does not:
- * a cache may travel without its sources). On GDR_OK, *out is the scene. */
-GDR_API gdr_status gdr_cache_read(const char *path, const char *build_options, gdr_scene **out, gdr_error *err);
-/* The same, and the precomputed visibility: *out_pvs is the loaded gdr_pvs (the caller destroys
- * it with gdr_pvs_destroy), or NULL when the cache holds none. out_pvs may be NULL. Either way a
- * 'PVIS' section is checked (gdr_pvs_load, and its object count against the scene's instances):
- * a damaged one makes the whole cache refused, naming the section. */
-GDR_API gdr_status gdr_cache_read_ex(const char *path, const char *build_options, gdr_scene **out,
-                                     gdr_pvs **out_pvs, gdr_error *err);
+ * a cache may travel without its sources). On GDR_OK, *out is the scene and, when out_pvs is not
+ * NULL, *out_pvs the precomputed visibility (a gdr_pvs the caller destroys with gdr_pvs_destroy),
+ * or NULL when the cache holds none. Either way a 'PVIS' section is checked (gdr_pvs_load, and its
+ * object count against the scene's instances): a damaged one makes the whole cache refused,
+ * naming the section. */
+GDR_API gdr_status gdr_cache_read(const char *path, const char *build_options, gdr_scene **out, gdr_pvs **out_pvs,
+                                  gdr_error *err);
 
-/* Parses a cache from memory without any staleness check (the fuzz target uses this). */
+/* Parses a cache from memory without any staleness check (the fuzz target uses this); out_pvs as
+ * in gdr_cache_read. */
 GDR_API gdr_status gdr_cache_read_memory(const void *data, size_t size, const char *name, gdr_scene **out,
-                                         gdr_error *err);
-GDR_API gdr_status gdr_cache_read_memory_ex(const void *data, size_t size, const char *name, gdr_scene **out,
-                                            gdr_pvs **out_pvs, gdr_error *err);
+                                         gdr_pvs **out_pvs, gdr_error *err);
 
 /* The cache path used for a source: SOURCE.gdrc next to it, or in cache_dir (named after a hash
  * of the absolute source path) when cache_dir is given. Returns the length written, or 0 when
@@ -137,15 +141,13 @@ GDR_API gdr_status gdr_import_file(const char *path, const gdr_import_options *o
                                    gdr_import_result *result, gdr_error *err);
 
 /* A source file (.gltf, .glb, .obj) through the cache, or a .gdrc file directly: what
- * gdr_scene_load_ex does for paths. See gdr_load_options in scene.h. Every mesh of the scene has
- * its clusters: read from the cache, or built (a cache written from a scene without them). */
+ * gdr_scene_load does for paths. See gdr_load_options in scene.h (NULL: defaults). Every mesh of
+ * the scene has its clusters: read from the cache, or built (a cache written from a scene without
+ * them). When out_pvs is not NULL, *out_pvs is the precomputed visibility of the cache the scene
+ * was read from, a gdr_pvs to destroy with gdr_pvs_destroy, or NULL (an import, or a cache without
+ * one). A stale cache is rebuilt from the source without it (the bake is not redone). */
 GDR_API gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options, gdr_scene **out,
-                                       gdr_error *err);
-/* The same, and the precomputed visibility of the cache the scene was read from: *out_pvs is a
- * gdr_pvs to destroy with gdr_pvs_destroy, or NULL (an import, or a cache without one). A stale
- * cache is rebuilt from the source without it (the bake is not redone). out_pvs may be NULL. */
-GDR_API gdr_status gdr_scene_load_file_ex(const char *path, const gdr_load_options *options, gdr_scene **out,
-                                          gdr_pvs **out_pvs, gdr_error *err);
+                                       gdr_pvs **out_pvs, gdr_error *err);
 
 #ifdef __cplusplus
 }

@@ -28,7 +28,7 @@ typedef struct gdr_renderer_desc {
      * long GPU frame wakes up slower, which would make CPU timings depend on the GPU's load. */
     bool busy_wait;
     bool disable_mesh_shaders; /* behave as a device without VK_EXT_mesh_shader (tests the fallback) */
-    bool disable_visibility_buffer; /* behave as a device without 64-bit buffer atomics (issue 8) */
+    bool disable_visibility_buffer; /* behave as a device without 64-bit buffer atomics */
     /* The GPU-driven pipelines record a frame slot's commands once and submit them again while
      * nothing they depend on changes (pipeline, raster mode, occlusion culling, overdraw view,
      * whether instance updates are pending). true: record every frame (to measure what recording
@@ -52,7 +52,7 @@ typedef enum gdr_cull_mode {
 /* How a frame is culled and submitted. */
 typedef enum gdr_pipeline {
     GDR_PIPELINE_DEFAULT = 0, /* mesh where the device has VK_EXT_mesh_shader, else indirect */
-    GDR_PIPELINE_MESH,        /* compute instance cull -> task shader meshlet cull -> mesh shader (issue 4) */
+    GDR_PIPELINE_MESH,        /* compute instance cull -> task shader meshlet cull -> mesh shader */
     GDR_PIPELINE_INDIRECT,    /* compute instance cull -> one vkCmdDrawIndexedIndirectCount (seed 003) */
     GDR_PIPELINE_CPU,         /* CPU-driven baseline: gdr/cull.h on the CPU, then one vkCmdDrawIndexed
                                  with its own binds per visible instance (seed 003's "before") */
@@ -68,7 +68,7 @@ typedef enum gdr_view {
     GDR_VIEW_MODE_LOD,       /* each cluster in the colour of its LOD DAG depth (mesh pipeline) */
 } gdr_view;
 
-/* How the mesh pipeline rasterises (issue 8). The visibility-buffer modes (HYBRID, HW, SW) write
+/* How the mesh pipeline rasterises. The visibility-buffer modes (HYBRID, HW, SW) write
  * one 64-bit (depth, cluster, triangle) value per pixel with atomics, then one full-screen pass
  * shades it; they need 64-bit buffer atomics (shaderBufferInt64Atomics). */
 typedef enum gdr_raster {
@@ -78,7 +78,7 @@ typedef enum gdr_raster {
     GDR_RASTER_HW,          /* every cluster through the mesh shaders, into the visibility buffer */
     GDR_RASTER_SW,          /* every cluster through the compute rasteriser, except those crossing the
                                near or far plane (which it cannot clip): the mesh shaders take them */
-    GDR_RASTER_FORWARD,     /* no visibility buffer: the mesh shaders' fragments are shaded (issue 4) */
+    GDR_RASTER_FORWARD,     /* no visibility buffer: the mesh shaders' fragments are shaded */
 } gdr_raster;
 
 /* The hybrid threshold when gdr_frame_desc.sw_threshold_px is 0 (docs/PIPELINE.md says how it was
@@ -98,12 +98,12 @@ typedef struct gdr_frame_desc {
     /* Mesh pipeline: keep the list of clusters the task shaders passed, for
      * gdr_renderer_read_visible_meshlets (tests, tools; costs an append per cluster). */
     bool record_visible_meshlets;
-    /* Mesh pipeline: the rasteriser (issue 8), and for HYBRID the projected triangle size in pixels
+    /* Mesh pipeline: the rasteriser, and for HYBRID the projected triangle size in pixels
      * below which a cluster goes to the compute rasteriser (0: GDR_DEFAULT_SW_THRESHOLD_PX). Other
      * pipelines draw forward; asking them for HYBRID, HW or SW is an error. */
     gdr_raster raster;
     float sw_threshold_px;
-    /* Mesh pipeline, meshes with a LOD DAG (issue 5; gdr/geometry.h "The cut"): the clusters drawn
+    /* Mesh pipeline, meshes with a LOD DAG (gdr/geometry.h "The cut"): the clusters drawn
      * are the cut whose projected error is within lod_error_px pixels (0, the default: full detail,
      * level 0), or with lod_fixed_depth the discrete cut at DAG depth lod_depth (0: level 0). The
      * indirect and CPU pipelines always draw full detail. */
@@ -114,11 +114,13 @@ typedef struct gdr_frame_desc {
      * DAG (gdr/geometry.h, "LOD hierarchy"), testing nodes by LOD error, frustum and (late phase)
      * occlusion, instead of testing every cluster of the DAG (OFF). DEFAULT: on. The cut is the same. */
     gdr_cull_mode lod_hierarchy;
-    /* Two-phase occlusion culling against the depth pyramid (issue 6; indirect pipeline: instances,
-     * mesh pipeline: instances and clusters; DEFAULT: on; off when cull is off). Conservative: the
-     * image is the same with it off. The history it keeps between frames is discarded when the
-     * pipeline changes and on a camera cut (the caller says so: the frame after a jump, a teleport,
-     * a new shot); without history everything goes through the late phase's test. */
+    /* Two-phase occlusion culling against the depth pyramid (indirect pipeline: instances, mesh
+     * pipeline: instances, nodes and clusters; off when cull is off). DEFAULT: on for the indirect
+     * pipeline, off for the mesh pipeline, where the H100 measurements found it slower on every
+     * scene (docs/OCCLUSION.md). Conservative: the image is the same with it off. The history it
+     * keeps between frames is discarded when the pipeline changes and on a camera cut (the caller
+     * says so: the frame after a jump, a teleport, a new shot); without history everything goes
+     * through the late phase's test. */
     gdr_cull_mode occlusion;
     bool occlusion_camera_cut;
 } gdr_frame_desc;

@@ -39,7 +39,7 @@ typedef struct gdr_material {
     uint32_t base_color_texture;         /* texture index or GDR_NO_INDEX */
     uint32_t normal_texture;             /* recorded for later use, or GDR_NO_INDEX */
     uint32_t metallic_roughness_texture; /* recorded for later use, or GDR_NO_INDEX */
-    /* Additions (issue 3). A zero-initialised material keeps its old meaning: opaque,
+    /* Surface parameters the importers fill. A zero-initialised material means: opaque,
      * single-sided; metallic/roughness 0 unless an importer sets them. */
     float metallic_factor;
     float roughness_factor;
@@ -50,7 +50,7 @@ typedef struct gdr_material {
 
 typedef enum gdr_alpha_mode { GDR_ALPHA_OPAQUE = 0, GDR_ALPHA_MASK = 1, GDR_ALPHA_BLEND = 2 } gdr_alpha_mode;
 
-/* A decoded image: tightly packed RGBA8 rows, top row first (issue 3). */
+/* A decoded image: tightly packed RGBA8 rows, top row first. */
 typedef struct gdr_texture {
     char name[GDR_NAME_MAX];
     uint32_t width, height;
@@ -84,7 +84,7 @@ typedef struct gdr_scene {
     uint32_t instance_count, instance_capacity;
     gdr_camera *cameras;
     uint32_t camera_count, camera_capacity;
-    /* Additions (issue 3). */
+    /* Decoded images the materials index (base colour, normal, metallic-roughness). */
     gdr_texture *textures;
     uint32_t texture_count, texture_capacity;
     char *extensions; /* the source's extensionsUsed, comma-separated, or NULL */
@@ -128,7 +128,7 @@ typedef struct gdr_demo_desc {
 
 GDR_API gdr_status gdr_scene_create_demo(const gdr_demo_desc *desc, gdr_scene **out, gdr_error *err);
 
-/* --- LOD field (issue 5): many copies of one dense mesh, from near to far ---------------------
+/* --- LOD field: many copies of one dense mesh, from near to far -------------------------------
  *
  * One dense closed mesh, a bumpy (2, 3) torus knot named "torus_knot" (a welded tube: watertight,
  * every edge shared by exactly two triangles; bounding radius about 1 m), instanced `instances`
@@ -152,7 +152,7 @@ typedef struct gdr_lod_field_desc {
 
 GDR_API gdr_status gdr_scene_create_lod_field(const gdr_lod_field_desc *desc, gdr_scene **out, gdr_error *err);
 
-/* --- Occlusion scene (issue 6): a wall of buildings in front of many small objects -------------
+/* --- Occlusion scene: a wall of buildings in front of many small objects -----------------------
  *
  * Right-handed, Y up; the default camera stands at (0, 1.7, 0) looking down -Z. Instances, in
  * this order:
@@ -206,14 +206,6 @@ GDR_API gdr_camera gdr_scene_occlusion_camera_path(uint32_t frame, bool *camera_
  * ":options"), which gdr_scene_load builds instead of reading a file. */
 GDR_API bool gdr_scene_spec_is_builtin(const char *spec);
 
-/* Loads a scene from a specification, a built-in scene with its level-0 clusters and LOD DAG:
- *     "demo[:instances=N,seed=S,spacing=X]"                 gdr_scene_create_demo
- *     "lod-field[:instances=N,seed=S,triangles=T,spacing=X]" gdr_scene_create_lod_field
- *     "occlusion[:seed=S,hidden=N,visible=N]"               gdr_scene_create_occlusion
- * (options in any order, each at most once; values as in the desc, 0 refused), or a file path of
- * a supported format. */
-GDR_API gdr_status gdr_scene_load(const char *spec, gdr_scene **out, gdr_error *err);
-
 /* Warnings from importers (a file that loads, but not entirely as written): `message` names the
  * file and the place, e.g. "box.gltf: meshes[0].primitives[1]: mode 1 (lines) skipped". */
 typedef void (*gdr_warning_fn)(void *user, const char *message);
@@ -238,7 +230,7 @@ typedef struct gdr_budget {
 /* The budget with every 0 replaced by its default. */
 GDR_API gdr_budget gdr_budget_resolve(const gdr_budget *budget);
 
-/* Options of gdr_scene_load_ex; zero-initialise, every field has a default. */
+/* Options of gdr_scene_load; zero-initialise, every field has a default. */
 typedef struct gdr_load_options {
     int no_cache;          /* 1: import the source, never read or write a .gdrc cache */
     const char *cache_dir; /* NULL: next to the source (FILE.gdrc), falling back to
@@ -251,10 +243,15 @@ typedef struct gdr_load_options {
                                 (absolute paths, '..', symlinks out); 0: refused */
 } gdr_load_options;
 
-/* gdr_scene_load with options (NULL: defaults). Source files (.gltf, .glb, .obj) go through the
- * processed-scene cache unless options->no_cache; a .gdrc file is read directly. */
-GDR_API gdr_status gdr_scene_load_ex(const char *spec, const gdr_load_options *options, gdr_scene **out,
-                                     gdr_error *err);
+/* Loads a scene from a specification, a built-in scene with its level-0 clusters and LOD DAG:
+ *     "demo[:instances=N,seed=S,spacing=X]"                 gdr_scene_create_demo
+ *     "lod-field[:instances=N,seed=S,triangles=T,spacing=X]" gdr_scene_create_lod_field
+ *     "occlusion[:seed=S,hidden=N,visible=N]"               gdr_scene_create_occlusion
+ * (options in any order, each at most once; values as in the desc, 0 refused), or a file path of
+ * a supported format. Source files (.gltf, .glb, .obj) go through the processed-scene cache unless
+ * options->no_cache; a .gdrc file is read directly. options: NULL for the defaults. */
+GDR_API gdr_status gdr_scene_load(const char *spec, const gdr_load_options *options, gdr_scene **out,
+                                  gdr_error *err);
 
 #ifdef __cplusplus
 }

@@ -5,10 +5,22 @@
 
 #include "cull/cull_internal.h"
 
-gdr_status gdr_cull_scene_create(const gdr_cull_scene_desc *desc, gdr_cull_scene **out, gdr_error *err)
+/* The desc with every zero field given its default. */
+static gdr_cull_scene_desc cull_scene_desc_defaults(const gdr_cull_scene_desc *in)
+{
+    gdr_cull_scene_desc d = *in;
+    d.octree_max_depth = d.octree_max_depth ? d.octree_max_depth : CULL_OCTREE_DEFAULT_DEPTH;
+    d.octree_leaf_objects = d.octree_leaf_objects ? d.octree_leaf_objects : CULL_OCTREE_DEFAULT_LEAF;
+    return d;
+}
+
+gdr_status gdr_cull_scene_create(const gdr_cull_scene_desc *desc_in, gdr_cull_scene **out, gdr_error *err)
 {
     *out = NULL;
-    if (!desc || (desc->object_count && !desc->objects))
+    if (!desc_in)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "cull scene: objects is NULL");
+    const gdr_cull_scene_desc d = cull_scene_desc_defaults(desc_in), *desc = &d;
+    if (desc->object_count && !desc->objects)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "cull scene: objects is NULL");
     if (desc->octree_max_depth > CULL_OCTREE_MAX_DEPTH)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "cull scene: octree_max_depth %u exceeds %u",
@@ -20,8 +32,8 @@ gdr_status gdr_cull_scene_create(const gdr_cull_scene_desc *desc, gdr_cull_scene
     if (!s)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "cull scene: out of memory");
     s->object_count = desc->object_count;
-    s->max_depth = desc->octree_max_depth ? desc->octree_max_depth : CULL_OCTREE_DEFAULT_DEPTH;
-    s->leaf_objects = desc->octree_leaf_objects ? desc->octree_leaf_objects : CULL_OCTREE_DEFAULT_LEAF;
+    s->max_depth = desc->octree_max_depth;
+    s->leaf_objects = desc->octree_leaf_objects;
     size_t n = s->object_count ? s->object_count : 1;
     s->objects = malloc(n * sizeof(*s->objects));
     s->object_node = malloc(n * sizeof(*s->object_node));

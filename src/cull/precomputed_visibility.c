@@ -192,20 +192,27 @@ static void bake_context_free(bake_context *ctx, uint32_t workers)
     free(ctx->unproven);
 }
 
+/* The desc with every zero field given its default. */
+static gdr_pvs_bake_desc pvs_bake_desc_defaults(const gdr_pvs_bake_desc *in)
+{
+    gdr_pvs_bake_desc d = *in;
+    d.samples_per_cell = d.samples_per_cell ? d.samples_per_cell : 8;
+    d.cube_resolution = d.cube_resolution ? d.cube_resolution : 64;
+    d.cells_per_chunk = d.cells_per_chunk ? d.cells_per_chunk : 16;
+    d.bucket_count_x = d.bucket_count_x ? d.bucket_count_x : 16;
+    d.bucket_count_z = d.bucket_count_z ? d.bucket_count_z : 16;
+    d.zstd_level = d.zstd_level ? d.zstd_level : 3;
+    d.seed = d.seed ? d.seed : 1;
+    return d;
+}
+
 gdr_status gdr_pvs_bake(const gdr_pvs_bake_desc *desc_in, gdr_pvs **out, gdr_pvs_bake_report *report, gdr_error *err)
 {
     *out = NULL;
     if (!desc_in || !desc_in->scene)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "pvs bake: scene is NULL");
     bake_context ctx = {0};
-    gdr_pvs_bake_desc d = *desc_in;
-    if (!d.samples_per_cell) d.samples_per_cell = 8;
-    if (!d.cube_resolution) d.cube_resolution = 64;
-    if (!d.cells_per_chunk) d.cells_per_chunk = 16;
-    if (!d.bucket_count_x) d.bucket_count_x = 16;
-    if (!d.bucket_count_z) d.bucket_count_z = 16;
-    if (!d.zstd_level) d.zstd_level = 3;
-    if (!d.seed) d.seed = 1;
+    gdr_pvs_bake_desc d = pvs_bake_desc_defaults(desc_in);
     if (d.bucket_count_x > PVS_MAX_BUCKETS_PER_AXIS || d.bucket_count_z > PVS_MAX_BUCKETS_PER_AXIS)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "pvs bake: more than %u buckets along an axis",
                              PVS_MAX_BUCKETS_PER_AXIS);

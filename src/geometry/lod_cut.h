@@ -1,5 +1,5 @@
-/* The LOD cut on the CPU: the reference the GPU selection (meshlet.task) is checked against
- * (issue 5). The per-group math is shared with the shaders (src/shaders/shared/lod_math.h); the
+/* The LOD cut on the CPU: the reference the GPU selection (meshlet.task) is checked against.
+ * The per-group math is shared with the shaders (src/shaders/shared/lod_math.h); the
  * rule itself is documented in gdr/geometry.h ("The cut"). */
 #ifndef GDR_GEOMETRY_LOD_CUT_H
 #define GDR_GEOMETRY_LOD_CUT_H

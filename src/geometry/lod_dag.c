@@ -1,4 +1,4 @@
-/* The cluster LOD DAG (issue 5, seed 004): group neighbouring clusters with METIS, merge and
+/* The cluster LOD DAG (seed 004): group neighbouring clusters with METIS, merge and
  * simplify each group with its shared border locked (meshoptimizer), split the result into new
  * clusters, repeat up to a root. The contract (and the cut rule it serves) is in gdr/geometry.h;
  * docs/GEOMETRY.md explains the choices.

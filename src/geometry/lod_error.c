@@ -18,12 +18,6 @@
 #include "geometry/lod_internal.h"
 
 #define NO_SOURCE UINT32_MAX
-/* At most this many triangles around one vertex are looked at: a distance to some of them is still
- * an upper bound, and a vertex shared by a whole fan must not make every query cost the fan. */
-#define RING_LIMIT 64u
-/* A group measures exactly against the level-0 triangles around its samples only while they are
- * at most this many per sample (plus a constant): a fan's hub would bring the whole fan in. */
-#define REGION_PER_SAMPLE 16u
 
 /* Squared distance from p to triangle (a, b, c), by the region of the closest point. */
 static float point_triangle_d2(gdr_vec3 P, gdr_vec3 A, gdr_vec3 B, gdr_vec3 C)
@@ -284,9 +278,7 @@ static float ring_d2(const lod_scratch *s, uint32_t l, gdr_vec3 p, uint32_t *nea
 {
     float best = INFINITY;
     *nearest = s->ring[s->ring_start[l]];
-    uint32_t end = s->ring_start[l + 1] - s->ring_start[l] > RING_LIMIT ? s->ring_start[l] + RING_LIMIT
-                                                                          : s->ring_start[l + 1];
-    for (uint32_t k = s->ring_start[l]; k < end; k++) {
+    for (uint32_t k = s->ring_start[l]; k < s->ring_start[l + 1]; k++) {
         const uint32_t *t = s->out_corners + (size_t)s->ring[k] * 3;
         float d = point_triangle_d2(p, load3(s->positions + (size_t)t[0] * 3), load3(s->positions + (size_t)t[1] * 3),
                                     load3(s->positions + (size_t)t[2] * 3));
@@ -330,13 +322,23 @@ static float samples_to_simplified(lod_scratch *s, uint32_t local_count)
 
 /* Distance (squared) from p to the level-0 triangles around position `position`: an upper bound of
  * the distance from p to S0. */
+/* A position's triangles are looked at up to this many: around a position of thousands (the centre
+ * of a fan) every probe would otherwise cost the whole fan. Fewer triangles only make a distance to
+ * them larger than the distance to the full-detail surface, so the bound stays a bound. */
+#define LOD_RING_LIMIT 64u
+#define LOD_WALK_LIMIT 32u
+
+static uint32_t ring_end(const lod_build *b, uint32_t position)
+{
+    uint32_t start = b->adjacency_start[position], end = b->adjacency_start[position + 1];
+    return end - start > LOD_RING_LIMIT ? start + LOD_RING_LIMIT : end;
+}
+
 static float to_full_detail_d2(const lod_build *b, uint32_t position, gdr_vec3 p)
 {
     float best = INFINITY;
     const gdr_vec3 *x = b->mesh->positions;
-    uint32_t first = b->adjacency_start[position], end = b->adjacency_start[position + 1];
-    end = end - first > RING_LIMIT ? first + RING_LIMIT : end;
-    for (uint32_t k = first; k < end; k++) {
+    for (uint32_t k = b->adjacency_start[position]; k < ring_end(b, position); k++) {
         const gdr_cluster *c = &b->clusters[b->adjacency[k] >> 7];
         const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(b->adjacency[k] & 127) * 3;
         const uint32_t *v = gdr_lod_cluster_vertices(b, c);
@@ -360,11 +362,12 @@ static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p)
 {
     uint32_t at = start;
     float best = position_d2(b, at, p);
-    for (;;) {
+    /* At most LOD_WALK_LIMIT steps: on a strip or a fan's rim a walk would cross the whole mesh one
+     * neighbour at a time. Where it stops short, the distance from there is only larger (a bound
+     * still), and a bound too loose sends the probe to the exact measure (probe_d2). */
+    for (uint32_t steps = 0; steps < LOD_WALK_LIMIT; steps++) {
         uint32_t from = at;
-        uint32_t first = b->adjacency_start[from], end = b->adjacency_start[from + 1];
-        end = end - first > RING_LIMIT ? first + RING_LIMIT : end;
-        for (uint32_t k = first; k < end; k++) {
+        for (uint32_t k = b->adjacency_start[from]; k < ring_end(b, from); k++) {
             const gdr_cluster *c = &b->clusters[b->adjacency[k] >> 7];
             const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(b->adjacency[k] & 127) * 3;
             const uint32_t *v = gdr_lod_cluster_vertices(b, c);
@@ -380,6 +383,7 @@ static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p)
         if (at == from)
             return at;
     }
+    return at;
 }
 
 static int compare_u32(const void *x, const void *y)
@@ -388,15 +392,13 @@ static int compare_u32(const void *x, const void *y)
     return a < b ? -1 : a > b;
 }
 
-/* A grid over the level-0 triangles around the group's samples (each once). Returns 1, 0 when out
- * of memory, -1 when there are too many of them (a fan's hub). */
+/* A grid over the level-0 triangles around the group's samples (each once). Returns 0 when out of
+ * memory. */
 static int build_region(const lod_build *b, lod_scratch *s)
 {
     size_t n = 0;
     for (uint32_t i = 0; i < s->gathered; i++)
         n += b->adjacency_start[s->sample_ids[i] + 1] - b->adjacency_start[s->sample_ids[i]];
-    if (n > (size_t)s->gathered * REGION_PER_SAMPLE + 1024)
-        return -1; /* too many: the walk's bound stays */
     if (!LOD_RESERVE(s, region_refs, n + 1))
         return 0;
     n = 0;
@@ -443,13 +445,10 @@ static float probe_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
     float d = to_full_detail_d2(ps->b, *at, p);
     if (d <= 4.0f * ps->worst || ps->failed) /* squared: up to twice the largest so far */
         return d;
-    if (!ps->s->region_built) {
-        int built = build_region(ps->b, ps->s);
-        ps->failed = built == 0;
-        ps->s->region_built = built == 1 ? 1 : -1;
-    }
-    if (ps->s->region_built != 1)
+    if (!ps->s->region_built && !build_region(ps->b, ps->s)) {
+        ps->failed = 1;
         return d;
+    }
     float exact;
     lod_triangle_grid_nearest(&ps->s->region_grid, p, point_triangle_d2, &exact);
     return exact < d ? exact : d;

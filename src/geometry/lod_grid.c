@@ -251,6 +251,10 @@ int lod_triangle_grid_build(lod_triangle_grid *g, const float *positions, const 
     return 1;
 }
 
+/* A cell's triangles are looked at up to this many (the centre of a fan lies in cells of thousands):
+ * the nearest of fewer triangles is farther, so the distance found stays an upper bound. */
+#define GRID_CELL_LIMIT 64u
+
 uint32_t lod_triangle_grid_nearest(const lod_triangle_grid *g, gdr_vec3 point, lod_point_triangle_fn *distance,
                                    float *distance_squared)
 {
@@ -277,7 +281,9 @@ uint32_t lod_triangle_grid_nearest(const lod_triangle_grid *g, gdr_vec3 point, l
                     if (x < 0 || x >= (int32_t)g->dim[0])
                         continue;
                     size_t c = ((size_t)z * g->dim[1] + (uint32_t)y) * g->dim[0] + (uint32_t)x;
-                    for (uint32_t i = g->start[c]; i < g->start[c + 1]; i++) {
+                    uint32_t end = g->start[c + 1] - g->start[c] > GRID_CELL_LIMIT ? g->start[c] + GRID_CELL_LIMIT
+                                                                                   : g->start[c + 1];
+                    for (uint32_t i = g->start[c]; i < end; i++) {
                         uint32_t t = g->items[i];
                         float d = distance(point, corner(g, t, 0), corner(g, t, 1), corner(g, t, 2));
                         if (d < best_d2 || (d == best_d2 && t < best)) {

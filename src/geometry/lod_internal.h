@@ -169,8 +169,6 @@ gdr_status gdr_lod_partition(lod_build *b, int32_t *part, uint32_t *parts, gdr_e
 
 /* lod_group.c: a thread-pool task that simplifies group g of the step into b->results[g]. */
 void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker);
-/* A sphere containing every sphere of the list (rounded up, with a relative slack of 1e-6). */
-gdr_vec4 gdr_lod_enclosing_sphere(const gdr_vec4 *spheres, size_t count);
 void gdr_lod_result_free(group_result *r);
 
 /* lod_error.c: the samples of the full-detail surface and the groups' measured deviation. */

@@ -248,6 +248,7 @@ typedef struct chunk_result {
 typedef struct chunk_job {
     const gdr_mesh *mesh;
     const gdr_meshlet_options *o;
+    uint32_t chunk_triangles; /* MESHLET_CHUNK_TRIANGLES, or fewer for a hostile mesh */
     chunk_result *results;
     uint32_t **maps; /* per worker: mesh vertex -> chunk-local vertex (UINT32_MAX: unused) */
 } chunk_job;
@@ -307,8 +308,8 @@ static void chunk_task(void *user, uint32_t c, uint32_t worker)
 {
     chunk_job *job = user;
     const gdr_mesh *mesh = job->mesh;
-    size_t first = (size_t)c * MESHLET_CHUNK_TRIANGLES * 3, n = mesh->index_count - first;
-    n = n > (size_t)MESHLET_CHUNK_TRIANGLES * 3 ? (size_t)MESHLET_CHUNK_TRIANGLES * 3 : n;
+    size_t first = (size_t)c * job->chunk_triangles * 3, n = mesh->index_count - first;
+    n = n > (size_t)job->chunk_triangles * 3 ? (size_t)job->chunk_triangles * 3 : n;
     uint32_t *map = job->maps[worker], count = 0;
     uint32_t *local = malloc(n * sizeof *local), *local_to_mesh = NULL;
     float *positions = NULL;
@@ -376,16 +377,17 @@ static gdr_status concatenate(const chunk_result *r, uint32_t chunks, gdr_mesh_c
 }
 
 /* Builds the chunks (with a pool when thread_count asks for one) and concatenates them. */
-static gdr_status build_chunks(const gdr_mesh *mesh, const gdr_meshlet_options *o, gdr_mesh_clusters *out)
+static gdr_status build_chunks(const gdr_mesh *mesh, const gdr_meshlet_options *o, uint32_t chunk_triangles,
+                               gdr_mesh_clusters *out)
 {
-    uint32_t chunks = (uint32_t)(((size_t)mesh->index_count / 3 + MESHLET_CHUNK_TRIANGLES - 1) /
-                                 MESHLET_CHUNK_TRIANGLES);
+    uint32_t chunks = (uint32_t)(((size_t)mesh->index_count / 3 + chunk_triangles - 1) / chunk_triangles);
     gdr_thread_pool *pool = NULL;
     gdr_error ignored;
     if (o->thread_count != 1 && gdr_thread_pool_create(o->thread_count, &pool, &ignored) != GDR_OK)
         pool = NULL; /* one thread then: the result is the same */
     uint32_t workers = gdr_thread_pool_thread_count(pool);
-    chunk_job job = {mesh, o, calloc(chunks, sizeof(chunk_result)), calloc(workers, sizeof(uint32_t *))};
+    chunk_job job = {mesh, o, chunk_triangles, calloc(chunks, sizeof(chunk_result)),
+                     calloc(workers, sizeof(uint32_t *))};
     gdr_status status = job.results && job.maps ? GDR_OK : GDR_ERROR_OUT_OF_MEMORY;
     for (uint32_t w = 0; w < workers && status == GDR_OK; w++) {
         job.maps[w] = malloc((size_t)mesh->vertex_count * sizeof *job.maps[w]);
@@ -413,73 +415,6 @@ static gdr_status build_chunks(const gdr_mesh *mesh, const gdr_meshlet_options *
     return status;
 }
 
-/* Meshes on which meshoptimizer's kd-tree of centroids degenerates (meshlet_chunks.h): built in
- * small chunks so that the work stays linear. */
-static gdr_status build_hostile(const gdr_mesh *mesh, gdr_meshlet_options o, gdr_mesh_clusters *out, gdr_error *err)
-{
-    size_t bound = gdr_meshlet_chunks_bound(mesh, o.max_vertices, o.max_triangles);
-    struct meshopt_Meshlet *meshlets = malloc(bound * sizeof *meshlets);
-    unsigned int *vertices = malloc(bound * o.max_vertices * sizeof *vertices);
-    unsigned char *triangles = malloc(bound * o.max_triangles * 3);
-    if (!meshlets || !vertices || !triangles) {
-        free(meshlets);
-        free(vertices);
-        free(triangles);
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for %zu meshlets", mesh->name,
-                             bound);
-    }
-    size_t count = gdr_meshlet_build_chunks(mesh, o.max_vertices, o.max_triangles, o.cone_weight, meshlets, vertices,
-                                            triangles);
-    if (count == 0 || count > bound) {
-        free(meshlets);
-        free(vertices);
-        free(triangles);
-        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "mesh '%s': meshoptimizer made %zu meshlets from %u "
-                             "triangles", mesh->name, count, mesh->index_count / 3);
-    }
-    /* Each meshlet's triangles start on a 4-byte boundary (meshoptimizer pads them): kept, so a
-     * shader can read them as 32-bit words. Every offset fits in 32 bits: no meshlet is empty, so
-     * there are at most index_count vertex entries and index_count + 3 * count triangle bytes. */
-    const struct meshopt_Meshlet *last = &meshlets[count - 1];
-    size_t vertex_total = (size_t)last->vertex_offset + last->vertex_count;
-    size_t triangle_bytes = (size_t)last->triangle_offset + ((size_t)last->triangle_count * 3 + 3) / 4 * 4;
-
-    gdr_mesh_clusters c = {0};
-    c.clusters = malloc(count * sizeof *c.clusters);
-    c.vertices = malloc(vertex_total * sizeof *c.vertices);
-    c.triangles = malloc(triangle_bytes);
-    if (!c.clusters || !c.vertices || !c.triangles || count > UINT32_MAX || triangle_bytes > UINT32_MAX) {
-        gdr_mesh_clusters_free(&c);
-        free(meshlets);
-        free(vertices);
-        free(triangles);
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for %zu meshlets", mesh->name,
-                             count);
-    }
-    c.cluster_count = c.level0_cluster_count = (uint32_t)count;
-    c.vertex_count = (uint32_t)vertex_total;
-    c.triangle_byte_count = (uint32_t)triangle_bytes;
-    memcpy(c.vertices, vertices, vertex_total * sizeof *c.vertices);
-    memcpy(c.triangles, triangles, triangle_bytes);
-    for (size_t i = 0; i < count; i++) {
-        const struct meshopt_Meshlet *m = &meshlets[i];
-        gdr_cluster *cl = &c.clusters[i];
-        *cl = (gdr_cluster){.vertex_offset = m->vertex_offset, .triangle_offset = m->triangle_offset,
-                            .vertex_count = m->vertex_count, .triangle_count = m->triangle_count,
-                            .group = GDR_NO_INDEX, .refined_group = GDR_NO_INDEX};
-        /* Zero the padding: the output must not depend on what malloc returned. */
-        size_t used = (size_t)m->triangle_offset + (size_t)m->triangle_count * 3;
-        size_t end = i + 1 < count ? meshlets[i + 1].triangle_offset : triangle_bytes;
-        memset(c.triangles + used, 0, end - used);
-        cluster_bounds(cl, c.vertices + m->vertex_offset, c.triangles + m->triangle_offset, mesh);
-    }
-    free(meshlets);
-    free(vertices);
-    free(triangles);
-    *out = c;
-    return GDR_OK;
-}
-
 gdr_status gdr_meshlets_build(const gdr_mesh *mesh, const gdr_meshlet_options *options, gdr_mesh_clusters *out,
                               gdr_error *err)
 {
@@ -495,11 +430,10 @@ gdr_status gdr_meshlets_build(const gdr_mesh *mesh, const gdr_meshlet_options *o
         status = check_mesh(mesh, err);
     if (status != GDR_OK)
         return status;
-    if (gdr_meshlet_needs_chunks(mesh)) {
-        status = build_hostile(mesh, o, out, err);
-        if (status != GDR_OK)
-            return status;
-    } else if (mesh->index_count / 3 <= MESHLET_CHUNK_TRIANGLES) {
+    /* A mesh whose kd-tree of centroids meshoptimizer could not split (meshlet_chunks.h) goes in
+     * small chunks, so that no leaf it scans holds more than one chunk; sound meshes as before. */
+    uint32_t chunk = gdr_meshlet_needs_chunks(mesh) ? GDR_MESHLET_HOSTILE_CHUNK : MESHLET_CHUNK_TRIANGLES;
+    if (mesh->index_count / 3 <= chunk) {
         /* One chunk: straight over the mesh's own vertices. */
         chunk_result r = {0};
         status = meshlets_of(mesh, &o, mesh->indices, mesh->index_count, &mesh->positions[0].x, mesh->vertex_count,
@@ -510,7 +444,7 @@ gdr_status gdr_meshlets_build(const gdr_mesh *mesh, const gdr_meshlet_options *o
         free(r.vertices);
         free(r.triangles);
     } else {
-        status = build_chunks(mesh, &o, out);
+        status = build_chunks(mesh, &o, chunk, out);
     }
     if (status == GDR_ERROR_INVALID_ARGUMENT)
         return gdr_error_set(err, status, "mesh '%s': meshoptimizer made no meshlets", mesh->name);

@@ -79,19 +79,17 @@ static gdr_status check_reader_limits(const char *path, const gdr_scene *s, gdr_
     return GDR_OK;
 }
 
-gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_cache_source *source, gdr_error *err)
+gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_cache_write_options *options,
+                           gdr_error *err)
 {
-    return gdr_cache_write_ex(path, scene, source, NULL, err);
-}
-
-gdr_status gdr_cache_write_ex(const char *path, const gdr_scene *scene, const gdr_cache_source *source,
-                              const gdr_pvs *pvs, gdr_error *err)
-{
+    static const gdr_cache_write_options defaults = {0};
+    if (!options)
+        options = &defaults;
     gdr_status limits = check_reader_limits(path, scene, err);
     if (limits != GDR_OK)
         return limits;
     /* The table has exactly one entry per section: no byte of the file lies outside a checksum. */
-    cache_write_input in = {scene, source, pvs};
+    cache_write_input in = {scene, &options->source, options->pvs};
     uint32_t expected = 0;
     for (uint32_t k = 0; k < CACHE_SECTION_COUNT; k++) {
         const cache_section *sec = &gdr_cache_sections[k];
@@ -278,13 +276,8 @@ static gdr_status parse_container(const char *name, const uint8_t *data, size_t 
     return GDR_OK;
 }
 
-gdr_status gdr_cache_read_memory(const void *data, size_t size, const char *name, gdr_scene **out, gdr_error *err)
-{
-    return gdr_cache_read_memory_ex(data, size, name, out, NULL, err);
-}
-
-gdr_status gdr_cache_read_memory_ex(const void *data, size_t size, const char *name, gdr_scene **out,
-                                    gdr_pvs **out_pvs, gdr_error *err)
+gdr_status gdr_cache_read_memory(const void *data, size_t size, const char *name, gdr_scene **out, gdr_pvs **out_pvs,
+                                 gdr_error *err)
 {
     *out = NULL;
     if (out_pvs)
@@ -456,13 +449,8 @@ static gdr_status check_fresh(const char *name, cache_view *v, const char *build
     return status;
 }
 
-gdr_status gdr_cache_read(const char *path, const char *build_options, gdr_scene **out, gdr_error *err)
-{
-    return gdr_cache_read_ex(path, build_options, out, NULL, err);
-}
-
-gdr_status gdr_cache_read_ex(const char *path, const char *build_options, gdr_scene **out, gdr_pvs **out_pvs,
-                             gdr_error *err)
+gdr_status gdr_cache_read(const char *path, const char *build_options, gdr_scene **out, gdr_pvs **out_pvs,
+                          gdr_error *err)
 {
     return gdr_io_cache_read_for(path, NULL, build_options, out, out_pvs, err);
 }

@@ -464,6 +464,72 @@ static gdr_status clean_triangles(gltf_ctx *c, const char *place, prim_arrays *a
     return GDR_OK;
 }
 
+/* Normals unit length (any zero or non-finite one: all generated from the faces instead) and
+ * finite texture coordinates (else dropped), with a warning each. */
+static void check_normals_and_uvs(gltf_ctx *c, const char *place, prim_arrays *a, uint32_t vertex_count)
+{
+    if (a->normals) {
+        uint32_t bad = 0;
+        for (uint32_t v = 0; v < vertex_count; v++) {
+            float length = gdr_vec3_length(a->normals[v]);
+            if (!isfinite(length) || length < 1e-6f)
+                bad++;
+            else
+                a->normals[v] = gdr_vec3_scale(a->normals[v], 1.0f / length);
+        }
+        if (bad) {
+            gdr_io_warn(&c->warnings, "%s: %s.attributes.NORMAL: %u of %u normals are zero or not finite; "
+                        "normals generated from the faces", c->name, place, bad, vertex_count);
+            free(a->normals);
+            a->normals = NULL;
+        }
+    }
+    if (a->uvs) {
+        for (uint32_t v = 0; v < vertex_count; v++)
+            if (!isfinite(a->uvs[v].x) || !isfinite(a->uvs[v].y)) {
+                gdr_io_warn(&c->warnings, "%s: %s.attributes.TEXCOORD_0: not finite; texture coordinates dropped",
+                            c->name, place);
+                free(a->uvs);
+                a->uvs = NULL;
+                break;
+            }
+    }
+}
+
+/* The primitive's indices (its accessor, or 0 .. vertex_count - 1 without one), each checked
+ * against vertex_count; their triangles are taken from the budget before anything is allocated. */
+static gdr_status read_indices(gltf_ctx *c, uint32_t accessor, uint32_t mode, uint32_t vertex_count,
+                               const char *place, uint32_t **out, uint32_t *count)
+{
+    char use[160];
+    snprintf(use, sizeof use, "%s.indices", place);
+    uint32_t n = vertex_count;
+    gltf_accessor_info info;
+    gdr_status status = accessor == GDR_NO_INDEX ? GDR_OK : gltf_accessor_info_get(c, accessor, use, &info);
+    if (status == GDR_OK && accessor != GDR_NO_INDEX)
+        n = info.count;
+    if (status == GDR_OK)
+        status = take_triangles(c, mode, n, accessor == GDR_NO_INDEX ? place : use);
+    if (status != GDR_OK)
+        return status;
+    uint32_t *indices = malloc(sizeof(uint32_t) * ((size_t)n ? n : 1));
+    if (!indices)
+        return gltf_fail(c, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", use);
+    *out = indices;
+    *count = n;
+    if (accessor == GDR_NO_INDEX) {
+        for (uint32_t i = 0; i < n; i++)
+            indices[i] = i;
+        return GDR_OK;
+    }
+    status = gltf_accessor_read_uints(c, accessor, use, indices);
+    for (uint32_t i = 0; i < n && status == GDR_OK; i++)
+        if (indices[i] >= vertex_count)
+            status = gltf_fail(c, GDR_ERROR_PARSE, "%s: index %u (at %u) is out of range (%u vertices)", use,
+                               indices[i], i, vertex_count);
+    return status;
+}
+
 /* One primitive -> one gdr mesh (or GDR_NO_INDEX when it has no triangles). */
 static gdr_status convert_primitive(gltf_ctx *c, const cJSON *prim, const char *place, const char *mesh_name,
                                     uint32_t *out_mesh, uint32_t *out_material)
@@ -516,70 +582,10 @@ static gdr_status convert_primitive(gltf_ctx *c, const cJSON *prim, const char *
     status = gdr_io_check_positions(a.positions, vertex_count, c->name, positions_place, c->err);
     if (status != GDR_OK)
         goto done;
-    if (a.normals) {
-        uint32_t bad = 0;
-        for (uint32_t v = 0; v < vertex_count; v++) {
-            float length = gdr_vec3_length(a.normals[v]);
-            if (!isfinite(length) || length < 1e-6f)
-                bad++;
-            else
-                a.normals[v] = gdr_vec3_scale(a.normals[v], 1.0f / length);
-        }
-        if (bad) {
-            gdr_io_warn(&c->warnings, "%s: %s.attributes.NORMAL: %u of %u normals are zero or not finite; "
-                        "normals generated from the faces", c->name, place, bad, vertex_count);
-            free(a.normals);
-            a.normals = NULL;
-        }
-    }
-    if (a.uvs) {
-        for (uint32_t v = 0; v < vertex_count; v++)
-            if (!isfinite(a.uvs[v].x) || !isfinite(a.uvs[v].y)) {
-                gdr_io_warn(&c->warnings, "%s: %s.attributes.TEXCOORD_0: not finite; texture coordinates dropped",
-                            c->name, place);
-                free(a.uvs);
-                a.uvs = NULL;
-                break;
-            }
-    }
-    if (indices_accessor != GDR_NO_INDEX) {
-        char use[160];
-        snprintf(use, sizeof use, "%s.indices", place);
-        gltf_accessor_info info;
-        status = gltf_accessor_info_get(c, indices_accessor, use, &info);
-        if (status != GDR_OK)
-            goto done;
-        n = info.count;
-        status = take_triangles(c, mode, n, use);
-        if (status != GDR_OK)
-            goto done;
-        a.indices = malloc(sizeof(uint32_t) * n);
-        if (!a.indices) {
-            status = gltf_fail(c, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", use);
-            goto done;
-        }
-        status = gltf_accessor_read_uints(c, indices_accessor, use, a.indices);
-        if (status != GDR_OK)
-            goto done;
-        for (uint32_t i = 0; i < n; i++)
-            if (a.indices[i] >= vertex_count) {
-                status = gltf_fail(c, GDR_ERROR_PARSE, "%s: index %u (at %u) is out of range (%u vertices)", use,
-                                   a.indices[i], i, vertex_count);
-                goto done;
-            }
-    } else {
-        n = vertex_count;
-        status = take_triangles(c, mode, n, place);
-        if (status != GDR_OK)
-            goto done;
-        a.indices = malloc(sizeof(uint32_t) * n);
-        if (!a.indices) {
-            status = gltf_fail(c, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", place);
-            goto done;
-        }
-        for (uint32_t i = 0; i < n; i++)
-            a.indices[i] = i;
-    }
+    check_normals_and_uvs(c, place, &a, vertex_count);
+    status = read_indices(c, indices_accessor, mode, vertex_count, place, &a.indices, &n);
+    if (status != GDR_OK)
+        goto done;
     if (mode == 4 && n % 3 != 0)
         gdr_io_warn(&c->warnings, "%s: %s: %u indices is not a multiple of 3; the last %u ignored", c->name, place,
                     n, n % 3);

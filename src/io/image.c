@@ -37,7 +37,7 @@ gdr_status gdr_image_decode(const void *data, size_t size, const char *name, uin
                             uint32_t *out_width, uint32_t *out_height, gdr_error *err)
 {
     *out_rgba = NULL;
-    uint32_t width, height;
+    uint32_t width = 0, height = 0;
     gdr_status status = gdr_io_image_size(data, size, name, &width, &height, err);
     if (status != GDR_OK)
         return status;

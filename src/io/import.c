@@ -91,13 +91,8 @@ static gdr_status finish_cache_read(const char *path, gdr_scene **out, gdr_pvs *
     return status;
 }
 
-gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options, gdr_scene **out, gdr_error *err)
-{
-    return gdr_scene_load_file_ex(path, options, out, NULL, err);
-}
-
-gdr_status gdr_scene_load_file_ex(const char *path, const gdr_load_options *options, gdr_scene **out,
-                                  gdr_pvs **out_pvs, gdr_error *err)
+gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options, gdr_scene **out, gdr_pvs **out_pvs,
+                               gdr_error *err)
 {
     static const gdr_load_options defaults = {0};
     if (!options)
@@ -108,7 +103,7 @@ gdr_status gdr_scene_load_file_ex(const char *path, const gdr_load_options *opti
     const char *build_options = gdr_cache_build_options();
     gdr_pvs *pvs = NULL;
     if (gdr_io_has_extension(path, ".gdrc")) {
-        gdr_status status = gdr_cache_read_ex(path, build_options, out, out_pvs ? &pvs : NULL, err);
+        gdr_status status = gdr_cache_read(path, build_options, out, out_pvs ? &pvs : NULL, err);
         return status == GDR_OK ? finish_cache_read(path, out, pvs, out_pvs, err) : status;
     }
     gdr_import_options import = {.warning = options->warning, .warning_user = options->warning_user,
@@ -143,11 +138,11 @@ gdr_status gdr_scene_load_file_ex(const char *path, const gdr_load_options *opti
     import.sources = &sources;
     gdr_status status = gdr_import_file(path, &import, out, NULL, err);
     if (status == GDR_OK) {
-        gdr_cache_source source = {build_options, &sources};
+        gdr_cache_write_options write = {.source = {build_options, &sources}};
         int written = 0;
         gdr_error write_err = {0};
         for (int i = 0; i < count && !written; i++)
-            written = gdr_cache_write(candidates[i], *out, &source, &write_err) == GDR_OK;
+            written = gdr_cache_write(candidates[i], *out, &write, &write_err) == GDR_OK;
         if (!written && count)
             warn(options, "cache not written: %s", write_err.message);
     }

@@ -80,7 +80,7 @@ gdr_status gdr_io_clean_unclustered_meshes(gdr_scene *scene, const char *name, g
 gdr_status gdr_io_image_size(const void *data, size_t size, const char *name, uint32_t *width, uint32_t *height,
                              gdr_error *err);
 
-/* gdr_cache_read_ex for the cache of `source` (NULL: a cache read on its own): the cache must
+/* gdr_cache_read for the cache of `source` (NULL: a cache read on its own): the cache must
  * record that file as the first of its sources, with the same size and contents (its folder may
  * have moved: the other sources are then looked for under the new folder), else it is stale. */
 gdr_status gdr_io_cache_read_for(const char *path, const char *source, const char *build_options, gdr_scene **out,

@@ -1,4 +1,4 @@
-/* The CPU-driven baseline (issue 7, seed 003's "before"): every frame the CPU culls the instances
+/* The CPU-driven baseline (seed 003's "before"): every frame the CPU culls the instances
  * with the gdr/cull.h library (octree, frustum planes) and records, per visible instance, seed 003's
  * six commands: its own binds (pipeline, vertex buffer, index buffer, descriptor set, push
  * constants) and one vkCmdDrawIndexed. It exists to be

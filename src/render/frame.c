@@ -86,6 +86,16 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
     slot->occlusion_applied = occlusion;
 }
 
+/* Two-phase occlusion culling where the frame asks for it, by default where it pays: on the indirect
+ * pipeline, not on the mesh pipeline, whose frames it made slower on every scene measured on the
+ * H100 (docs/OCCLUSION.md, "Which pipelines cull by default"). */
+static bool occlusion_wanted(const gdr_frame_desc *frame, gdr_pipeline pipeline)
+{
+    if (pipeline == GDR_PIPELINE_CPU || frame->cull == GDR_CULL_OFF || frame->occlusion == GDR_CULL_OFF)
+        return false;
+    return frame->occlusion == GDR_CULL_ON || pipeline == GDR_PIPELINE_INDIRECT;
+}
+
 /* Moves up to one frame's worth of pending instance updates into the slot's ring segment. */
 static uint32_t take_updates(gdr_renderer *r, gdr_frame_slot *slot)
 {
@@ -201,7 +211,7 @@ gdr_status gdr_frame_record_and_submit(gdr_renderer *r, gdr_frame_slot *slot, co
 {
     uint32_t update_count = take_updates(r, slot);
     /* Occlusion culling, with its history when the last frame left a usable one. */
-    bool occlusion = pipeline != GDR_PIPELINE_CPU && frame->cull != GDR_CULL_OFF && frame->occlusion != GDR_CULL_OFF;
+    bool occlusion = occlusion_wanted(frame, pipeline);
     bool history = occlusion && r->occlusion.history_valid && r->occlusion.history_pipeline == pipeline &&
                    !frame->occlusion_camera_cut;
     write_globals(r, slot, frame, pipeline, update_count, occlusion, history);

@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "geometry/lod_internal.h"
+#include "gdr/geometry.h"
 #include "render/renderer_internal.h"
 
 static GdrGpuInstance gpu_instance_from(const gdr_scene *scene, const gdr_instance *instance)

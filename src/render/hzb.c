@@ -132,17 +132,26 @@ static gdr_status create_descriptors(gdr_hzb *hzb, VkImageView depth_view, gdr_e
     return GDR_OK;
 }
 
-gdr_status gdr_hzb_create(gdr_vk_context *ctx, gdr_vk_allocator *allocator, const gdr_hzb_desc *desc, gdr_hzb *out,
-                          gdr_error *err)
+/* The desc with every zero field given its default. */
+static gdr_hzb_desc hzb_desc_defaults(const gdr_hzb_desc *in)
+{
+    gdr_hzb_desc d = *in;
+    d.depth_layout = d.depth_layout ? d.depth_layout : VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL;
+    d.reader_stages = d.reader_stages ? d.reader_stages : VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+    return d;
+}
+
+gdr_status gdr_hzb_create(gdr_vk_context *ctx, gdr_vk_allocator *allocator, const gdr_hzb_desc *desc_in,
+                          gdr_hzb *out, gdr_error *err)
 {
     memset(out, 0, sizeof *out);
+    const gdr_hzb_desc d = hzb_desc_defaults(desc_in), *desc = &d;
     if (desc->depth_width == 0 || desc->depth_height == 0 || !desc->depth_view)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "depth pyramid: depth size %ux%u, view %p",
                              desc->depth_width, desc->depth_height, (void *)desc->depth_view);
     gdr_hzb hzb = {.ctx = ctx, .depth_width = desc->depth_width, .depth_height = desc->depth_height,
                    .width = gdr_hzb_size_for(desc->depth_width), .height = gdr_hzb_size_for(desc->depth_height),
-                   .depth_layout = desc->depth_layout ? desc->depth_layout : VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL,
-                   .reader_stages = desc->reader_stages ? desc->reader_stages : VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT};
+                   .depth_layout = desc->depth_layout, .reader_stages = desc->reader_stages};
     hzb.level_count = level_count_for(hzb.width, hzb.height);
     if (hzb.level_count > GDR_HZB_MAX_LEVELS)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "depth pyramid: depth size %ux%u needs %u levels (at most %d)",

@@ -1,4 +1,4 @@
-/* The depth pyramid (HZB) for occlusion culling (issue 6, docs/OCCLUSION.md).
+/* The depth pyramid (HZB) for occlusion culling (docs/OCCLUSION.md).
  *
  * R32_SFLOAT, level 0 the depth size rounded DOWN to powers of two per axis (so one texel covers at
  * least one depth pixel), every level down to 1x1, each texel the minimum of the depth beneath it

@@ -1,4 +1,4 @@
-/* Two-phase occlusion culling (issue 6, docs/OCCLUSION.md): the depth pyramid the culling shaders
+/* Two-phase occlusion culling (docs/OCCLUSION.md): the depth pyramid the culling shaders
  * sample (set 0, binding 0 of every frame pipeline), the visibility history of instances and
  * clusters, and the recording of the passes between the two phases. The culling logic itself is in
  * drawcull.comp (instances) and meshlet.task (clusters). */

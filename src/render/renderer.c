@@ -59,13 +59,18 @@ static gdr_status create_targets(gdr_renderer *r, gdr_error *err)
     return GDR_OK;
 }
 
+/* The desc with every zero field (or a NULL desc) given its default. */
+static gdr_renderer_desc renderer_desc_defaults(const gdr_renderer_desc *in)
+{
+    gdr_renderer_desc d = in ? *in : (gdr_renderer_desc){0};
+    d.width = d.width ? d.width : 1280;
+    d.height = d.height ? d.height : 720;
+    return d;
+}
+
 gdr_status gdr_renderer_create(const gdr_renderer_desc *desc_in, gdr_renderer **out, gdr_error *err)
 {
-    gdr_renderer_desc desc = desc_in ? *desc_in : (gdr_renderer_desc){0};
-    if (desc.width == 0)
-        desc.width = 1280;
-    if (desc.height == 0)
-        desc.height = 720;
+    gdr_renderer_desc desc = renderer_desc_defaults(desc_in);
     if (desc.width > 16384 || desc.height > 16384)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render size %ux%u exceeds 16384x16384", desc.width,
                              desc.height);

@@ -10,15 +10,19 @@
 
 #define PI_F 3.14159265358979f
 
+/* The desc with every zero field (or a NULL desc) given its default. */
+static gdr_demo_desc demo_desc_defaults(const gdr_demo_desc *in)
+{
+    gdr_demo_desc d = in ? *in : (gdr_demo_desc){0};
+    d.instances = d.instances ? d.instances : 10000;
+    d.seed = d.seed ? d.seed : 1;
+    d.spacing = d.spacing != 0.0f ? d.spacing : 4.0f;
+    return d;
+}
+
 gdr_status gdr_scene_create_demo(const gdr_demo_desc *desc_in, gdr_scene **out, gdr_error *err)
 {
-    gdr_demo_desc desc = desc_in ? *desc_in : (gdr_demo_desc){0};
-    if (desc.instances == 0)
-        desc.instances = 10000;
-    if (desc.seed == 0)
-        desc.seed = 1;
-    if (desc.spacing == 0.0f)
-        desc.spacing = 4.0f;
+    gdr_demo_desc desc = demo_desc_defaults(desc_in);
     if (!(desc.spacing >= 3.0f && desc.spacing <= 1000.0f))
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "demo: spacing %g is outside [3, 1000]",
                              (double)desc.spacing);

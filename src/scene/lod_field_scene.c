@@ -1,4 +1,4 @@
-/* The LOD field (issue 5): one dense closed mesh, copied from near to far in front of the camera,
+/* The LOD field: one dense closed mesh, copied from near to far in front of the camera,
  * so that one view needs every level of the LOD DAG. */
 #include <math.h>
 #include <stdlib.h>
@@ -74,18 +74,21 @@ static gdr_status add_field_instances(gdr_scene *scene, const gdr_lod_field_desc
     return status;
 }
 
+/* The desc with every zero field (or a NULL desc) given its default. */
+static gdr_lod_field_desc lod_field_desc_defaults(const gdr_lod_field_desc *in)
+{
+    gdr_lod_field_desc d = in ? *in : (gdr_lod_field_desc){0};
+    d.instances = d.instances ? d.instances : 1000;
+    d.seed = d.seed ? d.seed : 1;
+    d.triangles = d.triangles ? d.triangles : 100000;
+    d.spacing = d.spacing != 0.0f ? d.spacing : 3.0f;
+    return d;
+}
+
 gdr_status gdr_scene_create_lod_field(const gdr_lod_field_desc *desc_in, gdr_scene **out, gdr_error *err)
 {
     *out = NULL;
-    gdr_lod_field_desc d = desc_in ? *desc_in : (gdr_lod_field_desc){0};
-    if (d.instances == 0)
-        d.instances = 1000;
-    if (d.seed == 0)
-        d.seed = 1;
-    if (d.triangles == 0)
-        d.triangles = 100000;
-    if (d.spacing == 0.0f)
-        d.spacing = 3.0f;
+    gdr_lod_field_desc d = lod_field_desc_defaults(desc_in);
     gdr_status status = check_desc(&d, err);
     if (status != GDR_OK)
         return status;

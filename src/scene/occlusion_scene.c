@@ -1,4 +1,4 @@
-/* The occlusion scene (issue 6): a wall of buildings between the camera and thousands of small
+/* The occlusion scene: a wall of buildings between the camera and thousands of small
  * objects, with gaps, objects in front, and a camera path that cuts, turns and looks past the wall. */
 #include <math.h>
 #include <stdio.h>
@@ -130,16 +130,20 @@ static const struct { uint32_t frame; const char *name; } path_cameras[] = {
     {0, "front"}, {70, "behind"}, {159, "past-end"}, {199, "above"}, {200, "close"}, {228, "gap"},
 };
 
+/* The desc with every zero field (or a NULL desc) given its default. */
+static gdr_occlusion_scene_desc occlusion_desc_defaults(const gdr_occlusion_scene_desc *in)
+{
+    gdr_occlusion_scene_desc d = in ? *in : (gdr_occlusion_scene_desc){0};
+    d.seed = d.seed ? d.seed : 1;
+    d.hidden = d.hidden ? d.hidden : 4000;
+    d.visible = d.visible ? d.visible : 300;
+    return d;
+}
+
 gdr_status gdr_scene_create_occlusion(const gdr_occlusion_scene_desc *desc_in, gdr_scene **out, gdr_error *err)
 {
     *out = NULL;
-    gdr_occlusion_scene_desc d = desc_in ? *desc_in : (gdr_occlusion_scene_desc){0};
-    if (d.seed == 0)
-        d.seed = 1;
-    if (d.hidden == 0)
-        d.hidden = 4000;
-    if (d.visible == 0)
-        d.visible = 300;
+    gdr_occlusion_scene_desc d = occlusion_desc_defaults(desc_in);
     if (d.hidden > 1000000u || d.visible > 1000000u)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "occlusion: %s %u is outside [1, 1000000]",
                              d.hidden > 1000000u ? "hidden" : "visible", d.hidden > 1000000u ? d.hidden : d.visible);

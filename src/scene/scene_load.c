@@ -121,7 +121,7 @@ static gdr_status create_builtin(builtin_scene which, const char *text, gdr_scen
     return status == GDR_OK ? gdr_scene_create_occlusion(&d, out, err) : status;
 }
 
-gdr_status gdr_scene_load_ex(const char *spec, const gdr_load_options *options, gdr_scene **out, gdr_error *err)
+gdr_status gdr_scene_load(const char *spec, const gdr_load_options *options, gdr_scene **out, gdr_error *err)
 {
     *out = NULL;
     const char *text;
@@ -137,10 +137,5 @@ gdr_status gdr_scene_load_ex(const char *spec, const gdr_load_options *options, 
         return status;
     }
     /* Files: .gltf / .glb / .obj through the processed-scene cache, .gdrc directly (src/io). */
-    return gdr_scene_load_file(spec, options, out, err);
-}
-
-gdr_status gdr_scene_load(const char *spec, gdr_scene **out, gdr_error *err)
-{
-    return gdr_scene_load_ex(spec, NULL, out, err);
+    return gdr_scene_load_file(spec, options, out, NULL, err);
 }

@@ -4,7 +4,7 @@
 // Both tests are conservative against the rasteriser: a triangle is culled only when its 8-bit
 // sub-pixel snapped form (Vulkan's minimum precision) could not produce a fragment either.
 // Two variants (src/shaders/CMakeLists.txt): the forward one draws the clusters its task workgroup
-// hands over in the payload; the visibility-buffer one (GDR_MESH_FROM_LIST, issue 8) is launched
+// hands over in the payload; the visibility-buffer one (GDR_MESH_FROM_LIST) is launched
 // without a task shader, one workgroup per mesh-shader entry that clustercull.comp appended to the
 // frame's visible-cluster list, and its fragments write the visibility buffer.
 #extension GL_EXT_mesh_shader : require
@@ -31,7 +31,7 @@ layout(location = 0) out vec3 out_normal[];
 layout(location = 1) out vec3 out_world_position[];
 layout(location = 2) perprimitiveEXT flat out vec4 out_color[];
 #ifdef GDR_MESH_FROM_LIST
-layout(location = 3) perprimitiveEXT flat out uint out_visibility_id[]; // list slot and triangle (issue 8)
+layout(location = 3) perprimitiveEXT flat out uint out_visibility_id[]; // list slot and triangle
 #endif
 
 shared vec3 screen[GDR_MESH_MAX_VERTICES]; // pixels (y up) and clip w

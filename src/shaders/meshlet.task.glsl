@@ -3,7 +3,7 @@
 // command (up to GDR_TASK_WORKGROUP_SIZE clusters of one visible instance), one thread per cluster
 // running the tests of shared/cluster_cull.h. Survivors are compacted into the payload with subgroup
 // ballots; one mesh workgroup each. (The visibility-buffer modes run the same tests in
-// clustercull.comp instead, issue 8.)
+// clustercull.comp instead.)
 #extension GL_EXT_mesh_shader : require
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
@@ -16,7 +16,7 @@
 #include "shared/cluster_cull.h"
 
 layout(local_size_x = GDR_TASK_WORKGROUP_SIZE) in;
-// Occlusion culling phase (issue 6): GDR_PHASE_NONE, _EARLY or _LATE.
+// Occlusion culling phase: GDR_PHASE_NONE, _EARLY or _LATE.
 layout(constant_id = 0) const uint PHASE = GDR_PHASE_NONE;
 
 taskPayloadSharedEXT GdrTaskPayload payload;

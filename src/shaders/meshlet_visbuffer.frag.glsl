@@ -1,5 +1,5 @@
 #version 460
-// The mesh-shader half of the visibility buffer (issue 8): each fragment writes its depth and
+// The mesh-shader half of the visibility buffer: each fragment writes its depth and
 // visibility id with the same 64-bit atomicMax as the compute rasteriser, so the two mix in one
 // frame. No colour and no depth attachment: the atomic is the depth test. The depth is
 // gl_FragCoord.z, the value the depth attachment would have received.

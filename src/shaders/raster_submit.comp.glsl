@@ -1,5 +1,5 @@
 #version 460
-// The launches of one raster phase (issue 8), one thread: from the clusters the cluster cull
+// The launches of one raster phase, one thread: from the clusters the cluster cull
 // appended since the last phase, the compute rasteriser's VkDispatchIndirectCommand (front of the
 // list) and the mesh shaders' VkDrawMeshTasksIndirectCommandEXT (back of the list), one workgroup per
 // cluster. Launches wider than a row use y; the shaders skip the tail of the last row. Mesh-shader

@@ -1,5 +1,5 @@
 #version 460
-// The compute rasteriser (issue 8): one workgroup per cluster that the cluster cull binned to it
+// The compute rasteriser: one workgroup per cluster that the cluster cull binned to it
 // (shared/raster_bin.h), the cluster's vertices transformed once into shared memory, then one
 // invocation per triangle. Coverage follows Vulkan's rules as the hardware applies them, so the two
 // rasterisers agree pixel for pixel where their clusters meet:

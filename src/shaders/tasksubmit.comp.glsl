@@ -7,7 +7,7 @@
 #include "shared/glsl_buffers.h"
 
 layout(local_size_x = 1) in;
-// The late phase of occlusion culling (issue 6) launches its own task commands.
+// The late phase of occlusion culling launches its own task commands.
 layout(constant_id = 0) const bool LATE = false;
 
 void main()

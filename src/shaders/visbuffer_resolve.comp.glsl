@@ -1,5 +1,5 @@
 #version 460
-// The visibility buffer's resolve (issue 8), one invocation per pixel in GDR_RESOLVE_TILE-square
+// The visibility buffer's resolve, one invocation per pixel in GDR_RESOLVE_TILE-square
 // workgroups. Each pixel's id names a cluster of the frame's list and a triangle; the triangle's
 // three vertices are fetched and transformed as the mesh shader does, the perspective-correct
 // barycentrics of the pixel centre are recomputed, and the interpolated normal and position are

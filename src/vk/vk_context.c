@@ -80,7 +80,7 @@ static gdr_status create_instance(gdr_vk_context *ctx, const gdr_vk_context_desc
                              .pEngineName = "gdr", .apiVersion = VK_API_VERSION_1_3};
     const char *layers[1] = {"VK_LAYER_KHRONOS_validation"};
     const char *extensions[1] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME};
-    bool validate = desc->validate || desc->synchronization_validation;
+    bool validate = desc->validate;
     if (validate && !layer_available(layers[0]))
         return gdr_error_set(err, GDR_ERROR_UNSUPPORTED,
                              "validation requested but VK_LAYER_KHRONOS_validation is not installed "
@@ -295,7 +295,7 @@ static gdr_status create_device(gdr_vk_context *ctx, bool disable_mesh_shaders, 
                                             .drawIndirectCount = VK_TRUE, .bufferDeviceAddress = VK_TRUE,
                                             .scalarBlockLayout = VK_TRUE, .hostQueryReset = VK_TRUE,
                                             .samplerFilterMinmax = VK_TRUE,
-                                            /* the visibility buffer (issue 8), where the device has it */
+                                            /* the visibility buffer, where the device has it */
                                             .shaderBufferInt64Atomics = f12.shaderBufferInt64Atomics};
     ctx->has_buffer_int64_atomics = f12.shaderBufferInt64Atomics == VK_TRUE;
     VkPhysicalDeviceVulkan11Features e11 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES, .pNext = &e12,
@@ -339,8 +339,17 @@ static gdr_status create_device(gdr_vk_context *ctx, bool disable_mesh_shaders, 
     return GDR_OK;
 }
 
-gdr_status gdr_vk_context_create(const gdr_vk_context_desc *desc, gdr_vk_context **out, gdr_error *err)
+/* The desc with its implied fields resolved (a NULL desc: the defaults). */
+static gdr_vk_context_desc context_desc_defaults(const gdr_vk_context_desc *in)
 {
+    gdr_vk_context_desc d = in ? *in : (gdr_vk_context_desc){0};
+    d.validate = d.validate || d.synchronization_validation; /* the layer carries the feature */
+    return d;
+}
+
+gdr_status gdr_vk_context_create(const gdr_vk_context_desc *desc_in, gdr_vk_context **out, gdr_error *err)
+{
+    const gdr_vk_context_desc d = context_desc_defaults(desc_in), *desc = &d;
     gdr_vk_context *ctx = calloc(1, sizeof *ctx);
     if (!ctx)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "out of memory");

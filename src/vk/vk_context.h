@@ -31,7 +31,7 @@ typedef struct gdr_vk_context {
     VkPhysicalDeviceMeshShaderPropertiesEXT mesh_shader_properties;
     PFN_vkCmdDrawMeshTasksIndirectEXT cmd_draw_mesh_tasks_indirect;
     /* 64-bit atomics on storage buffers (shaderBufferInt64Atomics), enabled when present: the
-     * visibility buffer of the hybrid rasteriser (issue 8) needs them. */
+     * visibility buffer of the hybrid rasteriser needs them. */
     bool has_buffer_int64_atomics;
     uint32_t subgroup_size;
     char driver_info[VK_MAX_DRIVER_NAME_SIZE + VK_MAX_DRIVER_INFO_SIZE + 2]; /* driver name and version, for stats and PERFORMANCE.md */

@@ -115,7 +115,7 @@ ls "$work" | grep -q '\.tmp\.' && { echo "FAIL: temporary files left behind"; fa
 expect 0 "bench" "$gdr" bench --sizes 20,40 --frames 2 $small --json "$work/bench.json" --validate
 grep -q '"instances_total"' "$work/bench.json" || { echo "FAIL: bench JSON"; failures=$((failures + 1)); }
 
-# The built-in scenes for LOD (issue 5) and occlusion (issue 6), rendered small; info and build
+# The built-in scenes for LOD and occlusion, rendered small; info and build
 # accept them; bad options are errors.
 tiny="--width 160 --height 90"
 # shellcheck disable=SC2086
@@ -141,7 +141,7 @@ expect 2 "occlusion zero hidden" "$gdr" build occlusion:hidden=0 -o "$work/bad.g
 }
 [ ! -e "$work/bad.gdrc" ] || { echo "FAIL: a failed build left a cache"; failures=$((failures + 1)); }
 
-# Precomputed visibility in the cache (issue 7): gdr build --pvs bakes it, gdr info reports it,
+# Precomputed visibility in the cache: gdr build --pvs bakes it, gdr info reports it,
 # a rebuild from the .gdrc keeps it, a damaged section is refused by name, a failed bake writes
 # nothing.
 printf 'g floor\nv -4 0 -4\nv 4 0 -4\nv 4 0 4\nv -4 0 4\nf 1 3 2\nf 1 4 3\ng wall\nv -4 0 0\nv 4 0 0\nv 4 2 0\nv -4 2 0\nf 5 6 7\nf 5 7 8\n' >"$work/room.obj"

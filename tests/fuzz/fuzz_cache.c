@@ -85,7 +85,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     gdr_scene *scene = NULL;
     gdr_pvs *pvs = NULL;
     gdr_error err;
-    if (gdr_cache_read_memory_ex(copy, size, "fuzz.gdrc", &scene, &pvs, &err) == GDR_OK) {
+    if (gdr_cache_read_memory(copy, size, "fuzz.gdrc", &scene, &pvs, &err) == GDR_OK) {
         if (pvs) {
             size_t n = gdr_pvs_serialized_size(pvs), length = 0;
             const uint8_t *section = pvs_section(copy, &length);

@@ -76,9 +76,9 @@ static void test_round_trip(void)
     char path[1024];
     path_for(path, sizeof path, "clusters");
     gdr_error err = {0};
-    CHECK(gdr_cache_write(path, s, &(gdr_cache_source){gdr_cache_build_options(), NULL}, &err) == GDR_OK);
+    CHECK(gdr_cache_write(path, s, &(gdr_cache_write_options){.source = {gdr_cache_build_options(), NULL}}, &err) == GDR_OK);
     gdr_scene *loaded = NULL;
-    CHECK(gdr_cache_read(path, gdr_cache_build_options(), &loaded, &err) == GDR_OK);
+    CHECK(gdr_cache_read(path, gdr_cache_build_options(), &loaded, NULL, &err) == GDR_OK);
     CHECK(loaded && loaded->mesh_count == s->mesh_count);
     for (uint32_t i = 0; loaded && i < s->mesh_count; i++) {
         CHECK(same_clusters(&s->meshes[i].clusters, &loaded->meshes[i].clusters));
@@ -90,10 +90,10 @@ static void test_round_trip(void)
     CHECK(loaded && loaded->meshes[s->mesh_count - 1].clusters.cluster_count == 0);
     gdr_scene_destroy(loaded);
 
-    /* Loading the file through gdr_scene_load_ex keeps what the cache holds and builds only what
+    /* Loading the file through gdr_scene_load keeps what the cache holds and builds only what
      * it lacks. */
     loaded = NULL;
-    CHECK(gdr_scene_load_ex(path, &(gdr_load_options){.no_progress = 1}, &loaded, &err) == GDR_OK);
+    CHECK(gdr_scene_load(path, &(gdr_load_options){.no_progress = 1}, &loaded, &err) == GDR_OK);
     for (uint32_t i = 0; loaded && i + 1 < s->mesh_count; i++)
         CHECK(same_clusters(&s->meshes[i].clusters, &loaded->meshes[i].clusters));
     const gdr_mesh *unbuilt = loaded ? &loaded->meshes[loaded->mesh_count - 1] : NULL;
@@ -181,10 +181,10 @@ static void run_cases(const uint8_t *good, uint8_t *bad, size_t size, const corr
         else
             put32(sec.data + k->at, k->value);
         gdr_scene *out = NULL;
-        CHECK(gdr_cache_read_memory(bad, size, "corrupt.gdrc", &out, &err) == GDR_ERROR_PARSE && out == NULL);
+        CHECK(gdr_cache_read_memory(bad, size, "corrupt.gdrc", &out, NULL, &err) == GDR_ERROR_PARSE && out == NULL);
         CHECK(strstr(err.message, "corrupted: section") != NULL);
         fix_checksums(bad);
-        gdr_status status = gdr_cache_read_memory(bad, size, "corrupt.gdrc", &out, &err);
+        gdr_status status = gdr_cache_read_memory(bad, size, "corrupt.gdrc", &out, NULL, &err);
         CHECK(status == GDR_ERROR_PARSE && out == NULL);
         CHECK(strncmp(err.message, "corrupt.gdrc: ", 14) == 0 && strstr(err.message, k->what) != NULL);
         if (!strstr(err.message, k->what))
@@ -292,19 +292,19 @@ static void test_corruption(void)
     put32(sec.entry + 4, 0);
     fix_checksums(bad);
     gdr_scene *out = NULL;
-    CHECK(gdr_cache_read_memory(bad, size, "corrupt.gdrc", &out, &err) == GDR_ERROR_PARSE);
+    CHECK(gdr_cache_read_memory(bad, size, "corrupt.gdrc", &out, NULL, &err) == GDR_ERROR_PARSE);
     CHECK(strstr(err.message, "corrupt.gdrc: section 'CLDT' is missing") != NULL);
     /* A version-1 file (no clusters) is refused by version: rebuilt by the loader. */
     memcpy(bad, good, size);
     put32(bad + 8, 1);
     fix_checksums(bad);
-    CHECK(gdr_cache_read_memory(bad, size, "corrupt.gdrc", &out, &err) == GDR_ERROR_UNSUPPORTED);
+    CHECK(gdr_cache_read_memory(bad, size, "corrupt.gdrc", &out, NULL, &err) == GDR_ERROR_UNSUPPORTED);
     char expected[96];
     snprintf(expected, sizeof expected, "cache format version 1, this build reads %u; rebuild it",
              GDR_CACHE_FORMAT_VERSION);
     CHECK(strstr(err.message, expected) != NULL);
     /* The untouched file still reads, and the edits above really did go through the parser. */
-    CHECK(gdr_cache_read_memory(good, size, "corrupt.gdrc", &out, &err) == GDR_OK);
+    CHECK(gdr_cache_read_memory(good, size, "corrupt.gdrc", &out, NULL, &err) == GDR_OK);
     CHECK(out && same_clusters(&out->meshes[0].clusters, c));
     CHECK(get32(find_section(good, "CLUS").data) == c->cluster_count);
     gdr_scene_destroy(out);

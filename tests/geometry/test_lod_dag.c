@@ -1,4 +1,4 @@
-/* The cluster LOD DAG (issue 5): the invariants of gdr/geometry.h on closed, open, seamed,
+/* The cluster LOD DAG: the invariants of gdr/geometry.h on closed, open, seamed,
  * degenerate and disconnected meshes, the CPU cut (exactly level 0 at threshold 0, exactly the
  * root at a huge one, every source-to-sink path of the DAG crossed exactly once and no crack for
  * random views), the discrete depth cut, determinism over thread counts, options and bad input. */

@@ -122,7 +122,7 @@ static void check_resubmission(void)
 int main(void)
 {
     gdr_error err = {0};
-    CHECK(gdr_scene_load("demo:instances=256,seed=11", &scene, &err) == GDR_OK);
+    CHECK(gdr_scene_load("demo:instances=256,seed=11", NULL, &scene, &err) == GDR_OK);
     if (!scene)
         return test_finish("test_gpu_culling");
     renderer = gpu_test_renderer(WIDTH, HEIGHT, scene);

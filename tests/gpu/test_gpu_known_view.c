@@ -13,7 +13,7 @@ int main(void)
     gdr_error err = {0};
     gdr_scene *scene = NULL;
     /* A 10 x 10 grid, spacing 4: object centres at x, z in {-18, -14, ..., 18}; instance 0 is the ground. */
-    CHECK(gdr_scene_load("demo:instances=100,seed=5", &scene, &err) == GDR_OK);
+    CHECK(gdr_scene_load("demo:instances=100,seed=5", NULL, &scene, &err) == GDR_OK);
     gdr_renderer *renderer = scene ? gpu_test_renderer(WIDTH, HEIGHT, scene) : NULL;
     if (!renderer) {
         CHECK(false);

@@ -1,4 +1,4 @@
-/* The LOD cut on the GPU (issue 5), on the default device (lavapipe in CI), validation on:
+/* The LOD cut on the GPU, on the default device (lavapipe in CI), validation on:
  *  - the clusters the task shaders select equal the CPU reference cut (geometry/lod_cut.h) for many
  *    cameras, thresholds and instance transforms, and the discrete depth cut exactly;
  *  - no cracks: a closed dense mesh rendered at several thresholds shows no background inside the
@@ -156,7 +156,7 @@ static void check_cuts(void)
 {
     gdr_error err = {0};
     gdr_scene *scenes[2] = {blob_scene(4, 24), NULL};
-    CHECK(gdr_scene_load("demo:instances=150,seed=11", &scenes[1], &err) == GDR_OK);
+    CHECK(gdr_scene_load("demo:instances=150,seed=11", NULL, &scenes[1], &err) == GDR_OK);
     const char *names[2] = {"blob row", "demo"};
     for (int s = 0; s < 2; s++) {
         gdr_scene *scene = scenes[s];

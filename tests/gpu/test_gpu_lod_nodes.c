@@ -20,7 +20,7 @@ static void check_scene(const char *spec)
 {
     gdr_error err = {0};
     gdr_scene *scene = NULL;
-    CHECK(gdr_scene_load_ex(spec, &(gdr_load_options){.no_progress = 1}, &scene, &err) == GDR_OK);
+    CHECK(gdr_scene_load(spec, &(gdr_load_options){.no_progress = 1}, &scene, &err) == GDR_OK);
     gdr_renderer *r = scene ? gpu_test_renderer(64, 64, scene) : NULL;
     CHECK(r != NULL);
     if (!r) {

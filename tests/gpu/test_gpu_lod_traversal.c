@@ -158,7 +158,7 @@ int main(void)
 {
     gdr_error err = {0};
     gdr_scene *scene = NULL;
-    CHECK(gdr_scene_load("lod-field:instances=60,triangles=30000,seed=3", &scene, &err) == GDR_OK);
+    CHECK(gdr_scene_load("lod-field:instances=60,triangles=30000,seed=3", NULL, &scene, &err) == GDR_OK);
     gdr_renderer *r = scene ? make_renderer(scene, (gdr_renderer_desc){0}) : NULL;
     if (r) {
         check_same_as_flat(r, 11);

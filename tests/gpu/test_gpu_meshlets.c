@@ -1,4 +1,4 @@
-/* The meshlet pipeline (issue 4) and the CPU-driven pipeline (issue 7) on the default device
+/* The meshlet pipeline and the CPU-driven pipeline on the default device
  * (lavapipe in CI), validation on:
  *  - culling at every level (instances, clusters by frustum and cone, triangles) never changes the
  *    image, for random cameras, cameras inside meshes and grazing views;
@@ -176,7 +176,7 @@ static void check_demo(void)
 {
     gdr_error err = {0};
     gdr_scene *scene = NULL;
-    CHECK(gdr_scene_load("demo:instances=144,seed=5", &scene, &err) == GDR_OK);
+    CHECK(gdr_scene_load("demo:instances=144,seed=5", NULL, &scene, &err) == GDR_OK);
     CHECK(scene && gdr_scene_build_clusters(scene, NULL, &err) == GDR_OK);
     renderer = scene ? gpu_test_renderer(WIDTH, HEIGHT, scene) : NULL;
     if (!renderer) {
@@ -244,7 +244,7 @@ static void check_gltf(void)
     gdr_error err = {0};
     gdr_scene *scene = NULL;
     gdr_load_options options = {.no_cache = 1, .no_progress = 1};
-    if (gdr_scene_load_ex(path, &options, &scene, &err) != GDR_OK) {
+    if (gdr_scene_load(path, &options, &scene, &err) != GDR_OK) {
         fprintf(stderr, "%s: %s\n", path, err.message);
         CHECK(false);
         return;

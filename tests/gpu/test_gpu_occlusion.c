@@ -1,4 +1,4 @@
-/* Two-phase occlusion culling (issue 6) on the default device (lavapipe in CI), with validation and
+/* Two-phase occlusion culling on the default device (lavapipe in CI), with validation and
  * synchronization validation on:
  *  - along the occlusion scene's camera path (240 frames: dolly, turns, camera cuts, objects coming
  *    out from behind the wall), the image with occlusion culling equals the image without it, pixel

@@ -1,4 +1,4 @@
-/* Hybrid rasterisation (issue 8) on the default device (lavapipe in CI), validation on:
+/* Hybrid rasterisation on the default device (lavapipe in CI), validation on:
  *  - coverage rules: crafted triangles (edges through pixel centres, vertices on pixel centres, a
  *    fan around a sample, a jittered mesh with edges at every slope, slivers, sub-pixel triangles,
  *    back faces) are covered by the compute rasteriser exactly as by the hardware, pixel for pixel,
@@ -167,7 +167,7 @@ static gdr_scene *load(const char *spec)
     gdr_error err = {0};
     gdr_scene *scene = NULL;
     gdr_load_options options = {.no_cache = 1, .no_progress = 1};
-    if (gdr_scene_load_ex(spec, &options, &scene, &err) != GDR_OK) {
+    if (gdr_scene_load(spec, &options, &scene, &err) != GDR_OK) {
         fprintf(stderr, "%s: %s\n", spec, err.message);
         CHECK(false);
         return NULL;

@@ -13,7 +13,7 @@ static void check_file(const char *relative, double min_coverage)
     gdr_error err = {0};
     gdr_scene *scene = NULL;
     gdr_load_options options = {.no_cache = 1, .no_progress = 1};
-    if (gdr_scene_load_ex(path, &options, &scene, &err) != GDR_OK) {
+    if (gdr_scene_load(path, &options, &scene, &err) != GDR_OK) {
         fprintf(stderr, "%s: %s\n", relative, err.message);
         CHECK(false);
         return;

@@ -1,6 +1,6 @@
 /* The processed-scene cache: build -> load gives an identical scene; every truncation and many
  * random byte flips are refused cleanly; stale, foreign-version and unknown-section handling;
- * gdr_scene_load_ex uses and rebuilds the cache next to the source; the optional precomputed
+ * gdr_scene_load uses and rebuilds the cache next to the source; the optional precomputed
  * visibility section (PVIS): round trip, absent, truncated, flipped, mismatched. */
 #include <stdio.h>
 #include <stdlib.h>
@@ -58,10 +58,10 @@ static void test_round_trip_and_corruption(const char *label, gdr_scene *scene)
     char path[1024];
     snprintf(path, sizeof path, "%s/%s.gdrc", GDR_IO_TEST_TMP, label);
     gdr_error err = {0};
-    gdr_cache_source source = {gdr_cache_build_options(), NULL};
-    CHECK(gdr_cache_write(path, scene, &source, &err) == GDR_OK);
+    gdr_cache_write_options plain_options = {.source = {gdr_cache_build_options(), NULL}};
+    CHECK(gdr_cache_write(path, scene, &plain_options, &err) == GDR_OK);
     gdr_scene *loaded = NULL;
-    CHECK(gdr_cache_read(path, gdr_cache_build_options(), &loaded, &err) == GDR_OK);
+    CHECK(gdr_cache_read(path, gdr_cache_build_options(), &loaded, NULL, &err) == GDR_OK);
     CHECK(loaded && same_scene(scene, loaded));
     gdr_scene_destroy(loaded);
 
@@ -75,7 +75,7 @@ static void test_round_trip_and_corruption(const char *label, gdr_scene *scene)
     unsigned refused = 0;
     for (size_t cut = 0; cut < size; cut += step) {
         gdr_scene *s = NULL;
-        gdr_status status = gdr_cache_read_memory(data, cut, label, &s, &err);
+        gdr_status status = gdr_cache_read_memory(data, cut, label, &s, NULL, &err);
         refused += status != GDR_OK;
         CHECK(status != GDR_OK && s == NULL);
         CHECK(strstr(err.message, label) != NULL);
@@ -91,7 +91,7 @@ static void test_round_trip_and_corruption(const char *label, gdr_scene *scene)
             copy[at] ^= (uint8_t)(1u + (unsigned)(test_random(&seed) * 254.0f));
         }
         gdr_scene *s = NULL;
-        gdr_status status = gdr_cache_read_memory(copy, size, label, &s, &err);
+        gdr_status status = gdr_cache_read_memory(copy, size, label, &s, NULL, &err);
         if (status == GDR_OK) {
             /* Only possible if flips cancelled out. */
             CHECK(memcmp(copy, data, size) == 0);
@@ -105,7 +105,7 @@ static void test_round_trip_and_corruption(const char *label, gdr_scene *scene)
     memcpy(copy, data, size);
     copy[8] = 99;
     gdr_scene *s = NULL;
-    CHECK(gdr_cache_read_memory(copy, size, label, &s, &err) == GDR_ERROR_UNSUPPORTED);
+    CHECK(gdr_cache_read_memory(copy, size, label, &s, NULL, &err) == GDR_ERROR_UNSUPPORTED);
     char expected[80];
     snprintf(expected, sizeof expected, "cache format version 99, this build reads %u", GDR_CACHE_FORMAT_VERSION);
     CHECK(strstr(err.message, expected) != NULL);
@@ -135,7 +135,7 @@ static void test_unknown_sections(gdr_scene *scene)
     h = XXH3_64bits(data, 40);
     memcpy(data + 40, &h, 8);
     gdr_scene *s = NULL;
-    CHECK(gdr_cache_read_memory(data, size, "sections", &s, &err) == GDR_OK);
+    CHECK(gdr_cache_read_memory(data, size, "sections", &s, NULL, &err) == GDR_OK);
     CHECK(s && same_scene(s, scene));
     gdr_scene_destroy(s);
     uint32_t required = 1;
@@ -145,12 +145,12 @@ static void test_unknown_sections(gdr_scene *scene)
     h = XXH3_64bits(data, 40);
     memcpy(data + 40, &h, 8);
     s = NULL;
-    CHECK(gdr_cache_read_memory(data, size, "sections", &s, &err) == GDR_ERROR_UNSUPPORTED);
+    CHECK(gdr_cache_read_memory(data, size, "sections", &s, NULL, &err) == GDR_ERROR_UNSUPPORTED);
     CHECK(strstr(err.message, "requires section 'LODX'") != NULL);
     free(data);
 }
 
-/* gdr_scene_load_ex: first load imports and writes SOURCE.gdrc; the second reads it; touching
+/* gdr_scene_load: first load imports and writes SOURCE.gdrc; the second reads it; touching
  * the source without changing it keeps it; changing the source rebuilds it. */
 static void test_automatic_cache(void)
 {
@@ -163,12 +163,12 @@ static void test_automatic_cache(void)
     gdr_load_options options = {.no_progress = 1};
     gdr_error err = {0};
     gdr_scene *s = NULL;
-    CHECK(gdr_scene_load_ex(obj, &options, &s, &err) == GDR_OK);
+    CHECK(gdr_scene_load(obj, &options, &s, &err) == GDR_OK);
     CHECK(access(cache, F_OK) == 0);
     gdr_scene_destroy(s);
     /* Replace the cache's geometry marker: a cache with 2 triangles proves the cache is read. */
     gdr_scene *two = NULL;
-    CHECK(gdr_scene_load_ex(obj, &(gdr_load_options){.no_cache = 1}, &two, &err) == GDR_OK);
+    CHECK(gdr_scene_load(obj, &(gdr_load_options){.no_cache = 1}, &two, &err) == GDR_OK);
     gdr_instance copy = two->instances[0];
     CHECK(gdr_scene_add_instance(two, &copy, &err) == GDR_OK);
     gdr_source_list sources = {0};
@@ -176,35 +176,35 @@ static void test_automatic_cache(void)
     gdr_scene *tmp = NULL;
     CHECK(gdr_import_file(obj, &import, &tmp, NULL, &err) == GDR_OK);
     gdr_scene_destroy(tmp);
-    gdr_cache_source source = {gdr_cache_build_options(), &sources};
-    CHECK(gdr_cache_write(cache, two, &source, &err) == GDR_OK);
+    gdr_cache_write_options plain_options = {.source = {gdr_cache_build_options(), &sources}};
+    CHECK(gdr_cache_write(cache, two, &plain_options, &err) == GDR_OK);
     gdr_scene_destroy(two);
     s = NULL;
-    CHECK(gdr_scene_load_ex(obj, &options, &s, &err) == GDR_OK);
+    CHECK(gdr_scene_load(obj, &options, &s, &err) == GDR_OK);
     CHECK(s && s->instance_count == 2); /* from the cache */
     gdr_scene_destroy(s);
     /* Same contents, new mtime: still fresh (the hash decides). */
     CHECK(test_write_file(obj, text, strlen(text)));
     s = NULL;
-    CHECK(gdr_scene_load_ex(obj, &options, &s, &err) == GDR_OK);
+    CHECK(gdr_scene_load(obj, &options, &s, &err) == GDR_OK);
     CHECK(s && s->instance_count == 2);
     gdr_scene_destroy(s);
     /* Changed source: the cache is stale, refused when read directly, rebuilt automatically. */
     const char *text2 = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
     CHECK(test_write_file(obj, text2, strlen(text2)));
     s = NULL;
-    CHECK(gdr_cache_read(cache, gdr_cache_build_options(), &s, &err) != GDR_OK);
+    CHECK(gdr_cache_read(cache, gdr_cache_build_options(), &s, NULL, &err) != GDR_OK);
     CHECK(strstr(err.message, "stale") != NULL);
-    CHECK(gdr_scene_load_ex(obj, &options, &s, &err) == GDR_OK);
+    CHECK(gdr_scene_load(obj, &options, &s, &err) == GDR_OK);
     CHECK(s && s->instance_count == 1 && s->meshes[0].index_count == 6);
     gdr_scene_destroy(s);
     s = NULL;
-    CHECK(gdr_cache_read(cache, gdr_cache_build_options(), &s, &err) == GDR_OK); /* rewritten */
+    CHECK(gdr_cache_read(cache, gdr_cache_build_options(), &s, NULL, &err) == GDR_OK); /* rewritten */
     CHECK(s && s->meshes[0].index_count == 6);
     gdr_scene_destroy(s);
     /* A build with other options is stale. */
     s = NULL;
-    CHECK(gdr_cache_read(cache, "import=0", &s, &err) != GDR_OK && strstr(err.message, "stale: built with options"));
+    CHECK(gdr_cache_read(cache, "import=0", &s, NULL, &err) != GDR_OK && strstr(err.message, "stale: built with options"));
     /* A corrupted cache is reported and rebuilt. */
     size_t size;
     uint8_t *data = test_read_file(cache, &size);
@@ -214,7 +214,7 @@ static void test_automatic_cache(void)
     test_warnings w = {0};
     options.warning = test_collect_warning;
     options.warning_user = &w;
-    CHECK(gdr_scene_load_ex(obj, &options, &s, &err) == GDR_OK);
+    CHECK(gdr_scene_load(obj, &options, &s, &err) == GDR_OK);
     CHECK(w.count == 1 && strstr(w.text, "corrupted") && strstr(w.text, "rebuilding"));
     gdr_scene_destroy(s);
     /* A cache folder. */
@@ -222,7 +222,7 @@ static void test_automatic_cache(void)
     snprintf(dir, sizeof dir, "%s/cache-dir", GDR_IO_TEST_TMP);
     options.cache_dir = dir;
     s = NULL;
-    CHECK(gdr_scene_load_ex(obj, &options, &s, &err) == GDR_OK);
+    CHECK(gdr_scene_load(obj, &options, &s, &err) == GDR_OK);
     gdr_scene_destroy(s);
     char in_dir[1400];
     CHECK(gdr_cache_path_for(obj, dir, in_dir, sizeof in_dir) > 0);
@@ -332,7 +332,7 @@ static void expect_refused(const uint8_t *data, size_t size, const char *what, g
     gdr_scene *s = (gdr_scene *)(uintptr_t)1;
     gdr_pvs *pvs = (gdr_pvs *)(uintptr_t)1;
     gdr_error err = {0};
-    gdr_status status = gdr_cache_read_memory_ex(data, size, "pvs.gdrc", &s, &pvs, &err);
+    gdr_status status = gdr_cache_read_memory(data, size, "pvs.gdrc", &s, &pvs, &err);
     CHECK(status != GDR_OK && s == NULL && pvs == NULL);
     CHECK(strstr(err.message, "pvs.gdrc") != NULL);
     if (what && !strstr(err.message, what)) {
@@ -359,13 +359,14 @@ static void test_pvs_section(void)
     snprintf(path, sizeof path, "%s/pvs.gdrc", GDR_IO_TEST_TMP);
     snprintf(plain, sizeof plain, "%s/no-pvs.gdrc", GDR_IO_TEST_TMP);
     gdr_error err = {0};
-    gdr_cache_source source = {gdr_cache_build_options(), NULL};
+    gdr_cache_write_options plain_options = {.source = {gdr_cache_build_options(), NULL}};
+    gdr_cache_write_options with_pvs = {.source = plain_options.source, .pvs = pvs};
 
     /* Round trip: the same scene and, byte for byte, the same PVS. */
-    CHECK(gdr_cache_write_ex(path, scene, &source, pvs, &err) == GDR_OK);
+    CHECK(gdr_cache_write(path, scene, &with_pvs, &err) == GDR_OK);
     gdr_scene *loaded = NULL;
     gdr_pvs *back = NULL;
-    CHECK(gdr_cache_read_ex(path, gdr_cache_build_options(), &loaded, &back, &err) == GDR_OK);
+    CHECK(gdr_cache_read(path, gdr_cache_build_options(), &loaded, &back, &err) == GDR_OK);
     CHECK(loaded && same_scene(scene, loaded));
     CHECK(back != NULL);
     if (back) {
@@ -377,22 +378,22 @@ static void test_pvs_section(void)
     }
     gdr_pvs_destroy(back);
     gdr_scene_destroy(loaded);
-    /* Readers that do not ask for it still load the scene; so does gdr_scene_load_file(_ex). */
+    /* Readers that do not ask for it still load the scene; so does gdr_scene_load_file. */
     loaded = NULL;
-    CHECK(gdr_cache_read(path, gdr_cache_build_options(), &loaded, &err) == GDR_OK && loaded);
+    CHECK(gdr_cache_read(path, gdr_cache_build_options(), &loaded, NULL, &err) == GDR_OK && loaded);
     gdr_scene_destroy(loaded);
     loaded = NULL;
     back = NULL;
-    CHECK(gdr_scene_load_file_ex(path, NULL, &loaded, &back, &err) == GDR_OK && loaded && back);
+    CHECK(gdr_scene_load_file(path, NULL, &loaded, &back, &err) == GDR_OK && loaded && back);
     CHECK(back && gdr_pvs_cell_count(back) == gdr_pvs_cell_count(pvs));
     gdr_pvs_destroy(back);
     gdr_scene_destroy(loaded);
 
     /* A cache without the section: loads, and says there is none. */
-    CHECK(gdr_cache_write(plain, scene, &source, &err) == GDR_OK);
+    CHECK(gdr_cache_write(plain, scene, &plain_options, &err) == GDR_OK);
     loaded = NULL;
     back = (gdr_pvs *)(uintptr_t)1;
-    CHECK(gdr_cache_read_ex(plain, NULL, &loaded, &back, &err) == GDR_OK && loaded && back == NULL);
+    CHECK(gdr_cache_read(plain, NULL, &loaded, &back, &err) == GDR_OK && loaded && back == NULL);
     gdr_scene_destroy(loaded);
 
     /* A PVS baked for another scene is refused by the writer; nothing is written. */
@@ -402,7 +403,7 @@ static void test_pvs_section(void)
     char wrong[1100];
     snprintf(wrong, sizeof wrong, "%s/wrong-pvs.gdrc", GDR_IO_TEST_TMP);
     unlink(wrong);
-    CHECK(gdr_cache_write_ex(wrong, other, &source, pvs, &err) == GDR_ERROR_INVALID_ARGUMENT);
+    CHECK(gdr_cache_write(wrong, other, &with_pvs, &err) == GDR_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(err.message, "baked for 43 objects, the scene has 44 instances") != NULL);
     CHECK(access(wrong, F_OK) != 0);
     gdr_scene_destroy(other);

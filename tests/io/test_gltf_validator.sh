@@ -38,7 +38,7 @@ failures=0 valid=0 invalid=0 loaded=0 refused=0 unsupported=0
 while IFS="$(printf '\t')" read -r verdict errors file; do
     timeout 10 "$gdr" info "$file" --no-cache > "$work/out" 2> "$work/err"
     status=$?
-    message=$(grep '^gdr: ' "$work/err" | grep -v '^gdr: warning:' | head -1)
+    message=$(grep -a '^gdr: ' "$work/err" | grep -av '^gdr: warning:' | head -1) # -a: a message may quote bytes that are not text
     if [ "$verdict" = valid ]; then valid=$((valid + 1)); else invalid=$((invalid + 1)); fi
     if [ $status -eq 0 ]; then
         loaded=$((loaded + 1))

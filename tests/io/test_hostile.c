@@ -272,18 +272,18 @@ static void test_fifo(void)
     CHECK(test_write_file(file, text, strlen(text)));
     gdr_scene *s = gltf_file(file, NULL, 0);
     CHECK(!s && strstr(err.message, "not a regular file"));
-    CHECK(gdr_cache_read(fifo, NULL, &s, &err) != GDR_OK && strstr(err.message, "not a regular file"));
+    CHECK(gdr_cache_read(fifo, NULL, &s, NULL, &err) != GDR_OK && strstr(err.message, "not a regular file"));
     /* A cache whose source list names the FIFO (with another mtime: its contents would be read). */
     char cache[1200];
     snprintf(cache, sizeof cache, "%s/fifo_list.gdrc", dir);
     s = obj_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", NULL);
     gdr_source_file f = {fifo, 0, 1, 42};
     gdr_source_list list = {&f, 1, 1};
-    gdr_cache_source source = {gdr_cache_build_options(), &list};
-    CHECK(s && gdr_cache_write(cache, s, &source, &err) == GDR_OK);
+    gdr_cache_write_options write = {.source = {gdr_cache_build_options(), &list}};
+    CHECK(s && gdr_cache_write(cache, s, &write, &err) == GDR_OK);
     gdr_scene_destroy(s);
     s = NULL;
-    CHECK(gdr_cache_read(cache, gdr_cache_build_options(), &s, &err) == GDR_OK);
+    CHECK(gdr_cache_read(cache, gdr_cache_build_options(), &s, NULL, &err) == GDR_OK);
     gdr_scene_destroy(s);
     alarm(0);
     unlink(fifo);
@@ -310,14 +310,14 @@ static void test_source_list_repeats(void)
         for (uint32_t i = 0; i < counts[k]; i++)
             files[i] = (gdr_source_file){big, size, 1 /* another mtime: contents compared */, hash};
         gdr_source_list list = {files, counts[k], counts[k]};
-        gdr_cache_source source = {gdr_cache_build_options(), &list};
+        gdr_cache_write_options write = {.source = {gdr_cache_build_options(), &list}};
         snprintf(cache, sizeof cache, "%s/repeats%d.gdrc", dir, k);
-        CHECK(gdr_cache_write(cache, s, &source, &err) == GDR_OK);
+        CHECK(gdr_cache_write(cache, s, &write, &err) == GDR_OK);
         free(files);
         struct timespec t0, t1;
         clock_gettime(CLOCK_MONOTONIC, &t0);
         gdr_scene *loaded = NULL;
-        CHECK(gdr_cache_read(cache, gdr_cache_build_options(), &loaded, &err) == GDR_OK); /* every entry fresh */
+        CHECK(gdr_cache_read(cache, gdr_cache_build_options(), &loaded, NULL, &err) == GDR_OK); /* every entry fresh */
         clock_gettime(CLOCK_MONOTONIC, &t1);
         seconds[k] = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
         gdr_scene_destroy(loaded);
@@ -356,7 +356,7 @@ static void test_cache_knows_its_source(void)
     CHECK(test_write_file(a_obj, one, strlen(one)));
     gdr_load_options o = {.no_progress = 1, .warning = test_collect_warning, .warning_user = &warnings};
     gdr_scene *s = NULL;
-    CHECK(gdr_scene_load_file(a_obj, &o, &s, &err) == GDR_OK && access(a_cache, F_OK) == 0);
+    CHECK(gdr_scene_load_file(a_obj, &o, &s, NULL, &err) == GDR_OK && access(a_cache, F_OK) == 0);
     gdr_scene_destroy(s);
     for (int edit = 0; edit < 2; edit++) {
         copy_file(a_cache, b_cache);
@@ -368,14 +368,14 @@ static void test_cache_knows_its_source(void)
         struct timespec times[2] = {st.st_atim, st.st_mtim};
         CHECK(utimensat(AT_FDCWD, b_obj, times, 0) == 0);
         s = NULL;
-        CHECK(gdr_scene_load_file(b_obj, &o, &s, &err) == GDR_OK);
+        CHECK(gdr_scene_load_file(b_obj, &o, &s, NULL, &err) == GDR_OK);
         float extent = s ? s->meshes[0].positions[1].x : 0;
         CHECK(s && s->meshes[0].index_count == (edit == 0 ? 3u : 6u) && extent == (edit == 0 ? 2.0f : 1.0f));
         gdr_scene_destroy(s);
     }
     /* A's own cache is still used for A. */
     s = NULL;
-    CHECK(gdr_scene_load_file(a_obj, &o, &s, &err) == GDR_OK && s && s->meshes[0].positions[1].x == 1.0f);
+    CHECK(gdr_scene_load_file(a_obj, &o, &s, NULL, &err) == GDR_OK && s && s->meshes[0].positions[1].x == 1.0f);
     gdr_scene_destroy(s);
 }
 

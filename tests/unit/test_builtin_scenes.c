@@ -1,5 +1,5 @@
-/* The built-in scenes made for tests and benchmarks: "lod-field" (issue 5) and "occlusion"
- * (issue 6). Small sizes: the LOD DAG of the field's mesh costs about 0.2 s per 100k triangles. */
+/* The built-in scenes made for tests and benchmarks: "lod-field" and "occlusion".
+ * Small sizes: the LOD DAG of the field's mesh costs about 0.2 s per 100k triangles. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -102,7 +102,7 @@ static void check_bad_specs(const char *const *bad, size_t count, const char *pr
     for (size_t i = 0; i < count; i++) {
         gdr_error err = {0};
         gdr_scene *scene = NULL;
-        gdr_status status = gdr_scene_load(bad[i], &scene, &err);
+        gdr_status status = gdr_scene_load(bad[i], NULL, &scene, &err);
         CHECK(status == GDR_ERROR_INVALID_ARGUMENT);
         CHECK(scene == NULL);
         if (status == GDR_OK || strncmp(err.message, prefix, strlen(prefix)) != 0) {
@@ -119,7 +119,7 @@ static void test_lod_field_load(void)
 {
     gdr_error err = {0};
     gdr_scene *scene = NULL, *again = NULL, *other = NULL;
-    CHECK(gdr_scene_load("lod-field:instances=60,triangles=3000,seed=7", &scene, &err) == GDR_OK);
+    CHECK(gdr_scene_load("lod-field:instances=60,triangles=3000,seed=7", NULL, &scene, &err) == GDR_OK);
     if (!scene) {
         fprintf(stderr, "%s\n", err.message);
         test_failure_count++;
@@ -139,9 +139,9 @@ static void test_lod_field_load(void)
 
     /* The same specification, options in another order, gives the same bytes; another seed moves
      * the copies but keeps the mesh. */
-    CHECK(gdr_scene_load("lod-field:seed=7,triangles=3000,instances=60", &again, &err) == GDR_OK);
+    CHECK(gdr_scene_load("lod-field:seed=7,triangles=3000,instances=60", NULL, &again, &err) == GDR_OK);
     CHECK(again && scenes_equal(scene, again));
-    CHECK(gdr_scene_load("lod-field:instances=60,triangles=3000,seed=8", &other, &err) == GDR_OK);
+    CHECK(gdr_scene_load("lod-field:instances=60,triangles=3000,seed=8", NULL, &other, &err) == GDR_OK);
     if (other) {
         CHECK(memcmp(other->meshes[0].positions, m->positions, sizeof(gdr_vec3) * m->vertex_count) == 0);
         CHECK(memcmp(other->instances, scene->instances, sizeof(gdr_instance) * 60) != 0);
@@ -222,7 +222,7 @@ static void test_lod_field_bad(void)
     CHECK(strstr(err.message, "instances") != NULL);
     CHECK(scene == NULL);
     /* Unknown-option messages list the known ones. */
-    CHECK(gdr_scene_load("lod-field:size=3", &scene, &err) != GDR_OK);
+    CHECK(gdr_scene_load("lod-field:size=3", NULL, &scene, &err) != GDR_OK);
     CHECK(strstr(err.message, "instances, seed, triangles, spacing") != NULL);
 }
 
@@ -323,7 +323,7 @@ static void test_occlusion_layout(void)
     const uint32_t visible = 80, hidden = 700;
     gdr_error err = {0};
     gdr_scene *scene = NULL, *again = NULL, *other = NULL;
-    CHECK(gdr_scene_load("occlusion:hidden=700,visible=80,seed=5", &scene, &err) == GDR_OK);
+    CHECK(gdr_scene_load("occlusion:hidden=700,visible=80,seed=5", NULL, &scene, &err) == GDR_OK);
     if (!scene) {
         fprintf(stderr, "%s\n", err.message);
         test_failure_count++;
@@ -394,9 +394,9 @@ static void test_occlusion_layout(void)
     CHECK(in_front == visible);
 
     /* Deterministic; the seed changes the details but not the regions. */
-    CHECK(gdr_scene_load("occlusion:seed=5,visible=80,hidden=700", &again, &err) == GDR_OK);
+    CHECK(gdr_scene_load("occlusion:seed=5,visible=80,hidden=700", NULL, &again, &err) == GDR_OK);
     CHECK(again && scenes_equal(scene, again));
-    CHECK(gdr_scene_load("occlusion:hidden=700,visible=80,seed=6", &other, &err) == GDR_OK);
+    CHECK(gdr_scene_load("occlusion:hidden=700,visible=80,seed=6", NULL, &other, &err) == GDR_OK);
     CHECK(other && !scenes_equal(scene, other));
     gdr_scene_destroy(other);
     gdr_scene_destroy(again);
@@ -497,7 +497,7 @@ static void test_occlusion_defaults_and_bad(void)
     CHECK(gdr_scene_create_occlusion(&(gdr_occlusion_scene_desc){.hidden = 2000000}, &scene, &err) ==
           GDR_ERROR_INVALID_ARGUMENT);
     CHECK(scene == NULL && strstr(err.message, "hidden") != NULL);
-    CHECK(gdr_scene_load("occlusion:size=3", &scene, &err) != GDR_OK);
+    CHECK(gdr_scene_load("occlusion:size=3", NULL, &scene, &err) != GDR_OK);
     CHECK(strstr(err.message, "seed, hidden, visible") != NULL);
 }
 
@@ -517,9 +517,9 @@ static void test_spec_names(void)
     /* The demo keeps its options and messages. */
     gdr_error err = {0};
     gdr_scene *scene = NULL;
-    CHECK(gdr_scene_load("demo:instances=0", &scene, &err) == GDR_ERROR_INVALID_ARGUMENT);
+    CHECK(gdr_scene_load("demo:instances=0", NULL, &scene, &err) == GDR_ERROR_INVALID_ARGUMENT);
     CHECK(strcmp(err.message, "demo: instances=0 is not an integer in [1, 16000000]") == 0);
-    CHECK(gdr_scene_load("demo:bogus=1", &scene, &err) == GDR_ERROR_INVALID_ARGUMENT);
+    CHECK(gdr_scene_load("demo:bogus=1", NULL, &scene, &err) == GDR_ERROR_INVALID_ARGUMENT);
     CHECK(strcmp(err.message, "demo: unknown option 'bogus' (instances, seed, spacing)") == 0);
 }
 

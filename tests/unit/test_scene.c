@@ -19,7 +19,7 @@ static void test_demo_scene(void)
 {
     gdr_error err = {0};
     gdr_scene *scene = NULL;
-    CHECK(gdr_scene_load("demo:instances=300,seed=3", &scene, &err) == GDR_OK);
+    CHECK(gdr_scene_load("demo:instances=300,seed=3", NULL, &scene, &err) == GDR_OK);
     if (!scene)
         return;
     CHECK(scene->instance_count == 301); /* the objects and the ground */
@@ -53,7 +53,7 @@ static void test_demo_scene(void)
     }
     /* The same specification gives the same scene. */
     gdr_scene *again = NULL;
-    CHECK(gdr_scene_load("demo:seed=3,instances=300", &again, &err) == GDR_OK);
+    CHECK(gdr_scene_load("demo:seed=3,instances=300", NULL, &again, &err) == GDR_OK);
     if (again) {
         CHECK(memcmp(again->instances, scene->instances, sizeof(gdr_instance) * scene->instance_count) == 0);
         gdr_scene_destroy(again);
@@ -68,7 +68,7 @@ static void test_bad_specs(void)
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         gdr_error err = {0};
         gdr_scene *scene = NULL;
-        CHECK(gdr_scene_load(bad[i], &scene, &err) != GDR_OK);
+        CHECK(gdr_scene_load(bad[i], NULL, &scene, &err) != GDR_OK);
         CHECK(scene == NULL);
         CHECK(err.message[0] != '\0');
     }

@@ -62,7 +62,7 @@ int gdr_cmd_bench(int argc, char **argv)
     const char *device = NULL, *json_path = NULL, *scene_spec = NULL;
     float lod_errors[MAX_LOD_ERRORS] = {1.0f};
     uint32_t lod_error_count = 1;
-    bool occlusion_modes[2] = {true, false};
+    bool occlusion_modes[2] = {true, false}, occlusion_given = false;
     uint32_t occlusion_count = 1;
     bool validate = false, has_camera = false, record_every_frame = false, lod_hierarchy = true;
     gdr_pipeline pipelines[3] = {GDR_PIPELINE_DEFAULT};
@@ -104,6 +104,7 @@ int gdr_cmd_bench(int argc, char **argv)
             ok = parse_lod_errors(value, lod_errors, &lod_error_count);
         else if (strcmp(arg, "--occlusion") == 0) {
             /* on, off, or both side by side */
+            occlusion_given = true;
             occlusion_count = strcmp(value, "on,off") == 0 || strcmp(value, "off,on") == 0 ? 2 : 1;
             if (occlusion_count == 2)
                 occlusion_modes[0] = value[1] == 'n', occlusion_modes[1] = !occlusion_modes[0];
@@ -152,7 +153,7 @@ int gdr_cmd_bench(int argc, char **argv)
         gdr_demo_desc demo = {.instances = sizes[s]};
         gdr_renderer_desc desc = {.width = width, .height = height, .device = device, .validate = validate,
                                   .busy_wait = true, .record_every_frame = record_every_frame};
-        gdr_status loaded = scene_spec ? gdr_scene_load(scene_spec, &scene, &err) : gdr_scene_create_demo(&demo, &scene, &err);
+        gdr_status loaded = scene_spec ? gdr_scene_load(scene_spec, NULL, &scene, &err) : gdr_scene_create_demo(&demo, &scene, &err);
         if (loaded != GDR_OK) {
             result = cli_load_failed(scene_spec ? scene_spec : "demo", &err);
         } else if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK ||
@@ -167,7 +168,9 @@ int gdr_cmd_bench(int argc, char **argv)
             gdr_camera camera = scene->camera_count > 0 ? scene->cameras[0] : gdr_scene_framing_camera(scene);
             gdr_frame_desc frame = {.camera = camera, .cull = GDR_CULL_ON, .pipeline = pipelines[p],
                                     .lod_error_px = lod_errors[run / occlusion_count % lod_error_count],
-                                    .occlusion = occlusion ? GDR_CULL_ON : GDR_CULL_OFF,
+                                    .occlusion = !occlusion_given ? GDR_CULL_DEFAULT
+                                                 : occlusion      ? GDR_CULL_ON
+                                                                  : GDR_CULL_OFF,
                                     .lod_hierarchy = lod_hierarchy ? GDR_CULL_ON : GDR_CULL_OFF};
             if (has_camera) {
                 frame.camera.position = camera_position;

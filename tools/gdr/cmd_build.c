@@ -88,9 +88,9 @@ int gdr_cmd_build(int argc, char **argv)
     gdr_load_options load = {.no_cache = 1, .no_progress = no_progress, .budget = budget,
                              .allow_outside_files = allow_outside_files};
     if (is_builtin) {
-        status = gdr_scene_load_ex(input, &load, &scene, &err);
+        status = gdr_scene_load(input, &load, &scene, &err);
     } else if (length > 5 && strcmp(input + length - 5, ".gdrc") == 0) {
-        status = gdr_scene_load_file_ex(input, &load, &scene, &pvs, &err);
+        status = gdr_scene_load_file(input, &load, &scene, &pvs, &err);
         if (status == GDR_OK && pvs && !pvs_wanted)
             printf("pvs: kept from %s (%u cells, %u objects)\n", input, gdr_pvs_cell_count(pvs),
                    gdr_pvs_object_count(pvs));
@@ -105,8 +105,8 @@ int gdr_cmd_build(int argc, char **argv)
         status = bake_pvs(scene, &pvs, &err); /* before writing: a failed bake leaves no file */
     }
     if (status == GDR_OK) {
-        gdr_cache_source source = {gdr_cache_build_options(), &sources};
-        status = gdr_cache_write_ex(output, scene, &source, pvs, &err);
+        gdr_cache_write_options write = {.source = {gdr_cache_build_options(), &sources}, .pvs = pvs};
+        status = gdr_cache_write(output, scene, &write, &err);
     }
     if (status == GDR_OK)
         printf("%s: %u meshes, %u instances, %llu triangles, %u materials, %u textures, %u cameras\n", output,

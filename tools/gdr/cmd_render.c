@@ -14,7 +14,7 @@ typedef struct render_options {
     const char *stats_json;
     uint32_t width, height, frames, camera_index;
     bool has_camera, has_camera_index, cull, validate;
-    bool meshlet_cull, cone_cull, triangle_cull, occlusion, lod_hierarchy;
+    bool meshlet_cull, cone_cull, triangle_cull, occlusion, occlusion_given, lod_hierarchy;
     gdr_pipeline pipeline;
     gdr_raster raster;
     float sw_threshold;
@@ -82,7 +82,7 @@ static int parse_render_options(int argc, char **argv, render_options *o)
         else if (strcmp(arg, "--triangle-cull") == 0)
             ok = cli_parse_on_off(arg, value, &o->triangle_cull);
         else if (strcmp(arg, "--occlusion") == 0)
-            ok = cli_parse_on_off(arg, value, &o->occlusion);
+            ok = o->occlusion_given = cli_parse_on_off(arg, value, &o->occlusion);
         else if (strcmp(arg, "--lod-hierarchy") == 0)
             ok = cli_parse_on_off(arg, value, &o->lod_hierarchy);
         else if (strcmp(arg, "--pipeline") == 0)
@@ -145,7 +145,7 @@ int gdr_cmd_render(int argc, char **argv)
         return usage;
     gdr_error err = {0};
     gdr_scene *scene = NULL;
-    if (gdr_scene_load_ex(o.scene, &o.load, &scene, &err) != GDR_OK)
+    if (gdr_scene_load(o.scene, &o.load, &scene, &err) != GDR_OK)
         return cli_load_failed(o.scene, &err);
     if (o.has_camera_index && o.camera_index >= scene->camera_count) {
         fprintf(stderr, "gdr: --camera-index %u: the scene has %u camera(s)\n", o.camera_index, scene->camera_count);
@@ -164,7 +164,9 @@ int gdr_cmd_render(int argc, char **argv)
                             .meshlet_cone_cull = o.cone_cull ? GDR_CULL_ON : GDR_CULL_OFF,
                             .triangle_cull = o.triangle_cull ? GDR_CULL_ON : GDR_CULL_OFF,
                             .lod_error_px = o.lod_error, .lod_fixed_depth = o.has_lod_depth, .lod_depth = o.lod_depth,
-                            .occlusion = o.occlusion ? GDR_CULL_ON : GDR_CULL_OFF,
+                            .occlusion = !o.occlusion_given ? GDR_CULL_DEFAULT
+                                         : o.occlusion       ? GDR_CULL_ON
+                                                             : GDR_CULL_OFF,
                             .lod_hierarchy = o.lod_hierarchy ? GDR_CULL_ON : GDR_CULL_OFF};
     if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK || gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK ||
         gdr_renderer_render(renderer, &frame, o.frames, &stats, &err) != GDR_OK) {

@@ -1,10 +1,10 @@
 /* GLSL only: the per-cluster tests of the mesh pipeline, shared by the task shader (forward raster)
- * and the cluster-cull compute pass (visibility-buffer raster, issue 8). One invocation per cluster
+ * and the cluster-cull compute pass (visibility-buffer raster). One invocation per cluster
  * of a task command (up to GDR_TASK_WORKGROUP_SIZE clusters of one visible instance):
- *  - the LOD cut (issue 5): is the cluster part of the cut this view needs?
+ *  - the LOD cut: is the cluster part of the cut this view needs?
  *  - its sphere against the frustum (the instance test's math), then its normal cone against the
  *    camera;
- *  - two-phase occlusion culling (issue 6).
+ *  - two-phase occlusion culling.
  * Include after glsl_buffers.h, cull_math.h, lod_math.h, occlusion_test.h and meshlet_payload.h. */
 #ifndef GDR_CLUSTER_CULL_H
 #define GDR_CLUSTER_CULL_H

@@ -37,7 +37,7 @@
 #define GDR_MAX_TASK_COMMANDS (1u << 24)
 /* Instance records the CPU can send per frame through the update ring. */
 #define GDR_INSTANCE_UPDATES_PER_FRAME 4096
-/* Hybrid rasterisation (issue 8): one software-raster workgroup per cluster; a visibility-buffer id
+/* Hybrid rasterisation: one software-raster workgroup per cluster; a visibility-buffer id
  * is (visible-cluster slot << GDR_VISBUFFER_TRIANGLE_BITS) | triangle, so a frame can name at most
  * GDR_RASTER_MAX_CLUSTERS visible clusters; vertices snap to GDR_SW_SUBPIXEL_BITS fractional bits
  * (subPixelPrecisionBits of lavapipe and of NVIDIA and AMD GPUs; the usual value). */

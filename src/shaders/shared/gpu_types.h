@@ -43,7 +43,7 @@ GDR_ASSERT_OFFSET(GdrGpuVertex, uv, 24);
 
 /* Where a mesh lives in the merged vertex, index and cluster buffers, and its bounds (seed 003, plan A).
  * The mesh's clusters are GdrGpuMeshlet[meshlet_offset .. + lod_cluster_count): level 0 first
- * (meshlet_count of them), then the coarser clusters of its LOD DAG (issue 5), the root group's last. */
+ * (meshlet_count of them), then the coarser clusters of its LOD DAG, the root group's last. */
 GDR_STRUCT_BEGIN(GdrGpuMesh)
     gdr_uint vertex_offset;
     gdr_uint first_index;
@@ -73,7 +73,7 @@ GDR_ASSERT_OFFSET(GdrGpuMesh, task_count, 36);
 GDR_ASSERT_OFFSET(GdrGpuMesh, root_refined_sphere, 64);
 
 /* One cluster of the geometry pool (gdr_cluster of gdr/geometry.h, with pool-global offsets), with
- * what the LOD cut (issue 5, gdr/geometry.h "The cut") needs of its two groups inline: the group it
+ * what the LOD cut (gdr/geometry.h "The cut") needs of its two groups inline: the group it
  * is part of ("group": without one, error INFINITY, never passes) and the group it was made from
  * ("refined": without one, error 0 and depth -1, always passes). */
 GDR_STRUCT_BEGIN(GdrGpuMeshlet)
@@ -160,7 +160,7 @@ GDR_STRUCT_END(GdrGpuTraversalLevel)
 GDR_ASSERT_SIZE(GdrGpuTraversalLevel, 16);
 
 #define GDR_TASK_LOD_ACCEPTED 1u /* the root shortcut chose these clusters: no LOD test */
-#define GDR_TASK_DRAWN_EARLY 2u  /* late phase (issue 6): the instance was drawn in the early phase */
+#define GDR_TASK_DRAWN_EARLY 2u  /* late phase: the instance was drawn in the early phase */
 #define GDR_TASK_FIRST 4u        /* the first command of its instance (for read-backs) */
 #define GDR_GPU_NO_GROUP 0xffffffffu
 
@@ -221,7 +221,7 @@ GDR_STRUCT_BEGIN(GdrGpuDrawStats)
     gdr_uint meshlets_lod_culled;    /* not in the LOD cut */
     gdr_uint lod_clusters[GDR_LOD_STATS_DEPTHS];  /* clusters drawn per DAG depth (last: that depth or more) */
     gdr_uint lod_triangles[GDR_LOD_STATS_DEPTHS]; /* their triangles, before triangle culling */
-    /* Two-phase occlusion culling (issue 6). The late phase appends its draws and task commands
+    /* Two-phase occlusion culling. The late phase appends its draws and task commands
      * after the early phase's region of those buffers and launches them with its own commands. */
     gdr_uint late_draw_count;
     gdr_uint late_task_count;
@@ -239,7 +239,7 @@ GDR_STRUCT_BEGIN(GdrGpuDrawStats)
     gdr_uint meshlets_late_drawn;      /* visible and not drawn early */
     gdr_uint reserved_occlusion0;
     gdr_uint reserved_occlusion1;
-    /* The cluster cull's launches (visibility-buffer modes, issue 8): one workgroup per
+    /* The cluster cull's launches (visibility-buffer modes): one workgroup per
      * GDR_CLUSTER_CULL_TASKS task commands, early (or only) and late phase. */
     gdr_uint cull_groups_x;
     gdr_uint cull_groups_y;
@@ -331,7 +331,7 @@ GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, viewport, 208);
 #define GDR_FRAME_RECORD_MESHLETS 8u  /* task shader: append (instance, cluster) of every visible cluster */
 #define GDR_FRAME_LOD 16u             /* task shader: the LOD cut over every cluster of the DAG */
 #define GDR_FRAME_LOD_DEPTH 32u       /* with GDR_FRAME_LOD: the discrete cut at depth lod_depth */
-#define GDR_FRAME_OCCLUSION 64u       /* two-phase occlusion culling against the depth pyramid (issue 6) */
+#define GDR_FRAME_OCCLUSION 64u       /* two-phase occlusion culling against the depth pyramid */
 #define GDR_FRAME_HISTORY 128u        /* with GDR_FRAME_OCCLUSION: last frame's visibility and pyramid are usable */
 #define GDR_FRAME_DEBUG_SHRINK_NODES 512u /* tests: a deliberately wrong node test (spheres a quarter of their size) */
 #define GDR_FRAME_LOD_HIERARCHY 256u  /* with GDR_FRAME_LOD: instances' clusters come from the traversal of
@@ -360,14 +360,14 @@ GDR_STRUCT_BEGIN(GdrGpuPushConstants)
 GDR_STRUCT_END(GdrGpuPushConstants)
 GDR_ASSERT_SIZE(GdrGpuPushConstants, 40);
 
-/* --- Hybrid rasterisation (issue 8): the visibility buffer and the software rasteriser ----------
+/* --- Hybrid rasterisation: the visibility buffer and the software rasteriser --------------------
  *
  * A visibility-buffer pixel is 64 bits: the high word the depth as float bits (reverse-Z, so
  * atomicMax keeps the nearest; 0 is empty), the low word (slot << GDR_VISBUFFER_TRIANGLE_BITS) |
  * triangle, where slot indexes the frame's list of visible clusters (GdrGpuRasterCluster). The
  * cluster cull (clustercull.comp) appends software-rasterised clusters from the front of that list
  * and mesh-shader clusters from the back. */
-#define GDR_GPU_RASTER_FORWARD 0u /* the mesh shaders shade (issue 4); no visibility buffer */
+#define GDR_GPU_RASTER_FORWARD 0u /* the mesh shaders shade; no visibility buffer */
 #define GDR_GPU_RASTER_HW 1u      /* every cluster through the mesh shaders into the visibility buffer */
 #define GDR_GPU_RASTER_SW 2u      /* every cluster the compute rasteriser can take (see raster_bin.h) */
 #define GDR_GPU_RASTER_HYBRID 3u  /* clusters whose triangles are small on screen to compute, the rest to mesh */

@@ -1,4 +1,4 @@
-/* The LOD cut's per-group math (issue 5), compiled by C (the CPU reference, src/geometry/lod_cut.c)
+/* The LOD cut's per-group math, compiled by C (the CPU reference, src/geometry/lod_cut.c)
  * and GLSL (meshlet.task, drawcull) alike. The rule is documented in gdr/geometry.h ("The cut"). */
 #ifndef GDR_LOD_MATH_H
 #define GDR_LOD_MATH_H

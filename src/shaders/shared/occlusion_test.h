@@ -1,4 +1,4 @@
-// GLSL only: the occlusion test of a culling shader (issue 6) against the depth pyramid, which the
+// GLSL only: the occlusion test of a culling shader against the depth pyramid, which the
 // frame binds as set 0, binding 0 (src/render/occlusion.c) with its min-reduction sampler. The math
 // is occlusion_math.h's, shared with the CPU.
 #ifndef GDR_OCCLUSION_TEST_H

@@ -1,4 +1,4 @@
-/* Hybrid rasterisation (issue 8): which rasteriser draws a visible cluster. The decision is shared
+/* Hybrid rasterisation: which rasteriser draws a visible cluster. The decision is shared
  * by C (tests, tools) and GLSL; the cluster cull's appends to the frame's visible-cluster list are
  * GLSL only (below). */
 #ifndef GDR_RASTER_BIN_H

@@ -1,4 +1,4 @@
-/* GLSL only: the visibility buffer and the frame's visible-cluster list (issue 8; the layout is
+/* GLSL only: the visibility buffer and the frame's visible-cluster list (the layout is
  * described in gpu_types.h). Include after glsl_buffers.h. */
 #ifndef GDR_VISBUFFER_H
 #define GDR_VISBUFFER_H
