@@ -257,6 +257,28 @@ static gdr_status upload_lod_nodes(gdr_renderer *r, const gdr_scene *scene, cons
     return status;
 }
 
+/* Every mesh's vertices and indices into the pool's arrays, the meshes' offsets and the instances
+ * into the host copies. */
+static void merge_geometry(gdr_renderer *r, const gdr_scene *scene, GdrGpuVertex *vertices, uint32_t *indices)
+{
+    gdr_gpu_scene *g = &r->scene;
+    uint32_t vertex_cursor = 0, index_cursor = 0;
+    for (uint32_t m = 0; m < scene->mesh_count; m++) {
+        const gdr_mesh *mesh = &scene->meshes[m];
+        g->cpu_meshes[m] = (GdrGpuMesh){.vertex_offset = vertex_cursor, .first_index = index_cursor,
+                                        .index_count = mesh->index_count, .bounds = mesh->bounds};
+        for (uint32_t v = 0; v < mesh->vertex_count; v++)
+            vertices[vertex_cursor + v] = (GdrGpuVertex){mesh->positions[v], mesh->normals[v], mesh->uvs[v]};
+        memcpy(indices + index_cursor, mesh->indices, sizeof(uint32_t) * mesh->index_count);
+        vertex_cursor += mesh->vertex_count;
+        index_cursor += mesh->index_count;
+    }
+    for (uint32_t i = 0; i < scene->instance_count; i++)
+        g->cpu_instances[i] = gpu_instance_from(scene, &scene->instances[i]);
+    g->mesh_count = scene->mesh_count;
+    g->instance_count = scene->instance_count;
+}
+
 gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_error *err)
 {
     gdr_gpu_scene *g = &r->scene;
@@ -278,21 +300,7 @@ gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
         free(indices);
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory");
     }
-    uint32_t vertex_cursor = 0, index_cursor = 0;
-    for (uint32_t m = 0; m < scene->mesh_count; m++) {
-        const gdr_mesh *mesh = &scene->meshes[m];
-        g->cpu_meshes[m] = (GdrGpuMesh){.vertex_offset = vertex_cursor, .first_index = index_cursor,
-                                        .index_count = mesh->index_count, .bounds = mesh->bounds};
-        for (uint32_t v = 0; v < mesh->vertex_count; v++)
-            vertices[vertex_cursor + v] = (GdrGpuVertex){mesh->positions[v], mesh->normals[v], mesh->uvs[v]};
-        memcpy(indices + index_cursor, mesh->indices, sizeof(uint32_t) * mesh->index_count);
-        vertex_cursor += mesh->vertex_count;
-        index_cursor += mesh->index_count;
-    }
-    for (uint32_t i = 0; i < scene->instance_count; i++)
-        g->cpu_instances[i] = gpu_instance_from(scene, &scene->instances[i]);
-    g->mesh_count = scene->mesh_count;
-    g->instance_count = scene->instance_count;
+    merge_geometry(r, scene, vertices, indices);
 
     const VkBufferUsageFlags dst = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
     gdr_status status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuVertex) * vertex_total,

@@ -39,14 +39,6 @@ GdrTaskRange task_range(GdrGpuFrameGlobals g, GdrGpuMesh mesh, mat4 model, out b
     return traverse ? GdrTaskRange(0u, 0u, 0u, 0u) : gdr_task_range(mesh.meshlet_offset, mesh.lod_cluster_count, 0u);
 }
 
-// Adds each lane's 0/1 to a counter with one atomic per subgroup.
-#define COUNT(field, condition)                                        \
-    {                                                                  \
-        uint n_ = subgroupAdd((condition) ? 1u : 0u);                  \
-        if (subgroupElect() && n_ > 0u)                                \
-            atomicAdd(stats.value.field, n_);                          \
-    }
-
 void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
@@ -76,24 +68,24 @@ void main()
         uint state = VisibilityRef(GDR_SCENE.instance_visibility).items[id];
         bool candidate = visible && (g.flags & GDR_FRAME_HISTORY) != 0u && (state & GDR_INSTANCE_VISIBLE_LAST_FRAME) != 0u;
         bool occluded = candidate && gdr_sphere_occluded(g, center, radius);
-        COUNT(instances_early_occluded, occluded);
+        GDR_COUNT(stats, instances_early_occluded, occluded);
         visible = candidate && !occluded;
-        COUNT(instances_early_drawn, visible);
+        GDR_COUNT(stats, instances_early_drawn, visible);
         VisibilityRef(GDR_SCENE.instance_visibility).items[id] = (state & GDR_INSTANCE_VISIBLE_LAST_FRAME) |
                                                          (visible ? GDR_INSTANCE_DRAWN_EARLY : 0u);
     } else if (PHASE == GDR_PHASE_LATE && id < g.instance_count) {
         uint state = VisibilityRef(GDR_SCENE.instance_visibility).items[id];
         drawn_early = (state & GDR_INSTANCE_DRAWN_EARLY) != 0u;
-        COUNT(instances_late_tested, visible);
+        GDR_COUNT(stats, instances_late_tested, visible);
         bool occluded = visible && gdr_sphere_occluded(g, center, radius);
-        COUNT(instances_late_occluded, occluded);
+        GDR_COUNT(stats, instances_late_occluded, occluded);
         visible = visible && !occluded;
         VisibilityRef(GDR_SCENE.instance_visibility).items[id] = visible ? GDR_INSTANCE_VISIBLE_LAST_FRAME : 0u;
         // The meshlet pipeline goes on testing the clusters of instances drawn early (those not
         // drawn early may be visible now); the indirect pipeline has drawn them whole.
         if (!EMIT_TASKS)
             visible = visible && !drawn_early;
-        COUNT(instances_late_drawn, visible && !drawn_early);
+        GDR_COUNT(stats, instances_late_drawn, visible && !drawn_early);
     }
 
     uvec4 ballot = subgroupBallot(visible);

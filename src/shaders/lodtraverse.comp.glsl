@@ -19,14 +19,6 @@
 layout(local_size_x = GDR_TRAVERSE_WORKGROUP_SIZE) in;
 layout(constant_id = 0) const uint PHASE = GDR_PHASE_NONE;
 
-// Adds each lane's 0/1 to a counter with one atomic per subgroup.
-#define COUNT(field, condition)                                        \
-    {                                                                  \
-        uint n_ = subgroupAdd((condition) ? 1u : 0u);                  \
-        if (subgroupElect() && n_ > 0u)                                \
-            atomicAdd(stats.value.field, n_);                          \
-    }
-
 void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
@@ -64,10 +56,10 @@ void main()
     GdrTaskRange range = leaf ? gdr_task_range(mesh.meshlet_offset + node.first, node.count, visit.flags)
                               : GdrTaskRange(0u, 0u, 0u, 0u);
     gdr_append_tasks(g, PHASE, leaf, visit.instance, range);
-    COUNT(nodes_tested, in_level);
-    COUNT(nodes_lod_culled, lod_culled);
-    COUNT(nodes_frustum_culled, frustum_culled);
-    COUNT(nodes_occluded, occluded);
+    GDR_COUNT(stats, nodes_tested, in_level);
+    GDR_COUNT(stats, nodes_lod_culled, lod_culled);
+    GDR_COUNT(stats, nodes_frustum_culled, frustum_culled);
+    GDR_COUNT(stats, nodes_occluded, occluded);
     if (PHASE == GDR_PHASE_LATE)
-        COUNT(late_nodes_tested, in_level);
+        GDR_COUNT(stats, late_nodes_tested, in_level);
 }

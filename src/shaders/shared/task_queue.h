@@ -11,6 +11,14 @@
 #define GDR_PHASE_EARLY 1u
 #define GDR_PHASE_LATE 2u
 
+// Adds each lane's 0/1 to the counter `field` of DrawStatsRef `stats`, one atomic per subgroup.
+#define GDR_COUNT(stats, field, condition)                             \
+    {                                                                  \
+        uint n_ = subgroupAdd((condition) ? 1u : 0u);                  \
+        if (subgroupElect() && n_ > 0u)                                \
+            atomicAdd(stats.value.field, n_);                          \
+    }
+
 // A run of clusters of one instance: `tasks` commands of up to GDR_TASK_WORKGROUP_SIZE clusters.
 struct GdrTaskRange {
     uint first;  // global cluster index
