@@ -115,6 +115,13 @@ static void visit_cell(const lod_grid *g, uint32_t x, uint32_t y, uint32_t z, co
     }
 }
 
+/* The largest Chebyshev distance a search of a grid of `dim` cells may need. */
+static int32_t search_radius(const uint32_t dim[3])
+{
+    uint32_t largest = dim[0] > dim[1] ? dim[0] : dim[1];
+    return (int32_t)(dim[2] > largest ? dim[2] : largest);
+}
+
 /* Cells at Chebyshev distance r from the query's cell are at least (r - 1) cell edges away, so
  * the search stops once the best distance is within that. */
 uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squared)
@@ -125,8 +132,7 @@ uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squ
         at[k] = (int32_t)cell_coordinate(g, q[k], k);
     uint32_t best = UINT32_MAX;
     float best_d2 = INFINITY;
-    int32_t max_r = (int32_t)(g->dim[0] > g->dim[1] ? g->dim[0] : g->dim[1]);
-    max_r = (int32_t)g->dim[2] > max_r ? (int32_t)g->dim[2] : max_r;
+    int32_t max_r = search_radius(g->dim);
     for (int32_t r = 0; r <= max_r; r++) {
         if (best != UINT32_MAX) {
             float reach = (float)(r - 1) * g->cell;
@@ -264,8 +270,7 @@ uint32_t lod_triangle_grid_nearest(const lod_triangle_grid *g, gdr_vec3 point, l
         at[k] = (int32_t)tri_cell(g, q[k], k);
     uint32_t best = UINT32_MAX;
     float best_d2 = INFINITY;
-    int32_t max_r = (int32_t)(g->dim[0] > g->dim[1] ? g->dim[0] : g->dim[1]);
-    max_r = (int32_t)g->dim[2] > max_r ? (int32_t)g->dim[2] : max_r;
+    int32_t max_r = search_radius(g->dim);
     for (int32_t r = 0; r <= max_r; r++) {
         float reach = (float)(r - 1) * g->cell;
         if (r > 0 && best != UINT32_MAX && reach * reach >= best_d2)
