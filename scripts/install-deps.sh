@@ -23,7 +23,8 @@ validator_missing() {
 PACKAGES="build-essential cmake pkg-config clang \
 libvulkan-dev glslc vulkan-validationlayers \
 libmeshoptimizer-dev libmetis-dev libcjson-dev libstb-dev libzstd-dev \
-libxxhash-dev libclang-rt-14-dev assimp-testmodels valgrind nodejs"
+libxxhash-dev libclang-rt-14-dev assimp-testmodels valgrind nodejs \
+libglfw3-dev xvfb xauth xdotool gnuplot-nox"
 BACKPORTS_PACKAGES="mesa-vulkan-drivers"
 
 missing=""
