@@ -20,7 +20,7 @@ typedef struct gdr_pipeline_entry {
     uint32_t constants[2];  /* specialisation constants 0, 1 of the compute or the task shader */
     uint32_t constant_count;
     gdr_pipeline_targets targets;
-    bool vertex_input;      /* GdrGpuVertex position and normal at locations 0 and 1 */
+    bool vertex_input;      /* GdrGpuVertex position, normal and uv at locations 0, 1 and 2 */
     bool cull_back;
 } gdr_pipeline_entry;
 
@@ -86,10 +86,10 @@ static gdr_status create_graphics(gdr_vk_context *ctx, VkPipelineLayout layout, 
                                   VkPipeline *out, gdr_error *err)
 {
     static const VkVertexInputBindingDescription binding = {0, sizeof(GdrGpuVertex), VK_VERTEX_INPUT_RATE_VERTEX};
-    /* uv stays in the vertex (for textures later) but the forward shading does not read it yet. */
-    static const VkVertexInputAttributeDescription attributes[2] = {
+    static const VkVertexInputAttributeDescription attributes[3] = {
         {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(GdrGpuVertex, position)},
         {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(GdrGpuVertex, normal)},
+        {2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(GdrGpuVertex, uv)},
     };
     VkSpecializationMapEntry constant_entries[2] = {{0, 0, 4}, {1, 4, 4}};
     VkSpecializationInfo constants = {e->constant_count, constant_entries, 4 * e->constant_count, e->constants};
@@ -97,7 +97,7 @@ static gdr_status create_graphics(gdr_vk_context *ctx, VkPipelineLayout layout, 
         .layout = layout, .vertex_shader = e->vertex, .task_shader = e->task,
         .task_specialization = e->constant_count ? &constants : NULL, .mesh_shader = e->mesh,
         .fragment_shader = e->fragment, .vertex_binding = e->vertex_input ? &binding : NULL,
-        .vertex_attributes = e->vertex_input ? attributes : NULL, .vertex_attribute_count = e->vertex_input ? 2 : 0,
+        .vertex_attributes = e->vertex_input ? attributes : NULL, .vertex_attribute_count = e->vertex_input ? 3 : 0,
         .color_format = e->targets == GDR_TARGETS_NONE ? VK_FORMAT_UNDEFINED : GDR_COLOR_FORMAT,
         .depth_format = e->targets == GDR_TARGETS_COLOR_DEPTH ? GDR_DEPTH_FORMAT : VK_FORMAT_UNDEFINED,
         .cull_mode = e->cull_back ? VK_CULL_MODE_BACK_BIT : VK_CULL_MODE_NONE,

@@ -30,6 +30,8 @@ out gl_MeshPerPrimitiveEXT { perprimitiveEXT bool gl_CullPrimitiveEXT; } gl_Mesh
 layout(location = 0) out vec3 out_normal[];
 layout(location = 1) out vec3 out_world_position[];
 layout(location = 2) perprimitiveEXT flat out vec4 out_color[];
+layout(location = 4) out vec2 out_uv[];
+layout(location = 5) perprimitiveEXT flat out uint out_material[];
 #ifdef GDR_MESH_FROM_LIST
 layout(location = 3) perprimitiveEXT flat out uint out_visibility_id[]; // list slot and triangle
 #endif
@@ -100,6 +102,7 @@ void main()
         gl_MeshVerticesEXT[v].gl_Position = clip;
         out_normal[v] = cofactor * vertex.normal;
         out_world_position[v] = world.xyz;
+        out_uv[v] = vertex.uv;
         vec2 ndc = clip.xy / clip.w;
         screen[v] = vec3((ndc * 0.5 + 0.5) * g.viewport, clip.w);
     }
@@ -115,6 +118,7 @@ void main()
         gl_MeshPrimitivesEXT[t].gl_CullPrimitiveEXT = why != 0u;
         out_color[t] = vec4(gdr_view_albedo(g.view_mode, instance.color.rgb, instance_index, meshlet_index, t,
                                             meshlet.group_depth), 1.0);
+        out_material[t] = instance.material;
 #ifdef GDR_MESH_FROM_LIST
         out_visibility_id[t] = gdr_visbuffer_id(slot, t);
 #endif

@@ -10,7 +10,9 @@
 // shades everything): specialisation constant DEPTH_ONLY skips the shading and the colour.
 // A compute pass rather than a full-screen fragment pass: on the Hopper GPUs a fragment pass that
 // writes depth costs about 1 ms at 1440p before any shading (docs/PERFORMANCE.md).
+#extension GL_EXT_nonuniform_qualifier : require
 #include "shared/glsl_buffers.h"
+#include "shared/material.h"
 #include "shared/meshlet_payload.h"
 #include "shared/shading.h"
 #include "shared/visbuffer.h"
@@ -21,6 +23,13 @@ layout(constant_id = 0) const bool DEPTH_ONLY = false;
 uint triangle_byte(uint at)
 {
     return (UintsRef(GDR_SCENE.meshlet_triangles).items[at >> 2] >> ((at & 3u) * 8u)) & 255u;
+}
+
+// Perspective-correct barycentrics from the rows of the linear system below (shade_pixel).
+vec3 barycentrics(vec3 x_row, vec3 y_row)
+{
+    vec3 b = cross(x_row, y_row);
+    return b / (b.x + b.y + b.z);
 }
 
 // Shades the pixel whose centre is `centre` (framebuffer pixels, y down) from its id.
@@ -40,26 +49,39 @@ vec4 shade_pixel(FrameGlobalsRef globals, vec2 viewport, vec2 centre, uint id)
     // the point b0 V0 + b1 V1 + b2 V2 (b summing to 1) projects to the pixel centre p when
     // sum b_i (x_i - p.x w_i) = 0 and sum b_i (y_i - p.y w_i) = 0, so b is parallel to X x Y.
     vec2 p = vec2(centre.x / (0.5 * viewport.x) - 1.0, 1.0 - centre.y / (0.5 * viewport.y));
-    vec3 world[3], normal[3], x_row, y_row;
+    vec3 world[3], normal[3], x_row, y_row, w_row;
+    vec2 uv[3];
     for (int i = 0; i < 3; i++) {
         uint vertex_index = UintsRef(GDR_SCENE.meshlet_vertices).items[vertex_offset + corners[i]];
         vec3 position = VerticesRef(GDR_SCENE.vertices).items[vertex_index].position;
         normal[i] = VerticesRef(GDR_SCENE.vertices).items[vertex_index].normal;
+        uv[i] = VerticesRef(GDR_SCENE.vertices).items[vertex_index].uv;
         vec4 w = model * vec4(position, 1.0);
         vec4 clip = view_projection * w;
         world[i] = w.xyz;
         x_row[i] = clip.x - p.x * clip.w;
         y_row[i] = clip.y - p.y * clip.w;
+        w_row[i] = clip.w;
     }
-    vec3 b = cross(x_row, y_row);
-    b /= b.x + b.y + b.z;
+    vec3 b = barycentrics(x_row, y_row);
+    // The texture-coordinate derivatives, analytically from the triangle: the barycentrics of the
+    // next pixel centre to the right and the next one down (NDC y falls as pixel y grows), as the
+    // forward path's dFdx/dFdy difference neighbouring pixels; so both select the same mip level.
+    vec3 bx = barycentrics(x_row - (2.0 / viewport.x) * w_row, y_row);
+    vec3 by = barycentrics(x_row, y_row + (2.0 / viewport.y) * w_row);
+    mat3x2 uvs = mat3x2(uv[0], uv[1], uv[2]);
+    vec2 uv_here = uvs * b;
 
     mat3 m = mat3(model);
     mat3 cofactor = mat3(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1]));
     vec3 n = cofactor * (b.x * normal[0] + b.y * normal[1] + b.z * normal[2]);
     vec3 position = b.x * world[0] + b.y * world[1] + b.z * world[2];
-    vec3 albedo = gdr_view_albedo(globals.value.view_mode, InstancesRef(GDR_SCENE.instances).items[entry.instance].color.rgb,
-                                  entry.instance, entry.meshlet, triangle, meshlets.items[entry.meshlet].group_depth);
+    GdrGpuInstance instance = InstancesRef(GDR_SCENE.instances).items[entry.instance];
+    vec3 albedo = globals.value.view_mode == GDR_VIEW_SHADED
+                    ? gdr_material_base_color(instance.material, vec4(instance.color.rgb, 1.0), uv_here,
+                                              uvs * bx - uv_here, uvs * by - uv_here).rgb
+                    : gdr_view_albedo(globals.value.view_mode, instance.color.rgb, entry.instance, entry.meshlet,
+                                      triangle, meshlets.items[entry.meshlet].group_depth);
     return gdr_shade(globals.value.light_direction.xyz, n, position, albedo);
 }
 

@@ -31,6 +31,7 @@ layout(buffer_reference, scalar) buffer RasterCountersRef { GdrGpuRasterCounters
 layout(buffer_reference, scalar) buffer RasterClustersRef { GdrGpuRasterCluster items[]; };
 layout(buffer_reference, scalar) writeonly buffer ResolvedRef { uint items[]; };
 layout(buffer_reference, scalar) buffer NodeVisitsRef { GdrGpuNodeVisit items[]; };
+layout(buffer_reference, scalar) readonly buffer MaterialsRef { GdrGpuMaterial items[]; };
 
 layout(push_constant, scalar) uniform PushConstantBlock { GdrGpuPushConstants push; };
 

@@ -30,6 +30,7 @@ GDR_DECLARE_REF(RasterCountersRef)
 GDR_DECLARE_REF(RasterClustersRef)
 GDR_DECLARE_REF(ResolvedRef)
 GDR_DECLARE_REF(NodeVisitsRef)
+GDR_DECLARE_REF(MaterialsRef)
 
 /* One vertex of the geometry pool (vertex input binding 0). */
 GDR_STRUCT_BEGIN(GdrGpuVertex)
@@ -171,11 +172,25 @@ GDR_STRUCT_BEGIN(GdrGpuInstance)
     gdr_uint mesh;
     gdr_uint flags;
     gdr_uint meshlet_visibility_offset; /* first bit of this instance's clusters in the cluster visibility bits */
-    gdr_uint reserved1;
+    gdr_uint material; /* index into GdrGpuScene.materials; the scene's default material when it has none */
 GDR_STRUCT_END(GdrGpuInstance)
 GDR_ASSERT_SIZE(GdrGpuInstance, 96);
 GDR_ASSERT_OFFSET(GdrGpuInstance, color, 64);
 GDR_ASSERT_OFFSET(GdrGpuInstance, mesh, 80);
+GDR_ASSERT_OFFSET(GdrGpuInstance, material, 92);
+
+#define GDR_GPU_NO_TEXTURE 0xffffffffu
+/* One glTF metallic-roughness material of the material buffer. Texture fields index the bindless
+ * texture array (set GDR_TEXTURE_SET, binding 0) or are GDR_GPU_NO_TEXTURE. Colours are linear. */
+GDR_STRUCT_BEGIN(GdrGpuMaterial)
+    gdr_vec4 base_color;          /* factor, multiplied with the texture and the instance colour */
+    gdr_uint base_color_texture;
+    gdr_uint alpha_mode;          /* gdr_alpha_mode: 0 opaque, 1 mask, 2 blend */
+    float alpha_cutoff;
+    gdr_uint double_sided;
+GDR_STRUCT_END(GdrGpuMaterial)
+GDR_ASSERT_SIZE(GdrGpuMaterial, 32);
+GDR_ASSERT_OFFSET(GdrGpuMaterial, base_color_texture, 16);
 
 /* A fixed-size "tag + data" record of the per-frame instance ring (seed 000). */
 #define GDR_UPDATE_TAG_INSTANCE 1u /* replace instance `index` with `instance` */
@@ -277,8 +292,9 @@ GDR_STRUCT_BEGIN(GdrGpuScene)
     GDR_REF(VisibilityRef) instance_visibility; /* occlusion history: GDR_INSTANCE_VISIBLE_* per instance */
     GDR_REF(VisibilityRef) meshlet_visibility;  /* occlusion history: a bit per cluster of every instance */
     GDR_REF(LodNodesRef) lod_nodes;           /* GdrGpuLodNode[], every mesh's LOD hierarchy (GdrGpuMesh.lod_node_*) */
+    GDR_REF(MaterialsRef) materials;          /* GdrGpuMaterial[], the scene's, then the default (white, untextured) */
 GDR_STRUCT_END(GdrGpuScene)
-GDR_ASSERT_SIZE(GdrGpuScene, 72);
+GDR_ASSERT_SIZE(GdrGpuScene, 80);
 
 /* A frame slot's buffers: written once, when the slot is made (and when a buffer made on first use
  * appears). Shaders read it and GdrGpuScene in place (GDR_SCENE, GDR_FRAME), never as a local
