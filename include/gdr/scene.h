@@ -46,7 +46,21 @@ typedef struct gdr_material {
     float alpha_cutoff;   /* used when alpha_mode is GDR_ALPHA_MASK */
     uint32_t alpha_mode;  /* gdr_alpha_mode */
     uint32_t double_sided; /* 0 or 1 */
+    uint32_t base_color_sampler; /* GDR_SAMPLER_* bits: the base colour texture's glTF sampler */
 } gdr_material;
+
+/* A texture reference's sampler state (glTF's sampler object), packed in a uint32: zero is glTF's
+ * default, repeat in both directions with linear filtering and linear mip selection. */
+#define GDR_SAMPLER_WRAP_REPEAT 0u
+#define GDR_SAMPLER_WRAP_CLAMP 1u
+#define GDR_SAMPLER_WRAP_MIRROR 2u
+#define GDR_SAMPLER_WRAP_S(bits) ((bits) & 3u)        /* a GDR_SAMPLER_WRAP_* for u */
+#define GDR_SAMPLER_WRAP_T(bits) (((bits) >> 2) & 3u) /* a GDR_SAMPLER_WRAP_* for v */
+#define GDR_SAMPLER_MAG_NEAREST (1u << 4)
+#define GDR_SAMPLER_MIN_NEAREST (1u << 5)
+#define GDR_SAMPLER_MIP_NEAREST (1u << 6)
+#define GDR_SAMPLER_MIP_NONE (1u << 7)  /* minification reads level 0 only */
+#define GDR_SAMPLER_STATES 256u         /* every packed state is below this */
 
 typedef enum gdr_alpha_mode { GDR_ALPHA_OPAQUE = 0, GDR_ALPHA_MASK = 1, GDR_ALPHA_BLEND = 2 } gdr_alpha_mode;
 

@@ -15,7 +15,7 @@
 
 #define FOURCC(a, b, c, d) ((uint32_t)(a) | (uint32_t)(b) << 8 | (uint32_t)(c) << 16 | (uint32_t)(d) << 24)
 
-enum { MESH_RECORD = 64 + 8 + 16, MATERIAL_RECORD = 64 + 16 + 12 + 12 + 8, INSTANCE_RECORD = 64 + 8 + 16,
+enum { MESH_RECORD = 64 + 8 + 16, MATERIAL_RECORD = 64 + 16 + 12 + 12 + 8 + 4, INSTANCE_RECORD = 64 + 8 + 16,
        CAMERA_RECORD = 64 + 12 + 16 + 16, TEXTURE_RECORD = 64 + 12, CLUSTERS_RECORD = 6 * 4,
        CLUSTER_RECORD = 4 * 4 + 16 + 12 + 12 + 4 + 3 * 4, GROUP_RECORD = 16 + 4 + 3 * 4,
        NODE_RECORD = 16 + 4 + 4 + 4 * 4 + 2 * 4 };
@@ -537,6 +537,7 @@ static void write_materials(writer *w, const cache_write_input *in)
         put_f32s(w, (const float[3]){m->metallic_factor, m->roughness_factor, m->alpha_cutoff}, 3);
         put_u32(w, m->alpha_mode);
         put_u32(w, m->double_sided);
+        put_u32(w, m->base_color_sampler);
     }
 }
 
@@ -555,13 +556,14 @@ static gdr_status read_one_material(cache_read_state *st, reader *ma, uint32_t i
     m.alpha_cutoff = factors[2];
     m.alpha_mode = get_u32(ma);
     m.double_sided = get_u32(ma);
+    m.base_color_sampler = get_u32(ma);
     uint32_t textures[3] = {m.base_color_texture, m.normal_texture, m.metallic_roughness_texture};
     for (int k = 0; k < 3; k++)
         if (textures[k] != GDR_NO_INDEX && textures[k] >= st->texture_count)
             return gdr_error_set(err, GDR_ERROR_PARSE, "%s: material %u: texture %u does not exist (%u textures)",
                                  st->name, i, textures[k], st->texture_count);
     if (!all_finite(&m.base_color.x, 4) || !all_finite(factors, 3) || m.alpha_mode > GDR_ALPHA_BLEND ||
-        m.double_sided > 1)
+        m.double_sided > 1 || m.base_color_sampler >= GDR_SAMPLER_STATES)
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: material %u: values out of range", st->name, i);
     return gdr_scene_add_material(st->scene, &m, NULL, err);
 }

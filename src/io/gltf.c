@@ -233,9 +233,56 @@ static gdr_status load_image(gltf_ctx *c, uint32_t image, int srgb, uint32_t *ou
     return GDR_OK;
 }
 
-/* A textureInfo object ({"index": N}) at place -> gdr texture index or GDR_NO_INDEX. */
+/* One of glTF's wrap modes (key of samplers[index]) as a GDR_SAMPLER_WRAP_*. */
+static gdr_status sampler_wrap(gltf_ctx *c, const cJSON *json, const char *key, const char *place, uint32_t *out)
+{
+    uint32_t mode = 10497;
+    gdr_status status = gltf_get_uint(c, json, key, place, 0, UINT32_MAX, &mode);
+    if (status != GDR_OK)
+        return status;
+    *out = mode == 10497 ? GDR_SAMPLER_WRAP_REPEAT : mode == 33071 ? GDR_SAMPLER_WRAP_CLAMP : GDR_SAMPLER_WRAP_MIRROR;
+    if (mode != 10497 && mode != 33071 && mode != 33648)
+        return gltf_fail(c, GDR_ERROR_PARSE, "%s.%s: %u is not a wrap mode (10497, 33071 or 33648)", place, key, mode);
+    return GDR_OK;
+}
+
+/* samplers[index] as GDR_SAMPLER_* bits; filters left out are linear (glTF leaves them to the
+ * implementation). */
+static gdr_status load_sampler(gltf_ctx *c, uint32_t index, uint32_t *out)
+{
+    *out = 0;
+    if (index >= c->sampler_count)
+        return gltf_fail(c, GDR_ERROR_PARSE, "samplers[%u] does not exist (%u samplers)", index, c->sampler_count);
+    char place[32];
+    snprintf(place, sizeof place, "samplers[%u]", index);
+    const cJSON *json = c->sampler_at[index];
+    uint32_t mag = 9729, min = 9987, wrap_s = 0, wrap_t = 0;
+    gdr_status status = gltf_get_uint(c, json, "magFilter", place, 0, UINT32_MAX, &mag);
+    if (status == GDR_OK)
+        status = gltf_get_uint(c, json, "minFilter", place, 0, UINT32_MAX, &min);
+    if (status == GDR_OK)
+        status = sampler_wrap(c, json, "wrapS", place, &wrap_s);
+    if (status == GDR_OK)
+        status = sampler_wrap(c, json, "wrapT", place, &wrap_t);
+    if (status != GDR_OK)
+        return status;
+    if (mag != 9728 && mag != 9729)
+        return gltf_fail(c, GDR_ERROR_PARSE, "%s.magFilter: %u is not NEAREST (9728) or LINEAR (9729)", place, mag);
+    if (min != 9728 && min != 9729 && (min < 9984 || min > 9987))
+        return gltf_fail(c, GDR_ERROR_PARSE, "%s.minFilter: %u is not a glTF minification filter", place, min);
+    /* 9728/9729: no mips; 9984..9987: NEAREST_MIPMAP_NEAREST, LINEAR_MIPMAP_NEAREST,
+     * NEAREST_MIPMAP_LINEAR, LINEAR_MIPMAP_LINEAR. */
+    bool min_nearest = min == 9728 || min == 9984 || min == 9986;
+    *out = wrap_s | wrap_t << 2 | (mag == 9728 ? GDR_SAMPLER_MAG_NEAREST : 0u) |
+           (min_nearest ? GDR_SAMPLER_MIN_NEAREST : 0u) | (min < 9984 ? GDR_SAMPLER_MIP_NONE : 0u) |
+           (min == 9984 || min == 9985 ? GDR_SAMPLER_MIP_NEAREST : 0u);
+    return GDR_OK;
+}
+
+/* A textureInfo object ({"index": N}) at place -> gdr texture index or GDR_NO_INDEX, and (when
+ * out_sampler is not NULL) its sampler's GDR_SAMPLER_* bits. */
 static gdr_status texture_ref(gltf_ctx *c, const cJSON *parent, const char *key, const char *place, int srgb,
-                              uint32_t *out)
+                              uint32_t *out, uint32_t *out_sampler)
 {
     *out = GDR_NO_INDEX;
     const cJSON *info = NULL;
@@ -261,10 +308,12 @@ static gdr_status texture_ref(gltf_ctx *c, const cJSON *parent, const char *key,
     char tplace[48];
     snprintf(tplace, sizeof tplace, "textures[%u]", texture);
     const cJSON *tjson = c->texture_at[texture];
-    uint32_t source = GDR_NO_INDEX;
+    uint32_t source = GDR_NO_INDEX, sampler = GDR_NO_INDEX;
     status = gltf_get_uint(c, tjson, "source", tplace, 0, UINT32_MAX - 1, &source);
     if (status == GDR_OK)
-        status = gltf_get_uint(c, tjson, "sampler", tplace, 0, UINT32_MAX, &(uint32_t){0});
+        status = gltf_get_uint(c, tjson, "sampler", tplace, 0, UINT32_MAX - 1, &sampler);
+    if (status == GDR_OK && sampler != GDR_NO_INDEX)
+        status = load_sampler(c, sampler, out_sampler ? out_sampler : &(uint32_t){0});
     if (status != GDR_OK)
         return status;
     if (source == GDR_NO_INDEX) {
@@ -321,9 +370,9 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
         if (status == GDR_OK)
             status = gltf_get_number(c, pbr, "roughnessFactor", pplace, &roughness);
         if (status == GDR_OK)
-            status = texture_ref(c, pbr, "baseColorTexture", pplace, 1, &m.base_color_texture);
+            status = texture_ref(c, pbr, "baseColorTexture", pplace, 1, &m.base_color_texture, &m.base_color_sampler);
         if (status == GDR_OK)
-            status = texture_ref(c, pbr, "metallicRoughnessTexture", pplace, 0, &m.metallic_roughness_texture);
+            status = texture_ref(c, pbr, "metallicRoughnessTexture", pplace, 0, &m.metallic_roughness_texture, NULL);
         if (status != GDR_OK)
             return status;
     } else {
@@ -331,11 +380,11 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
     }
     m.metallic_factor = (float)metallic;
     m.roughness_factor = (float)roughness;
-    status = texture_ref(c, json, "normalTexture", here, 0, &m.normal_texture);
+    status = texture_ref(c, json, "normalTexture", here, 0, &m.normal_texture, NULL);
     if (status == GDR_OK)
-        status = texture_ref(c, json, "occlusionTexture", here, 0, &(uint32_t){0});
+        status = texture_ref(c, json, "occlusionTexture", here, 0, &(uint32_t){0}, NULL);
     if (status == GDR_OK)
-        status = texture_ref(c, json, "emissiveTexture", here, 1, &(uint32_t){0});
+        status = texture_ref(c, json, "emissiveTexture", here, 1, &(uint32_t){0}, NULL);
     if (status != GDR_OK)
         return status;
     return gdr_scene_add_material(c->scene, &m, NULL, c->err);
@@ -1064,6 +1113,7 @@ static gdr_status import_document(gltf_ctx *c, const uint8_t *data, size_t size)
         {"images", &c->images, &c->image_count, &c->image_at},
         {"cameras", &c->cameras, &c->camera_count, &c->camera_at},
         {"scenes", &c->scenes, &c->scene_count, &c->scene_at},
+        {"samplers", &c->samplers, &c->sampler_count, &c->sampler_at},
     };
     for (size_t i = 0; i < sizeof tops / sizeof tops[0] && status == GDR_OK; i++)
         status = get_top_array(c, tops[i].key, tops[i].array, tops[i].count, tops[i].items);
@@ -1102,7 +1152,7 @@ gdr_status gdr_import_gltf_memory(const void *data, size_t size, const char *nam
         status = import_document(&c, data, size);
     cJSON_Delete(c.root);
     const cJSON **items[] = {c.accessor_at, c.view_at, c.buffer_at, c.mesh_at, c.node_at, c.material_at,
-                             c.texture_at, c.image_at, c.camera_at, c.scene_at};
+                             c.texture_at, c.image_at, c.camera_at, c.scene_at, c.sampler_at};
     for (size_t i = 0; i < sizeof items / sizeof items[0]; i++)
         free(items[i]);
     gltf_buffers_free(&c);

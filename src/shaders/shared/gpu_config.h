@@ -55,9 +55,11 @@
 #define GDR_BACKGROUND_R 0.42f
 #define GDR_BACKGROUND_G 0.55f
 #define GDR_BACKGROUND_B 0.72f
-/* Bindless textures: every texture of the scene in one runtime-sized array of combined image
- * samplers at binding 0 of this descriptor set (set 0 is the depth pyramid's), partially bound. */
+/* Bindless textures: every texture of the scene in one array of sampled images (binding 0 of this
+ * descriptor set; set 0 is the depth pyramid's) and a sampler per packed glTF sampler state
+ * (binding 1, GDR_SAMPLER_STATES of them), both partially bound; a material names one of each. */
 #define GDR_TEXTURE_SET 1
 #define GDR_MAX_TEXTURES 4096
+#define GDR_SAMPLER_SLOTS 256
 
 #endif

@@ -188,8 +188,10 @@ GDR_STRUCT_BEGIN(GdrGpuMaterial)
     gdr_uint alpha_mode;          /* gdr_alpha_mode: 0 opaque, 1 mask, 2 blend */
     float alpha_cutoff;
     gdr_uint double_sided;
+    gdr_uint base_color_sampler;  /* GDR_SAMPLER_* state (gdr/scene.h): index into the sampler array */
+    gdr_uint reserved0;
 GDR_STRUCT_END(GdrGpuMaterial)
-GDR_ASSERT_SIZE(GdrGpuMaterial, 32);
+GDR_ASSERT_SIZE(GdrGpuMaterial, 40);
 GDR_ASSERT_OFFSET(GdrGpuMaterial, base_color_texture, 16);
 
 /* A fixed-size "tag + data" record of the per-frame instance ring (seed 000). */

@@ -6,7 +6,8 @@
 
 #include "glsl_buffers.h"
 
-layout(set = GDR_TEXTURE_SET, binding = 0) uniform sampler2D gdr_textures[];
+layout(set = GDR_TEXTURE_SET, binding = 0) uniform texture2D gdr_images[];
+layout(set = GDR_TEXTURE_SET, binding = 1) uniform sampler gdr_samplers[GDR_SAMPLER_SLOTS];
 
 /* The linear base colour of material `material` at texture coordinate `uv`: its factor, times
  * its base-colour texture (sRGB decoded by the image format) sampled with the explicit
@@ -17,7 +18,9 @@ vec4 gdr_material_base_color(uint material, vec4 instance_color, vec2 uv, vec2 d
     GdrGpuMaterial m = MaterialsRef(GDR_SCENE.materials).items[material];
     vec4 color = m.base_color * instance_color;
     if (m.base_color_texture != GDR_GPU_NO_TEXTURE)
-        color *= textureGrad(gdr_textures[nonuniformEXT(m.base_color_texture)], uv, duv_dx, duv_dy);
+        color *= textureGrad(sampler2D(gdr_images[nonuniformEXT(m.base_color_texture)],
+                                       gdr_samplers[nonuniformEXT(m.base_color_sampler)]),
+                             uv, duv_dx, duv_dy);
     return color;
 }
 
