@@ -147,7 +147,7 @@ static inline void fourcc_text(uint32_t id, char out[5])
 enum {
     CACHE_SOURCE, CACHE_SCENE, CACHE_TEXTURES, CACHE_PIXELS, CACHE_MESHES, CACHE_GEOMETRY, CACHE_CLUSTERS,
     CACHE_CLUSTER_DATA, CACHE_HIERARCHY, CACHE_MATERIALS, CACHE_INSTANCES, CACHE_CAMERAS, CACHE_PVS,
-    CACHE_SECTION_COUNT
+    CACHE_PAGES, CACHE_SECTION_COUNT
 };
 
 /* What a file is written from. */
@@ -155,6 +155,7 @@ typedef struct cache_write_input {
     const gdr_scene *scene;
     const gdr_cache_source *source;
     const gdr_pvs *pvs; /* NULL: no PVIS section */
+    uint32_t page_bytes; /* 0: no PAGE section */
 } cache_write_input;
 
 typedef struct cache_read_state cache_read_state; /* cache_sections.c */
