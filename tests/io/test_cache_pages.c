@@ -57,6 +57,7 @@ static void check_pages_match(gdr_paged_cache *pc, const gdr_scene *scene)
         const gdr_mesh *mesh = &scene->meshes[m];
         const gdr_paged_mesh *pm = gdr_paged_cache_mesh(pc, m);
         CHECK(pm->group_count == mesh->clusters.group_count && pm->page_count >= 2);
+        CHECK(pm->pages[0].group_count >= 2);
         CHECK(pm->source_triangles == mesh->index_count / 3);
         uint32_t *seen = calloc(mesh->clusters.cluster_count, sizeof *seen);
         uint32_t last_depth = UINT32_MAX;
@@ -245,7 +246,8 @@ int main(void)
     snprintf(path, sizeof path, "%s/pages.gdrc", GDR_IO_TEST_TMP);
     gdr_cache_write_options bad = {.page_bytes = GDR_PAGE_BYTES_MIN - 1};
     CHECK(gdr_cache_write(path, scene, &bad, &err) == GDR_ERROR_INVALID_ARGUMENT);
-    gdr_cache_write_options write = {.page_bytes = GDR_PAGE_BYTES_MIN};
+    /* Pages of about three groups: several pages per mesh, several groups per page. */
+    gdr_cache_write_options write = {.page_bytes = 48u << 10};
     CHECK(gdr_cache_write(path, scene, &write, &err) == GDR_OK);
     /* The whole-file reader still reads it (and checks the page index). */
     gdr_scene *again = NULL;
