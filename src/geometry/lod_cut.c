@@ -40,6 +40,21 @@ uint32_t gdr_lod_cut_select(const gdr_mesh_clusters *clusters, const gdr_lod_vie
     return count;
 }
 
+uint32_t gdr_lod_cut_select_resident(const gdr_mesh_clusters *clusters, const gdr_lod_view *view,
+                                     const uint8_t *group_resident, uint8_t *selected)
+{
+    uint32_t count = 0;
+    for (uint32_t i = 0; i < clusters->cluster_count; i++) {
+        const gdr_cluster *c = &clusters->clusters[i];
+        uint32_t r = c->refined_group, g = c->group;
+        bool refined = r == GDR_NO_INDEX || !group_resident[r] || gdr_lod_group_passes(clusters, r, view);
+        bool group = g != GDR_NO_INDEX && (!group_resident[g] || gdr_lod_group_passes(clusters, g, view));
+        selected[i] = gdr_lod_cluster_drawn(refined, group);
+        count += selected[i];
+    }
+    return count;
+}
+
 static bool node_may_draw(const gdr_lod_node *n, const gdr_lod_view *view)
 {
     const float *m = view->transform.m;

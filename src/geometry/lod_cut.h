@@ -32,6 +32,15 @@ bool gdr_lod_group_passes(const gdr_mesh_clusters *clusters, uint32_t group, con
  * Returns the number of clusters selected. */
 uint32_t gdr_lod_cut_select(const gdr_mesh_clusters *clusters, const gdr_lod_view *view, uint8_t *selected);
 
+/* The cut of a streamed mesh, of which only some groups are resident (group_resident[g] != 0):
+ * a group that is absent counts as passing, so its clusters are not drawn and the clusters made
+ * from it, in the groups above, are drawn instead where those do not pass. When the resident
+ * groups are closed upwards (every group made from a resident group is resident, the root always
+ * is), each source-to-root path still holds exactly one drawn cluster: no hole, no crack. With
+ * every group resident it is gdr_lod_cut_select. Returns the number of clusters selected. */
+uint32_t gdr_lod_cut_select_resident(const gdr_mesh_clusters *clusters, const gdr_lod_view *view,
+                                     const uint8_t *group_resident, uint8_t *selected);
+
 /* What a hierarchical cut did: the work a traversal of the LOD hierarchy saves. */
 typedef struct gdr_lod_traversal_stats {
     uint64_t nodes_tested;    /* nodes whose test ran (the root and the children of nodes that passed) */
