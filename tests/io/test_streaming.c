@@ -210,16 +210,17 @@ static uint64_t simulate(const gdr_scene *scene, const char *path, uint64_t budg
     return s.trace;
 }
 
-static uint64_t total_pool_bytes(const char *path)
+static uint64_t total_pool_bytes(const char *path, uint32_t *pages)
 {
     gdr_paged_cache *pc = NULL;
     gdr_error err = {0};
     uint64_t total = 0;
+    *pages = 0;
     if (gdr_paged_cache_open(path, &pc, &err) != GDR_OK)
         return 0;
     for (uint32_t m = 0; m < gdr_paged_cache_mesh_count(pc); m++)
         for (uint32_t p = 0; p < gdr_paged_cache_mesh(pc, m)->page_count; p++)
-            total += gdr_page_pool_bytes(&gdr_paged_cache_mesh(pc, m)->pages[p]);
+            total += gdr_page_pool_bytes(&gdr_paged_cache_mesh(pc, m)->pages[p]), (*pages)++;
     gdr_paged_cache_close(pc);
     return total;
 }
@@ -330,8 +331,9 @@ int main(void)
     snprintf(damaged, sizeof damaged, "%s/streaming_damaged.gdrc", GDR_IO_TEST_TMP);
     gdr_cache_write_options write = {.page_bytes = GDR_PAGE_BYTES_MIN}; /* a group a page */
     CHECK(gdr_cache_write(path, scene, &write, &err) == GDR_OK);
-    uint64_t total = total_pool_bytes(path), budget = total / 10, upload = 64u << 10;
-    printf("pages: %llu bytes in the pool when all resident; budget %llu, upload budget %llu a frame\n",
+    uint32_t pages = 0;
+    uint64_t total = total_pool_bytes(path, &pages), budget = total / 10, upload = 64u << 10;
+    printf("%u pages: %llu bytes in the pool when all resident; budget %llu, upload budget %llu a frame\n", pages,
            (unsigned long long)total, (unsigned long long)budget, (unsigned long long)upload);
 
     uint32_t converged, failed, deferred;
