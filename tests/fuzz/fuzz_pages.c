@@ -9,6 +9,7 @@
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -47,8 +48,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     gdr_status status = cache_page_decode("fuzz.gdrc", 0, 0, &pm, bytes, stored, &page, &err);
     if (!fix && status == GDR_OK)
         abort(); /* a wrong checksum must be refused */
-    if (status != GDR_OK)
+    if (status != GDR_OK) {
+        if (getenv("FUZZ_PAGES_VERBOSE"))
+            fprintf(stderr, "%s\n", err.message);
         return 0;
+    }
     if (page.cluster_count != clusters || page.vertex_count != vertices)
         abort();
     for (uint32_t c = 0; c < page.cluster_count; c++) {
