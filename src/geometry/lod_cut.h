@@ -55,6 +55,21 @@ typedef struct gdr_lod_traversal_stats {
 uint32_t gdr_lod_cut_select_hierarchical(const gdr_mesh_clusters *clusters, const gdr_lod_view *view,
                                          uint8_t *selected, gdr_lod_traversal_stats *stats);
 
+/* For the cut over resident groups by traversal: absent[n] = the clusters below node n whose refined
+ * group is not resident (lod_node_count entries). A node test's second side ("no refined group
+ * below passes", gdr_lod_node_may_draw) only holds where this is 0: an absent refined group counts
+ * as passing. */
+void gdr_lod_nodes_count_absent_refined(const gdr_mesh_clusters *clusters, const uint8_t *group_resident,
+                                        uint32_t *absent);
+
+/* gdr_lod_cut_select_resident found by walking the hierarchy: a node is skipped when every group
+ * below passes (which an absent group does too), or, where absent[node] is 0, when no refined group
+ * below passes; a leaf's clusters get the resident rule. The same bytes as
+ * gdr_lod_cut_select_resident. stats (may be NULL) are added to. */
+uint32_t gdr_lod_cut_select_hierarchical_resident(const gdr_mesh_clusters *clusters, const gdr_lod_view *view,
+                                                  const uint8_t *group_resident, const uint32_t *absent,
+                                                  uint8_t *selected, gdr_lod_traversal_stats *stats);
+
 /* The discrete debug cut at DAG depth N (gdr/geometry.h): the same rule with
  * passes(g) = (depth(g) < depth and g is not the root). */
 uint32_t gdr_lod_cut_select_depth(const gdr_mesh_clusters *clusters, uint32_t depth, uint8_t *selected);

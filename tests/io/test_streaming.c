@@ -64,6 +64,8 @@ typedef struct sim {
     uint64_t trace;               /* a hash of every frame's numbers: runs compare it */
     uint32_t deferred_frames, failed_pages, max_loads, evictions;
     int exact, full;              /* this frame: the cut was exact; it equals the full cut */
+    int same_walk;                /* every frame: the traversal's cut is the flat one */
+    gdr_lod_traversal_stats traversal;
 } sim;
 
 static gdr_lod_view view_of(const gdr_scene *scene, uint32_t instance, gdr_vec3 camera)
@@ -86,6 +88,13 @@ static void frame_mesh(sim *s, uint32_t m, gdr_vec3 camera, gdr_stream_request *
     gdr_lod_view view = view_of(s->scene, m, camera); /* instance m draws mesh m */
     gdr_lod_cut_select_resident(mc, &view, resident, cut);
     gdr_lod_cut_select(mc, &view, full);
+    /* The traversal's cut over the same resident groups (what the GPU runs): the same bytes. */
+    uint32_t *absent = malloc(sizeof *absent * mc->lod_node_count);
+    uint8_t *walked = malloc(mc->cluster_count);
+    gdr_lod_nodes_count_absent_refined(mc, resident, absent);
+    gdr_lod_cut_select_hierarchical_resident(mc, &view, resident, absent, walked, &s->traversal);
+    s->same_walk &= memcmp(walked, cut, mc->cluster_count) == 0;
+    free(absent), free(walked);
     s->exact &= cut_is_exact(mc, cut);
     s->full &= memcmp(cut, full, mc->cluster_count) == 0;
     memset(s->used[m], 0, pm->page_count);
@@ -174,7 +183,8 @@ static gdr_vec3 camera_at(uint32_t frame)
 static uint64_t simulate(const gdr_scene *scene, const char *path, uint64_t budget, uint64_t upload_budget,
                          uint32_t *converged_at, uint32_t *failed_pages, uint32_t *deferred_frames)
 {
-    sim s = {.scene = scene, .budget = budget, .upload_budget = upload_budget, .trace = 14695981039346656037ull};
+    sim s = {.scene = scene, .budget = budget, .upload_budget = upload_budget, .trace = 14695981039346656037ull,
+             .same_walk = 1};
     gdr_error err = {0};
     CHECK(gdr_paged_cache_open(path, &s.cache, &err) == GDR_OK);
     gdr_residency_desc desc = {s.cache, budget, upload_budget};
@@ -198,6 +208,9 @@ static uint64_t simulate(const gdr_scene *scene, const char *path, uint64_t budg
            s.request_count, st.resident_pages, s.res ? gdr_residency_slot_count(s.res) : 0, st.deferred,
            s.evictions);
     CHECK(s.evictions > 0);
+    CHECK(s.same_walk);
+    printf("traversal: %llu nodes and %llu clusters tested\n", (unsigned long long)s.traversal.nodes_tested,
+           (unsigned long long)s.traversal.clusters_tested);
     *failed_pages = s.failed_pages;
     *deferred_frames = s.deferred_frames;
     gdr_page_loader_destroy(s.loader);
