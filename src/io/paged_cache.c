@@ -223,7 +223,7 @@ gdr_status gdr_paged_cache_open(const char *path, gdr_paged_cache **out, gdr_err
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: paged cache", path);
     }
     struct stat st;
-    pc->fd = open(path, O_RDONLY | O_CLOEXEC);
+    pc->fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC); /* a FIFO must not block the open */
     if (pc->fd < 0 || fstat(pc->fd, &st) != 0 || !S_ISREG(st.st_mode)) {
         gdr_status status = gdr_error_set(err, GDR_ERROR_IO, "%s: %s", path,
                                           pc->fd < 0 ? strerror(errno) : "not a regular file");
