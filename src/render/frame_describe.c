@@ -13,7 +13,7 @@ const char *gdr_frame_section_name(gdr_frame_section section)
 const char *gdr_frame_resource_name(gdr_frame_resource resource)
 {
     static const char *const names[GDR_RES_COUNT] = {
-        "instances", "visibility", "draw_stats", "draws", "tasks", "traversal", "visible_meshlets", "overdraw", "raster_counters",
+        "instances", "occluded", "draw_stats", "draws", "tasks", "traversal", "visible_meshlets", "overdraw", "raster_counters",
         "raster_clusters", "visbuffer", "resolved", "readback", "color", "depth", "hzb"};
     return (unsigned)resource < GDR_RES_COUNT ? names[resource] : "?";
 }

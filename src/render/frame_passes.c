@@ -47,9 +47,11 @@ static const gdr_pass_template clear = {
              {GDR_RES_VISBUFFER, TRANSFER, COPY_WRITE, .flags = GDR_USE_VISBUFFER}}};
 
 static const gdr_pass_template cull_draws = {
-    "instance_cull", gdr_pass_record_instance_cull, .what = "instances: frustum, occlusion; appends draw commands",
-    .uses = {{GDR_RES_INSTANCES, COMPUTE, READ}, {GDR_RES_VISIBILITY, COMPUTE, READ_WRITE}, HZB_READ(COMPUTE),
-             {GDR_RES_DRAWS, COMPUTE, WRITE}, {GDR_RES_DRAW_STATS, COMPUTE, READ_WRITE}}};
+    "instance_cull", gdr_pass_record_instance_cull,
+    .what = "instances (late phase: those the early one deferred): frustum, occlusion; appends draw commands",
+    .uses = {{GDR_RES_DRAW_STATS, INDIRECT, INDIRECT_READ}, {GDR_RES_INSTANCES, COMPUTE, READ},
+             {GDR_RES_OCCLUDED, COMPUTE, READ_WRITE}, HZB_READ(COMPUTE), {GDR_RES_DRAWS, COMPUTE, WRITE},
+             {GDR_RES_DRAW_STATS, COMPUTE, READ_WRITE}}};
 
 static const gdr_pass_template draw_indexed = {
     "draw_indexed", gdr_pass_record_draw_indexed, .what = "one vkCmdDrawIndexedIndirectCount",
@@ -58,17 +60,19 @@ static const gdr_pass_template draw_indexed = {
 
 static const gdr_pass_template cull_tasks = {
     "instance_cull", gdr_pass_record_instance_cull,
-    .what = "instances: frustum, occlusion, LOD root shortcut; appends task commands",
-    .uses = {{GDR_RES_INSTANCES, COMPUTE, READ}, {GDR_RES_VISIBILITY, COMPUTE, READ_WRITE}, HZB_READ(COMPUTE),
+    .what = "instances (late phase: those the early one deferred): frustum, occlusion, LOD root shortcut; "
+            "appends task commands",
+    .uses = {{GDR_RES_DRAW_STATS, INDIRECT, INDIRECT_READ}, {GDR_RES_INSTANCES, COMPUTE, READ},
+             {GDR_RES_OCCLUDED, COMPUTE, READ_WRITE}, HZB_READ(COMPUTE),
              {GDR_RES_TASKS, COMPUTE, WRITE}, {GDR_RES_DRAW_STATS, COMPUTE, READ_WRITE},
              {GDR_RES_DRAWS, COMPUTE, WRITE}, {GDR_RES_TRAVERSAL, COMPUTE, WRITE, .flags = GDR_USE_TRAVERSAL}}};
 
 static const gdr_pass_template lod_traverse = {
     "lod_traverse", gdr_pass_record_lod_traverse,
-    .what = "one level of the LOD hierarchies: nodes by LOD error, frustum, occlusion (late); leaves append tasks",
+    .what = "one level of the LOD hierarchies: nodes by LOD error, frustum, occlusion; leaves append tasks",
     .uses = {{GDR_RES_DRAW_STATS, INDIRECT, INDIRECT_READ}, {GDR_RES_DRAW_STATS, COMPUTE, READ_WRITE},
              {GDR_RES_TRAVERSAL, COMPUTE, READ_WRITE}, {GDR_RES_INSTANCES, COMPUTE, READ}, HZB_READ(COMPUTE),
-             {GDR_RES_TASKS, COMPUTE, WRITE}}};
+             {GDR_RES_OCCLUDED, COMPUTE, READ_WRITE}, {GDR_RES_TASKS, COMPUTE, WRITE}}};
 
 static const gdr_pass_template task_submit = {
     "task_submit", gdr_pass_record_task_submit, .what = "the task commands' count into the launches",
@@ -76,18 +80,20 @@ static const gdr_pass_template task_submit = {
 
 static const gdr_pass_template meshlets = {
     "meshlets", gdr_pass_record_meshlets,
-    .what = "task shaders test clusters, mesh shaders cull triangles, fragments shade",
+    .what = "task shaders test clusters (the early phase defers hidden ones), mesh shaders cull triangles, "
+            "fragments shade",
     .uses = {{GDR_RES_DRAW_STATS, INDIRECT, INDIRECT_READ}, {GDR_RES_DRAW_STATS, TASK | MESH, READ_WRITE},
-             {GDR_RES_TASKS, TASK, READ}, {GDR_RES_INSTANCES, TASK | MESH, READ},
-             {GDR_RES_VISIBILITY, TASK, READ_WRITE}, HZB_READ(TASK), {GDR_RES_VISIBLE_MESHLETS, TASK, WRITE},
+             {GDR_RES_TASKS, TASK, READ_WRITE}, {GDR_RES_INSTANCES, TASK | MESH, READ},
+             {GDR_RES_OCCLUDED, TASK, READ_WRITE}, HZB_READ(TASK), {GDR_RES_VISIBLE_MESHLETS, TASK, WRITE},
              COLOR_TARGET, DEPTH_TARGET, OVERDRAW_COUNTS(FRAGMENT)}};
 
 static const gdr_pass_template cluster_cull = {
     "cluster_cull", gdr_visbuffer_record_cluster_cull, GDR_RASTER_TIMER_CULL,
-    .what = "clusters: LOD cut, frustum, cone, occlusion; binned into the visible-cluster list",
+    .what = "clusters: LOD cut, frustum, cone, occlusion (the early phase defers hidden ones); binned into the "
+            "visible-cluster list",
     .uses = {{GDR_RES_DRAW_STATS, INDIRECT, INDIRECT_READ}, {GDR_RES_DRAW_STATS, COMPUTE, READ_WRITE},
-             {GDR_RES_TASKS, COMPUTE, READ}, {GDR_RES_INSTANCES, COMPUTE, READ},
-             {GDR_RES_VISIBILITY, COMPUTE, READ_WRITE}, HZB_READ(COMPUTE),
+             {GDR_RES_TASKS, COMPUTE, READ_WRITE}, {GDR_RES_INSTANCES, COMPUTE, READ},
+             {GDR_RES_OCCLUDED, COMPUTE, READ_WRITE}, HZB_READ(COMPUTE),
              {GDR_RES_RASTER_COUNTERS, COMPUTE, READ_WRITE}, {GDR_RES_RASTER_CLUSTERS, COMPUTE, WRITE},
              {GDR_RES_VISIBLE_MESHLETS, COMPUTE, WRITE}}};
 

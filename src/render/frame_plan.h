@@ -26,7 +26,7 @@ typedef enum gdr_occlusion_phase {
  * pass, images also get their layout transitions. */
 typedef enum gdr_frame_resource {
     GDR_RES_INSTANCES,        /* GdrGpuInstance[] (the update ring writes it) */
-    GDR_RES_VISIBILITY,       /* the occlusion history of instances and clusters */
+    GDR_RES_OCCLUDED,         /* the occluded lists: what the early phase defers to the late one */
     GDR_RES_DRAW_STATS,       /* the frame's counters and indirect launches (GdrGpuDrawStats) */
     GDR_RES_DRAWS,            /* indirect draw commands */
     GDR_RES_TASKS,            /* task commands */

@@ -79,33 +79,27 @@ void gdr_occlusion_destroy(gdr_renderer *r)
 gdr_status gdr_occlusion_scene_create(gdr_renderer *r, gdr_error *err)
 {
     gdr_occlusion *o = &r->occlusion;
-    uint64_t instances = r->scene.instance_count ? r->scene.instance_count : 1;
-    uint64_t words = (r->scene.instance_lod_cluster_count + 31) / 32;
-    words = words ? words : 1;
-    if (words > UINT32_MAX / 4)
-        return gdr_error_set(err, GDR_ERROR_CAPACITY, "occlusion: %llu clusters over all instances is too many",
-                             (unsigned long long)r->scene.instance_lod_cluster_count);
-    const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-    gdr_status status = gdr_vk_buffer_create(&r->allocator, 4 * instances, usage, GDR_VK_BUFFER_DEVICE,
-                                             &o->instance_visibility, err);
+    const gdr_gpu_scene *g = &r->scene;
+    /* One level's worth of visits: a frame that defers more traverses the rest in its early phase. */
+    o->occluded_node_capacity = r->debug_occluded_node_capacity ? r->debug_occluded_node_capacity : g->traversal_capacity;
+    const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    gdr_status status = gdr_vk_buffer_create(&r->allocator, 4 * (VkDeviceSize)(g->instance_count ? g->instance_count : 1),
+                                             usage, GDR_VK_BUFFER_DEVICE, &o->occluded_instances, err);
     if (status == GDR_OK)
-        status = gdr_vk_buffer_create(&r->allocator, 4 * words, usage, GDR_VK_BUFFER_DEVICE, &o->meshlet_visibility, err);
-    uint32_t *zeros = status == GDR_OK ? calloc(words > instances ? words : instances, 4) : NULL;
-    if (status == GDR_OK && !zeros)
-        status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "occlusion: out of memory");
+        status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuNodeVisit) * (VkDeviceSize)o->occluded_node_capacity,
+                                      usage, GDR_VK_BUFFER_DEVICE, &o->occluded_nodes, err);
     if (status == GDR_OK)
-        status = gdr_vk_buffer_upload(r->ctx, &r->staging, &o->instance_visibility, 0, zeros, 4 * instances, err);
-    if (status == GDR_OK)
-        status = gdr_vk_buffer_upload(r->ctx, &r->staging, &o->meshlet_visibility, 0, zeros, 4 * words, err);
-    free(zeros);
+        status = gdr_vk_buffer_create(&r->allocator, 4 * (VkDeviceSize)g->task_capacity, usage, GDR_VK_BUFFER_DEVICE,
+                                      &o->retest_masks, err);
     o->history_valid = false;
     return status;
 }
 
 void gdr_occlusion_scene_destroy(gdr_renderer *r)
 {
-    gdr_vk_buffer_destroy(r->ctx, &r->occlusion.instance_visibility);
-    gdr_vk_buffer_destroy(r->ctx, &r->occlusion.meshlet_visibility);
+    gdr_vk_buffer_destroy(r->ctx, &r->occlusion.occluded_instances);
+    gdr_vk_buffer_destroy(r->ctx, &r->occlusion.occluded_nodes);
+    gdr_vk_buffer_destroy(r->ctx, &r->occlusion.retest_masks);
     r->occlusion.history_valid = false;
 }
 

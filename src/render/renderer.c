@@ -84,6 +84,7 @@ gdr_status gdr_renderer_create(const gdr_renderer_desc *desc_in, gdr_renderer **
     r->record_every_frame = desc.record_every_frame;
     r->debug_task_capacity = desc.debug_task_capacity;
     r->debug_traversal_capacity = desc.debug_traversal_capacity;
+    r->debug_occluded_node_capacity = desc.debug_occluded_node_capacity;
     r->debug_shrink_lod_nodes = desc.debug_shrink_lod_nodes;
     gdr_vk_context_desc context_desc = {.device = desc.device, .validate = desc.validate,
                                         .synchronization_validation = desc.synchronization_validation,

@@ -39,53 +39,52 @@ GdrTaskRange task_range(GdrGpuFrameGlobals g, GdrGpuMesh mesh, mat4 model, out b
     return traverse ? GdrTaskRange(0u, 0u, 0u, 0u) : gdr_task_range(mesh.meshlet_offset, mesh.lod_cluster_count, 0u);
 }
 
+// The instance this invocation culls: the early (or only) phase's, one per instance; the late
+// phase's, one per instance the early phase deferred.
+uint instance_of_invocation(GdrGpuFrameGlobals g, DrawStatsRef stats)
+{
+    uint id = gl_GlobalInvocationID.x;
+    if (PHASE != GDR_PHASE_LATE)
+        return id;
+    return id < stats.value.late_instances.count ? WritableUintsRef(GDR_FRAME.occluded_instances).items[id]
+                                                 : g.instance_count;
+}
+
 void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
     DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
-    uint id = gl_GlobalInvocationID.x;
+    uint id = instance_of_invocation(g, stats);
     bool visible = false;
     GdrGpuMesh mesh;
     mat4 model;
-    vec3 center = vec3(0.0);
+    vec3 world_center = vec3(0.0);
     float radius = 0.0;
     if (id < g.instance_count) {
         model = InstancesRef(GDR_SCENE.instances).items[id].model;
         mesh = MeshesRef(GDR_SCENE.meshes).items[InstancesRef(GDR_SCENE.instances).items[id].mesh];
         visible = mesh.index_count > 0u; // nothing to draw otherwise
-        center = (g.view * (model * vec4(mesh.bounds.xyz, 1.0))).xyz;
+        world_center = (model * vec4(mesh.bounds.xyz, 1.0)).xyz;
         radius = mesh.bounds.w * gdr_max_axis_scale(model[0].xyz, model[1].xyz, model[2].xyz);
+        vec3 center = (g.view * vec4(world_center, 1.0)).xyz;
         if (visible && g.cull_enabled != 0u)
             visible = gdr_sphere_visible(g.frustum, center, radius, g.znear, g.zfar);
     }
 
-    // Two-phase occlusion culling (seeds 000, 002). Early: what was visible at the end
-    // of the last frame, unless last frame's pyramid hides it. Late: everything in the frustum
-    // against this frame's pyramid (built from the early phase's depth); draws what the early
-    // phase did not, and records what is visible for the next frame.
-    bool drawn_early = false;
-    if (PHASE == GDR_PHASE_EARLY && id < g.instance_count) {
-        uint state = VisibilityRef(GDR_SCENE.instance_visibility).items[id];
-        bool candidate = visible && (g.flags & GDR_FRAME_HISTORY) != 0u && (state & GDR_INSTANCE_VISIBLE_LAST_FRAME) != 0u;
-        bool occluded = candidate && gdr_sphere_occluded(g, center, radius);
-        GDR_COUNT(stats, instances_early_occluded, occluded);
-        visible = candidate && !occluded;
-        GDR_COUNT(stats, instances_early_drawn, visible);
-        VisibilityRef(GDR_SCENE.instance_visibility).items[id] = (state & GDR_INSTANCE_VISIBLE_LAST_FRAME) |
-                                                         (visible ? GDR_INSTANCE_DRAWN_EARLY : 0u);
-    } else if (PHASE == GDR_PHASE_LATE && id < g.instance_count) {
-        uint state = VisibilityRef(GDR_SCENE.instance_visibility).items[id];
-        drawn_early = (state & GDR_INSTANCE_DRAWN_EARLY) != 0u;
-        GDR_COUNT(stats, instances_late_tested, visible);
-        bool occluded = visible && gdr_sphere_occluded(g, center, radius);
-        GDR_COUNT(stats, instances_late_occluded, occluded);
+    // Two-phase occlusion culling (occlusion_test.h): the early phase defers what last frame's
+    // pyramid hides; the late phase retests those against this frame's.
+    if (PHASE != GDR_PHASE_NONE) {
+        bool occluded = visible && gdr_phase_occluded(g, PHASE, world_center, radius);
+        if (PHASE == GDR_PHASE_EARLY) {
+            gdr_defer_instances(occluded, id);
+            GDR_COUNT(stats, instances_early_occluded, occluded);
+            GDR_COUNT(stats, instances_early_drawn, visible && !occluded);
+        } else {
+            GDR_COUNT(stats, instances_late_tested, id < g.instance_count);
+            GDR_COUNT(stats, instances_late_occluded, occluded);
+            GDR_COUNT(stats, instances_late_drawn, visible && !occluded);
+        }
         visible = visible && !occluded;
-        VisibilityRef(GDR_SCENE.instance_visibility).items[id] = visible ? GDR_INSTANCE_VISIBLE_LAST_FRAME : 0u;
-        // The meshlet pipeline goes on testing the clusters of instances drawn early (those not
-        // drawn early may be visible now); the indirect pipeline has drawn them whole.
-        if (!EMIT_TASKS)
-            visible = visible && !drawn_early;
-        GDR_COUNT(stats, instances_late_drawn, visible && !drawn_early);
     }
 
     uvec4 ballot = subgroupBallot(visible);
@@ -106,18 +105,15 @@ void main()
     if (EMIT_TASKS) {
         bool traverse = false;
         GdrTaskRange range = visible ? task_range(g, mesh, model, traverse) : GdrTaskRange(0u, 0u, 0u, 0u);
-        uint flags = drawn_early ? GDR_TASK_DRAWN_EARLY : 0u;
-        range.flags |= flags;
         gdr_append_tasks(g, PHASE, visible, id, range);
-        gdr_queue_visits(g, PHASE, 0u, traverse && visible ? 1u : 0u, id, 0u, flags);
-        // The visible instances, for read-backs (the early phase's, then the late phase's others).
-        bool listed = visible && !drawn_early;
-        uvec4 listed_ballot = subgroupBallot(listed);
+        gdr_queue_visits(g, PHASE, 0u, traverse && visible ? 1u : 0u, id, 0u, 0u);
+        // The visible instances, for read-backs (each is drawn in one phase only).
+        uvec4 listed_ballot = subgroupBallot(visible);
         uint list_base = 0u;
         if (subgroupElect() && subgroupBallotBitCount(listed_ballot) > 0u)
             list_base = atomicAdd(stats.value.instances_listed, subgroupBallotBitCount(listed_ballot));
         list_base = subgroupBroadcastFirst(list_base) + subgroupBallotExclusiveBitCount(listed_ballot);
-        if (listed)
+        if (visible)
             DrawCommandsRef(GDR_FRAME.draws).items[list_base] = GdrGpuDrawCommand(0u, 0u, 0u, 0, id);
     } else if (visible) {
         // The late phase's draws follow the early phase's region (instance_count entries).

@@ -39,8 +39,9 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
         }
         if (s->traversal.applied)
             fprintf(out, "lod_hierarchy       %u levels; nodes %u tested (%u late), %u LOD-culled, %u outside the frustum, "
-                         "%u occluded%s\n", s->traversal.levels, s->traversal.nodes_tested, s->traversal.late_nodes_tested,
-                    s->traversal.nodes_lod_culled, s->traversal.nodes_frustum_culled, s->traversal.nodes_occluded,
+                         "%u deferred, %u occluded%s\n", s->traversal.levels, s->traversal.nodes_tested,
+                    s->traversal.late_nodes_tested, s->traversal.nodes_lod_culled, s->traversal.nodes_frustum_culled,
+                    s->traversal.nodes_early_occluded, s->traversal.nodes_occluded,
                     s->traversal.overflow ? "; VISITS LOST TO OVERFLOW" : "");
         if (s->traversal.overflow)
             fprintf(out, "traversal_overflow  %u node visits did not fit (their clusters were not drawn)\n",
@@ -60,8 +61,9 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
         fprintf(out, "draws               %u (in %u indirect draw call)\n", s->draws, s->draw_calls);
     }
     if (s->occlusion.applied) {
-        fprintf(out, "occlusion early     instances %u drawn, %u occluded (by last frame's pyramid); clusters %u drawn\n",
-                s->occlusion.instances_early_drawn, s->occlusion.instances_early_occluded, s->occlusion.meshlets_early_drawn);
+        fprintf(out, "occlusion early     instances %u drawn, %u deferred (behind last frame's pyramid); clusters %u drawn, "
+                "%u deferred; %u overflow\n", s->occlusion.instances_early_drawn, s->occlusion.instances_early_occluded,
+                s->occlusion.meshlets_early_drawn, s->occlusion.meshlets_early_occluded, s->occlusion.overflow);
         fprintf(out, "occlusion late      instances %u tested, %u occluded, %u drawn; clusters %u tested, %u occluded, "
                 "%u drawn\n", s->occlusion.instances_late_tested, s->occlusion.instances_late_occluded, s->occlusion.instances_late_drawn,
                 s->occlusion.meshlets_late_tested, s->occlusion.meshlets_late_occluded, s->occlusion.meshlets_late_drawn);
@@ -120,6 +122,8 @@ void stats_add_occlusion_json(cJSON *object, const gdr_frame_stats *s)
     cJSON_AddNumberToObject(object, "instances_late_occluded", s->occlusion.instances_late_occluded);
     cJSON_AddNumberToObject(object, "instances_late_drawn", s->occlusion.instances_late_drawn);
     cJSON_AddNumberToObject(object, "meshlets_early_drawn", s->occlusion.meshlets_early_drawn);
+    cJSON_AddNumberToObject(object, "meshlets_early_occluded", s->occlusion.meshlets_early_occluded);
+    cJSON_AddNumberToObject(object, "occluded_overflow", s->occlusion.overflow);
     cJSON_AddNumberToObject(object, "meshlets_late_tested", s->occlusion.meshlets_late_tested);
     cJSON_AddNumberToObject(object, "meshlets_late_occluded", s->occlusion.meshlets_late_occluded);
     cJSON_AddNumberToObject(object, "meshlets_late_drawn", s->occlusion.meshlets_late_drawn);
@@ -134,6 +138,7 @@ void stats_add_traversal_json(cJSON *object, const gdr_frame_stats *s)
     cJSON_AddNumberToObject(object, "nodes_tested", s->traversal.nodes_tested);
     cJSON_AddNumberToObject(object, "nodes_lod_culled", s->traversal.nodes_lod_culled);
     cJSON_AddNumberToObject(object, "nodes_frustum_culled", s->traversal.nodes_frustum_culled);
+    cJSON_AddNumberToObject(object, "nodes_early_occluded", s->traversal.nodes_early_occluded);
     cJSON_AddNumberToObject(object, "nodes_occluded", s->traversal.nodes_occluded);
     cJSON_AddNumberToObject(object, "late_nodes_tested", s->traversal.late_nodes_tested);
     cJSON_AddNumberToObject(object, "traversal_overflow", s->traversal.overflow);

@@ -18,7 +18,7 @@ layout(buffer_reference, scalar) readonly buffer VerticesRef { GdrGpuVertex item
 layout(buffer_reference, scalar) readonly buffer MeshletsRef { GdrGpuMeshlet items[]; };
 layout(buffer_reference, scalar) readonly buffer LodNodesRef { GdrGpuLodNode items[]; };
 layout(buffer_reference, scalar) readonly buffer UintsRef { uint items[]; };
-layout(buffer_reference, scalar) buffer VisibilityRef { uint items[]; };
+layout(buffer_reference, scalar) buffer WritableUintsRef { uint items[]; };
 layout(buffer_reference, scalar) writeonly buffer DrawCommandsRef { GdrGpuDrawCommand items[]; };
 layout(buffer_reference, scalar) buffer DrawStatsRef { GdrGpuDrawStats value; };
 layout(buffer_reference, scalar) readonly buffer InstanceUpdatesRef { GdrGpuInstanceUpdate items[]; };
