@@ -13,6 +13,9 @@
 #include "shared/lod_math.h"
 #include "shared/occlusion_test.h"
 #include "shared/task_queue.h"
+#include "shared/meshlet_payload.h"
+#include "shared/cluster_cull.h"
+#include "shared/raster_bin.h"
 
 layout(local_size_x = GDR_CULL_WORKGROUP_SIZE) in;
 layout(constant_id = 0) const bool EMIT_TASKS = false;
@@ -48,6 +51,26 @@ uint instance_of_invocation(GdrGpuFrameGlobals g, DrawStatsRef stats)
         return id;
     return id < stats.value.late_instances.count ? WritableUintsRef(GDR_FRAME.occluded_instances).items[id]
                                                  : g.instance_count;
+}
+
+// The clusters of a visible instance that needs at most GDR_DIRECT_CLUSTERS (`direct`): the cluster
+// cull's tests and binning, here. The early phase defers those behind last frame's pyramid with a
+// retest command (drawn now where the late region is full). Uniform control flow.
+void cull_direct_clusters(GdrGpuFrameGlobals g, bool direct, uint instance, GdrTaskRange range)
+{
+    GdrGpuTaskCommand task = GdrGpuTaskCommand(instance, range.first, direct ? range.count : 0u, range.flags | GDR_TASK_FIRST);
+    uint deferred = 0u;
+    for (uint c = 0u; c < GDR_DIRECT_CLUSTERS; c++) {
+        GdrClusterResult cluster = gdr_cluster_test_command(g, PHASE, task, c, true);
+        gdr_raster_append(g, cluster.visible, cluster.instance, cluster.meshlet);
+        gdr_cluster_count(g, PHASE, cluster);
+        if (PHASE == GDR_PHASE_EARLY && cluster.occluded)
+            deferred |= 1u << c;
+    }
+    bool failed = PHASE == GDR_PHASE_EARLY && deferred != 0u && !gdr_defer_clusters(g, task, deferred);
+    if (PHASE == GDR_PHASE_EARLY && subgroupBallotBitCount(subgroupBallot(failed)) > 0u)
+        for (uint c = 0u; c < GDR_DIRECT_CLUSTERS; c++)
+            gdr_raster_append(g, failed && (deferred & (1u << c)) != 0u, instance, range.first + c);
 }
 
 void main()
@@ -105,8 +128,12 @@ void main()
     if (EMIT_TASKS) {
         bool traverse = false;
         GdrTaskRange range = visible ? task_range(g, mesh, model, traverse) : GdrTaskRange(0u, 0u, 0u, 0u);
-        gdr_append_tasks(g, PHASE, visible, id, range);
+        bool direct_frame = (g.flags & GDR_FRAME_DIRECT_CLUSTERS) != 0u;
+        bool direct = direct_frame && visible && !traverse && range.count <= GDR_DIRECT_CLUSTERS;
+        gdr_append_tasks(g, PHASE, visible && !direct, id, range);
         gdr_queue_visits(g, PHASE, 0u, traverse && visible ? 1u : 0u, id, 0u, 0u);
+        if (direct_frame)
+            cull_direct_clusters(g, direct, id, range);
         // The visible instances, for read-backs (each is drawn in one phase only).
         uvec4 listed_ballot = subgroupBallot(visible);
         uint list_base = 0u;

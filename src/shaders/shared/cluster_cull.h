@@ -72,38 +72,24 @@ uint gdr_cluster_task_size(GdrGpuFrameGlobals g, uint phase, uint task_index)
     return gdr_task_region(g, phase).items[task_index].meshlet_count;
 }
 
-// The tests for cluster `lane` of task command `task_index` of `phase`'s region of the task list.
-GdrClusterResult gdr_cluster_test(GdrGpuFrameGlobals g, uint phase, uint task_index, uint lane)
+GdrClusterResult gdr_cluster_no_result()
 {
-    GdrClusterResult result;
-    result.in_task = false;
-    result.visible = false;
-    result.lod_culled = false;
-    result.frustum_culled = false;
-    result.cone_culled = false;
-    result.late_tested = false;
-    result.occluded = false;
-    result.instance = 0u;
-    result.meshlet = 0u;
-    result.flags = 0u;
-    result.depth = 0;
-    result.triangles = 0u;
-    DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
-    uint task_count = min(phase == GDR_PHASE_LATE ? stats.value.late_task_count : stats.value.task_count,
-                          g.task_capacity);
-    if (task_index >= task_count)
-        return result;
-    GdrGpuTaskCommand task = gdr_task_region(g, phase).items[task_index];
+    return GdrClusterResult(false, false, false, false, false, false, false, 0u, 0u, 0u, 0, 0u);
+}
+
+// The tests for cluster `lane` of command `task` (when `tested`: a retest command's clusters that
+// the early phase did not defer are not). A retest command's clusters passed the other tests in the
+// early phase (same camera), so only the occlusion test against this frame's pyramid is left.
+GdrClusterResult gdr_cluster_test_command(GdrGpuFrameGlobals g, uint phase, GdrGpuTaskCommand task, uint lane,
+                                          bool tested)
+{
+    GdrClusterResult result = gdr_cluster_no_result();
     result.instance = task.instance;
     result.flags = task.flags;
     result.meshlet = task.meshlet_first + lane;
-    if (lane >= task.meshlet_count)
+    if (lane >= task.meshlet_count || !tested)
         return result;
-    // A retest command's clusters passed the other tests in the early phase (same camera): only
-    // those the early phase deferred are tested, and only against this frame's pyramid.
     bool retest = phase == GDR_PHASE_LATE && (task.flags & GDR_TASK_RETEST) != 0u;
-    if (retest && (WritableUintsRef(GDR_FRAME.retest_masks).items[task_index] & (1u << lane)) == 0u)
-        return result;
     result.in_task = true;
 
     GdrGpuMeshlet meshlet = MeshletsRef(GDR_SCENE.meshlets).items[result.meshlet];
@@ -137,6 +123,21 @@ GdrClusterResult gdr_cluster_test(GdrGpuFrameGlobals g, uint phase, uint task_in
     result.occluded = visible && gdr_phase_occluded(g, phase, world_center, radius);
     result.visible = visible && !result.occluded;
     return result;
+}
+
+// The tests for cluster `lane` of task command `task_index` of `phase`'s region of the task list.
+GdrClusterResult gdr_cluster_test(GdrGpuFrameGlobals g, uint phase, uint task_index, uint lane)
+{
+    DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
+    uint task_count = min(phase == GDR_PHASE_LATE ? stats.value.late_task_count : stats.value.task_count,
+                          g.task_capacity);
+    if (task_index >= task_count)
+        return gdr_cluster_no_result();
+    GdrGpuTaskCommand task = gdr_task_region(g, phase).items[task_index];
+    bool retest = phase == GDR_PHASE_LATE && (task.flags & GDR_TASK_RETEST) != 0u;
+    bool deferred = retest && lane < 32u &&
+                    (WritableUintsRef(GDR_FRAME.retest_masks).items[task_index] & (1u << lane)) != 0u;
+    return gdr_cluster_test_command(g, phase, task, lane, !retest || deferred);
 }
 
 // Clusters and triangles drawn per DAG depth: one atomic per distinct depth in the subgroup.

@@ -363,6 +363,9 @@ GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, viewport, 208);
 #define GDR_FRAME_DEBUG_SHRINK_NODES 512u /* tests: a deliberately wrong node test (spheres a quarter of their size) */
 #define GDR_FRAME_LOD_HIERARCHY 256u  /* with GDR_FRAME_LOD: instances' clusters come from the traversal of
                                          their LOD hierarchy (lodtraverse.comp) instead of all their clusters */
+#define GDR_FRAME_DIRECT_CLUSTERS 1024u /* visibility-buffer modes: the instance cull tests the clusters of an
+                                           instance that needs at most GDR_DIRECT_CLUSTERS of them and bins
+                                           them itself, instead of a task command for the cluster cull */
 
 
 #define GDR_VIEW_SHADED 0u
