@@ -6,7 +6,7 @@
 const char *gdr_frame_section_name(gdr_frame_section section)
 {
     static const char *const names[GDR_SECTION_COUNT + 1] = {
-        "instance_update", "cull", "draw", "pyramid", "late_cull", "late_draw", "late_pyramid", "readback", "-"};
+        "instance_update", "cull", "draw", "pyramid", "late_cull", "late_draw", "readback", "-"};
     return (unsigned)section <= GDR_SECTION_COUNT ? names[section] : "?";
 }
 

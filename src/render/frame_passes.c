@@ -118,15 +118,16 @@ static const gdr_pass_template raster_sw = {
 
 static const gdr_pass_template resolve = {
     "resolve", gdr_visbuffer_record_resolve, GDR_RASTER_TIMER_RESOLVE,
-    .what = "shades every pixel of the visibility buffer (the early phase: depth only)",
-    .uses = {{GDR_RES_VISBUFFER, COMPUTE, READ}, {GDR_RES_RASTER_CLUSTERS, COMPUTE, READ},
+    .what = "shades every pixel of the visibility buffer (a late phase that drew nothing: no pixel)",
+    .uses = {{GDR_RES_RASTER_COUNTERS, INDIRECT, INDIRECT_READ}, {GDR_RES_VISBUFFER, COMPUTE, READ},
+             {GDR_RES_RASTER_CLUSTERS, COMPUTE, READ},
              {GDR_RES_INSTANCES, COMPUTE, READ}, {GDR_RES_RESOLVED, COMPUTE, WRITE}}};
 
 static const gdr_pass_template resolve_copy = {
     "resolve_copy", gdr_visbuffer_record_resolve_copy, GDR_RASTER_TIMER_RESOLVE,
     .what = "the resolved colour and depth into the images",
     .uses = {{GDR_RES_RESOLVED, COPY, COPY_READ},
-             {GDR_RES_COLOR, COPY, COPY_WRITE, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, true, GDR_USE_NOT_EARLY},
+             {GDR_RES_COLOR, COPY, COPY_WRITE, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, true},
              {GDR_RES_DEPTH, COPY, COPY_WRITE, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, true}}};
 
 static const gdr_pass_template pyramid = {
@@ -199,8 +200,6 @@ void gdr_frame_plan_build(const gdr_frame_config *config, gdr_frame_plan *plan)
         gdr_frame_plan_add(plan, &overdraw_max, last, draw);
         gdr_frame_plan_add(plan, &overdraw_paint, last, draw);
     }
-    if (two_phases) /* for the next frame's early phase */
-        gdr_frame_plan_add(plan, &pyramid, GDR_PHASE_LATE, GDR_SECTION_LATE_PYRAMID);
     gdr_frame_plan_add(plan, &readback, GDR_PHASE_ONLY, GDR_SECTION_READBACK);
     assert(plan->pass_count < GDR_FRAME_MAX_PASSES);
     gdr_frame_plan_derive(plan);

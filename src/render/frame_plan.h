@@ -54,7 +54,6 @@ typedef enum gdr_frame_section {
     GDR_SECTION_PYRAMID,
     GDR_SECTION_LATE_CULL,
     GDR_SECTION_LATE_DRAW,
-    GDR_SECTION_LATE_PYRAMID,
     GDR_SECTION_READBACK,
     GDR_SECTION_COUNT,
     GDR_SECTION_NONE = GDR_SECTION_COUNT /* not timed (the frame's first and last synchronisation) */
@@ -76,7 +75,6 @@ typedef enum gdr_raster_timer {
 #define GDR_USE_VISBUFFER 2u      /* only in visibility-buffer frames */
 #define GDR_USE_CLEARS 4u         /* an attachment the pass clears in the frame's first raster phase
                                      (old contents discarded) and loads in the late phase */
-#define GDR_USE_NOT_EARLY 8u      /* not in the early phase */
 #define GDR_USE_TRAVERSAL 16u     /* only in frames that traverse the LOD hierarchy */
 
 typedef struct gdr_resource_use {

@@ -205,31 +205,26 @@ void gdr_visbuffer_record_raster_sw(gdr_renderer *r, gdr_frame_slot *slot, const
     vkCmdDispatchIndirect(cmd, r->vis.counters.buffer, offsetof(GdrGpuRasterCounters, dispatch_x));
 }
 
-/* The resolve: shades every pixel (the early phase: its depth only, the late phase shades what both
- * phases drew) into the resolved buffer. */
+/* The resolve: shades every pixel into the resolved buffer, launched with what raster_submit.comp
+ * wrote: the whole screen in the frame's first raster phase and in a late phase that drew something,
+ * nothing otherwise (the resolved buffer then holds the early phase's image, which is the frame's). */
 void gdr_visbuffer_record_resolve(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
                                   VkCommandBuffer cmd)
 {
-    (void)slot;
-    gdr_pipeline_id id = pass->phase == GDR_PHASE_EARLY ? GDR_PIPE_RESOLVE_DEPTH : GDR_PIPE_RESOLVE;
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->pipelines[id]);
-    vkCmdDispatch(cmd, (r->width + GDR_RESOLVE_TILE - 1) / GDR_RESOLVE_TILE,
-                  (r->height + GDR_RESOLVE_TILE - 1) / GDR_RESOLVE_TILE, 1);
+    (void)slot, (void)pass;
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->pipelines[GDR_PIPE_RESOLVE]);
+    vkCmdDispatchIndirect(cmd, r->vis.counters.buffer, offsetof(GdrGpuRasterCounters, resolve_x));
 }
 
-/* The resolved colour (not in the early phase) and depth into the images (the depth for the
- * pyramid). */
+/* The resolved colour and depth into the images (the depth for the pyramid). */
 void gdr_visbuffer_record_resolve_copy(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
                                        VkCommandBuffer cmd)
 {
-    (void)slot;
+    (void)slot, (void)pass;
     VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
-    if (pass->phase != GDR_PHASE_EARLY) {
-        VkBufferImageCopy color = {.bufferOffset = 0, .imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
-                                   .imageExtent = {r->width, r->height, 1}};
-        vkCmdCopyBufferToImage(cmd, r->vis.resolved.buffer, r->color.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
-                               &color);
-    }
+    VkBufferImageCopy color = {.bufferOffset = 0, .imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+                               .imageExtent = {r->width, r->height, 1}};
+    vkCmdCopyBufferToImage(cmd, r->vis.resolved.buffer, r->color.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &color);
     VkBufferImageCopy depth = {.bufferOffset = pixels * sizeof(uint32_t),
                                .imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1},
                                .imageExtent = {r->width, r->height, 1}};

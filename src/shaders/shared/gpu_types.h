@@ -428,9 +428,14 @@ GDR_STRUCT_BEGIN(GdrGpuRasterCounters)
     gdr_uint draw_x;        /* VkDrawMeshTasksIndirectCommandEXT: one mesh workgroup per entry, in rows */
     gdr_uint draw_y;
     gdr_uint draw_z;
+    gdr_uint phases;        /* raster phases launched so far in the frame */
+    gdr_uint resolve_x;     /* VkDispatchIndirectCommand of the phase's resolve: GDR_RESOLVE_TILE tiles of */
+    gdr_uint resolve_y;     /* the screen in the first phase and in a later phase that drew something, */
+    gdr_uint resolve_z;     /* else none */
     gdr_uint reserved0;
 GDR_STRUCT_END(GdrGpuRasterCounters)
-GDR_ASSERT_SIZE(GdrGpuRasterCounters, 72);
+GDR_ASSERT_SIZE(GdrGpuRasterCounters, 88);
+GDR_ASSERT_OFFSET(GdrGpuRasterCounters, resolve_x, 72);
 GDR_ASSERT_OFFSET(GdrGpuRasterCounters, dispatch_z, 8);
 
 /* Per-frame raster parameters, written by the CPU into its frame's slot. */
