@@ -14,7 +14,7 @@ const char *gdr_frame_resource_name(gdr_frame_resource resource)
 {
     static const char *const names[GDR_RES_COUNT] = {
         "instances", "occluded", "draw_stats", "draws", "tasks", "traversal", "visible_meshlets", "overdraw", "raster_counters",
-        "raster_clusters", "visbuffer", "resolved", "readback", "color", "depth", "hzb"};
+        "raster_clusters", "visbuffer", "readback", "color", "depth", "hzb"};
     return (unsigned)resource < GDR_RES_COUNT ? names[resource] : "?";
 }
 

@@ -121,14 +121,18 @@ static const gdr_pass_template resolve = {
     .what = "shades every pixel of the visibility buffer (a late phase that drew nothing: no pixel)",
     .uses = {{GDR_RES_RASTER_COUNTERS, INDIRECT, INDIRECT_READ}, {GDR_RES_VISBUFFER, COMPUTE, READ},
              {GDR_RES_RASTER_CLUSTERS, COMPUTE, READ},
-             {GDR_RES_INSTANCES, COMPUTE, READ}, {GDR_RES_RESOLVED, COMPUTE, WRITE}}};
+             {GDR_RES_INSTANCES, COMPUTE, READ},
+             {GDR_RES_COLOR, COMPUTE, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL,
+              .flags = GDR_USE_CLEARS}}};
 
-static const gdr_pass_template resolve_copy = {
-    "resolve_copy", gdr_visbuffer_record_resolve_copy, GDR_RASTER_TIMER_RESOLVE,
-    .what = "the resolved colour and depth into the images",
-    .uses = {{GDR_RES_RESOLVED, COPY, COPY_READ},
-             {GDR_RES_COLOR, COPY, COPY_WRITE, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, true},
-             {GDR_RES_DEPTH, COPY, COPY_WRITE, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, true}}};
+/* The visibility-buffer modes build the pyramid from the visibility buffer's depth, not the depth
+ * image, which they never write (its descriptor is bound all the same: it gets the layout). */
+static const gdr_pass_template pyramid_visbuffer = {
+    "pyramid", gdr_pass_record_pyramid,
+    .what = "the depth pyramid of the visibility buffer's depth so far (its build orders its levels)",
+    .uses = {{GDR_RES_VISBUFFER, COMPUTE, READ},
+             {GDR_RES_DEPTH, COMPUTE, SAMPLED, VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL, true},
+             {GDR_RES_HZB, COMPUTE, SAMPLED | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL}}};
 
 static const gdr_pass_template pyramid = {
     "pyramid", gdr_pass_record_pyramid, .what = "the depth pyramid of the depth so far (its build orders its levels)",
@@ -175,8 +179,7 @@ static void add_phase(gdr_frame_plan *plan, gdr_occlusion_phase phase)
             gdr_frame_plan_add(plan, &meshlets, phase, draw);
             return;
         }
-        const gdr_pass_template *raster[] = {&cluster_cull, &raster_submit, &raster_hw, &raster_sw, &resolve,
-                                             &resolve_copy};
+        const gdr_pass_template *raster[] = {&cluster_cull, &raster_submit, &raster_hw, &raster_sw, &resolve};
         for (size_t i = 0; i < sizeof raster / sizeof raster[0]; i++)
             gdr_frame_plan_add(plan, raster[i], phase, draw);
     }
@@ -191,7 +194,8 @@ void gdr_frame_plan_build(const gdr_frame_config *config, gdr_frame_plan *plan)
     bool two_phases = config->occlusion && config->pipeline != GDR_PIPELINE_CPU;
     if (two_phases) {
         add_phase(plan, GDR_PHASE_EARLY);
-        gdr_frame_plan_add(plan, &pyramid, GDR_PHASE_EARLY, GDR_SECTION_PYRAMID);
+        gdr_frame_plan_add(plan, config->visbuffer ? &pyramid_visbuffer : &pyramid, GDR_PHASE_EARLY,
+                           GDR_SECTION_PYRAMID);
     }
     gdr_occlusion_phase last = two_phases ? GDR_PHASE_LATE : GDR_PHASE_ONLY;
     add_phase(plan, last);

@@ -133,8 +133,8 @@ void gdr_pass_record_meshlets(gdr_renderer *r, gdr_frame_slot *slot, const gdr_f
 
 void gdr_pass_record_pyramid(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass, VkCommandBuffer cmd)
 {
-    (void)pass;
-    gdr_hzb_record_build(&r->occlusion.hzb, cmd);
+    (void)pass; /* the visibility-buffer modes never write the depth image: their depth is the buffer's */
+    gdr_hzb_record_build(&r->occlusion.hzb, cmd, slot->plan.config.visbuffer ? r->vis.pixels.address : 0);
     gdr_frame_bind_state(r, slot, cmd); /* the build bound its own layout */
 }
 

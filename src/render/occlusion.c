@@ -18,18 +18,23 @@ gdr_status gdr_occlusion_create(gdr_renderer *r, gdr_error *err)
     gdr_hzb_desc desc = {.depth_width = r->width, .depth_height = r->height, .depth_view = r->depth.view,
                          .depth_layout = VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL, .reader_stages = readers};
     gdr_status status = gdr_hzb_create(r->ctx, &r->allocator, &desc, &o->hzb, err);
-    VkDescriptorSetLayoutBinding binding = {0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, reader_shaders, NULL};
-    VkDescriptorPoolSize size = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
+    /* Binding 1: the colour target, which the visibility buffer's resolve writes as a storage image. */
+    VkDescriptorSetLayoutBinding bindings[2] = {
+        {0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, reader_shaders, NULL},
+        {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL}};
+    VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1}};
     if (status == GDR_OK)
-        status = gdr_vk_descriptor_set_layout_create(r->ctx, &binding, 1, &o->set_layout, err);
+        status = gdr_vk_descriptor_set_layout_create(r->ctx, bindings, 2, &o->set_layout, err);
     if (status == GDR_OK)
-        status = gdr_vk_descriptor_pool_create(r->ctx, 1, &size, 1, &o->pool, err);
+        status = gdr_vk_descriptor_pool_create(r->ctx, 1, sizes, 2, &o->pool, err);
     if (status == GDR_OK)
         status = gdr_vk_descriptor_sets_allocate(r->ctx, o->pool, o->set_layout, 1, &o->set, err);
     if (status != GDR_OK)
         return status;
     gdr_vk_write_image_descriptor(r->ctx, o->set, 0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, o->hzb.min_sampler,
                                   o->hzb.view, GDR_HZB_LAYOUT);
+    gdr_vk_write_image_descriptor(r->ctx, o->set, 1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_NULL_HANDLE, r->color.view,
+                                  VK_IMAGE_LAYOUT_GENERAL);
     /* The culling shaders read the pyramid's descriptor even in frames that skip the test: give it
      * its layout (and "nothing is hidden": depth 0 is infinitely far) before any frame. */
     VkCommandBuffer cmd;
@@ -101,14 +106,6 @@ void gdr_occlusion_scene_destroy(gdr_renderer *r)
     gdr_vk_buffer_destroy(r->ctx, &r->occlusion.occluded_nodes);
     gdr_vk_buffer_destroy(r->ctx, &r->occlusion.retest_masks);
     r->occlusion.history_valid = false;
-}
-
-void gdr_occlusion_record_pyramid(gdr_renderer *r, VkCommandBuffer cmd)
-{
-    const gdr_hzb *hzb = &r->occlusion.hzb;
-    gdr_hzb_record_depth_to_read(hzb, cmd, r->depth.image, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
-    gdr_hzb_record_build(hzb, cmd);
-    gdr_hzb_record_depth_to_attachment(hzb, cmd, r->depth.image, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
 }
 
 void gdr_occlusion_params(const gdr_renderer *r, const gdr_mat4 *projection, float znear, GdrOcclusionParams *out)

@@ -41,9 +41,6 @@ void gdr_occlusion_destroy(gdr_renderer *r);
 gdr_status gdr_occlusion_scene_create(gdr_renderer *r, gdr_error *err);
 void gdr_occlusion_scene_destroy(gdr_renderer *r);
 
-/* Records the pyramid's build from the depth image just rendered (DEPTH_ATTACHMENT_OPTIMAL) and
- * gives the depth image back to rendering. */
-void gdr_occlusion_record_pyramid(gdr_renderer *r, VkCommandBuffer cmd);
 /* The camera's and the pyramid's part of the occlusion test for the frame globals. */
 void gdr_occlusion_params(const gdr_renderer *r, const gdr_mat4 *projection, float znear, GdrOcclusionParams *out);
 

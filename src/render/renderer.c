@@ -33,12 +33,11 @@ static gdr_status create_targets(gdr_renderer *r, gdr_error *err)
 {
     gdr_vk_image_desc color = {.width = r->width, .height = r->height, .format = GDR_COLOR_FORMAT,
                                .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-                                        VK_IMAGE_USAGE_TRANSFER_DST_BIT}; /* the visibility buffer's resolve */
+                                        VK_IMAGE_USAGE_STORAGE_BIT}; /* the visibility buffer's resolve */
     gdr_vk_image_desc depth = {.width = r->width, .height = r->height, .format = GDR_DEPTH_FORMAT,
                                .usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT |
                                         VK_IMAGE_USAGE_SAMPLED_BIT |      /* the depth pyramid */
-                                        VK_IMAGE_USAGE_TRANSFER_SRC_BIT | /* tests read it back */
-                                        VK_IMAGE_USAGE_TRANSFER_DST_BIT,  /* the visibility buffer's resolve */
+                                        VK_IMAGE_USAGE_TRANSFER_SRC_BIT,  /* tests read it back */
                                .aspect = VK_IMAGE_ASPECT_DEPTH_BIT};
     gdr_status status = gdr_vk_image_create(&r->allocator, &color, &r->color, err);
     if (status == GDR_OK)

@@ -29,7 +29,6 @@ layout(buffer_reference, scalar) buffer VisbufferRef { uint64_t items[]; };
 layout(buffer_reference, scalar) readonly buffer RasterParamsRef { GdrGpuRasterParams value; };
 layout(buffer_reference, scalar) buffer RasterCountersRef { GdrGpuRasterCounters value; };
 layout(buffer_reference, scalar) buffer RasterClustersRef { GdrGpuRasterCluster items[]; };
-layout(buffer_reference, scalar) writeonly buffer ResolvedRef { uint items[]; };
 layout(buffer_reference, scalar) buffer NodeVisitsRef { GdrGpuNodeVisit items[]; };
 
 layout(push_constant, scalar) uniform PushConstantBlock { GdrGpuPushConstants push; };

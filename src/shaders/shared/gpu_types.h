@@ -28,7 +28,6 @@ GDR_DECLARE_REF(VisbufferRef)
 GDR_DECLARE_REF(RasterParamsRef)
 GDR_DECLARE_REF(RasterCountersRef)
 GDR_DECLARE_REF(RasterClustersRef)
-GDR_DECLARE_REF(ResolvedRef)
 GDR_DECLARE_REF(NodeVisitsRef)
 
 /* One vertex of the geometry pool (vertex input binding 0). */
@@ -447,7 +446,7 @@ GDR_STRUCT_BEGIN(GdrGpuRasterParams)
     float sw_threshold_px;  /* hybrid: clusters whose triangles are smaller go to the compute rasteriser */
     gdr_uint hw_launch_limit; /* the most mesh workgroups one launch may have (maxMeshWorkGroupTotalCount) */
     gdr_vec2 ndc_scale;     /* the projection's P[0][0] and P[1][1] (x and y from view space to NDC) */
-    GDR_REF(ResolvedRef) resolved; /* the resolve's output: RGBA8 per pixel, then the depth bits per pixel */
+    gdr_uint64 reserved;
 GDR_STRUCT_END(GdrGpuRasterParams)
 GDR_ASSERT_SIZE(GdrGpuRasterParams, 48);
 GDR_ASSERT_OFFSET(GdrGpuRasterParams, mode, 16);
