@@ -125,6 +125,13 @@ typedef struct gdr_frame_desc {
      * through the late phase's test. */
     gdr_cull_mode occlusion;
     bool occlusion_camera_cut;
+    /* Instance tests of the GPU-driven pipelines and the CPU pipeline (when cull is on), besides the
+     * frustum, each instance's screen-size range (gdr_instance) and: the smallest screen size drawn
+     * (0: none; culls small detail); a world-space clip plane (a, b, c, d): instances entirely on its
+     * negative side (a x + b y + c z + d < 0) are not drawn (all zero: none; it culls whole
+     * instances, it does not clip the ones that cross it). */
+    float min_screen_size;
+    gdr_vec4 clip_plane;
 } gdr_frame_desc;
 
 /* "shaded", "meshlets", "instances", "triangles", "overdraw" or "lod". */
@@ -220,6 +227,13 @@ typedef struct gdr_frame_stats {
     uint32_t frames;
     uint32_t instances_total;
     uint32_t instances_visible; /* of the last frame */
+    /* GPU-driven pipelines, last frame: instances culled by the instance tests, each counted by the
+     * first that culled it (invalid, frustum, screen size, clip plane): bounds not finite or without
+     * volume (or a mesh without triangles), outside their screen-size range or below the frame's
+     * minimum, entirely behind the clip plane. */
+    uint32_t instances_invalid;
+    uint32_t instances_screen_size_culled;
+    uint32_t instances_clip_plane_culled;
     uint64_t triangles;         /* drawn in the last frame */
     uint32_t draws;             /* indirect draw commands executed in the last frame */
     uint32_t draw_calls;        /* draw calls the CPU recorded per frame */

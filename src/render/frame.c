@@ -82,6 +82,9 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .lod_depth = frame->lod_depth > INT32_MAX ? INT32_MAX : (int32_t)frame->lod_depth,
         .traversal_capacity = r->scene.traversal_capacity,
         .occluded_node_capacity = r->occlusion.occluded_node_capacity,
+        .min_screen_size = frame->min_screen_size,
+        .clip_plane = frame->clip_plane,
+        .screen_scale = fmaxf(fabsf(projection.m[0]), fabsf(projection.m[5])),
     };
     gdr_occlusion_params(r, &projection, camera->znear, &globals.occlusion);
     /* The early phase tests against last frame's pyramid as last frame's camera saw it. */

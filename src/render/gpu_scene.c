@@ -9,7 +9,8 @@
 
 static GdrGpuInstance gpu_instance_from(const gdr_scene *scene, const gdr_instance *instance)
 {
-    GdrGpuInstance g = {.model = instance->transform, .color = instance->color, .mesh = instance->mesh};
+    GdrGpuInstance g = {.model = instance->transform, .color = instance->color, .mesh = instance->mesh,
+                        .min_screen_size = instance->min_screen_size, .max_screen_size = instance->max_screen_size};
     if (instance->material != GDR_NO_INDEX) {
         gdr_vec4 base = scene->materials[instance->material].base_color;
         g.color = (gdr_vec4){g.color.x * base.x, g.color.y * base.y, g.color.z * base.z, g.color.w * base.w};

@@ -1,4 +1,5 @@
 /* The public renderer API: device and resources, scene upload, the frame loop and its statistics. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -260,6 +261,13 @@ static gdr_status check_frame(gdr_renderer *r, const gdr_frame_desc *frame, uint
     if (!(frame->lod_error_px >= 0.0f && frame->lod_error_px <= 1e30f))
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: lod_error_px must be finite and >= 0 (%g)",
                              (double)frame->lod_error_px);
+    if (!(frame->min_screen_size >= 0.0f && frame->min_screen_size <= 1e30f))
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: min_screen_size must be finite and >= 0 (%g)",
+                             (double)frame->min_screen_size);
+    const float *plane = &frame->clip_plane.x;
+    for (int i = 0; i < 4; i++)
+        if (!isfinite(plane[i]))
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: clip_plane must be finite");
     gdr_status status = resolve_pipeline(r, frame, pipeline, reason, reason_size, err);
     if (status == GDR_OK)
         status = gdr_visbuffer_resolve_mode(r, frame, *pipeline, &r->vis.mode, r->vis.reason, sizeof r->vis.reason, err);

@@ -1,5 +1,6 @@
 #version 460
-// Instance culling (seeds 000/001/003): one thread per instance; visible instances are appended,
+// Instance culling (seeds 000/001/002/003): one thread per instance, which tests its bounds (invalid
+// or empty, frustum, screen size, the global clip plane, occlusion); visible instances are appended,
 // compacted with subgroup ballots, as VkDrawIndexedIndirectCommands for one
 // vkCmdDrawIndexedIndirectCount (first_instance carries the instance index to the vertex shader),
 // or, for the meshlet pipeline (EMIT_TASKS), as task commands: one task workgroup per up to
@@ -40,6 +41,26 @@ GdrTaskRange task_range(GdrGpuFrameGlobals g, GdrGpuMesh mesh, mat4 model, out b
     traverse = (g.flags & GDR_FRAME_LOD_HIERARCHY) != 0u && mesh.lod_node_count > 0u &&
                mesh.lod_task_count > GDR_TRAVERSE_MIN_TASKS;
     return traverse ? GdrTaskRange(0u, 0u, 0u, 0u) : gdr_task_range(mesh.meshlet_offset, mesh.lod_cluster_count, 0u);
+}
+
+// Screen-size culling (seed 002): the bounding sphere's screen size (GdrGpuFrameGlobals) within the
+// instance's [min, max) and not below the frame's minimum; a zero limit is no limit.
+bool screen_size_visible(GdrGpuFrameGlobals g, GdrGpuInstance instance, vec3 world_center, float radius)
+{
+    float distance = length(world_center - g.camera_position.xyz);
+    float size = distance <= radius ? 3.0e38 : g.screen_scale * radius / distance; // inside: covers the screen
+    if (instance.min_screen_size > 0.0 && size < instance.min_screen_size)
+        return false;
+    if (g.min_screen_size > 0.0 && size < g.min_screen_size)
+        return false;
+    return !(instance.max_screen_size > 0.0 && size >= instance.max_screen_size);
+}
+
+// The global clip plane (seed 002): true when the sphere lies entirely on its negative side.
+bool behind_clip_plane(GdrGpuFrameGlobals g, vec3 world_center, float radius)
+{
+    vec4 plane = g.clip_plane;
+    return plane.xyz != vec3(0.0) && dot(plane.xyz, world_center) + plane.w < -radius * length(plane.xyz);
 }
 
 // The instance this invocation culls: the early (or only) phase's, one per instance; the late
@@ -83,16 +104,28 @@ void main()
     mat4 model;
     vec3 world_center = vec3(0.0);
     float radius = 0.0;
+    bool invalid = false, small_or_large = false, clipped = false;
     if (id < g.instance_count) {
-        model = InstancesRef(GDR_SCENE.instances).items[id].model;
-        mesh = MeshesRef(GDR_SCENE.meshes).items[InstancesRef(GDR_SCENE.instances).items[id].mesh];
-        visible = mesh.index_count > 0u; // nothing to draw otherwise
+        GdrGpuInstance instance = InstancesRef(GDR_SCENE.instances).items[id];
+        model = instance.model;
+        mesh = MeshesRef(GDR_SCENE.meshes).items[instance.mesh];
         world_center = (model * vec4(mesh.bounds.xyz, 1.0)).xyz;
         radius = mesh.bounds.w * gdr_max_axis_scale(model[0].xyz, model[1].xyz, model[2].xyz);
         vec3 center = (g.view * vec4(world_center, 1.0)).xyz;
-        if (visible && g.cull_enabled != 0u)
+        // Nothing to draw, or bounds that are not finite or hold no volume (seed 002's first test).
+        invalid = mesh.index_count == 0u || !(radius > 0.0) || isinf(radius) || any(isnan(world_center)) ||
+                  any(isinf(world_center));
+        visible = !invalid;
+        if (visible && g.cull_enabled != 0u) {
             visible = gdr_sphere_visible(g.frustum, center, radius, g.znear, g.zfar);
+            small_or_large = visible && !screen_size_visible(g, instance, world_center, radius);
+            clipped = visible && !small_or_large && behind_clip_plane(g, world_center, radius);
+            visible = visible && !small_or_large && !clipped;
+        }
     }
+    GDR_COUNT(stats, instances_invalid, invalid);
+    GDR_COUNT(stats, instances_screen_size_culled, small_or_large);
+    GDR_COUNT(stats, instances_clip_plane_culled, clipped);
 
     // Two-phase occlusion culling (occlusion_test.h): the early phase defers what last frame's
     // pyramid hides; the late phase retests those against this frame's.

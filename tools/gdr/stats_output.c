@@ -15,6 +15,9 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
         fprintf(out, "view                %s\n", context->view);
     fprintf(out, "instances_total     %u\n", s->instances_total);
     fprintf(out, "instances_visible   %u\n", s->instances_visible);
+    if (s->instances_invalid || s->instances_screen_size_culled || s->instances_clip_plane_culled)
+        fprintf(out, "instances_culled    %u invalid or empty bounds, %u by screen size, %u behind the clip plane\n",
+                s->instances_invalid, s->instances_screen_size_culled, s->instances_clip_plane_culled);
     fprintf(out, "triangles           %llu\n", (unsigned long long)s->triangles);
     if (s->pipeline == GDR_PIPELINE_MESH) {
         fprintf(out, "meshlets_total      %llu\n", (unsigned long long)s->meshlets_total);
@@ -168,6 +171,9 @@ char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
     cJSON_AddStringToObject(root, "view", context->view ? context->view : "shaded");
     cJSON_AddNumberToObject(root, "instances_total", s->instances_total);
     cJSON_AddNumberToObject(root, "instances_visible", s->instances_visible);
+    cJSON_AddNumberToObject(root, "instances_invalid", s->instances_invalid);
+    cJSON_AddNumberToObject(root, "instances_screen_size_culled", s->instances_screen_size_culled);
+    cJSON_AddNumberToObject(root, "instances_clip_plane_culled", s->instances_clip_plane_culled);
     cJSON_AddNumberToObject(root, "triangles", (double)s->triangles);
     cJSON_AddNumberToObject(root, "draws", s->draws);
     cJSON_AddNumberToObject(root, "draw_calls", s->draw_calls);

@@ -175,8 +175,8 @@ GDR_STRUCT_BEGIN(GdrGpuInstance)
     gdr_vec4 color;
     gdr_uint mesh;
     gdr_uint flags;
-    gdr_uint reserved0;
-    gdr_uint reserved1;
+    float min_screen_size; /* culled below this screen size (gdr_instance); 0: no minimum */
+    float max_screen_size; /* culled at this screen size or more; 0: no maximum */
 GDR_STRUCT_END(GdrGpuInstance)
 GDR_ASSERT_SIZE(GdrGpuInstance, 96);
 GDR_ASSERT_OFFSET(GdrGpuInstance, color, 64);
@@ -277,9 +277,12 @@ GDR_STRUCT_BEGIN(GdrGpuDrawStats)
     GdrGpuTraversalLevel late_instances;
     gdr_uint occluded_nodes[GDR_LOD_TREE_LEVELS];
     gdr_uint occluded_node_total;
-    gdr_uint reserved_occluded0;
-    gdr_uint reserved_occluded1;
-    gdr_uint reserved_occluded2;
+    /* The instance tests, each instance counted by the first that culls it (invalid, frustum, screen
+     * size, clip plane): bounds that are not finite or have no volume, a screen size outside the
+     * instance's range or below the frame's minimum, entirely behind the frame's clip plane. */
+    gdr_uint instances_invalid;
+    gdr_uint instances_screen_size_culled;
+    gdr_uint instances_clip_plane_culled;
 GDR_STRUCT_END(GdrGpuDrawStats)
 GDR_ASSERT_SIZE(GdrGpuDrawStats, 64 + 8 * GDR_LOD_STATS_DEPTHS + 96 + 32 * GDR_LOD_TREE_LEVELS + 32 + 32 +
                                      4 * GDR_LOD_TREE_LEVELS);
@@ -339,13 +342,22 @@ GDR_STRUCT_BEGIN(GdrGpuFrameGlobals)
     gdr_int lod_depth;        /* GDR_FRAME_LOD_DEPTH: the discrete cut's depth */
     gdr_uint traversal_capacity; /* node visits one traversal level holds (<= GDR_TRAVERSE_MAX_VISITS) */
     gdr_uint occluded_node_capacity; /* node visits the occluded list holds */
-    gdr_uint reserved2;
+    float min_screen_size;    /* the frame's smallest screen size drawn; 0: none */
     GdrOcclusionParams occlusion; /* GDR_FRAME_OCCLUSION: the camera and the depth pyramid */
     /* GDR_FRAME_HISTORY: last frame's camera, against whose pyramid the early phase tests. */
     gdr_mat4 previous_view;
     GdrOcclusionParams previous_occlusion;
+    /* The instance tests: instances entirely on the negative side of the plane (world space,
+     * n.p + d < 0) are culled; all zero: no plane. Screen size = screen_scale * radius / distance
+     * of the bounding sphere (the camera inside it: infinite), about its projected diameter over the
+     * viewport height, as gdr/cull.h defines it; screen_scale = max(|P00|, |P11|). */
+    gdr_vec4 clip_plane;
+    float screen_scale;
+    gdr_uint reserved3;
+    gdr_uint reserved4;
+    gdr_uint reserved5;
 GDR_STRUCT_END(GdrGpuFrameGlobals)
-GDR_ASSERT_SIZE(GdrGpuFrameGlobals, 368);
+GDR_ASSERT_SIZE(GdrGpuFrameGlobals, 400);
 GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, frustum, 128);
 GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, znear, 176);
 GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, update_count, 192);
