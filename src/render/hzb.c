@@ -10,7 +10,8 @@
 /* Workgroup size of depthreduce.comp.glsl, given to it as specialization constants 0 and 1. */
 #define HZB_GROUP_SIZE 8u
 
-_Static_assert(sizeof(GdrDepthReducePush) == 20, "GdrDepthReducePush: five uints, as the shader reads them");
+_Static_assert(sizeof(GdrDepthReducePush) == 32 && offsetof(GdrDepthReducePush, visibility_buffer) == 24,
+               "GdrDepthReducePush: six uints and an address, as the shader reads them");
 
 uint32_t gdr_hzb_size_for(uint32_t depth_size)
 {
@@ -210,7 +211,7 @@ static void pyramid_barrier(VkCommandBuffer cmd, const gdr_hzb *hzb, uint32_t fi
     gdr_vk_barrier(cmd, &(gdr_vk_barrier_desc){.images = &t, .image_count = 1});
 }
 
-void gdr_hzb_record_build(const gdr_hzb *hzb, VkCommandBuffer cmd)
+void gdr_hzb_record_build(const gdr_hzb *hzb, VkCommandBuffer cmd, VkDeviceAddress visibility_buffer)
 {
     const VkPipelineStageFlags2 compute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
     /* Discard the old pyramid once the previous build's writes and every read of them are done. */
@@ -225,6 +226,7 @@ void gdr_hzb_record_build(const gdr_hzb *hzb, VkCommandBuffer cmd)
             .destination_width = level_size(hzb->width, level),
             .destination_height = level_size(hzb->height, level),
             .from_depth = level == 0,
+            .visibility_buffer = level == 0 ? visibility_buffer : 0,
         };
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, hzb->pipeline_layout, 0, 1, &hzb->sets[level], 0,
                                 NULL);

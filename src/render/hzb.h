@@ -82,8 +82,11 @@ gdr_status gdr_hzb_create(gdr_vk_context *ctx, gdr_vk_allocator *allocator, cons
 void gdr_hzb_destroy(gdr_hzb *hzb);
 
 /* Records the whole build into `cmd` (outside a render pass), with every barrier it needs; see the
- * synchronization contract above. */
-void gdr_hzb_record_build(const gdr_hzb *hzb, VkCommandBuffer cmd);
+ * synchronization contract above. With a `visibility_buffer` address (else 0), level 0 comes from
+ * the depth in that buffer (GdrDepthReducePush.visibility_buffer, the depth image's size) instead
+ * of the depth image: its writes must be visible to compute shader reads, and the depth image must
+ * still be in the layout given at create (its descriptor stays bound; it is not read). */
+void gdr_hzb_record_build(const gdr_hzb *hzb, VkCommandBuffer cmd, VkDeviceAddress visibility_buffer);
 
 /* Records the barrier that makes a depth image that was just rendered (in `from`, typically
  * DEPTH_ATTACHMENT_OPTIMAL, written by the fragment tests) readable by the build, in the layout

@@ -24,6 +24,8 @@ typedef struct render_options {
     uint32_t lod_depth;
     gdr_vec3 camera_position;
     gdr_quat camera_rotation;
+    float min_screen_size;
+    gdr_vec4 clip_plane;
     const char *device;
     gdr_load_options load;
 } render_options;
@@ -98,6 +100,14 @@ static int parse_render_options(int argc, char **argv, render_options *o)
         }
         else if (strcmp(arg, "--lod-error") == 0)
             ok = cli_parse_float(arg, value, 0.0f, 1e6f, &o->lod_error);
+        else if (strcmp(arg, "--min-screen-size") == 0)
+            ok = cli_parse_float(arg, value, 0.0f, 1e6f, &o->min_screen_size);
+        else if (strcmp(arg, "--clip-plane") == 0) {
+            ok = cli_parse_floats(value, 4, &o->clip_plane.x);
+            if (!ok)
+                fprintf(stderr, "gdr: %s %s: expected 4 finite numbers a,b,c,d (the plane a x + b y + c z + d = 0)\n",
+                        arg, value);
+        }
         else if (strcmp(arg, "--lod-depth") == 0)
             ok = o->has_lod_depth = cli_parse_u32(arg, value, 0, 64, &o->lod_depth);
         else if (strcmp(arg, "--device") == 0)
@@ -167,7 +177,8 @@ int gdr_cmd_render(int argc, char **argv)
                             .occlusion = !o.occlusion_given ? GDR_CULL_DEFAULT
                                          : o.occlusion       ? GDR_CULL_ON
                                                              : GDR_CULL_OFF,
-                            .lod_hierarchy = o.lod_hierarchy ? GDR_CULL_ON : GDR_CULL_OFF};
+                            .lod_hierarchy = o.lod_hierarchy ? GDR_CULL_ON : GDR_CULL_OFF,
+                            .min_screen_size = o.min_screen_size, .clip_plane = o.clip_plane};
     if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK || gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK ||
         gdr_renderer_render(renderer, &frame, o.frames, &stats, &err) != GDR_OK) {
         result = fail(&err);

@@ -63,11 +63,15 @@
 
 /* Push constants of depthreduce.comp.glsl (the pyramid build, src/render/hzb.c). */
 GDR_STRUCT_BEGIN(GdrDepthReducePush)
-    gdr_uint source_width;      /* the depth buffer (from_depth) or the previous level */
+    gdr_uint source_width;      /* the depth buffer (level 0) or the previous level */
     gdr_uint source_height;
     gdr_uint destination_width; /* the level being written */
     gdr_uint destination_height;
     gdr_uint from_depth;        /* 1: level 0 from the depth buffer (footprint loop); 0: 2x2 from the previous level */
+    gdr_uint reserved;
+    /* Level 0: 0 to read the depth image; else the address of a visibility buffer (64 bits per pixel,
+     * rows top first, source_width wide, the depth's float bits in the high word) to read instead. */
+    gdr_uint64 visibility_buffer;
 GDR_STRUCT_END(GdrDepthReducePush)
 
 /* What the occlusion test needs to know about the camera and the pyramid. */
