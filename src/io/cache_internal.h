@@ -130,6 +130,19 @@ static inline const char *get_string(reader *r, uint32_t *length)
     return (const char *)take(r, *length);
 }
 
+/* One record of section 'INST' (docs/CACHE_FORMAT.md), as the whole-file and the paged reader
+ * read it; CACHE_INSTANCE_RECORD bytes. The caller checks the values. */
+#define CACHE_INSTANCE_RECORD (64u + 8u + 16u + 8u)
+static inline void cache_get_instance(reader *r, gdr_instance *inst)
+{
+    get_f32s(r, inst->transform.m, 16);
+    inst->mesh = get_u32(r);
+    inst->material = get_u32(r);
+    get_f32s(r, &inst->color.x, 4);
+    get_f32s(r, &inst->min_screen_size, 1);
+    get_f32s(r, &inst->max_screen_size, 1);
+}
+
 /* A section id as text for messages ('?' for bytes that are not printable). */
 static inline void fourcc_text(uint32_t id, char out[5])
 {

@@ -16,7 +16,7 @@
 
 #define FOURCC(a, b, c, d) ((uint32_t)(a) | (uint32_t)(b) << 8 | (uint32_t)(c) << 16 | (uint32_t)(d) << 24)
 
-enum { MESH_RECORD = 64 + 8 + 16, MATERIAL_RECORD = 64 + 16 + 12 + 12 + 8, INSTANCE_RECORD = 64 + 8 + 16 + 8,
+enum { MESH_RECORD = 64 + 8 + 16, MATERIAL_RECORD = 64 + 16 + 12 + 12 + 8, INSTANCE_RECORD = CACHE_INSTANCE_RECORD,
        CAMERA_RECORD = 64 + 12 + 16 + 16, TEXTURE_RECORD = 64 + 12, CLUSTERS_RECORD = 6 * 4,
        CLUSTER_RECORD = 4 * 4 + 16 + 12 + 12 + 4 + 3 * 4, GROUP_RECORD = 16 + 4 + 3 * 4,
        NODE_RECORD = 16 + 4 + 4 + 4 * 4 + 2 * 4 };
@@ -596,12 +596,7 @@ static gdr_status read_instances(cache_read_state *st, reader *in, gdr_error *er
     gdr_status status = expect_records(st, in, FOURCC('I', 'N', 'S', 'T'), st->instance_count, INSTANCE_RECORD, err);
     for (uint32_t i = 0; i < st->instance_count && status == GDR_OK; i++) {
         gdr_instance inst;
-        get_f32s(in, inst.transform.m, 16);
-        inst.mesh = get_u32(in);
-        inst.material = get_u32(in);
-        get_f32s(in, &inst.color.x, 4);
-        get_f32s(in, &inst.min_screen_size, 1);
-        get_f32s(in, &inst.max_screen_size, 1);
+        cache_get_instance(in, &inst);
         if (!all_finite(&inst.color.x, 4))
             return gdr_error_set(err, GDR_ERROR_PARSE, "%s: instance %u: colour is not finite", st->name, i);
         status = gdr_scene_add_instance(st->scene, &inst, err);

@@ -6,6 +6,7 @@
 #include <fcntl.h>
 #include <math.h>
 #include <stdatomic.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -17,7 +18,6 @@
 #define HEADER_SIZE 64u
 #define ENTRY_SIZE 32u
 #define MAX_SECTIONS 1024u
-#define INSTANCE_RECORD 88u
 #define FOURCC(a, b, c, d) ((uint32_t)(a) | (uint32_t)(b) << 8 | (uint32_t)(c) << 16 | (uint32_t)(d) << 24)
 
 struct gdr_paged_cache {
@@ -128,31 +128,39 @@ static gdr_status read_section(gdr_paged_cache *pc, const section_ref *ref, cons
     return status;
 }
 
+/* The instances, checked as the whole-file reader checks them (gdr_scene_add_instance against the
+ * counts of section 'SCNE', colours finite), into a scene that holds only them. */
 static gdr_status parse_instances(gdr_paged_cache *pc, const uint8_t *data, uint64_t size, gdr_error *err)
 {
-    if (size != (uint64_t)pc->instance_count * INSTANCE_RECORD)
+    if (size != (uint64_t)pc->instance_count * CACHE_INSTANCE_RECORD)
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'INST' holds %llu bytes, %u records need %llu",
                              pc->name, (unsigned long long)size, pc->instance_count,
-                             (unsigned long long)pc->instance_count * INSTANCE_RECORD);
-    pc->instances = calloc(pc->instance_count ? pc->instance_count : 1, sizeof *pc->instances);
-    if (!pc->instances)
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: %u instances", pc->name, pc->instance_count);
-    for (uint32_t i = 0; i < pc->instance_count; i++) {
-        const uint8_t *p = data + (size_t)i * INSTANCE_RECORD;
-        gdr_instance *in = &pc->instances[i];
-        memcpy(in->transform.m, p, 64);
-        in->mesh = load_u32(p + 64);
-        in->material = load_u32(p + 68);
-        memcpy(&in->color, p + 72, 16);
-        int finite = 1;
-        for (int k = 0; k < 16; k++)
-            finite &= isfinite(in->transform.m[k]);
-        if (!finite || in->mesh >= pc->mesh_count ||
-            (in->material != GDR_NO_INDEX && in->material >= pc->material_count))
-            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'INST': instance %u: bad record (mesh %u)",
-                                 pc->name, i, in->mesh);
+                             (unsigned long long)pc->instance_count * CACHE_INSTANCE_RECORD);
+    gdr_scene *holder;
+    gdr_status status = gdr_scene_create(&holder, err);
+    if (status != GDR_OK)
+        return status;
+    holder->mesh_count = pc->mesh_count; /* counts only: add_instance checks indices against them */
+    holder->material_count = pc->material_count;
+    reader r = {data, (size_t)size, 0, 0};
+    for (uint32_t i = 0; i < pc->instance_count && status == GDR_OK; i++) {
+        gdr_instance inst;
+        cache_get_instance(&r, &inst);
+        status = isfinite(inst.color.x) && isfinite(inst.color.y) && isfinite(inst.color.z) && isfinite(inst.color.w)
+                     ? gdr_scene_add_instance(holder, &inst, err)
+                     : gdr_error_set(err, GDR_ERROR_PARSE, "instance %u: colour is not finite", i);
     }
-    return GDR_OK;
+    if (status != GDR_OK) {
+        char message[GDR_ERROR_MESSAGE_MAX];
+        snprintf(message, sizeof message, "%s", err->message);
+        gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'INST': %s", pc->name, message);
+    } else {
+        pc->instances = holder->instances;
+        holder->instances = NULL;
+    }
+    holder->mesh_count = holder->material_count = holder->instance_count = 0;
+    gdr_scene_destroy(holder);
+    return status == GDR_OK ? GDR_OK : GDR_ERROR_PARSE;
 }
 
 /* The page section's header and index (its own checksum: the section's covers pages unread). */
@@ -205,7 +213,7 @@ static gdr_status open_sections(gdr_paged_cache *pc, gdr_error *err)
     }
     free(bytes);
     if (status == GDR_OK)
-        status = read_section(pc, &inst, "INST", (size_t)GDR_DEFAULT_MAX_INSTANCES * INSTANCE_RECORD, &bytes, err);
+        status = read_section(pc, &inst, "INST", (size_t)GDR_DEFAULT_MAX_INSTANCES * CACHE_INSTANCE_RECORD, &bytes, err);
     if (status == GDR_OK)
         status = parse_instances(pc, bytes, inst.size, err);
     free(bytes);
