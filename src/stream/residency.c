@@ -33,7 +33,11 @@ struct gdr_residency {
     uint64_t upload_budget;
     uint32_t frame, last_change, pinned_planned;
     uint32_t latest_use; /* the latest frame whose cut was marked (UINT32_MAX: none yet) */
-    uint32_t *scratch;       /* page_total: a request's closure */
+    uint32_t *scratch;       /* 2 x page_total: a request's closure, its protected ancestors */
+    /* Resident pages that are not pinned, least recently used first: lru_prev/next per page
+     * (UINT32_MAX: none), so that finding a page to evict walks the pool, never the scene. */
+    uint32_t *lru_prev, *lru_next;
+    uint32_t lru_head, lru_tail;
     gdr_residency_stats stats;
 };
 
@@ -148,8 +152,12 @@ gdr_status gdr_residency_create(const gdr_residency_desc *desc, gdr_residency **
     res->pages = calloc(res->page_total ? res->page_total : 1, sizeof *res->pages);
     res->page_mesh = malloc(sizeof *res->page_mesh * (res->page_total ? res->page_total : 1));
     res->scratch = malloc(sizeof *res->scratch * 2 * ((size_t)res->page_total + 1));
+    res->lru_prev = malloc(sizeof *res->lru_prev * ((size_t)res->page_total + 1));
+    res->lru_next = malloc(sizeof *res->lru_next * ((size_t)res->page_total + 1));
+    res->lru_head = res->lru_tail = UINT32_MAX;
     gdr_status status = GDR_OK;
-    if (!res->page_base || !res->pages || !res->page_mesh || !res->scratch || !build_edges(res))
+    if (!res->page_base || !res->pages || !res->page_mesh || !res->scratch || !res->lru_prev || !res->lru_next ||
+        !build_edges(res))
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "residency of %u pages", res->page_total);
     if (status == GDR_OK)
         status = size_pool(res, desc, err);
@@ -173,6 +181,7 @@ void gdr_residency_destroy(gdr_residency *res)
         return;
     free(res->page_base), free(res->page_mesh), free(res->pages), free(res->parent_first), free(res->parents);
     free(res->child_first), free(res->children), free(res->free_slots), free(res->scratch);
+    free(res->lru_prev), free(res->lru_next);
     free(res);
 }
 
@@ -182,6 +191,31 @@ static uint64_t page_bytes_of(const gdr_residency *res, uint32_t page)
 {
     uint32_t m = res->page_mesh[page];
     return gdr_page_pool_bytes(&gdr_paged_cache_mesh(res->cache, m)->pages[page - res->page_base[m]]);
+}
+
+static void lru_unlink(gdr_residency *res, uint32_t page)
+{
+    uint32_t prev = res->lru_prev[page], next = res->lru_next[page];
+    if (prev != UINT32_MAX)
+        res->lru_next[prev] = next;
+    else
+        res->lru_head = next;
+    if (next != UINT32_MAX)
+        res->lru_prev[next] = prev;
+    else
+        res->lru_tail = prev;
+}
+
+/* Appends a page as the most recently used. */
+static void lru_append(gdr_residency *res, uint32_t page)
+{
+    res->lru_prev[page] = res->lru_tail;
+    res->lru_next[page] = UINT32_MAX;
+    if (res->lru_tail != UINT32_MAX)
+        res->lru_next[res->lru_tail] = page;
+    else
+        res->lru_head = page;
+    res->lru_tail = page;
 }
 
 static void add_dependents(gdr_residency *res, uint32_t page, int delta)
@@ -207,6 +241,8 @@ static void remove_page(gdr_residency *res, uint32_t page, uint8_t new_state, in
     }
     if (!forced && (ps->pinned || ps->dependents > 0 || used_by_latest_cut(res, ps)))
         res->stats.evicted_in_use++;
+    if (ps->state == PAGE_RESIDENT && !ps->pinned)
+        lru_unlink(res, page);
     add_dependents(res, page, -1);
     res->free_slots[res->free_count++] = ps->slot;
     ps->slot = UINT32_MAX;
@@ -214,22 +250,17 @@ static void remove_page(gdr_residency *res, uint32_t page, uint8_t new_state, in
     res->last_change = res->frame;
 }
 
-/* The resident page unused for longest that may leave (not pinned, no resident child, not used by
- * the latest cut); ties: the later page (finer geometry) first. UINT32_MAX when none. */
+/* The resident page unused for longest that may leave (not pinned, no planned or resident child, not
+ * used by the latest cut, not an ancestor of the closure being planned): the first such in LRU
+ * order. The walk passes only resident pages (the pool), never the whole scene. UINT32_MAX: none. */
 static uint32_t eviction_candidate(const gdr_residency *res)
 {
-    uint32_t best = UINT32_MAX, best_used = 0;
-    for (uint32_t i = 0; i < res->page_total; i++) {
+    for (uint32_t i = res->lru_head; i != UINT32_MAX; i = res->lru_next[i]) {
         const page_state *ps = &res->pages[i];
-        if (ps->state != PAGE_RESIDENT || ps->pinned || ps->dependents > 0 || ps->requested == MARK_PROTECTED)
-            continue;
-        if (used_by_latest_cut(res, ps))
-            continue;
-        uint32_t used = ps->last_used == UINT32_MAX ? 0 : ps->last_used + 1;
-        if (best == UINT32_MAX || used <= best_used)
-            best = i, best_used = used;
+        if (ps->dependents == 0 && ps->requested != MARK_PROTECTED && !used_by_latest_cut(res, ps))
+            return i;
     }
-    return best;
+    return UINT32_MAX;
 }
 
 static int take_slot(gdr_residency *res, uint32_t *slot)
@@ -337,7 +368,8 @@ void gdr_residency_plan(gdr_residency *res, uint32_t frame, const gdr_stream_req
     gdr_stream_request *sorted = malloc(sizeof *sorted * (request_count ? request_count : 1));
     if (!sorted)
         return; /* out of memory: nothing planned this frame, the GPU asks again */
-    memcpy(sorted, requests, sizeof *sorted * request_count);
+    if (request_count)
+        memcpy(sorted, requests, sizeof *sorted * request_count);
     qsort(sorted, request_count, sizeof *sorted, compare_requests);
     int room = 1;
     for (uint32_t i = 0; i < request_count; i++) {
@@ -368,7 +400,12 @@ void gdr_residency_plan(gdr_residency *res, uint32_t frame, const gdr_stream_req
 void gdr_residency_mark_used(gdr_residency *res, uint32_t frame, uint32_t mesh, uint32_t page)
 {
     if (mesh < res->mesh_count && page < gdr_paged_cache_mesh(res->cache, mesh)->page_count) {
-        res->pages[res->page_base[mesh] + page].last_used = frame;
+        uint32_t global = res->page_base[mesh] + page;
+        res->pages[global].last_used = frame;
+        if (res->pages[global].state == PAGE_RESIDENT && !res->pages[global].pinned) {
+            lru_unlink(res, global); /* now the most recently used */
+            lru_append(res, global);
+        }
         res->latest_use = res->latest_use == UINT32_MAX || frame > res->latest_use ? frame : res->latest_use;
     }
 }
@@ -379,6 +416,8 @@ void gdr_residency_loaded(gdr_residency *res, uint32_t mesh, uint32_t page)
     if (ps->state == PAGE_PLANNED) {
         ps->state = PAGE_RESIDENT;
         res->last_change = res->frame;
+        if (!ps->pinned)
+            lru_append(res, res->page_base[mesh] + page);
     }
 }
 

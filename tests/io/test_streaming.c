@@ -22,7 +22,7 @@
 #include "test_util.h"
 
 #define PATH_FRAMES 40
-#define STILL_FRAMES 60
+#define STILL_FRAMES 30
 
 /* Every path from a level-0 cluster to the root holds exactly one selected cluster (clusters are
  * ordered by group and groups by depth, so the clusters made from a group come later). */
