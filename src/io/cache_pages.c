@@ -199,7 +199,8 @@ static void free_mesh_pages(mesh_pages *mp)
 }
 
 /* Orders the groups (root first, then by depth, coarsest first) and cuts the order into pages of
- * whole groups holding at least page_bytes raw bytes each (the last one less). */
+ * whole groups holding at least page_bytes raw bytes each (the last one less). A mesh with a page
+ * the reader would refuse (over CACHE_PAGE_MAX_RAW: a single huge group) is left without pages. */
 static int build_mesh_pages(const gdr_mesh *mesh, uint32_t page_bytes, mesh_pages *mp)
 {
     const gdr_mesh_clusters *mc = &mesh->clusters;
@@ -222,8 +223,13 @@ static int build_mesh_pages(const gdr_mesh *mesh, uint32_t page_bytes, mesh_page
     free(keys);
     for (uint32_t first = 0; first < mc->group_count;) {
         uint32_t end = first;
-        for (uint64_t raw = 0; end < mc->group_count && raw < page_bytes; end++)
+        uint64_t raw = 0;
+        for (; end < mc->group_count && raw < page_bytes; end++)
             raw += group_raw_bytes(mc, mp->order[end]);
+        if (raw > CACHE_PAGE_MAX_RAW) { /* a group the reader would refuse: the mesh is not paged */
+            free_mesh_pages(mp);
+            return 1;
+        }
         encoded_page *e = &mp->pages[mp->page_count];
         *e = (encoded_page){.first = first, .group_count = end - first};
         page_source src = {mesh, mp->order + first, end - first};
