@@ -42,7 +42,22 @@ static int compare_group_keys(const void *a, const void *b)
     return x->group < y->group ? -1 : x->group > y->group;
 }
 
-/* True when the mesh's groups cover its clusters exactly (every DAG does): it can be paged. */
+/* Whether cluster c's vertex list is its triangles' corners in order of first use (every builder
+ * makes it so; a page stores only the triangles and rebuilds the list from them). */
+static int vertices_in_first_use_order(const gdr_mesh_clusters *mc, const gdr_cluster *c)
+{
+    uint32_t seen = 0;
+    for (uint32_t i = 0; i < 3 * c->triangle_count; i++) {
+        uint32_t local = mc->triangles[c->triangle_offset + i];
+        if (local > seen)
+            return 0;
+        seen += local == seen;
+    }
+    return seen == c->vertex_count;
+}
+
+/* True when the mesh's groups cover its clusters exactly (every DAG does) and every cluster's vertex
+ * list can be rebuilt from its triangles: it can be paged. */
 static int mesh_pageable(const gdr_mesh_clusters *mc)
 {
     if (mc->group_count == 0)
@@ -53,7 +68,7 @@ static int mesh_pageable(const gdr_mesh_clusters *mc)
         if ((uint64_t)gr->first_cluster + gr->cluster_count > mc->cluster_count)
             return 0;
         for (uint32_t c = gr->first_cluster; c < gr->first_cluster + gr->cluster_count; c++)
-            if (mc->clusters[c].group != g)
+            if (mc->clusters[c].group != g || !vertices_in_first_use_order(mc, &mc->clusters[c]))
                 return 0;
         covered += gr->cluster_count;
     }
@@ -89,6 +104,7 @@ typedef struct page_source {
     const gdr_mesh *mesh;
     const uint32_t *groups;
     uint32_t group_count;
+    uint32_t *remap; /* mesh vertex -> page vertex, UINT32_MAX between pages (mesh vertex_count entries) */
 } page_source;
 
 static void put_cluster_record(writer *w, const gdr_cluster *c)
@@ -102,10 +118,11 @@ static void put_cluster_record(writer *w, const gdr_cluster *c)
     put_f32s(w, &c->cone_cutoff, 1);
 }
 
-/* The page's clusters' records, vertices (each cluster's own, in its order) and triangles (as
- * page vertex indices), unencoded; counts into *e. */
+/* The page's clusters' records, its vertices (each mesh vertex once, in order of first use by the
+ * triangles) and its triangles as indices of those, unencoded; counts into *e (vertex_count: the
+ * clusters' vertices, as decoded), the page's own vertex count into *unique. 0 when out of memory. */
 static int gather_page(const page_source *src, writer *records, gdr_page_vertex **vertices, uint32_t **indices,
-                       encoded_page *e)
+                       encoded_page *e, uint32_t *unique)
 {
     const gdr_mesh_clusters *mc = &src->mesh->clusters;
     uint64_t vc = 0, tc = 0;
@@ -116,26 +133,33 @@ static int gather_page(const page_source *src, writer *records, gdr_page_vertex 
     }
     *vertices = malloc(sizeof **vertices * (vc ? vc : 1));
     *indices = malloc(sizeof **indices * (tc ? 3 * tc : 1));
-    if (!*vertices || !*indices)
-        return 0;
-    uint32_t v = 0, t = 0;
-    for (uint32_t k = 0; k < src->group_count; k++) {
+    uint32_t *mesh_vertex = malloc(sizeof *mesh_vertex * (vc ? vc : 1));
+    int ok = *vertices && *indices && mesh_vertex;
+    uint32_t u = 0, t = 0;
+    for (uint32_t k = 0; ok && k < src->group_count; k++) {
         const gdr_cluster_group *gr = &mc->groups[src->groups[k]];
-        for (uint32_t ci = gr->first_cluster; ci < gr->first_cluster + gr->cluster_count; ci++) {
+        for (uint32_t ci = gr->first_cluster; ok && ci < gr->first_cluster + gr->cluster_count; ci++) {
             const gdr_cluster *c = &mc->clusters[ci];
             put_cluster_record(records, c);
-            for (uint32_t i = 0; i < c->triangle_count * 3; i++)
-                (*indices)[t++] = v + mc->triangles[c->triangle_offset + i];
-            for (uint32_t i = 0; i < c->vertex_count; i++) {
-                uint32_t mv = mc->vertices[c->vertex_offset + i];
-                (*vertices)[v++] = (gdr_page_vertex){src->mesh->positions[mv], src->mesh->normals[mv],
-                                                     src->mesh->uvs[mv]};
+            for (uint32_t i = 0; ok && i < c->triangle_count * 3; i++) {
+                uint32_t mv = mc->vertices[c->vertex_offset + mc->triangles[c->triangle_offset + i]];
+                if (src->remap[mv] == UINT32_MAX) {
+                    src->remap[mv] = u;
+                    mesh_vertex[u] = mv;
+                    (*vertices)[u++] = (gdr_page_vertex){src->mesh->positions[mv], src->mesh->normals[mv],
+                                                         src->mesh->uvs[mv]};
+                }
+                (*indices)[t++] = src->remap[mv];
             }
         }
     }
-    e->vertex_count = v;
+    for (uint32_t i = 0; mesh_vertex && i < u; i++)
+        src->remap[mesh_vertex[i]] = UINT32_MAX;
+    free(mesh_vertex);
+    e->vertex_count = (uint32_t)vc;
     e->triangle_count = t / 3;
-    return !records->failed;
+    *unique = u;
+    return ok && !records->failed;
 }
 
 /* Encodes `count` vertices and `index_count` indices onto the end of `body`; their sizes in vs, is. */
@@ -161,8 +185,9 @@ static int encode_page(const page_source *src, encoded_page *e)
     gdr_page_vertex *vertices = NULL;
     uint32_t *indices = NULL;
     size_t vs = 0, is = 0;
-    int ok = gather_page(src, &body, &vertices, &indices, e) &&
-             put_streams(&body, vertices, e->vertex_count, indices, 3 * (size_t)e->triangle_count, &vs, &is);
+    uint32_t unique = 0;
+    int ok = gather_page(src, &body, &vertices, &indices, e, &unique) &&
+             put_streams(&body, vertices, unique, indices, 3 * (size_t)e->triangle_count, &vs, &is);
     free(vertices);
     free(indices);
     size_t zbound = ZSTD_compressBound(body.size);
@@ -177,8 +202,8 @@ static int encode_page(const page_source *src, encoded_page *e)
         flags = PAGE_FLAG_ZSTD, body_stored = (uint32_t)z;
     else
         memcpy(stored + CACHE_PAGE_HEADER, body.data, body.size);
-    uint32_t header[8] = {PAGE_MAGIC, flags, (uint32_t)body.size, e->cluster_count, e->vertex_count,
-                          e->triangle_count, (uint32_t)vs, (uint32_t)is};
+    uint32_t header[8] = {PAGE_MAGIC, flags, (uint32_t)body.size, e->cluster_count, unique, e->triangle_count,
+                          (uint32_t)vs, (uint32_t)is};
     memcpy(stored, header, sizeof header);
     free(body.data);
     e->bytes = stored;
@@ -210,11 +235,14 @@ static int build_mesh_pages(const gdr_mesh *mesh, uint32_t page_bytes, mesh_page
     group_key *keys = malloc(sizeof *keys * mc->group_count);
     mp->order = malloc(sizeof *mp->order * mc->group_count);
     mp->pages = malloc(sizeof *mp->pages * mc->group_count);
-    if (!keys || !mp->order || !mp->pages) {
+    uint32_t *remap = malloc(sizeof *remap * (mesh->vertex_count ? mesh->vertex_count : 1));
+    if (!keys || !mp->order || !mp->pages || !remap) {
         free(keys);
+        free(remap);
         free_mesh_pages(mp);
         return 0;
     }
+    memset(remap, 0xff, sizeof *remap * mesh->vertex_count);
     for (uint32_t g = 0; g < mc->group_count; g++)
         keys[g] = (group_key){g, mc->groups[g].depth, isinf(mc->groups[g].error)};
     qsort(keys, mc->group_count, sizeof *keys, compare_group_keys);
@@ -227,19 +255,22 @@ static int build_mesh_pages(const gdr_mesh *mesh, uint32_t page_bytes, mesh_page
         for (; end < mc->group_count && raw < page_bytes; end++)
             raw += group_raw_bytes(mc, mp->order[end]);
         if (raw > CACHE_PAGE_MAX_RAW) { /* a group the reader would refuse: the mesh is not paged */
+            free(remap);
             free_mesh_pages(mp);
             return 1;
         }
         encoded_page *e = &mp->pages[mp->page_count];
         *e = (encoded_page){.first = first, .group_count = end - first};
-        page_source src = {mesh, mp->order + first, end - first};
+        page_source src = {mesh, mp->order + first, end - first, remap};
         if (!encode_page(&src, e)) {
+            free(remap);
             free_mesh_pages(mp);
             return 0;
         }
         mp->page_count++;
         first = end;
     }
+    free(remap);
     return 1;
 }
 
@@ -632,46 +663,74 @@ static gdr_status decode_clusters(const char *where, reader *r, const gdr_paged_
     return GDR_OK;
 }
 
-/* Triangles from the decoded page vertex indices: each inside its cluster's vertices. */
-static gdr_status decode_triangles(const char *where, const uint32_t *indices, gdr_page *out, gdr_error *err)
+/* One cluster's vertex list and local triangles from its triangles' page vertex indices: local
+ * indices in order of first use (how the writer's clusters list their vertices). `local_of` and
+ * `stamp` are per page vertex; stamp[u] == c + 1 marks u as seen in cluster c. */
+static gdr_status expand_cluster(const char *where, uint32_t c, const uint32_t *indices, const gdr_page_vertex *unique,
+                                 uint32_t unique_count, uint32_t *local_of, uint32_t *stamp, gdr_page *out,
+                                 gdr_error *err)
 {
-    out->triangles = calloc(out->triangle_byte_count ? out->triangle_byte_count : 1, 1);
-    if (!out->triangles)
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: %u triangle bytes", where, out->triangle_byte_count);
-    const uint32_t *at = indices;
-    for (uint32_t c = 0; c < out->cluster_count; c++) {
-        const gdr_page_cluster *pc = &out->clusters[c];
-        for (uint32_t i = 0; i < 3 * pc->triangle_count; i++, at++) {
-            uint32_t local = *at - pc->vertex_offset;
-            if (*at < pc->vertex_offset || local >= pc->vertex_count)
-                return PAGE_ERR("%s: cluster %u triangle %u: vertex %u outside the cluster's %u..%u", where, c, i / 3,
-                                *at, pc->vertex_offset, pc->vertex_offset + pc->vertex_count - 1);
-            out->triangles[pc->triangle_offset + i] = (uint8_t)local;
+    const gdr_page_cluster *pc = &out->clusters[c];
+    uint32_t seen = 0;
+    for (uint32_t i = 0; i < 3 * pc->triangle_count; i++) {
+        uint32_t u = indices[i];
+        if (u >= unique_count)
+            return PAGE_ERR("%s: cluster %u triangle %u: vertex %u of %u", where, c, i / 3, u, unique_count);
+        if (stamp[u] != c + 1) {
+            if (seen == pc->vertex_count)
+                return PAGE_ERR("%s: cluster %u: its triangles use more than its %u vertices", where, c,
+                                pc->vertex_count);
+            stamp[u] = c + 1;
+            local_of[u] = seen;
+            out->vertices[pc->vertex_offset + seen++] = unique[u];
         }
+        out->triangles[pc->triangle_offset + i] = (uint8_t)local_of[u];
     }
+    if (seen != pc->vertex_count)
+        return PAGE_ERR("%s: cluster %u: its triangles use %u of its %u vertices", where, c, seen, pc->vertex_count);
     return GDR_OK;
 }
 
-static gdr_status decode_streams(const char *where, reader *r, uint32_t vs, uint32_t is, const gdr_page_info *pi,
-                                 gdr_page *out, gdr_error *err)
+/* The clusters' vertices and triangles from the page's vertices and triangles. */
+static gdr_status expand_clusters(const char *where, const uint32_t *indices, const gdr_page_vertex *unique,
+                                  uint32_t unique_count, gdr_page *out, gdr_error *err)
+{
+    out->triangles = calloc(out->triangle_byte_count ? out->triangle_byte_count : 1, 1);
+    uint32_t *local_of = malloc(sizeof *local_of * unique_count), *stamp = calloc(unique_count, sizeof *stamp);
+    gdr_status status = GDR_OK;
+    if (!out->triangles || !local_of || !stamp)
+        status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: %u triangle bytes", where, out->triangle_byte_count);
+    for (uint32_t c = 0; c < out->cluster_count && status == GDR_OK; c++) {
+        status = expand_cluster(where, c, indices, unique, unique_count, local_of, stamp, out, err);
+        indices += 3 * out->clusters[c].triangle_count;
+    }
+    free(local_of), free(stamp);
+    return status;
+}
+
+/* The vertex stream holds the page's `unique` vertices, the index stream its triangles over them. */
+static gdr_status decode_streams(const char *where, reader *r, uint32_t unique, uint32_t vs, uint32_t is,
+                                 const gdr_page_info *pi, gdr_page *out, gdr_error *err)
 {
     const uint8_t *vstream = take(r, vs), *istream = take(r, is);
+    gdr_page_vertex *vertices = malloc(sizeof *vertices * unique);
     out->vertices = malloc(sizeof *out->vertices * pi->vertex_count);
     uint32_t *indices = malloc(sizeof *indices * 3 * (size_t)pi->triangle_count);
     gdr_status status = GDR_OK;
-    if (!out->vertices || !indices)
+    if (!vertices || !out->vertices || !indices)
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: %u vertices", where, pi->vertex_count);
     else if (!vstream || !istream || r->at != r->size)
         status = PAGE_ERR("%s: streams of %u and %u bytes do not fill the body", where, vs, is);
-    else if (meshopt_decodeVertexBuffer(out->vertices, pi->vertex_count, sizeof *out->vertices, vstream, vs) != 0)
+    else if (meshopt_decodeVertexBuffer(vertices, unique, sizeof *vertices, vstream, vs) != 0)
         status = PAGE_ERR("%s: vertex stream does not decode", where);
     else if (meshopt_decodeIndexBuffer(indices, 3 * (size_t)pi->triangle_count, 4, istream, is) != 0)
         status = PAGE_ERR("%s: index stream does not decode", where);
-    else if (!finite_floats(&out->vertices[0].position.x, (size_t)pi->vertex_count * 8))
+    else if (!finite_floats(&vertices[0].position.x, (size_t)unique * 8))
         status = PAGE_ERR("%s: a vertex is not finite", where);
     out->vertex_count = pi->vertex_count;
     if (status == GDR_OK)
-        status = decode_triangles(where, indices, out, err);
+        status = expand_clusters(where, indices, vertices, unique, out, err);
+    free(vertices);
     free(indices);
     return status;
 }
@@ -689,9 +748,11 @@ gdr_status cache_page_decode(const char *name, uint32_t mesh, uint32_t page, con
                         (unsigned long long)pi->offset);
     uint32_t h[8];
     memcpy(h, bytes, sizeof h);
-    size_t vbound = meshopt_encodeVertexBufferBound(pi->vertex_count, sizeof(gdr_page_vertex));
-    size_t ibound = meshopt_encodeIndexBufferBound(3 * (size_t)pi->triangle_count, pi->vertex_count);
-    if (h[0] != PAGE_MAGIC || h[1] > PAGE_FLAG_ZSTD || h[3] != pi->cluster_count || h[4] != pi->vertex_count ||
+    /* h[4]: the page's own vertices, each shared by the clusters that use it (at most theirs in all). */
+    size_t vbound = meshopt_encodeVertexBufferBound(h[4], sizeof(gdr_page_vertex));
+    size_t ibound = meshopt_encodeIndexBufferBound(3 * (size_t)pi->triangle_count, h[4]);
+    if (h[0] != PAGE_MAGIC || h[1] > PAGE_FLAG_ZSTD || h[3] != pi->cluster_count || h[4] == 0 ||
+        h[4] > pi->vertex_count ||
         h[5] != pi->triangle_count || h[6] > vbound || h[7] > ibound ||
         (uint64_t)h[2] != (uint64_t)pi->cluster_count * CACHE_PAGE_CLUSTER_RECORD + h[6] + h[7])
         return PAGE_ERR("%s: bad page header", where);
@@ -709,7 +770,7 @@ gdr_status cache_page_decode(const char *name, uint32_t mesh, uint32_t page, con
     if (status == GDR_OK)
         status = decode_clusters(where, &r, pm, pi, out, err);
     if (status == GDR_OK)
-        status = decode_streams(where, &r, h[6], h[7], pi, out, err);
+        status = decode_streams(where, &r, h[4], h[6], h[7], pi, out, err);
     free(owned);
     if (status != GDR_OK)
         gdr_page_free(out);

@@ -3,9 +3,10 @@
  * cluster records, meshoptimizer's vertex and index streams, the triangle checks) sees every
  * mutation. Input: u16 clusters in the first of two groups (0: one group), u8 flags (bit 0:
  * compute the checksum the index would hold; else a wrong one, which must be refused), u8 unused,
+ * u32 the clusters' vertex count in all (the index's; the header holds the page's shared ones),
  * then the page's bytes. A page that decodes must hold what its index entry says, every triangle
  * inside its cluster. The seed corpus/pages/page0.bin is page 0 of
- * `gdr build unique-field:meshes=1,triangles=1000 -o p.gdrc --pages=4` behind the prefix 0 0 1 0. */
+ * `gdr build unique-field:meshes=1,triangles=1000 -o p.gdrc --pages=4` behind the prefix 0 0 1 0 and its vertex count. */
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -20,13 +21,14 @@
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    if (size < 4 + CACHE_PAGE_HEADER)
+    if (size < 8 + CACHE_PAGE_HEADER)
         return 0;
-    const uint8_t *bytes = data + 4;
-    size_t stored = size - 4;
-    uint32_t h[8];
+    const uint8_t *bytes = data + 8;
+    size_t stored = size - 8;
+    uint32_t h[8], expanded;
     memcpy(h, bytes, sizeof h);
-    uint64_t clusters = h[3], vertices = h[4], triangles = h[5];
+    memcpy(&expanded, data + 4, 4);
+    uint64_t clusters = h[3], vertices = expanded, triangles = h[5];
     /* What the index parser would have refused already. */
     if (clusters == 0 || vertices < clusters || vertices > clusters * GDR_CLUSTER_MAX_VERTICES ||
         triangles < clusters || triangles > clusters * GDR_CLUSTER_MAX_TRIANGLES ||

@@ -16,16 +16,33 @@
 #include "gdr/paged_cache.h"
 #include "test_util.h"
 
-/* Triangle (a, b, c) equals (x, y, z) up to rotation. */
-static int same_triangle(const uint8_t *a, const uint8_t *x)
+/* A vertex of the page and one of the mesh: the same bytes. */
+static int same_vertex(const gdr_page_vertex *pv, const gdr_mesh *mesh, uint32_t v)
 {
-    for (int r = 0; r < 3; r++)
-        if (a[0] == x[r] && a[1] == x[(r + 1) % 3] && a[2] == x[(r + 2) % 3])
+    return !memcmp(&pv->position, &mesh->positions[v], 12) && !memcmp(&pv->normal, &mesh->normals[v], 12) &&
+           !memcmp(&pv->uv, &mesh->uvs[v], 8);
+}
+
+/* Decoded triangle t of cluster pc is the scene's triangle t of cluster sc, corner for corner up to
+ * a rotation (the index codec may rotate a triangle; the winding stays). */
+static int same_triangle(const gdr_mesh *mesh, const gdr_cluster *sc, const gdr_page *page,
+                         const gdr_page_cluster *pc, uint32_t t)
+{
+    const uint8_t *d = &page->triangles[pc->triangle_offset + 3 * t];
+    const uint8_t *x = &mesh->clusters.triangles[sc->triangle_offset + 3 * t];
+    for (int r = 0; r < 3; r++) {
+        int all = 1;
+        for (int k = 0; k < 3; k++)
+            all &= same_vertex(&page->vertices[pc->vertex_offset + d[(k + r) % 3]], mesh,
+                               mesh->clusters.vertices[sc->vertex_offset + x[k]]);
+        if (all)
             return 1;
+    }
     return 0;
 }
 
-/* The decoded cluster is the scene's cluster `c` of mesh `mesh`. */
+/* The decoded cluster is the scene's cluster `c` of mesh `mesh`: the same records, vertex count and
+ * triangles (by their corners' vertex bytes; the local order of vertices is rebuilt by the reader). */
 static int same_cluster(const gdr_mesh *mesh, uint32_t c, const gdr_page *page, const gdr_page_cluster *pc)
 {
     const gdr_cluster *sc = &mesh->clusters.clusters[c];
@@ -34,16 +51,8 @@ static int same_cluster(const gdr_mesh *mesh, uint32_t c, const gdr_page *page, 
         memcmp(&pc->cone_apex, &sc->cone_apex, 12) || memcmp(&pc->cone_axis, &sc->cone_axis, 12) ||
         pc->cone_cutoff != sc->cone_cutoff || pc->triangle_offset % 4 != 0)
         return 0;
-    for (uint32_t i = 0; i < sc->vertex_count; i++) {
-        uint32_t v = mesh->clusters.vertices[sc->vertex_offset + i];
-        const gdr_page_vertex *pv = &page->vertices[pc->vertex_offset + i];
-        if (memcmp(&pv->position, &mesh->positions[v], 12) || memcmp(&pv->normal, &mesh->normals[v], 12) ||
-            memcmp(&pv->uv, &mesh->uvs[v], 8))
-            return 0;
-    }
     for (uint32_t t = 0; t < sc->triangle_count; t++)
-        if (!same_triangle(&page->triangles[pc->triangle_offset + 3 * t],
-                           &mesh->clusters.triangles[sc->triangle_offset + 3 * t]))
+        if (!same_triangle(mesh, sc, page, pc, t))
             return 0;
     return 1;
 }
