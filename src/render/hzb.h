@@ -5,7 +5,7 @@
  * (reverse-Z: the farthest). Level 0 takes the minimum over every depth pixel its area overlaps, so
  * odd and non-power-of-two depth sizes lose no row or column.
  *
- * Built by compute, one dispatch per level (depthreduce.comp.glsl). Sampling it for the occlusion
+ * Built by compute, one dispatch per GDR_HZB_LEVELS_PER_DISPATCH levels (depthreduce.comp.glsl). Sampling it for the occlusion
  * test: src/shaders/shared/occlusion_math.h.
  *
  * Synchronization contract of gdr_hzb_record_build:
@@ -66,7 +66,7 @@ typedef struct gdr_hzb {
     VkPipelineLayout pipeline_layout;
     VkPipeline pipeline;
     VkDescriptorPool pool;
-    VkDescriptorSet sets[GDR_HZB_MAX_LEVELS]; /* set i: source (depth or level i - 1) -> level i */
+    VkDescriptorSet sets[GDR_HZB_MAX_LEVELS]; /* set d: source (depth or level 5d - 1) -> levels 5d .. 5d + 4 */
 } gdr_hzb;
 
 /* Level-0 size for a depth size: the largest power of two <= depth_size (depth_size > 0). */
