@@ -311,6 +311,15 @@ typedef struct gdr_visible_meshlet {
 GDR_API gdr_status gdr_renderer_read_visible_meshlets(gdr_renderer *renderer, gdr_visible_meshlet *meshlets,
                                                       uint32_t capacity, uint32_t *count, gdr_error *err);
 
+/* Tests: marks the groups of mesh `mesh` absent where group_resident[g] is 0 (its cluster data's
+ * group_count entries), as a streaming residency would, with node_absent_refined its
+ * lod_node_count counts of the clusters below each node whose refined group is absent. The
+ * traversal and the cluster tests then draw the cut over resident groups (docs/STREAMING.md): an
+ * absent group counts as passing. The geometry itself stays uploaded. Waits for the GPU. */
+GDR_API gdr_status gdr_renderer_debug_set_residency(gdr_renderer *renderer, uint32_t mesh,
+                                                    const uint8_t *group_resident,
+                                                    const uint32_t *node_absent_refined, gdr_error *err);
+
 GDR_API void gdr_renderer_size(const gdr_renderer *renderer, uint32_t *width, uint32_t *height);
 
 /* Writes, as Markdown, the passes of the frame of every configuration (pipeline, raster, occlusion

@@ -72,6 +72,7 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .update_count = update_count,
         .flags = frame_flags(frame, lod, occlusion, history, traversal_levels(r, frame, pipeline) > 0) |
                  (r->debug_shrink_lod_nodes ? GDR_FRAME_DEBUG_SHRINK_NODES : 0u) |
+                 (r->scene.absent_groups > 0 ? GDR_FRAME_PARTIAL_RESIDENCY : 0u) |
                  (pipeline == GDR_PIPELINE_MESH && r->vis.mode != GDR_GPU_RASTER_FORWARD ? GDR_FRAME_DIRECT_CLUSTERS
                                                                                         : 0u),
         .view_mode = (uint32_t)frame->view,

@@ -346,6 +346,8 @@ gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
     if (status == GDR_OK)
         status = upload_lod_nodes(r, scene, clusters, err);
     if (status == GDR_OK)
+        status = gdr_page_table_create(r, clusters, scene->mesh_count, err);
+    if (status == GDR_OK)
         size_queues(r, scene, clusters);
     if (status == GDR_OK) /* the traversal's visits: even levels, then odd levels */
         status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuNodeVisit) * 2 * (VkDeviceSize)g->traversal_capacity,
@@ -381,14 +383,16 @@ gdr_status gdr_gpu_scene_write_refs(gdr_renderer *r, gdr_error *err)
                         .vertices = g->vertices.address, .meshlets = g->meshlets.address,
                         .meshlet_vertices = g->meshlet_vertices.address,
                         .meshlet_triangles = g->meshlet_triangles.address,
-                        .lod_nodes = g->lod_nodes.address};
+                        .lod_nodes = g->lod_nodes.address, .page_table = g->page_table.address,
+                        .node_absent_refined = g->node_absent_refined.address};
     gdr_status status = gdr_vk_buffer_create(&r->allocator, sizeof refs,
                                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                              GDR_VK_BUFFER_DEVICE, &g->refs, err);
     if (status == GDR_OK)
         status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->refs, 0, &refs, sizeof refs, err);
     const gdr_vk_buffer *buffers[] = {&g->vertices, &g->indices, &g->meshes, &g->instances, &g->meshlets,
-                                      &g->meshlet_vertices, &g->meshlet_triangles, &g->refs,
+                                      &g->meshlet_vertices, &g->meshlet_triangles, &g->refs, &g->page_table,
+                                      &g->node_absent_refined,
                                       &r->occlusion.occluded_instances, &r->occlusion.occluded_nodes,
                                       &r->occlusion.retest_masks};
     g->bytes = 0;
@@ -410,6 +414,7 @@ void gdr_gpu_scene_destroy(gdr_renderer *r)
     gdr_vk_buffer_destroy(r->ctx, &g->lod_nodes);
     gdr_vk_buffer_destroy(r->ctx, &g->traversal);
     gdr_vk_buffer_destroy(r->ctx, &g->refs);
+    gdr_page_table_destroy(r);
     free(g->cpu_meshlets);
     free(g->cpu_meshes);
     free(g->cpu_instances);

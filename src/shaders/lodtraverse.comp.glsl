@@ -17,6 +17,7 @@
 #include "shared/lod_math.h"
 #include "shared/occlusion_test.h"
 #include "shared/task_queue.h"
+#include "shared/residency.h"
 
 layout(local_size_x = GDR_TRAVERSE_WORKGROUP_SIZE) in;
 layout(constant_id = 0) const uint PHASE = GDR_PHASE_NONE;
@@ -66,7 +67,8 @@ void main()
             node.bounds.w *= 0.25;
         }
         mat4 model = instance.model;
-        lod_culled = !gdr_lod_node_may_draw(node.sphere, node.max_error, node.min_refined_error, model[0].xyz,
+        float min_refined_error = gdr_node_min_refined_error(g, mesh.lod_node_offset + visit.node, node.min_refined_error);
+        lod_culled = !gdr_lod_node_may_draw(node.sphere, node.max_error, min_refined_error, model[0].xyz,
                                             model[1].xyz, model[2].xyz, model[3].xyz, g.camera_position.xyz, g.znear,
                                             g.lod_projection_scale, g.lod_threshold);
         world_center = (model * vec4(node.bounds.xyz, 1.0)).xyz;

@@ -11,6 +11,7 @@
 #define GDR_CLUSTER_CULL_H
 
 #include "task_queue.h" // the occlusion culling phases
+#include "residency.h"
 
 
 // What the tests decided for one invocation's cluster.
@@ -102,8 +103,11 @@ GdrClusterResult gdr_cluster_test_command(GdrGpuFrameGlobals g, uint phase, GdrG
     result.triangles = meshlet.triangle_count;
     bool visible = true;
     if (!retest && (g.flags & GDR_FRAME_LOD) != 0u && (task.flags & GDR_TASK_LOD_ACCEPTED) == 0u) {
-        visible = gdr_lod_passes(g, meshlet.refined_sphere, meshlet.refined_error, meshlet.refined_depth, model) &&
-                  !gdr_lod_passes(g, meshlet.group_sphere, meshlet.group_error, meshlet.group_depth, model);
+        // passes' (shared/residency.h): an absent group counts as passing.
+        visible = (gdr_group_absent(g, instance.mesh, meshlet.refined_group) ||
+                   gdr_lod_passes(g, meshlet.refined_sphere, meshlet.refined_error, meshlet.refined_depth, model)) &&
+                  !(gdr_group_absent(g, instance.mesh, meshlet.group) ||
+                    gdr_lod_passes(g, meshlet.group_sphere, meshlet.group_error, meshlet.group_depth, model));
         result.lod_culled = !visible;
     }
     bool cull = g.cull_enabled != 0u;

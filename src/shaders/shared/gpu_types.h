@@ -64,7 +64,7 @@ GDR_STRUCT_BEGIN(GdrGpuMesh)
     float root_refined_error;
     gdr_uint lod_node_count;    /* >= 1 for a mesh with clusters; node 0 of the mesh is its root */
     gdr_uint lod_node_levels;   /* levels of the mesh's hierarchy (a traversal level by level needs this many steps) */
-    gdr_uint reserved3;
+    gdr_uint page_table_offset; /* the mesh's groups' words in GdrGpuScene.page_table (shared/residency.h) */
 GDR_STRUCT_END(GdrGpuMesh)
 GDR_ASSERT_SIZE(GdrGpuMesh, 96);
 GDR_ASSERT_OFFSET(GdrGpuMesh, bounds, 16);
@@ -168,6 +168,7 @@ GDR_ASSERT_SIZE(GdrGpuTraversalLevel, 16);
                                     (the early phase found them behind last frame's pyramid) */
 #define GDR_TASK_FIRST 4u        /* the first command of its instance (for read-backs) */
 #define GDR_GPU_NO_GROUP 0xffffffffu
+#define GDR_GPU_PAGE_ABSENT 0xffffffffu /* a page-table word: the group is not resident */
 
 /* One instance of the persistent instance buffer. */
 GDR_STRUCT_BEGIN(GdrGpuInstance)
@@ -298,8 +299,10 @@ GDR_STRUCT_BEGIN(GdrGpuScene)
     GDR_REF(UintsRef) meshlet_vertices;       /* global vertex index per cluster-local vertex */
     GDR_REF(UintsRef) meshlet_triangles;      /* the bytes of the cluster-local triangles */
     GDR_REF(LodNodesRef) lod_nodes;           /* GdrGpuLodNode[], every mesh's LOD hierarchy (GdrGpuMesh.lod_node_*) */
+    GDR_REF(UintsRef) page_table;             /* per group of every mesh: GDR_GPU_PAGE_ABSENT or resident (shared/residency.h) */
+    GDR_REF(UintsRef) node_absent_refined;    /* per LOD node: clusters below whose refined group is absent */
 GDR_STRUCT_END(GdrGpuScene)
-GDR_ASSERT_SIZE(GdrGpuScene, 56);
+GDR_ASSERT_SIZE(GdrGpuScene, 72);
 
 /* A frame slot's buffers: written once, when the slot is made (and when a buffer made on first use
  * appears). Shaders read it and GdrGpuScene in place (GDR_SCENE, GDR_FRAME), never as a local
@@ -374,6 +377,7 @@ GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, viewport, 208);
 #define GDR_FRAME_DEBUG_SHRINK_NODES 512u /* tests: a deliberately wrong node test (spheres a quarter of their size) */
 #define GDR_FRAME_LOD_HIERARCHY 256u  /* with GDR_FRAME_LOD: instances' clusters come from the traversal of
                                          their LOD hierarchy (lodtraverse.comp) instead of all their clusters */
+#define GDR_FRAME_PARTIAL_RESIDENCY 2048u /* some LOD group is absent: read the page table (shared/residency.h) */
 #define GDR_FRAME_DIRECT_CLUSTERS 1024u /* visibility-buffer modes: the instance cull tests the clusters of an
                                            instance that needs at most GDR_DIRECT_CLUSTERS of them and bins
                                            them itself, instead of a task command for the cluster cull */
