@@ -320,6 +320,21 @@ GDR_API gdr_status gdr_renderer_debug_set_residency(gdr_renderer *renderer, uint
                                                     const uint8_t *group_resident,
                                                     const uint32_t *node_absent_refined, gdr_error *err);
 
+/* A group the last frame found absent where its cut needs it (docs/STREAMING.md): a cluster was
+ * drawn in its place while the group's projected error, `priority` (pixels), is above the
+ * threshold. One per such cluster and instance: the same group may come several times. */
+typedef struct gdr_group_request {
+    uint32_t mesh, group; /* group: index in the mesh's clusters.groups */
+    float priority;
+    uint32_t instance;
+} gdr_group_request;
+
+/* The last frame's requests, in no particular order; needs a mesh-pipeline frame. *dropped: the
+ * requests that did not fit the frame's list (4096, GDR_STREAM_REQUEST_CAPACITY of the shaders). */
+GDR_API gdr_status gdr_renderer_read_group_requests(gdr_renderer *renderer, gdr_group_request *requests,
+                                                    uint32_t capacity, uint32_t *count, uint32_t *dropped,
+                                                    gdr_error *err);
+
 GDR_API void gdr_renderer_size(const gdr_renderer *renderer, uint32_t *width, uint32_t *height);
 
 /* Writes, as Markdown, the passes of the frame of every configuration (pipeline, raster, occlusion

@@ -26,7 +26,8 @@ static GdrGpuFrameBuffers frame_buffers(const gdr_renderer *r, const gdr_frame_s
         .tasks = slot->tasks.address, .overdraw = r->overdraw.address, .visible_meshlets = r->visible_meshlets.address,
         .raster = r->vis.params[slot - r->slots].address, .traversal = r->scene.traversal.address,
         .occluded_instances = r->occlusion.occluded_instances.address,
-        .occluded_nodes = r->occlusion.occluded_nodes.address, .retest_masks = r->occlusion.retest_masks.address};
+        .occluded_nodes = r->occlusion.occluded_nodes.address, .retest_masks = r->occlusion.retest_masks.address,
+        .stream_requests = r->scene.stream_requests.address};
 }
 
 static uint32_t frame_flags(const gdr_frame_desc *frame, bool lod, bool occlusion, bool history, bool hierarchy)

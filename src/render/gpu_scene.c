@@ -392,7 +392,7 @@ gdr_status gdr_gpu_scene_write_refs(gdr_renderer *r, gdr_error *err)
         status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->refs, 0, &refs, sizeof refs, err);
     const gdr_vk_buffer *buffers[] = {&g->vertices, &g->indices, &g->meshes, &g->instances, &g->meshlets,
                                       &g->meshlet_vertices, &g->meshlet_triangles, &g->refs, &g->page_table,
-                                      &g->node_absent_refined,
+                                      &g->node_absent_refined, &g->stream_requests,
                                       &r->occlusion.occluded_instances, &r->occlusion.occluded_nodes,
                                       &r->occlusion.retest_masks};
     g->bytes = 0;

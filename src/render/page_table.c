@@ -4,6 +4,7 @@
  * starts resident; gdr_renderer_debug_set_residency marks groups absent as a streaming residency
  * would, to check the traversal's cut over resident groups against the CPU's. */
 #include <stdlib.h>
+#include <string.h>
 
 #include "renderer_internal.h"
 
@@ -33,6 +34,10 @@ gdr_status gdr_page_table_create(gdr_renderer *r, const gdr_mesh_clusters *const
     if (status == GDR_OK)
         status = gdr_vk_buffer_create(&r->allocator, sizeof *zeros * (nodes ? nodes : 1), usage, GDR_VK_BUFFER_DEVICE,
                                       &g->node_absent_refined, err);
+    if (status == GDR_OK) /* TRANSFER_SRC: read back */
+        status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuStreamRequest) * GDR_STREAM_REQUEST_CAPACITY,
+                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                      GDR_VK_BUFFER_DEVICE, &g->stream_requests, err);
     if (status == GDR_OK && groups)
         status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->page_table, 0, zeros, sizeof *zeros * groups, err);
     if (status == GDR_OK && nodes)
@@ -46,6 +51,7 @@ void gdr_page_table_destroy(gdr_renderer *r)
 {
     gdr_vk_buffer_destroy(r->ctx, &r->scene.page_table);
     gdr_vk_buffer_destroy(r->ctx, &r->scene.node_absent_refined);
+    gdr_vk_buffer_destroy(r->ctx, &r->scene.stream_requests);
     free(r->scene.cpu_mesh_absent);
     r->scene.cpu_mesh_absent = NULL;
 }
@@ -94,4 +100,32 @@ gdr_status gdr_renderer_debug_set_residency(gdr_renderer *r, uint32_t mesh, cons
                                       sizeof *words * m->lod_node_count, err);
     free(words);
     return status == GDR_OK ? update_absent_count(r, mesh, absent, err) : status;
+}
+
+gdr_status gdr_renderer_read_group_requests(gdr_renderer *r, gdr_group_request *requests, uint32_t capacity,
+                                            uint32_t *count, uint32_t *dropped, gdr_error *err)
+{
+    *count = *dropped = 0;
+    if (r->last_slot < 0 || r->slots[r->last_slot].pipeline != GDR_PIPELINE_MESH || !r->scene.stream_requests.buffer)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "read_group_requests: the last frame was not a "
+                             "mesh-pipeline frame of a scene");
+    GdrGpuDrawStats gpu;
+    memcpy(&gpu, r->slots[r->last_slot].stats_readback.mapped, sizeof gpu);
+    uint32_t n = gpu.stream_requests < GDR_STREAM_REQUEST_CAPACITY ? gpu.stream_requests : GDR_STREAM_REQUEST_CAPACITY;
+    if (n > capacity)
+        return gdr_error_set(err, GDR_ERROR_CAPACITY, "read_group_requests: %u requests, room for %u", n, capacity);
+    *dropped = gpu.stream_requests - n;
+    *count = n;
+    if (n == 0)
+        return GDR_OK;
+    gdr_vk_buffer readback = {0};
+    gdr_status status = gdr_vk_buffer_read_back(&r->allocator, r->scene.stream_requests.buffer, 0,
+                                                sizeof(GdrGpuStreamRequest) * (VkDeviceSize)n, &readback, err);
+    for (uint32_t i = 0; status == GDR_OK && i < n; i++) {
+        GdrGpuStreamRequest q;
+        memcpy(&q, (const uint8_t *)readback.mapped + sizeof q * i, sizeof q);
+        requests[i] = (gdr_group_request){q.mesh, q.group, q.priority, q.instance};
+    }
+    gdr_vk_buffer_destroy(r->ctx, &readback);
+    return status;
 }

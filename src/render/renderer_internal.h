@@ -47,6 +47,7 @@ typedef struct gdr_gpu_scene {
     gdr_vk_buffer lod_nodes;         /* GdrGpuLodNode[]: every mesh's LOD hierarchy, as gdr_lod_node */
     gdr_vk_buffer page_table;        /* uint32 per group of every mesh (shared/residency.h, page_table.c) */
     gdr_vk_buffer node_absent_refined; /* uint32 per LOD node: clusters below whose refined group is absent */
+    gdr_vk_buffer stream_requests;   /* GdrGpuStreamRequest[GDR_STREAM_REQUEST_CAPACITY]: the last frame's */
     gdr_vk_buffer refs;              /* GdrGpuScene: the addresses above, for the push constants */
     uint32_t group_total, node_total; /* LOD groups and nodes of every mesh */
     uint64_t absent_groups;          /* groups whose page-table word is GDR_GPU_PAGE_ABSENT */

@@ -71,11 +71,36 @@ static bool near_threshold(const gdr_mesh_clusters *c, uint32_t group, const gdr
     return fabsf(e - view->threshold) <= 1e-4f * view->threshold;
 }
 
+/* Marks asked[group] = 1 for each request of instance `instance`, and checks each: its mesh, a
+ * group of it that does not pass, the priority its projected error. */
+static void check_requests(const gdr_mesh_clusters *c, const gdr_lod_view *view, uint32_t instance, uint32_t mesh,
+                           const gdr_group_request *requests, uint32_t count, uint8_t *asked, uint32_t *wrong)
+{
+    for (uint32_t q = 0; q < count; q++) {
+        const gdr_group_request *rq = &requests[q];
+        if (rq->instance != instance)
+            continue;
+        bool ok = rq->mesh == mesh && rq->group < c->group_count && rq->priority > view->threshold;
+        if (ok) {
+            const float *m = view->transform.m;
+            float e = gdr_lod_group_projected_error(c->groups[rq->group].sphere, c->groups[rq->group].error,
+                                                    (gdr_vec3){m[0], m[1], m[2]}, (gdr_vec3){m[4], m[5], m[6]},
+                                                    (gdr_vec3){m[8], m[9], m[10]}, (gdr_vec3){m[12], m[13], m[14]},
+                                                    view->camera_position, view->znear, gdr_lod_projection_scale(view));
+            ok = fabsf(e - rq->priority) <= 1e-3f * e;
+            asked[rq->group] = 1;
+        }
+        if (!ok && ++*wrong <= 3)
+            fprintf(stderr, "request %u: mesh %u group %u priority %g: not a valid request of instance %u\n", q,
+                    rq->mesh, rq->group, (double)rq->priority, instance);
+    }
+}
+
 /* The clusters the GPU drew for `frame` against the CPU's resident cut (min_depth's residency) of
  * every instance; counts clusters that differ beyond rounding in *wrong and those that differ from
  * the fully resident cut in *changed. */
 static void compare_cut(gdr_renderer *r, const gdr_scene *scene, const gdr_frame_desc *frame, uint32_t min_depth,
-                        uint32_t *wrong, uint32_t *changed)
+                        uint32_t *wrong, uint32_t *changed, uint32_t *requested)
 {
     gdr_error err = {0};
     gdr_frame_stats stats;
@@ -96,6 +121,11 @@ static void compare_cut(gdr_renderer *r, const gdr_scene *scene, const gdr_frame
         return;
     }
     qsort(drawn, count, sizeof *drawn, compare_visible_meshlets);
+    gdr_group_request *requests = malloc(sizeof *requests * 4096);
+    uint32_t request_count = 0, dropped = 0;
+    CHECK(requests && gdr_renderer_read_group_requests(r, requests, 4096, &request_count, &dropped, &err) == GDR_OK &&
+          dropped == 0);
+    *requested += request_count;
     CHECK(stats.traversal.applied == (frame->lod_hierarchy != GDR_CULL_OFF));
     gdr_mat4 projection = gdr_perspective_reverse_z_infinite(frame->camera.yfov, (float)WIDTH / HEIGHT,
                                                              frame->camera.znear);
@@ -109,7 +139,9 @@ static void compare_cut(gdr_renderer *r, const gdr_scene *scene, const gdr_frame
         uint8_t *resident = residency_from_depth(c, min_depth, &absent);
         uint8_t *selected = malloc(c->cluster_count ? c->cluster_count : 1);
         uint8_t *full = malloc(c->cluster_count ? c->cluster_count : 1);
-        if (resident && selected && full) {
+        uint8_t *asked = calloc(c->group_count ? c->group_count : 1, 1);
+        if (resident && selected && full && asked && requests) {
+            check_requests(c, &view, i, scene->instances[i].mesh, requests, request_count, asked, wrong);
             gdr_lod_cut_select_hierarchical_resident(c, &view, resident, absent, selected, NULL);
             gdr_lod_cut_select(c, &view, full);
             for (uint32_t k = 0; k < c->cluster_count; k++) {
@@ -121,7 +153,19 @@ static void compare_cut(gdr_renderer *r, const gdr_scene *scene, const gdr_frame
                 if (gpu != (selected[k] != 0) && !unsure && ++*wrong <= 3)
                     fprintf(stderr, "instance %u cluster %u: GPU %s, CPU resident cut %s\n", i, k,
                             gpu ? "drawn" : "not drawn", selected[k] ? "drawn" : "not drawn");
+                /* The CPU's request: drawn in the place of an absent refined group that does not pass. */
+                uint32_t refined = c->clusters[k].refined_group;
+                bool wanted = selected[k] && refined != GDR_NO_INDEX && !resident[refined] &&
+                              !gdr_lod_group_passes(c, refined, &view);
+                if (refined != GDR_NO_INDEX && wanted != (asked[refined] != 0) && !unsure && ++*wrong <= 3)
+                    fprintf(stderr, "instance %u group %u: GPU %s, CPU %s\n", i, refined,
+                            wanted ? "not requested" : "requested", wanted ? "requested" : "not requested");
+                if (wanted)
+                    asked[refined] = 2; /* a group the CPU wants */
             }
+            for (uint32_t q = 0; q < c->group_count; q++)
+                if (asked[q] == 1 && ++*wrong <= 3) /* requested, and no drawn cluster wants it */
+                    fprintf(stderr, "instance %u group %u: requested, not wanted\n", i, q);
         } else {
             CHECK(false);
         }
@@ -129,7 +173,9 @@ static void compare_cut(gdr_renderer *r, const gdr_scene *scene, const gdr_frame
         free(absent);
         free(selected);
         free(full);
+        free(asked);
     }
+    free(requests);
     CHECK(cursor == count); /* nothing drawn outside the instances' clusters */
     free(drawn);
 }
@@ -163,18 +209,18 @@ int main(void)
         /* Groups below depth 2, then below depth 4, absent (dropping the node test's relaxation
          * shows only with the second). */
         for (uint32_t min_depth = 2; min_depth <= 4; min_depth += 2) {
-            uint32_t absent_groups = 0, wrong = 0, changed = 0;
+            uint32_t absent_groups = 0, wrong = 0, changed = 0, requested = 0;
             CHECK(set_residency(r, scene, min_depth, &absent_groups));
             for (int n = 0; n < 6; n++) {
                 frame.lod_error_px = thresholds[n % 3];
                 frame.lod_hierarchy = n < 3 ? GDR_CULL_DEFAULT : GDR_CULL_OFF;
                 frame.camera = test_look((gdr_vec3){0.5f * (float)n - 1.0f, 2.0f + 0.5f * (float)n, 2.0f - (float)n},
                                          0.1f, -0.3f, 1.0f, 0.1f);
-                compare_cut(r, scene, &frame, min_depth, &wrong, &changed);
+                compare_cut(r, scene, &frame, min_depth, &wrong, &changed, &requested);
             }
-            printf("depth < %u absent (%u groups): %u clusters differ from the CPU resident cut, %u cut choices "
-                   "changed by residency\n", min_depth, absent_groups, wrong, changed);
-            CHECK(absent_groups > 0 && wrong == 0 && changed > 0);
+            printf("depth < %u absent (%u groups): %u clusters or requests differ from the CPU resident cut, %u cut "
+                   "choices changed by residency, %u requests\n", min_depth, absent_groups, wrong, changed, requested);
+            CHECK(absent_groups > 0 && wrong == 0 && changed > 0 && requested > 0);
         }
         /* Every group resident again: the image of before. */
         uint32_t none = 0;
@@ -183,6 +229,10 @@ int main(void)
         frame.lod_error_px = 1.0f;
         frame.lod_hierarchy = GDR_CULL_DEFAULT;
         CHECK(render_image(r, &frame, after) && memcmp(before, after, WIDTH * HEIGHT * 4) == 0);
+        gdr_group_request request;
+        uint32_t requests = 1, dropped = 1;
+        CHECK(gdr_renderer_read_group_requests(r, &request, 1, &requests, &dropped, &err) == GDR_OK && requests == 0 &&
+              dropped == 0);
     }
     free(before);
     free(after);

@@ -103,11 +103,17 @@ GdrClusterResult gdr_cluster_test_command(GdrGpuFrameGlobals g, uint phase, GdrG
     result.triangles = meshlet.triangle_count;
     bool visible = true;
     if (!retest && (g.flags & GDR_FRAME_LOD) != 0u && (task.flags & GDR_TASK_LOD_ACCEPTED) == 0u) {
-        // passes' (shared/residency.h): an absent group counts as passing.
-        visible = (gdr_group_absent(g, instance.mesh, meshlet.refined_group) ||
-                   gdr_lod_passes(g, meshlet.refined_sphere, meshlet.refined_error, meshlet.refined_depth, model)) &&
+        // passes' (shared/residency.h): an absent group counts as passing; drawn in the place of an
+        // absent refined group that does not pass, the cluster asks for that group.
+        bool refined_absent = gdr_group_absent(g, instance.mesh, meshlet.refined_group);
+        bool refined_passes =
+            gdr_lod_passes(g, meshlet.refined_sphere, meshlet.refined_error, meshlet.refined_depth, model);
+        visible = (refined_absent || refined_passes) &&
                   !(gdr_group_absent(g, instance.mesh, meshlet.group) ||
                     gdr_lod_passes(g, meshlet.group_sphere, meshlet.group_error, meshlet.group_depth, model));
+        if (visible && refined_absent && !refined_passes)
+            gdr_request_group(g, task.instance, instance.mesh, meshlet.refined_group, meshlet.refined_sphere,
+                              meshlet.refined_error, model);
         result.lod_culled = !visible;
     }
     bool cull = g.cull_enabled != 0u;

@@ -32,6 +32,10 @@
  * level of the hierarchies (at most GDR_LOD_TREE_LEVELS, gdr/geometry.h's GDR_LOD_NODE_MAX_LEVELS);
  * a level holds at most GDR_TRAVERSE_MAX_VISITS visits (a one-dimensional indirect dispatch). */
 #define GDR_TRAVERSE_WORKGROUP_SIZE 64
+/* Stream requests a frame appends at most (shared/residency.h); the rest are counted and dropped:
+ * the groups still absent ask again the next frame. */
+#define GDR_STREAM_REQUEST_CAPACITY 4096
+
 /* Meshes of at most this many task commands of clusters are tested whole: their few commands cost
  * less than the traversal's levels (the same cut either way). */
 #define GDR_TRAVERSE_MIN_TASKS 8

@@ -29,6 +29,7 @@ GDR_DECLARE_REF(RasterParamsRef)
 GDR_DECLARE_REF(RasterCountersRef)
 GDR_DECLARE_REF(RasterClustersRef)
 GDR_DECLARE_REF(NodeVisitsRef)
+GDR_DECLARE_REF(StreamRequestsRef)
 
 /* One vertex of the geometry pool (vertex input binding 0). */
 GDR_STRUCT_BEGIN(GdrGpuVertex)
@@ -144,6 +145,17 @@ GDR_STRUCT_BEGIN(GdrGpuTaskCommand)
 GDR_STRUCT_END(GdrGpuTaskCommand)
 GDR_ASSERT_SIZE(GdrGpuTaskCommand, 16);
 
+/* A group a cluster test found absent while the full cut needs it (shared/residency.h): the
+ * cluster drawn in its place was made from it and its projected error (`priority`) is above the
+ * threshold. Read back into gdr_residency_plan's requests (mesh, group, priority). */
+GDR_STRUCT_BEGIN(GdrGpuStreamRequest)
+    gdr_uint mesh;
+    gdr_uint group;    /* mesh-local */
+    float priority;    /* the group's projected error, pixels */
+    gdr_uint instance; /* the instance that asked */
+GDR_STRUCT_END(GdrGpuStreamRequest)
+GDR_ASSERT_SIZE(GdrGpuStreamRequest, 16);
+
 /* One node visit of the LOD hierarchy traversal: node `node` (mesh-local GdrGpuLodNode index) of
  * instance `instance`, with the task flags its clusters' commands will carry (GDR_TASK_*). */
 GDR_STRUCT_BEGIN(GdrGpuNodeVisit)
@@ -257,7 +269,8 @@ GDR_STRUCT_BEGIN(GdrGpuDrawStats)
     gdr_uint late_cull_groups_x;
     gdr_uint late_cull_groups_y;
     gdr_uint late_cull_groups_z;
-    gdr_uint reserved_cull0;
+    gdr_uint stream_requests;       /* requests appended (GdrGpuFrameBuffers.stream_requests; may exceed
+                                       GDR_STREAM_REQUEST_CAPACITY: the rest were dropped) */
     gdr_uint reserved_cull1;
     /* The LOD hierarchy traversal: per phase (early or only, then late) and level. Level 0 holds
      * the roots the instance cull queues; the visits of level L + 1 the children of level L's. */
@@ -321,8 +334,9 @@ GDR_STRUCT_BEGIN(GdrGpuFrameBuffers)
     GDR_REF(NodeVisitsRef) occluded_nodes;    /* node visits [occluded_node_capacity], level after level */
     GDR_REF(WritableUintsRef) retest_masks;           /* per late task command with GDR_TASK_RETEST: its clusters to
                                                  retest (bit i: cluster meshlet_first + i) [task_capacity] */
+    GDR_REF(StreamRequestsRef) stream_requests; /* GdrGpuStreamRequest[GDR_STREAM_REQUEST_CAPACITY] */
 GDR_STRUCT_END(GdrGpuFrameBuffers)
-GDR_ASSERT_SIZE(GdrGpuFrameBuffers, 88);
+GDR_ASSERT_SIZE(GdrGpuFrameBuffers, 96);
 
 /* Per-frame constants, written by the CPU into its frame's slot. */
 GDR_STRUCT_BEGIN(GdrGpuFrameGlobals)

@@ -29,4 +29,19 @@ float gdr_node_min_refined_error(GdrGpuFrameGlobals g, uint node, float min_refi
     return UintsRef(GDR_SCENE.node_absent_refined).items[node] != 0u ? 0.0 : min_refined_error;
 }
 
+// The cluster test's request: a cluster drawn in the place of its absent refined group that the
+// full cut would refine (the group's projected error is above the threshold) asks for the group,
+// its projected error the priority. One append per such cluster (the CPU merges repeats); past
+// GDR_STREAM_REQUEST_CAPACITY only counted.
+void gdr_request_group(GdrGpuFrameGlobals g, uint instance, uint mesh, uint group, vec4 sphere, float error,
+                       mat4 model)
+{
+    float projected = gdr_lod_group_projected_error(sphere, error, model[0].xyz, model[1].xyz, model[2].xyz,
+                                                    model[3].xyz, g.camera_position.xyz, g.znear,
+                                                    g.lod_projection_scale);
+    uint at = atomicAdd(DrawStatsRef(GDR_FRAME.draw_stats).value.stream_requests, 1u);
+    if (at < GDR_STREAM_REQUEST_CAPACITY)
+        StreamRequestsRef(GDR_FRAME.stream_requests).items[at] = GdrGpuStreamRequest(mesh, group, projected, instance);
+}
+
 #endif
