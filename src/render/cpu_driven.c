@@ -90,7 +90,7 @@ gdr_status gdr_cpu_path_cull(gdr_renderer *r, const gdr_frame_desc *frame, gdr_e
     }
     double start = gdr_now_ms();
     gdr_cull_view view = {.skip_frustum = frame->cull == GDR_CULL_OFF};
-    gdr_frame_matrices(r, &frame->camera, &view.projection, &view.view);
+    gdr_frame_matrices(r, frame->cull_camera ? frame->cull_camera : &frame->camera, &view.projection, &view.view);
     gdr_cull_result result = {.visible = cpu->visible_bits};
     gdr_status status = gdr_cull_execute(cpu->cull_scene, &view, NULL, &result, NULL, err);
     if (status != GDR_OK)
