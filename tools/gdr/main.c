@@ -103,6 +103,8 @@ int main(int argc, char **argv)
         return gdr_cmd_bench(argc - 1, argv + 1);
     if (strcmp(command, "build") == 0)
         return gdr_cmd_build(argc - 1, argv + 1);
+    if (strcmp(command, "view") == 0)
+        return gdr_cmd_view(argc - 1, argv + 1);
     if (strcmp(command, "info") == 0)
         return gdr_cmd_info(argc - 1, argv + 1);
     fprintf(stderr, "gdr: unknown command '%s' (see gdr --help)\n", command);
