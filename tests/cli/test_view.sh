@@ -111,6 +111,14 @@ printf 'gdr-camera-path 1\n0 1 2 0 0 0 1\n0 1 nan 0 0 0 1\n' >"$work/bad.txt"
 "$gdr" render $scene $size --camera-path "$work/bad.txt" >/dev/null 2>"$work/err" && fail "a bad path was accepted"
 grep -q 'bad.txt:3' "$work/err" || fail "the bad path's message does not name its line: $(cat "$work/err")"
 
+# gdr bench along the path (every 40th pose): a row per pose, and a plot of GPU ms per pass.
+{ head -n 2 "$work/path.txt"; grep '^[-0-9]' "$work/path.txt" | awk 'NR % 40 == 1'; } >"$work/short.txt"
+poses=$(grep -c '^[-0-9]' "$work/short.txt")
+"$gdr" bench --scene $scene --width 64 --height 48 --camera-path "$work/short.txt" --json "$work/bench.json" \
+    --plot "$work/bench.svg" --validate >/dev/null 2>"$work/err" || { fail "bench --camera-path --plot"; cat "$work/err"; }
+[ "$(grep -c '"frame":' "$work/bench.json")" = "$poses" ] || fail "bench --camera-path: not one row per pose ($poses)"
+grep -q '<svg' "$work/bench.svg" && grep -q 'cull' "$work/bench.svg" || fail "bench --plot wrote no plot of the passes"
+
 # 4. No display, no presenting driver: a message and a non-zero exit; gdr render is unaffected.
 env -u DISPLAY -u WAYLAND_DISPLAY "$gdr" view $scene --frames 1 >/dev/null 2>"$work/err" && fail "view without a display"
 [ -s "$work/err" ] || fail "view without a display said nothing"
