@@ -63,6 +63,11 @@ typedef struct gdr_instance {
     uint32_t mesh;
     uint32_t material; /* material index or GDR_NO_INDEX (then `color` is used) */
     gdr_vec4 color;    /* per-instance colour, multiplied with the material's base colour */
+    /* Screen-size culling (gdr_frame_desc): drawn while the bounding sphere's screen size, about its
+     * projected diameter over the viewport height, is at least min_screen_size and below
+     * max_screen_size (LOD-range swaps, small-detail culling); 0: no limit. Finite, >= 0. */
+    float min_screen_size;
+    float max_screen_size;
 } gdr_instance;
 
 typedef struct gdr_camera {

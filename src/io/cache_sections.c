@@ -15,7 +15,7 @@
 
 #define FOURCC(a, b, c, d) ((uint32_t)(a) | (uint32_t)(b) << 8 | (uint32_t)(c) << 16 | (uint32_t)(d) << 24)
 
-enum { MESH_RECORD = 64 + 8 + 16, MATERIAL_RECORD = 64 + 16 + 12 + 12 + 8, INSTANCE_RECORD = 64 + 8 + 16,
+enum { MESH_RECORD = 64 + 8 + 16, MATERIAL_RECORD = 64 + 16 + 12 + 12 + 8, INSTANCE_RECORD = 64 + 8 + 16 + 8,
        CAMERA_RECORD = 64 + 12 + 16 + 16, TEXTURE_RECORD = 64 + 12, CLUSTERS_RECORD = 6 * 4,
        CLUSTER_RECORD = 4 * 4 + 16 + 12 + 12 + 4 + 3 * 4, GROUP_RECORD = 16 + 4 + 3 * 4,
        NODE_RECORD = 16 + 4 + 4 + 4 * 4 + 2 * 4 };
@@ -585,6 +585,8 @@ static void write_instances(writer *w, const cache_write_input *in)
         put_u32(w, inst->mesh);
         put_u32(w, inst->material);
         put_f32s(w, &inst->color.x, 4);
+        put_f32s(w, &inst->min_screen_size, 1);
+        put_f32s(w, &inst->max_screen_size, 1);
     }
 }
 
@@ -597,6 +599,8 @@ static gdr_status read_instances(cache_read_state *st, reader *in, gdr_error *er
         inst.mesh = get_u32(in);
         inst.material = get_u32(in);
         get_f32s(in, &inst.color.x, 4);
+        get_f32s(in, &inst.min_screen_size, 1);
+        get_f32s(in, &inst.max_screen_size, 1);
         if (!all_finite(&inst.color.x, 4))
             return gdr_error_set(err, GDR_ERROR_PARSE, "%s: instance %u: colour is not finite", st->name, i);
         status = gdr_scene_add_instance(st->scene, &inst, err);

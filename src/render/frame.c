@@ -24,7 +24,9 @@ static GdrGpuFrameBuffers frame_buffers(const gdr_renderer *r, const gdr_frame_s
     return (GdrGpuFrameBuffers){
         .draws = slot->draws.address, .draw_stats = slot->draw_stats.address, .updates = slot->updates.address,
         .tasks = slot->tasks.address, .overdraw = r->overdraw.address, .visible_meshlets = r->visible_meshlets.address,
-        .raster = r->vis.params[slot - r->slots].address, .traversal = r->scene.traversal.address};
+        .raster = r->vis.params[slot - r->slots].address, .traversal = r->scene.traversal.address,
+        .occluded_instances = r->occlusion.occluded_instances.address,
+        .occluded_nodes = r->occlusion.occluded_nodes.address, .retest_masks = r->occlusion.retest_masks.address};
 }
 
 static uint32_t frame_flags(const gdr_frame_desc *frame, bool lod, bool occlusion, bool history, bool hierarchy)
@@ -72,7 +74,9 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .cull_enabled = frame->cull != GDR_CULL_OFF,
         .update_count = update_count,
         .flags = frame_flags(frame, lod, occlusion, history, traversal_levels(r, frame, pipeline) > 0) |
-                 (r->debug_shrink_lod_nodes ? GDR_FRAME_DEBUG_SHRINK_NODES : 0u),
+                 (r->debug_shrink_lod_nodes ? GDR_FRAME_DEBUG_SHRINK_NODES : 0u) |
+                 (pipeline == GDR_PIPELINE_MESH && r->vis.mode != GDR_GPU_RASTER_FORWARD ? GDR_FRAME_DIRECT_CLUSTERS
+                                                                                        : 0u),
         .view_mode = (uint32_t)frame->view,
         .task_capacity = r->scene.task_capacity,
         .viewport = {(float)r->width, (float)r->height},
@@ -80,8 +84,17 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .lod_projection_scale = fabsf(projection.m[5]) * 0.5f * (float)r->height,
         .lod_depth = frame->lod_depth > INT32_MAX ? INT32_MAX : (int32_t)frame->lod_depth,
         .traversal_capacity = r->scene.traversal_capacity,
+        .occluded_node_capacity = r->occlusion.occluded_node_capacity,
+        .min_screen_size = frame->min_screen_size,
+        .clip_plane = frame->clip_plane,
+        .screen_scale = fmaxf(fabsf(projection.m[0]), fabsf(projection.m[5])),
     };
     gdr_occlusion_params(r, &projection, camera->znear, &globals.occlusion);
+    /* The early phase tests against last frame's pyramid as last frame's camera saw it. */
+    globals.previous_view = history ? r->occlusion.previous_view : view;
+    globals.previous_occlusion = history ? r->occlusion.previous_params : globals.occlusion;
+    r->occlusion.previous_view = view;
+    r->occlusion.previous_params = globals.occlusion;
     memcpy(slot->globals.mapped, &globals, sizeof globals);
     GdrGpuFrameBuffers buffers = frame_buffers(r, slot); /* (visible_meshlets is made on first use) */
     memcpy(slot->frame_buffers.mapped, &buffers, sizeof buffers);

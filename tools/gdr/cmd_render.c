@@ -89,6 +89,14 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
         }
         else if (strcmp(arg, "--lod-error") == 0)
             ok = cli_parse_float(arg, value, 0.0f, 1e6f, &o->lod_error);
+        else if (strcmp(arg, "--min-screen-size") == 0)
+            ok = cli_parse_float(arg, value, 0.0f, 1e6f, &o->min_screen_size);
+        else if (strcmp(arg, "--clip-plane") == 0) {
+            ok = cli_parse_floats(value, 4, &o->clip_plane.x);
+            if (!ok)
+                fprintf(stderr, "gdr: %s %s: expected 4 finite numbers a,b,c,d (the plane a x + b y + c z + d = 0)\n",
+                        arg, value);
+        }
         else if (strcmp(arg, "--lod-depth") == 0)
             ok = o->has_lod_depth = cli_parse_u32(arg, value, 0, 64, &o->lod_depth);
         else if (strcmp(arg, "--device") == 0)
@@ -140,7 +148,8 @@ gdr_frame_desc render_options_frame(const render_options *o, gdr_camera camera)
                             .occlusion = !o->occlusion_given ? GDR_CULL_DEFAULT
                                          : o->occlusion       ? GDR_CULL_ON
                                                              : GDR_CULL_OFF,
-                            .lod_hierarchy = o->lod_hierarchy ? GDR_CULL_ON : GDR_CULL_OFF};
+                            .lod_hierarchy = o->lod_hierarchy ? GDR_CULL_ON : GDR_CULL_OFF,
+                            .min_screen_size = o->min_screen_size, .clip_plane = o->clip_plane};
 }
 
 /* The frames asked for: o->frames of one view, or with --camera-path one frame per pose (the path

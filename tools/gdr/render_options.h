@@ -23,6 +23,8 @@ typedef struct render_options {
     uint32_t lod_depth;
     gdr_vec3 camera_position;
     gdr_quat camera_rotation;
+    float min_screen_size;
+    gdr_vec4 clip_plane;
     const char *device;
     const char *camera_path; /* --camera-path FILE: one pose per frame (docs/VIEWER.md) */
     bool frames_given;
