@@ -3,11 +3,12 @@
 # with xdotool change the view mode and freeze culling, resizing and unmapping while rendering, a
 # window manager's close request exits 0, a recorded path replays to the same image, and without a
 # display or a presenting driver gdr view fails with a message while gdr render works.
-# usage: test_view.sh GDR_BINARY X11_CLOSE_WINDOW_BINARY WORK_DIR
+# usage: test_view.sh GDR_BINARY X11_CLOSE_WINDOW_BINARY VIEW_DEMO_BINARY WORK_DIR
 set -u
 gdr=$1
 close_window=$2
-work=$3
+view_demo=$3
+work=$4
 rm -rf "$work" && mkdir -p "$work/shots"
 failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
@@ -45,6 +46,9 @@ cmp -s "$work/view.png" "$work/render.png" || fail "the viewer's screenshot diff
 # shellcheck disable=SC2086
 "$gdr" view $scene $size --frames 2 --screenshot "$work/overlay.png" --validate >/dev/null 2>&1 || fail "overlay run"
 cmp -s "$work/overlay.png" "$work/render.png" && fail "the overlay was not drawn"
+
+# examples/view_demo.c, the embedding frame loop, presents frames and exits 0.
+"$view_demo" 5 >"$work/out" 2>&1 || { fail "view_demo exited $?"; cat "$work/out"; }
 
 # 2. Interactive: keys, resizing, unmapping, a close request.
 # shellcheck disable=SC2086
