@@ -65,7 +65,7 @@ static gdr_status write_script(const char *script, const char *svg, const cJSON 
         return gdr_error_set(err, GDR_ERROR_IO, "--plot: cannot write %s", script);
     static char titles[PLOT_MAX_SERIES][96];
     int series = write_blocks(f, rows, along_path ? "frame" : "instances_total", titles);
-    fprintf(f, "set terminal svg size 960,600 dynamic background rgb 'white'\nset output '%s'\n", svg);
+    fprintf(f, "set terminal svg size 960,600 dynamic noenhanced background rgb 'white'\nset output '%s'\n", svg);
     fprintf(f, "set title 'GPU ms per pass%s'\nset xlabel '%s'\nset ylabel 'GPU ms'\nset key outside right\n"
                "set grid\n%s",
             along_path ? " along the camera path" : " against scene size", along_path ? "frame" : "instances",

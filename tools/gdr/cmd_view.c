@@ -350,6 +350,12 @@ static void start_settings(view_app *app, const gdr_scene *scene)
 
 int gdr_cmd_view(int argc, char **argv)
 {
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            printf("usage: gdr view SCENE [options]   (gdr --help lists the options)\nkeys:\n%s", view_key_help);
+            return 0;
+        }
+    }
     render_options o;
     view_options v = {.overlay = true};
     int result = render_options_parse("view", argc, argv, &o, view_extra_option, &v);

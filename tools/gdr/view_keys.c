@@ -7,12 +7,12 @@
 #include "view.h"
 
 const char view_key_help[] =
-    "W A S D        move            Q E     down / up\n"
-    "right button   look            wheel   speed (shift: x4)\n"
-    "V  view mode   P  pipeline     R  raster mode\n"
-    "O  occlusion   C  culling      F  freeze culling\n"
-    "]  LOD threshold x2            [  LOD threshold /2\n"
-    "F12  screenshot  Y  vsync  TAB  overlay  H  keys  ESC  quit\n";
+    "    W A S D        move            Q E     down / up\n"
+    "    right button   look            wheel   speed (shift: x4)\n"
+    "    V  view mode   P  pipeline     R  raster mode\n"
+    "    O  occlusion   C  culling      F  freeze culling\n"
+    "    ]  LOD threshold x2            [  LOD threshold /2\n"
+    "    F12  screenshot  Y  vsync  TAB  overlay  H  keys  ESC  quit\n";
 
 static void next_view(view_settings *s)
 {
