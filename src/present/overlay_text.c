@@ -37,8 +37,9 @@ uint32_t gdr_overlay_rects(const char *text, int x, int y, int scale, uint32_t w
     *background_count = 0;
     size_t length = strlen(text);
     char *copy = malloc(length + 1); /* stb_easy_font takes a mutable string */
-    /* About 70 quads per character at most (4 vertices of 16 bytes each). */
-    size_t vertex_bytes = (length + 1) * 70 * 4 * sizeof(easy_font_vertex);
+    /* Room for 16 quads of 4 vertices per character, more than a glyph has (stb_easy_font stops at
+     * the buffer's end rather than overflow it). */
+    size_t vertex_bytes = (length + 1) * 16 * 4 * sizeof(easy_font_vertex);
     easy_font_vertex *vertices = malloc(vertex_bytes);
     uint32_t count = 0;
     if (!copy || !vertices || capacity == 0)

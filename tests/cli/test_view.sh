@@ -122,6 +122,9 @@ poses=$(grep -c '^[-0-9]' "$work/short.txt")
     --plot "$work/bench.svg" --validate >/dev/null 2>"$work/err" || { fail "bench --camera-path --plot"; cat "$work/err"; }
 [ "$(grep -c '"frame":' "$work/bench.json")" = "$poses" ] || fail "bench --camera-path: not one row per pose ($poses)"
 grep -q '<svg' "$work/bench.svg" && grep -q 'cull' "$work/bench.svg" || fail "bench --plot wrote no plot of the passes"
+"$gdr" bench --plot-from "$work/bench.json" --plot "$work/again.svg" >/dev/null 2>&1 || fail "bench --plot-from"
+grep -q 'cull' "$work/again.svg" || fail "bench --plot-from wrote no plot of the passes"
+"$gdr" bench --plot-from "$work/path.txt" --plot "$work/bad.svg" >/dev/null 2>&1 && fail "--plot-from took a non-JSON file"
 
 # 4. No display, no presenting driver: a message and a non-zero exit; gdr render is unaffected.
 env -u DISPLAY -u WAYLAND_DISPLAY "$gdr" view $scene --frames 1 >/dev/null 2>"$work/err" && fail "view without a display"

@@ -91,31 +91,75 @@ static gdr_status run_gnuplot(const char *script, gdr_error *err)
     return GDR_OK;
 }
 
-static gdr_status copy_out(const char *from, const char *to, gdr_error *err)
+/* The whole file, at most `limit` bytes, NUL-terminated. */
+static gdr_status read_all(const char *path, size_t limit, char **out, size_t *out_size, gdr_error *err)
 {
-    FILE *f = fopen(from, "rb");
+    FILE *f = fopen(path, "rb");
     if (!f)
-        return gdr_error_set(err, GDR_ERROR_IO, "--plot: gnuplot wrote no %s", from);
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: cannot open", path);
     char *data = NULL;
     size_t size = 0, capacity = 0, got;
     char chunk[65536];
     gdr_status status = GDR_OK;
     while (status == GDR_OK && (got = fread(chunk, 1, sizeof chunk, f)) > 0) {
-        if (size + got > capacity) {
-            capacity = (size + got) * 2;
+        if (size + got > limit) {
+            status = gdr_error_set(err, GDR_ERROR_CAPACITY, "%s: larger than %zu bytes", path, limit);
+            break;
+        }
+        if (size + got + 1 > capacity) {
+            capacity = (size + got + 1) * 2;
             char *grown = realloc(data, capacity);
             if (!grown)
-                status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "--plot: out of memory");
+                status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
             else
                 data = grown;
         }
         if (status == GDR_OK)
             memcpy(data + size, chunk, got), size += got;
     }
+    if (status == GDR_OK && ferror(f))
+        status = gdr_error_set(err, GDR_ERROR_IO, "%s: read error", path);
     fclose(f);
-    if (status == GDR_OK)
-        status = gdr_write_file_atomic(to, data ? data : "", size, err);
+    if (status == GDR_OK && !data)
+        data = calloc(1, 1);
+    if (status != GDR_OK || !data) {
+        free(data);
+        return status != GDR_OK ? status : gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+    }
+    data[size] = '\0';
+    *out = data;
+    *out_size = size;
+    return GDR_OK;
+}
+
+static gdr_status copy_out(const char *from, const char *to, gdr_error *err)
+{
+    char *data;
+    size_t size;
+    gdr_status status = read_all(from, (size_t)1 << 30, &data, &size, err);
+    if (status != GDR_OK)
+        return status;
+    status = gdr_write_file_atomic(to, data, size, err);
     free(data);
+    return status;
+}
+
+gdr_status bench_plot_from_json(const char *json_path, const char *svg_path, gdr_error *err)
+{
+    char *text;
+    size_t size;
+    gdr_status status = read_all(json_path, (size_t)256 << 20, &text, &size, err);
+    if (status != GDR_OK)
+        return status;
+    cJSON *rows = cJSON_ParseWithLength(text, size);
+    free(text);
+    if (!cJSON_IsArray(rows)) {
+        cJSON_Delete(rows);
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: not the JSON array gdr bench --json writes", json_path);
+    }
+    bool along_path = cJSON_GetObjectItem(cJSON_GetArrayItem(rows, 0), "frame") != NULL;
+    status = bench_plot_svg(svg_path, rows, along_path, err);
+    cJSON_Delete(rows);
     return status;
 }
 

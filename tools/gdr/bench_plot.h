@@ -13,6 +13,9 @@
  * against instances_total, or against `frame` when along_path. Needs gnuplot. */
 gdr_status bench_plot_svg(const char *path, const cJSON *rows, bool along_path, gdr_error *err);
 
+/* The plot of rows a gdr bench --json run wrote (against the frame where the rows have "frame"). */
+gdr_status bench_plot_from_json(const char *json_path, const char *svg_path, gdr_error *err);
+
 /* Renders one frame per pose of the path (after 3 untimed frames at its first pose), printing a
  * line per frame and adding a JSON row per frame ("frame", "gpu_ms" per pass, "gpu_ms_per_frame",
  * "cpu_ms_per_frame", the counts) to rows. */

@@ -60,7 +60,7 @@ int gdr_cmd_bench(int argc, char **argv)
 {
     uint32_t sizes[MAX_SIZES] = {1000, 10000, 100000, 1000000}, size_count = 4;
     uint32_t frames = 20, width = 1920, height = 1080;
-    const char *device = NULL, *json_path = NULL, *scene_spec = NULL, *path_file = NULL, *plot_path = NULL;
+    const char *device = NULL, *json_path = NULL, *scene_spec = NULL, *path_file = NULL, *plot_path = NULL, *plot_from = NULL;
     camera_path path = {0};
     float lod_errors[MAX_LOD_ERRORS] = {1.0f};
     uint32_t lod_error_count = 1;
@@ -104,6 +104,8 @@ int gdr_cmd_bench(int argc, char **argv)
             path_file = value;
         else if (strcmp(arg, "--plot") == 0)
             plot_path = value;
+        else if (strcmp(arg, "--plot-from") == 0)
+            plot_from = value;
         else if (strcmp(arg, "--lod-hierarchy") == 0)
             ok = cli_parse_on_off(arg, value, &lod_hierarchy);
         else if (strcmp(arg, "--lod-errors") == 0)
@@ -143,6 +145,18 @@ int gdr_cmd_bench(int argc, char **argv)
     }
 
     gdr_error path_err = {0};
+    if (plot_from) { /* plot an earlier run's JSON, run nothing */
+        if (!plot_path) {
+            fprintf(stderr, "gdr bench: --plot-from needs --plot FILE.svg\n");
+            return 2;
+        }
+        if (bench_plot_from_json(plot_from, plot_path, &path_err) != GDR_OK) {
+            fprintf(stderr, "gdr: %s\n", path_err.message);
+            return 1;
+        }
+        printf("plot                %s\n", plot_path);
+        return 0;
+    }
     if (path_file && camera_path_read(path_file, &path, &path_err) != GDR_OK) {
         fprintf(stderr, "gdr: --camera-path: %s\n", path_err.message);
         return 1;

@@ -99,6 +99,7 @@ static void print_help(FILE *out)
           "  --camera-path FILE      time one frame per pose of the path (a row per frame)\n"
           "  --plot FILE.svg         plot GPU ms per pass against scene size, or per frame along\n"
           "                          --camera-path (needs gnuplot)\n"
+          "  --plot-from FILE.json   with --plot: plot an earlier run's --json instead of running\n"
           "  --device N|NAME, --validate, --json FILE\n"
           "\n"
           "exit status: 0 success, 1 failure, 2 bad usage, 3 validation messages\n",
