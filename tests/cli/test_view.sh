@@ -52,7 +52,8 @@ cmp -s "$work/overlay.png" "$work/render.png" && fail "the overlay was not drawn
 
 # 2. Interactive: keys, resizing, unmapping, a close request.
 # shellcheck disable=SC2086
-"$gdr" view $scene $size --overlay off --validate --screenshot-dir "$work/shots" --record-path "$work/path.txt" \
+# (Xvfb does not pace presents: --max-fps keeps the recorded path, replayed below, short.)
+"$gdr" view $scene $size --overlay off --validate --max-fps 30 --screenshot-dir "$work/shots" --record-path "$work/path.txt" \
     --screenshot "$work/last.png" >"$work/interactive.out" 2>&1 &
 viewer=$!
 window=$(timeout 20 xdotool search --sync --name "gdr view" | head -1)
@@ -85,12 +86,23 @@ screenshot
 cmp -s "$work/shots/gdr-view-0002.png" "$work/shots/gdr-view-0003.png" &&
     fail "frozen culling drew the same image as culling from the moved camera"
 cmp -s "$work/shots/gdr-view-0002.png" "$work/shots/gdr-view-0001.png" && fail "S did not move the camera"
+# The camera stays where S left it. Pipeline (P: mesh -> indirect -> cpu -> mesh), LOD threshold
+# (]: 1 -> 2 -> 4 px) and culling (C: off), each screenshot checked after the exit against gdr
+# render with the matching options from the path's last pose.
+xdotool key --window "$window" p
+screenshot
+xdotool key --window "$window" p
+screenshot
+xdotool key --window "$window" p bracketright bracketright
+screenshot
+xdotool key --window "$window" c
+screenshot
 # Resized, unmapped and mapped again, minimised, tiny: frames go on.
 xdotool windowsize "$window" 200 120
 sleep 0.3
 screenshot
-[ "$(png_size "$work/shots/gdr-view-0004.png")" = 200x120 ] ||
-    fail "after resizing, the screenshot is $(png_size "$work/shots/gdr-view-0004.png"), expected 200x120"
+[ "$(png_size "$work/shots/gdr-view-0008.png")" = 200x120 ] ||
+    fail "after resizing, the screenshot is $(png_size "$work/shots/gdr-view-0008.png"), expected 200x120"
 xdotool windowunmap "$window"; sleep 0.2; xdotool windowmap "$window"; sleep 0.2
 # Without a window manager nobody gives the mapped window its keyboard focus back.
 xdotool windowfocus "$window"
@@ -104,11 +116,28 @@ status=$?
 [ "$status" = 0 ] || { fail "closing the window: exit $status"; cat "$work/interactive.out"; }
 grep -q "validation" "$work/interactive.out" && { fail "validation messages"; cat "$work/interactive.out"; }
 
-# 3. The recorded path replayed by gdr render gives the viewer's last image (meshlets view: the
-# key above; culling follows the camera again).
+# The keys' screenshots against gdr render from the last pose (the camera did not move after S).
+{ head -n 1 "$work/path.txt"; tail -n 1 "$work/path.txt"; } >"$work/last_pose.txt"
+# key_matches SHOT DESCRIPTION RENDER_OPTIONS...
+key_matches() {
+    shot_file="$work/shots/gdr-view-$1.png"; what=$2; shift 2
+    # shellcheck disable=SC2086
+    "$gdr" render $scene $size --view meshlets --camera-path "$work/last_pose.txt" --out "$work/key.png" "$@" \
+        >/dev/null 2>&1 || fail "render $* exited $?"
+    cmp -s "$shot_file" "$work/key.png" || fail "$what: the screenshot differs from gdr render $*"
+}
+key_matches 0003 "F again (culling follows)"
+key_matches 0004 "P (indirect)" --pipeline indirect
+key_matches 0005 "P (cpu)" --pipeline cpu
+key_matches 0006 "P, ] ]" --pipeline mesh --lod-error 4
+key_matches 0007 "C" --pipeline mesh --lod-error 4 --cull off
+cmp -s "$work/shots/gdr-view-0006.png" "$work/shots/gdr-view-0003.png" && fail "] did not change the LOD cut"
+
+# 3. The recorded path replayed by gdr render gives the viewer's last image (the settings of the
+# keys above).
 # shellcheck disable=SC2086
-"$gdr" render $scene $size --view meshlets --camera-path "$work/path.txt" --out "$work/replay.png" --validate \
-    >/dev/null 2>&1 || fail "render --camera-path exited $?"
+"$gdr" render $scene $size --view meshlets --lod-error 4 --cull off --camera-path "$work/path.txt" \
+    --out "$work/replay.png" --validate >/dev/null 2>&1 || fail "render --camera-path exited $?"
 cmp -s "$work/replay.png" "$work/last.png" || fail "the replayed path's last image differs from the viewer's"
 [ "$(grep -c '^[-0-9]' "$work/path.txt")" -gt 10 ] || fail "the recorded path has too few frames"
 printf 'gdr-camera-path 1\n0 1 2 0 0 0 1\n0 1 nan 0 0 0 1\n' >"$work/bad.txt"

@@ -17,6 +17,7 @@
 typedef struct view_options {
     const char *record_path, *screenshot, *screenshot_dir;
     bool no_vsync, overlay;
+    float max_fps; /* 0: no limit but the present mode's */
 } view_options;
 
 typedef struct view_app {
@@ -49,14 +50,16 @@ static int view_extra_option(void *context, int argc, char **argv, int *i)
                           : strcmp(arg, "--screenshot") == 0     ? &v->screenshot
                           : strcmp(arg, "--screenshot-dir") == 0 ? &v->screenshot_dir
                                                                  : NULL;
-    bool overlay = strcmp(arg, "--overlay") == 0;
-    if (!target && !overlay)
+    bool overlay = strcmp(arg, "--overlay") == 0, max_fps = strcmp(arg, "--max-fps") == 0;
+    if (!target && !overlay && !max_fps)
         return 0;
     const char *value = cli_value(argc, argv, i);
     if (!value)
         return -1;
     if (overlay)
         return cli_parse_on_off(arg, value, &v->overlay) ? 1 : -1;
+    if (max_fps)
+        return cli_parse_float(arg, value, 1.0f, 10000.0f, &v->max_fps) ? 1 : -1;
     *target = value;
     return 1;
 }
@@ -295,7 +298,12 @@ static int run_loop(view_app *app)
     double previous = glfwGetTime(), rate_start = previous;
     uint32_t rate_frames = 0;
     int result = 0;
+    double next_frame = previous;
     while (result == 0) {
+        /* --max-fps: wait for the frame's time, handling events meanwhile. */
+        for (double now = glfwGetTime(); app->v->max_fps > 0 && now < next_frame; now = glfwGetTime())
+            glfwWaitEventsTimeout(next_frame - now);
+        next_frame = glfwGetTime() + (app->v->max_fps > 0 ? 1.0 / app->v->max_fps : 0.0);
         glfwPollEvents();
         bool closing = glfwWindowShouldClose(app->window) || app->settings.quit;
         bool last = closing || (frames && app->frames + 1 >= frames);

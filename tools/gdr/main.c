@@ -80,6 +80,7 @@ static void print_help(FILE *out)
           "  --camera-path FILE      fly the recorded path instead of the keys\n"
           "  --overlay on|off        statistics over the image (default on; TAB toggles it)\n"
           "  --no-vsync              present without waiting for the refresh (Y toggles it)\n"
+          "  --max-fps N             at most N frames per second (default: as the present mode allows)\n"
           "  keys:\n"
           "%s"
           "\n"
