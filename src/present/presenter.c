@@ -17,7 +17,6 @@
                                  "%s failed: VkResult %d (%s:%d)", #call, (int)try_result_, __FILE__, __LINE__); \
     } while (0)
 
-#define OVERLAY_MAX_RECTS 16384
 #define OVERLAY_SCALE 2
 
 static gdr_status create_sync(gdr_presenter *p, gdr_error *err)
@@ -44,6 +43,11 @@ gdr_status gdr_presenter_create(gdr_renderer *renderer, const gdr_presenter_desc
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "presenter: out of memory");
     p->renderer = renderer;
     p->vk = gdr_renderer_vulkan(renderer);
+    p->overlay_rects = malloc(sizeof *p->overlay_rects * GDR_OVERLAY_MAX_RECTS);
+    if (!p->overlay_rects) {
+        free(p);
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "presenter: out of memory");
+    }
     p->surface = desc->surface;
     p->window_width = desc->width;
     p->window_height = desc->height;
@@ -98,6 +102,7 @@ void gdr_presenter_destroy(gdr_presenter *p)
         vkDestroyFence(p->vk.device, p->done, NULL);
     if (p->pool)
         vkDestroyCommandPool(p->vk.device, p->pool, NULL);
+    free(p->overlay_rects);
     free(p);
 }
 
@@ -193,10 +198,10 @@ static void record_blit(gdr_presenter *p, VkCommandBuffer cmd, VkImage target)
  * image (COLOR_ATTACHMENT_OPTIMAL). */
 static void record_overlay(gdr_presenter *p, VkCommandBuffer cmd, uint32_t image, const char *text)
 {
-    static VkClearRect rects[OVERLAY_MAX_RECTS]; /* one presenter draws at a time (one queue) */
+    VkClearRect *rects = p->overlay_rects;
     VkExtent2D e = p->swapchain.extent;
     uint32_t background = 0;
-    uint32_t count = gdr_overlay_rects(text, 10, 10, OVERLAY_SCALE, e.width, e.height, rects, OVERLAY_MAX_RECTS,
+    uint32_t count = gdr_overlay_rects(text, 10, 10, OVERLAY_SCALE, e.width, e.height, rects, GDR_OVERLAY_MAX_RECTS,
                                        &background);
     VkRenderingAttachmentInfo color = {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
                                        .imageView = p->swapchain.views[image],

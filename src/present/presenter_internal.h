@@ -6,6 +6,7 @@
 #include "gdr/present.h"
 
 #define GDR_PRESENT_MAX_IMAGES 8
+#define GDR_OVERLAY_MAX_RECTS 16384
 
 typedef struct gdr_swapchain {
     VkSwapchainKHR handle;
@@ -34,6 +35,7 @@ struct gdr_presenter {
     bool submitted;
     VkSemaphore acquired;     /* reused only after `done`: the submit that waited on it has finished */
     bool linear_blit;         /* the renderer's format can be blitted with linear filtering */
+    VkClearRect *overlay_rects; /* GDR_OVERLAY_MAX_RECTS: the overlay's text as rectangles */
     /* The capture: one host-visible buffer of the swapchain's size. */
     VkBuffer capture;
     VkDeviceMemory capture_memory;
