@@ -155,6 +155,14 @@ grep -q '<svg' "$work/bench.svg" && grep -q 'cull' "$work/bench.svg" || fail "be
 grep -q 'cull' "$work/again.svg" || fail "bench --plot-from wrote no plot of the passes"
 "$gdr" bench --plot-from "$work/path.txt" --plot "$work/bad.svg" >/dev/null 2>&1 && fail "--plot-from took a non-JSON file"
 
+# Bad usage: status 2 and a message, before any window opens.
+for args in "" "demo --out x.png" "demo --max-fps 0" "demo --overlay maybe" "demo --record-path"; do
+    # shellcheck disable=SC2086
+    "$gdr" view $args >/dev/null 2>"$work/err"
+    status=$?
+    [ "$status" = 2 ] && [ -s "$work/err" ] || fail "gdr view $args: exit $status, expected 2 with a message"
+done
+
 # 4. No display, no presenting driver: a message and a non-zero exit; gdr render is unaffected.
 env -u DISPLAY -u WAYLAND_DISPLAY "$gdr" view $scene --frames 1 >/dev/null 2>"$work/err" && fail "view without a display"
 [ -s "$work/err" ] || fail "view without a display said nothing"
