@@ -26,6 +26,8 @@ static void print_help(FILE *out)
           "                          dense closed mesh of about T triangles (default 100000), near to far\n"
           "  occlusion[:seed=S,hidden=N,visible=N]    a wall of buildings in front of N hidden objects\n"
           "                          (default 4000), N visible ones in front (default 300), gaps\n"
+          "  unique-field[:meshes=M,seed=S,triangles=T,spacing=M]   M different dense meshes (default\n"
+          "                          100) of about T triangles (default 100000), one copy each\n"
           "Source files go through a .gdrc cache next to them.\n"
           "\n"
           "render options:\n"
