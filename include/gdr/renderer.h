@@ -43,6 +43,12 @@ typedef struct gdr_renderer_desc {
     /* Tests only: a deliberately wrong LOD hierarchy (node spheres shrunk), to show that the image
      * tests catch a node test that is not conservative. */
     bool debug_shrink_lod_nodes;
+    /* Presenting to a window (gdr/present.h): the instance extensions the window system needs
+     * (e.g. from glfwGetRequiredInstanceExtensions; at most 8), and whether the device must be able
+     * to present (VK_KHR_swapchain). Without them the renderer is headless. */
+    const char *const *instance_extensions;
+    uint32_t instance_extension_count;
+    bool presentable;
 } gdr_renderer_desc;
 
 typedef enum gdr_cull_mode {
@@ -132,6 +138,13 @@ typedef struct gdr_frame_desc {
      * instances, it does not clip the ones that cross it). */
     float min_screen_size;
     gdr_vec4 clip_plane;
+    /* Culling from another point of view ("freeze culling"): when not NULL, instances, LOD nodes
+     * and clusters are culled and their LOD chosen for this camera while the image is drawn from
+     * `camera`, so what the culling camera keeps can be looked at from outside. Its projection
+     * (yfov, aspect, znear, zfar) must equal `camera`'s. Occlusion culling is off in such frames
+     * (the depth pyramid is the drawing camera's), and the hybrid rasteriser's per-cluster choice
+     * is made for the culling camera. */
+    const gdr_camera *cull_camera;
 } gdr_frame_desc;
 
 /* "shaded", "meshlets", "instances", "triangles", "overdraw" or "lod". */

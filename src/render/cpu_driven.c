@@ -101,7 +101,8 @@ gdr_status gdr_cpu_path_cull(gdr_renderer *r, const gdr_frame_desc *frame, gdr_e
                 cpu->visible_bits[i / 32] |= 1u << (i % 32);
     } else {
         gdr_cull_view view = {.min_screen_size = frame->min_screen_size, .clip_plane = frame->clip_plane};
-        gdr_frame_matrices(r, &frame->camera, &view.projection, &view.view);
+        gdr_frame_matrices(r, frame->cull_camera ? frame->cull_camera : &frame->camera, &view.projection,
+                           &view.view);
         gdr_cull_result result = {.visible = cpu->visible_bits};
         status = gdr_cull_execute(cpu->cull_scene, &view, NULL, &result, NULL, err);
     }

@@ -53,18 +53,21 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
                           uint32_t update_count, bool occlusion, bool history)
 {
     const gdr_camera *camera = &frame->camera;
-    gdr_mat4 projection, view;
+    /* Culling and LOD use `view`, `frustum` and `camera_position`; drawing uses view_projection. */
+    const gdr_camera *cull_camera = frame->cull_camera ? frame->cull_camera : camera;
+    gdr_mat4 projection, view, cull_projection, cull_view;
     gdr_frame_matrices(r, camera, &projection, &view);
+    gdr_frame_matrices(r, cull_camera, &cull_projection, &cull_view);
     gdr_vec3 light = gdr_vec3_normalize((gdr_vec3){0.35f, 0.85f, 0.4f});
     /* The LOD cut: only where the mesh pipeline draws clusters, and only when it asks for something
      * other than level 0 (threshold 0 and depth 0 both select exactly level 0). */
     bool lod = pipeline == GDR_PIPELINE_MESH &&
                (frame->lod_fixed_depth ? frame->lod_depth > 0 : frame->lod_error_px > 0.0f);
     GdrGpuFrameGlobals globals = {
-        .view = view,
+        .view = cull_view,
         .view_projection = gdr_mat4_mul(projection, view),
-        .frustum = gdr_frustum_symmetric(projection),
-        .camera_position = {camera->position.x, camera->position.y, camera->position.z, 1.0f},
+        .frustum = gdr_frustum_symmetric(cull_projection),
+        .camera_position = {cull_camera->position.x, cull_camera->position.y, cull_camera->position.z, 1.0f},
         .light_direction = {light.x, light.y, light.z, 0.0f},
         .znear = camera->znear,
         .zfar = camera->zfar > 0.0f ? camera->zfar : INFINITY,
@@ -106,7 +109,8 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
  * H100 (docs/OCCLUSION.md, "Which pipelines cull by default"). */
 static bool occlusion_wanted(const gdr_frame_desc *frame, gdr_pipeline pipeline)
 {
-    if (pipeline == GDR_PIPELINE_CPU || frame->cull == GDR_CULL_OFF || frame->occlusion == GDR_CULL_OFF)
+    if (pipeline == GDR_PIPELINE_CPU || frame->cull == GDR_CULL_OFF || frame->occlusion == GDR_CULL_OFF ||
+        frame->cull_camera)
         return false;
     return frame->occlusion == GDR_CULL_ON || pipeline == GDR_PIPELINE_INDIRECT;
 }

@@ -88,7 +88,10 @@ gdr_status gdr_renderer_create(const gdr_renderer_desc *desc_in, gdr_renderer **
     r->debug_shrink_lod_nodes = desc.debug_shrink_lod_nodes;
     gdr_vk_context_desc context_desc = {.device = desc.device, .validate = desc.validate,
                                         .synchronization_validation = desc.synchronization_validation,
-                                        .disable_mesh_shaders = desc.disable_mesh_shaders};
+                                        .disable_mesh_shaders = desc.disable_mesh_shaders,
+                                        .instance_extensions = desc.instance_extensions,
+                                        .instance_extension_count = desc.instance_extension_count,
+                                        .swapchain = desc.presentable};
     gdr_status status = gdr_vk_context_create(&context_desc, &r->ctx, err);
     if (status == GDR_OK) {
         gdr_vk_allocator_init(&r->allocator, r->ctx);
@@ -256,6 +259,11 @@ static gdr_status check_frame(gdr_renderer *r, const gdr_frame_desc *frame, uint
                              "render: camera needs 0 < yfov < pi, znear > 0 and zfar = 0 or > znear "
                              "(yfov %g, znear %g, zfar %g)", (double)camera->yfov, (double)camera->znear,
                              (double)camera->zfar);
+    const gdr_camera *cull = frame->cull_camera;
+    if (cull && (cull->yfov != camera->yfov || cull->aspect != camera->aspect || cull->znear != camera->znear ||
+                 cull->zfar != camera->zfar))
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
+                             "render: the culling camera's projection (yfov, aspect, znear, zfar) must be the camera's");
     if ((unsigned)frame->view > GDR_VIEW_MODE_LOD)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: unknown view %d", (int)frame->view);
     if (!(frame->lod_error_px >= 0.0f && frame->lod_error_px <= 1e30f))
