@@ -227,6 +227,15 @@ typedef struct gdr_traversal_stats {
     uint32_t overflow;
 } gdr_traversal_stats;
 
+/* Streaming (docs/STREAMING.md): the LOD groups absent from the page table, and the requests the
+ * frame's cluster tests made for absent groups its cut needs (one per cluster drawn in such a
+ * group's place; the dropped ones did not fit GDR_STREAM_REQUEST_CAPACITY). Mesh pipeline. */
+typedef struct gdr_streaming_stats {
+    uint64_t absent_groups;
+    uint32_t requests;
+    uint32_t requests_dropped;
+} gdr_streaming_stats;
+
 /* GPU memory: what the renderer holds from the device (whole blocks), and of what it placed in
  * them, the scene's part (geometry, clusters, instances, occluded lists) and the rest (render
  * targets, frame slots, visibility buffer, read-backs). */
@@ -281,6 +290,7 @@ typedef struct gdr_frame_stats {
     gdr_lod_stats_frame lod;
     gdr_occlusion_stats occlusion;
     gdr_traversal_stats traversal;
+    gdr_streaming_stats streaming;
     gdr_memory_stats memory;
 } gdr_frame_stats;
 

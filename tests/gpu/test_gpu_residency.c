@@ -126,6 +126,8 @@ static void compare_cut(gdr_renderer *r, const gdr_scene *scene, const gdr_frame
     CHECK(requests && gdr_renderer_read_group_requests(r, requests, 4096, &request_count, &dropped, &err) == GDR_OK &&
           dropped == 0);
     *requested += request_count;
+    CHECK(stats.streaming.requests == request_count && stats.streaming.requests_dropped == dropped &&
+          stats.streaming.absent_groups > 0);
     CHECK(stats.traversal.applied == (frame->lod_hierarchy != GDR_CULL_OFF));
     gdr_mat4 projection = gdr_perspective_reverse_z_infinite(frame->camera.yfov, (float)WIDTH / HEIGHT,
                                                              frame->camera.znear);
