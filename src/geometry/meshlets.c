@@ -188,9 +188,9 @@ static void cluster_bounds(gdr_cluster *c, const uint32_t *vertices, const uint8
                                                            sizeof(gdr_vec3));
     int has_area = b.radius > 0.0f || b.cone_cutoff != 0.0f || b.cone_axis[0] != 0.0f ||
                    b.cone_axis[1] != 0.0f || b.cone_axis[2] != 0.0f;
-    /* The centre is kept in float, as stored, and the radius measured from exactly that point.
-     * (Computed in double and rounded with (double)(float), gcc 12 at -O3 vectorised two of the
-     * three coordinates without the rounding: the radius came out up to 2 ulps short.) */
+    /* The centre as stored (float), so that the radius is measured from exactly the stored point.
+     * (Kept in doubles rounded through float, gcc 12 -O3's basic-block vectorizer measured from the
+     * unrounded x and y and stored the rounded ones: radii short by an ulp or two.) */
     float center[3] = {b.center[0], b.center[1], b.center[2]};
     if (!has_area) {
         /* The middle of the vertices' bounding box. */
@@ -208,8 +208,7 @@ static void cluster_bounds(gdr_cluster *c, const uint32_t *vertices, const uint8
     double radius = has_area ? b.radius : 0.0;
     for (uint32_t i = 0; i < c->vertex_count; i++) {
         const gdr_vec3 p = mesh->positions[vertices[i]];
-        double dx = (double)p.x - (double)center[0], dy = (double)p.y - (double)center[1],
-               dz = (double)p.z - (double)center[2];
+        double dx = (double)p.x - center[0], dy = (double)p.y - center[1], dz = (double)p.z - center[2];
         double d = sqrt(dx * dx + dy * dy + dz * dz);
         radius = d > radius ? d : radius;
     }

@@ -114,7 +114,8 @@ struct gdr_renderer {
     gdr_frame_slot slots[GDR_FRAMES_IN_FLIGHT];
     uint32_t frame_index;
     bool record_every_frame;      /* gdr_renderer_desc.record_every_frame: never resubmit */
-    uint32_t debug_task_capacity, debug_traversal_capacity; /* gdr_renderer_desc's test settings */
+    uint32_t debug_task_capacity, debug_traversal_capacity, debug_occluded_node_capacity; /* gdr_renderer_desc's
+                                                                                               test settings */
     bool debug_shrink_lod_nodes;
     int last_slot; /* slot of the last submitted frame, -1 before the first */
 };

@@ -21,6 +21,11 @@
  * instance's root group, one or two clusters. */
 #define GDR_CLUSTER_CULL_TASKS 32
 #define GDR_CLUSTER_CULL_LANES 8
+/* An instance that needs at most this many clusters (a distant instance's root group, a small mesh)
+ * has them tested and binned by its instance-cull invocation (GDR_FRAME_DIRECT_CLUSTERS): a task
+ * command of one or two clusters costs the cluster cull a whole GDR_CLUSTER_CULL_LANES slot and a
+ * second pass over the instance. */
+#define GDR_DIRECT_CLUSTERS 4
 /* LOD statistics: clusters and triangles drawn per DAG depth, the last bucket for deeper ones. */
 #define GDR_LOD_STATS_DEPTHS 32
 /* The LOD hierarchy traversal (lodtraverse.comp): one invocation per node visit, one dispatch per
