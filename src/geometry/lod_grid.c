@@ -122,24 +122,8 @@ static int32_t search_radius(const uint32_t dim[3])
     return (int32_t)(dim[2] > largest ? dim[2] : largest);
 }
 
-/* How near to q a cell at Chebyshev distance r from q's cell `at` (or anything only in such
- * cells) can be: at least (r - 1) cell edges, and at least the distance from q to the faces of the
- * box of the cells nearer than r (q lies inside it), less a thousandth of a cell for the rounding
- * of q's cell coordinate. The box bound is the tighter one: q sits half a cell from its cell's
- * faces on average, so a search ends one ring sooner (27 cells instead of 125) most times. */
-static float unseen_reach(const float q[3], const float lo[3], const int32_t at[3], int32_t r, float cell)
-{
-    float reach = (float)(r - 1) * cell, box = INFINITY;
-    for (int k = 0; k < 3; k++) {
-        float below = q[k] - (lo[k] + (float)(at[k] - r + 1) * cell);
-        float above = lo[k] + (float)(at[k] + r) * cell - q[k];
-        box = fminf(box, fminf(below, above));
-    }
-    box -= 1e-3f * cell;
-    return box > reach ? box : reach;
-}
-
-/* The search stops once the best distance is within unseen_reach of the next ring. */
+/* Cells at Chebyshev distance r from the query's cell are at least (r - 1) cell edges away, so
+ * the search stops once the best distance is within that. */
 uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squared)
 {
     const float q[3] = {point.x, point.y, point.z};
@@ -151,7 +135,7 @@ uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squ
     int32_t max_r = search_radius(g->dim);
     for (int32_t r = 0; r <= max_r; r++) {
         if (best != UINT32_MAX) {
-            float reach = unseen_reach(q, g->lo, at, r, g->cell);
+            float reach = (float)(r - 1) * g->cell;
             if (r > 0 && reach * reach >= best_d2)
                 break;
         }
@@ -274,11 +258,8 @@ int lod_triangle_grid_build(lod_triangle_grid *g, const float *positions, const 
 }
 
 /* A cell's triangles are looked at up to this many (the centre of a fan lies in cells of thousands):
- * the nearest of fewer triangles is farther, so the distance found stays an upper bound. Sound
- * meshes have such cells too (a long simplified triangle is listed in every cell of its box): at 64
- * the blob's samples missed their nearest triangle by up to 20x, and coarse groups' errors came
- * out larger than they are; at 1,024 none did. */
-#define GRID_CELL_LIMIT 1024u
+ * the nearest of fewer triangles is farther, so the distance found stays an upper bound. */
+#define GRID_CELL_LIMIT 64u
 
 uint32_t lod_triangle_grid_nearest(const lod_triangle_grid *g, gdr_vec3 point, lod_point_triangle_fn *distance,
                                    float *distance_squared)
@@ -291,7 +272,7 @@ uint32_t lod_triangle_grid_nearest(const lod_triangle_grid *g, gdr_vec3 point, l
     float best_d2 = INFINITY;
     int32_t max_r = search_radius(g->dim);
     for (int32_t r = 0; r <= max_r; r++) {
-        float reach = unseen_reach(q, g->lo, at, r, g->cell);
+        float reach = (float)(r - 1) * g->cell;
         if (r > 0 && best != UINT32_MAX && reach * reach >= best_d2)
             break;
         for (int32_t z = at[2] - r; z <= at[2] + r; z++) {
