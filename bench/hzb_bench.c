@@ -62,11 +62,11 @@ static gdr_status time_builds(gdr_vk_context *ctx, const gdr_hzb *hzb, uint32_t 
     gdr_status status = gdr_vk_begin_one_time(ctx, &cmd, err);
     if (status == GDR_OK) {
         for (uint32_t i = 0; i < WARMUP_BUILDS; i++)
-            gdr_hzb_record_build(hzb, cmd);
+            gdr_hzb_record_build(hzb, cmd, 0);
         for (uint32_t i = 0; i < runs; i++) {
             /* ALL_COMMANDS: the first stamp waits for everything before, the second for the build. */
             vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, pool, 2 * i);
-            gdr_hzb_record_build(hzb, cmd);
+            gdr_hzb_record_build(hzb, cmd, 0);
             vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, pool, 2 * i + 1);
         }
         status = gdr_vk_end_one_time(ctx, cmd, err);

@@ -81,7 +81,7 @@ GDR_API gdr_status gdr_image_decode(const void *data, size_t size, const char *n
 
 /* --- processed-scene cache ------------------------------------------------------------------ */
 
-#define GDR_CACHE_FORMAT_VERSION 5u
+#define GDR_CACHE_FORMAT_VERSION 6u
 
 /* What a cache was built from: the build options (a string that changes whenever the processing
  * would produce different data, e.g. "import=1") and the source files. */
@@ -104,6 +104,11 @@ typedef struct gdr_cache_write_options {
                                 optional section 'PVIS'; it must have been baked for this scene
                                 (gdr_pvs_object_count(pvs) == scene->instance_count), else
                                 GDR_ERROR_INVALID_ARGUMENT and nothing is written */
+    uint32_t page_bytes;     /* 0: no geometry pages. Otherwise the optional section 'PAGE' holds every
+                                mesh's LOD DAG groups in pages filled to this many raw bytes, in
+                                [GDR_PAGE_BYTES_MIN, GDR_PAGE_BYTES_MAX] (gdr/paged_cache.h;
+                                GDR_PAGE_BYTES_DEFAULT is the measured choice), read on demand by
+                                gdr_paged_cache_open; out of range: GDR_ERROR_INVALID_ARGUMENT */
 } gdr_cache_write_options;
 
 /* Writes scene to path through a temporary file in the same folder and a rename. options: NULL for

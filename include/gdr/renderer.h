@@ -34,13 +34,21 @@ typedef struct gdr_renderer_desc {
      * whether instance updates are pending). true: record every frame (to measure what recording
      * costs). The CPU pipeline always records. */
     bool record_every_frame;
-    /* Tests only: the task list's and the LOD traversal's capacities per frame phase (0: sized from
-     * the scene), to provoke their overflow, which the statistics report. */
+    /* Tests only: the task list's and the LOD traversal's capacities per frame phase, and the
+     * occluded-node list's (0: sized from the scene), to provoke their overflow, which the statistics
+     * report. */
     uint32_t debug_task_capacity;
     uint32_t debug_traversal_capacity;
+    uint32_t debug_occluded_node_capacity;
     /* Tests only: a deliberately wrong LOD hierarchy (node spheres shrunk), to show that the image
      * tests catch a node test that is not conservative. */
     bool debug_shrink_lod_nodes;
+    /* Presenting to a window (gdr/present.h): the instance extensions the window system needs
+     * (e.g. from glfwGetRequiredInstanceExtensions; at most 8), and whether the device must be able
+     * to present (VK_KHR_swapchain). Without them the renderer is headless. */
+    const char *const *instance_extensions;
+    uint32_t instance_extension_count;
+    bool presentable;
 } gdr_renderer_desc;
 
 typedef enum gdr_cull_mode {
@@ -123,6 +131,20 @@ typedef struct gdr_frame_desc {
      * through the late phase's test. */
     gdr_cull_mode occlusion;
     bool occlusion_camera_cut;
+    /* Instance tests of the GPU-driven pipelines and the CPU pipeline (when cull is on), besides the
+     * frustum, each instance's screen-size range (gdr_instance) and: the smallest screen size drawn
+     * (0: none; culls small detail); a world-space clip plane (a, b, c, d): instances entirely on its
+     * negative side (a x + b y + c z + d < 0) are not drawn (all zero: none; it culls whole
+     * instances, it does not clip the ones that cross it). */
+    float min_screen_size;
+    gdr_vec4 clip_plane;
+    /* Culling from another point of view ("freeze culling"): when not NULL, instances, LOD nodes
+     * and clusters are culled and their LOD chosen for this camera while the image is drawn from
+     * `camera`, so what the culling camera keeps can be looked at from outside. Its projection
+     * (yfov, aspect, znear, zfar) must equal `camera`'s. Occlusion culling is off in such frames
+     * (the depth pyramid is the drawing camera's), and the hybrid rasteriser's per-cluster choice
+     * is made for the culling camera. */
+    const gdr_camera *cull_camera;
 } gdr_frame_desc;
 
 /* "shaded", "meshlets", "instances", "triangles", "overdraw" or "lod". */
@@ -169,24 +191,28 @@ typedef struct gdr_lod_stats_frame {
     uint64_t triangles_per_depth[GDR_LOD_STATS_DEPTH_COUNT];
 } gdr_lod_stats_frame;
 
-/* Occlusion culling, last frame, per phase (early: what was visible last frame; late: the rest of
- * what is in the frustum, against this frame's pyramid). Clusters: mesh pipeline. */
+/* Occlusion culling, last frame, per phase (early: tested against last frame's pyramid, what it
+ * hides deferred; late: the deferred ones retested against this frame's pyramid). Clusters: mesh
+ * pipeline (nodes: gdr_traversal_stats). Each drawn instance and cluster is drawn in one phase. */
 typedef struct gdr_occlusion_stats {
     bool applied;
     uint32_t instances_early_drawn;
-    uint32_t instances_early_occluded; /* visible last frame, hidden behind last frame's pyramid */
-    uint32_t instances_late_tested;
-    uint32_t instances_late_occluded;
-    uint32_t instances_late_drawn;     /* not drawn early */
+    uint32_t instances_early_occluded; /* hidden behind last frame's pyramid: deferred */
+    uint32_t instances_late_tested;    /* = the deferred ones */
+    uint32_t instances_late_occluded;  /* hidden behind this frame's pyramid: culled */
+    uint32_t instances_late_drawn;
     uint32_t meshlets_early_drawn;
-    uint32_t meshlets_late_tested;
+    uint32_t meshlets_early_occluded;  /* deferred */
+    uint32_t meshlets_late_tested;     /* the deferred ones and the clusters of late instances and nodes */
     uint32_t meshlets_late_occluded;
     uint32_t meshlets_late_drawn;
+    uint32_t overflow; /* hidden items that found no room in an occluded list: handled in the early phase */
 } gdr_occlusion_stats;
 
 /* The LOD hierarchy traversal (mesh pipeline, LOD cut by error), last frame, both phases: node
  * visits, those whose subtree cannot hold a cluster of the cut, those outside the frustum, those
- * behind the depth pyramid (late phase), the late phase's visits, and visits that did not fit the
+ * deferred by the early phase (behind last frame's pyramid), those culled behind this frame's
+ * pyramid (late phase), the late phase's visits, and visits that did not fit the
  * traversal's queue (their subtrees were not drawn; 0 unless the scene outgrows
  * GDR_TRAVERSE_MAX_VISITS visits per level). */
 typedef struct gdr_traversal_stats {
@@ -195,13 +221,23 @@ typedef struct gdr_traversal_stats {
     uint32_t nodes_tested;
     uint32_t nodes_lod_culled;
     uint32_t nodes_frustum_culled;
+    uint32_t nodes_early_occluded;
     uint32_t nodes_occluded;
     uint32_t late_nodes_tested;
     uint32_t overflow;
 } gdr_traversal_stats;
 
+/* Streaming (docs/STREAMING.md): the LOD groups absent from the page table, and the requests the
+ * frame's cluster tests made for absent groups its cut needs (one per cluster drawn in such a
+ * group's place; the dropped ones did not fit GDR_STREAM_REQUEST_CAPACITY). Mesh pipeline. */
+typedef struct gdr_streaming_stats {
+    uint64_t absent_groups;
+    uint32_t requests;
+    uint32_t requests_dropped;
+} gdr_streaming_stats;
+
 /* GPU memory: what the renderer holds from the device (whole blocks), and of what it placed in
- * them, the scene's part (geometry, clusters, instances, occlusion history) and the rest (render
+ * them, the scene's part (geometry, clusters, instances, occluded lists) and the rest (render
  * targets, frame slots, visibility buffer, read-backs). */
 typedef struct gdr_memory_stats {
     uint64_t device_bytes;
@@ -213,6 +249,13 @@ typedef struct gdr_frame_stats {
     uint32_t frames;
     uint32_t instances_total;
     uint32_t instances_visible; /* of the last frame */
+    /* GPU-driven pipelines, last frame: instances culled by the instance tests, each counted by the
+     * first that culled it (invalid, frustum, screen size, clip plane): bounds not finite or without
+     * volume (or a mesh without triangles), outside their screen-size range or below the frame's
+     * minimum, entirely behind the clip plane. */
+    uint32_t instances_invalid;
+    uint32_t instances_screen_size_culled;
+    uint32_t instances_clip_plane_culled;
     uint64_t triangles;         /* drawn in the last frame */
     uint32_t draws;             /* indirect draw commands executed in the last frame */
     uint32_t draw_calls;        /* draw calls the CPU recorded per frame */
@@ -247,6 +290,7 @@ typedef struct gdr_frame_stats {
     gdr_lod_stats_frame lod;
     gdr_occlusion_stats occlusion;
     gdr_traversal_stats traversal;
+    gdr_streaming_stats streaming;
     gdr_memory_stats memory;
 } gdr_frame_stats;
 
@@ -289,6 +333,30 @@ typedef struct gdr_visible_meshlet {
  * with record_visible_meshlets. */
 GDR_API gdr_status gdr_renderer_read_visible_meshlets(gdr_renderer *renderer, gdr_visible_meshlet *meshlets,
                                                       uint32_t capacity, uint32_t *count, gdr_error *err);
+
+/* Tests: marks the groups of mesh `mesh` absent where group_resident[g] is 0 (its cluster data's
+ * group_count entries), as a streaming residency would, with node_absent_refined its
+ * lod_node_count counts of the clusters below each node whose refined group is absent. The
+ * traversal and the cluster tests then draw the cut over resident groups (docs/STREAMING.md): an
+ * absent group counts as passing. The geometry itself stays uploaded. Waits for the GPU. */
+GDR_API gdr_status gdr_renderer_debug_set_residency(gdr_renderer *renderer, uint32_t mesh,
+                                                    const uint8_t *group_resident,
+                                                    const uint32_t *node_absent_refined, gdr_error *err);
+
+/* A group the last frame found absent where its cut needs it (docs/STREAMING.md): a cluster was
+ * drawn in its place while the group's projected error, `priority` (pixels), is above the
+ * threshold. One per such cluster and instance: the same group may come several times. */
+typedef struct gdr_group_request {
+    uint32_t mesh, group; /* group: index in the mesh's clusters.groups */
+    float priority;
+    uint32_t instance;
+} gdr_group_request;
+
+/* The last frame's requests, in no particular order; needs a mesh-pipeline frame. *dropped: the
+ * requests that did not fit the frame's list (4096, GDR_STREAM_REQUEST_CAPACITY of the shaders). */
+GDR_API gdr_status gdr_renderer_read_group_requests(gdr_renderer *renderer, gdr_group_request *requests,
+                                                    uint32_t capacity, uint32_t *count, uint32_t *dropped,
+                                                    gdr_error *err);
 
 GDR_API void gdr_renderer_size(const gdr_renderer *renderer, uint32_t *width, uint32_t *height);
 

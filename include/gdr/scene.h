@@ -77,6 +77,11 @@ typedef struct gdr_instance {
     uint32_t mesh;
     uint32_t material; /* material index or GDR_NO_INDEX (then `color` is used) */
     gdr_vec4 color;    /* per-instance colour, multiplied with the material's base colour */
+    /* Screen-size culling (gdr_frame_desc): drawn while the bounding sphere's screen size, about its
+     * projected diameter over the viewport height, is at least min_screen_size and below
+     * max_screen_size (LOD-range swaps, small-detail culling); 0: no limit. Finite, >= 0. */
+    float min_screen_size;
+    float max_screen_size;
 } gdr_instance;
 
 typedef struct gdr_camera {
@@ -166,6 +171,27 @@ typedef struct gdr_lod_field_desc {
 
 GDR_API gdr_status gdr_scene_create_lod_field(const gdr_lod_field_desc *desc, gdr_scene **out, gdr_error *err);
 
+/* --- Unique field: many different dense meshes, one copy each ---------------------------------
+ *
+ * `meshes` different closed meshes (tori whose tube radius follows waves of the mesh's own
+ * frequencies and phases, named "unique_M"; about `triangles` triangles each, welded: every edge
+ * has exactly two triangles; within 0.95 m of the mesh origin), one instance each, on a square
+ * grid of `spacing` metres in the XZ plane (rows from z = -4 along -Z, centres at y = 1), each
+ * turned randomly about Y and tilted a little. The processed geometry grows with meshes x
+ * triangles and no instance shares another's: the scene for geometry streaming. Camera 0 at
+ * (0, 3.5, 0), 20 degrees down, looks along the field. Deterministic: the same desc gives the same
+ * bytes. gdr_scene_create_unique_field builds level-0 clusters; gdr_scene_load("unique-field...")
+ * also builds the LOD DAG. */
+typedef struct gdr_unique_field_desc {
+    uint32_t meshes;    /* 0: 100; at most 100000 */
+    uint32_t seed;      /* 0: 1 */
+    uint32_t triangles; /* per mesh, approximately (the lattice rounds it); 0: 100000; in [1000, 16000000] */
+    float spacing;      /* grid spacing in metres; 0: 3; in [2.5, 1000] */
+} gdr_unique_field_desc;
+
+GDR_API gdr_status gdr_scene_create_unique_field(const gdr_unique_field_desc *desc, gdr_scene **out,
+                                                 gdr_error *err);
+
 /* --- Occlusion scene: a wall of buildings in front of many small objects -----------------------
  *
  * Right-handed, Y up; the default camera stands at (0, 1.7, 0) looking down -Z. Instances, in
@@ -216,7 +242,7 @@ GDR_API gdr_status gdr_scene_create_occlusion(const gdr_occlusion_scene_desc *de
  * The camera never enters a building or an object; yfov 60 degrees, znear 0.1, infinite far. */
 GDR_API gdr_camera gdr_scene_occlusion_camera_path(uint32_t frame, bool *camera_cut);
 
-/* True when `spec` names a built-in scene ("demo", "lod-field", "occlusion", alone or followed by
+/* True when `spec` names a built-in scene ("demo", "lod-field", "occlusion", "unique-field", alone or followed by
  * ":options"), which gdr_scene_load builds instead of reading a file. */
 GDR_API bool gdr_scene_spec_is_builtin(const char *spec);
 
@@ -261,6 +287,7 @@ typedef struct gdr_load_options {
  *     "demo[:instances=N,seed=S,spacing=X]"                 gdr_scene_create_demo
  *     "lod-field[:instances=N,seed=S,triangles=T,spacing=X]" gdr_scene_create_lod_field
  *     "occlusion[:seed=S,hidden=N,visible=N]"               gdr_scene_create_occlusion
+ *     "unique-field[:meshes=M,seed=S,triangles=T,spacing=X]" gdr_scene_create_unique_field
  * (options in any order, each at most once; values as in the desc, 0 refused), or a file path of
  * a supported format. Source files (.gltf, .glb, .obj) go through the processed-scene cache unless
  * options->no_cache; a .gdrc file is read directly. options: NULL for the defaults. */

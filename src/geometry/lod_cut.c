@@ -40,6 +40,27 @@ uint32_t gdr_lod_cut_select(const gdr_mesh_clusters *clusters, const gdr_lod_vie
     return count;
 }
 
+/* The rule with absent groups counted as passing (lod_cut.h). */
+static uint32_t select_cluster_resident(const gdr_mesh_clusters *clusters, uint32_t i, const gdr_lod_view *view,
+                                        const uint8_t *group_resident, uint8_t *selected)
+{
+    const gdr_cluster *c = &clusters->clusters[i];
+    uint32_t r = c->refined_group, g = c->group;
+    bool refined = r == GDR_NO_INDEX || !group_resident[r] || gdr_lod_group_passes(clusters, r, view);
+    bool group = g != GDR_NO_INDEX && (!group_resident[g] || gdr_lod_group_passes(clusters, g, view));
+    selected[i] = gdr_lod_cluster_drawn(refined, group);
+    return selected[i];
+}
+
+uint32_t gdr_lod_cut_select_resident(const gdr_mesh_clusters *clusters, const gdr_lod_view *view,
+                                     const uint8_t *group_resident, uint8_t *selected)
+{
+    uint32_t count = 0;
+    for (uint32_t i = 0; i < clusters->cluster_count; i++)
+        count += select_cluster_resident(clusters, i, view, group_resident, selected);
+    return count;
+}
+
 static bool node_may_draw(const gdr_lod_node *n, const gdr_lod_view *view)
 {
     const float *m = view->transform.m;
@@ -75,6 +96,68 @@ uint32_t gdr_lod_cut_select_hierarchical(const gdr_mesh_clusters *clusters, cons
         local.clusters_tested += n->count;
         for (uint32_t i = n->first; i < n->first + n->count; i++)
             count += select_cluster(clusters, i, view, selected);
+    }
+    if (stats) {
+        stats->nodes_tested += local.nodes_tested;
+        stats->leaves_accepted += local.leaves_accepted;
+        stats->clusters_tested += local.clusters_tested;
+    }
+    return count;
+}
+
+void gdr_lod_nodes_count_absent_refined(const gdr_mesh_clusters *clusters, const uint8_t *group_resident,
+                                        uint32_t *absent)
+{
+    /* Breadth first: children come after their parent, so a reverse walk sees them first. */
+    for (uint32_t n = clusters->lod_node_count; n-- > 0;) {
+        const gdr_lod_node *node = &clusters->lod_nodes[n];
+        uint32_t count = 0;
+        for (uint32_t i = node->first; i < node->first + node->count; i++) {
+            if (!(node->flags & GDR_LOD_NODE_LEAF)) {
+                count += absent[i];
+                continue;
+            }
+            uint32_t r = clusters->clusters[i].refined_group;
+            count += r != GDR_NO_INDEX && !group_resident[r];
+        }
+        absent[n] = count;
+    }
+}
+
+/* The node test with absent groups: side (1) (every group below passes) holds as it is; side (2)
+ * (no refined group below passes) only where none below is absent. */
+static bool node_may_draw_resident(const gdr_lod_node *n, uint32_t absent, const gdr_lod_view *view)
+{
+    gdr_lod_node relaxed = *n;
+    if (absent > 0)
+        relaxed.min_refined_error = 0.0f; /* a cluster below always "passes" its refined side */
+    return node_may_draw(&relaxed, view);
+}
+
+uint32_t gdr_lod_cut_select_hierarchical_resident(const gdr_mesh_clusters *clusters, const gdr_lod_view *view,
+                                                  const uint8_t *group_resident, const uint32_t *absent,
+                                                  uint8_t *selected, gdr_lod_traversal_stats *stats)
+{
+    memset(selected, 0, clusters->cluster_count);
+    uint32_t stack[GDR_LOD_NODE_MAX_CHILDREN * GDR_LOD_NODE_MAX_LEVELS], top = 0, count = 0;
+    gdr_lod_traversal_stats local = {0};
+    if (clusters->lod_node_count)
+        stack[top++] = 0;
+    while (top > 0) {
+        uint32_t index = stack[--top];
+        const gdr_lod_node *n = &clusters->lod_nodes[index];
+        local.nodes_tested++;
+        if (!node_may_draw_resident(n, absent[index], view))
+            continue;
+        if (!(n->flags & GDR_LOD_NODE_LEAF)) {
+            for (uint32_t k = n->count; k-- > 0;)
+                stack[top++] = n->first + k;
+            continue;
+        }
+        local.leaves_accepted++;
+        local.clusters_tested += n->count;
+        for (uint32_t i = n->first; i < n->first + n->count; i++)
+            count += select_cluster_resident(clusters, i, view, group_resident, selected);
     }
     if (stats) {
         stats->nodes_tested += local.nodes_tested;

@@ -32,6 +32,15 @@ bool gdr_lod_group_passes(const gdr_mesh_clusters *clusters, uint32_t group, con
  * Returns the number of clusters selected. */
 uint32_t gdr_lod_cut_select(const gdr_mesh_clusters *clusters, const gdr_lod_view *view, uint8_t *selected);
 
+/* The cut of a streamed mesh, of which only some groups are resident (group_resident[g] != 0):
+ * a group that is absent counts as passing, so its clusters are not drawn and the clusters made
+ * from it, in the groups above, are drawn instead where those do not pass. When the resident
+ * groups are closed upwards (every group made from a resident group is resident, the root always
+ * is), each source-to-root path still holds exactly one drawn cluster: no hole, no crack. With
+ * every group resident it is gdr_lod_cut_select. Returns the number of clusters selected. */
+uint32_t gdr_lod_cut_select_resident(const gdr_mesh_clusters *clusters, const gdr_lod_view *view,
+                                     const uint8_t *group_resident, uint8_t *selected);
+
 /* What a hierarchical cut did: the work a traversal of the LOD hierarchy saves. */
 typedef struct gdr_lod_traversal_stats {
     uint64_t nodes_tested;    /* nodes whose test ran (the root and the children of nodes that passed) */
@@ -45,6 +54,21 @@ typedef struct gdr_lod_traversal_stats {
  * falls back to the flat cut (every cluster tested). stats (may be NULL) are added to. */
 uint32_t gdr_lod_cut_select_hierarchical(const gdr_mesh_clusters *clusters, const gdr_lod_view *view,
                                          uint8_t *selected, gdr_lod_traversal_stats *stats);
+
+/* For the cut over resident groups by traversal: absent[n] = the clusters below node n whose refined
+ * group is not resident (lod_node_count entries). A node test's second side ("no refined group
+ * below passes", gdr_lod_node_may_draw) only holds where this is 0: an absent refined group counts
+ * as passing. */
+void gdr_lod_nodes_count_absent_refined(const gdr_mesh_clusters *clusters, const uint8_t *group_resident,
+                                        uint32_t *absent);
+
+/* gdr_lod_cut_select_resident found by walking the hierarchy: a node is skipped when every group
+ * below passes (which an absent group does too), or, where absent[node] is 0, when no refined group
+ * below passes; a leaf's clusters get the resident rule. The same bytes as
+ * gdr_lod_cut_select_resident. stats (may be NULL) are added to. */
+uint32_t gdr_lod_cut_select_hierarchical_resident(const gdr_mesh_clusters *clusters, const gdr_lod_view *view,
+                                                  const uint8_t *group_resident, const uint32_t *absent,
+                                                  uint8_t *selected, gdr_lod_traversal_stats *stats);
 
 /* The discrete debug cut at DAG depth N (gdr/geometry.h): the same rule with
  * passes(g) = (depth(g) < depth and g is not the root). */

@@ -10,14 +10,14 @@
 #include "geometry/lod_internal.h"
 #include "shaders/shared/gpu_types.h"
 
-_Static_assert(sizeof(gdr_lod_node) == sizeof(GdrGpuLodNode) &&
+_Static_assert(sizeof(gdr_lod_node) == offsetof(GdrGpuLodNode, bounds) &&
                    offsetof(gdr_lod_node, max_error) == offsetof(GdrGpuLodNode, max_error) &&
                    offsetof(gdr_lod_node, min_refined_error) == offsetof(GdrGpuLodNode, min_refined_error) &&
                    offsetof(gdr_lod_node, first) == offsetof(GdrGpuLodNode, first) &&
                    offsetof(gdr_lod_node, count) == offsetof(GdrGpuLodNode, count) &&
                    offsetof(gdr_lod_node, group) == offsetof(GdrGpuLodNode, group) &&
                    offsetof(gdr_lod_node, flags) == offsetof(GdrGpuLodNode, flags),
-               "gdr_lod_node is uploaded as GdrGpuLodNode");
+               "gdr_lod_node is uploaded as the first fields of GdrGpuLodNode");
 _Static_assert(GDR_LOD_NODE_LEAF == GDR_GPU_LOD_NODE_LEAF &&
                    GDR_LOD_NODE_MAX_CHILDREN == GDR_GPU_LOD_NODE_MAX_CHILDREN &&
                    GDR_NO_INDEX == GDR_GPU_NO_GROUP,

@@ -188,7 +188,10 @@ static void cluster_bounds(gdr_cluster *c, const uint32_t *vertices, const uint8
                                                            sizeof(gdr_vec3));
     int has_area = b.radius > 0.0f || b.cone_cutoff != 0.0f || b.cone_axis[0] != 0.0f ||
                    b.cone_axis[1] != 0.0f || b.cone_axis[2] != 0.0f;
-    double center[3] = {b.center[0], b.center[1], b.center[2]};
+    /* The centre as stored (float), so that the radius is measured from exactly the stored point.
+     * (Kept in doubles rounded through float, gcc 12 -O3's basic-block vectorizer measured from the
+     * unrounded x and y and stored the rounded ones: radii short by an ulp or two.) */
+    float center[3] = {b.center[0], b.center[1], b.center[2]};
     if (!has_area) {
         /* The middle of the vertices' bounding box. */
         double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
@@ -200,16 +203,16 @@ static void cluster_bounds(gdr_cluster *c, const uint32_t *vertices, const uint8
             }
         }
         for (int k = 0; k < 3; k++)
-            center[k] = (double)(float)(0.5 * (lo[k] + hi[k]));
+            center[k] = (float)(0.5 * (lo[k] + hi[k]));
     }
     double radius = has_area ? b.radius : 0.0;
     for (uint32_t i = 0; i < c->vertex_count; i++) {
         const gdr_vec3 p = mesh->positions[vertices[i]];
-        double dx = p.x - center[0], dy = p.y - center[1], dz = p.z - center[2];
+        double dx = (double)p.x - center[0], dy = (double)p.y - center[1], dz = (double)p.z - center[2];
         double d = sqrt(dx * dx + dy * dy + dz * dz);
         radius = d > radius ? d : radius;
     }
-    c->sphere = (gdr_vec4){(float)center[0], (float)center[1], (float)center[2], round_up_to_float(radius)};
+    c->sphere = (gdr_vec4){center[0], center[1], center[2], round_up_to_float(radius)};
     if (has_area && b.cone_cutoff < 1.0f) {
         c->cone_apex = (gdr_vec3){b.cone_apex[0], b.cone_apex[1], b.cone_apex[2]};
         c->cone_axis = (gdr_vec3){b.cone_axis[0], b.cone_axis[1], b.cone_axis[2]};

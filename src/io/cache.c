@@ -89,7 +89,7 @@ gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_c
     if (limits != GDR_OK)
         return limits;
     /* The table has exactly one entry per section: no byte of the file lies outside a checksum. */
-    cache_write_input in = {scene, &options->source, options->pvs};
+    cache_write_input in = {scene, &options->source, options->pvs, options->page_bytes};
     uint32_t expected = 0;
     for (uint32_t k = 0; k < CACHE_SECTION_COUNT; k++) {
         const cache_section *sec = &gdr_cache_sections[k];

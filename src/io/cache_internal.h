@@ -130,6 +130,19 @@ static inline const char *get_string(reader *r, uint32_t *length)
     return (const char *)take(r, *length);
 }
 
+/* One record of section 'INST' (docs/CACHE_FORMAT.md), as the whole-file and the paged reader
+ * read it; CACHE_INSTANCE_RECORD bytes. The caller checks the values. */
+#define CACHE_INSTANCE_RECORD (64u + 8u + 16u + 8u)
+static inline void cache_get_instance(reader *r, gdr_instance *inst)
+{
+    get_f32s(r, inst->transform.m, 16);
+    inst->mesh = get_u32(r);
+    inst->material = get_u32(r);
+    get_f32s(r, &inst->color.x, 4);
+    get_f32s(r, &inst->min_screen_size, 1);
+    get_f32s(r, &inst->max_screen_size, 1);
+}
+
 /* A section id as text for messages ('?' for bytes that are not printable). */
 static inline void fourcc_text(uint32_t id, char out[5])
 {
@@ -147,7 +160,7 @@ static inline void fourcc_text(uint32_t id, char out[5])
 enum {
     CACHE_SOURCE, CACHE_SCENE, CACHE_TEXTURES, CACHE_PIXELS, CACHE_MESHES, CACHE_GEOMETRY, CACHE_CLUSTERS,
     CACHE_CLUSTER_DATA, CACHE_HIERARCHY, CACHE_MATERIALS, CACHE_INSTANCES, CACHE_CAMERAS, CACHE_PVS,
-    CACHE_SECTION_COUNT
+    CACHE_PAGES, CACHE_SECTION_COUNT
 };
 
 /* What a file is written from. */
@@ -155,6 +168,7 @@ typedef struct cache_write_input {
     const gdr_scene *scene;
     const gdr_cache_source *source;
     const gdr_pvs *pvs; /* NULL: no PVIS section */
+    uint32_t page_bytes; /* 0: no PAGE section */
 } cache_write_input;
 
 typedef struct cache_read_state cache_read_state; /* cache_sections.c */

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "io/cache_internal.h"
+#include "io/cache_pages.h"
 #include "io/io_internal.h"
 
 #if !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
@@ -15,7 +16,7 @@
 
 #define FOURCC(a, b, c, d) ((uint32_t)(a) | (uint32_t)(b) << 8 | (uint32_t)(c) << 16 | (uint32_t)(d) << 24)
 
-enum { MESH_RECORD = 64 + 8 + 16, MATERIAL_RECORD = 64 + 16 + 12 + 12 + 8 + 4, INSTANCE_RECORD = 64 + 8 + 16,
+enum { MESH_RECORD = 64 + 8 + 16, MATERIAL_RECORD = 64 + 16 + 12 + 12 + 8 + 4, INSTANCE_RECORD = CACHE_INSTANCE_RECORD,
        CAMERA_RECORD = 64 + 12 + 16 + 16, TEXTURE_RECORD = 64 + 12, CLUSTERS_RECORD = 6 * 4,
        CLUSTER_RECORD = 4 * 4 + 16 + 12 + 12 + 4 + 3 * 4, GROUP_RECORD = 16 + 4 + 3 * 4,
        NODE_RECORD = 16 + 4 + 4 + 4 * 4 + 2 * 4 };
@@ -587,6 +588,8 @@ static void write_instances(writer *w, const cache_write_input *in)
         put_u32(w, inst->mesh);
         put_u32(w, inst->material);
         put_f32s(w, &inst->color.x, 4);
+        put_f32s(w, &inst->min_screen_size, 1);
+        put_f32s(w, &inst->max_screen_size, 1);
     }
 }
 
@@ -595,10 +598,7 @@ static gdr_status read_instances(cache_read_state *st, reader *in, gdr_error *er
     gdr_status status = expect_records(st, in, FOURCC('I', 'N', 'S', 'T'), st->instance_count, INSTANCE_RECORD, err);
     for (uint32_t i = 0; i < st->instance_count && status == GDR_OK; i++) {
         gdr_instance inst;
-        get_f32s(in, inst.transform.m, 16);
-        inst.mesh = get_u32(in);
-        inst.material = get_u32(in);
-        get_f32s(in, &inst.color.x, 4);
+        cache_get_instance(in, &inst);
         if (!all_finite(&inst.color.x, 4))
             return gdr_error_set(err, GDR_ERROR_PARSE, "%s: instance %u: colour is not finite", st->name, i);
         status = gdr_scene_add_instance(st->scene, &inst, err);
@@ -685,6 +685,42 @@ static gdr_status read_pvs(cache_read_state *st, reader *r, gdr_error *err)
     return GDR_OK;
 }
 
+/* --- PAGE: the geometry in pages, for reading on demand (cache_pages.c, paged_cache.c) --------- */
+
+static int has_pages(const cache_write_input *in) { return in->page_bytes != 0; }
+
+static gdr_status check_page_bytes(const cache_write_input *in, const char *path, gdr_error *err)
+{
+    if (in->page_bytes >= GDR_PAGE_BYTES_MIN && in->page_bytes <= GDR_PAGE_BYTES_MAX)
+        return GDR_OK;
+    return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: page size %u bytes is outside [%u, %u]", path,
+                         in->page_bytes, GDR_PAGE_BYTES_MIN, GDR_PAGE_BYTES_MAX);
+}
+
+static void write_pages(writer *w, const cache_write_input *in) { cache_pages_write(w, in->scene, in->page_bytes); }
+
+/* The whole-file reader checks the page index (the section checksum covers the pages' bytes);
+ * the pages themselves are decoded, and checked, by the paged reader. */
+static gdr_status read_pages(cache_read_state *st, reader *r, gdr_error *err)
+{
+    uint32_t mesh_count;
+    uint64_t index_size, index_hash;
+    gdr_status status = cache_pages_parse_header(st->name, r->data, r->size, &mesh_count, &index_size,
+                                                 &index_hash, err);
+    if (status != GDR_OK)
+        return status;
+    if (mesh_count != st->mesh_count)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'PAGE': %u meshes, the scene has %u", st->name,
+                             mesh_count, st->mesh_count);
+    if (gdr_io_hash(r->data + CACHE_PAGES_HEADER, (size_t)index_size) != index_hash)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'PAGE': index checksum mismatch", st->name);
+    gdr_paged_mesh *meshes;
+    status = cache_pages_parse_index(st->name, r->data + CACHE_PAGES_HEADER, index_size, mesh_count, 0, r->size,
+                                     &meshes, err);
+    cache_pages_free_index(meshes, mesh_count);
+    return status;
+}
+
 /* --- the table ------------------------------------------------------------------------------------- */
 
 #define REQUIRED CACHE_SECTION_REQUIRED
@@ -705,6 +741,7 @@ const cache_section gdr_cache_sections[CACHE_SECTION_COUNT] = {
     [CACHE_CAMERAS] = {FOURCC('C', 'A', 'M', 'R'), REQUIRED, 0, NULL, NULL, write_cameras, read_cameras},
     /* optional: readers that predate it skip it */
     [CACHE_PVS] = {FOURCC('P', 'V', 'I', 'S'), 0, 1, has_pvs, check_pvs_objects, write_pvs, read_pvs},
+    [CACHE_PAGES] = {FOURCC('P', 'A', 'G', 'E'), 0, 1, has_pages, check_page_bytes, write_pages, read_pages},
 };
 #undef REQUIRED
 

@@ -16,7 +16,9 @@ static gdr_cull_object object_from_instance(const GdrGpuInstance *instance, cons
     gdr_vec4 b = mesh->bounds;
     gdr_vec3 center = gdr_mat4_transform_point(instance->model, (gdr_vec3){b.x, b.y, b.z});
     float radius = b.w * gdr_mat4_max_axis_scale(instance->model);
-    return (gdr_cull_object){.center = center, .radius = radius, .extent = {radius, radius, radius}};
+    return (gdr_cull_object){.center = center, .radius = radius, .extent = {radius, radius, radius},
+                             .min_screen_size = instance->min_screen_size,
+                             .max_screen_size = instance->max_screen_size};
 }
 
 /* Keeps only what the instances' bounds need of the scene, per mesh (the renderer holds no pointer
@@ -55,6 +57,8 @@ static gdr_status build_cull_scene(gdr_renderer *r, gdr_error *err)
         const GdrGpuInstance *instance = &r->scene.cpu_instances[i];
         const gdr_cull_mesh_bounds *b = instance->mesh < cpu->mesh_count ? &cpu->mesh_bounds[instance->mesh] : &none;
         objects[i] = gdr_cull_object_from_mesh_bounds(b, &instance->model);
+        objects[i].min_screen_size = instance->min_screen_size;
+        objects[i].max_screen_size = instance->max_screen_size;
     }
     gdr_cull_scene_desc desc = {.objects = objects, .object_count = count};
     gdr_status status = gdr_cull_scene_create(&desc, &cpu->cull_scene, err);
@@ -89,10 +93,19 @@ gdr_status gdr_cpu_path_cull(gdr_renderer *r, const gdr_frame_desc *frame, gdr_e
             return built;
     }
     double start = gdr_now_ms();
-    gdr_cull_view view = {.skip_frustum = frame->cull == GDR_CULL_OFF};
-    gdr_frame_matrices(r, &frame->camera, &view.projection, &view.view);
-    gdr_cull_result result = {.visible = cpu->visible_bits};
-    gdr_status status = gdr_cull_execute(cpu->cull_scene, &view, NULL, &result, NULL, err);
+    gdr_status status = GDR_OK;
+    if (frame->cull == GDR_CULL_OFF) { /* nothing culled: every instance with something to draw */
+        memset(cpu->visible_bits, 0, sizeof(uint32_t) * gdr_cull_word_count(r->scene.instance_count));
+        for (uint32_t i = 0; i < r->scene.instance_count; i++)
+            if (r->scene.cpu_meshes[r->scene.cpu_instances[i].mesh].index_count > 0)
+                cpu->visible_bits[i / 32] |= 1u << (i % 32);
+    } else {
+        gdr_cull_view view = {.min_screen_size = frame->min_screen_size, .clip_plane = frame->clip_plane};
+        gdr_frame_matrices(r, frame->cull_camera ? frame->cull_camera : &frame->camera, &view.projection,
+                           &view.view);
+        gdr_cull_result result = {.visible = cpu->visible_bits};
+        status = gdr_cull_execute(cpu->cull_scene, &view, NULL, &result, NULL, err);
+    }
     if (status != GDR_OK)
         return status;
     uint32_t count = 0;

@@ -24,7 +24,10 @@ static GdrGpuFrameBuffers frame_buffers(const gdr_renderer *r, const gdr_frame_s
     return (GdrGpuFrameBuffers){
         .draws = slot->draws.address, .draw_stats = slot->draw_stats.address, .updates = slot->updates.address,
         .tasks = slot->tasks.address, .overdraw = r->overdraw.address, .visible_meshlets = r->visible_meshlets.address,
-        .raster = r->vis.params[slot - r->slots].address, .traversal = r->scene.traversal.address};
+        .raster = r->vis.params[slot - r->slots].address, .traversal = r->scene.traversal.address,
+        .occluded_instances = r->occlusion.occluded_instances.address,
+        .occluded_nodes = r->occlusion.occluded_nodes.address, .retest_masks = r->occlusion.retest_masks.address,
+        .stream_requests = r->scene.stream_requests.address};
 }
 
 static uint32_t frame_flags(const gdr_frame_desc *frame, bool lod, bool occlusion, bool history, bool hierarchy)
@@ -50,18 +53,21 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
                           uint32_t update_count, bool occlusion, bool history)
 {
     const gdr_camera *camera = &frame->camera;
-    gdr_mat4 projection, view;
+    /* Culling and LOD use `view`, `frustum` and `camera_position`; drawing uses view_projection. */
+    const gdr_camera *cull_camera = frame->cull_camera ? frame->cull_camera : camera;
+    gdr_mat4 projection, view, cull_projection, cull_view;
     gdr_frame_matrices(r, camera, &projection, &view);
+    gdr_frame_matrices(r, cull_camera, &cull_projection, &cull_view);
     gdr_vec3 light = gdr_vec3_normalize((gdr_vec3){0.35f, 0.85f, 0.4f});
     /* The LOD cut: only where the mesh pipeline draws clusters, and only when it asks for something
      * other than level 0 (threshold 0 and depth 0 both select exactly level 0). */
     bool lod = pipeline == GDR_PIPELINE_MESH &&
                (frame->lod_fixed_depth ? frame->lod_depth > 0 : frame->lod_error_px > 0.0f);
     GdrGpuFrameGlobals globals = {
-        .view = view,
+        .view = cull_view,
         .view_projection = gdr_mat4_mul(projection, view),
-        .frustum = gdr_frustum_symmetric(projection),
-        .camera_position = {camera->position.x, camera->position.y, camera->position.z, 1.0f},
+        .frustum = gdr_frustum_symmetric(cull_projection),
+        .camera_position = {cull_camera->position.x, cull_camera->position.y, cull_camera->position.z, 1.0f},
         .light_direction = {light.x, light.y, light.z, 0.0f},
         .znear = camera->znear,
         .zfar = camera->zfar > 0.0f ? camera->zfar : INFINITY,
@@ -69,7 +75,10 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .cull_enabled = frame->cull != GDR_CULL_OFF,
         .update_count = update_count,
         .flags = frame_flags(frame, lod, occlusion, history, traversal_levels(r, frame, pipeline) > 0) |
-                 (r->debug_shrink_lod_nodes ? GDR_FRAME_DEBUG_SHRINK_NODES : 0u),
+                 (r->debug_shrink_lod_nodes ? GDR_FRAME_DEBUG_SHRINK_NODES : 0u) |
+                 (r->scene.absent_groups > 0 ? GDR_FRAME_PARTIAL_RESIDENCY : 0u) |
+                 (pipeline == GDR_PIPELINE_MESH && r->vis.mode != GDR_GPU_RASTER_FORWARD ? GDR_FRAME_DIRECT_CLUSTERS
+                                                                                        : 0u),
         .view_mode = (uint32_t)frame->view,
         .task_capacity = r->scene.task_capacity,
         .viewport = {(float)r->width, (float)r->height},
@@ -77,8 +86,17 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .lod_projection_scale = fabsf(projection.m[5]) * 0.5f * (float)r->height,
         .lod_depth = frame->lod_depth > INT32_MAX ? INT32_MAX : (int32_t)frame->lod_depth,
         .traversal_capacity = r->scene.traversal_capacity,
+        .occluded_node_capacity = r->occlusion.occluded_node_capacity,
+        .min_screen_size = frame->min_screen_size,
+        .clip_plane = frame->clip_plane,
+        .screen_scale = fmaxf(fabsf(projection.m[0]), fabsf(projection.m[5])),
     };
     gdr_occlusion_params(r, &projection, camera->znear, &globals.occlusion);
+    /* The early phase tests against last frame's pyramid as last frame's camera saw it. */
+    globals.previous_view = history ? r->occlusion.previous_view : view;
+    globals.previous_occlusion = history ? r->occlusion.previous_params : globals.occlusion;
+    r->occlusion.previous_view = view;
+    r->occlusion.previous_params = globals.occlusion;
     memcpy(slot->globals.mapped, &globals, sizeof globals);
     GdrGpuFrameBuffers buffers = frame_buffers(r, slot); /* (visible_meshlets is made on first use) */
     memcpy(slot->frame_buffers.mapped, &buffers, sizeof buffers);
@@ -91,7 +109,8 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
  * H100 (docs/OCCLUSION.md, "Which pipelines cull by default"). */
 static bool occlusion_wanted(const gdr_frame_desc *frame, gdr_pipeline pipeline)
 {
-    if (pipeline == GDR_PIPELINE_CPU || frame->cull == GDR_CULL_OFF || frame->occlusion == GDR_CULL_OFF)
+    if (pipeline == GDR_PIPELINE_CPU || frame->cull == GDR_CULL_OFF || frame->occlusion == GDR_CULL_OFF ||
+        frame->cull_camera)
         return false;
     return frame->occlusion == GDR_CULL_ON || pipeline == GDR_PIPELINE_INDIRECT;
 }

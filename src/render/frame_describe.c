@@ -6,15 +6,15 @@
 const char *gdr_frame_section_name(gdr_frame_section section)
 {
     static const char *const names[GDR_SECTION_COUNT + 1] = {
-        "instance_update", "cull", "draw", "pyramid", "late_cull", "late_draw", "late_pyramid", "readback", "-"};
+        "instance_update", "cull", "draw", "pyramid", "late_cull", "late_draw", "readback", "-"};
     return (unsigned)section <= GDR_SECTION_COUNT ? names[section] : "?";
 }
 
 const char *gdr_frame_resource_name(gdr_frame_resource resource)
 {
     static const char *const names[GDR_RES_COUNT] = {
-        "instances", "visibility", "draw_stats", "draws", "tasks", "traversal", "visible_meshlets", "overdraw", "raster_counters",
-        "raster_clusters", "visbuffer", "resolved", "readback", "color", "depth", "hzb"};
+        "instances", "occluded", "draw_stats", "draws", "tasks", "traversal", "visible_meshlets", "overdraw", "raster_counters",
+        "raster_clusters", "visbuffer", "readback", "color", "depth", "hzb"};
     return (unsigned)resource < GDR_RES_COUNT ? names[resource] : "?";
 }
 

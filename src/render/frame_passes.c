@@ -47,9 +47,11 @@ static const gdr_pass_template clear = {
              {GDR_RES_VISBUFFER, TRANSFER, COPY_WRITE, .flags = GDR_USE_VISBUFFER}}};
 
 static const gdr_pass_template cull_draws = {
-    "instance_cull", gdr_pass_record_instance_cull, .what = "instances: frustum, occlusion; appends draw commands",
-    .uses = {{GDR_RES_INSTANCES, COMPUTE, READ}, {GDR_RES_VISIBILITY, COMPUTE, READ_WRITE}, HZB_READ(COMPUTE),
-             {GDR_RES_DRAWS, COMPUTE, WRITE}, {GDR_RES_DRAW_STATS, COMPUTE, READ_WRITE}}};
+    "instance_cull", gdr_pass_record_instance_cull,
+    .what = "instances (late phase: those the early one deferred): frustum, occlusion; appends draw commands",
+    .uses = {{GDR_RES_DRAW_STATS, INDIRECT, INDIRECT_READ}, {GDR_RES_INSTANCES, COMPUTE, READ},
+             {GDR_RES_OCCLUDED, COMPUTE, READ_WRITE}, HZB_READ(COMPUTE), {GDR_RES_DRAWS, COMPUTE, WRITE},
+             {GDR_RES_DRAW_STATS, COMPUTE, READ_WRITE}}};
 
 static const gdr_pass_template draw_indexed = {
     "draw_indexed", gdr_pass_record_draw_indexed, .what = "one vkCmdDrawIndexedIndirectCount",
@@ -58,17 +60,19 @@ static const gdr_pass_template draw_indexed = {
 
 static const gdr_pass_template cull_tasks = {
     "instance_cull", gdr_pass_record_instance_cull,
-    .what = "instances: frustum, occlusion, LOD root shortcut; appends task commands",
-    .uses = {{GDR_RES_INSTANCES, COMPUTE, READ}, {GDR_RES_VISIBILITY, COMPUTE, READ_WRITE}, HZB_READ(COMPUTE),
+    .what = "instances (late phase: those the early one deferred): frustum, occlusion, LOD root shortcut; "
+            "appends task commands",
+    .uses = {{GDR_RES_DRAW_STATS, INDIRECT, INDIRECT_READ}, {GDR_RES_INSTANCES, COMPUTE, READ},
+             {GDR_RES_OCCLUDED, COMPUTE, READ_WRITE}, HZB_READ(COMPUTE),
              {GDR_RES_TASKS, COMPUTE, WRITE}, {GDR_RES_DRAW_STATS, COMPUTE, READ_WRITE},
              {GDR_RES_DRAWS, COMPUTE, WRITE}, {GDR_RES_TRAVERSAL, COMPUTE, WRITE, .flags = GDR_USE_TRAVERSAL}}};
 
 static const gdr_pass_template lod_traverse = {
     "lod_traverse", gdr_pass_record_lod_traverse,
-    .what = "one level of the LOD hierarchies: nodes by LOD error, frustum, occlusion (late); leaves append tasks",
+    .what = "one level of the LOD hierarchies: nodes by LOD error, frustum, occlusion; leaves append tasks",
     .uses = {{GDR_RES_DRAW_STATS, INDIRECT, INDIRECT_READ}, {GDR_RES_DRAW_STATS, COMPUTE, READ_WRITE},
              {GDR_RES_TRAVERSAL, COMPUTE, READ_WRITE}, {GDR_RES_INSTANCES, COMPUTE, READ}, HZB_READ(COMPUTE),
-             {GDR_RES_TASKS, COMPUTE, WRITE}}};
+             {GDR_RES_OCCLUDED, COMPUTE, READ_WRITE}, {GDR_RES_TASKS, COMPUTE, WRITE}}};
 
 static const gdr_pass_template task_submit = {
     "task_submit", gdr_pass_record_task_submit, .what = "the task commands' count into the launches",
@@ -76,18 +80,20 @@ static const gdr_pass_template task_submit = {
 
 static const gdr_pass_template meshlets = {
     "meshlets", gdr_pass_record_meshlets,
-    .what = "task shaders test clusters, mesh shaders cull triangles, fragments shade",
+    .what = "task shaders test clusters (the early phase defers hidden ones), mesh shaders cull triangles, "
+            "fragments shade",
     .uses = {{GDR_RES_DRAW_STATS, INDIRECT, INDIRECT_READ}, {GDR_RES_DRAW_STATS, TASK | MESH, READ_WRITE},
-             {GDR_RES_TASKS, TASK, READ}, {GDR_RES_INSTANCES, TASK | MESH, READ},
-             {GDR_RES_VISIBILITY, TASK, READ_WRITE}, HZB_READ(TASK), {GDR_RES_VISIBLE_MESHLETS, TASK, WRITE},
+             {GDR_RES_TASKS, TASK, READ_WRITE}, {GDR_RES_INSTANCES, TASK | MESH, READ},
+             {GDR_RES_OCCLUDED, TASK, READ_WRITE}, HZB_READ(TASK), {GDR_RES_VISIBLE_MESHLETS, TASK, WRITE},
              COLOR_TARGET, DEPTH_TARGET, OVERDRAW_COUNTS(FRAGMENT)}};
 
 static const gdr_pass_template cluster_cull = {
     "cluster_cull", gdr_visbuffer_record_cluster_cull, GDR_RASTER_TIMER_CULL,
-    .what = "clusters: LOD cut, frustum, cone, occlusion; binned into the visible-cluster list",
+    .what = "clusters: LOD cut, frustum, cone, occlusion (the early phase defers hidden ones); binned into the "
+            "visible-cluster list",
     .uses = {{GDR_RES_DRAW_STATS, INDIRECT, INDIRECT_READ}, {GDR_RES_DRAW_STATS, COMPUTE, READ_WRITE},
-             {GDR_RES_TASKS, COMPUTE, READ}, {GDR_RES_INSTANCES, COMPUTE, READ},
-             {GDR_RES_VISIBILITY, COMPUTE, READ_WRITE}, HZB_READ(COMPUTE),
+             {GDR_RES_TASKS, COMPUTE, READ_WRITE}, {GDR_RES_INSTANCES, COMPUTE, READ},
+             {GDR_RES_OCCLUDED, COMPUTE, READ_WRITE}, HZB_READ(COMPUTE),
              {GDR_RES_RASTER_COUNTERS, COMPUTE, READ_WRITE}, {GDR_RES_RASTER_CLUSTERS, COMPUTE, WRITE},
              {GDR_RES_VISIBLE_MESHLETS, COMPUTE, WRITE}}};
 
@@ -112,16 +118,21 @@ static const gdr_pass_template raster_sw = {
 
 static const gdr_pass_template resolve = {
     "resolve", gdr_visbuffer_record_resolve, GDR_RASTER_TIMER_RESOLVE,
-    .what = "shades every pixel of the visibility buffer (the early phase: depth only)",
-    .uses = {{GDR_RES_VISBUFFER, COMPUTE, READ}, {GDR_RES_RASTER_CLUSTERS, COMPUTE, READ},
-             {GDR_RES_INSTANCES, COMPUTE, READ}, {GDR_RES_RESOLVED, COMPUTE, WRITE}}};
+    .what = "shades every pixel of the visibility buffer (a late phase that drew nothing: no pixel)",
+    .uses = {{GDR_RES_RASTER_COUNTERS, INDIRECT, INDIRECT_READ}, {GDR_RES_VISBUFFER, COMPUTE, READ},
+             {GDR_RES_RASTER_CLUSTERS, COMPUTE, READ},
+             {GDR_RES_INSTANCES, COMPUTE, READ},
+             {GDR_RES_COLOR, COMPUTE, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL,
+              .flags = GDR_USE_CLEARS}}};
 
-static const gdr_pass_template resolve_copy = {
-    "resolve_copy", gdr_visbuffer_record_resolve_copy, GDR_RASTER_TIMER_RESOLVE,
-    .what = "the resolved colour and depth into the images",
-    .uses = {{GDR_RES_RESOLVED, COPY, COPY_READ},
-             {GDR_RES_COLOR, COPY, COPY_WRITE, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, true, GDR_USE_NOT_EARLY},
-             {GDR_RES_DEPTH, COPY, COPY_WRITE, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, true}}};
+/* The visibility-buffer modes build the pyramid from the visibility buffer's depth, not the depth
+ * image, which they never write (its descriptor is bound all the same: it gets the layout). */
+static const gdr_pass_template pyramid_visbuffer = {
+    "pyramid", gdr_pass_record_pyramid,
+    .what = "the depth pyramid of the visibility buffer's depth so far (its build orders its levels)",
+    .uses = {{GDR_RES_VISBUFFER, COMPUTE, READ},
+             {GDR_RES_DEPTH, COMPUTE, SAMPLED, VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL, true},
+             {GDR_RES_HZB, COMPUTE, SAMPLED | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL}}};
 
 static const gdr_pass_template pyramid = {
     "pyramid", gdr_pass_record_pyramid, .what = "the depth pyramid of the depth so far (its build orders its levels)",
@@ -168,8 +179,7 @@ static void add_phase(gdr_frame_plan *plan, gdr_occlusion_phase phase)
             gdr_frame_plan_add(plan, &meshlets, phase, draw);
             return;
         }
-        const gdr_pass_template *raster[] = {&cluster_cull, &raster_submit, &raster_hw, &raster_sw, &resolve,
-                                             &resolve_copy};
+        const gdr_pass_template *raster[] = {&cluster_cull, &raster_submit, &raster_hw, &raster_sw, &resolve};
         for (size_t i = 0; i < sizeof raster / sizeof raster[0]; i++)
             gdr_frame_plan_add(plan, raster[i], phase, draw);
     }
@@ -184,7 +194,8 @@ void gdr_frame_plan_build(const gdr_frame_config *config, gdr_frame_plan *plan)
     bool two_phases = config->occlusion && config->pipeline != GDR_PIPELINE_CPU;
     if (two_phases) {
         add_phase(plan, GDR_PHASE_EARLY);
-        gdr_frame_plan_add(plan, &pyramid, GDR_PHASE_EARLY, GDR_SECTION_PYRAMID);
+        gdr_frame_plan_add(plan, config->visbuffer ? &pyramid_visbuffer : &pyramid, GDR_PHASE_EARLY,
+                           GDR_SECTION_PYRAMID);
     }
     gdr_occlusion_phase last = two_phases ? GDR_PHASE_LATE : GDR_PHASE_ONLY;
     add_phase(plan, last);
@@ -193,8 +204,6 @@ void gdr_frame_plan_build(const gdr_frame_config *config, gdr_frame_plan *plan)
         gdr_frame_plan_add(plan, &overdraw_max, last, draw);
         gdr_frame_plan_add(plan, &overdraw_paint, last, draw);
     }
-    if (two_phases) /* for the next frame's early phase */
-        gdr_frame_plan_add(plan, &pyramid, GDR_PHASE_LATE, GDR_SECTION_LATE_PYRAMID);
     gdr_frame_plan_add(plan, &readback, GDR_PHASE_ONLY, GDR_SECTION_READBACK);
     assert(plan->pass_count < GDR_FRAME_MAX_PASSES);
     gdr_frame_plan_derive(plan);

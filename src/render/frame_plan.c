@@ -9,13 +9,11 @@ static const VkAccessFlags2 write_access =
     VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
     VK_ACCESS_2_HOST_WRITE_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT;
 
-static bool use_applies(const gdr_resource_use *use, const gdr_frame_config *config, gdr_occlusion_phase phase)
+static bool use_applies(const gdr_resource_use *use, const gdr_frame_config *config)
 {
     if ((use->flags & GDR_USE_OVERDRAW_VIEW) && !config->overdraw)
         return false;
     if ((use->flags & GDR_USE_VISBUFFER) && !config->visbuffer)
-        return false;
-    if ((use->flags & GDR_USE_NOT_EARLY) && phase == GDR_PHASE_EARLY)
         return false;
     if ((use->flags & GDR_USE_TRAVERSAL) && config->traversal_levels == 0)
         return false;
@@ -37,7 +35,7 @@ void gdr_frame_plan_add_step(gdr_frame_plan *plan, const gdr_pass_template *pass
     *p = (gdr_frame_pass){.template_ = pass, .phase = phase, .step = step, .section = section, .timestamp = -1};
     for (uint32_t i = 0; i < GDR_PASS_MAX_USES; i++) {
         gdr_resource_use use = pass->uses[i];
-        if (!use_applies(&use, &plan->config, phase))
+        if (!use_applies(&use, &plan->config))
             continue;
         if (use.flags & GDR_USE_CLEARS)
             use.discard = phase != GDR_PHASE_LATE;

@@ -26,7 +26,7 @@ typedef enum gdr_occlusion_phase {
  * pass, images also get their layout transitions. */
 typedef enum gdr_frame_resource {
     GDR_RES_INSTANCES,        /* GdrGpuInstance[] (the update ring writes it) */
-    GDR_RES_VISIBILITY,       /* the occlusion history of instances and clusters */
+    GDR_RES_OCCLUDED,         /* the occluded lists: what the early phase defers to the late one */
     GDR_RES_DRAW_STATS,       /* the frame's counters and indirect launches (GdrGpuDrawStats) */
     GDR_RES_DRAWS,            /* indirect draw commands */
     GDR_RES_TASKS,            /* task commands */
@@ -36,7 +36,6 @@ typedef enum gdr_frame_resource {
     GDR_RES_RASTER_COUNTERS,  /* GdrGpuRasterCounters with the rasterisers' launches */
     GDR_RES_RASTER_CLUSTERS,  /* the visible-cluster list */
     GDR_RES_VISBUFFER,        /* the 64-bit visibility buffer */
-    GDR_RES_RESOLVED,         /* the resolve's colour and depth */
     GDR_RES_READBACK,         /* host-visible copies of the counters */
     GDR_RES_COLOR,            /* image: the colour target */
     GDR_RES_DEPTH,            /* image: the depth target */
@@ -54,7 +53,6 @@ typedef enum gdr_frame_section {
     GDR_SECTION_PYRAMID,
     GDR_SECTION_LATE_CULL,
     GDR_SECTION_LATE_DRAW,
-    GDR_SECTION_LATE_PYRAMID,
     GDR_SECTION_READBACK,
     GDR_SECTION_COUNT,
     GDR_SECTION_NONE = GDR_SECTION_COUNT /* not timed (the frame's first and last synchronisation) */
@@ -74,9 +72,9 @@ typedef enum gdr_raster_timer {
 #define GDR_USE_ALWAYS 0u
 #define GDR_USE_OVERDRAW_VIEW 1u  /* only in frames of the overdraw view */
 #define GDR_USE_VISBUFFER 2u      /* only in visibility-buffer frames */
-#define GDR_USE_CLEARS 4u         /* an attachment the pass clears in the frame's first raster phase
-                                     (old contents discarded) and loads in the late phase */
-#define GDR_USE_NOT_EARLY 8u      /* not in the early phase */
+#define GDR_USE_CLEARS 4u         /* an image the pass writes whole (clears, or the resolve) in the
+                                     frame's first raster phase (old contents discarded) and keeps in
+                                     the late phase */
 #define GDR_USE_TRAVERSAL 16u     /* only in frames that traverse the LOD hierarchy */
 
 typedef struct gdr_resource_use {

@@ -77,7 +77,9 @@ void gdr_pass_record_instance_cull(gdr_renderer *r, gdr_frame_slot *slot, const 
 {
     gdr_pipeline_id first = slot->plan.config.pipeline == GDR_PIPELINE_MESH ? GDR_PIPE_CULL_TASKS : GDR_PIPE_CULL_DRAWS;
     bind_compute(r, cmd, first + pass->phase);
-    if (r->scene.instance_count > 0)
+    if (pass->phase == GDR_PHASE_LATE) /* the instances the early phase deferred */
+        vkCmdDispatchIndirect(cmd, slot->draw_stats.buffer, offsetof(GdrGpuDrawStats, late_instances));
+    else if (r->scene.instance_count > 0)
         vkCmdDispatch(cmd, groups_for(r->scene.instance_count, GDR_CULL_WORKGROUP_SIZE), 1, 1);
 }
 
@@ -132,8 +134,8 @@ void gdr_pass_record_meshlets(gdr_renderer *r, gdr_frame_slot *slot, const gdr_f
 
 void gdr_pass_record_pyramid(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass, VkCommandBuffer cmd)
 {
-    (void)pass;
-    gdr_hzb_record_build(&r->occlusion.hzb, cmd);
+    (void)pass; /* the visibility-buffer modes never write the depth image: their depth is the buffer's */
+    gdr_hzb_record_build(&r->occlusion.hzb, cmd, slot->plan.config.visbuffer ? r->vis.pixels.address : 0);
     gdr_frame_bind_state(r, slot, cmd); /* the build bound its own layout */
 }
 

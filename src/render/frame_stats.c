@@ -22,9 +22,11 @@ static void fill_occlusion(const GdrGpuDrawStats *gpu, bool applied, gdr_occlusi
         .instances_late_occluded = gpu->instances_late_occluded,
         .instances_late_drawn = gpu->instances_late_drawn,
         .meshlets_early_drawn = gpu->meshlets_early_drawn,
+        .meshlets_early_occluded = gpu->meshlets_early_occluded,
         .meshlets_late_tested = gpu->meshlets_late_tested,
         .meshlets_late_occluded = gpu->meshlets_late_occluded,
         .meshlets_late_drawn = gpu->meshlets_late_drawn,
+        .overflow = gpu->occluded_overflow,
     };
 }
 
@@ -33,6 +35,9 @@ static void fill_gpu_driven(const gdr_frame_slot *slot, const GdrGpuDrawStats *g
 {
     bool occlusion = slot->occlusion_applied;
     stats->instances_visible = gpu->draw_count + (occlusion ? gpu->instances_late_drawn : 0);
+    stats->instances_invalid = gpu->instances_invalid;
+    stats->instances_screen_size_culled = gpu->instances_screen_size_culled;
+    stats->instances_clip_plane_culled = gpu->instances_clip_plane_culled;
     stats->draws = slot->pipeline == GDR_PIPELINE_MESH
                        ? gpu->task_groups_x * gpu->task_groups_y + gpu->late_task_groups_x * gpu->late_task_groups_y
                        : gpu->draw_count + gpu->late_draw_count;
@@ -50,6 +55,7 @@ static void fill_traversal(const gdr_frame_slot *slot, const GdrGpuDrawStats *gp
         .nodes_tested = gpu->nodes_tested,
         .nodes_lod_culled = gpu->nodes_lod_culled,
         .nodes_frustum_culled = gpu->nodes_frustum_culled,
+        .nodes_early_occluded = gpu->nodes_early_occluded,
         .nodes_occluded = gpu->nodes_occluded,
         .late_nodes_tested = gpu->late_nodes_tested,
         .overflow = gpu->traversal_overflow,
@@ -70,6 +76,8 @@ static void fill_mesh(const gdr_renderer *r, const gdr_frame_slot *slot, const G
     stats->task_workgroups = gpu->task_count + gpu->late_task_count;
     stats->task_overflow = gpu->task_overflow;
     fill_traversal(slot, gpu, &stats->traversal);
+    uint32_t kept = gpu->stream_requests < GDR_STREAM_REQUEST_CAPACITY ? gpu->stream_requests : GDR_STREAM_REQUEST_CAPACITY;
+    stats->streaming = (gdr_streaming_stats){r->scene.absent_groups, kept, gpu->stream_requests - kept};
     stats->lod.applied = slot->lod_applied;
     stats->lod.meshlets_culled = gpu->meshlets_lod_culled;
     for (uint32_t d = 0; d < GDR_LOD_STATS_DEPTH_COUNT; d++) {

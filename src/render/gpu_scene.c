@@ -13,7 +13,9 @@ static GdrGpuInstance gpu_instance_from(const gdr_scene *scene, const gdr_instan
      * without one take the default material the material buffer appends after the scene's. */
     bool has_material = instance->material < scene->material_count;
     return (GdrGpuInstance){.model = instance->transform, .color = instance->color, .mesh = instance->mesh,
-                            .material = has_material ? instance->material : scene->material_count};
+                            .material = has_material ? instance->material : scene->material_count,
+                            .min_screen_size = instance->min_screen_size,
+                            .max_screen_size = instance->max_screen_size};
 }
 
 /* The clusters of every mesh: the scene's own, or built here for meshes that have none (a scene
@@ -144,14 +146,10 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
     uint64_t instance_meshlets = 0, instance_lod_clusters = 0;
     for (uint32_t i = 0; i < scene->instance_count; i++) {
         instance_meshlets += g->cpu_meshes[scene->instances[i].mesh].meshlet_count;
-        g->cpu_instances[i].meshlet_visibility_offset = (uint32_t)instance_lod_clusters; /* checked below */
         instance_lod_clusters += g->cpu_meshes[scene->instances[i].mesh].lod_cluster_count;
     }
     g->instance_meshlet_count = instance_meshlets;
     g->instance_lod_cluster_count = instance_lod_clusters;
-    if (status == GDR_OK && instance_lod_clusters > UINT32_MAX)
-        status = gdr_error_set(err, GDR_ERROR_CAPACITY, "scene: %llu clusters over all instances exceed 32-bit indices",
-                               (unsigned long long)instance_lod_clusters);
     g->meshlet_count = (uint32_t)meshlet_total;
     const VkBufferUsageFlags usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     if (status == GDR_OK)
@@ -180,8 +178,6 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
     return status;
 }
 
-/* The LOD hierarchy pool: every mesh's gdr_lod_node array as it is (the bytes of GdrGpuLodNode,
- * mesh-local indices), one after another. Fills the meshes' lod_node fields. */
 /* Task commands one instance of mesh `c` can need in a phase: all its clusters (flat), or one run
  * per hierarchy leaf the traversal reaches. */
 static uint64_t tasks_per_instance(const gdr_mesh_clusters *c, const GdrGpuMesh *mesh)
@@ -218,6 +214,36 @@ static void size_queues(gdr_renderer *r, const gdr_scene *scene, const gdr_mesh_
     g->traversal_capacity = g->traversal_capacity ? g->traversal_capacity : 1;
 }
 
+/* Mesh c's nodes for the GPU: each gdr_lod_node's bytes, then its culling sphere, which encloses its
+ * clusters' spheres (leaf) or its children's culling spheres (inner node). Children follow their
+ * parent in the array (the root is node 0), so one pass from the end finds every child's first;
+ * a node whose children do not follow it keeps its LOD sphere, which also holds them. */
+static void gpu_lod_nodes(const gdr_mesh_clusters *c, GdrGpuLodNode *out)
+{
+    gdr_vec4 spheres[GDR_LOD_NODE_MAX_CHILDREN];
+    for (uint32_t n = c->lod_node_count; n-- > 0;) {
+        const gdr_lod_node *node = &c->lod_nodes[n];
+        memcpy(&out[n], node, sizeof *node);
+        out[n].bounds = node->sphere;
+        bool leaf = (node->flags & GDR_LOD_NODE_LEAF) != 0;
+        if (leaf && (uint64_t)node->first + node->count <= c->cluster_count) {
+            gdr_vec4 *cluster_spheres = malloc(sizeof *cluster_spheres * (node->count ? node->count : 1));
+            for (uint32_t i = 0; cluster_spheres && i < node->count; i++)
+                cluster_spheres[i] = c->clusters[node->first + i].sphere;
+            if (cluster_spheres && node->count)
+                out[n].bounds = gdr_lod_enclosing_sphere(cluster_spheres, node->count);
+            free(cluster_spheres);
+        } else if (!leaf && node->first > n && node->count <= GDR_LOD_NODE_MAX_CHILDREN &&
+                   (uint64_t)node->first + node->count <= c->lod_node_count && node->count) {
+            for (uint32_t i = 0; i < node->count; i++)
+                spheres[i] = out[node->first + i].bounds;
+            out[n].bounds = gdr_lod_enclosing_sphere(spheres, node->count);
+        }
+    }
+}
+
+/* The LOD hierarchy pool: every mesh's nodes (gpu_lod_nodes, mesh-local indices), one after another.
+ * Fills the meshes' lod_node fields. */
 static gdr_status upload_lod_nodes(gdr_renderer *r, const gdr_scene *scene, const gdr_mesh_clusters *const *clusters,
                                    gdr_error *err)
 {
@@ -241,8 +267,7 @@ static gdr_status upload_lod_nodes(gdr_renderer *r, const gdr_scene *scene, cons
         bool traversed = g->cpu_meshes[m].lod_task_count > GDR_TRAVERSE_MIN_TASKS; /* as drawcull.comp decides */
         if (traversed && c->lod_node_levels > g->traversal_levels)
             g->traversal_levels = c->lod_node_levels;
-        if (c->lod_node_count)
-            memcpy(nodes + cursor, c->lod_nodes, sizeof *nodes * c->lod_node_count);
+        gpu_lod_nodes(c, nodes + cursor);
         cursor += c->lod_node_count;
     }
     /* TRANSFER_SRC: tests read the pool back. */
@@ -321,6 +346,8 @@ gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
     if (status == GDR_OK)
         status = upload_lod_nodes(r, scene, clusters, err);
     if (status == GDR_OK)
+        status = gdr_page_table_create(r, clusters, scene->mesh_count, err);
+    if (status == GDR_OK)
         size_queues(r, scene, clusters);
     if (status == GDR_OK) /* the traversal's visits: even levels, then odd levels */
         status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuNodeVisit) * 2 * (VkDeviceSize)g->traversal_capacity,
@@ -356,18 +383,19 @@ gdr_status gdr_gpu_scene_write_refs(gdr_renderer *r, gdr_error *err)
                         .vertices = g->vertices.address, .meshlets = g->meshlets.address,
                         .meshlet_vertices = g->meshlet_vertices.address,
                         .meshlet_triangles = g->meshlet_triangles.address,
-                        .instance_visibility = r->occlusion.instance_visibility.address,
-                        .meshlet_visibility = r->occlusion.meshlet_visibility.address,
-                        .lod_nodes = g->lod_nodes.address, .materials = r->materials.buffer.address};
+                        .lod_nodes = g->lod_nodes.address, .page_table = g->page_table.address,
+                        .node_absent_refined = g->node_absent_refined.address,
+                        .materials = r->materials.buffer.address};
     gdr_status status = gdr_vk_buffer_create(&r->allocator, sizeof refs,
                                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                              GDR_VK_BUFFER_DEVICE, &g->refs, err);
     if (status == GDR_OK)
         status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->refs, 0, &refs, sizeof refs, err);
     const gdr_vk_buffer *buffers[] = {&g->vertices, &g->indices, &g->meshes, &g->instances, &g->meshlets,
-                                      &g->meshlet_vertices, &g->meshlet_triangles, &g->refs,
-                                      &r->occlusion.instance_visibility, &r->occlusion.meshlet_visibility};
-    g->bytes = 0;
+                                      &g->meshlet_vertices, &g->meshlet_triangles, &g->refs, &g->page_table,
+                                      &g->node_absent_refined, &g->stream_requests,
+                                      &r->occlusion.occluded_instances, &r->occlusion.occluded_nodes,
+                                      &r->occlusion.retest_masks};
     g->bytes = r->materials.bytes;
     for (size_t i = 0; i < sizeof buffers / sizeof buffers[0]; i++)
         g->bytes += buffers[i]->size;
@@ -387,6 +415,7 @@ void gdr_gpu_scene_destroy(gdr_renderer *r)
     gdr_vk_buffer_destroy(r->ctx, &g->lod_nodes);
     gdr_vk_buffer_destroy(r->ctx, &g->traversal);
     gdr_vk_buffer_destroy(r->ctx, &g->refs);
+    gdr_page_table_destroy(r);
     free(g->cpu_meshlets);
     free(g->cpu_meshes);
     free(g->cpu_instances);

@@ -7,10 +7,11 @@
 #include "vk/vk_descriptors.h"
 #include "vk/vk_image.h"
 
-/* Workgroup size of depthreduce.comp.glsl, given to it as specialization constants 0 and 1. */
-#define HZB_GROUP_SIZE 8u
+/* Workgroup size of depthreduce.comp.glsl: a TILE x TILE tile of the first level of a dispatch. */
+#define HZB_TILE 16u
 
-_Static_assert(sizeof(GdrDepthReducePush) == 20, "GdrDepthReducePush: five uints, as the shader reads them");
+_Static_assert(sizeof(GdrDepthReducePush) == 32 && offsetof(GdrDepthReducePush, visibility_buffer) == 24,
+               "GdrDepthReducePush: six uints and an address, as the shader reads them");
 
 uint32_t gdr_hzb_size_for(uint32_t depth_size)
 {
@@ -72,14 +73,19 @@ static gdr_status create_image(gdr_hzb *hzb, gdr_vk_allocator *allocator, gdr_er
     return GDR_OK;
 }
 
+static uint32_t dispatch_count(const gdr_hzb *hzb)
+{
+    return (hzb->level_count + GDR_HZB_LEVELS_PER_DISPATCH - 1) / GDR_HZB_LEVELS_PER_DISPATCH;
+}
+
 static gdr_status create_pipeline(gdr_hzb *hzb, gdr_error *err)
 {
     gdr_vk_context *ctx = hzb->ctx;
     VkDescriptorSetLayoutBinding bindings[2] = {
         {.binding = 0, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT},
-        {.binding = 1, .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, .descriptorCount = 1,
-         .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT},
+        {.binding = 1, .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+         .descriptorCount = GDR_HZB_LEVELS_PER_DISPATCH, .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT},
     };
     gdr_status status = gdr_vk_descriptor_set_layout_create(ctx, bindings, 2, &hzb->set_layout, err);
     if (status == GDR_OK)
@@ -93,14 +99,10 @@ static gdr_status create_pipeline(gdr_hzb *hzb, gdr_error *err)
                                             .pCode = gdr_shader_depthreduce_comp.code};
     VkShaderModule module;
     GDR_VK_TRY(err, vkCreateShaderModule(ctx->device, &module_info, NULL, &module));
-    uint32_t group_size[2] = {HZB_GROUP_SIZE, HZB_GROUP_SIZE};
-    VkSpecializationMapEntry entries[2] = {{0, 0, sizeof(uint32_t)}, {1, sizeof(uint32_t), sizeof(uint32_t)}};
-    VkSpecializationInfo specialization = {.mapEntryCount = 2, .pMapEntries = entries,
-                                           .dataSize = sizeof group_size, .pData = group_size};
     VkComputePipelineCreateInfo info = {
         .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
         .stage = {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, .stage = VK_SHADER_STAGE_COMPUTE_BIT,
-                  .module = module, .pName = "main", .pSpecializationInfo = &specialization},
+                  .module = module, .pName = "main"},
         .layout = hzb->pipeline_layout,
     };
     VkResult result = vkCreateComputePipelines(ctx->device, VK_NULL_HANDLE, 1, &info, NULL, &hzb->pipeline);
@@ -109,25 +111,37 @@ static gdr_status create_pipeline(gdr_hzb *hzb, gdr_error *err)
     return GDR_OK;
 }
 
+/* Set d: the source (the depth image, or the level before the dispatch's first) and the
+ * GDR_HZB_LEVELS_PER_DISPATCH levels from 5d (past the last level: the last one again, never
+ * written). */
 static gdr_status create_descriptors(gdr_hzb *hzb, VkImageView depth_view, gdr_error *err)
 {
     gdr_vk_context *ctx = hzb->ctx;
-    VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, hzb->level_count},
-                                     {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, hzb->level_count}};
-    gdr_status status = gdr_vk_descriptor_pool_create(ctx, hzb->level_count, sizes, 2, &hzb->pool, err);
+    uint32_t sets = dispatch_count(hzb);
+    VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, sets},
+                                     {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, sets * GDR_HZB_LEVELS_PER_DISPATCH}};
+    gdr_status status = gdr_vk_descriptor_pool_create(ctx, sets, sizes, 2, &hzb->pool, err);
     if (status == GDR_OK)
-        status = gdr_vk_descriptor_sets_allocate(ctx, hzb->pool, hzb->set_layout, hzb->level_count, hzb->sets, err);
+        status = gdr_vk_descriptor_sets_allocate(ctx, hzb->pool, hzb->set_layout, sets, hzb->sets, err);
     if (status != GDR_OK)
         return status;
-    for (uint32_t level = 0; level < hzb->level_count; level++) {
-        if (level == 0)
+    for (uint32_t d = 0; d < sets; d++) {
+        uint32_t first = d * GDR_HZB_LEVELS_PER_DISPATCH;
+        if (d == 0)
             gdr_vk_write_image_descriptor(ctx, hzb->sets[0], 0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                                           hzb->depth_sampler, depth_view, hzb->depth_layout);
         else
-            gdr_vk_write_image_descriptor(ctx, hzb->sets[level], 0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-                                          hzb->min_sampler, hzb->level_views[level - 1], GDR_HZB_LAYOUT);
-        gdr_vk_write_image_descriptor(ctx, hzb->sets[level], 1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_NULL_HANDLE,
-                                      hzb->level_views[level], GDR_HZB_LAYOUT);
+            gdr_vk_write_image_descriptor(ctx, hzb->sets[d], 0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                                          hzb->min_sampler, hzb->level_views[first - 1], GDR_HZB_LAYOUT);
+        VkDescriptorImageInfo levels[GDR_HZB_LEVELS_PER_DISPATCH];
+        for (uint32_t k = 0; k < GDR_HZB_LEVELS_PER_DISPATCH; k++) {
+            uint32_t level = first + k < hzb->level_count ? first + k : hzb->level_count - 1;
+            levels[k] = (VkDescriptorImageInfo){.imageView = hzb->level_views[level], .imageLayout = GDR_HZB_LAYOUT};
+        }
+        VkWriteDescriptorSet write = {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = hzb->sets[d],
+                                      .dstBinding = 1, .descriptorCount = GDR_HZB_LEVELS_PER_DISPATCH,
+                                      .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, .pImageInfo = levels};
+        vkUpdateDescriptorSets(ctx->device, 1, &write, 0, NULL);
     }
     return GDR_OK;
 }
@@ -210,7 +224,7 @@ static void pyramid_barrier(VkCommandBuffer cmd, const gdr_hzb *hzb, uint32_t fi
     gdr_vk_barrier(cmd, &(gdr_vk_barrier_desc){.images = &t, .image_count = 1});
 }
 
-void gdr_hzb_record_build(const gdr_hzb *hzb, VkCommandBuffer cmd)
+void gdr_hzb_record_build(const gdr_hzb *hzb, VkCommandBuffer cmd, VkDeviceAddress visibility_buffer)
 {
     const VkPipelineStageFlags2 compute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
     /* Discard the old pyramid once the previous build's writes and every read of them are done. */
@@ -218,22 +232,24 @@ void gdr_hzb_record_build(const gdr_hzb *hzb, VkCommandBuffer cmd)
                     VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, compute,
                     VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, hzb->pipeline);
-    for (uint32_t level = 0; level < hzb->level_count; level++) {
+    for (uint32_t d = 0; d < dispatch_count(hzb); d++) {
+        uint32_t first = d * GDR_HZB_LEVELS_PER_DISPATCH, left = hzb->level_count - first;
         GdrDepthReducePush push = {
-            .source_width = level == 0 ? hzb->depth_width : level_size(hzb->width, level - 1),
-            .source_height = level == 0 ? hzb->depth_height : level_size(hzb->height, level - 1),
-            .destination_width = level_size(hzb->width, level),
-            .destination_height = level_size(hzb->height, level),
-            .from_depth = level == 0,
+            .source_width = d == 0 ? hzb->depth_width : level_size(hzb->width, first - 1),
+            .source_height = d == 0 ? hzb->depth_height : level_size(hzb->height, first - 1),
+            .destination_width = level_size(hzb->width, first),
+            .destination_height = level_size(hzb->height, first),
+            .from_depth = d == 0,
+            .level_count = left < GDR_HZB_LEVELS_PER_DISPATCH ? left : GDR_HZB_LEVELS_PER_DISPATCH,
+            .visibility_buffer = d == 0 ? visibility_buffer : 0,
         };
-        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, hzb->pipeline_layout, 0, 1, &hzb->sets[level], 0,
-                                NULL);
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, hzb->pipeline_layout, 0, 1, &hzb->sets[d], 0, NULL);
         vkCmdPushConstants(cmd, hzb->pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-        vkCmdDispatch(cmd, (push.destination_width + HZB_GROUP_SIZE - 1) / HZB_GROUP_SIZE,
-                      (push.destination_height + HZB_GROUP_SIZE - 1) / HZB_GROUP_SIZE, 1);
-        if (level + 1 < hzb->level_count) /* the next dispatch samples this level */
-            pyramid_barrier(cmd, hzb, level, 1, GDR_HZB_LAYOUT, compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, compute,
-                            VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+        vkCmdDispatch(cmd, (push.destination_width + HZB_TILE - 1) / HZB_TILE,
+                      (push.destination_height + HZB_TILE - 1) / HZB_TILE, 1);
+        if (first + push.level_count < hzb->level_count) /* the next dispatch samples the last level written */
+            pyramid_barrier(cmd, hzb, first, push.level_count, GDR_HZB_LAYOUT, compute,
+                            VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, compute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
     }
     pyramid_barrier(cmd, hzb, 0, hzb->level_count, GDR_HZB_LAYOUT, compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                     hzb->reader_stages, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);

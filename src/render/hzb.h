@@ -5,7 +5,7 @@
  * (reverse-Z: the farthest). Level 0 takes the minimum over every depth pixel its area overlaps, so
  * odd and non-power-of-two depth sizes lose no row or column.
  *
- * Built by compute, one dispatch per level (depthreduce.comp.glsl). Sampling it for the occlusion
+ * Built by compute, one dispatch per GDR_HZB_LEVELS_PER_DISPATCH levels (depthreduce.comp.glsl). Sampling it for the occlusion
  * test: src/shaders/shared/occlusion_math.h.
  *
  * Synchronization contract of gdr_hzb_record_build:
@@ -66,7 +66,7 @@ typedef struct gdr_hzb {
     VkPipelineLayout pipeline_layout;
     VkPipeline pipeline;
     VkDescriptorPool pool;
-    VkDescriptorSet sets[GDR_HZB_MAX_LEVELS]; /* set i: source (depth or level i - 1) -> level i */
+    VkDescriptorSet sets[GDR_HZB_MAX_LEVELS]; /* set d: source (depth or level 5d - 1) -> levels 5d .. 5d + 4 */
 } gdr_hzb;
 
 /* Level-0 size for a depth size: the largest power of two <= depth_size (depth_size > 0). */
@@ -82,8 +82,11 @@ gdr_status gdr_hzb_create(gdr_vk_context *ctx, gdr_vk_allocator *allocator, cons
 void gdr_hzb_destroy(gdr_hzb *hzb);
 
 /* Records the whole build into `cmd` (outside a render pass), with every barrier it needs; see the
- * synchronization contract above. */
-void gdr_hzb_record_build(const gdr_hzb *hzb, VkCommandBuffer cmd);
+ * synchronization contract above. With a `visibility_buffer` address (else 0), level 0 comes from
+ * the depth in that buffer (GdrDepthReducePush.visibility_buffer, the depth image's size) instead
+ * of the depth image: its writes must be visible to compute shader reads, and the depth image must
+ * still be in the layout given at create (its descriptor stays bound; it is not read). */
+void gdr_hzb_record_build(const gdr_hzb *hzb, VkCommandBuffer cmd, VkDeviceAddress visibility_buffer);
 
 /* Records the barrier that makes a depth image that was just rendered (in `from`, typically
  * DEPTH_ATTACHMENT_OPTIMAL, written by the fragment tests) readable by the build, in the layout

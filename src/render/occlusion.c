@@ -18,18 +18,23 @@ gdr_status gdr_occlusion_create(gdr_renderer *r, gdr_error *err)
     gdr_hzb_desc desc = {.depth_width = r->width, .depth_height = r->height, .depth_view = r->depth.view,
                          .depth_layout = VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL, .reader_stages = readers};
     gdr_status status = gdr_hzb_create(r->ctx, &r->allocator, &desc, &o->hzb, err);
-    VkDescriptorSetLayoutBinding binding = {0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, reader_shaders, NULL};
-    VkDescriptorPoolSize size = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
+    /* Binding 1: the colour target, which the visibility buffer's resolve writes as a storage image. */
+    VkDescriptorSetLayoutBinding bindings[2] = {
+        {0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, reader_shaders, NULL},
+        {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL}};
+    VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1}};
     if (status == GDR_OK)
-        status = gdr_vk_descriptor_set_layout_create(r->ctx, &binding, 1, &o->set_layout, err);
+        status = gdr_vk_descriptor_set_layout_create(r->ctx, bindings, 2, &o->set_layout, err);
     if (status == GDR_OK)
-        status = gdr_vk_descriptor_pool_create(r->ctx, 1, &size, 1, &o->pool, err);
+        status = gdr_vk_descriptor_pool_create(r->ctx, 1, sizes, 2, &o->pool, err);
     if (status == GDR_OK)
         status = gdr_vk_descriptor_sets_allocate(r->ctx, o->pool, o->set_layout, 1, &o->set, err);
     if (status != GDR_OK)
         return status;
     gdr_vk_write_image_descriptor(r->ctx, o->set, 0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, o->hzb.min_sampler,
                                   o->hzb.view, GDR_HZB_LAYOUT);
+    gdr_vk_write_image_descriptor(r->ctx, o->set, 1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_NULL_HANDLE, r->color.view,
+                                  VK_IMAGE_LAYOUT_GENERAL);
     /* The culling shaders read the pyramid's descriptor even in frames that skip the test: give it
      * its layout (and "nothing is hidden": depth 0 is infinitely far) before any frame. */
     VkCommandBuffer cmd;
@@ -79,42 +84,28 @@ void gdr_occlusion_destroy(gdr_renderer *r)
 gdr_status gdr_occlusion_scene_create(gdr_renderer *r, gdr_error *err)
 {
     gdr_occlusion *o = &r->occlusion;
-    uint64_t instances = r->scene.instance_count ? r->scene.instance_count : 1;
-    uint64_t words = (r->scene.instance_lod_cluster_count + 31) / 32;
-    words = words ? words : 1;
-    if (words > UINT32_MAX / 4)
-        return gdr_error_set(err, GDR_ERROR_CAPACITY, "occlusion: %llu clusters over all instances is too many",
-                             (unsigned long long)r->scene.instance_lod_cluster_count);
-    const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-    gdr_status status = gdr_vk_buffer_create(&r->allocator, 4 * instances, usage, GDR_VK_BUFFER_DEVICE,
-                                             &o->instance_visibility, err);
+    const gdr_gpu_scene *g = &r->scene;
+    /* One level's worth of visits: a frame that defers more traverses the rest in its early phase. */
+    o->occluded_node_capacity = r->debug_occluded_node_capacity ? r->debug_occluded_node_capacity : g->traversal_capacity;
+    const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    gdr_status status = gdr_vk_buffer_create(&r->allocator, 4 * (VkDeviceSize)(g->instance_count ? g->instance_count : 1),
+                                             usage, GDR_VK_BUFFER_DEVICE, &o->occluded_instances, err);
     if (status == GDR_OK)
-        status = gdr_vk_buffer_create(&r->allocator, 4 * words, usage, GDR_VK_BUFFER_DEVICE, &o->meshlet_visibility, err);
-    uint32_t *zeros = status == GDR_OK ? calloc(words > instances ? words : instances, 4) : NULL;
-    if (status == GDR_OK && !zeros)
-        status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "occlusion: out of memory");
+        status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuNodeVisit) * (VkDeviceSize)o->occluded_node_capacity,
+                                      usage, GDR_VK_BUFFER_DEVICE, &o->occluded_nodes, err);
     if (status == GDR_OK)
-        status = gdr_vk_buffer_upload(r->ctx, &r->staging, &o->instance_visibility, 0, zeros, 4 * instances, err);
-    if (status == GDR_OK)
-        status = gdr_vk_buffer_upload(r->ctx, &r->staging, &o->meshlet_visibility, 0, zeros, 4 * words, err);
-    free(zeros);
+        status = gdr_vk_buffer_create(&r->allocator, 4 * (VkDeviceSize)g->task_capacity, usage, GDR_VK_BUFFER_DEVICE,
+                                      &o->retest_masks, err);
     o->history_valid = false;
     return status;
 }
 
 void gdr_occlusion_scene_destroy(gdr_renderer *r)
 {
-    gdr_vk_buffer_destroy(r->ctx, &r->occlusion.instance_visibility);
-    gdr_vk_buffer_destroy(r->ctx, &r->occlusion.meshlet_visibility);
+    gdr_vk_buffer_destroy(r->ctx, &r->occlusion.occluded_instances);
+    gdr_vk_buffer_destroy(r->ctx, &r->occlusion.occluded_nodes);
+    gdr_vk_buffer_destroy(r->ctx, &r->occlusion.retest_masks);
     r->occlusion.history_valid = false;
-}
-
-void gdr_occlusion_record_pyramid(gdr_renderer *r, VkCommandBuffer cmd)
-{
-    const gdr_hzb *hzb = &r->occlusion.hzb;
-    gdr_hzb_record_depth_to_read(hzb, cmd, r->depth.image, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
-    gdr_hzb_record_build(hzb, cmd);
-    gdr_hzb_record_depth_to_attachment(hzb, cmd, r->depth.image, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
 }
 
 void gdr_occlusion_params(const gdr_renderer *r, const gdr_mat4 *projection, float znear, GdrOcclusionParams *out)

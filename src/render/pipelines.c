@@ -73,8 +73,6 @@ static const gdr_pipeline_entry entries[GDR_PIPE_COUNT] = {
     [GDR_PIPE_RASTER_SW] = {"raster_sw", GDR_NEEDS_VISIBILITY_BUFFER, .compute = &gdr_shader_raster_sw_comp},
     [GDR_PIPE_RESOLVE] = {"resolve", GDR_NEEDS_VISIBILITY_BUFFER, .compute = &gdr_shader_visbuffer_resolve_comp,
                           .constants = {0}, .constant_count = 1},
-    [GDR_PIPE_RESOLVE_DEPTH] = {"resolve_depth", GDR_NEEDS_VISIBILITY_BUFFER,
-                                .compute = &gdr_shader_visbuffer_resolve_comp, .constants = {1}, .constant_count = 1},
 };
 
 const char *gdr_pipeline_id_name(gdr_pipeline_id id)

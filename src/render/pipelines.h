@@ -25,7 +25,6 @@ typedef enum gdr_pipeline_id {
     GDR_PIPE_RASTER_HW,
     GDR_PIPE_RASTER_SW,
     GDR_PIPE_RESOLVE,
-    GDR_PIPE_RESOLVE_DEPTH,
     GDR_PIPE_COUNT
 } gdr_pipeline_id;
 

@@ -1,4 +1,5 @@
 /* The public renderer API: device and resources, scene upload, the frame loop and its statistics. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -35,12 +36,11 @@ static gdr_status create_targets(gdr_renderer *r, gdr_error *err)
 {
     gdr_vk_image_desc color = {.width = r->width, .height = r->height, .format = GDR_COLOR_FORMAT,
                                .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-                                        VK_IMAGE_USAGE_TRANSFER_DST_BIT}; /* the visibility buffer's resolve */
+                                        VK_IMAGE_USAGE_STORAGE_BIT}; /* the visibility buffer's resolve */
     gdr_vk_image_desc depth = {.width = r->width, .height = r->height, .format = GDR_DEPTH_FORMAT,
                                .usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT |
                                         VK_IMAGE_USAGE_SAMPLED_BIT |      /* the depth pyramid */
-                                        VK_IMAGE_USAGE_TRANSFER_SRC_BIT | /* tests read it back */
-                                        VK_IMAGE_USAGE_TRANSFER_DST_BIT,  /* the visibility buffer's resolve */
+                                        VK_IMAGE_USAGE_TRANSFER_SRC_BIT,  /* tests read it back */
                                .aspect = VK_IMAGE_ASPECT_DEPTH_BIT};
     gdr_status status = gdr_vk_image_create(&r->allocator, &color, &r->color, err);
     if (status == GDR_OK)
@@ -86,10 +86,14 @@ gdr_status gdr_renderer_create(const gdr_renderer_desc *desc_in, gdr_renderer **
     r->record_every_frame = desc.record_every_frame;
     r->debug_task_capacity = desc.debug_task_capacity;
     r->debug_traversal_capacity = desc.debug_traversal_capacity;
+    r->debug_occluded_node_capacity = desc.debug_occluded_node_capacity;
     r->debug_shrink_lod_nodes = desc.debug_shrink_lod_nodes;
     gdr_vk_context_desc context_desc = {.device = desc.device, .validate = desc.validate,
                                         .synchronization_validation = desc.synchronization_validation,
-                                        .disable_mesh_shaders = desc.disable_mesh_shaders};
+                                        .disable_mesh_shaders = desc.disable_mesh_shaders,
+                                        .instance_extensions = desc.instance_extensions,
+                                        .instance_extension_count = desc.instance_extension_count,
+                                        .swapchain = desc.presentable};
     gdr_status status = gdr_vk_context_create(&context_desc, &r->ctx, err);
     if (status == GDR_OK) {
         gdr_vk_allocator_init(&r->allocator, r->ctx);
@@ -262,11 +266,23 @@ static gdr_status check_frame(gdr_renderer *r, const gdr_frame_desc *frame, uint
                              "render: camera needs 0 < yfov < pi, znear > 0 and zfar = 0 or > znear "
                              "(yfov %g, znear %g, zfar %g)", (double)camera->yfov, (double)camera->znear,
                              (double)camera->zfar);
+    const gdr_camera *cull = frame->cull_camera;
+    if (cull && (cull->yfov != camera->yfov || cull->aspect != camera->aspect || cull->znear != camera->znear ||
+                 cull->zfar != camera->zfar))
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
+                             "render: the culling camera's projection (yfov, aspect, znear, zfar) must be the camera's");
     if ((unsigned)frame->view > GDR_VIEW_MODE_LOD)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: unknown view %d", (int)frame->view);
     if (!(frame->lod_error_px >= 0.0f && frame->lod_error_px <= 1e30f))
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: lod_error_px must be finite and >= 0 (%g)",
                              (double)frame->lod_error_px);
+    if (!(frame->min_screen_size >= 0.0f && frame->min_screen_size <= 1e30f))
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: min_screen_size must be finite and >= 0 (%g)",
+                             (double)frame->min_screen_size);
+    const float *plane = &frame->clip_plane.x;
+    for (int i = 0; i < 4; i++)
+        if (!isfinite(plane[i]))
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: clip_plane must be finite");
     gdr_status status = resolve_pipeline(r, frame, pipeline, reason, reason_size, err);
     if (status == GDR_OK)
         status = gdr_visbuffer_resolve_mode(r, frame, *pipeline, &r->vis.mode, r->vis.reason, sizeof r->vis.reason, err);

@@ -46,7 +46,13 @@ typedef struct gdr_gpu_scene {
     gdr_vk_buffer meshlet_triangles; /* uint32[] holding 3 bytes per cluster triangle */
     gdr_vk_buffer traversal;         /* GdrGpuNodeVisit[2 * traversal_capacity]: the traversal's levels */
     gdr_vk_buffer lod_nodes;         /* GdrGpuLodNode[]: every mesh's LOD hierarchy, as gdr_lod_node */
+    gdr_vk_buffer page_table;        /* uint32 per group of every mesh (shared/residency.h, page_table.c) */
+    gdr_vk_buffer node_absent_refined; /* uint32 per LOD node: clusters below whose refined group is absent */
+    gdr_vk_buffer stream_requests;   /* GdrGpuStreamRequest[GDR_STREAM_REQUEST_CAPACITY]: the last frame's */
     gdr_vk_buffer refs;              /* GdrGpuScene: the addresses above, for the push constants */
+    uint32_t group_total, node_total; /* LOD groups and nodes of every mesh */
+    uint64_t absent_groups;          /* groups whose page-table word is GDR_GPU_PAGE_ABSENT */
+    uint32_t *cpu_mesh_absent;       /* absent groups per mesh (NULL until a group was marked) */
     uint32_t mesh_count;
     uint32_t instance_count;
     uint32_t meshlet_count;
@@ -116,7 +122,8 @@ struct gdr_renderer {
     gdr_frame_slot slots[GDR_FRAMES_IN_FLIGHT];
     uint32_t frame_index;
     bool record_every_frame;      /* gdr_renderer_desc.record_every_frame: never resubmit */
-    uint32_t debug_task_capacity, debug_traversal_capacity; /* gdr_renderer_desc's test settings */
+    uint32_t debug_task_capacity, debug_traversal_capacity, debug_occluded_node_capacity; /* gdr_renderer_desc's
+                                                                                               test settings */
     bool debug_shrink_lod_nodes;
     int last_slot; /* slot of the last submitted frame, -1 before the first */
 };
@@ -129,6 +136,11 @@ gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
 /* The scene's buffer addresses (GdrGpuScene) for the push constants; after the occlusion history. */
 gdr_status gdr_gpu_scene_write_refs(gdr_renderer *r, gdr_error *err);
 void gdr_gpu_scene_destroy(gdr_renderer *r);
+/* The page table and the per-node absent counts (page_table.c), every group resident; fills the
+ * meshes' page_table_offset. */
+gdr_status gdr_page_table_create(gdr_renderer *r, const gdr_mesh_clusters *const *clusters, uint32_t mesh_count,
+                                 gdr_error *err);
+void gdr_page_table_destroy(gdr_renderer *r);
 gdr_status gdr_frame_slots_create(gdr_renderer *r, gdr_error *err);
 void gdr_frame_slots_destroy(gdr_renderer *r);
 

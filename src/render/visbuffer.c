@@ -33,10 +33,6 @@ gdr_status gdr_visbuffer_create(gdr_renderer *r, bool disabled, gdr_error *err)
                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
                                           VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                       GDR_VK_BUFFER_DEVICE, &v->pixels, err);
-    if (status == GDR_OK) /* the resolve's colour and depth, copied into the images */
-        status = gdr_vk_buffer_create(&r->allocator, (VkDeviceSize)r->width * r->height * 2 * sizeof(uint32_t),
-                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                                      GDR_VK_BUFFER_DEVICE, &v->resolved, err);
     if (status == GDR_OK)
         status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuRasterCounters),
                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
@@ -66,7 +62,6 @@ void gdr_visbuffer_destroy(gdr_renderer *r)
 {
     gdr_visbuffer *v = &r->vis;
     gdr_vk_buffer_destroy(r->ctx, &v->pixels);
-    gdr_vk_buffer_destroy(r->ctx, &v->resolved);
     gdr_vk_buffer_destroy(r->ctx, &v->clusters);
     gdr_vk_buffer_destroy(r->ctx, &v->counters);
     for (uint32_t i = 0; i < GDR_FRAMES_IN_FLIGHT; i++) {
@@ -154,7 +149,6 @@ void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_f
         .sw_threshold_px = gdr_visbuffer_threshold(frame),
         .ndc_scale = {fabsf(projection.m[0]), fabsf(projection.m[5])},
         .hw_launch_limit = (uint32_t)(rows * GDR_MESH_GROUPS_PER_ROW),
-        .resolved = v->resolved.address,
     };
     memcpy(v->params[slot_index].mapped, &params, sizeof params);
 }
@@ -205,35 +199,15 @@ void gdr_visbuffer_record_raster_sw(gdr_renderer *r, gdr_frame_slot *slot, const
     vkCmdDispatchIndirect(cmd, r->vis.counters.buffer, offsetof(GdrGpuRasterCounters, dispatch_x));
 }
 
-/* The resolve: shades every pixel (the early phase: its depth only, the late phase shades what both
- * phases drew) into the resolved buffer. */
+/* The resolve: shades every pixel into the colour image, launched with what raster_submit.comp wrote:
+ * the whole screen in the frame's first raster phase and in a late phase that drew something,
+ * nothing otherwise (the image then holds the early phase's, which is the frame's). */
 void gdr_visbuffer_record_resolve(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
                                   VkCommandBuffer cmd)
 {
-    (void)slot;
-    gdr_pipeline_id id = pass->phase == GDR_PHASE_EARLY ? GDR_PIPE_RESOLVE_DEPTH : GDR_PIPE_RESOLVE;
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->pipelines[id]);
-    vkCmdDispatch(cmd, (r->width + GDR_RESOLVE_TILE - 1) / GDR_RESOLVE_TILE,
-                  (r->height + GDR_RESOLVE_TILE - 1) / GDR_RESOLVE_TILE, 1);
-}
-
-/* The resolved colour (not in the early phase) and depth into the images (the depth for the
- * pyramid). */
-void gdr_visbuffer_record_resolve_copy(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
-                                       VkCommandBuffer cmd)
-{
-    (void)slot;
-    VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
-    if (pass->phase != GDR_PHASE_EARLY) {
-        VkBufferImageCopy color = {.bufferOffset = 0, .imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
-                                   .imageExtent = {r->width, r->height, 1}};
-        vkCmdCopyBufferToImage(cmd, r->vis.resolved.buffer, r->color.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
-                               &color);
-    }
-    VkBufferImageCopy depth = {.bufferOffset = pixels * sizeof(uint32_t),
-                               .imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1},
-                               .imageExtent = {r->width, r->height, 1}};
-    vkCmdCopyBufferToImage(cmd, r->vis.resolved.buffer, r->depth.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &depth);
+    (void)slot, (void)pass;
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->pipelines[GDR_PIPE_RESOLVE]);
+    vkCmdDispatchIndirect(cmd, r->vis.counters.buffer, offsetof(GdrGpuRasterCounters, resolve_x));
 }
 
 void gdr_visbuffer_stats(gdr_renderer *r, uint32_t slot_index, gdr_frame_stats *stats)
@@ -306,16 +280,24 @@ gdr_status gdr_visbuffer_read_pixels(gdr_renderer *r, gdr_visbuffer_pixel *pixel
     return status;
 }
 
+/* The depth of a visibility-buffer frame is the high word of each pixel (the depth image is not
+ * written); a forward frame's is the depth image. */
 gdr_status gdr_visbuffer_read_depth(gdr_renderer *r, float *depth, gdr_error *err)
 {
     gdr_vk_buffer copy = {0};
-    size_t bytes = (size_t)r->width * r->height * sizeof(float);
+    size_t count = (size_t)r->width * r->height;
     gdr_status status = check_frame(r, false, err);
-    if (status == GDR_OK)
+    bool from_visbuffer = status == GDR_OK && r->vis.slot_mode[r->last_slot] != GDR_GPU_RASTER_FORWARD;
+    if (status == GDR_OK && from_visbuffer)
+        status = gdr_vk_buffer_read_back(&r->allocator, r->vis.pixels.buffer, 0, count * sizeof(uint64_t), &copy, err);
+    else if (status == GDR_OK)
         status = gdr_vk_image_read_back(&r->allocator, &r->depth, VK_IMAGE_ASPECT_DEPTH_BIT,
                                         VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, sizeof(float), &copy, err);
-    if (status == GDR_OK)
-        memcpy(depth, copy.mapped, bytes);
+    for (size_t p = 0; status == GDR_OK && p < count; p++) {
+        uint32_t bits = from_visbuffer ? (uint32_t)(((const uint64_t *)copy.mapped)[p] >> 32)
+                                       : ((const uint32_t *)copy.mapped)[p];
+        memcpy(&depth[p], &bits, sizeof bits);
+    }
     gdr_vk_buffer_destroy(r->ctx, &copy);
     return status;
 }

@@ -11,8 +11,8 @@
  *     cluster at the back of the list; its fragments write (depth, id) with a 64-bit atomicMax
  *     (meshlet_visbuffer.frag), no attachments;
  *  4. raster_sw (raster_sw.comp), one workgroup per cluster at the front, the same atomics;
- *  5. resolve (visbuffer_resolve.comp) shades every pixel into a buffer, and resolve_copy copies its
- *     colour and depth into the images.
+ *  5. resolve (visbuffer_resolve.comp) shades every pixel into the colour image (a storage image);
+ *     the depth stays in the visibility buffer, from which the depth pyramid is built.
  * The frame's clear pass zeroes the counters and the visibility buffer.
  *
  * The list holds every cluster of every instance's DAG (at most GDR_RASTER_MAX_CLUSTERS entries),
@@ -31,7 +31,6 @@ typedef struct gdr_visbuffer {
     bool supported;              /* mesh shaders and 64-bit buffer atomics */
     char missing[160];           /* why not, when not */
     gdr_vk_buffer pixels;        /* uint64 per pixel */
-    gdr_vk_buffer resolved;      /* the resolve's output: RGBA8 per pixel, then float depth per pixel */
     gdr_vk_buffer clusters;      /* GdrGpuRasterCluster[capacity], made with the scene */
     gdr_vk_buffer counters;      /* GdrGpuRasterCounters */
     gdr_vk_buffer params[GDR_FRAMES_IN_FLIGHT];            /* GdrGpuRasterParams, host-written */
@@ -73,8 +72,6 @@ void gdr_visbuffer_record_raster_sw(gdr_renderer *r, struct gdr_frame_slot *slot
                                     VkCommandBuffer cmd);
 void gdr_visbuffer_record_resolve(gdr_renderer *r, struct gdr_frame_slot *slot, const struct gdr_frame_pass *pass,
                                   VkCommandBuffer cmd);
-void gdr_visbuffer_record_resolve_copy(gdr_renderer *r, struct gdr_frame_slot *slot, const struct gdr_frame_pass *pass,
-                                       VkCommandBuffer cmd);
 /* Fills the raster fields of `stats` from the last frame (slot `slot_index`), once every slot has
  * finished; the timings are means over the frames of the render call. */
 void gdr_visbuffer_stats(gdr_renderer *r, uint32_t slot_index, gdr_frame_stats *stats);

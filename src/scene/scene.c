@@ -1,3 +1,4 @@
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -173,6 +174,11 @@ gdr_status gdr_scene_add_instance(gdr_scene *scene, const gdr_instance *instance
         if (!isfinite(instance->transform.m[i]))
             return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "instance %u: transform is not finite",
                                  scene->instance_count);
+    if (!(instance->min_screen_size >= 0.0f && instance->min_screen_size <= FLT_MAX) ||
+        !(instance->max_screen_size >= 0.0f && instance->max_screen_size <= FLT_MAX))
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
+                             "instance %u: screen sizes must be finite and >= 0 (min %g, max %g)", scene->instance_count,
+                             (double)instance->min_screen_size, (double)instance->max_screen_size);
     gdr_status status = reserve_one((void **)&scene->instances, &scene->instance_capacity,
                                     scene->instance_count, sizeof(gdr_instance), err);
     if (status != GDR_OK)

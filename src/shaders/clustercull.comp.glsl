@@ -24,15 +24,47 @@ layout(local_size_x = GDR_CLUSTER_CULL_LANES * GDR_CLUSTER_CULL_TASKS) in;
 layout(constant_id = 0) const uint PHASE = GDR_PHASE_NONE;
 
 shared uint largest_task; // clusters in the workgroup's largest task command
+// Early phase: per task command, its clusters behind last frame's pyramid; after the deferral,
+// only those of commands that found no room in the late region (drawn now instead).
+shared uint deferred[GDR_CLUSTER_CULL_TASKS];
+shared bool deferral_failed;
+
+// Early phase: one retest command per task command with hidden clusters; where the late region is
+// full, those clusters are drawn now.
+void defer_hidden_clusters(GdrGpuFrameGlobals g, uint task_index, uint task_slot, uint lane)
+{
+    barrier();
+    if (lane == 0u && deferred[task_slot] != 0u) {
+        GdrGpuTaskCommand task = gdr_task_region(g, GDR_PHASE_EARLY).items[task_index];
+        if (gdr_defer_clusters(g, task, deferred[task_slot]))
+            deferred[task_slot] = 0u;
+        else
+            deferral_failed = true;
+    }
+    barrier();
+    if (!deferral_failed)
+        return;
+    GdrGpuTaskCommand task = gdr_task_region(g, GDR_PHASE_EARLY).items[min(task_index, g.task_capacity - 1u)];
+    for (uint first = 0u; first < largest_task; first += GDR_CLUSTER_CULL_LANES) {
+        uint cluster = first + lane;
+        bool draw = cluster < 32u && (deferred[task_slot] & (1u << cluster)) != 0u;
+        gdr_raster_append(g, draw, task.instance, task.meshlet_first + cluster);
+    }
+}
 
 void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
     uint group = gl_WorkGroupID.x + gl_WorkGroupID.y * GDR_TASK_GROUPS_PER_ROW;
-    uint task_index = group * GDR_CLUSTER_CULL_TASKS + gl_LocalInvocationIndex / GDR_CLUSTER_CULL_LANES;
+    uint task_slot = gl_LocalInvocationIndex / GDR_CLUSTER_CULL_LANES;
+    uint task_index = group * GDR_CLUSTER_CULL_TASKS + task_slot;
     uint lane = gl_LocalInvocationIndex % GDR_CLUSTER_CULL_LANES;
-    if (gl_LocalInvocationIndex == 0u)
+    if (gl_LocalInvocationIndex == 0u) {
         largest_task = 0u;
+        deferral_failed = false;
+    }
+    if (lane == 0u)
+        deferred[task_slot] = 0u;
     barrier();
     if (lane == 0u)
         atomicMax(largest_task, gdr_cluster_task_size(g, PHASE, task_index));
@@ -42,5 +74,9 @@ void main()
         GdrClusterResult cluster = gdr_cluster_test(g, PHASE, task_index, first + lane);
         gdr_raster_append(g, cluster.visible, cluster.instance, cluster.meshlet);
         gdr_cluster_count(g, PHASE, cluster);
+        if (PHASE == GDR_PHASE_EARLY && cluster.occluded)
+            atomicOr(deferred[task_slot], 1u << (first + lane));
     }
+    if (PHASE == GDR_PHASE_EARLY)
+        defer_hidden_clusters(g, task_index, task_slot, lane);
 }

@@ -1,5 +1,6 @@
 #version 460
-// Instance culling (seeds 000/001/003): one thread per instance; visible instances are appended,
+// Instance culling (seeds 000/001/002/003): one thread per instance, which tests its bounds (invalid
+// or empty, frustum, screen size, the global clip plane, occlusion); visible instances are appended,
 // compacted with subgroup ballots, as VkDrawIndexedIndirectCommands for one
 // vkCmdDrawIndexedIndirectCount (first_instance carries the instance index to the vertex shader),
 // or, for the meshlet pipeline (EMIT_TASKS), as task commands: one task workgroup per up to
@@ -13,6 +14,9 @@
 #include "shared/lod_math.h"
 #include "shared/occlusion_test.h"
 #include "shared/task_queue.h"
+#include "shared/meshlet_payload.h"
+#include "shared/cluster_cull.h"
+#include "shared/raster_bin.h"
 
 layout(local_size_x = GDR_CULL_WORKGROUP_SIZE) in;
 layout(constant_id = 0) const bool EMIT_TASKS = false;
@@ -39,53 +43,104 @@ GdrTaskRange task_range(GdrGpuFrameGlobals g, GdrGpuMesh mesh, mat4 model, out b
     return traverse ? GdrTaskRange(0u, 0u, 0u, 0u) : gdr_task_range(mesh.meshlet_offset, mesh.lod_cluster_count, 0u);
 }
 
+// Screen-size culling (seed 002): the bounding sphere's screen size (GdrGpuFrameGlobals) within the
+// instance's [min, max) and not below the frame's minimum; a zero limit is no limit.
+bool screen_size_visible(GdrGpuFrameGlobals g, GdrGpuInstance instance, vec3 world_center, float radius)
+{
+    float distance = length(world_center - g.camera_position.xyz);
+    float size = distance <= radius ? 3.0e38 : g.screen_scale * radius / distance; // inside: covers the screen
+    if (instance.min_screen_size > 0.0 && size < instance.min_screen_size)
+        return false;
+    if (g.min_screen_size > 0.0 && size < g.min_screen_size)
+        return false;
+    return !(instance.max_screen_size > 0.0 && size >= instance.max_screen_size);
+}
+
+// The global clip plane (seed 002): true when the sphere lies entirely on its negative side.
+bool behind_clip_plane(GdrGpuFrameGlobals g, vec3 world_center, float radius)
+{
+    vec4 plane = g.clip_plane;
+    return plane.xyz != vec3(0.0) && dot(plane.xyz, world_center) + plane.w < -radius * length(plane.xyz);
+}
+
+// The instance this invocation culls: the early (or only) phase's, one per instance; the late
+// phase's, one per instance the early phase deferred.
+uint instance_of_invocation(GdrGpuFrameGlobals g, DrawStatsRef stats)
+{
+    uint id = gl_GlobalInvocationID.x;
+    if (PHASE != GDR_PHASE_LATE)
+        return id;
+    return id < stats.value.late_instances.count ? WritableUintsRef(GDR_FRAME.occluded_instances).items[id]
+                                                 : g.instance_count;
+}
+
+// The clusters of a visible instance that needs at most GDR_DIRECT_CLUSTERS (`direct`): the cluster
+// cull's tests and binning, here. The early phase defers those behind last frame's pyramid with a
+// retest command (drawn now where the late region is full). Uniform control flow.
+void cull_direct_clusters(GdrGpuFrameGlobals g, bool direct, uint instance, GdrTaskRange range)
+{
+    GdrGpuTaskCommand task = GdrGpuTaskCommand(instance, range.first, direct ? range.count : 0u, range.flags | GDR_TASK_FIRST);
+    uint deferred = 0u;
+    for (uint c = 0u; c < GDR_DIRECT_CLUSTERS; c++) {
+        GdrClusterResult cluster = gdr_cluster_test_command(g, PHASE, task, c, true);
+        gdr_raster_append(g, cluster.visible, cluster.instance, cluster.meshlet);
+        gdr_cluster_count(g, PHASE, cluster);
+        if (PHASE == GDR_PHASE_EARLY && cluster.occluded)
+            deferred |= 1u << c;
+    }
+    bool failed = PHASE == GDR_PHASE_EARLY && deferred != 0u && !gdr_defer_clusters(g, task, deferred);
+    if (PHASE == GDR_PHASE_EARLY && subgroupBallotBitCount(subgroupBallot(failed)) > 0u)
+        for (uint c = 0u; c < GDR_DIRECT_CLUSTERS; c++)
+            gdr_raster_append(g, failed && (deferred & (1u << c)) != 0u, instance, range.first + c);
+}
+
 void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
     DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
-    uint id = gl_GlobalInvocationID.x;
+    uint id = instance_of_invocation(g, stats);
     bool visible = false;
     GdrGpuMesh mesh;
     mat4 model;
-    vec3 center = vec3(0.0);
+    vec3 world_center = vec3(0.0);
     float radius = 0.0;
+    bool invalid = false, small_or_large = false, clipped = false;
     if (id < g.instance_count) {
-        model = InstancesRef(GDR_SCENE.instances).items[id].model;
-        mesh = MeshesRef(GDR_SCENE.meshes).items[InstancesRef(GDR_SCENE.instances).items[id].mesh];
-        visible = mesh.index_count > 0u; // nothing to draw otherwise
-        center = (g.view * (model * vec4(mesh.bounds.xyz, 1.0))).xyz;
+        GdrGpuInstance instance = InstancesRef(GDR_SCENE.instances).items[id];
+        model = instance.model;
+        mesh = MeshesRef(GDR_SCENE.meshes).items[instance.mesh];
+        world_center = (model * vec4(mesh.bounds.xyz, 1.0)).xyz;
         radius = mesh.bounds.w * gdr_max_axis_scale(model[0].xyz, model[1].xyz, model[2].xyz);
-        if (visible && g.cull_enabled != 0u)
+        vec3 center = (g.view * vec4(world_center, 1.0)).xyz;
+        // Nothing to draw, or bounds that are not finite or hold no volume (seed 002's first test).
+        invalid = mesh.index_count == 0u || !(radius > 0.0) || isinf(radius) || any(isnan(world_center)) ||
+                  any(isinf(world_center));
+        visible = !invalid;
+        if (visible && g.cull_enabled != 0u) {
             visible = gdr_sphere_visible(g.frustum, center, radius, g.znear, g.zfar);
+            small_or_large = visible && !screen_size_visible(g, instance, world_center, radius);
+            clipped = visible && !small_or_large && behind_clip_plane(g, world_center, radius);
+            visible = visible && !small_or_large && !clipped;
+        }
     }
+    GDR_COUNT(stats, instances_invalid, invalid);
+    GDR_COUNT(stats, instances_screen_size_culled, small_or_large);
+    GDR_COUNT(stats, instances_clip_plane_culled, clipped);
 
-    // Two-phase occlusion culling (seeds 000, 002). Early: what was visible at the end
-    // of the last frame, unless last frame's pyramid hides it. Late: everything in the frustum
-    // against this frame's pyramid (built from the early phase's depth); draws what the early
-    // phase did not, and records what is visible for the next frame.
-    bool drawn_early = false;
-    if (PHASE == GDR_PHASE_EARLY && id < g.instance_count) {
-        uint state = VisibilityRef(GDR_SCENE.instance_visibility).items[id];
-        bool candidate = visible && (g.flags & GDR_FRAME_HISTORY) != 0u && (state & GDR_INSTANCE_VISIBLE_LAST_FRAME) != 0u;
-        bool occluded = candidate && gdr_sphere_occluded(g, center, radius);
-        GDR_COUNT(stats, instances_early_occluded, occluded);
-        visible = candidate && !occluded;
-        GDR_COUNT(stats, instances_early_drawn, visible);
-        VisibilityRef(GDR_SCENE.instance_visibility).items[id] = (state & GDR_INSTANCE_VISIBLE_LAST_FRAME) |
-                                                         (visible ? GDR_INSTANCE_DRAWN_EARLY : 0u);
-    } else if (PHASE == GDR_PHASE_LATE && id < g.instance_count) {
-        uint state = VisibilityRef(GDR_SCENE.instance_visibility).items[id];
-        drawn_early = (state & GDR_INSTANCE_DRAWN_EARLY) != 0u;
-        GDR_COUNT(stats, instances_late_tested, visible);
-        bool occluded = visible && gdr_sphere_occluded(g, center, radius);
-        GDR_COUNT(stats, instances_late_occluded, occluded);
+    // Two-phase occlusion culling (occlusion_test.h): the early phase defers what last frame's
+    // pyramid hides; the late phase retests those against this frame's.
+    if (PHASE != GDR_PHASE_NONE) {
+        bool occluded = visible && gdr_phase_occluded(g, PHASE, world_center, radius);
+        if (PHASE == GDR_PHASE_EARLY) {
+            gdr_defer_instances(occluded, id);
+            GDR_COUNT(stats, instances_early_occluded, occluded);
+            GDR_COUNT(stats, instances_early_drawn, visible && !occluded);
+        } else {
+            GDR_COUNT(stats, instances_late_tested, id < g.instance_count);
+            GDR_COUNT(stats, instances_late_occluded, occluded);
+            GDR_COUNT(stats, instances_late_drawn, visible && !occluded);
+        }
         visible = visible && !occluded;
-        VisibilityRef(GDR_SCENE.instance_visibility).items[id] = visible ? GDR_INSTANCE_VISIBLE_LAST_FRAME : 0u;
-        // The meshlet pipeline goes on testing the clusters of instances drawn early (those not
-        // drawn early may be visible now); the indirect pipeline has drawn them whole.
-        if (!EMIT_TASKS)
-            visible = visible && !drawn_early;
-        GDR_COUNT(stats, instances_late_drawn, visible && !drawn_early);
     }
 
     uvec4 ballot = subgroupBallot(visible);
@@ -106,18 +161,19 @@ void main()
     if (EMIT_TASKS) {
         bool traverse = false;
         GdrTaskRange range = visible ? task_range(g, mesh, model, traverse) : GdrTaskRange(0u, 0u, 0u, 0u);
-        uint flags = drawn_early ? GDR_TASK_DRAWN_EARLY : 0u;
-        range.flags |= flags;
-        gdr_append_tasks(g, PHASE, visible, id, range);
-        gdr_queue_visits(g, PHASE, 0u, traverse && visible ? 1u : 0u, id, 0u, flags);
-        // The visible instances, for read-backs (the early phase's, then the late phase's others).
-        bool listed = visible && !drawn_early;
-        uvec4 listed_ballot = subgroupBallot(listed);
+        bool direct_frame = (g.flags & GDR_FRAME_DIRECT_CLUSTERS) != 0u;
+        bool direct = direct_frame && visible && !traverse && range.count <= GDR_DIRECT_CLUSTERS;
+        gdr_append_tasks(g, PHASE, visible && !direct, id, range);
+        gdr_queue_visits(g, PHASE, 0u, traverse && visible ? 1u : 0u, id, 0u, 0u);
+        if (direct_frame)
+            cull_direct_clusters(g, direct, id, range);
+        // The visible instances, for read-backs (each is drawn in one phase only).
+        uvec4 listed_ballot = subgroupBallot(visible);
         uint list_base = 0u;
         if (subgroupElect() && subgroupBallotBitCount(listed_ballot) > 0u)
             list_base = atomicAdd(stats.value.instances_listed, subgroupBallotBitCount(listed_ballot));
         list_base = subgroupBroadcastFirst(list_base) + subgroupBallotExclusiveBitCount(listed_ballot);
-        if (listed)
+        if (visible)
             DrawCommandsRef(GDR_FRAME.draws).items[list_base] = GdrGpuDrawCommand(0u, 0u, 0u, 0, id);
     } else if (visible) {
         // The late phase's draws follow the early phase's region (instance_count entries).

@@ -21,6 +21,27 @@ layout(constant_id = 0) const uint PHASE = GDR_PHASE_NONE;
 
 taskPayloadSharedEXT GdrTaskPayload payload;
 shared uint visible_count;
+shared uint deferred;       // early phase: the command's clusters behind last frame's pyramid
+shared bool deferral_failed;
+
+// Early phase: one retest command for the clusters behind last frame's pyramid; where the late
+// region is full, they are drawn now instead.
+void defer_hidden_clusters(GdrGpuFrameGlobals g, uint task_index, uint lane, inout GdrClusterResult cluster)
+{
+    if (lane == 0u) {
+        deferred = 0u;
+        deferral_failed = false;
+    }
+    barrier();
+    if (cluster.occluded)
+        atomicOr(deferred, 1u << lane);
+    barrier();
+    if (lane == 0u && deferred != 0u)
+        deferral_failed = !gdr_defer_clusters(g, gdr_task_region(g, GDR_PHASE_EARLY).items[task_index], deferred);
+    barrier();
+    if (deferral_failed && cluster.occluded)
+        cluster.visible = true;
+}
 
 void main()
 {
@@ -30,6 +51,8 @@ void main()
     if (lane == 0u)
         visible_count = 0u;
     GdrClusterResult cluster = gdr_cluster_test(g, PHASE, task_index, lane);
+    if (PHASE == GDR_PHASE_EARLY)
+        defer_hidden_clusters(g, task_index, lane, cluster);
     barrier();
 
     uvec4 ballot = subgroupBallot(cluster.visible);

@@ -3,7 +3,9 @@
 // appended since the last phase, the compute rasteriser's VkDispatchIndirectCommand (front of the
 // list) and the mesh shaders' VkDrawMeshTasksIndirectCommandEXT (back of the list), one workgroup per
 // cluster. Launches wider than a row use y; the shaders skip the tail of the last row. Mesh-shader
-// clusters beyond the device's launch limit are dropped and counted as overflow.
+// clusters beyond the device's launch limit are dropped and counted as overflow. And the resolve's
+// VkDispatchIndirectCommand: the whole screen in the frame's first phase and in a later phase with
+// clusters to draw, nothing otherwise (the visibility buffer has not changed since the last resolve).
 #include "shared/glsl_buffers.h"
 #include "shared/visbuffer.h"
 
@@ -34,4 +36,11 @@ void main()
     counters.value.draw_x = rows > 1u ? GDR_MESH_GROUPS_PER_ROW : hw_count;
     counters.value.draw_y = rows;
     counters.value.draw_z = 1u;
+
+    bool resolve = counters.value.phases == 0u || count > 0u || hw_count > 0u;
+    uvec2 tiles = (uvec2(FrameGlobalsRef(push.globals).value.viewport) + GDR_RESOLVE_TILE - 1u) / GDR_RESOLVE_TILE;
+    counters.value.resolve_x = resolve ? tiles.x : 0u;
+    counters.value.resolve_y = resolve ? tiles.y : 0u;
+    counters.value.resolve_z = resolve ? 1u : 0u;
+    counters.value.phases += 1u;
 }

@@ -79,8 +79,16 @@ static gdr_status create_instance(gdr_vk_context *ctx, const gdr_vk_context_desc
     VkApplicationInfo app = {.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO, .pApplicationName = "gdr",
                              .pEngineName = "gdr", .apiVersion = VK_API_VERSION_1_3};
     const char *layers[1] = {"VK_LAYER_KHRONOS_validation"};
-    const char *extensions[1] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME};
+    const char *extensions[GDR_VK_MAX_INSTANCE_EXTENSIONS + 1];
+    uint32_t extension_count = 0;
     bool validate = desc->validate;
+    if (desc->instance_extension_count > GDR_VK_MAX_INSTANCE_EXTENSIONS)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%u instance extensions asked for, at most %d",
+                             desc->instance_extension_count, GDR_VK_MAX_INSTANCE_EXTENSIONS);
+    for (uint32_t i = 0; i < desc->instance_extension_count; i++)
+        extensions[extension_count++] = desc->instance_extensions[i];
+    if (validate)
+        extensions[extension_count++] = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
     if (validate && !layer_available(layers[0]))
         return gdr_error_set(err, GDR_ERROR_UNSUPPORTED,
                              "validation requested but VK_LAYER_KHRONOS_validation is not installed "
@@ -104,10 +112,15 @@ static gdr_status create_instance(gdr_vk_context *ctx, const gdr_vk_context_desc
         .pApplicationInfo = &app,
         .enabledLayerCount = validate ? 1u : 0u,
         .ppEnabledLayerNames = layers,
-        .enabledExtensionCount = validate ? 1u : 0u,
+        .enabledExtensionCount = extension_count,
         .ppEnabledExtensionNames = extensions,
     };
     VkResult result = vkCreateInstance(&info, NULL, &ctx->instance);
+    if (result == VK_ERROR_EXTENSION_NOT_PRESENT && desc->instance_extension_count > 0)
+        return gdr_error_set(err, GDR_ERROR_UNSUPPORTED,
+                             "the Vulkan loader lacks an instance extension for presenting (%s%s): no presentable "
+                             "Vulkan driver", desc->instance_extensions[0],
+                             desc->instance_extension_count > 1 ? ", ..." : "");
     if (result == VK_ERROR_INCOMPATIBLE_DRIVER || result == VK_ERROR_INITIALIZATION_FAILED)
         return gdr_error_set(err, GDR_ERROR_UNSUPPORTED,
                              "no Vulkan 1.3 driver found (%s); install mesa-vulkan-drivers for lavapipe",
@@ -226,7 +239,7 @@ static void note_missing(char *list, size_t size, bool present, const char *name
     snprintf(list + used, size - used, "%s%s", used ? ", " : "", name);
 }
 
-static gdr_status create_device(gdr_vk_context *ctx, bool disable_mesh_shaders, gdr_error *err)
+static gdr_status create_device(gdr_vk_context *ctx, bool disable_mesh_shaders, bool swapchain, gdr_error *err)
 {
     VkPhysicalDevice pd = ctx->physical_device;
     if (ctx->properties.apiVersion < VK_API_VERSION_1_3)
@@ -315,8 +328,13 @@ static gdr_status create_device(gdr_vk_context *ctx, bool disable_mesh_shaders, 
     VkPhysicalDeviceMeshShaderFeaturesEXT mesh = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT,
                                                   .taskShader = VK_TRUE, .meshShader = VK_TRUE};
     check_mesh_shader_support(ctx, subgroup.supportedStages, disable_mesh_shaders);
-    const char *extensions[1];
+    const char *extensions[2];
     uint32_t extension_count = 0;
+    if (swapchain && !device_extension_available(pd, VK_KHR_SWAPCHAIN_EXTENSION_NAME))
+        return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "device '%s' cannot present: it has no %s",
+                             ctx->properties.deviceName, VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+    if (swapchain)
+        extensions[extension_count++] = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
     if (ctx->has_mesh_shader) {
         extensions[extension_count++] = VK_EXT_MESH_SHADER_EXTENSION_NAME;
         e13.pNext = &mesh;
@@ -364,7 +382,7 @@ gdr_status gdr_vk_context_create(const gdr_vk_context_desc *desc_in, gdr_vk_cont
     if (status == GDR_OK)
         status = choose_physical_device(ctx, desc->device, err);
     if (status == GDR_OK)
-        status = create_device(ctx, desc->disable_mesh_shaders, err);
+        status = create_device(ctx, desc->disable_mesh_shaders, desc->swapchain, err);
     if (status != GDR_OK) {
         gdr_vk_context_destroy(ctx);
         return status;

@@ -7,11 +7,18 @@
 
 #include "gdr/core.h"
 
+#define GDR_VK_MAX_INSTANCE_EXTENSIONS 8
+
 typedef struct gdr_vk_context_desc {
     const char *device;   /* NULL: first discrete GPU, else the first device; "N": index; else a name substring */
     bool validate;        /* enable VK_LAYER_KHRONOS_validation and count its messages */
     bool synchronization_validation; /* also enable synchronization validation (implies validate) */
     bool disable_mesh_shaders; /* behave as a device without VK_EXT_mesh_shader (tests of the fallback) */
+    /* Presentation: instance extensions a window system needs (VK_KHR_surface, ...), and whether the
+     * device must have VK_KHR_swapchain (enabled; its absence is an error naming the device). */
+    const char *const *instance_extensions;
+    uint32_t instance_extension_count;
+    bool swapchain;
 } gdr_vk_context_desc;
 
 typedef struct gdr_vk_context {

@@ -138,6 +138,17 @@ expect 2 "lod-field spacing too small" "$gdr" info lod-field:spacing=1
 expect 2 "occlusion unknown option" "$gdr" info occlusion:walls=3
 grep -q 'seed, hidden, visible' "$work/stderr" || { echo "FAIL: occlusion option message: $(cat "$work/stderr")"; failures=$((failures + 1)); }
 expect 2 "occlusion zero hidden" "$gdr" build occlusion:hidden=0 -o "$work/bad.gdrc"
+expect 0 "render unique-field" "$gdr" render unique-field:meshes=4,triangles=2000 $tiny --validate
+expect 0 "build unique-field with pages" "$gdr" build unique-field:meshes=3,triangles=2000 -o "$work/unique.gdrc" --pages=16 --no-progress
+expect 0 "info of a paged cache" "$gdr" info "$work/unique.gdrc"
+grep -q '^pages: *[1-9][0-9]* pages of [1-9][0-9]* groups, [0-9]* bytes, [0-9.]* bytes per source triangle' "$work/stdout" ||
+    { echo "FAIL: info pages: $(cat "$work/stdout")"; failures=$((failures + 1)); }
+grep -q '^cache: *[1-9][0-9]* bytes, [0-9.]* bytes per source triangle$' "$work/stdout" ||
+    { echo "FAIL: info cache bytes: $(cat "$work/stdout")"; failures=$((failures + 1)); }
+expect 0 "info of a cache without pages" "$gdr" info "$work/field.gdrc"
+grep -q '^pages: *none' "$work/stdout" || { echo "FAIL: info no pages: $(cat "$work/stdout")"; failures=$((failures + 1)); }
+expect 2 "page size too small" "$gdr" build unique-field:meshes=1,triangles=1000 -o "$work/bad.gdrc" --pages=1
+expect 2 "unique-field no meshes" "$gdr" info unique-field:meshes=0
 }
 [ ! -e "$work/bad.gdrc" ] || { echo "FAIL: a failed build left a cache"; failures=$((failures + 1)); }
 

@@ -1,5 +1,6 @@
 /* The LOD hierarchy on the GPU: after gdr_renderer_set_scene the node pool (read back from the
- * device; lavapipe in CI) holds every mesh's gdr_lod_node array byte for byte, and each mesh's
+ * device; lavapipe in CI) holds every mesh's gdr_lod_node array byte for byte with a culling sphere
+ * per node that holds what is below it, and each mesh's
  * GdrGpuMesh (as uploaded) names its range and level count. Validation on: no message. */
 #include <string.h>
 
@@ -14,6 +15,33 @@ static const void *read_back(gdr_renderer *r, VkBuffer buffer, VkDeviceSize size
         return NULL;
     }
     return copy->mapped;
+}
+
+static bool sphere_inside(gdr_vec4 inner, gdr_vec4 outer)
+{
+    gdr_vec3 d = {inner.x - outer.x, inner.y - outer.y, inner.z - outer.z};
+    return gdr_vec3_length(d) + inner.w <= outer.w * (1.0f + 1e-5f) + 1e-6f;
+}
+
+/* Each node's gdr_lod_node bytes as they are; its culling sphere holds its clusters' (leaf) or its
+ * children's culling spheres (inner node). */
+static bool same_nodes(const GdrGpuLodNode *gpu, const gdr_mesh_clusters *c)
+{
+    for (uint32_t n = 0; n < c->lod_node_count; n++) {
+        const gdr_lod_node *node = &c->lod_nodes[n];
+        if (memcmp(&gpu[n], node, sizeof *node) != 0)
+            return false;
+        for (uint32_t i = 0; i < node->count; i++) {
+            bool leaf = node->flags & GDR_LOD_NODE_LEAF;
+            gdr_vec4 child = leaf ? c->clusters[node->first + i].sphere : gpu[node->first + i].bounds;
+            if (!sphere_inside(child, gpu[n].bounds)) {
+                fprintf(stderr, "node %u child %u (%s) outside: %g %g %g %g in %g %g %g %g\n", n, i, leaf ? "cluster" : "node",
+                        child.x, child.y, child.z, child.w, gpu[n].bounds.x, gpu[n].bounds.y, gpu[n].bounds.z, gpu[n].bounds.w);
+                return false;
+            }
+        }
+    }
+    return true;
 }
 
 static void check_scene(const char *spec)
@@ -41,7 +69,7 @@ static void check_scene(const char *spec)
         bad += g->lod_node_count != c->lod_node_count || g->lod_node_levels != c->lod_node_levels ||
                (c->cluster_count > 0) != (g->lod_node_count > 0) ||
                (uint64_t)g->lod_node_offset + g->lod_node_count > total ||
-               memcmp(nodes + g->lod_node_offset, c->lod_nodes, sizeof *nodes * c->lod_node_count) != 0;
+               !same_nodes(nodes + g->lod_node_offset, c);
     }
     CHECK(bad == 0);
     CHECK(r->scene.lod_nodes.address != 0);

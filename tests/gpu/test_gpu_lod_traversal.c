@@ -93,8 +93,8 @@ static void check_same_as_flat(gdr_renderer *r, unsigned seed)
         CHECK(hierarchy.stats.traversal.applied && !flat.stats.traversal.applied);
         CHECK(memcmp(hierarchy.image, flat.image, WIDTH * HEIGHT * 4) == 0);
         /* Without occlusion culling the same clusters too. (With it, which clusters were drawn can
-         * differ where nothing shows: the traversal leaves the history bits of clusters below a
-         * skipped node as they were, so a cluster hidden since may still be drawn early.) */
+         * differ where nothing shows: a deferred node defers its whole subtree, so the pyramid the
+         * late phase tests against differs from the flat frame's.) */
         if (frame.occlusion == GDR_CULL_OFF) {
             CHECK(same_clusters(&hierarchy, &flat));
             CHECK(hierarchy.stats.triangles == flat.stats.triangles);
@@ -154,6 +154,71 @@ static void check_overflow_reported(const gdr_scene *scene)
     }
 }
 
+/* A low wall (a box) across the field's first rows: it hides the lower parts of the knots behind
+ * it, so that their hierarchies' lower nodes are occluded while their upper nodes are not. */
+static bool add_wall(gdr_scene *scene)
+{
+    gdr_error err = {0};
+    gdr_vec3 corners[8];
+    for (uint32_t v = 0; v < 8; v++)
+        corners[v] = (gdr_vec3){v & 1 ? 1.0f : -1.0f, v & 2 ? 1.0f : -1.0f, v & 4 ? 1.0f : -1.0f};
+    const uint32_t faces[36] = {4, 5, 7, 4, 7, 6, 0, 2, 3, 0, 3, 1, 1, 3, 7, 1, 7, 5,
+                                0, 4, 6, 0, 6, 2, 2, 6, 7, 2, 7, 3, 0, 1, 5, 0, 5, 4};
+    uint32_t mesh = 0;
+    gdr_instance wall = {.transform = gdr_mat4_from_trs((gdr_vec3){0.0f, 1.5f, -2.0f}, gdr_quat_identity(),
+                                                        (gdr_vec3){3.0f, 1.5f, 0.05f}),
+                         .material = GDR_NO_INDEX, .color = {0.6f, 0.6f, 0.6f, 1.0f}};
+    bool ok = gdr_scene_add_mesh(scene, "wall", corners, NULL, NULL, 8, faces, 36, &mesh, &err) == GDR_OK;
+    wall.mesh = mesh;
+    ok = ok && gdr_scene_add_instance(scene, &wall, &err) == GDR_OK &&
+         gdr_scene_build_clusters(scene, NULL, &err) == GDR_OK;
+    if (!ok)
+        fprintf(stderr, "wall: %s\n", err.message);
+    return ok;
+}
+
+/* Occlusion culling with the traversal: nodes hidden behind last frame's pyramid are deferred and
+ * retested, and where the occluded-node list is too small they are traversed in the early phase
+ * (counted as overflow): every image equals the one without occlusion culling. */
+static void check_deferred_nodes(gdr_scene *scene)
+{
+    gdr_renderer *r = add_wall(scene) ? make_renderer(scene, (gdr_renderer_desc){0}) : NULL;
+    gdr_renderer *small = r ? make_renderer(scene, (gdr_renderer_desc){.debug_occluded_node_capacity = 2}) : NULL;
+    CHECK(r != NULL && small != NULL);
+    uint64_t deferred = 0, retested = 0, occluded = 0, overflow = 0;
+    uint32_t differing = 0;
+    for (int n = 0; n < 4 && small; n++) {
+        /* Above and behind the wall, a little higher than the knots behind it, then rising: the
+         * second frame tests against the first one's pyramid, which hides nodes that now show. */
+        gdr_frame_desc frame = {.camera = test_look((gdr_vec3){0.4f * (float)n - 0.6f, 2.2f, 0.5f}, 0.0f, -0.1f, 1.0f, 0.1f),
+                                .pipeline = GDR_PIPELINE_MESH, .lod_error_px = 0.3f, .occlusion = GDR_CULL_ON};
+        frame_result on = {0}, listed = {0}, off = {0};
+        CHECK(render(r, &frame, 1, &on) && render(small, &frame, 1, &listed));
+        release(&on);
+        release(&listed);
+        frame.camera.position.y += 0.4f * (float)(n + 1);
+        CHECK(render(r, &frame, 1, &on) && render(small, &frame, 1, &listed));
+        frame.occlusion = GDR_CULL_OFF;
+        CHECK(render(r, &frame, 1, &off));
+        differing += memcmp(on.image, off.image, WIDTH * HEIGHT * 4) != 0;
+        differing += memcmp(listed.image, off.image, WIDTH * HEIGHT * 4) != 0;
+        deferred += on.stats.traversal.nodes_early_occluded;
+        retested += on.stats.traversal.late_nodes_tested;
+        occluded += on.stats.traversal.nodes_occluded;
+        overflow += listed.stats.occlusion.overflow;
+        CHECK(on.stats.occlusion.overflow == 0 && on.stats.traversal.overflow == 0);
+        release(&on);
+        release(&listed);
+        release(&off);
+    }
+    printf("occlusion with the traversal: %llu nodes deferred, %llu late visits, %llu occluded; a 2-entry list: "
+           "%llu overflow; %u images differ\n", (unsigned long long)deferred, (unsigned long long)retested,
+           (unsigned long long)occluded, (unsigned long long)overflow, differing);
+    CHECK(differing == 0 && deferred > 0 && retested >= deferred && occluded > 0 && overflow > 0);
+    gdr_renderer_destroy(small);
+    gdr_renderer_destroy(r);
+}
+
 int main(void)
 {
     gdr_error err = {0};
@@ -164,6 +229,7 @@ int main(void)
         check_same_as_flat(r, 11);
         check_wrong_node_test_is_caught(scene, r);
         check_overflow_reported(scene);
+        check_deferred_nodes(scene);
     } else {
         CHECK(false);
     }

@@ -104,8 +104,13 @@ static void check_path(const gdr_scene *scene, uint32_t hidden, gdr_pipeline pip
         /* The phases add up: what is drawn is drawn once, in one phase. */
         CHECK(on.instances_visible == on.occlusion.instances_early_drawn + on.occlusion.instances_late_drawn);
         CHECK(on.occlusion.instances_late_occluded <= on.occlusion.instances_late_tested);
+        /* The late phase retests exactly what the early phase deferred; without a history (the first
+         * frame, an announced cut) nothing is deferred. */
+        CHECK(on.occlusion.instances_late_tested == on.occlusion.instances_early_occluded);
+        CHECK(on.occlusion.overflow == 0);
         if (f == 0 || (announce_cuts && cut))
-            CHECK(on.occlusion.instances_early_drawn == 0 && on.occlusion.meshlets_early_drawn == 0); /* no history: all late */
+            CHECK(on.occlusion.instances_early_occluded == 0 && on.occlusion.meshlets_early_occluded == 0 &&
+                  on.occlusion.instances_late_drawn == 0);
         if (pipeline == GDR_PIPELINE_MESH) {
             CHECK(on.meshlets_visible == on.occlusion.meshlets_early_drawn + on.occlusion.meshlets_late_drawn);
             CHECK(on.occlusion.meshlets_late_occluded <= on.occlusion.meshlets_late_tested);

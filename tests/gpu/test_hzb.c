@@ -387,7 +387,7 @@ static void test_size(gdr_vk_context *ctx, const sample_pass *pass, uint32_t dw,
                          VK_ACCESS_2_TRANSFER_WRITE_BIT, fragment_tests, depth_rw);
     depth_pass(cmd, depth.view, dw, dh);
     gdr_hzb_record_depth_to_read(&hzb, cmd, depth.image, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
-    gdr_hzb_record_build(&hzb, cmd);
+    gdr_hzb_record_build(&hzb, cmd, 0);
     /* The occlusion query and fetch, as a culling shader in reader_stages makes them. */
     sample_push push = {.params = params, .count = SPHERES};
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pass->pipeline);
@@ -414,7 +414,7 @@ static void test_size(gdr_vk_context *ctx, const sample_pass *pass, uint32_t dw,
     VkDependencyInfo after_copy_dependency = {.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO, .memoryBarrierCount = 1,
                                               .pMemoryBarriers = &after_copy};
     vkCmdPipelineBarrier2(cmd, &after_copy_dependency);
-    gdr_hzb_record_build(&hzb, cmd);
+    gdr_hzb_record_build(&hzb, cmd, 0);
     copy_pyramid_out(cmd, &hzb, &p, &readback[1]);
     VkMemoryBarrier2 to_host = {.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
                                 .srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,

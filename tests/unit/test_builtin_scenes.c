@@ -501,6 +501,40 @@ static void test_occlusion_defaults_and_bad(void)
     CHECK(strstr(err.message, "seed, hidden, visible") != NULL);
 }
 
+/* --- unique-field ------------------------------------------------------------------------------ */
+
+static void test_unique_field(void)
+{
+    gdr_error err = {0};
+    gdr_scene *scene = NULL, *again = NULL, *other = NULL;
+    CHECK(gdr_scene_load("unique-field:meshes=5,triangles=2000,seed=2", NULL, &scene, &err) == GDR_OK);
+    if (!scene)
+        return;
+    CHECK(scene->mesh_count == 5 && scene->instance_count == 5 && scene->camera_count == 1);
+    for (uint32_t m = 0; m < scene->mesh_count; m++) {
+        const gdr_mesh *mesh = &scene->meshes[m];
+        CHECK(scene->instances[m].mesh == m);
+        CHECK(mesh->index_count / 3 >= 1800 && mesh->index_count / 3 <= 2200);
+        CHECK(watertight(mesh));
+        for (uint32_t v = 0; v < mesh->vertex_count; v++)
+            CHECK(gdr_vec3_length(mesh->positions[v]) <= 0.95f);
+        CHECK(mesh->clusters.group_count > 0); /* gdr_scene_load builds the LOD DAG */
+        for (uint32_t k = 0; k < m; k++) /* every mesh its own shape */
+            CHECK(memcmp(mesh->positions, scene->meshes[k].positions, 12 * (size_t)mesh->vertex_count) != 0);
+    }
+    CHECK(gdr_scene_load("unique-field:seed=2,triangles=2000,meshes=5", NULL, &again, &err) == GDR_OK);
+    CHECK(gdr_scene_load("unique-field:meshes=5,triangles=2000,seed=3", NULL, &other, &err) == GDR_OK);
+    if (again && other) {
+        CHECK(memcmp(again->meshes[4].positions, scene->meshes[4].positions, 12 * (size_t)scene->meshes[4].vertex_count) == 0);
+        CHECK(memcmp(other->meshes[4].positions, scene->meshes[4].positions, 12 * (size_t)scene->meshes[4].vertex_count) != 0);
+    }
+    gdr_scene_destroy(scene), gdr_scene_destroy(again), gdr_scene_destroy(other);
+    static const char *const bad[] = {"unique-field:meshes=0", "unique-field:meshes=100001",
+                                      "unique-field:triangles=999", "unique-field:spacing=1",
+                                      "unique-field:instances=3", "unique-field:seed=0"};
+    check_bad_specs(bad, sizeof bad / sizeof bad[0], "unique-field: ");
+}
+
 static void test_spec_names(void)
 {
     CHECK(gdr_scene_spec_is_builtin("demo"));
@@ -509,6 +543,7 @@ static void test_spec_names(void)
     CHECK(gdr_scene_spec_is_builtin("lod-field:triangles=5000"));
     CHECK(gdr_scene_spec_is_builtin("occlusion"));
     CHECK(gdr_scene_spec_is_builtin("occlusion:seed=2"));
+    CHECK(gdr_scene_spec_is_builtin("unique-field:meshes=2"));
     CHECK(!gdr_scene_spec_is_builtin("demos"));
     CHECK(!gdr_scene_spec_is_builtin("lod-field.gltf"));
     CHECK(!gdr_scene_spec_is_builtin("occlusion.obj"));
@@ -532,5 +567,6 @@ int main(void)
     test_occlusion_layout();
     test_occlusion_camera_path();
     test_occlusion_defaults_and_bad();
+    test_unique_field();
     return test_finish("test_builtin_scenes");
 }

@@ -59,20 +59,27 @@ bool cli_parse_choice(const char *option, const char *text, const char *const *n
     return false;
 }
 
+bool cli_parse_floats(const char *text, int count, float *out)
+{
+    const char *cursor = text;
+    for (int i = 0; i < count; i++) {
+        char *end;
+        errno = 0;
+        out[i] = strtof(cursor, &end);
+        bool separator_ok = i < count - 1 ? *end == ',' : *end == '\0';
+        if (errno || end == cursor || !separator_ok || !isfinite(out[i]))
+            return false;
+        cursor = end + 1;
+    }
+    return true;
+}
+
 bool cli_parse_camera(const char *option, const char *text, gdr_vec3 *position, gdr_quat *rotation)
 {
     float v[7];
-    const char *cursor = text;
-    for (int i = 0; i < 7; i++) {
-        char *end;
-        errno = 0;
-        v[i] = strtof(cursor, &end);
-        bool separator_ok = i < 6 ? *end == ',' : *end == '\0';
-        if (errno || end == cursor || !separator_ok || !isfinite(v[i])) {
-            fprintf(stderr, "gdr: %s %s: expected 7 finite numbers px,py,pz,qx,qy,qz,qw\n", option, text);
-            return false;
-        }
-        cursor = end + 1;
+    if (!cli_parse_floats(text, 7, v)) {
+        fprintf(stderr, "gdr: %s %s: expected 7 finite numbers px,py,pz,qx,qy,qz,qw\n", option, text);
+        return false;
     }
     float length = sqrtf(v[3] * v[3] + v[4] * v[4] + v[5] * v[5] + v[6] * v[6]);
     if (length < 1e-6f) {

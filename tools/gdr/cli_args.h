@@ -21,6 +21,8 @@ bool cli_parse_pipeline(const char *option, const char *text, gdr_pipeline *out)
 bool cli_parse_raster(const char *option, const char *text, gdr_raster *out);
 /* "px,py,pz,qx,qy,qz,qw": position and rotation quaternion (normalised; must not be zero). */
 bool cli_parse_camera(const char *option, const char *text, gdr_vec3 *position, gdr_quat *rotation);
+/* `count` finite numbers separated by commas into out[0 .. count); false (nothing printed) if not. */
+bool cli_parse_floats(const char *text, int count, float *out);
 /* --budget "triangles=N,instances=N,pixels=N,bytes=N" (any of them, each a positive integer): the
  * limits on what one untrusted file may make gdr allocate (docs/SECURITY.md). */
 bool cli_parse_budget(const char *option, const char *text, gdr_budget *out);

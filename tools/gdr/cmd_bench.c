@@ -6,6 +6,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "bench_plot.h"
 #include "cli_args.h"
 #include "commands.h"
 #include "stats_output.h"
@@ -59,7 +60,8 @@ int gdr_cmd_bench(int argc, char **argv)
 {
     uint32_t sizes[MAX_SIZES] = {1000, 10000, 100000, 1000000}, size_count = 4;
     uint32_t frames = 20, width = 1920, height = 1080;
-    const char *device = NULL, *json_path = NULL, *scene_spec = NULL;
+    const char *device = NULL, *json_path = NULL, *scene_spec = NULL, *path_file = NULL, *plot_path = NULL, *plot_from = NULL;
+    camera_path path = {0};
     float lod_errors[MAX_LOD_ERRORS] = {1.0f};
     uint32_t lod_error_count = 1;
     bool occlusion_modes[2] = {true, false}, occlusion_given = false;
@@ -98,6 +100,12 @@ int gdr_cmd_bench(int argc, char **argv)
             json_path = value;
         else if (strcmp(arg, "--scene") == 0)
             scene_spec = value;
+        else if (strcmp(arg, "--camera-path") == 0)
+            path_file = value;
+        else if (strcmp(arg, "--plot") == 0)
+            plot_path = value;
+        else if (strcmp(arg, "--plot-from") == 0)
+            plot_from = value;
         else if (strcmp(arg, "--lod-hierarchy") == 0)
             ok = cli_parse_on_off(arg, value, &lod_hierarchy);
         else if (strcmp(arg, "--lod-errors") == 0)
@@ -136,6 +144,23 @@ int gdr_cmd_bench(int argc, char **argv)
             return 2;
     }
 
+    gdr_error path_err = {0};
+    if (plot_from) { /* plot an earlier run's JSON, run nothing */
+        if (!plot_path) {
+            fprintf(stderr, "gdr bench: --plot-from needs --plot FILE.svg\n");
+            return 2;
+        }
+        if (bench_plot_from_json(plot_from, plot_path, &path_err) != GDR_OK) {
+            fprintf(stderr, "gdr: %s\n", path_err.message);
+            return 1;
+        }
+        printf("plot                %s\n", plot_path);
+        return 0;
+    }
+    if (path_file && camera_path_read(path_file, &path, &path_err) != GDR_OK) {
+        fprintf(stderr, "gdr: --camera-path: %s\n", path_err.message);
+        return 1;
+    }
     cJSON *rows = cJSON_CreateArray();
     if (scene_spec)
         size_count = 1; /* the one scene given */
@@ -175,6 +200,13 @@ int gdr_cmd_bench(int argc, char **argv)
             if (has_camera) {
                 frame.camera.position = camera_position;
                 frame.camera.rotation = camera_rotation;
+            }
+            if (path.count) { /* a frame per pose, each timed */
+                if (bench_run_path(renderer, &frame, &path, rows, &err) != GDR_OK) {
+                    fprintf(stderr, "gdr: %s\n", err.message);
+                    result = 1;
+                }
+                continue;
             }
             /* Untimed warm-up frames: first-use costs (pipeline caches, page faults) are not per-frame costs. */
             if (gdr_renderer_render(renderer, &frame, 3, NULL, &err) != GDR_OK ||
@@ -227,7 +259,6 @@ int gdr_cmd_bench(int argc, char **argv)
         gdr_scene_destroy(scene);
     }
     char *json = cJSON_Print(rows);
-    cJSON_Delete(rows);
     if (json) {
         gdr_error err = {0};
         printf("%s\n", json);
@@ -237,5 +268,14 @@ int gdr_cmd_bench(int argc, char **argv)
         }
         free(json);
     }
+    gdr_error plot_err = {0};
+    if (result == 0 && plot_path && bench_plot_svg(plot_path, rows, path.count > 0, &plot_err) != GDR_OK) {
+        fprintf(stderr, "gdr: %s\n", plot_err.message);
+        result = 1;
+    } else if (result == 0 && plot_path) {
+        printf("plot                %s\n", plot_path);
+    }
+    cJSON_Delete(rows);
+    camera_path_free(&path);
     return result;
 }

@@ -10,13 +10,17 @@
 #include "core/thread_pool.h"
 #include "gdr/cull.h"
 #include "gdr/io.h"
+#include "gdr/paged_cache.h"
 
 static void build_usage(void)
 {
-    fputs("usage: gdr build INPUT -o OUTPUT.gdrc [--pvs] [--no-progress] [--budget KEY=N,...] [--allow-outside-files]\n"
-          "  INPUT: a .gltf, .glb or .obj file, a .gdrc cache, or a built-in scene: 'demo', 'lod-field'\n"
-          "         or 'occlusion', each with optional ':key=value,...' (see gdr --help)\n"
-          "  --pvs: bake precomputed visibility (default options, every processor) into the cache\n",
+    fputs("usage: gdr build INPUT -o OUTPUT.gdrc [--pvs] [--pages[=KIB]] [--no-progress] [--budget KEY=N,...]\n"
+          "                 [--allow-outside-files]\n"
+          "  INPUT: a .gltf, .glb or .obj file, a .gdrc cache, or a built-in scene: 'demo', 'lod-field',\n"
+          "         'occlusion' or 'unique-field', each with optional ':key=value,...' (see gdr --help)\n"
+          "  --pvs: bake precomputed visibility (default options, every processor) into the cache\n"
+          "  --pages[=KIB]: also store the geometry in compressed pages of KIB kibibytes (default 128),\n"
+          "         read on demand for streaming (docs/CACHE_FORMAT.md, section 'PAGE')\n",
           stderr);
 }
 
@@ -49,6 +53,7 @@ int gdr_cmd_build(int argc, char **argv)
 {
     const char *input = NULL, *output = NULL;
     int no_progress = 0, pvs_wanted = 0, allow_outside_files = 0;
+    uint32_t page_bytes = 0;
     gdr_budget budget = {0};
     for (int i = 1; i < argc; i++) {
         if ((strcmp(argv[i], "-o") == 0 || strcmp(argv[i], "--out") == 0) && i + 1 < argc) {
@@ -57,6 +62,18 @@ int gdr_cmd_build(int argc, char **argv)
             no_progress = 1;
         } else if (strcmp(argv[i], "--pvs") == 0) {
             pvs_wanted = 1;
+        } else if (strcmp(argv[i], "--pages") == 0) {
+            page_bytes = GDR_PAGE_BYTES_DEFAULT;
+        } else if (strncmp(argv[i], "--pages=", 8) == 0) {
+            char *end;
+            unsigned long kib = strtoul(argv[i] + 8, &end, 10);
+            if (*end || end == argv[i] + 8 || argv[i][8] == '-' || kib < GDR_PAGE_BYTES_MIN / 1024 ||
+                kib > GDR_PAGE_BYTES_MAX / 1024) {
+                fprintf(stderr, "gdr: build: --pages=%s: expected kibibytes in [%u, %u]\n", argv[i] + 8,
+                        GDR_PAGE_BYTES_MIN / 1024, GDR_PAGE_BYTES_MAX / 1024);
+                return 2;
+            }
+            page_bytes = (uint32_t)kib * 1024u;
         } else if (strcmp(argv[i], "--allow-outside-files") == 0) {
             allow_outside_files = 1;
         } else if (strcmp(argv[i], "--budget") == 0 && i + 1 < argc) {
@@ -105,7 +122,8 @@ int gdr_cmd_build(int argc, char **argv)
         status = bake_pvs(scene, &pvs, &err); /* before writing: a failed bake leaves no file */
     }
     if (status == GDR_OK) {
-        gdr_cache_write_options write = {.source = {gdr_cache_build_options(), &sources}, .pvs = pvs};
+        gdr_cache_write_options write = {.source = {gdr_cache_build_options(), &sources}, .pvs = pvs,
+                                         .page_bytes = page_bytes};
         status = gdr_cache_write(output, scene, &write, &err);
     }
     if (status == GDR_OK)

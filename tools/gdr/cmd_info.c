@@ -2,22 +2,50 @@
  * of the precomputed visibility its cache holds. */
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "cli_args.h"
 #include "commands.h"
 #include "gdr/cull.h"
 #include "gdr/io.h"
+#include "gdr/paged_cache.h"
 #include "gdr/renderer.h"
 
 #define INFO_USAGE                                                                                       \
-    "usage: gdr info FILE|demo|lod-field|occlusion[:...] [--no-cache] [--cache-dir DIR] [--budget KEY=N,...]\n" \
-    "       [--allow-outside-files]\n"                                                                 \
+    "usage: gdr info FILE|demo|lod-field|occlusion|unique-field[:...] [--no-cache] [--cache-dir DIR]\n"  \
+    "       [--budget KEY=N,...] [--allow-outside-files]\n"                                             \
     "       gdr info --passes\n"
 
 static void count_warning(void *user, const char *message)
 {
     (*(unsigned *)user)++;
     fprintf(stderr, "gdr: warning: %s\n", message);
+}
+
+/* The cache's size per source triangle (the LOD DAG's input), whole and its pages alone. */
+static void print_cache_bytes(const char *path, uint64_t source_triangles)
+{
+    struct stat st;
+    if (stat(path, &st) != 0 || source_triangles == 0)
+        return;
+    printf("cache:       %lld bytes, %.1f bytes per source triangle\n", (long long)st.st_size,
+           (double)st.st_size / (double)source_triangles);
+    gdr_paged_cache *paged = NULL;
+    gdr_error err = {0};
+    if (gdr_paged_cache_open(path, &paged, &err) != GDR_OK) {
+        printf("pages:       none (%s)\n", err.message);
+        return;
+    }
+    uint64_t pages = 0, groups = 0;
+    for (uint32_t m = 0; m < gdr_paged_cache_mesh_count(paged); m++) {
+        pages += gdr_paged_cache_mesh(paged, m)->page_count;
+        groups += gdr_paged_cache_mesh(paged, m)->group_count;
+    }
+    uint64_t bytes = gdr_paged_cache_page_bytes(paged);
+    printf("pages:       %llu pages of %llu groups, %llu bytes, %.1f bytes per source triangle (opening read %llu)\n",
+           (unsigned long long)pages, (unsigned long long)groups, (unsigned long long)bytes,
+           (double)bytes / (double)source_triangles, (unsigned long long)gdr_paged_cache_bytes_read(paged));
+    gdr_paged_cache_close(paged);
 }
 
 int gdr_cmd_info(int argc, char **argv)
@@ -98,6 +126,9 @@ int gdr_cmd_info(int argc, char **argv)
                gdr_pvs_serialized_size(pvs));
     else
         printf("pvs:         none\n");
+    size_t length = strlen(input);
+    if (length > 5 && strcmp(input + length - 5, ".gdrc") == 0)
+        print_cache_bytes(input, unique_triangles);
     if (warnings)
         printf("warnings:    %u\n", warnings);
     gdr_pvs_destroy(pvs);

@@ -6,29 +6,13 @@
 #include "cli_args.h"
 #include "commands.h"
 #include "gdr/gdr.h"
+#include "camera_path.h"
+#include "render_options.h"
 #include "stats_output.h"
 
-typedef struct render_options {
-    const char *scene;
-    const char *out_png;
-    const char *stats_json;
-    uint32_t width, height, frames, camera_index;
-    bool has_camera, has_camera_index, cull, validate;
-    bool meshlet_cull, cone_cull, triangle_cull, occlusion, occlusion_given, lod_hierarchy;
-    gdr_pipeline pipeline;
-    gdr_raster raster;
-    float sw_threshold;
-    gdr_view view;
-    float lod_error;
-    bool has_lod_depth;
-    uint32_t lod_depth;
-    gdr_vec3 camera_position;
-    gdr_quat camera_rotation;
-    const char *device;
-    gdr_load_options load;
-} render_options;
 
-static int parse_render_options(int argc, char **argv, render_options *o)
+int render_options_parse(const char *command, int argc, char **argv, render_options *o, render_extra_option extra,
+                         void *context)
 {
     *o = (render_options){.width = 1280, .height = 720, .frames = 1, .cull = true, .meshlet_cull = true,
                           .cone_cull = true, .triangle_cull = true, .lod_error = 1.0f, .occlusion = true,
@@ -38,7 +22,7 @@ static int parse_render_options(int argc, char **argv, render_options *o)
         const char *arg = argv[i], *value;
         if (arg[0] != '-' || strcmp(arg, "-") == 0) {
             if (o->scene) {
-                fprintf(stderr, "gdr render: only one scene, got '%s' and '%s'\n", o->scene, arg);
+                fprintf(stderr, "gdr %s: only one scene, got '%s' and '%s'\n", command, o->scene, arg);
                 return 2;
             }
             o->scene = arg;
@@ -56,6 +40,11 @@ static int parse_render_options(int argc, char **argv, render_options *o)
             o->load.allow_outside_files = 1;
             continue;
         }
+        int consumed = extra ? extra(context, argc, argv, &i) : 0;
+        if (consumed < 0)
+            return 2;
+        if (consumed > 0)
+            continue;
         if (!(value = cli_value(argc, argv, &i)))
             return 2;
         bool ok = true;
@@ -68,7 +57,9 @@ static int parse_render_options(int argc, char **argv, render_options *o)
         else if (strcmp(arg, "--height") == 0)
             ok = cli_parse_u32(arg, value, 1, 16384, &o->height);
         else if (strcmp(arg, "--frames") == 0)
-            ok = cli_parse_u32(arg, value, 1, 100000, &o->frames);
+            ok = o->frames_given = cli_parse_u32(arg, value, 1, 100000, &o->frames);
+        else if (strcmp(arg, "--camera-path") == 0)
+            o->camera_path = value;
         else if (strcmp(arg, "--camera") == 0)
             ok = o->has_camera = cli_parse_camera(arg, value, &o->camera_position, &o->camera_rotation);
         else if (strcmp(arg, "--camera-index") == 0)
@@ -98,6 +89,14 @@ static int parse_render_options(int argc, char **argv, render_options *o)
         }
         else if (strcmp(arg, "--lod-error") == 0)
             ok = cli_parse_float(arg, value, 0.0f, 1e6f, &o->lod_error);
+        else if (strcmp(arg, "--min-screen-size") == 0)
+            ok = cli_parse_float(arg, value, 0.0f, 1e6f, &o->min_screen_size);
+        else if (strcmp(arg, "--clip-plane") == 0) {
+            ok = cli_parse_floats(value, 4, &o->clip_plane.x);
+            if (!ok)
+                fprintf(stderr, "gdr: %s %s: expected 4 finite numbers a,b,c,d (the plane a x + b y + c z + d = 0)\n",
+                        arg, value);
+        }
         else if (strcmp(arg, "--lod-depth") == 0)
             ok = o->has_lod_depth = cli_parse_u32(arg, value, 0, 64, &o->lod_depth);
         else if (strcmp(arg, "--device") == 0)
@@ -107,14 +106,14 @@ static int parse_render_options(int argc, char **argv, render_options *o)
         else if (strcmp(arg, "--budget") == 0)
             ok = cli_parse_budget(arg, value, &o->load.budget);
         else {
-            fprintf(stderr, "gdr render: unknown option '%s' (see gdr --help)\n", arg);
+            fprintf(stderr, "gdr %s: unknown option '%s' (see gdr --help)\n", command, arg);
             return 2;
         }
         if (!ok)
             return 2;
     }
     if (!o->scene) {
-        fprintf(stderr, "gdr render: which scene? e.g. 'gdr render demo' (see gdr --help)\n");
+        fprintf(stderr, "gdr %s: which scene? e.g. 'gdr %s demo' (see gdr --help)\n", command, command);
         return 2;
     }
     return 0;
@@ -126,7 +125,7 @@ static int fail(const gdr_error *err)
     return 1;
 }
 
-static gdr_camera choose_camera(const gdr_scene *scene, const render_options *o)
+gdr_camera render_options_camera(const gdr_scene *scene, const render_options *o)
 {
     gdr_camera camera = scene->camera_count > 0 ? scene->cameras[o->has_camera_index ? o->camera_index : 0]
                                                 : gdr_scene_framing_camera(scene);
@@ -137,10 +136,47 @@ static gdr_camera choose_camera(const gdr_scene *scene, const render_options *o)
     return camera;
 }
 
+gdr_frame_desc render_options_frame(const render_options *o, gdr_camera camera)
+{
+    return (gdr_frame_desc){.camera = camera, .cull = o->cull ? GDR_CULL_ON : GDR_CULL_OFF,
+                            .read_back = o->out_png != NULL, .pipeline = o->pipeline, .view = o->view,
+                            .raster = o->raster, .sw_threshold_px = o->sw_threshold,
+                            .meshlet_frustum_cull = o->meshlet_cull ? GDR_CULL_ON : GDR_CULL_OFF,
+                            .meshlet_cone_cull = o->cone_cull ? GDR_CULL_ON : GDR_CULL_OFF,
+                            .triangle_cull = o->triangle_cull ? GDR_CULL_ON : GDR_CULL_OFF,
+                            .lod_error_px = o->lod_error, .lod_fixed_depth = o->has_lod_depth, .lod_depth = o->lod_depth,
+                            .occlusion = !o->occlusion_given ? GDR_CULL_DEFAULT
+                                         : o->occlusion       ? GDR_CULL_ON
+                                                             : GDR_CULL_OFF,
+                            .lod_hierarchy = o->lod_hierarchy ? GDR_CULL_ON : GDR_CULL_OFF,
+                            .min_screen_size = o->min_screen_size, .clip_plane = o->clip_plane};
+}
+
+/* The frames asked for: o->frames of one view, or with --camera-path one frame per pose (the path
+ * repeated to make --frames N, N the path's length by default); the statistics are the last call's. */
+static gdr_status render_frames(gdr_renderer *renderer, gdr_frame_desc *frame, const render_options *o,
+                                gdr_frame_stats *stats, gdr_error *err)
+{
+    if (!o->camera_path)
+        return gdr_renderer_render(renderer, frame, o->frames, stats, err);
+    camera_path path;
+    gdr_status status = camera_path_read(o->camera_path, &path, err);
+    uint32_t frames = o->frames_given ? o->frames : path.count;
+    bool read_back = frame->read_back;
+    for (uint32_t f = 0; f < frames && status == GDR_OK; f++) {
+        frame->camera.position = path.poses[f % path.count].position;
+        frame->camera.rotation = path.poses[f % path.count].rotation;
+        frame->read_back = read_back && f + 1 == frames;
+        status = gdr_renderer_render(renderer, frame, 1, stats, err);
+    }
+    camera_path_free(&path);
+    return status;
+}
+
 int gdr_cmd_render(int argc, char **argv)
 {
     render_options o;
-    int usage = parse_render_options(argc, argv, &o);
+    int usage = render_options_parse("render", argc, argv, &o, NULL, NULL);
     if (usage)
         return usage;
     gdr_error err = {0};
@@ -157,19 +193,9 @@ int gdr_cmd_render(int argc, char **argv)
     gdr_frame_stats stats;
     uint8_t *pixels = NULL;
     int result = 0;
-    gdr_frame_desc frame = {.camera = choose_camera(scene, &o), .cull = o.cull ? GDR_CULL_ON : GDR_CULL_OFF,
-                            .read_back = o.out_png != NULL, .pipeline = o.pipeline, .view = o.view,
-                            .raster = o.raster, .sw_threshold_px = o.sw_threshold,
-                            .meshlet_frustum_cull = o.meshlet_cull ? GDR_CULL_ON : GDR_CULL_OFF,
-                            .meshlet_cone_cull = o.cone_cull ? GDR_CULL_ON : GDR_CULL_OFF,
-                            .triangle_cull = o.triangle_cull ? GDR_CULL_ON : GDR_CULL_OFF,
-                            .lod_error_px = o.lod_error, .lod_fixed_depth = o.has_lod_depth, .lod_depth = o.lod_depth,
-                            .occlusion = !o.occlusion_given ? GDR_CULL_DEFAULT
-                                         : o.occlusion       ? GDR_CULL_ON
-                                                             : GDR_CULL_OFF,
-                            .lod_hierarchy = o.lod_hierarchy ? GDR_CULL_ON : GDR_CULL_OFF};
+    gdr_frame_desc frame = render_options_frame(&o, render_options_camera(scene, &o));
     if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK || gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK ||
-        gdr_renderer_render(renderer, &frame, o.frames, &stats, &err) != GDR_OK) {
+        render_frames(renderer, &frame, &o, &stats, &err) != GDR_OK) {
         result = fail(&err);
         goto done;
     }

@@ -7,5 +7,6 @@ int gdr_cmd_render(int argc, char **argv);
 int gdr_cmd_bench(int argc, char **argv);
 int gdr_cmd_build(int argc, char **argv); /* gdr build INPUT -o OUTPUT.gdrc */
 int gdr_cmd_info(int argc, char **argv);  /* gdr info FILE */
+int gdr_cmd_view(int argc, char **argv);  /* gdr view SCENE: the interactive window */
 
 #endif

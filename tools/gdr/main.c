@@ -3,14 +3,16 @@
 #include <string.h>
 
 #include "commands.h"
+#include "view.h"
 #include "gdr/gdr.h"
 
 static void print_help(FILE *out)
 {
-    fputs("gdr - a GPU-driven renderer on Vulkan\n"
+    fprintf(out, "gdr - a GPU-driven renderer on Vulkan\n"
           "\n"
           "usage:\n"
           "  gdr render SCENE [options]   render SCENE headless; print statistics\n"
+          "  gdr view SCENE [options]     the scene in a window: fly through it, switch views, watch culling\n"
           "  gdr bench [options]          render the demo scene at several sizes; print a table and JSON\n"
           "  gdr build INPUT -o OUT.gdrc [--pvs]   import INPUT and write the processed-scene cache\n"
           "                               (--pvs: bake the precomputed visibility into it)\n"
@@ -24,6 +26,8 @@ static void print_help(FILE *out)
           "                          dense closed mesh of about T triangles (default 100000), near to far\n"
           "  occlusion[:seed=S,hidden=N,visible=N]    a wall of buildings in front of N hidden objects\n"
           "                          (default 4000), N visible ones in front (default 300), gaps\n"
+          "  unique-field[:meshes=M,seed=S,triangles=T,spacing=M]   M different dense meshes (default\n"
+          "                          100) of about T triangles (default 100000), one copy each\n"
           "Source files go through a .gdrc cache next to them.\n"
           "\n"
           "render options:\n"
@@ -49,9 +53,16 @@ static void print_help(FILE *out)
           "  --lod-error PIXELS      LOD cut: coarsest clusters whose projected error is within PIXELS\n"
           "                          (mesh pipeline; default 1; 0 draws full detail)\n"
           "  --lod-depth N           draw the discrete cut at LOD DAG depth N instead (0: full detail)\n"
+          "  --min-screen-size S     do not draw instances whose bounding sphere's screen size (about\n"
+          "                          its projected diameter over the image height) is below S\n"
+          "                          (GPU-driven and CPU pipelines; default 0: no minimum)\n"
+          "  --clip-plane a,b,c,d    do not draw instances entirely on the negative side of the plane\n"
+          "                          a x + b y + c z + d = 0 (world space; default: none)\n"
           "  --lod-hierarchy on|off  find the cut by traversing each mesh's LOD hierarchy, or by testing\n"
           "                          every cluster of the DAG (the same cut; default on)\n"
           "  --frames N              render N frames (timings are means over them; default 1)\n"
+          "  --camera-path FILE      one frame per pose of a recorded path (gdr view --record-path;\n"
+          "                          --frames N repeats it to N frames; docs/VIEWER.md)\n"
           "  --device N|NAME         Vulkan device by index or name substring (default: first discrete GPU)\n"
           "  --validate              enable the Khronos validation layer; messages are counted and\n"
           "                          make the exit status 3\n"
@@ -62,6 +73,18 @@ static void print_help(FILE *out)
           "                          see docs/SECURITY.md for the defaults\n"
           "  --allow-outside-files   let a glTF name buffers and images outside its own folder\n"
           "                          (absolute paths, '..', links pointing out; default: refused)\n"
+          "\n"
+          "view options (and the render options above but --out and --stats):\n"
+          "  --frames N              present N frames, then exit (default: until closed or Escape)\n"
+          "  --screenshot FILE.png   write the last presented image (what the window shows)\n"
+          "  --screenshot-dir DIR    where F12 writes gdr-view-NNNN.png (default .)\n"
+          "  --record-path FILE      write the camera of every frame as a camera path\n"
+          "  --camera-path FILE      fly the recorded path instead of the keys\n"
+          "  --overlay on|off        statistics over the image (default on; TAB toggles it)\n"
+          "  --no-vsync              present without waiting for the refresh (Y toggles it)\n"
+          "  --max-fps N             at most N frames per second (default: as the present mode allows)\n"
+          "  keys:\n"
+          "%s"
           "\n"
           "bench options:\n"
           "  --sizes N,N,...         instance counts (default 1000,10000,100000,1000000)\n"
@@ -76,10 +99,14 @@ static void print_help(FILE *out)
           "  --camera px,py,pz,qx,qy,qz,qw   instead of the demo camera\n"
           "  --record-every-frame    record the GPU-driven frames' commands every frame (default:\n"
           "                          once, then submitted again while nothing they depend on changes)\n"
+          "  --camera-path FILE      time one frame per pose of the path (a row per frame)\n"
+          "  --plot FILE.svg         plot GPU ms per pass against scene size, or per frame along\n"
+          "                          --camera-path (needs gnuplot)\n"
+          "  --plot-from FILE.json   with --plot: plot an earlier run's --json instead of running\n"
           "  --device N|NAME, --validate, --json FILE\n"
           "\n"
           "exit status: 0 success, 1 failure, 2 bad usage, 3 validation messages\n",
-          out);
+          view_key_help);
 }
 
 int main(int argc, char **argv)
@@ -103,6 +130,8 @@ int main(int argc, char **argv)
         return gdr_cmd_bench(argc - 1, argv + 1);
     if (strcmp(command, "build") == 0)
         return gdr_cmd_build(argc - 1, argv + 1);
+    if (strcmp(command, "view") == 0)
+        return gdr_cmd_view(argc - 1, argv + 1);
     if (strcmp(command, "info") == 0)
         return gdr_cmd_info(argc - 1, argv + 1);
     fprintf(stderr, "gdr: unknown command '%s' (see gdr --help)\n", command);

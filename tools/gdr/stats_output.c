@@ -15,6 +15,9 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
         fprintf(out, "view                %s\n", context->view);
     fprintf(out, "instances_total     %u\n", s->instances_total);
     fprintf(out, "instances_visible   %u\n", s->instances_visible);
+    if (s->instances_invalid || s->instances_screen_size_culled || s->instances_clip_plane_culled)
+        fprintf(out, "instances_culled    %u invalid or empty bounds, %u by screen size, %u behind the clip plane\n",
+                s->instances_invalid, s->instances_screen_size_culled, s->instances_clip_plane_culled);
     fprintf(out, "triangles           %llu\n", (unsigned long long)s->triangles);
     if (s->pipeline == GDR_PIPELINE_MESH) {
         fprintf(out, "meshlets_total      %llu\n", (unsigned long long)s->meshlets_total);
@@ -39,8 +42,9 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
         }
         if (s->traversal.applied)
             fprintf(out, "lod_hierarchy       %u levels; nodes %u tested (%u late), %u LOD-culled, %u outside the frustum, "
-                         "%u occluded%s\n", s->traversal.levels, s->traversal.nodes_tested, s->traversal.late_nodes_tested,
-                    s->traversal.nodes_lod_culled, s->traversal.nodes_frustum_culled, s->traversal.nodes_occluded,
+                         "%u deferred, %u occluded%s\n", s->traversal.levels, s->traversal.nodes_tested,
+                    s->traversal.late_nodes_tested, s->traversal.nodes_lod_culled, s->traversal.nodes_frustum_culled,
+                    s->traversal.nodes_early_occluded, s->traversal.nodes_occluded,
                     s->traversal.overflow ? "; VISITS LOST TO OVERFLOW" : "");
         if (s->traversal.overflow)
             fprintf(out, "traversal_overflow  %u node visits did not fit (their clusters were not drawn)\n",
@@ -60,8 +64,9 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
         fprintf(out, "draws               %u (in %u indirect draw call)\n", s->draws, s->draw_calls);
     }
     if (s->occlusion.applied) {
-        fprintf(out, "occlusion early     instances %u drawn, %u occluded (by last frame's pyramid); clusters %u drawn\n",
-                s->occlusion.instances_early_drawn, s->occlusion.instances_early_occluded, s->occlusion.meshlets_early_drawn);
+        fprintf(out, "occlusion early     instances %u drawn, %u deferred (behind last frame's pyramid); clusters %u drawn, "
+                "%u deferred; %u overflow\n", s->occlusion.instances_early_drawn, s->occlusion.instances_early_occluded,
+                s->occlusion.meshlets_early_drawn, s->occlusion.meshlets_early_occluded, s->occlusion.overflow);
         fprintf(out, "occlusion late      instances %u tested, %u occluded, %u drawn; clusters %u tested, %u occluded, "
                 "%u drawn\n", s->occlusion.instances_late_tested, s->occlusion.instances_late_occluded, s->occlusion.instances_late_drawn,
                 s->occlusion.meshlets_late_tested, s->occlusion.meshlets_late_occluded, s->occlusion.meshlets_late_drawn);
@@ -120,6 +125,8 @@ void stats_add_occlusion_json(cJSON *object, const gdr_frame_stats *s)
     cJSON_AddNumberToObject(object, "instances_late_occluded", s->occlusion.instances_late_occluded);
     cJSON_AddNumberToObject(object, "instances_late_drawn", s->occlusion.instances_late_drawn);
     cJSON_AddNumberToObject(object, "meshlets_early_drawn", s->occlusion.meshlets_early_drawn);
+    cJSON_AddNumberToObject(object, "meshlets_early_occluded", s->occlusion.meshlets_early_occluded);
+    cJSON_AddNumberToObject(object, "occluded_overflow", s->occlusion.overflow);
     cJSON_AddNumberToObject(object, "meshlets_late_tested", s->occlusion.meshlets_late_tested);
     cJSON_AddNumberToObject(object, "meshlets_late_occluded", s->occlusion.meshlets_late_occluded);
     cJSON_AddNumberToObject(object, "meshlets_late_drawn", s->occlusion.meshlets_late_drawn);
@@ -134,6 +141,7 @@ void stats_add_traversal_json(cJSON *object, const gdr_frame_stats *s)
     cJSON_AddNumberToObject(object, "nodes_tested", s->traversal.nodes_tested);
     cJSON_AddNumberToObject(object, "nodes_lod_culled", s->traversal.nodes_lod_culled);
     cJSON_AddNumberToObject(object, "nodes_frustum_culled", s->traversal.nodes_frustum_culled);
+    cJSON_AddNumberToObject(object, "nodes_early_occluded", s->traversal.nodes_early_occluded);
     cJSON_AddNumberToObject(object, "nodes_occluded", s->traversal.nodes_occluded);
     cJSON_AddNumberToObject(object, "late_nodes_tested", s->traversal.late_nodes_tested);
     cJSON_AddNumberToObject(object, "traversal_overflow", s->traversal.overflow);
@@ -163,6 +171,9 @@ char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
     cJSON_AddStringToObject(root, "view", context->view ? context->view : "shaded");
     cJSON_AddNumberToObject(root, "instances_total", s->instances_total);
     cJSON_AddNumberToObject(root, "instances_visible", s->instances_visible);
+    cJSON_AddNumberToObject(root, "instances_invalid", s->instances_invalid);
+    cJSON_AddNumberToObject(root, "instances_screen_size_culled", s->instances_screen_size_culled);
+    cJSON_AddNumberToObject(root, "instances_clip_plane_culled", s->instances_clip_plane_culled);
     cJSON_AddNumberToObject(root, "triangles", (double)s->triangles);
     cJSON_AddNumberToObject(root, "draws", s->draws);
     cJSON_AddNumberToObject(root, "draw_calls", s->draw_calls);

@@ -4,12 +4,14 @@
  *  - the LOD cut: is the cluster part of the cut this view needs?
  *  - its sphere against the frustum (the instance test's math), then its normal cone against the
  *    camera;
- *  - two-phase occlusion culling.
+ *  - two-phase occlusion culling (occlusion_test.h; the early phase's hidden clusters are retested in
+ *    the late phase through retest commands).
  * Include after glsl_buffers.h, cull_math.h, lod_math.h, occlusion_test.h and meshlet_payload.h. */
 #ifndef GDR_CLUSTER_CULL_H
 #define GDR_CLUSTER_CULL_H
 
 #include "task_queue.h" // the occlusion culling phases
+#include "residency.h"
 
 
 // What the tests decided for one invocation's cluster.
@@ -18,7 +20,7 @@ struct GdrClusterResult {
     bool visible;        // draw it
     bool lod_culled, frustum_culled, cone_culled;
     bool late_tested;    // late phase: passed the other tests, so tested against the pyramid
-    bool occluded;
+    bool occluded;       // behind the phase's pyramid: early, deferred; late, culled
     uint instance;
     uint meshlet;        // global GdrGpuMeshlet index
     uint flags;          // the task command's GDR_TASK_* flags
@@ -37,31 +39,27 @@ bool gdr_lod_passes(GdrGpuFrameGlobals g, vec4 sphere, float error, int depth, m
                                          g.camera_position.xyz, g.znear, g.lod_projection_scale) <= g.lod_threshold;
 }
 
-// Two-phase occlusion culling of one cluster that passed the other tests (`candidate`), with one
-// visibility bit per cluster of every instance. Early: draw it if it was visible at the end of the
-// last frame. Late: test it against this frame's pyramid, record the result for the next frame and
-// draw it if visible and not drawn early. (Clusters are not tested against last frame's pyramid in
-// the early phase: the late phase could then not tell which ones the early phase drew.)
-bool gdr_cluster_occlusion_phase(GdrGpuFrameGlobals g, uint phase, GdrGpuInstance instance, GdrGpuTaskCommand task,
-                                 uint lane, bool candidate, vec3 center, float radius, out bool occluded)
+// The task commands of `phase`'s region of the task list: the late phase's follow the early
+// phase's task_capacity entries (drawcull.comp). A macro: a function returning a reference makes
+// glslang emit a pointer variable without the aliasing decoration that SPIR-V requires.
+#define gdr_task_region(g, phase)                                                                          \
+    TaskCommandsRef(uint64_t(GDR_FRAME.tasks) + ((phase) == GDR_PHASE_LATE ? uint64_t((g).task_capacity) * 16ul : 0ul))
+
+// Early phase: a late task command that retests the clusters of `task` in `mask` (bit i: cluster
+// meshlet_first + i), those behind last frame's pyramid. False when the late region is full: the
+// caller then draws them now (counted as overflow), so nothing is lost.
+bool gdr_defer_clusters(GdrGpuFrameGlobals g, GdrGpuTaskCommand task, uint mask)
 {
-    uint mesh_first = MeshesRef(GDR_SCENE.meshes).items[instance.mesh].meshlet_offset;
-    uint bit = instance.meshlet_visibility_offset + (task.meshlet_first + lane - mesh_first);
-    VisibilityRef bits = VisibilityRef(GDR_SCENE.meshlet_visibility);
-    bool was_visible = (bits.items[bit >> 5] & (1u << (bit & 31u))) != 0u;
-    occluded = false;
-    if (phase == GDR_PHASE_EARLY)
-        return candidate && was_visible;
-    occluded = candidate && gdr_sphere_occluded(g, center, radius);
-    bool visible = candidate && !occluded;
-    if (visible != was_visible) {
-        if (visible)
-            atomicOr(bits.items[bit >> 5], 1u << (bit & 31u));
-        else
-            atomicAnd(bits.items[bit >> 5], ~(1u << (bit & 31u)));
+    DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
+    uint slot = atomicAdd(stats.value.late_task_count, 1u);
+    if (slot >= g.task_capacity) {
+        atomicAdd(stats.value.occluded_overflow, bitCount(mask));
+        return false;
     }
-    bool drawn_early = (task.flags & GDR_TASK_DRAWN_EARLY) != 0u && was_visible && candidate;
-    return visible && !drawn_early;
+    uint flags = (task.flags & ~GDR_TASK_FIRST) | GDR_TASK_RETEST;
+    gdr_task_region(g, GDR_PHASE_LATE).items[slot] = GdrGpuTaskCommand(task.instance, task.meshlet_first, task.meshlet_count, flags);
+    WritableUintsRef(GDR_FRAME.retest_masks).items[slot] = mask;
+    return true;
 }
 
 // The clusters of task command `task_index` of `phase`'s region of the task list (0 past its end).
@@ -72,70 +70,84 @@ uint gdr_cluster_task_size(GdrGpuFrameGlobals g, uint phase, uint task_index)
                           g.task_capacity);
     if (task_index >= task_count)
         return 0u;
-    return TaskCommandsRef(uint64_t(GDR_FRAME.tasks) + (phase == GDR_PHASE_LATE ? uint64_t(g.task_capacity) * 16ul : 0ul))
-        .items[task_index].meshlet_count;
+    return gdr_task_region(g, phase).items[task_index].meshlet_count;
 }
 
-// The tests for cluster `lane` of task command `task_index` of `phase`'s region of the task list.
-GdrClusterResult gdr_cluster_test(GdrGpuFrameGlobals g, uint phase, uint task_index, uint lane)
+GdrClusterResult gdr_cluster_no_result()
 {
-    GdrClusterResult result;
-    result.in_task = false;
-    result.visible = false;
-    result.lod_culled = false;
-    result.frustum_culled = false;
-    result.cone_culled = false;
-    result.late_tested = false;
-    result.occluded = false;
-    result.instance = 0u;
-    result.meshlet = 0u;
-    result.flags = 0u;
-    result.depth = 0;
-    result.triangles = 0u;
-    DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
-    uint task_count = min(phase == GDR_PHASE_LATE ? stats.value.late_task_count : stats.value.task_count,
-                          g.task_capacity);
-    if (task_index >= task_count)
-        return result;
-    // The late phase's commands follow the early phase's region (drawcull.comp).
-    GdrGpuTaskCommand task =
-        TaskCommandsRef(uint64_t(GDR_FRAME.tasks) + (phase == GDR_PHASE_LATE ? uint64_t(g.task_capacity) * 16ul : 0ul)).items[task_index];
+    return GdrClusterResult(false, false, false, false, false, false, false, 0u, 0u, 0u, 0, 0u);
+}
+
+// The tests for cluster `lane` of command `task` (when `tested`: a retest command's clusters that
+// the early phase did not defer are not). A retest command's clusters passed the other tests in the
+// early phase (same camera), so only the occlusion test against this frame's pyramid is left.
+GdrClusterResult gdr_cluster_test_command(GdrGpuFrameGlobals g, uint phase, GdrGpuTaskCommand task, uint lane,
+                                          bool tested)
+{
+    GdrClusterResult result = gdr_cluster_no_result();
     result.instance = task.instance;
     result.flags = task.flags;
     result.meshlet = task.meshlet_first + lane;
-    if (lane >= task.meshlet_count)
+    if (lane >= task.meshlet_count || !tested)
         return result;
+    bool retest = phase == GDR_PHASE_LATE && (task.flags & GDR_TASK_RETEST) != 0u;
     result.in_task = true;
 
     GdrGpuMeshlet meshlet = MeshletsRef(GDR_SCENE.meshlets).items[result.meshlet];
     GdrGpuInstance instance = InstancesRef(GDR_SCENE.instances).items[task.instance];
     mat4 model = instance.model;
-    vec3 center = (g.view * (model * vec4(meshlet.sphere.xyz, 1.0))).xyz;
+    vec3 world_center = (model * vec4(meshlet.sphere.xyz, 1.0)).xyz;
+    vec3 center = (g.view * vec4(world_center, 1.0)).xyz;
     float radius = meshlet.sphere.w * gdr_max_axis_scale(model[0].xyz, model[1].xyz, model[2].xyz);
     result.depth = meshlet.group_depth;
     result.triangles = meshlet.triangle_count;
     bool visible = true;
-    if ((g.flags & GDR_FRAME_LOD) != 0u && (task.flags & GDR_TASK_LOD_ACCEPTED) == 0u) {
-        visible = gdr_lod_passes(g, meshlet.refined_sphere, meshlet.refined_error, meshlet.refined_depth, model) &&
-                  !gdr_lod_passes(g, meshlet.group_sphere, meshlet.group_error, meshlet.group_depth, model);
+    if (!retest && (g.flags & GDR_FRAME_LOD) != 0u && (task.flags & GDR_TASK_LOD_ACCEPTED) == 0u) {
+        // passes' (shared/residency.h): an absent group counts as passing; drawn in the place of an
+        // absent refined group that does not pass, the cluster asks for that group.
+        bool refined_absent = gdr_group_absent(g, instance.mesh, meshlet.refined_group);
+        bool refined_passes =
+            gdr_lod_passes(g, meshlet.refined_sphere, meshlet.refined_error, meshlet.refined_depth, model);
+        visible = (refined_absent || refined_passes) &&
+                  !(gdr_group_absent(g, instance.mesh, meshlet.group) ||
+                    gdr_lod_passes(g, meshlet.group_sphere, meshlet.group_error, meshlet.group_depth, model));
+        if (visible && refined_absent && !refined_passes)
+            gdr_request_group(g, task.instance, instance.mesh, meshlet.refined_group, meshlet.refined_sphere,
+                              meshlet.refined_error, model);
         result.lod_culled = !visible;
     }
     bool cull = g.cull_enabled != 0u;
-    if (visible && cull && (g.flags & GDR_FRAME_MESHLET_FRUSTUM) != 0u) {
+    if (!retest && visible && cull && (g.flags & GDR_FRAME_MESHLET_FRUSTUM) != 0u) {
         visible = gdr_sphere_visible(g.frustum, center, radius, g.znear, g.zfar);
         result.frustum_culled = !visible;
     }
     mat3 linear = mat3(model);
-    if (visible && cull && (g.flags & GDR_FRAME_MESHLET_CONE) != 0u && determinant(linear) > 0.0) {
+    if (!retest && visible && cull && (g.flags & GDR_FRAME_MESHLET_CONE) != 0u && determinant(linear) > 0.0) {
         vec3 camera = inverse(linear) * (g.camera_position.xyz - model[3].xyz);
         result.cone_culled = gdr_cone_backfacing(meshlet.cone_apex, meshlet.cone_axis, meshlet.cone_cutoff, camera);
         visible = !result.cone_culled;
     }
     result.late_tested = phase == GDR_PHASE_LATE && visible;
-    if (phase != GDR_PHASE_NONE)
-        visible = gdr_cluster_occlusion_phase(g, phase, instance, task, lane, visible, center, radius, result.occluded);
-    result.visible = visible;
+    // Occlusion (occlusion_test.h): early, hidden behind last frame's pyramid means deferred to the
+    // late phase (the caller appends a retest command); late, behind this frame's, culled.
+    result.occluded = visible && gdr_phase_occluded(g, phase, world_center, radius);
+    result.visible = visible && !result.occluded;
     return result;
+}
+
+// The tests for cluster `lane` of task command `task_index` of `phase`'s region of the task list.
+GdrClusterResult gdr_cluster_test(GdrGpuFrameGlobals g, uint phase, uint task_index, uint lane)
+{
+    DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
+    uint task_count = min(phase == GDR_PHASE_LATE ? stats.value.late_task_count : stats.value.task_count,
+                          g.task_capacity);
+    if (task_index >= task_count)
+        return gdr_cluster_no_result();
+    GdrGpuTaskCommand task = gdr_task_region(g, phase).items[task_index];
+    bool retest = phase == GDR_PHASE_LATE && (task.flags & GDR_TASK_RETEST) != 0u;
+    bool deferred = retest && lane < 32u &&
+                    (WritableUintsRef(GDR_FRAME.retest_masks).items[task_index] & (1u << lane)) != 0u;
+    return gdr_cluster_test_command(g, phase, task, lane, !retest || deferred);
 }
 
 // Clusters and triangles drawn per DAG depth: one atomic per distinct depth in the subgroup.
@@ -169,9 +181,8 @@ void gdr_cluster_count(GdrGpuFrameGlobals g, uint phase, GdrClusterResult r)
     }
     gdr_count_lod_depths(stats, r.visible, r.depth, r.triangles);
     if (phase == GDR_PHASE_EARLY) {
-        uint n = subgroupAdd(r.visible ? 1u : 0u);
-        if (subgroupElect() && n > 0u)
-            atomicAdd(stats.value.meshlets_early_drawn, n);
+        GDR_COUNT(stats, meshlets_early_drawn, r.visible);
+        GDR_COUNT(stats, meshlets_early_occluded, r.occluded);
     } else if (phase == GDR_PHASE_LATE) {
         uint n = subgroupAdd(r.visible ? 1u : 0u);
         uint t = subgroupAdd(r.late_tested ? 1u : 0u);

@@ -18,7 +18,7 @@ layout(buffer_reference, scalar) readonly buffer VerticesRef { GdrGpuVertex item
 layout(buffer_reference, scalar) readonly buffer MeshletsRef { GdrGpuMeshlet items[]; };
 layout(buffer_reference, scalar) readonly buffer LodNodesRef { GdrGpuLodNode items[]; };
 layout(buffer_reference, scalar) readonly buffer UintsRef { uint items[]; };
-layout(buffer_reference, scalar) buffer VisibilityRef { uint items[]; };
+layout(buffer_reference, scalar) buffer WritableUintsRef { uint items[]; };
 layout(buffer_reference, scalar) writeonly buffer DrawCommandsRef { GdrGpuDrawCommand items[]; };
 layout(buffer_reference, scalar) buffer DrawStatsRef { GdrGpuDrawStats value; };
 layout(buffer_reference, scalar) readonly buffer InstanceUpdatesRef { GdrGpuInstanceUpdate items[]; };
@@ -29,9 +29,9 @@ layout(buffer_reference, scalar) buffer VisbufferRef { uint64_t items[]; };
 layout(buffer_reference, scalar) readonly buffer RasterParamsRef { GdrGpuRasterParams value; };
 layout(buffer_reference, scalar) buffer RasterCountersRef { GdrGpuRasterCounters value; };
 layout(buffer_reference, scalar) buffer RasterClustersRef { GdrGpuRasterCluster items[]; };
-layout(buffer_reference, scalar) writeonly buffer ResolvedRef { uint items[]; };
 layout(buffer_reference, scalar) buffer NodeVisitsRef { GdrGpuNodeVisit items[]; };
 layout(buffer_reference, scalar) readonly buffer MaterialsRef { GdrGpuMaterial items[]; };
+layout(buffer_reference, scalar) writeonly buffer StreamRequestsRef { GdrGpuStreamRequest items[]; };
 
 layout(push_constant, scalar) uniform PushConstantBlock { GdrGpuPushConstants push; };
 

@@ -21,12 +21,21 @@
  * instance's root group, one or two clusters. */
 #define GDR_CLUSTER_CULL_TASKS 32
 #define GDR_CLUSTER_CULL_LANES 8
+/* An instance that needs at most this many clusters (a distant instance's root group, a small mesh)
+ * has them tested and binned by its instance-cull invocation (GDR_FRAME_DIRECT_CLUSTERS): a task
+ * command of one or two clusters costs the cluster cull a whole GDR_CLUSTER_CULL_LANES slot and a
+ * second pass over the instance. */
+#define GDR_DIRECT_CLUSTERS 4
 /* LOD statistics: clusters and triangles drawn per DAG depth, the last bucket for deeper ones. */
 #define GDR_LOD_STATS_DEPTHS 32
 /* The LOD hierarchy traversal (lodtraverse.comp): one invocation per node visit, one dispatch per
  * level of the hierarchies (at most GDR_LOD_TREE_LEVELS, gdr/geometry.h's GDR_LOD_NODE_MAX_LEVELS);
  * a level holds at most GDR_TRAVERSE_MAX_VISITS visits (a one-dimensional indirect dispatch). */
 #define GDR_TRAVERSE_WORKGROUP_SIZE 64
+/* Stream requests a frame appends at most (shared/residency.h); the rest are counted and dropped:
+ * the groups still absent ask again the next frame. */
+#define GDR_STREAM_REQUEST_CAPACITY 4096
+
 /* Meshes of at most this many task commands of clusters are tested whole: their few commands cost
  * less than the traversal's levels (the same cut either way). */
 #define GDR_TRAVERSE_MIN_TASKS 8

@@ -17,7 +17,7 @@ GDR_DECLARE_REF(VerticesRef)
 GDR_DECLARE_REF(MeshletsRef)
 GDR_DECLARE_REF(LodNodesRef)
 GDR_DECLARE_REF(UintsRef)
-GDR_DECLARE_REF(VisibilityRef)
+GDR_DECLARE_REF(WritableUintsRef)
 GDR_DECLARE_REF(DrawCommandsRef)
 GDR_DECLARE_REF(DrawStatsRef)
 GDR_DECLARE_REF(InstanceUpdatesRef)
@@ -28,9 +28,9 @@ GDR_DECLARE_REF(VisbufferRef)
 GDR_DECLARE_REF(RasterParamsRef)
 GDR_DECLARE_REF(RasterCountersRef)
 GDR_DECLARE_REF(RasterClustersRef)
-GDR_DECLARE_REF(ResolvedRef)
 GDR_DECLARE_REF(NodeVisitsRef)
 GDR_DECLARE_REF(MaterialsRef)
+GDR_DECLARE_REF(StreamRequestsRef)
 
 /* One vertex of the geometry pool (vertex input binding 0). */
 GDR_STRUCT_BEGIN(GdrGpuVertex)
@@ -66,7 +66,7 @@ GDR_STRUCT_BEGIN(GdrGpuMesh)
     float root_refined_error;
     gdr_uint lod_node_count;    /* >= 1 for a mesh with clusters; node 0 of the mesh is its root */
     gdr_uint lod_node_levels;   /* levels of the mesh's hierarchy (a traversal level by level needs this many steps) */
-    gdr_uint reserved3;
+    gdr_uint page_table_offset; /* the mesh's groups' words in GdrGpuScene.page_table (shared/residency.h) */
 GDR_STRUCT_END(GdrGpuMesh)
 GDR_ASSERT_SIZE(GdrGpuMesh, 96);
 GDR_ASSERT_OFFSET(GdrGpuMesh, bounds, 16);
@@ -106,7 +106,7 @@ GDR_ASSERT_OFFSET(GdrGpuMeshlet, group_sphere, 80);
 GDR_ASSERT_OFFSET(GdrGpuMeshlet, group_error, 112);
 
 /* One node of a mesh's LOD hierarchy: gdr_lod_node of gdr/geometry.h, whose contract it shares
- * (the CPU array is uploaded as it is). Indices are mesh-local: an inner node's children are nodes
+ * (its fields are uploaded as they are), and a culling sphere. Indices are mesh-local: an inner node's children are nodes
  * [first, first + count) of its mesh, a leaf's clusters are the mesh's clusters
  * [first, first + count). The node test is gdr_lod_node_may_draw (lod_math.h). */
 GDR_STRUCT_BEGIN(GdrGpuLodNode)
@@ -119,8 +119,13 @@ GDR_STRUCT_BEGIN(GdrGpuLodNode)
     gdr_uint flags;          /* GDR_GPU_LOD_NODE_LEAF */
     gdr_uint reserved0;
     gdr_uint reserved1;
+    /* Mesh space: contains the culling sphere of every cluster below, and nothing of the LOD
+     * spheres, which grow with every level (`sphere` holds both): the frustum and occlusion tests
+     * use it, the LOD test uses `sphere`. Computed at upload (gpu_scene.c). */
+    gdr_vec4 bounds;
 GDR_STRUCT_END(GdrGpuLodNode)
-GDR_ASSERT_SIZE(GdrGpuLodNode, 48);
+GDR_ASSERT_SIZE(GdrGpuLodNode, 64);
+GDR_ASSERT_OFFSET(GdrGpuLodNode, bounds, 48);
 GDR_ASSERT_OFFSET(GdrGpuLodNode, max_error, 16);
 GDR_ASSERT_OFFSET(GdrGpuLodNode, min_refined_error, 20);
 GDR_ASSERT_OFFSET(GdrGpuLodNode, first, 24);
@@ -141,8 +146,19 @@ GDR_STRUCT_BEGIN(GdrGpuTaskCommand)
 GDR_STRUCT_END(GdrGpuTaskCommand)
 GDR_ASSERT_SIZE(GdrGpuTaskCommand, 16);
 
+/* A group a cluster test found absent while the full cut needs it (shared/residency.h): the
+ * cluster drawn in its place was made from it and its projected error (`priority`) is above the
+ * threshold. Read back into gdr_residency_plan's requests (mesh, group, priority). */
+GDR_STRUCT_BEGIN(GdrGpuStreamRequest)
+    gdr_uint mesh;
+    gdr_uint group;    /* mesh-local */
+    float priority;    /* the group's projected error, pixels */
+    gdr_uint instance; /* the instance that asked */
+GDR_STRUCT_END(GdrGpuStreamRequest)
+GDR_ASSERT_SIZE(GdrGpuStreamRequest, 16);
+
 /* One node visit of the LOD hierarchy traversal: node `node` (mesh-local GdrGpuLodNode index) of
- * instance `instance`, with the task flags its clusters' commands will carry (GDR_TASK_DRAWN_EARLY). */
+ * instance `instance`, with the task flags its clusters' commands will carry (GDR_TASK_*). */
 GDR_STRUCT_BEGIN(GdrGpuNodeVisit)
     gdr_uint instance;
     gdr_uint node;
@@ -161,23 +177,25 @@ GDR_STRUCT_END(GdrGpuTraversalLevel)
 GDR_ASSERT_SIZE(GdrGpuTraversalLevel, 16);
 
 #define GDR_TASK_LOD_ACCEPTED 1u /* the root shortcut chose these clusters: no LOD test */
-#define GDR_TASK_DRAWN_EARLY 2u  /* late phase: the instance was drawn in the early phase */
+#define GDR_TASK_RETEST 2u       /* late phase: retest only the clusters of the command's retest mask
+                                    (the early phase found them behind last frame's pyramid) */
 #define GDR_TASK_FIRST 4u        /* the first command of its instance (for read-backs) */
 #define GDR_GPU_NO_GROUP 0xffffffffu
+#define GDR_GPU_PAGE_ABSENT 0xffffffffu /* a page-table word: the group is not resident */
 
 /* One instance of the persistent instance buffer. */
 GDR_STRUCT_BEGIN(GdrGpuInstance)
     gdr_mat4 model;
     gdr_vec4 color;
     gdr_uint mesh;
-    gdr_uint flags;
-    gdr_uint meshlet_visibility_offset; /* first bit of this instance's clusters in the cluster visibility bits */
-    gdr_uint material; /* index into GdrGpuScene.materials; the scene's default material when it has none */
+    gdr_uint material;     /* index into GdrGpuScene.materials; the scene's default material when it has none */
+    float min_screen_size; /* culled below this screen size (gdr_instance); 0: no minimum */
+    float max_screen_size; /* culled at this screen size or more; 0: no maximum */
 GDR_STRUCT_END(GdrGpuInstance)
 GDR_ASSERT_SIZE(GdrGpuInstance, 96);
 GDR_ASSERT_OFFSET(GdrGpuInstance, color, 64);
 GDR_ASSERT_OFFSET(GdrGpuInstance, mesh, 80);
-GDR_ASSERT_OFFSET(GdrGpuInstance, material, 92);
+GDR_ASSERT_OFFSET(GdrGpuInstance, material, 84);
 
 #define GDR_GPU_NO_TEXTURE 0xffffffffu
 /* One glTF metallic-roughness material of the material buffer. Texture fields index the bindless
@@ -238,24 +256,28 @@ GDR_STRUCT_BEGIN(GdrGpuDrawStats)
     gdr_uint meshlets_lod_culled;    /* not in the LOD cut */
     gdr_uint lod_clusters[GDR_LOD_STATS_DEPTHS];  /* clusters drawn per DAG depth (last: that depth or more) */
     gdr_uint lod_triangles[GDR_LOD_STATS_DEPTHS]; /* their triangles, before triangle culling */
-    /* Two-phase occlusion culling. The late phase appends its draws and task commands
-     * after the early phase's region of those buffers and launches them with its own commands. */
+    /* Two-phase occlusion culling. The early phase tests against last frame's pyramid and defers
+     * what it hides to the occluded lists; the late phase retests only those against this frame's
+     * pyramid, appending its draws and task commands after the early phase's region of those buffers
+     * and launching them with its own commands. */
     gdr_uint late_draw_count;
     gdr_uint late_task_count;
     gdr_uint late_task_groups_x; /* VkDrawMeshTasksIndirectCommandEXT of the late phase */
     gdr_uint late_task_groups_y;
     gdr_uint late_task_groups_z;
-    gdr_uint instances_early_drawn;    /* visible last frame, in the frustum, not behind last frame's pyramid */
-    gdr_uint instances_early_occluded; /* visible last frame, in the frustum, behind last frame's pyramid */
-    gdr_uint instances_late_tested;    /* in the frustum, tested against this frame's pyramid */
+    gdr_uint instances_early_drawn;    /* in the frustum, not behind last frame's pyramid */
+    gdr_uint instances_early_occluded; /* in the frustum, behind last frame's pyramid: deferred */
+    gdr_uint instances_late_tested;    /* the deferred ones, tested against this frame's pyramid */
     gdr_uint instances_late_occluded;
-    gdr_uint instances_late_drawn;     /* visible and not drawn early */
+    gdr_uint instances_late_drawn;
     gdr_uint meshlets_early_drawn;
-    gdr_uint meshlets_late_tested;     /* clusters that passed the other tests, late phase */
+    gdr_uint meshlets_late_tested;     /* deferred clusters retested, and clusters of late commands that
+                                          passed the other tests */
     gdr_uint meshlets_late_occluded;
-    gdr_uint meshlets_late_drawn;      /* visible and not drawn early */
-    gdr_uint reserved_occlusion0;
-    gdr_uint reserved_occlusion1;
+    gdr_uint meshlets_late_drawn;
+    gdr_uint meshlets_early_occluded;  /* behind last frame's pyramid: deferred to the late phase */
+    gdr_uint occluded_overflow;        /* hidden items that found no room in an occluded list: drawn (or
+                                          traversed) in the early phase instead, never lost */
     /* The cluster cull's launches (visibility-buffer modes): one workgroup per
      * GDR_CLUSTER_CULL_TASKS task commands, early (or only) and late phase. */
     gdr_uint cull_groups_x;
@@ -264,7 +286,8 @@ GDR_STRUCT_BEGIN(GdrGpuDrawStats)
     gdr_uint late_cull_groups_x;
     gdr_uint late_cull_groups_y;
     gdr_uint late_cull_groups_z;
-    gdr_uint reserved_cull0;
+    gdr_uint stream_requests;       /* requests appended (GdrGpuFrameBuffers.stream_requests; may exceed
+                                       GDR_STREAM_REQUEST_CAPACITY: the rest were dropped) */
     gdr_uint reserved_cull1;
     /* The LOD hierarchy traversal: per phase (early or only, then late) and level. Level 0 holds
      * the roots the instance cull queues; the visits of level L + 1 the children of level L's. */
@@ -277,9 +300,23 @@ GDR_STRUCT_BEGIN(GdrGpuDrawStats)
     gdr_uint traversal_overflow;    /* visits that did not fit a level (GDR_TRAVERSE_MAX_VISITS or the
                                        scene's capacity): their subtrees were not drawn */
     gdr_uint instances_listed;      /* mesh pipeline: visible instances in the draw-command list (read-backs) */
-    gdr_uint reserved_traversal0;
+    gdr_uint nodes_early_occluded;  /* early phase: behind last frame's pyramid, deferred to the late phase */
+    /* The occluded lists the early phase fills and the late phase reads: the late instance cull's
+     * count and launch (over GdrGpuFrameBuffers.occluded_instances); the nodes deferred per level
+     * (stored level after level in GdrGpuFrameBuffers.occluded_nodes: level L's start at the sum of
+     * the counts before it), and the running total that places them. */
+    GdrGpuTraversalLevel late_instances;
+    gdr_uint occluded_nodes[GDR_LOD_TREE_LEVELS];
+    gdr_uint occluded_node_total;
+    /* The instance tests, each instance counted by the first that culls it (invalid, frustum, screen
+     * size, clip plane): bounds that are not finite or have no volume, a screen size outside the
+     * instance's range or below the frame's minimum, entirely behind the frame's clip plane. */
+    gdr_uint instances_invalid;
+    gdr_uint instances_screen_size_culled;
+    gdr_uint instances_clip_plane_culled;
 GDR_STRUCT_END(GdrGpuDrawStats)
-GDR_ASSERT_SIZE(GdrGpuDrawStats, 64 + 8 * GDR_LOD_STATS_DEPTHS + 96 + 32 * GDR_LOD_TREE_LEVELS + 32);
+GDR_ASSERT_SIZE(GdrGpuDrawStats, 64 + 8 * GDR_LOD_STATS_DEPTHS + 96 + 32 * GDR_LOD_TREE_LEVELS + 32 + 32 +
+                                     4 * GDR_LOD_TREE_LEVELS);
 GDR_ASSERT_OFFSET(GdrGpuDrawStats, draw_count, 0);
 GDR_ASSERT_OFFSET(GdrGpuDrawStats, task_groups_x, 16);
 
@@ -291,12 +328,12 @@ GDR_STRUCT_BEGIN(GdrGpuScene)
     GDR_REF(MeshletsRef) meshlets;            /* GdrGpuMeshlet[], all meshes' clusters */
     GDR_REF(UintsRef) meshlet_vertices;       /* global vertex index per cluster-local vertex */
     GDR_REF(UintsRef) meshlet_triangles;      /* the bytes of the cluster-local triangles */
-    GDR_REF(VisibilityRef) instance_visibility; /* occlusion history: GDR_INSTANCE_VISIBLE_* per instance */
-    GDR_REF(VisibilityRef) meshlet_visibility;  /* occlusion history: a bit per cluster of every instance */
     GDR_REF(LodNodesRef) lod_nodes;           /* GdrGpuLodNode[], every mesh's LOD hierarchy (GdrGpuMesh.lod_node_*) */
     GDR_REF(MaterialsRef) materials;          /* GdrGpuMaterial[], the scene's, then the default (white, untextured) */
+    GDR_REF(UintsRef) page_table;             /* per group of every mesh: GDR_GPU_PAGE_ABSENT or resident (shared/residency.h) */
+    GDR_REF(UintsRef) node_absent_refined;    /* per LOD node: clusters below whose refined group is absent */
 GDR_STRUCT_END(GdrGpuScene)
-GDR_ASSERT_SIZE(GdrGpuScene, 80);
+GDR_ASSERT_SIZE(GdrGpuScene, 88);
 
 /* A frame slot's buffers: written once, when the slot is made (and when a buffer made on first use
  * appears). Shaders read it and GdrGpuScene in place (GDR_SCENE, GDR_FRAME), never as a local
@@ -310,8 +347,14 @@ GDR_STRUCT_BEGIN(GdrGpuFrameBuffers)
     GDR_REF(VisibleMeshletsRef) visible_meshlets; /* (instance, global cluster) pairs when recording */
     GDR_REF(RasterParamsRef) raster;          /* GdrGpuRasterParams of the slot */
     GDR_REF(NodeVisitsRef) traversal;         /* GdrGpuNodeVisit[2 * traversal_capacity]: even, odd levels */
+    /* Two-phase occlusion culling: what the early phase found behind last frame's pyramid. */
+    GDR_REF(WritableUintsRef) occluded_instances;     /* instance indices [instance_count] */
+    GDR_REF(NodeVisitsRef) occluded_nodes;    /* node visits [occluded_node_capacity], level after level */
+    GDR_REF(WritableUintsRef) retest_masks;           /* per late task command with GDR_TASK_RETEST: its clusters to
+                                                 retest (bit i: cluster meshlet_first + i) [task_capacity] */
+    GDR_REF(StreamRequestsRef) stream_requests; /* GdrGpuStreamRequest[GDR_STREAM_REQUEST_CAPACITY] */
 GDR_STRUCT_END(GdrGpuFrameBuffers)
-GDR_ASSERT_SIZE(GdrGpuFrameBuffers, 64);
+GDR_ASSERT_SIZE(GdrGpuFrameBuffers, 96);
 
 /* Per-frame constants, written by the CPU into its frame's slot. */
 GDR_STRUCT_BEGIN(GdrGpuFrameGlobals)
@@ -333,11 +376,23 @@ GDR_STRUCT_BEGIN(GdrGpuFrameGlobals)
     float lod_projection_scale; /* P[1][1] * 0.5 * viewport height */
     gdr_int lod_depth;        /* GDR_FRAME_LOD_DEPTH: the discrete cut's depth */
     gdr_uint traversal_capacity; /* node visits one traversal level holds (<= GDR_TRAVERSE_MAX_VISITS) */
-    gdr_uint reserved1;
-    gdr_uint reserved2;
+    gdr_uint occluded_node_capacity; /* node visits the occluded list holds */
+    float min_screen_size;    /* the frame's smallest screen size drawn; 0: none */
     GdrOcclusionParams occlusion; /* GDR_FRAME_OCCLUSION: the camera and the depth pyramid */
+    /* GDR_FRAME_HISTORY: last frame's camera, against whose pyramid the early phase tests. */
+    gdr_mat4 previous_view;
+    GdrOcclusionParams previous_occlusion;
+    /* The instance tests: instances entirely on the negative side of the plane (world space,
+     * n.p + d < 0) are culled; all zero: no plane. Screen size = screen_scale * radius / distance
+     * of the bounding sphere (the camera inside it: infinite), about its projected diameter over the
+     * viewport height, as gdr/cull.h defines it; screen_scale = max(|P00|, |P11|). */
+    gdr_vec4 clip_plane;
+    float screen_scale;
+    gdr_uint reserved3;
+    gdr_uint reserved4;
+    gdr_uint reserved5;
 GDR_STRUCT_END(GdrGpuFrameGlobals)
-GDR_ASSERT_SIZE(GdrGpuFrameGlobals, 272);
+GDR_ASSERT_SIZE(GdrGpuFrameGlobals, 400);
 GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, frustum, 128);
 GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, znear, 176);
 GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, update_count, 192);
@@ -350,13 +405,15 @@ GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, viewport, 208);
 #define GDR_FRAME_LOD 16u             /* task shader: the LOD cut over every cluster of the DAG */
 #define GDR_FRAME_LOD_DEPTH 32u       /* with GDR_FRAME_LOD: the discrete cut at depth lod_depth */
 #define GDR_FRAME_OCCLUSION 64u       /* two-phase occlusion culling against the depth pyramid */
-#define GDR_FRAME_HISTORY 128u        /* with GDR_FRAME_OCCLUSION: last frame's visibility and pyramid are usable */
+#define GDR_FRAME_HISTORY 128u        /* with GDR_FRAME_OCCLUSION: last frame's pyramid and camera are usable */
 #define GDR_FRAME_DEBUG_SHRINK_NODES 512u /* tests: a deliberately wrong node test (spheres a quarter of their size) */
 #define GDR_FRAME_LOD_HIERARCHY 256u  /* with GDR_FRAME_LOD: instances' clusters come from the traversal of
                                          their LOD hierarchy (lodtraverse.comp) instead of all their clusters */
+#define GDR_FRAME_PARTIAL_RESIDENCY 2048u /* some LOD group is absent: read the page table (shared/residency.h) */
+#define GDR_FRAME_DIRECT_CLUSTERS 1024u /* visibility-buffer modes: the instance cull tests the clusters of an
+                                           instance that needs at most GDR_DIRECT_CLUSTERS of them and bins
+                                           them itself, instead of a task command for the cluster cull */
 
-#define GDR_INSTANCE_VISIBLE_LAST_FRAME 1u /* drawn and not occluded at the end of the last frame */
-#define GDR_INSTANCE_DRAWN_EARLY 2u        /* drawn by this frame's early phase */
 
 #define GDR_VIEW_SHADED 0u
 #define GDR_VIEW_MESHLETS 1u  /* colour from a hash of the cluster's global index */
@@ -418,9 +475,14 @@ GDR_STRUCT_BEGIN(GdrGpuRasterCounters)
     gdr_uint draw_x;        /* VkDrawMeshTasksIndirectCommandEXT: one mesh workgroup per entry, in rows */
     gdr_uint draw_y;
     gdr_uint draw_z;
+    gdr_uint phases;        /* raster phases launched so far in the frame */
+    gdr_uint resolve_x;     /* VkDispatchIndirectCommand of the phase's resolve: GDR_RESOLVE_TILE tiles of */
+    gdr_uint resolve_y;     /* the screen in the first phase and in a later phase that drew something, */
+    gdr_uint resolve_z;     /* else none */
     gdr_uint reserved0;
 GDR_STRUCT_END(GdrGpuRasterCounters)
-GDR_ASSERT_SIZE(GdrGpuRasterCounters, 72);
+GDR_ASSERT_SIZE(GdrGpuRasterCounters, 88);
+GDR_ASSERT_OFFSET(GdrGpuRasterCounters, resolve_x, 72);
 GDR_ASSERT_OFFSET(GdrGpuRasterCounters, dispatch_z, 8);
 
 /* Per-frame raster parameters, written by the CPU into its frame's slot. */
@@ -432,7 +494,7 @@ GDR_STRUCT_BEGIN(GdrGpuRasterParams)
     float sw_threshold_px;  /* hybrid: clusters whose triangles are smaller go to the compute rasteriser */
     gdr_uint hw_launch_limit; /* the most mesh workgroups one launch may have (maxMeshWorkGroupTotalCount) */
     gdr_vec2 ndc_scale;     /* the projection's P[0][0] and P[1][1] (x and y from view space to NDC) */
-    GDR_REF(ResolvedRef) resolved; /* the resolve's output: RGBA8 per pixel, then the depth bits per pixel */
+    gdr_uint64 reserved;
 GDR_STRUCT_END(GdrGpuRasterParams)
 GDR_ASSERT_SIZE(GdrGpuRasterParams, 48);
 GDR_ASSERT_OFFSET(GdrGpuRasterParams, mode, 16);

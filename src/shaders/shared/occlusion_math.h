@@ -61,13 +61,21 @@
  * 2^-16 is far above those ULPs and changes no real culling decision. */
 #define GDR_HZB_DEPTH_SLACK (1.0f / 65536.0f)
 
+/* Levels of the depth pyramid one dispatch of depthreduce.comp.glsl writes (one 16x16 tile of the
+ * first, reduced in shared memory to 1x1 of the fifth). */
+#define GDR_HZB_LEVELS_PER_DISPATCH 5
+
 /* Push constants of depthreduce.comp.glsl (the pyramid build, src/render/hzb.c). */
 GDR_STRUCT_BEGIN(GdrDepthReducePush)
-    gdr_uint source_width;      /* the depth buffer (from_depth) or the previous level */
+    gdr_uint source_width;      /* the depth buffer (level 0) or the level before the first written */
     gdr_uint source_height;
-    gdr_uint destination_width; /* the level being written */
+    gdr_uint destination_width; /* the first level this dispatch writes */
     gdr_uint destination_height;
     gdr_uint from_depth;        /* 1: level 0 from the depth buffer (footprint loop); 0: 2x2 from the previous level */
+    gdr_uint level_count;       /* levels written: 1 .. GDR_HZB_LEVELS_PER_DISPATCH */
+    /* Level 0: 0 to read the depth image; else the address of a visibility buffer (64 bits per pixel,
+     * rows top first, source_width wide, the depth's float bits in the high word) to read instead. */
+    gdr_uint64 visibility_buffer;
 GDR_STRUCT_END(GdrDepthReducePush)
 
 /* What the occlusion test needs to know about the camera and the pyramid. */

@@ -75,6 +75,9 @@ void gdr_queue_visits(GdrGpuFrameGlobals g, uint phase, uint level, uint count, 
     if (subgroupElect() && subgroup_total > 0u) {
         base = atomicAdd(stats.value.traversal[index].count, subgroup_total);
         uint queued = min(base + subgroup_total, g.traversal_capacity);
+        // A late level also visits the nodes the early phase deferred to it (final by now).
+        if (phase == GDR_PHASE_LATE)
+            queued += stats.value.occluded_nodes[min(level, GDR_LOD_TREE_LEVELS - 1u)];
         atomicMax(stats.value.traversal[index].dispatch_x,
                   (queued + GDR_TRAVERSE_WORKGROUP_SIZE - 1u) / GDR_TRAVERSE_WORKGROUP_SIZE);
         atomicMax(stats.value.traversal[index].dispatch_y, 1u);
@@ -90,6 +93,56 @@ void gdr_queue_visits(GdrGpuFrameGlobals g, uint phase, uint level, uint count, 
         else
             atomicAdd(stats.value.traversal_overflow, 1u);
     }
+}
+
+// Early phase: appends the instances hidden behind last frame's pyramid (`occluded`) to the
+// occluded-instance list, which holds every instance, and sizes the late instance cull's launch.
+void gdr_defer_instances(bool occluded, uint instance)
+{
+    DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
+    uvec4 ballot = subgroupBallot(occluded);
+    uint total = subgroupBallotBitCount(ballot);
+    uint base = 0u;
+    if (subgroupElect() && total > 0u) {
+        base = atomicAdd(stats.value.late_instances.count, total);
+        atomicMax(stats.value.late_instances.dispatch_x,
+                  (base + total + GDR_CULL_WORKGROUP_SIZE - 1u) / GDR_CULL_WORKGROUP_SIZE);
+        atomicMax(stats.value.late_instances.dispatch_y, 1u);
+        atomicMax(stats.value.late_instances.dispatch_z, 1u);
+    }
+    base = subgroupBroadcastFirst(base) + subgroupBallotExclusiveBitCount(ballot);
+    if (occluded)
+        WritableUintsRef(GDR_FRAME.occluded_instances).items[base] = instance;
+}
+
+// Early phase: appends the node visits hidden behind last frame's pyramid (`occluded`) to the
+// occluded-node list for late level `level`, with that level's launch. Returns whether this lane's
+// visit was stored: one that found no room is traversed now instead (counted as overflow), so
+// nothing is lost. Levels run one after another, so each level's visits follow the level before's.
+bool gdr_defer_nodes(GdrGpuFrameGlobals g, bool occluded, uint level, GdrGpuNodeVisit visit)
+{
+    DrawStatsRef stats = DrawStatsRef(GDR_FRAME.draw_stats);
+    uvec4 ballot = subgroupBallot(occluded);
+    uint total = subgroupBallotBitCount(ballot);
+    uint base = 0u;
+    if (subgroupElect() && total > 0u)
+        base = atomicAdd(stats.value.occluded_node_total, total);
+    base = subgroupBroadcastFirst(base);
+    uint slot = base + subgroupBallotExclusiveBitCount(ballot);
+    bool stored = occluded && slot < g.occluded_node_capacity;
+    if (stored)
+        NodeVisitsRef(GDR_FRAME.occluded_nodes).items[slot] = visit;
+    uint stored_total = subgroupAdd(stored ? 1u : 0u);
+    GDR_COUNT(stats, occluded_overflow, occluded && !stored);
+    if (subgroupElect() && stored_total > 0u) {
+        uint before = atomicAdd(stats.value.occluded_nodes[level], stored_total);
+        uint index = GDR_LOD_TREE_LEVELS + level;
+        atomicMax(stats.value.traversal[index].dispatch_x,
+                  (before + stored_total + GDR_TRAVERSE_WORKGROUP_SIZE - 1u) / GDR_TRAVERSE_WORKGROUP_SIZE);
+        atomicMax(stats.value.traversal[index].dispatch_y, 1u);
+        atomicMax(stats.value.traversal[index].dispatch_z, 1u);
+    }
+    return stored;
 }
 
 #endif

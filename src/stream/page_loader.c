@@ -1,0 +1,146 @@
+/* The page loader thread (page_loader.h): a queue of loads, a worker that decodes them in order,
+ * results handed back in submission order. */
+#include "stream/page_loader.h"
+
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct gdr_page_loader {
+    gdr_paged_cache *cache;
+    pthread_t thread;
+    pthread_mutex_t lock;
+    pthread_cond_t work, done;
+    gdr_page_result *jobs; /* [collected, submitted): queued, being decoded or finished */
+    uint8_t *finished;
+    uint32_t capacity, submitted, taken, collected;
+    int quit;
+};
+
+static void *loader_main(void *user)
+{
+    gdr_page_loader *l = user;
+    pthread_mutex_lock(&l->lock);
+    for (;;) {
+        while (!l->quit && l->taken == l->submitted)
+            pthread_cond_wait(&l->work, &l->lock);
+        if (l->quit)
+            break;
+        uint32_t index = l->taken++;
+        gdr_stream_load load = l->jobs[index].load;
+        pthread_mutex_unlock(&l->lock);
+        gdr_page_result result = {.load = load};
+        result.status = gdr_paged_cache_read_page(l->cache, load.mesh, load.page, &result.page, &result.error);
+        pthread_mutex_lock(&l->lock);
+        l->jobs[index] = result; /* the arrays may have moved meanwhile: index, not pointer */
+        l->finished[index] = 1;
+        pthread_cond_broadcast(&l->done);
+    }
+    pthread_mutex_unlock(&l->lock);
+    return NULL;
+}
+
+gdr_status gdr_page_loader_create(gdr_paged_cache *cache, gdr_page_loader **out, gdr_error *err)
+{
+    *out = NULL;
+    gdr_page_loader *l = calloc(1, sizeof *l);
+    if (!l)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "page loader");
+    l->cache = cache;
+    pthread_mutex_init(&l->lock, NULL);
+    pthread_cond_init(&l->work, NULL);
+    pthread_cond_init(&l->done, NULL);
+    if (pthread_create(&l->thread, NULL, loader_main, l) != 0) {
+        pthread_mutex_destroy(&l->lock);
+        pthread_cond_destroy(&l->work);
+        pthread_cond_destroy(&l->done);
+        free(l);
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "page loader: cannot start its thread");
+    }
+    *out = l;
+    return GDR_OK;
+}
+
+void gdr_page_loader_destroy(gdr_page_loader *l)
+{
+    if (!l)
+        return;
+    pthread_mutex_lock(&l->lock);
+    l->quit = 1;
+    pthread_cond_broadcast(&l->work);
+    pthread_mutex_unlock(&l->lock);
+    pthread_join(l->thread, NULL);
+    for (uint32_t i = l->collected; i < l->submitted; i++)
+        if (l->finished[i])
+            gdr_page_free(&l->jobs[i].page);
+    pthread_mutex_destroy(&l->lock);
+    pthread_cond_destroy(&l->work);
+    pthread_cond_destroy(&l->done);
+    free(l->jobs);
+    free(l->finished);
+    free(l);
+}
+
+/* Room for `count` more jobs: collected jobs are dropped from the front when none is in flight. */
+static int reserve(gdr_page_loader *l, uint32_t count)
+{
+    if (l->collected == l->submitted)
+        l->collected = l->submitted = l->taken = 0;
+    if (l->submitted + count <= l->capacity)
+        return 1;
+    uint32_t capacity = l->capacity ? l->capacity : 64;
+    while (capacity < l->submitted + count)
+        capacity *= 2;
+    gdr_page_result *jobs = realloc(l->jobs, sizeof *jobs * capacity);
+    if (!jobs)
+        return 0;
+    l->jobs = jobs;
+    uint8_t *finished = realloc(l->finished, capacity);
+    if (!finished)
+        return 0;
+    l->finished = finished;
+    l->capacity = capacity;
+    return 1;
+}
+
+gdr_status gdr_page_loader_submit(gdr_page_loader *l, const gdr_stream_load *loads, uint32_t count, gdr_error *err)
+{
+    pthread_mutex_lock(&l->lock);
+    if (!reserve(l, count)) {
+        pthread_mutex_unlock(&l->lock);
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "page loader: %u loads", count);
+    }
+    for (uint32_t i = 0; i < count; i++) {
+        l->jobs[l->submitted + i] = (gdr_page_result){.load = loads[i]};
+        l->finished[l->submitted + i] = 0;
+    }
+    l->submitted += count;
+    pthread_cond_signal(&l->work);
+    pthread_mutex_unlock(&l->lock);
+    return GDR_OK;
+}
+
+uint32_t gdr_page_loader_collect(gdr_page_loader *l, int wait_all, gdr_page_result *out, uint32_t capacity)
+{
+    uint32_t n = 0;
+    pthread_mutex_lock(&l->lock);
+    while (n < capacity && l->collected < l->submitted) {
+        if (!l->finished[l->collected]) {
+            if (!wait_all)
+                break;
+            pthread_cond_wait(&l->done, &l->lock);
+            continue;
+        }
+        out[n++] = l->jobs[l->collected++];
+    }
+    pthread_mutex_unlock(&l->lock);
+    return n;
+}
+
+uint32_t gdr_page_loader_pending(gdr_page_loader *l)
+{
+    pthread_mutex_lock(&l->lock);
+    uint32_t n = l->submitted - l->collected;
+    pthread_mutex_unlock(&l->lock);
+    return n;
+}

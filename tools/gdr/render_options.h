@@ -1,0 +1,46 @@
+/* The options of gdr render, shared by gdr view: the scene, the camera and the frame description. */
+#ifndef GDR_RENDER_OPTIONS_H
+#define GDR_RENDER_OPTIONS_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "gdr/gdr.h"
+
+typedef struct render_options {
+    const char *scene;
+    const char *out_png;
+    const char *stats_json;
+    uint32_t width, height, frames, camera_index;
+    bool has_camera, has_camera_index, cull, validate;
+    bool meshlet_cull, cone_cull, triangle_cull, occlusion, occlusion_given, lod_hierarchy;
+    gdr_pipeline pipeline;
+    gdr_raster raster;
+    float sw_threshold;
+    gdr_view view;
+    float lod_error;
+    bool has_lod_depth;
+    uint32_t lod_depth;
+    gdr_vec3 camera_position;
+    gdr_quat camera_rotation;
+    float min_screen_size;
+    gdr_vec4 clip_plane;
+    const char *device;
+    const char *camera_path; /* --camera-path FILE: one pose per frame (docs/VIEWER.md) */
+    bool frames_given;
+    gdr_load_options load;
+} render_options;
+
+/* Another command's own option at argv[*i]: returns 1 when it took it (advancing *i past a value),
+ * 0 when it does not know it, -1 after printing why its value is bad. */
+typedef int (*render_extra_option)(void *context, int argc, char **argv, int *i);
+
+/* Parses `gdr COMMAND` arguments into *o; returns 0, or 2 after printing what is wrong. */
+int render_options_parse(const char *command, int argc, char **argv, render_options *o, render_extra_option extra,
+                         void *context);
+/* The scene's camera (--camera-index, or one framing the scene), with --camera's pose. */
+gdr_camera render_options_camera(const gdr_scene *scene, const render_options *o);
+/* The frame description the options ask for, seen from `camera`. */
+gdr_frame_desc render_options_frame(const render_options *o, gdr_camera camera);
+
+#endif
