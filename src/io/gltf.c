@@ -282,8 +282,9 @@ static gdr_status load_sampler(gltf_ctx *c, uint32_t index, uint32_t *out)
 /* A textureInfo object ({"index": N}) at place -> gdr texture index or GDR_NO_INDEX, and (when
  * out_sampler is not NULL) its sampler's GDR_SAMPLER_* bits. */
 static gdr_status texture_ref(gltf_ctx *c, const cJSON *parent, const char *key, const char *place, int srgb,
-                              uint32_t *out, uint32_t *out_sampler)
+                              gdr_texture_ref *ref)
 {
+    uint32_t *out = &ref->texture, *out_sampler = &ref->sampler;
     *out = GDR_NO_INDEX;
     const cJSON *info = NULL;
     char here[160];
@@ -313,7 +314,7 @@ static gdr_status texture_ref(gltf_ctx *c, const cJSON *parent, const char *key,
     if (status == GDR_OK)
         status = gltf_get_uint(c, tjson, "sampler", tplace, 0, UINT32_MAX - 1, &sampler);
     if (status == GDR_OK && sampler != GDR_NO_INDEX)
-        status = load_sampler(c, sampler, out_sampler ? out_sampler : &(uint32_t){0});
+        status = load_sampler(c, sampler, out_sampler);
     if (status != GDR_OK)
         return status;
     if (source == GDR_NO_INDEX) {
@@ -331,8 +332,7 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
     char here[48];
     snprintf(here, sizeof here, "materials[%u]", index);
     const cJSON *json = c->material_at[index];
-    gdr_material m = {.base_color = {1, 1, 1, 1}, .metallic_factor = 1.0f, .roughness_factor = 1.0f,
-                      .alpha_cutoff = 0.5f, .alpha_mode = GDR_ALPHA_OPAQUE};
+    gdr_material m = gdr_material_default();
     const char *name = NULL, *alpha_mode = NULL;
     const cJSON *pbr = NULL, *double_sided = cJSON_GetObjectItemCaseSensitive(json, "doubleSided");
     double metallic = 1.0, roughness = 1.0, cutoff = 0.5;
@@ -344,7 +344,7 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
     if (status == GDR_OK)
         status = gltf_get_object(c, json, "pbrMetallicRoughness", here, 0, &pbr);
     if (status == GDR_OK)
-        status = gltf_get_floats(c, json, "emissiveFactor", here, 3, (float[3]){0});
+        status = gltf_get_floats(c, json, "emissiveFactor", here, 3, &m.emissive.x);
     if (status != GDR_OK)
         return status;
     if (double_sided && !cJSON_IsBool(double_sided))
@@ -370,21 +370,19 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
         if (status == GDR_OK)
             status = gltf_get_number(c, pbr, "roughnessFactor", pplace, &roughness);
         if (status == GDR_OK)
-            status = texture_ref(c, pbr, "baseColorTexture", pplace, 1, &m.base_color_texture, &m.base_color_sampler);
+            status = texture_ref(c, pbr, "baseColorTexture", pplace, 1, &m.base_color_texture);
         if (status == GDR_OK)
-            status = texture_ref(c, pbr, "metallicRoughnessTexture", pplace, 0, &m.metallic_roughness_texture, NULL);
+            status = texture_ref(c, pbr, "metallicRoughnessTexture", pplace, 0, &m.metallic_roughness_texture);
         if (status != GDR_OK)
             return status;
-    } else {
-        m.base_color_texture = m.metallic_roughness_texture = GDR_NO_INDEX;
     }
     m.metallic_factor = (float)metallic;
     m.roughness_factor = (float)roughness;
-    status = texture_ref(c, json, "normalTexture", here, 0, &m.normal_texture, NULL);
+    status = texture_ref(c, json, "normalTexture", here, 0, &m.normal_texture);
     if (status == GDR_OK)
-        status = texture_ref(c, json, "occlusionTexture", here, 0, &(uint32_t){0}, NULL);
+        status = texture_ref(c, json, "occlusionTexture", here, 0, &m.occlusion_texture);
     if (status == GDR_OK)
-        status = texture_ref(c, json, "emissiveTexture", here, 1, &(uint32_t){0}, NULL);
+        status = texture_ref(c, json, "emissiveTexture", here, 1, &m.emissive_texture);
     if (status != GDR_OK)
         return status;
     return gdr_scene_add_material(c->scene, &m, NULL, c->err);

@@ -77,6 +77,7 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .flags = frame_flags(frame, lod, occlusion, history, traversal_levels(r, frame, pipeline) > 0) |
                  (r->debug_shrink_lod_nodes ? GDR_FRAME_DEBUG_SHRINK_NODES : 0u) |
                  (r->scene.absent_groups > 0 ? GDR_FRAME_PARTIAL_RESIDENCY : 0u) |
+                 (r->materials.scene_flags & GDR_MATERIALS_MASKED ? GDR_FRAME_ALPHA_TEST : 0u) |
                  (pipeline == GDR_PIPELINE_MESH && r->vis.mode != GDR_GPU_RASTER_FORWARD ? GDR_FRAME_DIRECT_CLUSTERS
                                                                                         : 0u),
         .view_mode = (uint32_t)frame->view,
@@ -90,6 +91,7 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .min_screen_size = frame->min_screen_size,
         .clip_plane = frame->clip_plane,
         .screen_scale = fmaxf(fabsf(projection.m[0]), fabsf(projection.m[5])),
+        .eye_position = {camera->position.x, camera->position.y, camera->position.z, 1.0f},
     };
     gdr_occlusion_params(r, &projection, camera->znear, &globals.occlusion);
     /* The early phase tests against last frame's pyramid as last frame's camera saw it. */

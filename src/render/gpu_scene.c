@@ -385,7 +385,9 @@ gdr_status gdr_gpu_scene_write_refs(gdr_renderer *r, gdr_error *err)
                         .meshlet_triangles = g->meshlet_triangles.address,
                         .lod_nodes = g->lod_nodes.address, .page_table = g->page_table.address,
                         .node_absent_refined = g->node_absent_refined.address,
-                        .materials = r->materials.buffer.address};
+                        .materials = r->materials.buffer.address,
+                        .vertex_colors = r->materials.vertex_colors.address,
+                        .mesh_color_offsets = r->materials.mesh_color_offsets.address};
     gdr_status status = gdr_vk_buffer_create(&r->allocator, sizeof refs,
                                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                              GDR_VK_BUFFER_DEVICE, &g->refs, err);

@@ -1,72 +1,104 @@
 /* Materials on the GPU (materials.h). */
 #include "render/materials.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-#include <stb/stb_image_resize.h>
 
 #include "render/renderer_internal.h"
 #include "vk/vk_descriptors.h"
 
-uint32_t gdr_mip_level_count(uint32_t width, uint32_t height)
-{
-    uint32_t levels = 1;
-    for (uint32_t side = width > height ? width : height; side > 1; side >>= 1)
-        levels++;
-    return levels;
-}
-
-bool gdr_mip_downsample(const uint8_t *prev, uint32_t prev_w, uint32_t prev_h, uint32_t srgb, uint8_t *out)
-{
-    uint32_t w = prev_w > 1 ? prev_w / 2 : 1, h = prev_h > 1 ? prev_h / 2 : 1;
-    /* Wrap at the edges: glTF's default sampler repeats. Alpha-weighted, so transparent texels
-     * do not bleed their colour into the level below. */
-    return stbir_resize_uint8_generic(prev, (int)prev_w, (int)prev_h, 0, out, (int)w, (int)h, 0, 4, 3, 0,
-                                      STBIR_EDGE_WRAP, STBIR_FILTER_BOX,
-                                      srgb ? STBIR_COLORSPACE_SRGB : STBIR_COLORSPACE_LINEAR, NULL) != 0;
-}
-
-static gdr_status create_sampler(gdr_vk_context *ctx, VkSampler *out, gdr_error *err)
-{
-    VkSamplerCreateInfo info = {.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, .magFilter = VK_FILTER_LINEAR,
-                                .minFilter = VK_FILTER_LINEAR, .mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR,
-                                .addressModeU = VK_SAMPLER_ADDRESS_MODE_REPEAT,
-                                .addressModeV = VK_SAMPLER_ADDRESS_MODE_REPEAT,
-                                .addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT, .maxLod = VK_LOD_CLAMP_NONE};
-    GDR_VK_TRY(err, vkCreateSampler(ctx->device, &info, NULL, out));
-    return GDR_OK;
-}
+_Static_assert(GDR_SAMPLER_STATES == GDR_SAMPLER_SLOTS, "one sampler slot per packed sampler state");
+_Static_assert(GDR_ALPHA_MODE_OPAQUE == GDR_ALPHA_OPAQUE && GDR_ALPHA_MODE_MASK == GDR_ALPHA_MASK &&
+                   GDR_ALPHA_MODE_BLEND == GDR_ALPHA_BLEND,
+               "the shaders' alpha modes are gdr_alpha_mode's");
 
 gdr_status gdr_materials_create(gdr_renderer *r, gdr_error *err)
 {
     gdr_materials *m = &r->materials;
-    VkDescriptorBindingFlags flags = VK_DESCRIPTOR_BINDING_PARTIALLY_BOUND_BIT;
+    const VkDescriptorBindingFlags flags[2] = {VK_DESCRIPTOR_BINDING_PARTIALLY_BOUND_BIT,
+                                               VK_DESCRIPTOR_BINDING_PARTIALLY_BOUND_BIT};
     VkDescriptorSetLayoutBindingFlagsCreateInfo binding_flags = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_BINDING_FLAGS_CREATE_INFO, .bindingCount = 1,
-        .pBindingFlags = &flags};
-    VkDescriptorSetLayoutBinding binding = {0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, GDR_MAX_TEXTURES,
-                                            VK_SHADER_STAGE_ALL, NULL};
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_BINDING_FLAGS_CREATE_INFO, .bindingCount = 2,
+        .pBindingFlags = flags};
+    const VkDescriptorSetLayoutBinding bindings[2] = {
+        {0, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, GDR_MAX_TEXTURES, VK_SHADER_STAGE_ALL, NULL},
+        {1, VK_DESCRIPTOR_TYPE_SAMPLER, GDR_SAMPLER_SLOTS, VK_SHADER_STAGE_ALL, NULL}};
     VkDescriptorSetLayoutCreateInfo info = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
-                                            .pNext = &binding_flags, .bindingCount = 1, .pBindings = &binding};
+                                            .pNext = &binding_flags, .bindingCount = 2, .pBindings = bindings};
     GDR_VK_TRY(err, vkCreateDescriptorSetLayout(r->ctx->device, &info, NULL, &m->set_layout));
-    VkDescriptorPoolSize size = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, GDR_MAX_TEXTURES};
-    gdr_status status = gdr_vk_descriptor_pool_create(r->ctx, 1, &size, 1, &m->pool, err);
+    const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, GDR_MAX_TEXTURES},
+                                           {VK_DESCRIPTOR_TYPE_SAMPLER, GDR_SAMPLER_SLOTS}};
+    gdr_status status = gdr_vk_descriptor_pool_create(r->ctx, 1, sizes, 2, &m->pool, err);
     if (status == GDR_OK)
         status = gdr_vk_descriptor_sets_allocate(r->ctx, m->pool, m->set_layout, 1, &m->set, err);
-    if (status == GDR_OK)
-        status = create_sampler(r->ctx, &m->sampler, err);
     return status;
+}
+
+static VkSamplerAddressMode address_mode(uint32_t wrap)
+{
+    return wrap == GDR_SAMPLER_WRAP_CLAMP    ? VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE
+           : wrap == GDR_SAMPLER_WRAP_MIRROR ? VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT
+                                             : VK_SAMPLER_ADDRESS_MODE_REPEAT;
+}
+
+/* The sampler of packed state `state` (GDR_SAMPLER_*), made on first use and written into slot
+ * `state` of binding 1. Minification without mips reads level 0 only (maxLod 0). */
+static gdr_status use_sampler(gdr_renderer *r, uint32_t state, gdr_error *err)
+{
+    gdr_materials *m = &r->materials;
+    if (m->samplers[state])
+        return GDR_OK;
+    VkSamplerCreateInfo info = {
+        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
+        .magFilter = state & GDR_SAMPLER_MAG_NEAREST ? VK_FILTER_NEAREST : VK_FILTER_LINEAR,
+        .minFilter = state & GDR_SAMPLER_MIN_NEAREST ? VK_FILTER_NEAREST : VK_FILTER_LINEAR,
+        .mipmapMode = state & GDR_SAMPLER_MIP_NEAREST ? VK_SAMPLER_MIPMAP_MODE_NEAREST : VK_SAMPLER_MIPMAP_MODE_LINEAR,
+        .addressModeU = address_mode(GDR_SAMPLER_WRAP_S(state)), .addressModeV = address_mode(GDR_SAMPLER_WRAP_T(state)),
+        .addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT,
+        .maxLod = state & GDR_SAMPLER_MIP_NONE ? 0.0f : VK_LOD_CLAMP_NONE};
+    GDR_VK_TRY(err, vkCreateSampler(r->ctx->device, &info, NULL, &m->samplers[state]));
+    VkDescriptorImageInfo image = {.sampler = m->samplers[state]};
+    VkWriteDescriptorSet write = {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = m->set, .dstBinding = 1,
+                                  .dstArrayElement = state, .descriptorCount = 1,
+                                  .descriptorType = VK_DESCRIPTOR_TYPE_SAMPLER, .pImageInfo = &image};
+    vkUpdateDescriptorSets(r->ctx->device, 1, &write, 0, NULL);
+    return GDR_OK;
+}
+
+static GdrGpuTextureRef gpu_texture_ref(const gdr_texture_ref *t, uint32_t texture_count)
+{
+    float c = cosf(t->rotation), s = sinf(t->rotation);
+    return (GdrGpuTextureRef){.texture = t->texture < texture_count ? t->texture : GDR_GPU_NO_TEXTURE,
+                              .sampler_slot = t->sampler, .offset = t->offset,
+                              .matrix = {c * t->scale.x, s * t->scale.x, -s * t->scale.y, c * t->scale.y}};
 }
 
 static GdrGpuMaterial gpu_material_from(const gdr_material *s, uint32_t texture_count)
 {
-    GdrGpuMaterial g = {.base_color = s->base_color, .base_color_texture = GDR_GPU_NO_TEXTURE,
-                        .alpha_mode = s->alpha_mode, .alpha_cutoff = s->alpha_cutoff,
-                        .double_sided = s->double_sided};
-    if (s->base_color_texture < texture_count)
-        g.base_color_texture = s->base_color_texture;
+    GdrGpuMaterial g = {.base_color = s->base_color, .emissive = s->emissive, .metallic = s->metallic_factor,
+                        .roughness = s->roughness_factor, .normal_scale = s->normal_scale,
+                        .occlusion_strength = s->occlusion_strength, .alpha_cutoff = s->alpha_cutoff,
+                        .alpha_mode = s->alpha_mode, .double_sided = s->double_sided};
+    const gdr_texture_ref *refs[GDR_MATERIAL_TEXTURES] = {
+        [GDR_MATERIAL_BASE_COLOR] = &s->base_color_texture, [GDR_MATERIAL_METALLIC_ROUGHNESS] = &s->metallic_roughness_texture,
+        [GDR_MATERIAL_NORMAL] = &s->normal_texture, [GDR_MATERIAL_OCCLUSION] = &s->occlusion_texture,
+        [GDR_MATERIAL_EMISSIVE] = &s->emissive_texture};
+    for (int k = 0; k < GDR_MATERIAL_TEXTURES; k++)
+        g.textures[k] = gpu_texture_ref(refs[k], texture_count);
     return g;
+}
+
+/* A device buffer holding `bytes` of `data`, counted in the materials' memory. */
+static gdr_status upload_buffer(gdr_renderer *r, gdr_vk_buffer *buffer, const void *data, size_t bytes, gdr_error *err)
+{
+    gdr_status status = gdr_vk_buffer_create(&r->allocator, bytes,
+                                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                             GDR_VK_BUFFER_DEVICE, buffer, err);
+    if (status == GDR_OK)
+        status = gdr_vk_buffer_upload(r->ctx, &r->staging, buffer, 0, data, bytes, err);
+    r->materials.bytes += buffer->size;
+    return status;
 }
 
 static gdr_status upload_material_buffer(gdr_renderer *r, const gdr_scene *scene, gdr_error *err)
@@ -76,18 +108,64 @@ static gdr_status upload_material_buffer(gdr_renderer *r, const gdr_scene *scene
     GdrGpuMaterial *materials = malloc(sizeof *materials * count);
     if (!materials)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "materials: out of memory for %u materials", count);
-    for (uint32_t i = 0; i < scene->material_count; i++)
-        materials[i] = gpu_material_from(&scene->materials[i], scene->texture_count);
-    materials[scene->material_count] = (GdrGpuMaterial){.base_color = {1, 1, 1, 1},
-                                                        .base_color_texture = GDR_GPU_NO_TEXTURE};
+    /* Instances without a material: a white dielectric of roughness 0.5 (importers give glTF's
+     * primitives without a material glTF's default material themselves). */
+    gdr_material fallback = gdr_material_default();
+    fallback.metallic_factor = 0.0f;
+    fallback.roughness_factor = 0.5f;
+    gdr_status status = GDR_OK;
+    for (uint32_t i = 0; i < count && status == GDR_OK; i++) {
+        const gdr_material *s = i < scene->material_count ? &scene->materials[i] : &fallback;
+        materials[i] = gpu_material_from(s, scene->texture_count);
+        if (s->alpha_mode != GDR_ALPHA_OPAQUE)
+            m->scene_flags |= GDR_MATERIALS_MASKED;
+        for (int k = 0; k < GDR_MATERIAL_TEXTURES && status == GDR_OK; k++)
+            status = materials[i].textures[k].sampler_slot < GDR_SAMPLER_STATES
+                         ? use_sampler(r, materials[i].textures[k].sampler_slot, err)
+                         : gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "material %u: sampler state %u is out of range",
+                                         i, materials[i].textures[k].sampler_slot);
+    }
     m->material_count = scene->material_count;
-    gdr_status status = gdr_vk_buffer_create(&r->allocator, sizeof *materials * count,
-                                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                             GDR_VK_BUFFER_DEVICE, &m->buffer, err);
     if (status == GDR_OK)
-        status = gdr_vk_buffer_upload(r->ctx, &r->staging, &m->buffer, 0, materials, sizeof *materials * count, err);
-    m->bytes += m->buffer.size;
+        status = upload_buffer(r, &m->buffer, materials, sizeof *materials * count, err);
     free(materials);
+    return status;
+}
+
+/* RGBA16 unorm in two words: r | g << 16, b | a << 16. */
+static void pack_color(gdr_vec4 c, uint32_t *out)
+{
+    uint32_t q[4];
+    const float *f = &c.x;
+    for (int k = 0; k < 4; k++)
+        q[k] = (uint32_t)lroundf((f[k] < 0.0f ? 0.0f : f[k] > 1.0f ? 1.0f : f[k]) * 65535.0f);
+    out[0] = q[0] | q[1] << 16;
+    out[1] = q[2] | q[3] << 16;
+}
+
+static gdr_status upload_vertex_colors(gdr_renderer *r, const gdr_scene *scene, gdr_error *err)
+{
+    gdr_materials *m = &r->materials;
+    uint64_t total = 0;
+    uint32_t *offsets = malloc(sizeof *offsets * (scene->mesh_count ? scene->mesh_count : 1));
+    for (uint32_t i = 0; offsets && i < scene->mesh_count; i++) {
+        offsets[i] = scene->meshes[i].colors && total < UINT32_MAX ? (uint32_t)total : GDR_GPU_NO_COLORS;
+        total += scene->meshes[i].colors ? scene->meshes[i].vertex_count : 0;
+    }
+    uint32_t *words = offsets && total < UINT32_MAX / 2 ? malloc(sizeof *words * 2 * (total ? total : 1)) : NULL;
+    gdr_status status = words ? GDR_OK
+                              : gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "vertex colours: out of memory for %llu colours",
+                                              (unsigned long long)total);
+    for (uint32_t i = 0; status == GDR_OK && i < scene->mesh_count; i++)
+        for (uint32_t v = 0; offsets[i] != GDR_GPU_NO_COLORS && v < scene->meshes[i].vertex_count; v++)
+            pack_color(scene->meshes[i].colors[v], words + 2 * ((size_t)offsets[i] + v));
+    if (status == GDR_OK)
+        status = upload_buffer(r, &m->vertex_colors, words, sizeof *words * 2 * (total ? total : 1), err);
+    if (status == GDR_OK)
+        status = upload_buffer(r, &m->mesh_color_offsets, offsets, sizeof *offsets * (scene->mesh_count ? scene->mesh_count : 1),
+                               err);
+    free(words);
+    free(offsets);
     return status;
 }
 
@@ -129,59 +207,31 @@ static gdr_status upload_level(gdr_renderer *r, VkImage image, uint32_t level, c
     return status;
 }
 
-/* Every level of texture t: level 0 from the scene, each next one downsampled from the last into
- * one of two buffers used in turn (each as large as level 1). */
-static gdr_status upload_levels(gdr_renderer *r, const gdr_texture *t, const gdr_vk_image *image, gdr_error *err)
-{
-    uint32_t w = t->width, h = t->height;
-    size_t level1_bytes = (size_t)(w > 1 ? w / 2 : 1) * (h > 1 ? h / 2 : 1) * 4;
-    uint8_t *buffers[2] = {malloc(level1_bytes), malloc(level1_bytes)};
-    const uint8_t *current = t->rgba;
-    gdr_status status = buffers[0] && buffers[1] ? GDR_OK
-                                                 : gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "texture '%s': out of memory",
-                                                                 t->name);
-    for (uint32_t l = 0; status == GDR_OK && l < image->mip_levels; l++) {
-        status = upload_level(r, image->image, l, current, w, h, err);
-        if (status != GDR_OK || l + 1 == image->mip_levels)
-            break;
-        uint8_t *next = buffers[l & 1];
-        if (!gdr_mip_downsample(current, w, h, t->srgb, next))
-            status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "texture '%s': mip level %u: resize failed", t->name, l + 1);
-        w = w > 1 ? w / 2 : 1;
-        h = h > 1 ? h / 2 : 1;
-        current = next;
-    }
-    free(buffers[0]);
-    free(buffers[1]);
-    return status;
-}
-
 static gdr_status upload_texture(gdr_renderer *r, const gdr_texture *t, uint32_t index, gdr_error *err)
 {
     gdr_materials *m = &r->materials;
     gdr_vk_image_desc desc = {.width = t->width, .height = t->height,
                               .format = t->srgb ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM,
                               .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                              .mip_levels = gdr_mip_level_count(t->width, t->height)};
+                              .mip_levels = t->levels};
     gdr_vk_image *image = &m->textures[index];
     gdr_status status = gdr_vk_image_create(&r->allocator, &desc, image, err);
     if (status == GDR_OK)
         status = transition(r->ctx, image->image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, err);
-    if (status == GDR_OK)
-        status = upload_levels(r, t, image, err);
+    for (uint32_t l = 0; status == GDR_OK && l < t->levels; l++) {
+        uint32_t w = t->width >> l ? t->width >> l : 1, h = t->height >> l ? t->height >> l : 1;
+        status = upload_level(r, image->image, l, t->rgba + gdr_texture_level_offset(t->width, t->height, l), w, h, err);
+    }
     if (status == GDR_OK)
         status = transition(r->ctx, image->image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                             VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, err);
     if (status != GDR_OK)
         return status;
-    uint64_t bytes = 0;
-    for (uint32_t w = t->width, h = t->height, l = 0; l < desc.mip_levels; l++, w = w > 1 ? w / 2 : 1, h = h > 1 ? h / 2 : 1)
-        bytes += (uint64_t)w * h * 4;
-    m->bytes += bytes;
-    VkDescriptorImageInfo info = {m->sampler, image->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    m->bytes += gdr_texture_level_offset(t->width, t->height, t->levels);
+    VkDescriptorImageInfo info = {.imageView = image->view, .imageLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     VkWriteDescriptorSet write = {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = m->set, .dstBinding = 0,
                                   .dstArrayElement = index, .descriptorCount = 1,
-                                  .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &info};
+                                  .descriptorType = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, .pImageInfo = &info};
     vkUpdateDescriptorSets(r->ctx->device, 1, &write, 0, NULL);
     return GDR_OK;
 }
@@ -193,6 +243,8 @@ gdr_status gdr_materials_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
         return gdr_error_set(err, GDR_ERROR_CAPACITY, "scene: %u textures; the renderer holds at most %u",
                              scene->texture_count, GDR_MAX_TEXTURES);
     gdr_status status = upload_material_buffer(r, scene, err);
+    if (status == GDR_OK)
+        status = upload_vertex_colors(r, scene, err);
     m->textures = calloc(scene->texture_count ? scene->texture_count : 1, sizeof *m->textures);
     if (status == GDR_OK && !m->textures)
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "materials: out of memory for %u textures",
@@ -212,8 +264,11 @@ void gdr_materials_destroy(gdr_renderer *r)
         gdr_vk_image_destroy(r->ctx, &m->textures[i]);
     free(m->textures);
     gdr_vk_buffer_destroy(r->ctx, &m->buffer);
-    if (m->sampler)
-        vkDestroySampler(device, m->sampler, NULL);
+    gdr_vk_buffer_destroy(r->ctx, &m->vertex_colors);
+    gdr_vk_buffer_destroy(r->ctx, &m->mesh_color_offsets);
+    for (uint32_t i = 0; i < GDR_SAMPLER_STATES; i++)
+        if (m->samplers[i])
+            vkDestroySampler(device, m->samplers[i], NULL);
     if (m->pool)
         vkDestroyDescriptorPool(device, m->pool, NULL);
     if (m->set_layout)

@@ -1,7 +1,7 @@
-/* Materials on the GPU: the material buffer (GdrGpuMaterial per scene material, then a default
- * white untextured one for instances without a material) and the bindless textures (one image per
- * scene texture with its full mip chain, in the runtime-sized combined-image-sampler array at set
- * GDR_TEXTURE_SET, binding 0, of every frame pipeline). */
+/* Materials on the GPU: the material buffer (GdrGpuMaterial per scene material, then glTF's default
+ * material for instances without one), the vertex colours, and the bindless textures: one image per
+ * scene texture with its mip chain (gdr_texture) in the sampled-image array at set GDR_TEXTURE_SET,
+ * binding 0, and a sampler per glTF sampler state the materials use at binding 1. */
 #ifndef GDR_RENDER_MATERIALS_H
 #define GDR_RENDER_MATERIALS_H
 
@@ -12,29 +12,28 @@
 typedef struct gdr_renderer gdr_renderer;
 
 typedef struct gdr_materials {
-    VkDescriptorSetLayout set_layout; /* binding 0: GDR_MAX_TEXTURES combined image samplers, partially bound */
+    VkDescriptorSetLayout set_layout; /* binding 0: GDR_MAX_TEXTURES sampled images; 1: GDR_SAMPLER_SLOTS samplers */
     VkDescriptorPool pool;
     VkDescriptorSet set;
-    VkSampler sampler;                /* trilinear, repeat in both directions */
+    VkSampler samplers[GDR_SAMPLER_STATES]; /* made for the states the materials use, else VK_NULL_HANDLE */
     gdr_vk_buffer buffer;             /* GdrGpuMaterial[material_count + 1] */
+    gdr_vk_buffer vertex_colors;      /* uint32[2] per vertex of the meshes that have colours: RGBA16 unorm */
+    gdr_vk_buffer mesh_color_offsets; /* uint32 per mesh: its first entry in vertex_colors, or GDR_GPU_NO_COLORS */
     gdr_vk_image *textures;           /* texture_count images, R8G8B8A8 sRGB or UNORM, every mip level */
     uint32_t texture_count;
     uint32_t material_count;          /* the scene's; the default material is at this index */
-    uint64_t bytes;                   /* device memory of the buffer and the textures */
+    uint32_t scene_flags;             /* GDR_MATERIALS_* of the scene's materials */
+    uint64_t bytes;                   /* device memory of the buffers and the textures */
 } gdr_materials;
 
-/* The descriptor set layout, pool, set and sampler; before the frame pipelines (their layout takes
+#define GDR_MATERIALS_MASKED 1u /* some material is MASK or BLEND: the raster paths test alpha */
+
+/* The descriptor set layout, pool and set; before the frame pipelines (their layout takes
  * set_layout as set GDR_TEXTURE_SET). */
 gdr_status gdr_materials_create(gdr_renderer *r, gdr_error *err);
-/* The scene's materials and textures (mip chains built here, on the CPU), written into the set. */
+/* The scene's materials, vertex colours and textures, written into the set; after the geometry
+ * (the vertex colours follow its vertex offsets). */
 gdr_status gdr_materials_upload(gdr_renderer *r, const gdr_scene *scene, gdr_error *err);
 void gdr_materials_destroy(gdr_renderer *r);
-
-/* Levels of a full mip chain down to 1x1 for a width x height image. */
-uint32_t gdr_mip_level_count(uint32_t width, uint32_t height);
-/* Mip level `level` (>= 1) of an RGBA8 image from level - 1 (prev, prev_w x prev_h), with a box
- * filter in linear light for sRGB data (srgb = 1) or directly on the values otherwise; out holds
- * max(prev_w / 2, 1) x max(prev_h / 2, 1) texels. Returns false when stb's resizer fails. */
-bool gdr_mip_downsample(const uint8_t *prev, uint32_t prev_w, uint32_t prev_h, uint32_t srgb, uint8_t *out);
 
 #endif

@@ -17,6 +17,7 @@ typedef struct gdr_pipeline_entry {
     gdr_pipeline_needs needs;
     const gdr_spirv *compute;                        /* compute pipelines */
     const gdr_spirv *vertex, *task, *mesh, *fragment; /* graphics pipelines */
+    const gdr_spirv *alpha_fragment; /* the fragment shader that alpha-tests, for scenes with MASK or BLEND materials */
     uint32_t constants[2];  /* specialisation constants 0, 1 of the compute or the task shader */
     uint32_t constant_count;
     gdr_pipeline_targets targets;
@@ -47,15 +48,18 @@ static const gdr_pipeline_entry entries[GDR_PIPE_COUNT] = {
     [GDR_PIPE_TASK_SUBMIT_LATE] = {"task_submit_late", GDR_NEEDS_MESH_SHADER, .compute = &gdr_shader_tasksubmit_comp,
                                    .constants = {1}, .constant_count = 1},
     [GDR_PIPE_DRAW_INDEXED] = {"draw_indexed", .vertex = &gdr_shader_mesh_vert, .fragment = &gdr_shader_mesh_frag,
-                               .vertex_input = true, .cull_back = true},
+                               .alpha_fragment = &gdr_shader_mesh_alpha_frag, .vertex_input = true, .cull_back = true},
     [GDR_PIPE_MESHLETS] = {"meshlets", GDR_NEEDS_MESH_SHADER, .task = &gdr_shader_meshlet_task,
-                           .mesh = &gdr_shader_meshlet_mesh, .fragment = &gdr_shader_meshlet_frag, .constants = {0},
+                           .mesh = &gdr_shader_meshlet_mesh, .fragment = &gdr_shader_meshlet_frag,
+                           .alpha_fragment = &gdr_shader_meshlet_alpha_frag, .constants = {0},
                            .constant_count = 1, .cull_back = true},
     [GDR_PIPE_MESHLETS + 1] = {"meshlets_early", GDR_NEEDS_MESH_SHADER, .task = &gdr_shader_meshlet_task,
                                .mesh = &gdr_shader_meshlet_mesh, .fragment = &gdr_shader_meshlet_frag,
+                           .alpha_fragment = &gdr_shader_meshlet_alpha_frag,
                                .constants = {1}, .constant_count = 1, .cull_back = true},
     [GDR_PIPE_MESHLETS + 2] = {"meshlets_late", GDR_NEEDS_MESH_SHADER, .task = &gdr_shader_meshlet_task,
                                .mesh = &gdr_shader_meshlet_mesh, .fragment = &gdr_shader_meshlet_frag,
+                           .alpha_fragment = &gdr_shader_meshlet_alpha_frag,
                                .constants = {2}, .constant_count = 1, .cull_back = true},
     [GDR_PIPE_OVERDRAW_MAX] = {"overdraw_max", .compute = &gdr_shader_overdraw_max_comp},
     [GDR_PIPE_OVERDRAW_PAINT] = {"overdraw_paint", .vertex = &gdr_shader_overdraw_paint_vert,
@@ -117,6 +121,24 @@ gdr_status gdr_pipelines_create(gdr_vk_context *ctx, VkPipelineLayout layout, co
                                        : create_graphics(ctx, layout, e, &pipelines[id], err);
         if (status != GDR_OK)
             return status;
+    }
+    return GDR_OK;
+}
+
+gdr_status gdr_pipelines_use_alpha_test(gdr_vk_context *ctx, VkPipelineLayout layout, VkPipeline pipelines[GDR_PIPE_COUNT],
+                                        gdr_error *err)
+{
+    for (uint32_t id = 0; id < GDR_PIPE_COUNT; id++) {
+        if (!entries[id].alpha_fragment || !pipelines[id])
+            continue;
+        gdr_pipeline_entry alpha = entries[id];
+        alpha.fragment = alpha.alpha_fragment;
+        VkPipeline created;
+        gdr_status status = create_graphics(ctx, layout, &alpha, &created, err);
+        if (status != GDR_OK)
+            return status;
+        vkDestroyPipeline(ctx->device, pipelines[id], NULL);
+        pipelines[id] = created;
     }
     return GDR_OK;
 }

@@ -42,6 +42,10 @@ const char *gdr_pipeline_id_name(gdr_pipeline_id id);
  * says the device meets; the others stay VK_NULL_HANDLE. */
 gdr_status gdr_pipelines_create(gdr_vk_context *ctx, VkPipelineLayout layout, const bool available[3],
                                 VkPipeline pipelines[GDR_PIPE_COUNT], gdr_error *err);
+/* Replaces the forward raster pipelines (vertex and mesh shaders) by their alpha-testing variants,
+ * for a scene with MASK or BLEND materials (the visibility buffer's raster tests alpha by a frame flag). */
+gdr_status gdr_pipelines_use_alpha_test(gdr_vk_context *ctx, VkPipelineLayout layout, VkPipeline pipelines[GDR_PIPE_COUNT],
+                                        gdr_error *err);
 void gdr_pipelines_destroy(gdr_vk_context *ctx, VkPipeline pipelines[GDR_PIPE_COUNT]);
 
 #endif

@@ -1,7 +1,10 @@
 #version 460
-// Forward shading (shared/shading.h, shared/material.h) of the vertex pipeline and, compiled with
-// GDR_PER_PRIMITIVE_COLOR (meshlet.frag), of the mesh shaders, whose colour (the debug views) and
-// material come per primitive.
+// Forward shading of the vertex pipeline and, compiled with GDR_PER_PRIMITIVE_COLOR (meshlet.frag),
+// of the mesh shaders, whose debug colour and material come per primitive. The shaded view shades
+// the material (shared/material.h), the debug views their colour (shared/shading.h).
+// Compiled with GDR_ALPHA_TEST (the *_alpha variants, used when the scene has MASK or BLEND
+// materials) it cuts out what the material's alpha test drops; that needs late depth tests, so the
+// variants without it keep early_fragment_tests.
 #ifdef GDR_PER_PRIMITIVE_COLOR
 #extension GL_EXT_mesh_shader : require
 #define GDR_COLOR_INPUT perprimitiveEXT flat in
@@ -13,24 +16,30 @@
 #include "shared/material.h"
 #include "shared/shading.h"
 
+#ifndef GDR_ALPHA_TEST
 layout(early_fragment_tests) in;
+#endif
 
 layout(location = 0) in vec3 in_normal;
 layout(location = 1) in vec3 in_world_position;
 layout(location = 2) GDR_COLOR_INPUT vec4 in_color;
 layout(location = 4) in vec2 in_uv;
 layout(location = 5) GDR_COLOR_INPUT uint in_material;
+layout(location = 6) in vec4 in_vertex_color;
 
 layout(location = 0) out vec4 out_color;
 
 void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
-    if (g.view_mode == GDR_VIEW_OVERDRAW) // fragments that passed the depth test, per pixel
+    GdrSurfacePoint p = GdrSurfacePoint(in_world_position, in_normal, in_uv, in_vertex_color * in_color, dFdx(in_uv),
+                                        dFdy(in_uv), dFdx(in_world_position), dFdy(in_world_position));
+#ifdef GDR_ALPHA_TEST
+    if (!gdr_material_keeps(MaterialsRef(GDR_SCENE.materials).items[in_material], p, uvec2(gl_FragCoord.xy)))
+        discard;
+#endif
+    if (g.view_mode == GDR_VIEW_OVERDRAW) // fragments that passed the depth test (alpha variants: every one kept)
         atomicAdd(OverdrawRef(GDR_FRAME.overdraw).items[uint(gl_FragCoord.y) * uint(g.viewport.x) + uint(gl_FragCoord.x)], 1u);
-    // The shaded view takes its colour from the material; the debug views from in_color alone.
-    vec3 albedo = g.view_mode == GDR_VIEW_SHADED
-                    ? gdr_material_base_color(in_material, in_color, in_uv, dFdx(in_uv), dFdy(in_uv)).rgb
-                    : in_color.rgb;
-    out_color = gdr_shade(g.light_direction.xyz, in_normal, in_world_position, albedo);
+    out_color = g.view_mode == GDR_VIEW_SHADED ? gdr_shade_material(in_material, p, g)
+                                               : gdr_shade(g.light_direction.xyz, in_normal, in_world_position, in_color.rgb);
 }

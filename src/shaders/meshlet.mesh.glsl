@@ -9,8 +9,10 @@
 // frame's visible-cluster list, and its fragments write the visibility buffer.
 #extension GL_EXT_mesh_shader : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_EXT_nonuniform_qualifier : require
 
 #include "shared/glsl_buffers.h"
+#include "shared/material.h"
 #include "shared/meshlet_payload.h"
 #include "shared/shading.h"
 #include "shared/visbuffer.h"
@@ -32,6 +34,7 @@ layout(location = 1) out vec3 out_world_position[];
 layout(location = 2) perprimitiveEXT flat out vec4 out_color[];
 layout(location = 4) out vec2 out_uv[];
 layout(location = 5) perprimitiveEXT flat out uint out_material[];
+layout(location = 6) out vec4 out_vertex_color[];
 #ifdef GDR_MESH_FROM_LIST
 layout(location = 3) perprimitiveEXT flat out uint out_visibility_id[]; // list slot and triangle
 #endif
@@ -103,6 +106,7 @@ void main()
         out_normal[v] = cofactor * vertex.normal;
         out_world_position[v] = world.xyz;
         out_uv[v] = vertex.uv;
+        out_vertex_color[v] = gdr_vertex_color(instance.mesh, vertex_index);
         vec2 ndc = clip.xy / clip.w;
         screen[v] = vec3((ndc * 0.5 + 0.5) * g.viewport, clip.w);
     }

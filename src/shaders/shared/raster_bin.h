@@ -67,6 +67,11 @@ void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint m
         triangles = meshlet.triangle_count;
         sw = gdr_raster_bin_sw(params.value.mode, params.value.sw_threshold_px, center, radius, float(triangles), g.znear,
                                g.zfar, params.value.ndc_scale, g.viewport.y);
+        // Alpha-tested materials are rasterised by the mesh shaders, whose fragments sample the mask.
+        if (sw && (g.flags & GDR_FRAME_ALPHA_TEST) != 0u) {
+            uint material = InstancesRef(GDR_SCENE.instances).items[instance].material;
+            sw = MaterialsRef(GDR_SCENE.materials).items[material].alpha_mode == GDR_ALPHA_MODE_OPAQUE;
+        }
     }
     bool hw = visible && !sw;
     RasterCountersRef counters = RasterCountersRef(params.value.counters);
