@@ -58,7 +58,7 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
     gdr_mat4 projection, view, cull_projection, cull_view;
     gdr_frame_matrices(r, camera, &projection, &view);
     gdr_frame_matrices(r, cull_camera, &cull_projection, &cull_view);
-    gdr_vec3 light = gdr_vec3_normalize((gdr_vec3){0.35f, 0.85f, 0.4f});
+    gdr_vec3 light = gdr_vec3_normalize((gdr_vec3){GDR_LIGHT_TOWARDS_X, GDR_LIGHT_TOWARDS_Y, GDR_LIGHT_TOWARDS_Z});
     /* The LOD cut: only where the mesh pipeline draws clusters, and only when it asks for something
      * other than level 0 (threshold 0 and depth 0 both select exactly level 0). */
     bool lod = pipeline == GDR_PIPELINE_MESH &&

@@ -61,6 +61,10 @@
 /* The visibility buffer's resolve: one workgroup per square tile of this many pixels a side. */
 #define GDR_RESOLVE_TILE 8
 /* The background colour, written as is into the UNORM colour target. */
+/* The frame's directional light: the direction towards it, in world space, before normalisation. */
+#define GDR_LIGHT_TOWARDS_X 0.35f
+#define GDR_LIGHT_TOWARDS_Y 0.85f
+#define GDR_LIGHT_TOWARDS_Z 0.4f
 #define GDR_BACKGROUND_R 0.42f
 #define GDR_BACKGROUND_G 0.55f
 #define GDR_BACKGROUND_B 0.72f
