@@ -189,8 +189,241 @@ static void test_cases(void)
     gdr_scene_destroy(s);
 }
 
+/* BoxTextured up close: the front face's texture magnified, so that the reference's level-0
+ * bilinear sample is what every path reads. */
+static void test_box_textured(const char *relative)
+{
+    enum { W = 240, H = 240 };
+    char path[256];
+    snprintf(path, sizeof path, "%s%s", MODELS, relative);
+    gdr_scene *s = NULL;
+    gdr_error err = {0};
+    gdr_load_options options = {.no_cache = 1, .no_progress = 1};
+    if (gdr_scene_load(path, &options, &s, &err) != GDR_OK) {
+        fprintf(stderr, "%s: %s\n", relative, err.message);
+        CHECK(false);
+        return;
+    }
+    CHECK(s->texture_count == 1 && s->material_count >= 1);
+    gdr_renderer *r = gpu_test_renderer(W, H, s);
+    gdr_camera camera = gdr_scene_framing_camera(s);
+    gdr_vec4 b = s->meshes[0].bounds;
+    gdr_vec3 centre = gdr_mat4_transform_point(s->instances[0].transform, (gdr_vec3){b.x, b.y, b.z});
+    camera.position = gdr_vec3_add(centre, gdr_vec3_scale(gdr_vec3_sub(camera.position, centre), 0.3f));
+    camera.aspect = 0.0f;
+    uint8_t *rgba = malloc((size_t)W * H * 4);
+    for (size_t p = 0; r && p < PATH_COUNT; p++) {
+        CHECK(render_path(r, &camera, &paths[p], GDR_CULL_DEFAULT, rgba));
+        uint32_t compared = compare_with_reference(s, &camera, W, H, rgba, relative);
+        printf("%s, %s: %u pixels match the reference\n", relative, paths[p].name, compared);
+        CHECK(compared >= 200);
+    }
+    free(rgba);
+    gdr_renderer_destroy(r);
+    gdr_scene_destroy(s);
+}
+
+/* A plane of 8 x 8 units with a 64 x 64 checkerboard (8-texel squares) repeated 8 times, glTF's
+ * default sampler (trilinear, repeat): every pixel minified, so mip selection decides its colour. */
+static gdr_scene *checker_scene(void)
+{
+    gdr_scene *s = NULL;
+    gdr_error err = {0};
+    CHECK(gdr_scene_create(&s, &err) == GDR_OK);
+    uint8_t texels[64 * 64 * 4];
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++) {
+            uint8_t v = ((x / 8 + y / 8) & 1) ? 230 : 20;
+            uint8_t *t = texels + (y * 64 + x) * 4;
+            t[0] = v;
+            t[1] = (uint8_t)(255 - v);
+            t[2] = 128;
+            t[3] = 255;
+        }
+    uint32_t texture = 0, material = 0, mesh = add_quad(s, "plane", 0.0f, 8.0f);
+    CHECK(gdr_scene_add_texture(s, "checker", 64, 64, texels, 1, &texture, &err) == GDR_OK);
+    gdr_material m = gdr_material_default();
+    m.metallic_factor = 0.0f;
+    m.base_color_texture = tex(texture, 0);
+    CHECK(gdr_scene_add_material(s, &m, &material, &err) == GDR_OK);
+    gdr_instance inst = {.transform = gdr_mat4_from_trs((gdr_vec3){-4, -4, 0}, gdr_quat_identity(), (gdr_vec3){8, 8, 1}),
+                         .mesh = mesh, .material = material, .color = {1, 1, 1, 1}};
+    CHECK(gdr_scene_add_instance(s, &inst, &err) == GDR_OK);
+    return s;
+}
+
+/* Largest channel difference and the share of pixels differing by more than `tolerance`. */
+static int image_difference(const uint8_t *a, const uint8_t *b, uint32_t pixels, int tolerance, double *share_over)
+{
+    int largest = 0;
+    uint32_t over = 0;
+    for (uint32_t p = 0; p < pixels; p++) {
+        int worst = 0;
+        for (int k = 0; k < 3; k++) {
+            int d = abs((int)a[p * 4 + k] - (int)b[p * 4 + k]);
+            worst = d > worst ? d : worst;
+        }
+        largest = worst > largest ? worst : largest;
+        over += worst > tolerance;
+    }
+    *share_over = (double)over / pixels;
+    return largest;
+}
+
+/* Head-on, every path gives the forward mesh path's image to within one step of 255 (the same mip
+ * level and weights, rounded differently); at a grazing angle the resolve's derivatives (the next
+ * pixel's) and the forward paths' (a 2 x 2 quad's) differ by up to a pixel's change of the
+ * derivative, which moves the trilinear weights: MIP_TOLERANCE bounds that. A wrong mip level (one
+ * off) moves many pixels by tens of steps. */
+#define MIP_TOLERANCE 6
+static void test_checker_mips(void)
+{
+    enum { W = 160, H = 120 };
+    gdr_scene *s = checker_scene();
+    gdr_renderer *r = gpu_test_renderer(W, H, s);
+    CHECK(r != NULL);
+    const gdr_camera views[2] = {test_look((gdr_vec3){0.3f, 0.2f, 5.0f}, 0.0f, 0.0f, 0.9f, 0.1f),
+                                 test_look((gdr_vec3){0.0f, -5.0f, 0.9f}, 0.0f, 1.35f, 0.9f, 0.1f)};
+    uint8_t *reference = malloc((size_t)W * H * 4), *rgba = malloc((size_t)W * H * 4);
+    for (int v = 0; r && v < 2; v++) {
+        CHECK(render_path(r, &views[v], &paths[0], GDR_CULL_DEFAULT, reference));
+        for (size_t p = 1; p < PATH_COUNT; p++) {
+            CHECK(render_path(r, &views[v], &paths[p], GDR_CULL_DEFAULT, rgba));
+            double share = 0.0;
+            int largest = image_difference(reference, rgba, W * H, v == 0 ? 1 : MIP_TOLERANCE, &share);
+            printf("checker %s, %s vs %s: largest difference %d, %.3f%% of pixels beyond %d\n",
+                   v == 0 ? "head-on" : "grazing", paths[p].name, paths[0].name, largest, 100.0 * share,
+                   v == 0 ? 1 : MIP_TOLERANCE);
+            CHECK(v == 0 ? largest <= 1 : share <= 0.002);
+        }
+    }
+    free(reference);
+    free(rgba);
+    gdr_renderer_destroy(r);
+    gdr_scene_destroy(s);
+}
+
+/* A MASK quad with holes (alpha 0 on alternate texels of a 4 x 4 texture) and a BLEND quad (alpha
+ * 0.5 everywhere) in front of a red wall, and a yellow tile hidden behind the middle of each quad
+ * but for the holes: if a quad were drawn opaque, or counted as an opaque occluder, its tile would
+ * be hidden or culled. */
+#define TILE_X(i) ((i) == 0 ? -0.8f : 0.4f)
+#define TILE_Y 0.3f
+#define TILE_Z -0.2f
+#define TILE_SIZE 0.4f
+static gdr_scene *alpha_scene(void)
+{
+    gdr_scene *s = NULL;
+    gdr_error err = {0};
+    CHECK(gdr_scene_create(&s, &err) == GDR_OK);
+    uint8_t texels[4 * 4 * 4];
+    for (int i = 0; i < 16; i++) {
+        texels[i * 4 + 0] = 40;
+        texels[i * 4 + 1] = 90;
+        texels[i * 4 + 2] = 220;
+        texels[i * 4 + 3] = ((i % 4 + i / 4) & 1) ? 0 : 255;
+    }
+    uint32_t texture = 0, mesh = add_quad(s, "quad", 0.0f, 1.0f), ids[4];
+    CHECK(gdr_scene_add_texture(s, "holes", 4, 4, texels, 1, &texture, &err) == GDR_OK);
+    gdr_material m[4] = {gdr_material_default(), gdr_material_default(), gdr_material_default(),
+                         gdr_material_default()};
+    m[0].alpha_mode = GDR_ALPHA_MASK;
+    m[0].base_color_texture = tex(texture, NEAREST);
+    m[1].alpha_mode = GDR_ALPHA_BLEND;
+    m[1].base_color = (gdr_vec4){0.15f, 0.35f, 0.85f, 0.5f};
+    m[2].base_color = (gdr_vec4){1.0f, 0.05f, 0.05f, 1.0f}; /* the wall */
+    m[3].base_color = (gdr_vec4){1.0f, 1.0f, 0.05f, 1.0f};  /* the tiles */
+    for (int i = 0; i < 4; i++) {
+        m[i].metallic_factor = 0.0f;
+        CHECK(gdr_scene_add_material(s, &m[i], &ids[i], &err) == GDR_OK);
+    }
+    place(s, mesh, ids[0], -1.1f, 0.0f, 0.0f);
+    place(s, mesh, ids[1], 0.1f, 0.0f, 0.0f);
+    gdr_instance wall = {.transform = gdr_mat4_from_trs((gdr_vec3){-2.0f, -0.5f, -0.5f}, gdr_quat_identity(), (gdr_vec3){4, 2, 1}),
+                         .mesh = mesh, .material = ids[2], .color = {1, 1, 1, 1}};
+    CHECK(gdr_scene_add_instance(s, &wall, &err) == GDR_OK);
+    for (int i = 0; i < 2; i++) {
+        gdr_instance tile = {.transform = gdr_mat4_from_trs((gdr_vec3){TILE_X(i), TILE_Y, TILE_Z}, gdr_quat_identity(),
+                                                            (gdr_vec3){TILE_SIZE, TILE_SIZE, 1}),
+                             .mesh = mesh, .material = ids[3], .color = {1, 1, 1, 1}};
+        CHECK(gdr_scene_add_instance(s, &tile, &err) == GDR_OK);
+    }
+    return s;
+}
+
+static bool is_red(const uint8_t *c) { return c[0] > 2 * c[2] && c[0] > 100; }
+static bool is_blue(const uint8_t *c) { return c[2] > 2 * c[0]; }
+static bool is_yellow(const uint8_t *c) { return c[0] > 100 && c[1] > 100 && c[2] < c[1] / 2; }
+
+/* Whether the ray (o, d) passes through tile i (behind quad i). */
+static bool through_tile(ref_vec3 o, ref_vec3 d, int i)
+{
+    double t = (TILE_Z - o.z) / d.z, x = o.x + t * d.x - TILE_X(i), y = o.y + t * d.y - TILE_Y;
+    return x > 0.02 && x < TILE_SIZE - 0.02 && y > 0.02 && y < TILE_SIZE - 0.02;
+}
+
+static void test_alpha(void)
+{
+    enum { W = 200, H = 100 };
+    gdr_scene *s = alpha_scene();
+    gdr_renderer *r = gpu_test_renderer(W, H, s);
+    CHECK(r != NULL);
+    gdr_camera camera = test_look((gdr_vec3){0.0f, 0.5f, 2.2f}, 0.0f, 0.0f, 0.6f, 0.1f);
+    uint8_t *rgba = malloc((size_t)W * H * 4);
+    for (size_t p = 0; r && p < PATH_COUNT; p++) {
+        /* Two frames with occlusion culling on: the second tests against the first's pyramid. */
+        gdr_cull_mode occlusion = paths[p].pipeline == GDR_PIPELINE_CPU ? GDR_CULL_DEFAULT : GDR_CULL_ON;
+        CHECK(render_path(r, &camera, &paths[p], occlusion, rgba) && render_path(r, &camera, &paths[p], occlusion, rgba));
+        uint32_t hole_red = 0, hole_other = 0, solid_blue = 0, solid_other = 0, blend_red = 0, blend_blue = 0;
+        uint32_t tile_seen[2] = {0, 0}, tile_missed[2] = {0, 0};
+        for (uint32_t y = 0; y < H; y++)
+            for (uint32_t x = 0; x < W; x++) {
+                ref_vec3 o, d;
+                ref_pixel_ray(&camera, W, H, x, y, &o, &d);
+                ref_hit h = ref_raycast(s, o, d); /* the quads are nearer than the wall */
+                if (!h.hit || h.instance >= 2)
+                    continue;
+                const uint8_t *c = rgba + ((size_t)y * W + x) * 4;
+                bool tile = through_tile(o, d, (int)h.instance);
+                double u = h.position.x - (h.instance == 0 ? -1.1 : 0.1), v = 1.0 - h.position.y;
+                double fu = u * 4 - floor(u * 4), fv = v * 4 - floor(v * 4);
+                if (fu < 0.1 || fu > 0.9 || fv < 0.1 || fv > 0.9)
+                    continue; /* texel edges */
+                if (h.instance == 0) {
+                    bool hole = (((int)(u * 4) + (int)(v * 4)) & 1) != 0;
+                    hole_red += hole && !tile && is_red(c);
+                    hole_other += hole && !tile && !is_red(c);
+                    tile_seen[0] += hole && tile && is_yellow(c);
+                    tile_missed[0] += hole && tile && !is_yellow(c);
+                    solid_blue += !hole && is_blue(c);
+                    solid_other += !hole && !is_blue(c);
+                } else {
+                    blend_red += !tile && is_red(c);
+                    blend_blue += !tile && is_blue(c);
+                    tile_seen[1] += tile && is_yellow(c);
+                    tile_missed[1] += tile && !is_yellow(c) && !is_blue(c);
+                }
+            }
+        double blend_share = (double)blend_red / (blend_red + blend_blue + 1e-9);
+        printf("alpha, %s: mask holes %u red, %u not; solid %u blue, %u not; blend %.2f red; tiles seen %u, %u, "
+               "missed %u, %u\n", paths[p].name, hole_red, hole_other, solid_blue, solid_other, blend_share,
+               tile_seen[0], tile_seen[1], tile_missed[0], tile_missed[1]);
+        CHECK(hole_red > 200 && hole_other == 0 && solid_blue > 200 && solid_other == 0);
+        CHECK(tile_seen[0] > 20 && tile_seen[1] > 20 && tile_missed[0] == 0 && tile_missed[1] == 0);
+        CHECK(blend_share > 0.4 && blend_share < 0.6 && blend_red + blend_blue > 400);
+    }
+    free(rgba);
+    gdr_renderer_destroy(r);
+    gdr_scene_destroy(s);
+}
+
 int main(void)
 {
     test_cases();
+    test_box_textured("BoxTextured-glTF/BoxTextured.gltf");
+    test_box_textured("BoxTextured-glTF-Binary/BoxTextured.glb");
+    test_box_textured("BoxTextured-glTF-Embedded/BoxTextured.gltf");
+    test_checker_mips();
+    test_alpha();
     return test_finish("test_gpu_materials");
 }
