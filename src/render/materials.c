@@ -119,6 +119,8 @@ static gdr_status upload_material_buffer(gdr_renderer *r, const gdr_scene *scene
         materials[i] = gpu_material_from(s, scene->texture_count);
         if (s->alpha_mode != GDR_ALPHA_OPAQUE)
             m->scene_flags |= GDR_MATERIALS_MASKED;
+        if (s->double_sided)
+            m->scene_flags |= GDR_MATERIALS_DOUBLE_SIDED;
         for (int k = 0; k < GDR_MATERIAL_TEXTURES && status == GDR_OK; k++)
             status = materials[i].textures[k].sampler_slot < GDR_SAMPLER_STATES
                          ? use_sampler(r, materials[i].textures[k].sampler_slot, err)

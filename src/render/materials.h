@@ -26,7 +26,8 @@ typedef struct gdr_materials {
     uint64_t bytes;                   /* device memory of the buffers and the textures */
 } gdr_materials;
 
-#define GDR_MATERIALS_MASKED 1u /* some material is MASK or BLEND: the raster paths test alpha */
+#define GDR_MATERIALS_MASKED 1u       /* some material is MASK or BLEND: the raster paths test alpha */
+#define GDR_MATERIALS_DOUBLE_SIDED 2u /* some material is double-sided: back faces culled per material */
 
 /* The descriptor set layout, pool and set; before the frame pipelines (their layout takes
  * set_layout as set GDR_TEXTURE_SET). */

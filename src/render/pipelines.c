@@ -125,14 +125,15 @@ gdr_status gdr_pipelines_create(gdr_vk_context *ctx, VkPipelineLayout layout, co
     return GDR_OK;
 }
 
-gdr_status gdr_pipelines_use_alpha_test(gdr_vk_context *ctx, VkPipelineLayout layout, VkPipeline pipelines[GDR_PIPE_COUNT],
-                                        gdr_error *err)
+gdr_status gdr_pipelines_for_materials(gdr_vk_context *ctx, VkPipelineLayout layout, bool double_sided,
+                                       VkPipeline pipelines[GDR_PIPE_COUNT], gdr_error *err)
 {
     for (uint32_t id = 0; id < GDR_PIPE_COUNT; id++) {
-        if (!entries[id].alpha_fragment || !pipelines[id])
+        if (!pipelines[id] || !(entries[id].alpha_fragment || (double_sided && entries[id].cull_back)))
             continue;
         gdr_pipeline_entry alpha = entries[id];
-        alpha.fragment = alpha.alpha_fragment;
+        alpha.fragment = alpha.alpha_fragment ? alpha.alpha_fragment : alpha.fragment;
+        alpha.cull_back = alpha.cull_back && !double_sided;
         VkPipeline created;
         gdr_status status = create_graphics(ctx, layout, &alpha, &created, err);
         if (status != GDR_OK)

@@ -156,8 +156,9 @@ gdr_status gdr_renderer_set_scene(gdr_renderer *r, const gdr_scene *scene, gdr_e
     gdr_status status = gdr_gpu_scene_upload(r, scene, err);
     if (status == GDR_OK)
         status = gdr_materials_upload(r, scene, err);
-    if (status == GDR_OK && (r->materials.scene_flags & GDR_MATERIALS_MASKED))
-        status = gdr_pipelines_use_alpha_test(r->ctx, r->layout, r->pipelines, err);
+    if (status == GDR_OK && r->materials.scene_flags)
+        status = gdr_pipelines_for_materials(r->ctx, r->layout, r->materials.scene_flags & GDR_MATERIALS_DOUBLE_SIDED,
+                                             r->pipelines, err);
     if (status == GDR_OK)
         status = gdr_frame_slots_create(r, err);
     if (status == GDR_OK)

@@ -13,6 +13,7 @@
 
 #include "shared/glsl_buffers.h"
 #include "shared/material.h"
+#include "shared/material_flags.h"
 #include "shared/meshlet_payload.h"
 #include "shared/shading.h"
 #include "shared/visbuffer.h"
@@ -113,12 +114,14 @@ void main()
     barrier();
 
     bool cull = g.cull_enabled != 0u && (g.flags & GDR_FRAME_TRIANGLE_CULL) != 0u;
+    bool double_sided = gdr_material_double_sided(g, instance.material);
     uint emitted = 0u, backfacing = 0u, small = 0u;
     for (uint t = lane; t < meshlet.triangle_count; t += GDR_MESH_WORKGROUP_SIZE) {
         uint at = meshlet.triangle_offset + t * 3u;
         uvec3 corners = uvec3(triangle_byte(at), triangle_byte(at + 1u), triangle_byte(at + 2u));
         gl_PrimitiveTriangleIndicesEXT[t] = corners;
         uint why = cull ? triangle_culled(screen[corners.x], screen[corners.y], screen[corners.z]) : 0u;
+        why = why == 1u && double_sided ? 0u : why;
         gl_MeshPrimitivesEXT[t].gl_CullPrimitiveEXT = why != 0u;
         out_color[t] = vec4(gdr_view_albedo(g.view_mode, instance.color.rgb, instance_index, meshlet_index, t,
                                             meshlet.group_depth), 1.0);

@@ -8,6 +8,7 @@
 #extension GL_EXT_nonuniform_qualifier : require
 #include "shared/glsl_buffers.h"
 #include "shared/material.h"
+#include "shared/material_flags.h"
 #include "shared/visbuffer.h"
 
 layout(location = 1) in vec3 in_world_position;
@@ -22,6 +23,8 @@ void main()
     // MASK and BLEND materials cut their holes here (the cluster binning sends their clusters to
     // this path, never to the compute rasteriser), so the visibility buffer, and the depth pyramid
     // built from it, hold only what is kept: occlusion culling stays conservative.
+    if ((g.flags & GDR_FRAME_DOUBLE_SIDED) != 0u && !gl_FrontFacing && !gdr_material_double_sided(g, in_material))
+        return; // this pipeline does not cull back faces in scenes with double-sided materials
     if ((g.flags & GDR_FRAME_ALPHA_TEST) != 0u) {
         GdrGpuMaterial m = MaterialsRef(GDR_SCENE.materials).items[in_material];
         GdrSurfacePoint p = GdrSurfacePoint(in_world_position, vec3(0.0), in_uv, in_vertex_color,

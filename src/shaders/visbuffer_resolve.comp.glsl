@@ -87,6 +87,11 @@ vec4 shade_pixel(FrameGlobalsRef globals, vec2 viewport, vec2 centre, uint id)
     if (UintsRef(GDR_SCENE.mesh_color_offsets).items[instance.mesh] != GDR_GPU_NO_COLORS)
         color *= b.x * gdr_vertex_color(instance.mesh, vertex_index[0]) + b.y * gdr_vertex_color(instance.mesh, vertex_index[1]) +
                  b.z * gdr_vertex_color(instance.mesh, vertex_index[2]);
+    // A back face (only double-sided materials draw them) is shaded with the normal reversed; the
+    // winding seen from the eye decides, as the rasteriser's facing does.
+    vec3 geometric = cross(world[1] - world[0], world[2] - world[0]);
+    if (dot(geometric, globals.value.eye_position.xyz - position) < 0.0)
+        n = -n;
     GdrSurfacePoint point = GdrSurfacePoint(position, n, uvs * b, color, uvs * bx, uvs * by, world * bx, world * by);
     return gdr_shade_material(instance.material, point, globals.value);
 }

@@ -70,6 +70,9 @@ static inline ref_hit ref_raycast(const gdr_scene *scene, ref_vec3 o, ref_vec3 d
             double u = rv_dot(s, q) / det, v = rv_dot(d, r) / det, dist = rv_dot(e2, r) / det;
             if (u < 0 || v < 0 || u + v > 1 || dist <= 0 || dist >= best_t)
                 continue;
+            bool double_sided = inst->material < scene->material_count && scene->materials[inst->material].double_sided;
+            if (!double_sided && rv_dot(rv_cross(e1, e2), d) > 0)
+                continue; /* the back face of a single-sided material */
             best_t = dist;
             best = (ref_hit){.hit = true, .instance = i, .b = {1 - u - v, u, v}, .position = rv_add(o, rv_scale(d, dist))};
             for (int k = 0; k < 3; k++) {
@@ -299,6 +302,8 @@ static inline bool ref_shade_pixel(const gdr_scene *scene, const gdr_camera *cam
         n = rv_add(n, rv_scale(cof, h.b[k]));
     }
     n = rv_normalize(n);
+    if (m.double_sided && rv_dot(rv_cross(rv_sub(h.p[1], h.p[0]), rv_sub(h.p[2], h.p[0])), rv_sub(o, h.position)) < 0)
+        n = rv_scale(n, -1); /* a back face, shaded with the normal reversed */
     const float *ic = &inst->color.x, *bc = &m.base_color.x;
     ref_vec3 base = rv(bc[0] * ic[0] * vc[0] * texel[0][0], bc[1] * ic[1] * vc[1] * texel[0][1],
                        bc[2] * ic[2] * vc[2] * texel[0][2]);
