@@ -13,6 +13,7 @@
 
 #include "gpu_test_util.h"
 #include "material_reference.h"
+#include "scene/procedural_meshes.h"
 
 #define MODELS "/usr/share/assimp/models/glTF2/"
 /* Per channel, of 255: the GPU evaluates the same formulas in float, with 8-bit sRGB texture
@@ -466,6 +467,92 @@ static void test_double_sided(void)
     gdr_scene_destroy(s);
 }
 
+/* Peak signal-to-noise ratio of b against a (RGB, 8 bits), in dB. */
+static double psnr(const uint8_t *a, const uint8_t *b, uint32_t pixels)
+{
+    double sum = 0.0;
+    for (uint32_t p = 0; p < pixels; p++)
+        for (int k = 0; k < 3; k++) {
+            double d = (double)a[p * 4 + k] - (double)b[p * 4 + k];
+            sum += d * d;
+        }
+    double mse = sum / (pixels * 3.0);
+    return mse > 0.0 ? 10.0 * log10(255.0 * 255.0 / mse) : 99.0;
+}
+
+/* Pixels of b whose colour is more than `tolerance` from every pixel of a within one pixel (a
+ * tear, a hole or a texture slid by more than a pixel shows as such pixels). */
+static uint32_t beyond_one_pixel(const uint8_t *a, const uint8_t *b, uint32_t w, uint32_t h, int tolerance)
+{
+    uint32_t count = 0;
+    for (uint32_t y = 0; y < h; y++)
+        for (uint32_t x = 0; x < w; x++) {
+            bool near = false;
+            for (int dy = -1; dy <= 1 && !near; dy++)
+                for (int dx = -1; dx <= 1 && !near; dx++) {
+                    int nx = (int)x + dx, ny = (int)y + dy;
+                    if (nx < 0 || ny < 0 || nx >= (int)w || ny >= (int)h)
+                        continue;
+                    const uint8_t *pa = a + ((size_t)ny * w + nx) * 4, *pb = b + ((size_t)y * w + x) * 4;
+                    near = abs(pa[0] - pb[0]) <= tolerance && abs(pa[1] - pb[1]) <= tolerance &&
+                           abs(pa[2] - pb[2]) <= tolerance;
+                }
+            count += !near;
+        }
+    return count;
+}
+
+/* A textured torus (a u seam: the first and last ring of vertices share positions, not uvs) with
+ * its LOD DAG, at a LOD threshold of 1 pixel against full detail: UVs and normals are the kept
+ * vertices' own, so the image stays within a pixel of full detail and the seam does not open. */
+static void test_textured_lod(void)
+{
+    enum { W = 256, H = 160 };
+    gdr_scene *s = NULL;
+    gdr_error err = {0};
+    CHECK(gdr_scene_create(&s, &err) == GDR_OK);
+    uint32_t mesh = 0, texture = 0, material = 0;
+    CHECK(gdr_procedural_torus(s, 1.0f, 0.35f, 300, 100, &mesh, &err) == GDR_OK);
+    uint8_t texels[32 * 32 * 4];
+    for (int i = 0; i < 32 * 32; i++) {
+        bool dark = ((i % 32) / 4 + (i / 32) / 4) & 1;
+        texels[i * 4 + 0] = dark ? 40 : 220;
+        texels[i * 4 + 1] = dark ? 60 : 180;
+        texels[i * 4 + 2] = dark ? 160 : 90;
+        texels[i * 4 + 3] = 255;
+    }
+    CHECK(gdr_scene_add_texture(s, "checker", 32, 32, texels, 1, &texture, &err) == GDR_OK);
+    gdr_material m = gdr_material_default();
+    m.metallic_factor = 0.0f;
+    m.base_color_texture = tex(texture, 0);
+    m.base_color_texture.scale = (gdr_vec2){4.0f, 2.0f};
+    CHECK(gdr_scene_add_material(s, &m, &material, &err) == GDR_OK);
+    gdr_instance inst = {.transform = gdr_mat4_identity(), .mesh = mesh, .material = material, .color = {1, 1, 1, 1}};
+    CHECK(gdr_scene_add_instance(s, &inst, &err) == GDR_OK);
+    gdr_lod_options options = {0};
+    CHECK(gdr_scene_build_lod(s, &options, NULL, &err) == GDR_OK);
+    gdr_renderer *r = gpu_test_renderer(W, H, s);
+    CHECK(r != NULL);
+    gdr_camera camera = test_look((gdr_vec3){0.0f, 2.2f, 2.6f}, 0.0f, -0.7f, 0.8f, 0.1f);
+    uint8_t *full = malloc((size_t)W * H * 4), *lod = malloc((size_t)W * H * 4);
+    gdr_frame_desc frame = {.camera = camera, .cull = GDR_CULL_ON, .read_back = true, .pipeline = GDR_PIPELINE_MESH};
+    gdr_frame_stats full_stats = {0}, lod_stats = {0};
+    CHECK(r && gdr_renderer_render(r, &frame, 1, &full_stats, &err) == GDR_OK && gdr_renderer_read_color(r, full, &err) == GDR_OK);
+    frame.lod_error_px = 1.0f;
+    CHECK(r && gdr_renderer_render(r, &frame, 1, &lod_stats, &err) == GDR_OK && gdr_renderer_read_color(r, lod, &err) == GDR_OK);
+    double quality = psnr(full, lod, W * H);
+    uint32_t beyond = beyond_one_pixel(full, lod, W, H, 24) + beyond_one_pixel(lod, full, W, H, 24);
+    printf("textured LOD at 1 px: %llu of %llu triangles, PSNR %.1f dB against full detail, %u pixels beyond a "
+           "pixel's reach\n", (unsigned long long)lod_stats.triangles, (unsigned long long)full_stats.triangles, quality,
+           beyond);
+    CHECK(lod_stats.triangles * 2 < full_stats.triangles); /* the cut is well coarser than level 0 */
+    CHECK(quality >= 30.0 && beyond <= W * H / 200);
+    free(full);
+    free(lod);
+    gdr_renderer_destroy(r);
+    gdr_scene_destroy(s);
+}
+
 int main(void)
 {
     test_cases();
@@ -475,5 +562,6 @@ int main(void)
     test_checker_mips();
     test_alpha();
     test_double_sided();
+    test_textured_lod();
     return test_finish("test_gpu_materials");
 }
