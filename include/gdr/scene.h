@@ -175,6 +175,8 @@ typedef struct gdr_demo_desc {
     uint32_t instances; /* 0: 10000 */
     uint32_t seed;      /* 0: 1 */
     float spacing;      /* grid spacing in metres; 0: 4 */
+    uint32_t textures;  /* 1: every shape and the ground get a textured material (base colour, normal and
+                         * metallic-roughness maps, generated); 0: plain colours */
 } gdr_demo_desc;
 
 GDR_API gdr_status gdr_scene_create_demo(const gdr_demo_desc *desc, gdr_scene **out, gdr_error *err);
