@@ -79,6 +79,7 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
                  (r->scene.absent_groups > 0 ? GDR_FRAME_PARTIAL_RESIDENCY : 0u) |
                  (r->materials.scene_flags & GDR_MATERIALS_MASKED ? GDR_FRAME_ALPHA_TEST : 0u) |
                  (r->materials.scene_flags & GDR_MATERIALS_DOUBLE_SIDED ? GDR_FRAME_DOUBLE_SIDED : 0u) |
+                 (r->materials.scene_flags & GDR_MATERIALS_VERTEX_COLORS ? GDR_FRAME_VERTEX_COLORS : 0u) |
                  (pipeline == GDR_PIPELINE_MESH && r->vis.mode != GDR_GPU_RASTER_FORWARD ? GDR_FRAME_DIRECT_CLUSTERS
                                                                                         : 0u),
         .view_mode = (uint32_t)frame->view,

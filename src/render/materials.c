@@ -152,6 +152,7 @@ static gdr_status upload_vertex_colors(gdr_renderer *r, const gdr_scene *scene, 
     uint32_t *offsets = malloc(sizeof *offsets * (scene->mesh_count ? scene->mesh_count : 1));
     for (uint32_t i = 0; offsets && i < scene->mesh_count; i++) {
         offsets[i] = scene->meshes[i].colors && total < UINT32_MAX ? (uint32_t)total : GDR_GPU_NO_COLORS;
+        m->scene_flags |= scene->meshes[i].colors ? GDR_MATERIALS_VERTEX_COLORS : 0u;
         total += scene->meshes[i].colors ? scene->meshes[i].vertex_count : 0;
     }
     uint32_t *words = offsets && total < UINT32_MAX / 2 ? malloc(sizeof *words * 2 * (total ? total : 1)) : NULL;

@@ -28,6 +28,7 @@ typedef struct gdr_materials {
 
 #define GDR_MATERIALS_MASKED 1u       /* some material is MASK or BLEND: the raster paths test alpha */
 #define GDR_MATERIALS_DOUBLE_SIDED 2u /* some material is double-sided: back faces culled per material */
+#define GDR_MATERIALS_VERTEX_COLORS 4u /* some mesh has vertex colours */
 
 /* The descriptor set layout, pool and set; before the frame pipelines (their layout takes
  * set_layout as set GDR_TEXTURE_SET). */

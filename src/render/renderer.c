@@ -156,7 +156,7 @@ gdr_status gdr_renderer_set_scene(gdr_renderer *r, const gdr_scene *scene, gdr_e
     gdr_status status = gdr_gpu_scene_upload(r, scene, err);
     if (status == GDR_OK)
         status = gdr_materials_upload(r, scene, err);
-    if (status == GDR_OK && r->materials.scene_flags)
+    if (status == GDR_OK && (r->materials.scene_flags & (GDR_MATERIALS_MASKED | GDR_MATERIALS_DOUBLE_SIDED)))
         status = gdr_pipelines_for_materials(r->ctx, r->layout, r->materials.scene_flags & GDR_MATERIALS_DOUBLE_SIDED,
                                              r->pipelines, err);
     if (status == GDR_OK)

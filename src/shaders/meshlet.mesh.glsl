@@ -107,7 +107,11 @@ void main()
         out_normal[v] = cofactor * vertex.normal;
         out_world_position[v] = world.xyz;
         out_uv[v] = vertex.uv;
-        out_vertex_color[v] = gdr_vertex_color(instance.mesh, vertex_index);
+#ifdef GDR_MESH_FROM_LIST
+        // The visibility buffer's fragments need the attributes only to alpha-test.
+        if ((g.flags & GDR_FRAME_ALPHA_TEST) != 0u)
+#endif
+            out_vertex_color[v] = gdr_vertex_color(g, instance.mesh, vertex_index);
         vec2 ndc = clip.xy / clip.w;
         screen[v] = vec3((ndc * 0.5 + 0.5) * g.viewport, clip.w);
     }

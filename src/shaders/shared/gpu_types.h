@@ -445,6 +445,7 @@ GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, viewport, 208);
                                          their LOD hierarchy (lodtraverse.comp) instead of all their clusters */
 #define GDR_FRAME_ALPHA_TEST 4096u     /* some material is MASK or BLEND: raster paths test alpha (shared/material.h) */
 #define GDR_FRAME_DOUBLE_SIDED 8192u   /* some material is double-sided: back faces are culled per material */
+#define GDR_FRAME_VERTEX_COLORS 16384u /* some mesh has vertex colours (GdrGpuScene.vertex_colors) */
 #define GDR_FRAME_PARTIAL_RESIDENCY 2048u /* some LOD group is absent: read the page table (shared/residency.h) */
 #define GDR_FRAME_DIRECT_CLUSTERS 1024u /* visibility-buffer modes: the instance cull tests the clusters of an
                                            instance that needs at most GDR_DIRECT_CLUSTERS of them and bins

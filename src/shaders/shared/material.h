@@ -34,9 +34,12 @@ struct GdrSurface {
     vec3 emissive;   // linear
 };
 
-/* The vertex colour of vertex `vertex` (an index into GdrGpuScene.vertices) of mesh `mesh`. */
-vec4 gdr_vertex_color(uint mesh, uint vertex)
+/* The vertex colour of vertex `vertex` (an index into GdrGpuScene.vertices) of mesh `mesh`; white
+ * without reading anything in frames of scenes without vertex colours. */
+vec4 gdr_vertex_color(GdrGpuFrameGlobals g, uint mesh, uint vertex)
 {
+    if ((g.flags & GDR_FRAME_VERTEX_COLORS) == 0u)
+        return vec4(1.0);
     uint first = UintsRef(GDR_SCENE.mesh_color_offsets).items[mesh];
     if (first == GDR_GPU_NO_COLORS)
         return vec4(1.0);
