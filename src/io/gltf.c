@@ -233,21 +233,23 @@ static gdr_status load_image(gltf_ctx *c, uint32_t image, int srgb, uint32_t *ou
     return GDR_OK;
 }
 
-/* One of glTF's wrap modes (key of samplers[index]) as a GDR_SAMPLER_WRAP_*. */
+/* One of glTF's wrap modes (key of samplers[index]) as a GDR_SAMPLER_WRAP_*; a value glTF does not
+ * define is repeat (glTF's default), with a warning. */
 static gdr_status sampler_wrap(gltf_ctx *c, const cJSON *json, const char *key, const char *place, uint32_t *out)
 {
     uint32_t mode = 10497;
     gdr_status status = gltf_get_uint(c, json, key, place, 0, UINT32_MAX, &mode);
     if (status != GDR_OK)
         return status;
-    *out = mode == 10497 ? GDR_SAMPLER_WRAP_REPEAT : mode == 33071 ? GDR_SAMPLER_WRAP_CLAMP : GDR_SAMPLER_WRAP_MIRROR;
+    *out = mode == 33071 ? GDR_SAMPLER_WRAP_CLAMP : mode == 33648 ? GDR_SAMPLER_WRAP_MIRROR : GDR_SAMPLER_WRAP_REPEAT;
     if (mode != 10497 && mode != 33071 && mode != 33648)
-        return gltf_fail(c, GDR_ERROR_PARSE, "%s.%s: %u is not a wrap mode (10497, 33071 or 33648)", place, key, mode);
+        gdr_io_warn(&c->warnings, "%s: %s.%s: %u is not a wrap mode (10497, 33071 or 33648); repeat is used", c->name,
+                    place, key, mode);
     return GDR_OK;
 }
 
 /* samplers[index] as GDR_SAMPLER_* bits; filters left out are linear (glTF leaves them to the
- * implementation). */
+ * implementation), and so are values glTF does not define (with a warning). */
 static gdr_status load_sampler(gltf_ctx *c, uint32_t index, uint32_t *out)
 {
     *out = 0;
@@ -266,10 +268,16 @@ static gdr_status load_sampler(gltf_ctx *c, uint32_t index, uint32_t *out)
         status = sampler_wrap(c, json, "wrapT", place, &wrap_t);
     if (status != GDR_OK)
         return status;
-    if (mag != 9728 && mag != 9729)
-        return gltf_fail(c, GDR_ERROR_PARSE, "%s.magFilter: %u is not NEAREST (9728) or LINEAR (9729)", place, mag);
-    if (min != 9728 && min != 9729 && (min < 9984 || min > 9987))
-        return gltf_fail(c, GDR_ERROR_PARSE, "%s.minFilter: %u is not a glTF minification filter", place, min);
+    if (mag != 9728 && mag != 9729) {
+        gdr_io_warn(&c->warnings, "%s: %s.magFilter: %u is not NEAREST (9728) or LINEAR (9729); linear is used",
+                    c->name, place, mag);
+        mag = 9729;
+    }
+    if (min != 9728 && min != 9729 && (min < 9984 || min > 9987)) {
+        gdr_io_warn(&c->warnings, "%s: %s.minFilter: %u is not a glTF minification filter; trilinear is used", c->name,
+                    place, min);
+        min = 9987;
+    }
     /* 9728/9729: no mips; 9984..9987: NEAREST_MIPMAP_NEAREST, LINEAR_MIPMAP_NEAREST,
      * NEAREST_MIPMAP_LINEAR, LINEAR_MIPMAP_LINEAR. */
     bool min_nearest = min == 9728 || min == 9984 || min == 9986;
