@@ -27,36 +27,79 @@ typedef struct gdr_mesh {
     gdr_vec3 *positions; /* vertex_count entries */
     gdr_vec3 *normals;   /* vertex_count entries, unit length */
     gdr_vec2 *uvs;       /* vertex_count entries (zero when the source has none) */
+    gdr_vec4 *colors;    /* vertex_count linear RGBA vertex colours (glTF COLOR_0), or NULL: white */
     uint32_t index_count; /* a multiple of 3: a triangle list, counter-clockwise front faces */
     uint32_t *indices;
     gdr_vec4 bounds; /* bounding sphere in mesh space: centre xyz, radius w */
     gdr_mesh_clusters clusters; /* meshlets and LOD DAG (gdr/geometry.h); empty until built */
 } gdr_mesh;
 
+/* A texture reference's sampler state (glTF's sampler object), packed in a uint32: zero is glTF's
+ * default, repeat in both directions with linear filtering and linear mip selection. */
+#define GDR_SAMPLER_WRAP_REPEAT 0u
+#define GDR_SAMPLER_WRAP_CLAMP 1u
+#define GDR_SAMPLER_WRAP_MIRROR 2u
+#define GDR_SAMPLER_WRAP_S(bits) ((bits) & 3u)        /* a GDR_SAMPLER_WRAP_* for u */
+#define GDR_SAMPLER_WRAP_T(bits) (((bits) >> 2) & 3u) /* a GDR_SAMPLER_WRAP_* for v */
+#define GDR_SAMPLER_MAG_NEAREST (1u << 4)
+#define GDR_SAMPLER_MIN_NEAREST (1u << 5)
+#define GDR_SAMPLER_MIP_NEAREST (1u << 6)
+#define GDR_SAMPLER_MIP_NONE (1u << 7)  /* minification reads level 0 only */
+#define GDR_SAMPLER_STATES 256u         /* every packed state is below this */
+
+/* A material's use of a texture (glTF's textureInfo): which texture, its sampler, and the
+ * KHR_texture_transform of the texture coordinate, uv' = offset + R(rotation) (scale * uv) with
+ * the rows of R(a) (cos a, -sin a) and (sin a, cos a): the extension's matrix T * R * S. The coordinate is the
+ * mesh's one uv set (TEXCOORD_0). */
+typedef struct gdr_texture_ref {
+    uint32_t texture;  /* texture index or GDR_NO_INDEX */
+    uint32_t sampler;  /* GDR_SAMPLER_* bits */
+    gdr_vec2 offset;   /* (0, 0) without a transform */
+    gdr_vec2 scale;    /* (1, 1) without a transform */
+    float rotation;    /* radians, 0 without a transform */
+} gdr_texture_ref;
+
+/* A glTF metallic-roughness material. Start from gdr_material_default() (glTF's defaults); a
+ * zero-initialised material references texture 0 everywhere. */
 typedef struct gdr_material {
     char name[GDR_NAME_MAX];
     gdr_vec4 base_color; /* linear RGBA factor */
-    uint32_t base_color_texture;         /* texture index or GDR_NO_INDEX */
-    uint32_t normal_texture;             /* recorded for later use, or GDR_NO_INDEX */
-    uint32_t metallic_roughness_texture; /* recorded for later use, or GDR_NO_INDEX */
-    /* Surface parameters the importers fill. A zero-initialised material means: opaque,
-     * single-sided; metallic/roughness 0 unless an importer sets them. */
+    gdr_texture_ref base_color_texture;         /* sRGB RGBA, multiplied with base_color */
+    gdr_texture_ref metallic_roughness_texture; /* linear: G roughness, B metallic (times the factors) */
+    gdr_texture_ref normal_texture;             /* linear tangent-space normal, xy scaled by normal_scale */
+    gdr_texture_ref occlusion_texture;          /* linear: R, blended in by occlusion_strength */
+    gdr_texture_ref emissive_texture;           /* sRGB RGB, multiplied with emissive */
+    gdr_vec3 emissive;        /* linear emissive factor, KHR_materials_emissive_strength applied */
     float metallic_factor;
     float roughness_factor;
-    float alpha_cutoff;   /* used when alpha_mode is GDR_ALPHA_MASK */
-    uint32_t alpha_mode;  /* gdr_alpha_mode */
-    uint32_t double_sided; /* 0 or 1 */
+    float normal_scale;       /* 1 by default */
+    float occlusion_strength; /* 1 by default */
+    float alpha_cutoff;       /* used when alpha_mode is GDR_ALPHA_MASK; 0.5 by default */
+    uint32_t alpha_mode;      /* gdr_alpha_mode */
+    uint32_t double_sided;    /* 0 or 1 */
 } gdr_material;
+
+/* glTF's default material: white, metallic 1, roughness 1, no textures (every reference
+ * GDR_NO_INDEX with the default sampler and no transform), opaque with cutoff 0.5, single-sided. */
+GDR_API gdr_material gdr_material_default(void);
 
 typedef enum gdr_alpha_mode { GDR_ALPHA_OPAQUE = 0, GDR_ALPHA_MASK = 1, GDR_ALPHA_BLEND = 2 } gdr_alpha_mode;
 
-/* A decoded image: tightly packed RGBA8 rows, top row first. */
+/* A decoded image with its full mip chain: level l is max(width >> l, 1) x max(height >> l, 1)
+ * tightly packed RGBA8 texels, top row first; the levels follow each other in `rgba`, level 0
+ * first, down to 1 x 1 (gdr_texture_level_count, gdr_texture_level_offset). */
 typedef struct gdr_texture {
     char name[GDR_NAME_MAX];
-    uint32_t width, height;
-    uint8_t *rgba; /* width * height * 4 bytes */
-    uint32_t srgb; /* 1: colour data (base colour); 0: linear data (normals, metallic-roughness) */
+    uint32_t width, height; /* level 0 */
+    uint32_t levels;        /* gdr_texture_level_count(width, height) */
+    uint8_t *rgba;          /* every level: gdr_texture_level_offset(width, height, levels) bytes */
+    uint32_t srgb; /* 1: colour data (base colour, emissive); 0: linear data (normals, metallic-roughness, occlusion) */
 } gdr_texture;
+
+/* Levels of a full mip chain of a width x height image, down to 1 x 1. */
+GDR_API uint32_t gdr_texture_level_count(uint32_t width, uint32_t height);
+/* Byte offset of level `level` in a chain of a width x height image (level = the count: the chain's size). */
+GDR_API size_t gdr_texture_level_offset(uint32_t width, uint32_t height, uint32_t level);
 
 typedef struct gdr_instance {
     gdr_mat4 transform; /* mesh space -> world space */
@@ -110,7 +153,10 @@ GDR_API gdr_status gdr_scene_add_material(gdr_scene *scene, const gdr_material *
 GDR_API gdr_status gdr_scene_add_instance(gdr_scene *scene, const gdr_instance *instance,
                                           gdr_error *err);
 GDR_API gdr_status gdr_scene_add_camera(gdr_scene *scene, const gdr_camera *camera, gdr_error *err);
-/* Adds a texture whose pixels (width * height * 4 bytes, RGBA8) are copied. */
+/* Gives mesh `mesh` vertex colours (vertex_count linear RGBA values, each in [0, 1]; copied). */
+GDR_API gdr_status gdr_scene_set_mesh_colors(gdr_scene *scene, uint32_t mesh, const gdr_vec4 *colors, gdr_error *err);
+/* Adds a texture whose level 0 (width * height * 4 bytes, RGBA8) is copied; the other levels of its
+ * mip chain are built here (a box filter, in linear light for sRGB data, alpha-weighted). */
 GDR_API gdr_status gdr_scene_add_texture(gdr_scene *scene, const char *name, uint32_t width, uint32_t height,
                                          const uint8_t *rgba, uint32_t srgb, uint32_t *out_index,
                                          gdr_error *err);
@@ -129,6 +175,8 @@ typedef struct gdr_demo_desc {
     uint32_t instances; /* 0: 10000 */
     uint32_t seed;      /* 0: 1 */
     float spacing;      /* grid spacing in metres; 0: 4 */
+    uint32_t textures;  /* 1: every shape and the ground get a textured material (base colour, normal and
+                         * metallic-roughness maps, generated); 0: plain colours */
 } gdr_demo_desc;
 
 GDR_API gdr_status gdr_scene_create_demo(const gdr_demo_desc *desc, gdr_scene **out, gdr_error *err);

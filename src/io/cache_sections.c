@@ -14,9 +14,11 @@
 #error "the cache reader and writer assume a little-endian host"
 #endif
 
+enum { TEXTURE_REF_RECORD = 4 * 4 + 4 * 4 };
+
 #define FOURCC(a, b, c, d) ((uint32_t)(a) | (uint32_t)(b) << 8 | (uint32_t)(c) << 16 | (uint32_t)(d) << 24)
 
-enum { MESH_RECORD = 64 + 8 + 16, MATERIAL_RECORD = 64 + 16 + 12 + 12 + 8, INSTANCE_RECORD = CACHE_INSTANCE_RECORD,
+enum { MESH_RECORD = 64 + 8 + 16, MATERIAL_RECORD = 64 + 16 + 5 * TEXTURE_REF_RECORD + 12 + 5 * 4 + 8, INSTANCE_RECORD = CACHE_INSTANCE_RECORD,
        CAMERA_RECORD = 64 + 12 + 16 + 16, TEXTURE_RECORD = 64 + 12, CLUSTERS_RECORD = 6 * 4,
        CLUSTER_RECORD = 4 * 4 + 16 + 12 + 12 + 4 + 3 * 4, GROUP_RECORD = 16 + 4 + 3 * 4,
        NODE_RECORD = 16 + 4 + 4 + 4 * 4 + 2 * 4 };
@@ -151,6 +153,7 @@ static void write_pixels(writer *w, const cache_write_input *in)
     const gdr_scene *s = in->scene;
     for (uint32_t i = 0; i < s->texture_count; i++)
         put(w, s->textures[i].rgba, (size_t)s->textures[i].width * s->textures[i].height * 4);
+    /* Only level 0 is stored for now: gdr_scene_add_texture rebuilds the chain at read. */
 }
 
 static gdr_status read_pixels(cache_read_state *st, reader *px, gdr_error *err)
@@ -525,6 +528,14 @@ static gdr_status read_hierarchy(cache_read_state *st, reader *r, gdr_error *err
 
 /* --- MATL: materials --------------------------------------------------------------------------- */
 
+static void put_texture_ref(writer *w, const gdr_texture_ref *t)
+{
+    put_u32(w, t->texture);
+    put_u32(w, t->sampler);
+    put_f32s(w, (const float[5]){t->offset.x, t->offset.y, t->scale.x, t->scale.y, t->rotation}, 5);
+    put_u32(w, 0); /* reserved */
+}
+
 static void write_materials(writer *w, const cache_write_input *in)
 {
     const gdr_scene *s = in->scene;
@@ -532,37 +543,62 @@ static void write_materials(writer *w, const cache_write_input *in)
         const gdr_material *m = &s->materials[i];
         put_name(w, m->name);
         put_f32s(w, &m->base_color.x, 4);
-        put_u32(w, m->base_color_texture);
-        put_u32(w, m->normal_texture);
-        put_u32(w, m->metallic_roughness_texture);
-        put_f32s(w, (const float[3]){m->metallic_factor, m->roughness_factor, m->alpha_cutoff}, 3);
+        const gdr_texture_ref *refs[5] = {&m->base_color_texture, &m->metallic_roughness_texture, &m->normal_texture,
+                                          &m->occlusion_texture, &m->emissive_texture};
+        for (int k = 0; k < 5; k++)
+            put_texture_ref(w, refs[k]);
+        put_f32s(w, &m->emissive.x, 3);
+        put_f32s(w, (const float[5]){m->metallic_factor, m->roughness_factor, m->normal_scale, m->occlusion_strength,
+                                     m->alpha_cutoff}, 5);
         put_u32(w, m->alpha_mode);
         put_u32(w, m->double_sided);
     }
 }
 
+/* One texture reference, checked: the texture exists, the sampler state is known, the transform finite. */
+static gdr_status get_texture_ref(cache_read_state *st, reader *ma, uint32_t material, gdr_texture_ref *t, gdr_error *err)
+{
+    t->texture = get_u32(ma);
+    t->sampler = get_u32(ma);
+    float f[5];
+    get_f32s(ma, f, 5);
+    (void)get_u32(ma);
+    t->offset = (gdr_vec2){f[0], f[1]};
+    t->scale = (gdr_vec2){f[2], f[3]};
+    t->rotation = f[4];
+    if (t->texture != GDR_NO_INDEX && t->texture >= st->texture_count)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: material %u: texture %u does not exist (%u textures)",
+                             st->name, material, t->texture, st->texture_count);
+    if (t->sampler >= GDR_SAMPLER_STATES || !all_finite(f, 5))
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: material %u: a texture's sampler or transform is out of range",
+                             st->name, material);
+    return GDR_OK;
+}
+
 static gdr_status read_one_material(cache_read_state *st, reader *ma, uint32_t i, gdr_error *err)
 {
     gdr_material m;
-    float factors[3];
+    float factors[5];
     get_name(ma, m.name);
     get_f32s(ma, &m.base_color.x, 4);
-    m.base_color_texture = get_u32(ma);
-    m.normal_texture = get_u32(ma);
-    m.metallic_roughness_texture = get_u32(ma);
-    get_f32s(ma, factors, 3);
+    gdr_texture_ref *refs[5] = {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture,
+                                &m.occlusion_texture, &m.emissive_texture};
+    for (int k = 0; k < 5; k++) {
+        gdr_status status = get_texture_ref(st, ma, i, refs[k], err);
+        if (status != GDR_OK)
+            return status;
+    }
+    get_f32s(ma, &m.emissive.x, 3);
+    get_f32s(ma, factors, 5);
     m.metallic_factor = factors[0];
     m.roughness_factor = factors[1];
-    m.alpha_cutoff = factors[2];
+    m.normal_scale = factors[2];
+    m.occlusion_strength = factors[3];
+    m.alpha_cutoff = factors[4];
     m.alpha_mode = get_u32(ma);
     m.double_sided = get_u32(ma);
-    uint32_t textures[3] = {m.base_color_texture, m.normal_texture, m.metallic_roughness_texture};
-    for (int k = 0; k < 3; k++)
-        if (textures[k] != GDR_NO_INDEX && textures[k] >= st->texture_count)
-            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: material %u: texture %u does not exist (%u textures)",
-                                 st->name, i, textures[k], st->texture_count);
-    if (!all_finite(&m.base_color.x, 4) || !all_finite(factors, 3) || m.alpha_mode > GDR_ALPHA_BLEND ||
-        m.double_sided > 1)
+    if (!all_finite(&m.base_color.x, 4) || !all_finite(&m.emissive.x, 3) || !all_finite(factors, 5) ||
+        m.alpha_mode > GDR_ALPHA_BLEND || m.double_sided > 1)
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: material %u: values out of range", st->name, i);
     return gdr_scene_add_material(st->scene, &m, NULL, err);
 }

@@ -233,10 +233,66 @@ static gdr_status load_image(gltf_ctx *c, uint32_t image, int srgb, uint32_t *ou
     return GDR_OK;
 }
 
-/* A textureInfo object ({"index": N}) at place -> gdr texture index or GDR_NO_INDEX. */
-static gdr_status texture_ref(gltf_ctx *c, const cJSON *parent, const char *key, const char *place, int srgb,
-                              uint32_t *out)
+/* One of glTF's wrap modes (key of samplers[index]) as a GDR_SAMPLER_WRAP_*; a value glTF does not
+ * define is repeat (glTF's default), with a warning. */
+static gdr_status sampler_wrap(gltf_ctx *c, const cJSON *json, const char *key, const char *place, uint32_t *out)
 {
+    uint32_t mode = 10497;
+    gdr_status status = gltf_get_uint(c, json, key, place, 0, UINT32_MAX, &mode);
+    if (status != GDR_OK)
+        return status;
+    *out = mode == 33071 ? GDR_SAMPLER_WRAP_CLAMP : mode == 33648 ? GDR_SAMPLER_WRAP_MIRROR : GDR_SAMPLER_WRAP_REPEAT;
+    if (mode != 10497 && mode != 33071 && mode != 33648)
+        gdr_io_warn(&c->warnings, "%s: %s.%s: %u is not a wrap mode (10497, 33071 or 33648); repeat is used", c->name,
+                    place, key, mode);
+    return GDR_OK;
+}
+
+/* samplers[index] as GDR_SAMPLER_* bits; filters left out are linear (glTF leaves them to the
+ * implementation), and so are values glTF does not define (with a warning). */
+static gdr_status load_sampler(gltf_ctx *c, uint32_t index, uint32_t *out)
+{
+    *out = 0;
+    if (index >= c->sampler_count)
+        return gltf_fail(c, GDR_ERROR_PARSE, "samplers[%u] does not exist (%u samplers)", index, c->sampler_count);
+    char place[32];
+    snprintf(place, sizeof place, "samplers[%u]", index);
+    const cJSON *json = c->sampler_at[index];
+    uint32_t mag = 9729, min = 9987, wrap_s = 0, wrap_t = 0;
+    gdr_status status = gltf_get_uint(c, json, "magFilter", place, 0, UINT32_MAX, &mag);
+    if (status == GDR_OK)
+        status = gltf_get_uint(c, json, "minFilter", place, 0, UINT32_MAX, &min);
+    if (status == GDR_OK)
+        status = sampler_wrap(c, json, "wrapS", place, &wrap_s);
+    if (status == GDR_OK)
+        status = sampler_wrap(c, json, "wrapT", place, &wrap_t);
+    if (status != GDR_OK)
+        return status;
+    if (mag != 9728 && mag != 9729) {
+        gdr_io_warn(&c->warnings, "%s: %s.magFilter: %u is not NEAREST (9728) or LINEAR (9729); linear is used",
+                    c->name, place, mag);
+        mag = 9729;
+    }
+    if (min != 9728 && min != 9729 && (min < 9984 || min > 9987)) {
+        gdr_io_warn(&c->warnings, "%s: %s.minFilter: %u is not a glTF minification filter; trilinear is used", c->name,
+                    place, min);
+        min = 9987;
+    }
+    /* 9728/9729: no mips; 9984..9987: NEAREST_MIPMAP_NEAREST, LINEAR_MIPMAP_NEAREST,
+     * NEAREST_MIPMAP_LINEAR, LINEAR_MIPMAP_LINEAR. */
+    bool min_nearest = min == 9728 || min == 9984 || min == 9986;
+    *out = wrap_s | wrap_t << 2 | (mag == 9728 ? GDR_SAMPLER_MAG_NEAREST : 0u) |
+           (min_nearest ? GDR_SAMPLER_MIN_NEAREST : 0u) | (min < 9984 ? GDR_SAMPLER_MIP_NONE : 0u) |
+           (min == 9984 || min == 9985 ? GDR_SAMPLER_MIP_NEAREST : 0u);
+    return GDR_OK;
+}
+
+/* A textureInfo object ({"index": N}) at place -> gdr texture index or GDR_NO_INDEX, and (when
+ * out_sampler is not NULL) its sampler's GDR_SAMPLER_* bits. */
+static gdr_status texture_ref(gltf_ctx *c, const cJSON *parent, const char *key, const char *place, int srgb,
+                              gdr_texture_ref *ref)
+{
+    uint32_t *out = &ref->texture, *out_sampler = &ref->sampler;
     *out = GDR_NO_INDEX;
     const cJSON *info = NULL;
     char here[160];
@@ -261,10 +317,12 @@ static gdr_status texture_ref(gltf_ctx *c, const cJSON *parent, const char *key,
     char tplace[48];
     snprintf(tplace, sizeof tplace, "textures[%u]", texture);
     const cJSON *tjson = c->texture_at[texture];
-    uint32_t source = GDR_NO_INDEX;
+    uint32_t source = GDR_NO_INDEX, sampler = GDR_NO_INDEX;
     status = gltf_get_uint(c, tjson, "source", tplace, 0, UINT32_MAX - 1, &source);
     if (status == GDR_OK)
-        status = gltf_get_uint(c, tjson, "sampler", tplace, 0, UINT32_MAX, &(uint32_t){0});
+        status = gltf_get_uint(c, tjson, "sampler", tplace, 0, UINT32_MAX - 1, &sampler);
+    if (status == GDR_OK && sampler != GDR_NO_INDEX)
+        status = load_sampler(c, sampler, out_sampler);
     if (status != GDR_OK)
         return status;
     if (source == GDR_NO_INDEX) {
@@ -282,8 +340,7 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
     char here[48];
     snprintf(here, sizeof here, "materials[%u]", index);
     const cJSON *json = c->material_at[index];
-    gdr_material m = {.base_color = {1, 1, 1, 1}, .metallic_factor = 1.0f, .roughness_factor = 1.0f,
-                      .alpha_cutoff = 0.5f, .alpha_mode = GDR_ALPHA_OPAQUE};
+    gdr_material m = gdr_material_default();
     const char *name = NULL, *alpha_mode = NULL;
     const cJSON *pbr = NULL, *double_sided = cJSON_GetObjectItemCaseSensitive(json, "doubleSided");
     double metallic = 1.0, roughness = 1.0, cutoff = 0.5;
@@ -295,7 +352,7 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
     if (status == GDR_OK)
         status = gltf_get_object(c, json, "pbrMetallicRoughness", here, 0, &pbr);
     if (status == GDR_OK)
-        status = gltf_get_floats(c, json, "emissiveFactor", here, 3, (float[3]){0});
+        status = gltf_get_floats(c, json, "emissiveFactor", here, 3, &m.emissive.x);
     if (status != GDR_OK)
         return status;
     if (double_sided && !cJSON_IsBool(double_sided))
@@ -326,16 +383,14 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
             status = texture_ref(c, pbr, "metallicRoughnessTexture", pplace, 0, &m.metallic_roughness_texture);
         if (status != GDR_OK)
             return status;
-    } else {
-        m.base_color_texture = m.metallic_roughness_texture = GDR_NO_INDEX;
     }
     m.metallic_factor = (float)metallic;
     m.roughness_factor = (float)roughness;
     status = texture_ref(c, json, "normalTexture", here, 0, &m.normal_texture);
     if (status == GDR_OK)
-        status = texture_ref(c, json, "occlusionTexture", here, 0, &(uint32_t){0});
+        status = texture_ref(c, json, "occlusionTexture", here, 0, &m.occlusion_texture);
     if (status == GDR_OK)
-        status = texture_ref(c, json, "emissiveTexture", here, 1, &(uint32_t){0});
+        status = texture_ref(c, json, "emissiveTexture", here, 1, &m.emissive_texture);
     if (status != GDR_OK)
         return status;
     return gdr_scene_add_material(c->scene, &m, NULL, c->err);
@@ -1064,6 +1119,7 @@ static gdr_status import_document(gltf_ctx *c, const uint8_t *data, size_t size)
         {"images", &c->images, &c->image_count, &c->image_at},
         {"cameras", &c->cameras, &c->camera_count, &c->camera_at},
         {"scenes", &c->scenes, &c->scene_count, &c->scene_at},
+        {"samplers", &c->samplers, &c->sampler_count, &c->sampler_at},
     };
     for (size_t i = 0; i < sizeof tops / sizeof tops[0] && status == GDR_OK; i++)
         status = get_top_array(c, tops[i].key, tops[i].array, tops[i].count, tops[i].items);
@@ -1102,7 +1158,7 @@ gdr_status gdr_import_gltf_memory(const void *data, size_t size, const char *nam
         status = import_document(&c, data, size);
     cJSON_Delete(c.root);
     const cJSON **items[] = {c.accessor_at, c.view_at, c.buffer_at, c.mesh_at, c.node_at, c.material_at,
-                             c.texture_at, c.image_at, c.camera_at, c.scene_at};
+                             c.texture_at, c.image_at, c.camera_at, c.scene_at, c.sampler_at};
     for (size_t i = 0; i < sizeof items / sizeof items[0]; i++)
         free(items[i]);
     gltf_buffers_free(&c);

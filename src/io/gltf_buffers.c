@@ -257,7 +257,7 @@ gdr_status gltf_buffer_get(gltf_ctx *c, uint32_t index, const char *place, const
             if (meshopt && cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(meshopt, "fallback")))
                 return gltf_fail(c, GDR_ERROR_PARSE, "%s: %s is an EXT_meshopt_compression fallback without data",
                                  place, here);
-            return gltf_fail(c, GDR_ERROR_PARSE, "%s: has no uri%s", here,
+            return gltf_fail(c, GDR_ERROR_PARSE, "%s: has no uri%s, so its data is not usable", here,
                              c->is_glb ? " and is not the GLB binary chunk" : "");
         }
         if (available < byte_length) {

@@ -38,12 +38,12 @@ typedef struct gltf_ctx {
     int is_glb;
 
     cJSON *accessors, *buffer_views, *buffers_json, *meshes, *nodes, *materials, *textures, *images, *cameras,
-        *scenes;
+        *scenes, *samplers;
     uint32_t accessor_count, view_count, buffer_count, mesh_count, node_count, material_count, texture_count,
-        image_count, camera_count, scene_count;
+        image_count, camera_count, scene_count, sampler_count;
     /* The elements of each top-level array by index (count + 1 entries, malloc'ed). */
     const cJSON **accessor_at, **view_at, **buffer_at, **mesh_at, **node_at, **material_at, **texture_at,
-        **image_at, **camera_at, **scene_at;
+        **image_at, **camera_at, **scene_at, **sampler_at;
     gdr_io_budget budget;
     int allow_outside_files;
 

@@ -131,15 +131,19 @@ void gdr_cpu_path_record_draws(gdr_renderer *r, VkCommandBuffer cmd, const GdrGp
         const GdrGpuMesh *mesh = &g->cpu_meshes[g->cpu_instances[i].mesh];
         /* As seed 003's renderer does for every object: bindPipeline, bindVertexBuffers,
          * bindIndexBuffer, bindDescriptorSets, pushConstants, drawIndexed. gdr's scenes draw with
-         * one pipeline and one descriptor set (the frame's set 0), so those two binds name the same
-         * objects each time, as in an engine that binds per object without sorting. */
+         * one pipeline and the frame's descriptor sets (0 and the bindless textures), so those two
+         * binds name the same objects each time, as in an engine that binds per object without
+         * sorting. */
+        const VkDescriptorSet sets[2] = {r->occlusion.set, r->materials.set};
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pipelines[GDR_PIPE_DRAW_INDEXED]);
-        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->layout, 0, 1, &r->occlusion.set, 0, NULL);
-        VkDeviceSize vertex_offset = (VkDeviceSize)mesh->vertex_offset * sizeof(GdrGpuVertex);
-        vkCmdBindVertexBuffers(cmd, 0, 1, &g->vertices.buffer, &vertex_offset);
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->layout, 0, 2, sets, 0, NULL);
+        /* The vertex buffer from its start and the mesh's first vertex as the draw's vertexOffset, so
+         * that gl_VertexIndex is the pool-global index the vertex colours are looked up by. */
+        const VkDeviceSize buffer_start = 0;
+        vkCmdBindVertexBuffers(cmd, 0, 1, &g->vertices.buffer, &buffer_start);
         vkCmdBindIndexBuffer(cmd, g->indices.buffer, (VkDeviceSize)mesh->first_index * sizeof(uint32_t),
                              VK_INDEX_TYPE_UINT32);
         vkCmdPushConstants(cmd, r->layout, VK_SHADER_STAGE_ALL, 0, sizeof *push, push);
-        vkCmdDrawIndexed(cmd, mesh->index_count, 1, 0, 0, i);
+        vkCmdDrawIndexed(cmd, mesh->index_count, 1, 0, (int32_t)mesh->vertex_offset, i);
     }
 }

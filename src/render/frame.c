@@ -58,7 +58,7 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
     gdr_mat4 projection, view, cull_projection, cull_view;
     gdr_frame_matrices(r, camera, &projection, &view);
     gdr_frame_matrices(r, cull_camera, &cull_projection, &cull_view);
-    gdr_vec3 light = gdr_vec3_normalize((gdr_vec3){0.35f, 0.85f, 0.4f});
+    gdr_vec3 light = gdr_vec3_normalize((gdr_vec3){GDR_LIGHT_TOWARDS_X, GDR_LIGHT_TOWARDS_Y, GDR_LIGHT_TOWARDS_Z});
     /* The LOD cut: only where the mesh pipeline draws clusters, and only when it asks for something
      * other than level 0 (threshold 0 and depth 0 both select exactly level 0). */
     bool lod = pipeline == GDR_PIPELINE_MESH &&
@@ -77,6 +77,9 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .flags = frame_flags(frame, lod, occlusion, history, traversal_levels(r, frame, pipeline) > 0) |
                  (r->debug_shrink_lod_nodes ? GDR_FRAME_DEBUG_SHRINK_NODES : 0u) |
                  (r->scene.absent_groups > 0 ? GDR_FRAME_PARTIAL_RESIDENCY : 0u) |
+                 (r->materials.scene_flags & GDR_MATERIALS_MASKED ? GDR_FRAME_ALPHA_TEST : 0u) |
+                 (r->materials.scene_flags & GDR_MATERIALS_DOUBLE_SIDED ? GDR_FRAME_DOUBLE_SIDED : 0u) |
+                 (r->materials.scene_flags & GDR_MATERIALS_VERTEX_COLORS ? GDR_FRAME_VERTEX_COLORS : 0u) |
                  (pipeline == GDR_PIPELINE_MESH && r->vis.mode != GDR_GPU_RASTER_FORWARD ? GDR_FRAME_DIRECT_CLUSTERS
                                                                                         : 0u),
         .view_mode = (uint32_t)frame->view,
@@ -90,6 +93,7 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .min_screen_size = frame->min_screen_size,
         .clip_plane = frame->clip_plane,
         .screen_scale = fmaxf(fabsf(projection.m[0]), fabsf(projection.m[5])),
+        .eye_position = {camera->position.x, camera->position.y, camera->position.z, 1.0f},
     };
     gdr_occlusion_params(r, &projection, camera->znear, &globals.occlusion);
     /* The early phase tests against last frame's pyramid as last frame's camera saw it. */

@@ -16,8 +16,9 @@ void gdr_frame_bind_state(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer
 {
     GdrGpuPushConstants push = gdr_frame_push_constants(r, slot);
     vkCmdPushConstants(cmd, r->layout, VK_SHADER_STAGE_ALL, 0, sizeof push, &push);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->layout, 0, 1, &r->occlusion.set, 0, NULL);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->layout, 0, 1, &r->occlusion.set, 0, NULL);
+    const VkDescriptorSet sets[2] = {r->occlusion.set, r->materials.set}; /* set 0, set GDR_TEXTURE_SET */
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->layout, 0, 2, sets, 0, NULL);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->layout, 0, 2, sets, 0, NULL);
 }
 
 /* The colour and depth attachments: cleared in the frame's first raster phase, else loaded. */

@@ -9,13 +9,13 @@
 
 static GdrGpuInstance gpu_instance_from(const gdr_scene *scene, const gdr_instance *instance)
 {
-    GdrGpuInstance g = {.model = instance->transform, .color = instance->color, .mesh = instance->mesh,
-                        .min_screen_size = instance->min_screen_size, .max_screen_size = instance->max_screen_size};
-    if (instance->material != GDR_NO_INDEX) {
-        gdr_vec4 base = scene->materials[instance->material].base_color;
-        g.color = (gdr_vec4){g.color.x * base.x, g.color.y * base.y, g.color.z * base.z, g.color.w * base.w};
-    }
-    return g;
+    /* The material's factors and textures are applied by the shaders (shared/material.h); instances
+     * without one take the default material the material buffer appends after the scene's. */
+    bool has_material = instance->material < scene->material_count;
+    return (GdrGpuInstance){.model = instance->transform, .color = instance->color, .mesh = instance->mesh,
+                            .material = has_material ? instance->material : scene->material_count,
+                            .min_screen_size = instance->min_screen_size,
+                            .max_screen_size = instance->max_screen_size};
 }
 
 /* The clusters of every mesh: the scene's own, or built here for meshes that have none (a scene
@@ -384,7 +384,10 @@ gdr_status gdr_gpu_scene_write_refs(gdr_renderer *r, gdr_error *err)
                         .meshlet_vertices = g->meshlet_vertices.address,
                         .meshlet_triangles = g->meshlet_triangles.address,
                         .lod_nodes = g->lod_nodes.address, .page_table = g->page_table.address,
-                        .node_absent_refined = g->node_absent_refined.address};
+                        .node_absent_refined = g->node_absent_refined.address,
+                        .materials = r->materials.buffer.address,
+                        .vertex_colors = r->materials.vertex_colors.address,
+                        .mesh_color_offsets = r->materials.mesh_color_offsets.address};
     gdr_status status = gdr_vk_buffer_create(&r->allocator, sizeof refs,
                                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                              GDR_VK_BUFFER_DEVICE, &g->refs, err);
@@ -395,7 +398,7 @@ gdr_status gdr_gpu_scene_write_refs(gdr_renderer *r, gdr_error *err)
                                       &g->node_absent_refined, &g->stream_requests,
                                       &r->occlusion.occluded_instances, &r->occlusion.occluded_nodes,
                                       &r->occlusion.retest_masks};
-    g->bytes = 0;
+    g->bytes = r->materials.bytes;
     for (size_t i = 0; i < sizeof buffers / sizeof buffers[0]; i++)
         g->bytes += buffers[i]->size;
     return status;

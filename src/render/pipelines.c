@@ -17,10 +17,11 @@ typedef struct gdr_pipeline_entry {
     gdr_pipeline_needs needs;
     const gdr_spirv *compute;                        /* compute pipelines */
     const gdr_spirv *vertex, *task, *mesh, *fragment; /* graphics pipelines */
+    const gdr_spirv *alpha_fragment; /* the fragment shader that alpha-tests, for scenes with MASK or BLEND materials */
     uint32_t constants[2];  /* specialisation constants 0, 1 of the compute or the task shader */
     uint32_t constant_count;
     gdr_pipeline_targets targets;
-    bool vertex_input;      /* GdrGpuVertex position and normal at locations 0 and 1 */
+    bool vertex_input;      /* GdrGpuVertex position, normal and uv at locations 0, 1 and 2 */
     bool cull_back;
 } gdr_pipeline_entry;
 
@@ -47,15 +48,18 @@ static const gdr_pipeline_entry entries[GDR_PIPE_COUNT] = {
     [GDR_PIPE_TASK_SUBMIT_LATE] = {"task_submit_late", GDR_NEEDS_MESH_SHADER, .compute = &gdr_shader_tasksubmit_comp,
                                    .constants = {1}, .constant_count = 1},
     [GDR_PIPE_DRAW_INDEXED] = {"draw_indexed", .vertex = &gdr_shader_mesh_vert, .fragment = &gdr_shader_mesh_frag,
-                               .vertex_input = true, .cull_back = true},
+                               .alpha_fragment = &gdr_shader_mesh_alpha_frag, .vertex_input = true, .cull_back = true},
     [GDR_PIPE_MESHLETS] = {"meshlets", GDR_NEEDS_MESH_SHADER, .task = &gdr_shader_meshlet_task,
-                           .mesh = &gdr_shader_meshlet_mesh, .fragment = &gdr_shader_meshlet_frag, .constants = {0},
+                           .mesh = &gdr_shader_meshlet_mesh, .fragment = &gdr_shader_meshlet_frag,
+                           .alpha_fragment = &gdr_shader_meshlet_alpha_frag, .constants = {0},
                            .constant_count = 1, .cull_back = true},
     [GDR_PIPE_MESHLETS + 1] = {"meshlets_early", GDR_NEEDS_MESH_SHADER, .task = &gdr_shader_meshlet_task,
                                .mesh = &gdr_shader_meshlet_mesh, .fragment = &gdr_shader_meshlet_frag,
+                           .alpha_fragment = &gdr_shader_meshlet_alpha_frag,
                                .constants = {1}, .constant_count = 1, .cull_back = true},
     [GDR_PIPE_MESHLETS + 2] = {"meshlets_late", GDR_NEEDS_MESH_SHADER, .task = &gdr_shader_meshlet_task,
                                .mesh = &gdr_shader_meshlet_mesh, .fragment = &gdr_shader_meshlet_frag,
+                           .alpha_fragment = &gdr_shader_meshlet_alpha_frag,
                                .constants = {2}, .constant_count = 1, .cull_back = true},
     [GDR_PIPE_OVERDRAW_MAX] = {"overdraw_max", .compute = &gdr_shader_overdraw_max_comp},
     [GDR_PIPE_OVERDRAW_PAINT] = {"overdraw_paint", .vertex = &gdr_shader_overdraw_paint_vert,
@@ -68,7 +72,8 @@ static const gdr_pipeline_entry entries[GDR_PIPE_COUNT] = {
                                    .compute = &gdr_shader_clustercull_comp, .constants = {2}, .constant_count = 1},
     [GDR_PIPE_RASTER_SUBMIT] = {"raster_submit", GDR_NEEDS_VISIBILITY_BUFFER, .compute = &gdr_shader_raster_submit_comp},
     [GDR_PIPE_RASTER_HW] = {"raster_hw", GDR_NEEDS_VISIBILITY_BUFFER, .mesh = &gdr_shader_meshlet_list_mesh,
-                            .fragment = &gdr_shader_meshlet_visbuffer_frag, .targets = GDR_TARGETS_NONE,
+                            .fragment = &gdr_shader_meshlet_visbuffer_frag,
+                            .alpha_fragment = &gdr_shader_meshlet_visbuffer_alpha_frag, .targets = GDR_TARGETS_NONE,
                             .cull_back = true},
     [GDR_PIPE_RASTER_SW] = {"raster_sw", GDR_NEEDS_VISIBILITY_BUFFER, .compute = &gdr_shader_raster_sw_comp},
     [GDR_PIPE_RESOLVE] = {"resolve", GDR_NEEDS_VISIBILITY_BUFFER, .compute = &gdr_shader_visbuffer_resolve_comp,
@@ -84,10 +89,10 @@ static gdr_status create_graphics(gdr_vk_context *ctx, VkPipelineLayout layout, 
                                   VkPipeline *out, gdr_error *err)
 {
     static const VkVertexInputBindingDescription binding = {0, sizeof(GdrGpuVertex), VK_VERTEX_INPUT_RATE_VERTEX};
-    /* uv stays in the vertex (for textures later) but the forward shading does not read it yet. */
-    static const VkVertexInputAttributeDescription attributes[2] = {
+    static const VkVertexInputAttributeDescription attributes[3] = {
         {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(GdrGpuVertex, position)},
         {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(GdrGpuVertex, normal)},
+        {2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(GdrGpuVertex, uv)},
     };
     VkSpecializationMapEntry constant_entries[2] = {{0, 0, 4}, {1, 4, 4}};
     VkSpecializationInfo constants = {e->constant_count, constant_entries, 4 * e->constant_count, e->constants};
@@ -95,7 +100,7 @@ static gdr_status create_graphics(gdr_vk_context *ctx, VkPipelineLayout layout, 
         .layout = layout, .vertex_shader = e->vertex, .task_shader = e->task,
         .task_specialization = e->constant_count ? &constants : NULL, .mesh_shader = e->mesh,
         .fragment_shader = e->fragment, .vertex_binding = e->vertex_input ? &binding : NULL,
-        .vertex_attributes = e->vertex_input ? attributes : NULL, .vertex_attribute_count = e->vertex_input ? 2 : 0,
+        .vertex_attributes = e->vertex_input ? attributes : NULL, .vertex_attribute_count = e->vertex_input ? 3 : 0,
         .color_format = e->targets == GDR_TARGETS_NONE ? VK_FORMAT_UNDEFINED : GDR_COLOR_FORMAT,
         .depth_format = e->targets == GDR_TARGETS_COLOR_DEPTH ? GDR_DEPTH_FORMAT : VK_FORMAT_UNDEFINED,
         .cull_mode = e->cull_back ? VK_CULL_MODE_BACK_BIT : VK_CULL_MODE_NONE,
@@ -117,6 +122,25 @@ gdr_status gdr_pipelines_create(gdr_vk_context *ctx, VkPipelineLayout layout, co
                                        : create_graphics(ctx, layout, e, &pipelines[id], err);
         if (status != GDR_OK)
             return status;
+    }
+    return GDR_OK;
+}
+
+gdr_status gdr_pipelines_for_materials(gdr_vk_context *ctx, VkPipelineLayout layout, bool double_sided,
+                                       VkPipeline pipelines[GDR_PIPE_COUNT], gdr_error *err)
+{
+    for (uint32_t id = 0; id < GDR_PIPE_COUNT; id++) {
+        if (!pipelines[id] || !(entries[id].alpha_fragment || (double_sided && entries[id].cull_back)))
+            continue;
+        gdr_pipeline_entry alpha = entries[id];
+        alpha.fragment = alpha.alpha_fragment ? alpha.alpha_fragment : alpha.fragment;
+        alpha.cull_back = alpha.cull_back && !double_sided;
+        VkPipeline created;
+        gdr_status status = create_graphics(ctx, layout, &alpha, &created, err);
+        if (status != GDR_OK)
+            return status;
+        vkDestroyPipeline(ctx->device, pipelines[id], NULL);
+        pipelines[id] = created;
     }
     return GDR_OK;
 }

@@ -42,6 +42,12 @@ const char *gdr_pipeline_id_name(gdr_pipeline_id id);
  * says the device meets; the others stay VK_NULL_HANDLE. */
 gdr_status gdr_pipelines_create(gdr_vk_context *ctx, VkPipelineLayout layout, const bool available[3],
                                 VkPipeline pipelines[GDR_PIPE_COUNT], gdr_error *err);
+/* For a scene with MASK, BLEND or double-sided materials: replaces the raster pipelines (vertex and
+ * mesh shaders, forward and visibility buffer) by their alpha-testing variants, which also drop the
+ * back faces of single-sided materials; with `double_sided`, those are made without the pipeline
+ * state's back-face culling. */
+gdr_status gdr_pipelines_for_materials(gdr_vk_context *ctx, VkPipelineLayout layout, bool double_sided,
+                                       VkPipeline pipelines[GDR_PIPE_COUNT], gdr_error *err);
 void gdr_pipelines_destroy(gdr_vk_context *ctx, VkPipeline pipelines[GDR_PIPE_COUNT]);
 
 #endif

@@ -16,11 +16,13 @@ double gdr_now_ms(void)
     return (double)t.tv_sec * 1e3 + (double)t.tv_nsec * 1e-6;
 }
 
-/* The frame pipelines' layout (the push-constant block, and set 0 for the depth pyramid), then the
- * registry's pipelines that the device can run. */
+/* The frame pipelines' layout (the push-constant block, set 0 for the depth pyramid, set
+ * GDR_TEXTURE_SET for the bindless textures), then the registry's pipelines that the device can run. */
 static gdr_status create_pipelines(gdr_renderer *r, gdr_error *err)
 {
-    gdr_status status = gdr_vk_pipeline_layout_create_with_sets(r->ctx, &r->occlusion.set_layout, 1, VK_SHADER_STAGE_ALL,
+    const VkDescriptorSetLayout sets[2] = {r->occlusion.set_layout, r->materials.set_layout};
+    _Static_assert(GDR_TEXTURE_SET == 1, "the set layouts' order");
+    gdr_status status = gdr_vk_pipeline_layout_create_with_sets(r->ctx, sets, 2, VK_SHADER_STAGE_ALL,
                                                                 sizeof(GdrGpuPushConstants), &r->layout, err);
     const bool available[3] = {[GDR_NEEDS_CORE] = true,
                                [GDR_NEEDS_MESH_SHADER] = r->ctx->has_mesh_shader,
@@ -104,6 +106,8 @@ gdr_status gdr_renderer_create(const gdr_renderer_desc *desc_in, gdr_renderer **
     if (status == GDR_OK)
         status = gdr_visbuffer_create(r, desc.disable_visibility_buffer, err);
     if (status == GDR_OK)
+        status = gdr_materials_create(r, err);
+    if (status == GDR_OK)
         status = create_pipelines(r, err);
     if (status != GDR_OK) {
         gdr_renderer_destroy(r);
@@ -130,6 +134,7 @@ void gdr_renderer_destroy(gdr_renderer *r)
         if (r->layout)
             vkDestroyPipelineLayout(device, r->layout, NULL);
         gdr_occlusion_destroy(r);
+        gdr_materials_destroy(r);
         gdr_vk_image_destroy(r->ctx, &r->color);
         gdr_vk_image_destroy(r->ctx, &r->depth);
         gdr_vk_buffer_destroy(r->ctx, &r->color_readback);
@@ -149,6 +154,11 @@ gdr_status gdr_renderer_set_scene(gdr_renderer *r, const gdr_scene *scene, gdr_e
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
                              "the renderer already holds a scene: create another renderer for a new scene");
     gdr_status status = gdr_gpu_scene_upload(r, scene, err);
+    if (status == GDR_OK)
+        status = gdr_materials_upload(r, scene, err);
+    if (status == GDR_OK && (r->materials.scene_flags & (GDR_MATERIALS_MASKED | GDR_MATERIALS_DOUBLE_SIDED)))
+        status = gdr_pipelines_for_materials(r->ctx, r->layout, r->materials.scene_flags & GDR_MATERIALS_DOUBLE_SIDED,
+                                             r->pipelines, err);
     if (status == GDR_OK)
         status = gdr_frame_slots_create(r, err);
     if (status == GDR_OK)

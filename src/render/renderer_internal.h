@@ -4,6 +4,7 @@
 
 #include "gdr/renderer.h"
 #include "render/frame_plan.h"
+#include "render/materials.h"
 #include "render/occlusion.h"
 #include "render/pipelines.h"
 #include "shaders/shared/gpu_types.h"
@@ -109,6 +110,7 @@ struct gdr_renderer {
     VkPipelineLayout layout;
     VkPipeline pipelines[GDR_PIPE_COUNT]; /* the registry's (pipelines.h); NULL where the device cannot */
     gdr_occlusion occlusion;
+    gdr_materials materials;      /* the material buffer and the bindless textures (set GDR_TEXTURE_SET) */
     gdr_vk_buffer overdraw;       /* uint32 per pixel, then the maximum (overdraw view) */
     gdr_vk_buffer visible_meshlets; /* uint32 pairs, one per cluster of every instance; made on first use */
     gdr_visbuffer vis;            /* the visibility buffer and the hybrid rasteriser */

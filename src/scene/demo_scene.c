@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "gdr/scene.h"
+#include "scene/demo_materials.h"
 #include "scene/procedural_meshes.h"
 #include "scene/scene_random.h"
 
@@ -40,8 +41,16 @@ gdr_status gdr_scene_create_demo(const gdr_demo_desc *desc_in, gdr_scene **out, 
     if (status == GDR_OK) status = gdr_procedural_blob(scene, 4, &shapes[3], err);
     if (status == GDR_OK) status = gdr_procedural_ground(scene, half, 32, &ground, err);
 
+    uint32_t materials[5] = {GDR_NO_INDEX, GDR_NO_INDEX, GDR_NO_INDEX, GDR_NO_INDEX, GDR_NO_INDEX};
+    if (status == GDR_OK && desc.textures)
+        status = gdr_demo_add_materials(scene, 5, materials, err);
+    if (status == GDR_OK && desc.textures) { /* the ground's uvs span it once: smaller tiles */
+        gdr_material *g = &scene->materials[materials[4]];
+        g->base_color_texture.scale = g->normal_texture.scale = g->metallic_roughness_texture.scale =
+            (gdr_vec2){0.5f * half, 0.5f * half};
+    }
     if (status == GDR_OK) {
-        gdr_instance floor = {gdr_mat4_identity(), ground, GDR_NO_INDEX, {0.55f, 0.55f, 0.5f, 1.0f}};
+        gdr_instance floor = {gdr_mat4_identity(), ground, materials[4], {0.55f, 0.55f, 0.5f, 1.0f}};
         status = gdr_scene_add_instance(scene, &floor, err);
     }
     for (uint32_t i = 0; i < desc.instances && status == GDR_OK; i++) {
@@ -59,7 +68,7 @@ gdr_status gdr_scene_create_demo(const gdr_demo_desc *desc_in, gdr_scene **out, 
         gdr_instance instance = {
             .transform = gdr_mat4_from_trs((gdr_vec3){x, y, z}, rotation, (gdr_vec3){scale, scale, scale}),
             .mesh = shapes[shape],
-            .material = GDR_NO_INDEX,
+            .material = materials[shape],
             .color = gdr_hue_color(gdr_hash_unit(desc.seed, i, 4)),
         };
         status = gdr_scene_add_instance(scene, &instance, err);

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "gdr/scene.h"
+#include "scene/texture_mips.h"
 
 /* Grows *array (of element_size bytes each) so it holds at least count + 1 elements. */
 static gdr_status reserve_one(void **array, uint32_t *capacity, uint32_t count, size_t element_size,
@@ -40,6 +41,7 @@ void gdr_scene_destroy(gdr_scene *scene)
         free(scene->meshes[i].positions);
         free(scene->meshes[i].normals);
         free(scene->meshes[i].uvs);
+        free(scene->meshes[i].colors);
         free(scene->meshes[i].indices);
         gdr_mesh_clusters_free(&scene->meshes[i].clusters);
     }
@@ -148,6 +150,38 @@ gdr_status gdr_scene_add_mesh(gdr_scene *scene, const char *name, const gdr_vec3
     return GDR_OK;
 }
 
+gdr_material gdr_material_default(void)
+{
+    const gdr_texture_ref none = {.texture = GDR_NO_INDEX, .scale = {1.0f, 1.0f}};
+    return (gdr_material){.base_color = {1, 1, 1, 1}, .base_color_texture = none,
+                          .metallic_roughness_texture = none, .normal_texture = none,
+                          .occlusion_texture = none, .emissive_texture = none, .metallic_factor = 1.0f,
+                          .roughness_factor = 1.0f, .normal_scale = 1.0f, .occlusion_strength = 1.0f,
+                          .alpha_cutoff = 0.5f, .alpha_mode = GDR_ALPHA_OPAQUE};
+}
+
+gdr_status gdr_scene_set_mesh_colors(gdr_scene *scene, uint32_t mesh, const gdr_vec4 *colors, gdr_error *err)
+{
+    if (mesh >= scene->mesh_count)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "vertex colours: mesh %u does not exist (%u meshes)",
+                             mesh, scene->mesh_count);
+    gdr_mesh *m = &scene->meshes[mesh];
+    for (uint32_t i = 0; i < m->vertex_count; i++) {
+        const float *c = &colors[i].x;
+        for (int k = 0; k < 4; k++)
+            if (!(c[k] >= 0.0f && c[k] <= 1.0f))
+                return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
+                                     "mesh '%s': vertex colour %u is not in [0, 1]", m->name, i);
+    }
+    gdr_vec4 *copy = malloc(sizeof *copy * (m->vertex_count ? m->vertex_count : 1));
+    if (!copy)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for vertex colours", m->name);
+    memcpy(copy, colors, sizeof *copy * m->vertex_count);
+    free(m->colors);
+    m->colors = copy;
+    return GDR_OK;
+}
+
 gdr_status gdr_scene_add_material(gdr_scene *scene, const gdr_material *material, uint32_t *out_index,
                                   gdr_error *err)
 {
@@ -216,15 +250,20 @@ gdr_status gdr_scene_add_texture(gdr_scene *scene, const char *name, uint32_t wi
     if (status != GDR_OK)
         return status;
     size_t bytes = (size_t)width * height * 4;
-    gdr_texture texture = {0};
+    gdr_texture texture = {.levels = gdr_texture_level_count(width, height)};
     snprintf(texture.name, sizeof texture.name, "%s", name ? name : "");
     texture.width = width;
     texture.height = height;
     texture.srgb = srgb ? 1u : 0u;
-    texture.rgba = malloc(bytes);
+    texture.rgba = malloc(gdr_texture_level_offset(width, height, texture.levels));
     if (!texture.rgba)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "texture '%s': out of memory", texture.name);
     memcpy(texture.rgba, rgba, bytes);
+    if (!gdr_texture_build_levels(width, height, texture.srgb, texture.rgba)) {
+        free(texture.rgba);
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "texture '%s': out of memory for its mip levels",
+                             texture.name);
+    }
     if (out_index)
         *out_index = scene->texture_count;
     scene->textures[scene->texture_count++] = texture;

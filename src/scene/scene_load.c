@@ -102,8 +102,9 @@ static gdr_status create_builtin(builtin_scene which, const char *text, gdr_scen
         gdr_demo_desc d = {0};
         scene_option o[] = {{"instances", &d.instances, NULL, 1, 16000000},
                             {"seed", &d.seed, NULL, 1, 16000000},
-                            {"spacing", NULL, &d.spacing, 0, 0}};
-        status = parse_options(name, text, o, 3, err);
+                            {"spacing", NULL, &d.spacing, 0, 0},
+                            {"textures", &d.textures, NULL, 0, 1}};
+        status = parse_options(name, text, o, 4, err);
         return status == GDR_OK ? gdr_scene_create_demo(&d, out, err) : status;
     }
     if (which == BUILTIN_LOD_FIELD) {

@@ -1,14 +1,20 @@
 #version 460
+#extension GL_EXT_nonuniform_qualifier : require
 // Forward path vertex shader: the instance comes from gl_InstanceIndex (= the draw's first_instance).
 #include "shared/glsl_buffers.h"
+#include "shared/material.h"
 #include "shared/shading.h"
 
 layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
 
 layout(location = 0) out vec3 out_normal;
 layout(location = 1) out vec3 out_world_position;
 layout(location = 2) flat out vec4 out_color;
+layout(location = 4) out vec2 out_uv;
+layout(location = 5) flat out uint out_material;
+layout(location = 6) out vec4 out_vertex_color;
 
 void main()
 {
@@ -21,6 +27,9 @@ void main()
     mat3 cofactor = mat3(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1]));
     out_normal = cofactor * in_normal;
     out_world_position = world.xyz;
+    out_uv = in_uv;
+    out_material = instance.material;
+    out_vertex_color = gdr_vertex_color(g, instance.mesh, gl_VertexIndex); // gl_VertexIndex counts the draw's vertexOffset
     out_color = g.view_mode == GDR_VIEW_INSTANCES ? vec4(gdr_id_color(gl_InstanceIndex), 1.0)
               : g.view_mode == GDR_VIEW_LOD    ? vec4(gdr_depth_color(0), 1.0) // full detail: depth 0
                                                : instance.color;

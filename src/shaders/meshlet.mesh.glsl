@@ -9,8 +9,11 @@
 // frame's visible-cluster list, and its fragments write the visibility buffer.
 #extension GL_EXT_mesh_shader : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_EXT_nonuniform_qualifier : require
 
 #include "shared/glsl_buffers.h"
+#include "shared/material.h"
+#include "shared/material_flags.h"
 #include "shared/meshlet_payload.h"
 #include "shared/shading.h"
 #include "shared/visbuffer.h"
@@ -30,6 +33,9 @@ out gl_MeshPerPrimitiveEXT { perprimitiveEXT bool gl_CullPrimitiveEXT; } gl_Mesh
 layout(location = 0) out vec3 out_normal[];
 layout(location = 1) out vec3 out_world_position[];
 layout(location = 2) perprimitiveEXT flat out vec4 out_color[];
+layout(location = 4) out vec2 out_uv[];
+layout(location = 5) perprimitiveEXT flat out uint out_material[];
+layout(location = 6) out vec4 out_vertex_color[];
 #ifdef GDR_MESH_FROM_LIST
 layout(location = 3) perprimitiveEXT flat out uint out_visibility_id[]; // list slot and triangle
 #endif
@@ -100,21 +106,30 @@ void main()
         gl_MeshVerticesEXT[v].gl_Position = clip;
         out_normal[v] = cofactor * vertex.normal;
         out_world_position[v] = world.xyz;
+        out_uv[v] = vertex.uv;
+#ifdef GDR_MESH_FROM_LIST
+        // The visibility buffer's fragments need the attributes only to alpha-test.
+        if ((g.flags & GDR_FRAME_ALPHA_TEST) != 0u)
+#endif
+            out_vertex_color[v] = gdr_vertex_color(g, instance.mesh, vertex_index);
         vec2 ndc = clip.xy / clip.w;
         screen[v] = vec3((ndc * 0.5 + 0.5) * g.viewport, clip.w);
     }
     barrier();
 
     bool cull = g.cull_enabled != 0u && (g.flags & GDR_FRAME_TRIANGLE_CULL) != 0u;
+    bool double_sided = gdr_material_double_sided(g, instance.material);
     uint emitted = 0u, backfacing = 0u, small = 0u;
     for (uint t = lane; t < meshlet.triangle_count; t += GDR_MESH_WORKGROUP_SIZE) {
         uint at = meshlet.triangle_offset + t * 3u;
         uvec3 corners = uvec3(triangle_byte(at), triangle_byte(at + 1u), triangle_byte(at + 2u));
         gl_PrimitiveTriangleIndicesEXT[t] = corners;
         uint why = cull ? triangle_culled(screen[corners.x], screen[corners.y], screen[corners.z]) : 0u;
+        why = why == 1u && double_sided ? 0u : why;
         gl_MeshPrimitivesEXT[t].gl_CullPrimitiveEXT = why != 0u;
         out_color[t] = vec4(gdr_view_albedo(g.view_mode, instance.color.rgb, instance_index, meshlet_index, t,
                                             meshlet.group_depth), 1.0);
+        out_material[t] = instance.material;
 #ifdef GDR_MESH_FROM_LIST
         out_visibility_id[t] = gdr_visbuffer_id(slot, t);
 #endif

@@ -2,8 +2,8 @@
 // The visibility buffer's resolve, one invocation per pixel in GDR_RESOLVE_TILE-square
 // workgroups. Each pixel's id names a cluster of the frame's list and a triangle; the triangle's
 // three vertices are fetched and transformed as the mesh shader does, the perspective-correct
-// barycentrics of the pixel centre are recomputed, and the interpolated normal and position are
-// shaded by gdr_shade, as the forward path shades them. Writes every pixel's colour into the colour
+// barycentrics of the pixel centre are recomputed, and the interpolated attributes are shaded by
+// the material (shared/material.h), as the forward paths shade them. Writes every pixel's colour into the colour
 // target (set 0, binding 1, a storage image; empty pixels get the background). The depth stays in
 // the visibility buffer, where the depth pyramid reads it: a buffer-to-image copy of the colour and
 // the depth cost 0.16 ms each at 1440p on the H100, three times the resolve.
@@ -12,7 +12,9 @@
 // no second resolve.
 // A compute pass rather than a full-screen fragment pass: on the Hopper GPUs a fragment pass that
 // writes depth costs about 1 ms at 1440p before any shading (docs/PERFORMANCE.md).
+#extension GL_EXT_nonuniform_qualifier : require
 #include "shared/glsl_buffers.h"
+#include "shared/material.h"
 #include "shared/meshlet_payload.h"
 #include "shared/shading.h"
 #include "shared/visbuffer.h"
@@ -23,6 +25,13 @@ layout(set = 0, binding = 1, rgba8) uniform writeonly image2D color_target;
 uint triangle_byte(uint at)
 {
     return (UintsRef(GDR_SCENE.meshlet_triangles).items[at >> 2] >> ((at & 3u) * 8u)) & 255u;
+}
+
+// Perspective-correct barycentrics from the rows of the linear system below (shade_pixel).
+vec3 barycentrics(vec3 x_row, vec3 y_row)
+{
+    vec3 b = cross(x_row, y_row);
+    return b / (b.x + b.y + b.z);
 }
 
 // Shades the pixel whose centre is `centre` (framebuffer pixels, y down) from its id.
@@ -42,27 +51,50 @@ vec4 shade_pixel(FrameGlobalsRef globals, vec2 viewport, vec2 centre, uint id)
     // the point b0 V0 + b1 V1 + b2 V2 (b summing to 1) projects to the pixel centre p when
     // sum b_i (x_i - p.x w_i) = 0 and sum b_i (y_i - p.y w_i) = 0, so b is parallel to X x Y.
     vec2 p = vec2(centre.x / (0.5 * viewport.x) - 1.0, 1.0 - centre.y / (0.5 * viewport.y));
-    vec3 world[3], normal[3], x_row, y_row;
+    vec3 x_row, y_row, w_row;
+    mat3 world, normal;
+    mat3x2 uvs;
+    uint vertex_index[3];
     for (int i = 0; i < 3; i++) {
-        uint vertex_index = UintsRef(GDR_SCENE.meshlet_vertices).items[vertex_offset + corners[i]];
-        vec3 position = VerticesRef(GDR_SCENE.vertices).items[vertex_index].position;
-        normal[i] = VerticesRef(GDR_SCENE.vertices).items[vertex_index].normal;
-        vec4 w = model * vec4(position, 1.0);
+        vertex_index[i] = UintsRef(GDR_SCENE.meshlet_vertices).items[vertex_offset + corners[i]];
+        GdrGpuVertex vertex = VerticesRef(GDR_SCENE.vertices).items[vertex_index[i]];
+        normal[i] = vertex.normal;
+        uvs[i] = vertex.uv;
+        vec4 w = model * vec4(vertex.position, 1.0);
         vec4 clip = view_projection * w;
         world[i] = w.xyz;
         x_row[i] = clip.x - p.x * clip.w;
         y_row[i] = clip.y - p.y * clip.w;
+        w_row[i] = clip.w;
     }
-    vec3 b = cross(x_row, y_row);
-    b /= b.x + b.y + b.z;
-
+    vec3 b = barycentrics(x_row, y_row);
     mat3 m = mat3(model);
     mat3 cofactor = mat3(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1]));
-    vec3 n = cofactor * (b.x * normal[0] + b.y * normal[1] + b.z * normal[2]);
-    vec3 position = b.x * world[0] + b.y * world[1] + b.z * world[2];
-    vec3 albedo = gdr_view_albedo(globals.value.view_mode, InstancesRef(GDR_SCENE.instances).items[entry.instance].color.rgb,
-                                  entry.instance, entry.meshlet, triangle, meshlets.items[entry.meshlet].group_depth);
-    return gdr_shade(globals.value.light_direction.xyz, n, position, albedo);
+    vec3 n = cofactor * (normal * b);
+    vec3 position = world * b;
+    GdrGpuInstance instance = InstancesRef(GDR_SCENE.instances).items[entry.instance];
+    if (globals.value.view_mode != GDR_VIEW_SHADED) {
+        vec3 albedo = gdr_view_albedo(globals.value.view_mode, instance.color.rgb, entry.instance, entry.meshlet,
+                                      triangle, meshlets.items[entry.meshlet].group_depth);
+        return gdr_shade(globals.value.light_direction.xyz, n, position, albedo);
+    }
+    // The derivatives, analytically from the triangle: the barycentrics of the next pixel centre to
+    // the right and of the next one down (NDC y falls as pixel y grows), as the forward path's
+    // dFdx/dFdy difference neighbouring pixels; so both select the same mip level and tangent frame.
+    vec3 bx = barycentrics(x_row - (2.0 / viewport.x) * w_row, y_row) - b;
+    vec3 by = barycentrics(x_row, y_row + (2.0 / viewport.y) * w_row) - b;
+    vec4 color = instance.color;
+    if ((globals.value.flags & GDR_FRAME_VERTEX_COLORS) != 0u)
+        color *= b.x * gdr_vertex_color(globals.value, instance.mesh, vertex_index[0]) +
+                 b.y * gdr_vertex_color(globals.value, instance.mesh, vertex_index[1]) +
+                 b.z * gdr_vertex_color(globals.value, instance.mesh, vertex_index[2]);
+    // A back face (only double-sided materials draw them) is shaded with the normal reversed; the
+    // winding seen from the eye decides, as the rasteriser's facing does.
+    vec3 geometric = cross(world[1] - world[0], world[2] - world[0]);
+    if (dot(geometric, globals.value.eye_position.xyz - position) < 0.0)
+        n = -n;
+    GdrSurfacePoint point = GdrSurfacePoint(position, n, uvs * b, color, uvs * bx, uvs * by, world * bx, world * by);
+    return gdr_shade_material(instance.material, point, globals.value);
 }
 
 void main()

@@ -271,6 +271,11 @@ static gdr_status create_device(gdr_vk_context *ctx, bool disable_mesh_shaders, 
     note_missing(missing, sizeof missing, f12.scalarBlockLayout, "scalarBlockLayout");
     note_missing(missing, sizeof missing, f12.hostQueryReset, "hostQueryReset");
     note_missing(missing, sizeof missing, f12.samplerFilterMinmax, "samplerFilterMinmax"); /* depth pyramid */
+    /* the bindless textures */
+    note_missing(missing, sizeof missing, f12.runtimeDescriptorArray, "runtimeDescriptorArray");
+    note_missing(missing, sizeof missing, f12.descriptorBindingPartiallyBound, "descriptorBindingPartiallyBound");
+    note_missing(missing, sizeof missing, f12.shaderSampledImageArrayNonUniformIndexing,
+                 "shaderSampledImageArrayNonUniformIndexing");
     note_missing(missing, sizeof missing, f13.dynamicRendering, "dynamicRendering");
     note_missing(missing, sizeof missing, f13.synchronization2, "synchronization2");
     note_missing(missing, sizeof missing, f13.maintenance4, "maintenance4");
@@ -307,7 +312,9 @@ static gdr_status create_device(gdr_vk_context *ctx, bool disable_mesh_shaders, 
     VkPhysicalDeviceVulkan12Features e12 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, .pNext = &e13,
                                             .drawIndirectCount = VK_TRUE, .bufferDeviceAddress = VK_TRUE,
                                             .scalarBlockLayout = VK_TRUE, .hostQueryReset = VK_TRUE,
-                                            .samplerFilterMinmax = VK_TRUE,
+                                            .samplerFilterMinmax = VK_TRUE, .runtimeDescriptorArray = VK_TRUE,
+                                            .descriptorBindingPartiallyBound = VK_TRUE,
+                                            .shaderSampledImageArrayNonUniformIndexing = VK_TRUE,
                                             /* the visibility buffer, where the device has it */
                                             .shaderBufferInt64Atomics = f12.shaderBufferInt64Atomics};
     ctx->has_buffer_int64_atomics = f12.shaderBufferInt64Atomics == VK_TRUE;

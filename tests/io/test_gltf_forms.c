@@ -294,7 +294,8 @@ static void test_glb_and_files(void)
     if (s) {
         CHECK(s->instance_count == 1 && s->material_count == 1 && s->texture_count == 2);
         gdr_material *m = &s->materials[0];
-        CHECK(m->base_color_texture == 0 && m->normal_texture == 1 && m->metallic_roughness_texture == GDR_NO_INDEX);
+        CHECK(m->base_color_texture.texture == 0 && m->normal_texture.texture == 1 &&
+              m->metallic_roughness_texture.texture == GDR_NO_INDEX);
         CHECK_NEAR(m->base_color.y, 0.5, 0);
         CHECK_NEAR(m->metallic_factor, 0.25, 0);
         CHECK(m->alpha_mode == GDR_ALPHA_MASK && m->double_sided == 1);
@@ -335,8 +336,8 @@ static void test_glb_and_files(void)
     s = NULL;
     CHECK(gdr_import_gltf(path, &with_sources, &s, NULL, &err) == GDR_OK);
     if (s) {
-        CHECK(s->texture_count == 1 && s->materials[0].base_color_texture == 0);
-        CHECK(s->materials[0].normal_texture == GDR_NO_INDEX);
+        CHECK(s->texture_count == 1 && s->materials[0].base_color_texture.texture == 0);
+        CHECK(s->materials[0].normal_texture.texture == GDR_NO_INDEX);
         CHECK(warnings.count == 1 && strstr(warnings.text, "images[1].uri") && strstr(warnings.text, "missing.png"));
         CHECK(sources.count == 3); /* the .gltf, the .bin and the .png */
         gdr_scene_destroy(s);

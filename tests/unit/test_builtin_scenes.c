@@ -555,7 +555,7 @@ static void test_spec_names(void)
     CHECK(gdr_scene_load("demo:instances=0", NULL, &scene, &err) == GDR_ERROR_INVALID_ARGUMENT);
     CHECK(strcmp(err.message, "demo: instances=0 is not an integer in [1, 16000000]") == 0);
     CHECK(gdr_scene_load("demo:bogus=1", NULL, &scene, &err) == GDR_ERROR_INVALID_ARGUMENT);
-    CHECK(strcmp(err.message, "demo: unknown option 'bogus' (instances, seed, spacing)") == 0);
+    CHECK(strcmp(err.message, "demo: unknown option 'bogus' (instances, seed, spacing, textures)") == 0);
 }
 
 int main(void)

@@ -11,6 +11,7 @@
 #define GDR_CLUSTER_CULL_H
 
 #include "task_queue.h" // the occlusion culling phases
+#include "material_flags.h"
 #include "residency.h"
 
 
@@ -122,7 +123,8 @@ GdrClusterResult gdr_cluster_test_command(GdrGpuFrameGlobals g, uint phase, GdrG
         result.frustum_culled = !visible;
     }
     mat3 linear = mat3(model);
-    if (!retest && visible && cull && (g.flags & GDR_FRAME_MESHLET_CONE) != 0u && determinant(linear) > 0.0) {
+    if (!retest && visible && cull && (g.flags & GDR_FRAME_MESHLET_CONE) != 0u && determinant(linear) > 0.0 &&
+        !gdr_material_double_sided(g, instance.material)) {
         vec3 camera = inverse(linear) * (g.camera_position.xyz - model[3].xyz);
         result.cone_culled = gdr_cone_backfacing(meshlet.cone_apex, meshlet.cone_axis, meshlet.cone_cutoff, camera);
         visible = !result.cone_culled;

@@ -30,6 +30,7 @@ layout(buffer_reference, scalar) readonly buffer RasterParamsRef { GdrGpuRasterP
 layout(buffer_reference, scalar) buffer RasterCountersRef { GdrGpuRasterCounters value; };
 layout(buffer_reference, scalar) buffer RasterClustersRef { GdrGpuRasterCluster items[]; };
 layout(buffer_reference, scalar) buffer NodeVisitsRef { GdrGpuNodeVisit items[]; };
+layout(buffer_reference, scalar) readonly buffer MaterialsRef { GdrGpuMaterial items[]; };
 layout(buffer_reference, scalar) writeonly buffer StreamRequestsRef { GdrGpuStreamRequest items[]; };
 
 layout(push_constant, scalar) uniform PushConstantBlock { GdrGpuPushConstants push; };

@@ -61,8 +61,18 @@
 /* The visibility buffer's resolve: one workgroup per square tile of this many pixels a side. */
 #define GDR_RESOLVE_TILE 8
 /* The background colour, written as is into the UNORM colour target. */
+/* The frame's directional light: the direction towards it, in world space, before normalisation. */
+#define GDR_LIGHT_TOWARDS_X 0.35f
+#define GDR_LIGHT_TOWARDS_Y 0.85f
+#define GDR_LIGHT_TOWARDS_Z 0.4f
 #define GDR_BACKGROUND_R 0.42f
 #define GDR_BACKGROUND_G 0.55f
 #define GDR_BACKGROUND_B 0.72f
+/* Bindless textures: every texture of the scene in one array of sampled images (binding 0 of this
+ * descriptor set; set 0 is the depth pyramid's) and a sampler per packed glTF sampler state
+ * (binding 1, GDR_SAMPLER_STATES of them), both partially bound; a material names one of each. */
+#define GDR_TEXTURE_SET 1
+#define GDR_MAX_TEXTURES 4096
+#define GDR_SAMPLER_SLOTS 256
 
 #endif

@@ -29,6 +29,7 @@ GDR_DECLARE_REF(RasterParamsRef)
 GDR_DECLARE_REF(RasterCountersRef)
 GDR_DECLARE_REF(RasterClustersRef)
 GDR_DECLARE_REF(NodeVisitsRef)
+GDR_DECLARE_REF(MaterialsRef)
 GDR_DECLARE_REF(StreamRequestsRef)
 
 /* One vertex of the geometry pool (vertex input binding 0). */
@@ -187,13 +188,60 @@ GDR_STRUCT_BEGIN(GdrGpuInstance)
     gdr_mat4 model;
     gdr_vec4 color;
     gdr_uint mesh;
-    gdr_uint flags;
+    gdr_uint material;     /* index into GdrGpuScene.materials; the scene's default material when it has none */
     float min_screen_size; /* culled below this screen size (gdr_instance); 0: no minimum */
     float max_screen_size; /* culled at this screen size or more; 0: no maximum */
 GDR_STRUCT_END(GdrGpuInstance)
 GDR_ASSERT_SIZE(GdrGpuInstance, 96);
 GDR_ASSERT_OFFSET(GdrGpuInstance, color, 64);
 GDR_ASSERT_OFFSET(GdrGpuInstance, mesh, 80);
+GDR_ASSERT_OFFSET(GdrGpuInstance, material, 84);
+
+#define GDR_GPU_NO_TEXTURE 0xffffffffu
+#define GDR_GPU_NO_COLORS 0xffffffffu /* a mesh without vertex colours: white */
+/* A material's use of a texture: the bindless image (set GDR_TEXTURE_SET, binding 0) or
+ * GDR_GPU_NO_TEXTURE, the sampler (binding 1, one per packed GDR_SAMPLER_* state) and the
+ * texture-coordinate transform uv' = offset + mat2(matrix) * uv (KHR_texture_transform's rotation
+ * and scale, column-major). */
+GDR_STRUCT_BEGIN(GdrGpuTextureRef)
+    gdr_uint texture;
+    gdr_uint sampler_slot;
+    gdr_vec2 offset;
+    gdr_vec4 matrix;
+GDR_STRUCT_END(GdrGpuTextureRef)
+GDR_ASSERT_SIZE(GdrGpuTextureRef, 32);
+
+/* GdrGpuMaterial.alpha_mode: gdr_alpha_mode's values. */
+#define GDR_ALPHA_MODE_OPAQUE 0u
+#define GDR_ALPHA_MODE_MASK 1u
+#define GDR_ALPHA_MODE_BLEND 2u
+
+/* GdrGpuMaterial.textures: which texture is where. */
+#define GDR_MATERIAL_BASE_COLOR 0
+#define GDR_MATERIAL_METALLIC_ROUGHNESS 1
+#define GDR_MATERIAL_NORMAL 2
+#define GDR_MATERIAL_OCCLUSION 3
+#define GDR_MATERIAL_EMISSIVE 4
+#define GDR_MATERIAL_TEXTURES 5
+
+/* One glTF metallic-roughness material of the material buffer (gdr_material, gdr/scene.h).
+ * Colours are linear. */
+GDR_STRUCT_BEGIN(GdrGpuMaterial)
+    gdr_vec4 base_color;          /* factor, multiplied with the texture, the vertex and the instance colour */
+    gdr_vec3 emissive;            /* factor, emissive strength applied */
+    float metallic;
+    float roughness;
+    float normal_scale;
+    float occlusion_strength;
+    float alpha_cutoff;
+    gdr_uint alpha_mode;          /* gdr_alpha_mode: 0 opaque, 1 mask, 2 blend */
+    gdr_uint double_sided;
+    gdr_uint reserved0;
+    gdr_uint reserved1;
+    GdrGpuTextureRef textures[GDR_MATERIAL_TEXTURES];
+GDR_STRUCT_END(GdrGpuMaterial)
+GDR_ASSERT_SIZE(GdrGpuMaterial, 224);
+GDR_ASSERT_OFFSET(GdrGpuMaterial, textures, 64);
 
 /* A fixed-size "tag + data" record of the per-frame instance ring (seed 000). */
 #define GDR_UPDATE_TAG_INSTANCE 1u /* replace instance `index` with `instance` */
@@ -312,10 +360,13 @@ GDR_STRUCT_BEGIN(GdrGpuScene)
     GDR_REF(UintsRef) meshlet_vertices;       /* global vertex index per cluster-local vertex */
     GDR_REF(UintsRef) meshlet_triangles;      /* the bytes of the cluster-local triangles */
     GDR_REF(LodNodesRef) lod_nodes;           /* GdrGpuLodNode[], every mesh's LOD hierarchy (GdrGpuMesh.lod_node_*) */
+    GDR_REF(MaterialsRef) materials;          /* GdrGpuMaterial[], the scene's, then glTF's default material */
+    GDR_REF(UintsRef) vertex_colors;          /* 2 words (RGBA16 unorm) per vertex of the meshes with colours */
+    GDR_REF(UintsRef) mesh_color_offsets;     /* per mesh: first vertex colour (2 words each), or GDR_GPU_NO_COLORS */
     GDR_REF(UintsRef) page_table;             /* per group of every mesh: GDR_GPU_PAGE_ABSENT or resident (shared/residency.h) */
     GDR_REF(UintsRef) node_absent_refined;    /* per LOD node: clusters below whose refined group is absent */
 GDR_STRUCT_END(GdrGpuScene)
-GDR_ASSERT_SIZE(GdrGpuScene, 72);
+GDR_ASSERT_SIZE(GdrGpuScene, 96);
 
 /* A frame slot's buffers: written once, when the slot is made (and when a buffer made on first use
  * appears). Shaders read it and GdrGpuScene in place (GDR_SCENE, GDR_FRAME), never as a local
@@ -373,8 +424,9 @@ GDR_STRUCT_BEGIN(GdrGpuFrameGlobals)
     gdr_uint reserved3;
     gdr_uint reserved4;
     gdr_uint reserved5;
+    gdr_vec4 eye_position;    /* world space: the rendering camera's (camera_position is the culling camera's) */
 GDR_STRUCT_END(GdrGpuFrameGlobals)
-GDR_ASSERT_SIZE(GdrGpuFrameGlobals, 400);
+GDR_ASSERT_SIZE(GdrGpuFrameGlobals, 416);
 GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, frustum, 128);
 GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, znear, 176);
 GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, update_count, 192);
@@ -391,6 +443,9 @@ GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, viewport, 208);
 #define GDR_FRAME_DEBUG_SHRINK_NODES 512u /* tests: a deliberately wrong node test (spheres a quarter of their size) */
 #define GDR_FRAME_LOD_HIERARCHY 256u  /* with GDR_FRAME_LOD: instances' clusters come from the traversal of
                                          their LOD hierarchy (lodtraverse.comp) instead of all their clusters */
+#define GDR_FRAME_ALPHA_TEST 4096u     /* some material is MASK or BLEND: raster paths test alpha (shared/material.h) */
+#define GDR_FRAME_DOUBLE_SIDED 8192u   /* some material is double-sided: back faces are culled per material */
+#define GDR_FRAME_VERTEX_COLORS 16384u /* some mesh has vertex colours (GdrGpuScene.vertex_colors) */
 #define GDR_FRAME_PARTIAL_RESIDENCY 2048u /* some LOD group is absent: read the page table (shared/residency.h) */
 #define GDR_FRAME_DIRECT_CLUSTERS 1024u /* visibility-buffer modes: the instance cull tests the clusters of an
                                            instance that needs at most GDR_DIRECT_CLUSTERS of them and bins

@@ -47,6 +47,7 @@ GDR_SHARED_FN bool gdr_raster_bin_sw(gdr_uint mode, float threshold_px, gdr_vec3
 }
 
 #ifdef GDR_GLSL
+#include "material_flags.h"
 #include "visbuffer.h"
 
 /* The cluster cull (clustercull.comp), every invocation in uniform control flow, after the tests:
@@ -67,6 +68,12 @@ void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint m
         triangles = meshlet.triangle_count;
         sw = gdr_raster_bin_sw(params.value.mode, params.value.sw_threshold_px, center, radius, float(triangles), g.znear,
                                g.zfar, params.value.ndc_scale, g.viewport.y);
+        // Alpha-tested and double-sided materials are rasterised by the mesh shaders, whose
+        // fragments sample the mask and whose pipelines then cull back faces per material.
+        if (sw && (g.flags & (GDR_FRAME_ALPHA_TEST | GDR_FRAME_DOUBLE_SIDED)) != 0u) {
+            uint material = InstancesRef(GDR_SCENE.instances).items[instance].material;
+            sw = !gdr_material_alpha_tested(g, material) && !gdr_material_double_sided(g, material);
+        }
     }
     bool hw = visible && !sw;
     RasterCountersRef counters = RasterCountersRef(params.value.counters);

@@ -16,6 +16,80 @@ vec4 gdr_shade(vec3 light_direction, vec3 normal, vec3 world_position, vec3 albe
     return vec4(pow(color, vec3(1.0 / 2.2)), 1.0);
 }
 
+/* --- The shaded view: glTF's metallic-roughness BRDF (the specification's appendix B) ---------- */
+
+#define GDR_PI 3.14159265358979
+
+/* Irradiance of the directional light on a surface facing it, and the ambient term: a sky/ground
+ * hemisphere whose irradiance goes from GDR_AMBIENT_GROUND (normal straight down) to
+ * GDR_AMBIENT_GROUND + GDR_AMBIENT_SKY (straight up). A white diffuse surface facing the light and
+ * the sky reflects 0.7 + 0.35 of white, as the forward shading of the debug views. */
+#define GDR_LIGHT_IRRADIANCE (0.7 * GDR_PI)
+#define GDR_AMBIENT_GROUND 0.18
+#define GDR_AMBIENT_SKY 0.17
+
+/* GGX normal distribution, alpha = roughness^2. */
+float gdr_ggx_d(float n_h, float alpha)
+{
+    float a2 = alpha * alpha;
+    float d = n_h * n_h * (a2 - 1.0) + 1.0;
+    return a2 / (GDR_PI * d * d);
+}
+
+/* Smith's height-correlated visibility for GGX: G / (4 |n.l| |n.v|). */
+float gdr_smith_v(float n_l, float n_v, float alpha)
+{
+    float a2 = alpha * alpha;
+    float gl = n_v * sqrt(n_l * n_l * (1.0 - a2) + a2);
+    float gv = n_l * sqrt(n_v * n_v * (1.0 - a2) + a2);
+    return gl + gv > 0.0 ? 0.5 / (gl + gv) : 0.0;
+}
+
+/* Khronos PBR Neutral tone mapping: colours below about 0.76 pass unchanged (minus a small toe
+ * offset near black), brighter ones are compressed towards white without hue shifts. */
+vec3 gdr_tone_map(vec3 color)
+{
+    const float start = 0.8 - 0.04, desaturation = 0.15;
+    float x = min(color.r, min(color.g, color.b));
+    float offset = x < 0.08 ? x - 6.25 * x * x : 0.04;
+    color -= offset;
+    float peak = max(color.r, max(color.g, color.b));
+    if (peak < start)
+        return color;
+    float d = 1.0 - start;
+    float new_peak = 1.0 - d * d / (peak + d - start);
+    color *= new_peak / peak;
+    float g = 1.0 - 1.0 / (desaturation * (peak - new_peak) + 1.0);
+    return mix(color, vec3(new_peak), g);
+}
+
+/* The sRGB transfer function (IEC 61966-2-1), linear [0, 1] to encoded. */
+vec3 gdr_srgb_encode(vec3 c)
+{
+    c = clamp(c, 0.0, 1.0);
+    return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
+
+/* Outgoing radiance towards the viewer at surface s (unit normal n, unit vectors l towards the
+ * light and v towards the viewer), then tone mapped and sRGB encoded. */
+vec4 gdr_shade_surface(vec3 base_color, vec3 n, float metallic, float roughness, float occlusion, vec3 emissive,
+                       vec3 l, vec3 v)
+{
+    vec3 c_diff = mix(base_color, vec3(0.0), metallic);
+    vec3 f0 = mix(vec3(0.04), base_color, metallic);
+    float alpha = max(roughness * roughness, 1e-3);
+    float n_v = max(dot(n, v), 1e-4), n_l = max(dot(n, l), 0.0);
+    vec3 h = normalize(l + v);
+    float v_h = max(dot(v, h), 0.0), n_h = max(dot(n, h), 0.0);
+    vec3 fresnel = f0 + (1.0 - f0) * pow(1.0 - v_h, 5.0);
+    vec3 brdf = (1.0 - fresnel) * c_diff / GDR_PI + fresnel * gdr_ggx_d(n_h, alpha) * gdr_smith_v(n_l, n_v, alpha);
+    // Ambient: the hemisphere's irradiance, reflected diffusely by c_diff and specularly by f0 (an
+    // environment of one colour integrates the specular lobe to about f0).
+    float ambient = (GDR_AMBIENT_GROUND + GDR_AMBIENT_SKY * (0.5 + 0.5 * n.y)) * occlusion;
+    vec3 radiance = brdf * GDR_LIGHT_IRRADIANCE * n_l + (c_diff + f0) * ambient + emissive;
+    return vec4(gdr_srgb_encode(gdr_tone_map(radiance)), 1.0);
+}
+
 /* A bright colour from an id: three bytes of its hash, lifted away from black. */
 vec3 gdr_id_color(uint id)
 {
