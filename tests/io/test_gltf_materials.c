@@ -133,6 +133,33 @@ static void check_colors(const gdr_scene *s)
     CHECK_NEAR(u16->colors[3].w, 0, 0);
 }
 
+/* A flipped byte in the last mip level of the texture data: the cache is refused, naming the section. */
+static void test_damaged_pixels(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    static uint8_t data[1 << 20];
+    size_t size = fread(data, 1, sizeof data, f);
+    fclose(f);
+    uint32_t sections = 0;
+    memcpy(&sections, data + 16, 4);
+    uint64_t offset = 0, length = 0;
+    for (uint32_t i = 0; i < sections && 64 + (size_t)i * 32 + 32 <= size; i++)
+        if (memcmp(data + 64 + (size_t)i * 32, "TXPX", 4) == 0) {
+            memcpy(&offset, data + 64 + (size_t)i * 32 + 8, 8);
+            memcpy(&length, data + 64 + (size_t)i * 32 + 16, 8);
+        }
+    CHECK(length == 2 * gdr_texture_level_offset(4, 2, 3) && offset + length <= size);
+    if (!length || offset + length > size)
+        return;
+    data[offset + length - 2] ^= 0x10; /* the 1 x 1 level of the second texture */
+    gdr_scene *s = NULL;
+    CHECK(gdr_cache_read_memory(data, size, "materials.gdrc", &s, NULL, &err) != GDR_OK && s == NULL);
+    CHECK(strstr(err.message, "materials.gdrc") && strstr(err.message, "'TXPX'"));
+}
+
 static void test_import_and_cache(void)
 {
     gdr_scene *s = import_materials();
@@ -159,6 +186,7 @@ static void test_import_and_cache(void)
         gdr_scene_destroy(r);
     }
     gdr_scene_destroy(s);
+    test_damaged_pixels(path);
 }
 
 /* A 4 x 2 texture's levels 1 (2 x 1) and 2 (1 x 1) against box averages: of the values for linear
