@@ -81,7 +81,7 @@ GDR_API gdr_status gdr_image_decode(const void *data, size_t size, const char *n
 
 /* --- processed-scene cache ------------------------------------------------------------------ */
 
-#define GDR_CACHE_FORMAT_VERSION 6u
+#define GDR_CACHE_FORMAT_VERSION 7u
 
 /* What a cache was built from: the build options (a string that changes whenever the processing
  * would produce different data, e.g. "import=1") and the source files. */

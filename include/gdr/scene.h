@@ -49,7 +49,8 @@ typedef struct gdr_mesh {
 
 /* A material's use of a texture (glTF's textureInfo): which texture, its sampler, and the
  * KHR_texture_transform of the texture coordinate, uv' = offset + R(rotation) (scale * uv) with
- * the rows of R(a) (cos a, -sin a) and (sin a, cos a): the extension's matrix T * R * S. The coordinate is the
+ * the rows of R(a) (cos a, sin a) and (-sin a, cos a): the extension's matrix T * R * S, a
+ * counter-clockwise rotation of the image as seen with v running down (glTF's TextureTransformTest). The coordinate is the
  * mesh's one uv set (TEXCOORD_0). */
 typedef struct gdr_texture_ref {
     uint32_t texture;  /* texture index or GDR_NO_INDEX */
@@ -160,6 +161,11 @@ GDR_API gdr_status gdr_scene_set_mesh_colors(gdr_scene *scene, uint32_t mesh, co
 GDR_API gdr_status gdr_scene_add_texture(gdr_scene *scene, const char *name, uint32_t width, uint32_t height,
                                          const uint8_t *rgba, uint32_t srgb, uint32_t *out_index,
                                          gdr_error *err);
+/* Adds a texture whose whole mip chain (gdr_texture_level_offset(width, height, levels) bytes, the
+ * layout gdr_texture describes) is copied as it is: a chain built before, e.g. read from a cache. */
+GDR_API gdr_status gdr_scene_add_texture_levels(gdr_scene *scene, const char *name, uint32_t width, uint32_t height,
+                                                const uint8_t *chain, uint32_t srgb, uint32_t *out_index,
+                                                gdr_error *err);
 /* Replaces the scene's extension list (copied; NULL clears it). */
 GDR_API gdr_status gdr_scene_set_extensions(gdr_scene *scene, const char *extensions, gdr_error *err);
 

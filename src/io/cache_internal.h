@@ -158,7 +158,7 @@ static inline void fourcc_text(uint32_t id, char out[5])
 /* Every section this build knows, in the order they are written and read (a section may use what
  * the ones before it read). */
 enum {
-    CACHE_SOURCE, CACHE_SCENE, CACHE_TEXTURES, CACHE_PIXELS, CACHE_MESHES, CACHE_GEOMETRY, CACHE_CLUSTERS,
+    CACHE_SOURCE, CACHE_SCENE, CACHE_TEXTURES, CACHE_PIXELS, CACHE_MESHES, CACHE_GEOMETRY, CACHE_COLORS, CACHE_CLUSTERS,
     CACHE_CLUSTER_DATA, CACHE_HIERARCHY, CACHE_MATERIALS, CACHE_INSTANCES, CACHE_CAMERAS, CACHE_PVS,
     CACHE_PAGES, CACHE_SECTION_COUNT
 };

@@ -152,8 +152,8 @@ static void write_pixels(writer *w, const cache_write_input *in)
 {
     const gdr_scene *s = in->scene;
     for (uint32_t i = 0; i < s->texture_count; i++)
-        put(w, s->textures[i].rgba, (size_t)s->textures[i].width * s->textures[i].height * 4);
-    /* Only level 0 is stored for now: gdr_scene_add_texture rebuilds the chain at read. */
+        put(w, s->textures[i].rgba, gdr_texture_level_offset(s->textures[i].width, s->textures[i].height,
+                                                             s->textures[i].levels));
 }
 
 static gdr_status read_pixels(cache_read_state *st, reader *px, gdr_error *err)
@@ -167,11 +167,13 @@ static gdr_status read_pixels(cache_read_state *st, reader *px, gdr_error *err)
             srgb > 1)
             return gdr_error_set(err, GDR_ERROR_PARSE, "%s: texture %u: size %ux%u or flags are out of range",
                                  st->name, i, width, height);
-        const uint8_t *pixels = take(px, (size_t)width * height * 4);
+        /* The whole mip chain, stored so that loading builds nothing. */
+        size_t chain = gdr_texture_level_offset(width, height, gdr_texture_level_count(width, height));
+        const uint8_t *pixels = take(px, chain);
         if (!pixels)
             return gdr_error_set(err, GDR_ERROR_PARSE, "%s: texture %u: pixel data runs past section 'TXPX'",
                                  st->name, i);
-        gdr_status status = gdr_scene_add_texture(st->scene, tname, width, height, pixels, srgb, NULL, err);
+        gdr_status status = gdr_scene_add_texture_levels(st->scene, tname, width, height, pixels, srgb, NULL, err);
         if (status != GDR_OK)
             return status;
     }
@@ -250,6 +252,44 @@ static gdr_status read_one_mesh(cache_read_state *st, reader *geo, uint32_t i, g
     if (status == GDR_OK)
         st->scene->meshes[st->scene->mesh_count - 1].bounds = bounds;
     return status;
+}
+
+/* --- VCOL: per mesh, 0, or 1 and its vertex colours (RGBA floats) ---------------------------------- */
+
+static void write_colors(writer *w, const cache_write_input *in)
+{
+    const gdr_scene *s = in->scene;
+    for (uint32_t i = 0; i < s->mesh_count; i++) {
+        const gdr_mesh *m = &s->meshes[i];
+        put_u32(w, m->colors ? 1u : 0u);
+        if (m->colors)
+            put(w, m->colors, sizeof(gdr_vec4) * m->vertex_count);
+    }
+}
+
+static gdr_status read_colors(cache_read_state *st, reader *r, gdr_error *err)
+{
+    for (uint32_t i = 0; i < st->scene->mesh_count; i++) {
+        uint32_t flag = get_u32(r);
+        if (flag > 1)
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: mesh %u: vertex colour flag %u is not 0 or 1", st->name, i,
+                                 flag);
+        if (!flag)
+            continue;
+        uint32_t n = st->scene->meshes[i].vertex_count;
+        const void *data = take(r, sizeof(gdr_vec4) * (size_t)n);
+        gdr_vec4 *colors = data ? malloc(sizeof(gdr_vec4) * ((size_t)n + 1)) : NULL;
+        if (!data)
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: mesh %u: vertex colours run past section 'VCOL'", st->name, i);
+        if (!colors)
+            return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", st->name);
+        memcpy(colors, data, sizeof(gdr_vec4) * (size_t)n);
+        gdr_status status = gdr_scene_set_mesh_colors(st->scene, i, colors, err); /* checks each value */
+        free(colors);
+        if (status != GDR_OK)
+            return status;
+    }
+    return expect_end(st, r, "VCOL", err);
 }
 
 static gdr_status read_geometry(cache_read_state *st, reader *geo, gdr_error *err)
@@ -766,6 +806,7 @@ const cache_section gdr_cache_sections[CACHE_SECTION_COUNT] = {
     [CACHE_PIXELS] = {FOURCC('T', 'X', 'P', 'X'), REQUIRED, 0, NULL, NULL, write_pixels, read_pixels},
     [CACHE_MESHES] = {FOURCC('M', 'E', 'S', 'H'), REQUIRED, 0, NULL, NULL, write_meshes, read_meshes},
     [CACHE_GEOMETRY] = {FOURCC('G', 'E', 'O', 'M'), REQUIRED, 0, NULL, NULL, write_geometry, read_geometry},
+    [CACHE_COLORS] = {FOURCC('V', 'C', 'O', 'L'), REQUIRED, 0, NULL, NULL, write_colors, read_colors},
     [CACHE_CLUSTERS] = {FOURCC('C', 'L', 'U', 'S'), REQUIRED, 0, NULL, NULL, write_cluster_counts, read_cluster_counts},
     [CACHE_CLUSTER_DATA] = {FOURCC('C', 'L', 'D', 'T'), REQUIRED, 0, NULL, NULL, write_cluster_data, read_cluster_data},
     [CACHE_HIERARCHY] = {FOURCC('L', 'O', 'D', 'H'), REQUIRED, 0, NULL, check_hierarchy_present, write_hierarchy,

@@ -163,10 +163,11 @@ static gdr_status check_asset_and_extensions(gltf_ctx *c)
 static gdr_status load_image(gltf_ctx *c, uint32_t image, int srgb, uint32_t *out)
 {
     *out = GDR_NO_INDEX;
-    if (c->image_texture[image] == GLTF_IMAGE_FAILED)
+    uint32_t *slot = &c->image_texture[2 * image + (srgb ? 1 : 0)];
+    if (*slot == GLTF_IMAGE_FAILED)
         return GDR_OK;
-    if (c->image_texture[image] != GDR_NO_INDEX) {
-        *out = c->image_texture[image];
+    if (*slot != GDR_NO_INDEX) {
+        *out = *slot;
         return GDR_OK;
     }
     char here[48];
@@ -223,13 +224,13 @@ static gdr_status load_image(gltf_ctx *c, uint32_t image, int srgb, uint32_t *ou
         free(rgba);
         if (status != GDR_OK)
             return status;
-        c->image_texture[image] = *out;
+        *slot = *out;
         return GDR_OK;
     }
     if (status == GDR_ERROR_OUT_OF_MEMORY)
         return gdr_error_set(c->err, status, "%s", image_err.message);
     gdr_io_warn(&c->warnings, "%s (texture left out)", image_err.message);
-    c->image_texture[image] = GLTF_IMAGE_FAILED;
+    *slot = GLTF_IMAGE_FAILED;
     return GDR_OK;
 }
 
@@ -287,30 +288,61 @@ static gdr_status load_sampler(gltf_ctx *c, uint32_t index, uint32_t *out)
     return GDR_OK;
 }
 
-/* A textureInfo object ({"index": N}) at place -> gdr texture index or GDR_NO_INDEX, and (when
- * out_sampler is not NULL) its sampler's GDR_SAMPLER_* bits. */
+/* A textureInfo's KHR_texture_transform (offset, rotation, scale) into ref, and the texture
+ * coordinate set it may name instead of the textureInfo's. */
+static gdr_status texture_transform(gltf_ctx *c, const cJSON *info, const char *here, gdr_texture_ref *ref,
+                                    uint32_t *texcoord)
+{
+    const cJSON *t = gltf_extension(info, "KHR_texture_transform");
+    if (!t)
+        return GDR_OK;
+    char place[224];
+    snprintf(place, sizeof place, "%s.extensions.KHR_texture_transform", here);
+    double rotation = 0.0;
+    gdr_status status = gltf_get_floats(c, t, "offset", place, 2, &ref->offset.x);
+    if (status == GDR_OK)
+        status = gltf_get_floats(c, t, "scale", place, 2, &ref->scale.x);
+    if (status == GDR_OK)
+        status = gltf_get_number(c, t, "rotation", place, &rotation);
+    if (status == GDR_OK)
+        status = gltf_get_uint(c, t, "texCoord", place, 0, UINT32_MAX, texcoord);
+    ref->rotation = (float)rotation;
+    return status;
+}
+
+/* A textureInfo object ({"index": N, ...}) at place -> ref: the gdr texture (GDR_NO_INDEX when it
+ * is absent, cannot be decoded or uses a texture coordinate set other than 0, the only one gdr
+ * meshes carry: left out with a warning), its sampler's GDR_SAMPLER_* bits and its transform.
+ * `factor_key` ("scale" of a normal texture, "strength" of an occlusion texture) goes to *factor. */
 static gdr_status texture_ref(gltf_ctx *c, const cJSON *parent, const char *key, const char *place, int srgb,
-                              gdr_texture_ref *ref)
+                              const char *factor_key, float *factor, gdr_texture_ref *ref)
 {
     uint32_t *out = &ref->texture, *out_sampler = &ref->sampler;
     *out = GDR_NO_INDEX;
     const cJSON *info = NULL;
     char here[160];
     snprintf(here, sizeof here, "%s.%s", place, key);
-    uint32_t texture = 0;
-    double scale = 1.0;
+    uint32_t texture = 0, texcoord = 0;
+    double value = factor ? *factor : 1.0;
     gdr_status status = gltf_get_object(c, parent, key, place, 0, &info);
     if (status != GDR_OK || !info)
         return status;
-    status = gltf_get_uint(c, info, "texCoord", here, 0, UINT32_MAX, &(uint32_t){0});
-    if (status == GDR_OK)
-        status = gltf_get_number(c, info, "scale", here, &scale);
-    if (status == GDR_OK)
-        status = gltf_get_number(c, info, "strength", here, &scale);
+    status = gltf_get_uint(c, info, "texCoord", here, 0, UINT32_MAX, &texcoord);
+    if (status == GDR_OK && factor_key)
+        status = gltf_get_number(c, info, factor_key, here, &value);
     if (status == GDR_OK)
         status = gltf_get_uint(c, info, "index", here, 1, UINT32_MAX, &texture);
+    if (status == GDR_OK)
+        status = texture_transform(c, info, here, ref, &texcoord);
     if (status != GDR_OK)
         return status;
+    if (factor)
+        *factor = (float)value;
+    if (texcoord != 0) {
+        gdr_io_warn(&c->warnings, "%s: %s: texture coordinate set %u is not supported (meshes carry set 0); texture "
+                    "left out", c->name, here, texcoord);
+        return GDR_OK;
+    }
     if (texture >= c->texture_count)
         return gltf_fail(c, GDR_ERROR_PARSE, "%s.index: texture %u does not exist (%u textures)", here, texture,
                          c->texture_count);
@@ -333,6 +365,24 @@ static gdr_status texture_ref(gltf_ctx *c, const cJSON *parent, const char *key,
         return gltf_fail(c, GDR_ERROR_PARSE, "%s.source: image %u does not exist (%u images)", tplace, source,
                          c->image_count);
     return load_image(c, source, srgb, out);
+}
+
+/* KHR_materials_emissive_strength: the emissive factor times emissiveStrength (>= 0). */
+static gdr_status emissive_strength(gltf_ctx *c, const cJSON *json, const char *here, gdr_vec3 *emissive)
+{
+    const cJSON *e = gltf_extension(json, "KHR_materials_emissive_strength");
+    if (!e)
+        return GDR_OK;
+    char place[160];
+    snprintf(place, sizeof place, "%s.extensions.KHR_materials_emissive_strength", here);
+    double strength = 1.0;
+    gdr_status status = gltf_get_number(c, e, "emissiveStrength", place, &strength);
+    if (status != GDR_OK)
+        return status;
+    if (!(strength >= 0.0 && strength <= 1e6))
+        return gltf_fail(c, GDR_ERROR_PARSE, "%s.emissiveStrength: %g is not in [0, 1e6]", place, strength);
+    *emissive = gdr_vec3_scale(*emissive, (float)strength);
+    return GDR_OK;
 }
 
 static gdr_status load_material(gltf_ctx *c, uint32_t index)
@@ -378,22 +428,41 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
         if (status == GDR_OK)
             status = gltf_get_number(c, pbr, "roughnessFactor", pplace, &roughness);
         if (status == GDR_OK)
-            status = texture_ref(c, pbr, "baseColorTexture", pplace, 1, &m.base_color_texture);
+            status = texture_ref(c, pbr, "baseColorTexture", pplace, 1, NULL, NULL, &m.base_color_texture);
         if (status == GDR_OK)
-            status = texture_ref(c, pbr, "metallicRoughnessTexture", pplace, 0, &m.metallic_roughness_texture);
+            status = texture_ref(c, pbr, "metallicRoughnessTexture", pplace, 0, NULL, NULL, &m.metallic_roughness_texture);
         if (status != GDR_OK)
             return status;
     }
     m.metallic_factor = (float)metallic;
     m.roughness_factor = (float)roughness;
-    status = texture_ref(c, json, "normalTexture", here, 0, &m.normal_texture);
+    status = texture_ref(c, json, "normalTexture", here, 0, "scale", &m.normal_scale, &m.normal_texture);
     if (status == GDR_OK)
-        status = texture_ref(c, json, "occlusionTexture", here, 0, &m.occlusion_texture);
+        status = texture_ref(c, json, "occlusionTexture", here, 0, "strength", &m.occlusion_strength,
+                             &m.occlusion_texture);
     if (status == GDR_OK)
-        status = texture_ref(c, json, "emissiveTexture", here, 1, &m.emissive_texture);
+        status = texture_ref(c, json, "emissiveTexture", here, 1, NULL, NULL, &m.emissive_texture);
+    if (status == GDR_OK)
+        status = emissive_strength(c, json, here, &m.emissive);
     if (status != GDR_OK)
         return status;
     return gdr_scene_add_material(c->scene, &m, NULL, c->err);
+}
+
+/* glTF's default material, for primitives without one: added to the scene the first time. */
+static gdr_status default_material(gltf_ctx *c, uint32_t *out)
+{
+    if (!c->default_material_plus_one) {
+        gdr_material m = gdr_material_default();
+        snprintf(m.name, sizeof m.name, "default");
+        uint32_t index = 0;
+        gdr_status status = gdr_scene_add_material(c->scene, &m, &index, c->err);
+        if (status != GDR_OK)
+            return status;
+        c->default_material_plus_one = index + 1;
+    }
+    *out = c->default_material_plus_one - 1;
+    return GDR_OK;
 }
 
 /* --- meshes ---------------------------------------------------------------------------------- */
@@ -450,6 +519,7 @@ static uint32_t triangulate(uint32_t mode, const uint32_t *in, uint32_t n, uint3
 typedef struct prim_arrays {
     gdr_vec3 *positions, *normals;
     gdr_vec2 *uvs;
+    gdr_vec4 *colors;
     uint32_t *indices, *triangles;
 } prim_arrays;
 
@@ -458,6 +528,7 @@ static void prim_arrays_free(prim_arrays *a)
     free(a->positions);
     free(a->normals);
     free(a->uvs);
+    free(a->colors);
     free(a->indices);
     free(a->triangles);
 }
@@ -490,6 +561,53 @@ static gdr_status read_attribute(gltf_ctx *c, const cJSON *attributes, const cha
     return gltf_accessor_read_floats(c, accessor, use, components, *out);
 }
 
+/* COLOR_0 (VEC3 or VEC4; float, or unsigned byte or short normalized) as RGBA, alpha 1 for VEC3;
+ * values outside [0, 1] or not finite drop the colours with a warning. */
+static gdr_status read_colors(gltf_ctx *c, const cJSON *attributes, const char *place, uint32_t vertex_count,
+                              gdr_vec4 **out)
+{
+    uint32_t accessor = GDR_NO_INDEX;
+    char use[160];
+    snprintf(use, sizeof use, "%s.attributes", place);
+    gdr_status status = gltf_get_uint(c, attributes, "COLOR_0", use, 0, UINT32_MAX - 1, &accessor);
+    if (status != GDR_OK || accessor == GDR_NO_INDEX)
+        return status;
+    snprintf(use, sizeof use, "%s.attributes.COLOR_0", place);
+    gltf_accessor_info info;
+    status = gltf_accessor_info_get(c, accessor, use, &info);
+    if (status != GDR_OK)
+        return status;
+    if (info.components != 3 && info.components != 4)
+        return gltf_fail(c, GDR_ERROR_PARSE, "%s: accessor %u has %u components, expected 3 or 4", use, accessor,
+                         info.components);
+    if (info.count != vertex_count)
+        return gltf_fail(c, GDR_ERROR_PARSE, "%s: accessor %u count %u differs from POSITION count %u", use, accessor,
+                         info.count, vertex_count);
+    float *values = malloc(sizeof(float) * info.components * (size_t)(vertex_count ? vertex_count : 1));
+    *out = malloc(sizeof(gdr_vec4) * (vertex_count ? vertex_count : 1));
+    if (!values || !*out) {
+        free(values);
+        return gltf_fail(c, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", use);
+    }
+    status = gltf_accessor_read_floats(c, accessor, use, info.components, values);
+    bool in_range = true;
+    for (uint32_t v = 0; status == GDR_OK && v < vertex_count; v++) {
+        float rgba[4] = {0, 0, 0, 1};
+        for (uint32_t k = 0; k < info.components; k++) {
+            rgba[k] = values[(size_t)v * info.components + k];
+            in_range = in_range && rgba[k] >= 0.0f && rgba[k] <= 1.0f;
+        }
+        (*out)[v] = (gdr_vec4){rgba[0], rgba[1], rgba[2], rgba[3]};
+    }
+    free(values);
+    if (status == GDR_OK && !in_range) {
+        gdr_io_warn(&c->warnings, "%s: %s: values outside [0, 1] or not finite; vertex colours dropped", c->name, use);
+        free(*out);
+        *out = NULL;
+    }
+    return status;
+}
+
 /* The triangles `n` indices of topology `mode` make, from the budget, before anything is allocated
  * for them. */
 static gdr_status take_triangles(gltf_ctx *c, uint32_t mode, uint32_t n, const char *place)
@@ -507,7 +625,7 @@ static gdr_status clean_triangles(gltf_ctx *c, const char *place, prim_arrays *a
     gdr_status status = gdr_io_drop_bad_triangles(a->positions, *vertex_count, a->triangles, index_count,
                                                   &degenerate, &duplicate);
     if (status == GDR_OK)
-        status = gdr_io_split_shared_vertices(&a->positions, &a->normals, &a->uvs, vertex_count, a->triangles,
+        status = gdr_io_split_shared_vertices(&a->positions, &a->normals, &a->uvs, &a->colors, vertex_count, a->triangles,
                                               *index_count, &added);
     if (status != GDR_OK)
         return gltf_fail(c, status, "%s: out of memory", place);
@@ -627,6 +745,8 @@ static gdr_status convert_primitive(gltf_ctx *c, const cJSON *prim, const char *
         status = read_attribute(c, attributes, "NORMAL", place, 3, &normal_count, &normals);
     if (status == GDR_OK)
         status = read_attribute(c, attributes, "TEXCOORD_0", place, 2, &uv_count, &uvs);
+    if (status == GDR_OK)
+        status = read_colors(c, attributes, place, vertex_count, &a.colors);
     a.positions = (gdr_vec3 *)positions;
     a.normals = (gdr_vec3 *)normals;
     a.uvs = (gdr_vec2 *)uvs;
@@ -659,6 +779,8 @@ static gdr_status convert_primitive(gltf_ctx *c, const cJSON *prim, const char *
         goto done;
     status = gdr_scene_add_mesh(c->scene, mesh_name, a.positions, a.normals, a.uvs, vertex_count, a.triangles,
                                 triangle_indices, out_mesh, c->err);
+    if (status == GDR_OK && a.colors)
+        status = gdr_scene_set_mesh_colors(c->scene, *out_mesh, a.colors, c->err);
 done:
     prim_arrays_free(&a);
     return status;
@@ -762,7 +884,10 @@ static gdr_status add_instances(gltf_ctx *c, uint32_t mesh, gdr_mat4 transform, 
             continue;
         gdr_instance instance = {.transform = transform, .mesh = c->prim_mesh[first + p],
                                  .material = c->prim_material[first + p], .color = {1, 1, 1, 1}};
-        gdr_status status = gdr_scene_add_instance(c->scene, &instance, c->err);
+        gdr_status status = instance.material == GDR_NO_INDEX ? default_material(c, &instance.material) : GDR_OK;
+        if (status != GDR_OK)
+            return status;
+        status = gdr_scene_add_instance(c->scene, &instance, c->err);
         if (status != GDR_OK)
             return gltf_fail(c, status, "meshes[%u]: %s", mesh, c->err ? c->err->message : "");
     }
@@ -1128,11 +1253,11 @@ static gdr_status import_document(gltf_ctx *c, const uint8_t *data, size_t size)
     c->buffers = calloc(c->buffer_count + 1, sizeof *c->buffers);
     c->views = calloc(c->view_count + 1, sizeof *c->views);
     c->mesh_first = malloc(sizeof(uint32_t) * (c->mesh_count + 1));
-    c->image_texture = malloc(sizeof(uint32_t) * (c->image_count + 1));
+    c->image_texture = malloc(sizeof(uint32_t) * 2 * (c->image_count + 1));
     if (!c->buffers || !c->views || !c->mesh_first || !c->image_texture)
         return gltf_fail(c, GDR_ERROR_OUT_OF_MEMORY, "out of memory");
     memset(c->mesh_first, 0xff, sizeof(uint32_t) * (c->mesh_count + 1));
-    memset(c->image_texture, 0xff, sizeof(uint32_t) * (c->image_count + 1));
+    memset(c->image_texture, 0xff, sizeof(uint32_t) * 2 * (c->image_count + 1));
     for (uint32_t m = 0; m < c->material_count && status == GDR_OK; m++)
         status = load_material(c, m);
     if (status == GDR_OK)

@@ -45,6 +45,7 @@ typedef struct gltf_ctx {
     const cJSON **accessor_at, **view_at, **buffer_at, **mesh_at, **node_at, **material_at, **texture_at,
         **image_at, **camera_at, **scene_at, **sampler_at;
     gdr_io_budget budget;
+    uint32_t default_material_plus_one; /* the scene's glTF default material + 1; 0 until a primitive needs it */
     int allow_outside_files;
 
     gltf_buffer *buffers;
@@ -57,7 +58,7 @@ typedef struct gltf_ctx {
     uint32_t *prim_mesh;      /* grows as meshes are converted */
     uint32_t *prim_material;
     uint32_t prim_count, prim_capacity;
-    uint32_t *image_texture;  /* per glTF image: gdr texture, GDR_NO_INDEX, or UINT32_MAX - 1 (failed) */
+    uint32_t *image_texture;  /* per glTF image, linear then sRGB: gdr texture, GDR_NO_INDEX, or UINT32_MAX - 1 (failed) */
 } gltf_ctx;
 
 #define GLTF_IMAGE_FAILED (UINT32_MAX - 1u)

@@ -67,7 +67,7 @@ gdr_status gdr_io_drop_bad_triangles(const gdr_vec3 *positions, uint32_t vertex_
 /* Gives every block of GDR_IO_MAX_VERTEX_VALENCE uses of a vertex (in index order) beyond the first
  * its own copy (same position, normal, uv): the arrays (malloc'ed; normals and uvs may be NULL) grow,
  * *added copies. Returns GDR_ERROR_OUT_OF_MEMORY or GDR_OK. */
-gdr_status gdr_io_split_shared_vertices(gdr_vec3 **positions, gdr_vec3 **normals, gdr_vec2 **uvs,
+gdr_status gdr_io_split_shared_vertices(gdr_vec3 **positions, gdr_vec3 **normals, gdr_vec2 **uvs, gdr_vec4 **colors,
                                         uint32_t *vertex_count, uint32_t *indices, uint32_t index_count,
                                         uint32_t *added);
 

@@ -139,7 +139,7 @@ static void *extend(void *array, size_t element, uint32_t count, uint32_t grown,
     return bigger;
 }
 
-gdr_status gdr_io_split_shared_vertices(gdr_vec3 **positions, gdr_vec3 **normals, gdr_vec2 **uvs,
+gdr_status gdr_io_split_shared_vertices(gdr_vec3 **positions, gdr_vec3 **normals, gdr_vec2 **uvs, gdr_vec4 **colors,
                                         uint32_t *vertex_count, uint32_t *indices, uint32_t index_count,
                                         uint32_t *added)
 {
@@ -183,8 +183,11 @@ gdr_status gdr_io_split_shared_vertices(gdr_vec3 **positions, gdr_vec3 **normals
     gdr_vec2 *t = *uvs ? extend(*uvs, sizeof(gdr_vec2), n, grown, sources) : NULL;
     if (t)
         *uvs = t;
+    gdr_vec4 *col = *colors ? extend(*colors, sizeof(gdr_vec4), n, grown, sources) : NULL;
+    if (col)
+        *colors = col;
     free(uses), free(sources), free(copy);
-    if (!p || (*normals && !nn) || (*uvs && !t))
+    if (!p || (*normals && !nn) || (*uvs && !t) || (*colors && !col))
         return GDR_ERROR_OUT_OF_MEMORY;
     *vertex_count = grown;
     *added = (uint32_t)extra;
@@ -201,7 +204,7 @@ gdr_status gdr_io_clean_unclustered_meshes(gdr_scene *scene, const char *name, g
         gdr_status status = gdr_io_drop_bad_triangles(m->positions, m->vertex_count, m->indices, &m->index_count,
                                                       &degenerate, &duplicate);
         if (status == GDR_OK)
-            status = gdr_io_split_shared_vertices(&m->positions, &m->normals, &m->uvs, &m->vertex_count, m->indices,
+            status = gdr_io_split_shared_vertices(&m->positions, &m->normals, &m->uvs, &m->colors, &m->vertex_count, m->indices,
                                                   m->index_count, &added);
         if (status != GDR_OK)
             return gdr_error_set(err, status, "%s: mesh %u: out of memory", name, i);

@@ -258,8 +258,8 @@ static gdr_status clean_group(obj_ctx *c, gdr_vec3 **positions, gdr_vec3 **norma
     gdr_status status = gdr_io_drop_bad_triangles(*positions, *vertex_count, m->indices, &m->index_count,
                                                   &degenerate, &duplicate);
     if (status == GDR_OK)
-        status = gdr_io_split_shared_vertices(positions, normals, uvs, vertex_count, m->indices, m->index_count,
-                                              &added);
+        status = gdr_io_split_shared_vertices(positions, normals, uvs, &(gdr_vec4 *){NULL}, vertex_count, m->indices,
+                                              m->index_count, &added);
     if (status != GDR_OK)
         return obj_fail(c, status, "out of memory");
     /* Zero-area faces draw nothing and are common in real files: dropped silently. */

@@ -71,7 +71,7 @@ static GdrGpuTextureRef gpu_texture_ref(const gdr_texture_ref *t, uint32_t textu
     float c = cosf(t->rotation), s = sinf(t->rotation);
     return (GdrGpuTextureRef){.texture = t->texture < texture_count ? t->texture : GDR_GPU_NO_TEXTURE,
                               .sampler_slot = t->sampler, .offset = t->offset,
-                              .matrix = {c * t->scale.x, s * t->scale.x, -s * t->scale.y, c * t->scale.y}};
+                              .matrix = {c * t->scale.x, -s * t->scale.x, s * t->scale.y, c * t->scale.y}};
 }
 
 static GdrGpuMaterial gpu_material_from(const gdr_material *s, uint32_t texture_count)

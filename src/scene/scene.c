@@ -239,8 +239,10 @@ uint64_t gdr_scene_triangle_count(const gdr_scene *scene)
     return total;
 }
 
-gdr_status gdr_scene_add_texture(gdr_scene *scene, const char *name, uint32_t width, uint32_t height,
-                                 const uint8_t *rgba, uint32_t srgb, uint32_t *out_index, gdr_error *err)
+/* A texture of `levels` levels (width x height at level 0) whose chain is copied from `chain`, all
+ * of it when `whole_chain`, else level 0 only and the rest built here. */
+static gdr_status add_texture(gdr_scene *scene, const char *name, uint32_t width, uint32_t height, const uint8_t *chain,
+                              bool whole_chain, uint32_t srgb, uint32_t *out_index, gdr_error *err)
 {
     if (width == 0 || height == 0 || width > 32768 || height > 32768)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "texture '%s': size %ux%u is out of range",
@@ -249,17 +251,15 @@ gdr_status gdr_scene_add_texture(gdr_scene *scene, const char *name, uint32_t wi
                                     sizeof(gdr_texture), err);
     if (status != GDR_OK)
         return status;
-    size_t bytes = (size_t)width * height * 4;
-    gdr_texture texture = {.levels = gdr_texture_level_count(width, height)};
+    gdr_texture texture = {.width = width, .height = height, .levels = gdr_texture_level_count(width, height),
+                           .srgb = srgb ? 1u : 0u};
     snprintf(texture.name, sizeof texture.name, "%s", name ? name : "");
-    texture.width = width;
-    texture.height = height;
-    texture.srgb = srgb ? 1u : 0u;
-    texture.rgba = malloc(gdr_texture_level_offset(width, height, texture.levels));
+    size_t chain_bytes = gdr_texture_level_offset(width, height, texture.levels);
+    texture.rgba = malloc(chain_bytes);
     if (!texture.rgba)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "texture '%s': out of memory", texture.name);
-    memcpy(texture.rgba, rgba, bytes);
-    if (!gdr_texture_build_levels(width, height, texture.srgb, texture.rgba)) {
+    memcpy(texture.rgba, chain, whole_chain ? chain_bytes : (size_t)width * height * 4);
+    if (!whole_chain && !gdr_texture_build_levels(width, height, texture.srgb, texture.rgba)) {
         free(texture.rgba);
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "texture '%s': out of memory for its mip levels",
                              texture.name);
@@ -268,6 +268,18 @@ gdr_status gdr_scene_add_texture(gdr_scene *scene, const char *name, uint32_t wi
         *out_index = scene->texture_count;
     scene->textures[scene->texture_count++] = texture;
     return GDR_OK;
+}
+
+gdr_status gdr_scene_add_texture(gdr_scene *scene, const char *name, uint32_t width, uint32_t height,
+                                 const uint8_t *rgba, uint32_t srgb, uint32_t *out_index, gdr_error *err)
+{
+    return add_texture(scene, name, width, height, rgba, false, srgb, out_index, err);
+}
+
+gdr_status gdr_scene_add_texture_levels(gdr_scene *scene, const char *name, uint32_t width, uint32_t height,
+                                        const uint8_t *chain, uint32_t srgb, uint32_t *out_index, gdr_error *err)
+{
+    return add_texture(scene, name, width, height, chain, true, srgb, out_index, err);
 }
 
 gdr_status gdr_scene_set_extensions(gdr_scene *scene, const char *extensions, gdr_error *err)

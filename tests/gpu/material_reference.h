@@ -118,8 +118,8 @@ static inline void ref_texel(const gdr_texture *t, int64_t x, int64_t y, double 
 static inline void ref_transform_uv(const gdr_texture_ref *r, const double uv[2], double out[2])
 {
     double c = cos(r->rotation), s = sin(r->rotation), u = uv[0] * r->scale.x, v = uv[1] * r->scale.y;
-    out[0] = r->offset.x + c * u - s * v;
-    out[1] = r->offset.y + s * u + c * v;
+    out[0] = r->offset.x + c * u + s * v;
+    out[1] = r->offset.y - s * u + c * v;
 }
 
 /* Texture reference r at uv, level 0 (magnification filter), linear values. */

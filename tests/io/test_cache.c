@@ -32,7 +32,8 @@ static int same_scene(const gdr_scene *a, const gdr_scene *b)
             memcmp(x->positions, y->positions, 12 * (size_t)x->vertex_count) ||
             memcmp(x->normals, y->normals, 12 * (size_t)x->vertex_count) ||
             memcmp(x->uvs, y->uvs, 8 * (size_t)x->vertex_count) ||
-            memcmp(x->indices, y->indices, 4 * (size_t)x->index_count) || !same_clusters(&x->clusters, &y->clusters))
+            memcmp(x->indices, y->indices, 4 * (size_t)x->index_count) || !same_clusters(&x->clusters, &y->clusters) ||
+            !x->colors != !y->colors || (x->colors && memcmp(x->colors, y->colors, 16 * (size_t)x->vertex_count)))
             return 0;
     }
     for (uint32_t i = 0; i < a->material_count; i++)
@@ -47,7 +48,7 @@ static int same_scene(const gdr_scene *a, const gdr_scene *b)
     for (uint32_t i = 0; i < a->texture_count; i++) {
         const gdr_texture *x = &a->textures[i], *y = &b->textures[i];
         if (strcmp(x->name, y->name) || x->width != y->width || x->height != y->height || x->srgb != y->srgb ||
-            memcmp(x->rgba, y->rgba, (size_t)x->width * x->height * 4))
+            x->levels != y->levels || memcmp(x->rgba, y->rgba, gdr_texture_level_offset(x->width, x->height, x->levels)))
             return 0;
     }
     return 1;
@@ -523,6 +524,17 @@ int main(void)
     uint8_t pixels[2 * 2 * 4] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16};
     CHECK(gdr_scene_add_texture(demo, "t", 2, 2, pixels, 1, NULL, &err) == GDR_OK);
     CHECK(gdr_scene_set_extensions(demo, "EXT_test", &err) == GDR_OK);
+    /* ... and a material using it with a transform, and vertex colours on one mesh. */
+    gdr_material material = gdr_material_default();
+    material.base_color_texture = (gdr_texture_ref){.texture = 0, .sampler = GDR_SAMPLER_WRAP_MIRROR,
+                                                    .offset = {0.5f, 0.25f}, .scale = {2, 3}, .rotation = 0.5f};
+    material.emissive = (gdr_vec3){1, 2, 3};
+    CHECK(gdr_scene_add_material(demo, &material, NULL, &err) == GDR_OK);
+    gdr_vec4 *colors = calloc(demo->meshes[1].vertex_count, sizeof *colors);
+    for (uint32_t v = 0; colors && v < demo->meshes[1].vertex_count; v++)
+        colors[v] = (gdr_vec4){(float)(v % 7) / 7.0f, 0.5f, 1.0f, (float)(v % 3) / 3.0f};
+    CHECK(colors && gdr_scene_set_mesh_colors(demo, 1, colors, &err) == GDR_OK);
+    free(colors);
     if (demo) {
         test_round_trip_and_corruption("demo", demo);
         test_unknown_sections(demo);

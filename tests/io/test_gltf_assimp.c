@@ -70,6 +70,7 @@ static void collect(void *user, const char *message)
 typedef struct expected {
     uint32_t instances, meshes, cameras, materials;
     uint8_t used[4096]; /* (mesh, primitive) pairs seen, mesh * 16 + primitive */
+    int default_material; /* an instanced triangle primitive has no material: glTF's default one is added */
 } expected;
 
 static int triangle_primitive(const cJSON *prim)
@@ -91,6 +92,7 @@ static void walk(const cJSON *root, int node, expected *e)
             if (!triangle_primitive(prim))
                 continue;
             e->instances++;
+            e->default_material |= cJSON_GetObjectItem(prim, "material") == NULL;
             int key = mesh->valueint * 16 + p;
             if (key < 4096 && !e->used[key]) {
                 e->used[key] = 1;
@@ -138,7 +140,7 @@ static int expected_counts(const char *path, expected *e)
     for (const cJSON *n = s && cJSON_GetObjectItem(s, "nodes") ? cJSON_GetObjectItem(s, "nodes")->child : NULL; n;
          n = n->next)
         walk(root, n->valueint, e);
-    e->materials = (uint32_t)cJSON_GetArraySize(cJSON_GetObjectItem(root, "materials"));
+    e->materials = (uint32_t)cJSON_GetArraySize(cJSON_GetObjectItem(root, "materials")) + (e->default_material ? 1u : 0u);
     cJSON_Delete(root);
     return 1;
 }
