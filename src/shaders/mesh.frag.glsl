@@ -33,20 +33,21 @@ layout(location = 0) out vec4 out_color;
 
 void main()
 {
-    GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
+    FrameGlobalsRef g = FrameGlobalsRef(push.globals); // fields read where used, not copied per fragment
     GdrSurfacePoint p = GdrSurfacePoint(in_world_position, in_normal, in_uv, in_vertex_color * in_color, dFdx(in_uv),
                                         dFdy(in_uv), dFdx(in_world_position), dFdy(in_world_position));
 #ifdef GDR_ALPHA_TEST
     // Scenes with double-sided materials draw without the pipeline's back-face culling: the back
     // faces of the single-sided ones are dropped here.
-    if (!gl_FrontFacing && !gdr_material_double_sided(g, in_material))
+    if (!gl_FrontFacing && !gdr_material_double_sided(g.value.flags, in_material))
         discard;
-    if (!gdr_material_keeps(MaterialsRef(GDR_SCENE.materials).items[in_material], p, uvec2(gl_FragCoord.xy)))
+    if (!gdr_material_keeps(in_material, p, uvec2(gl_FragCoord.xy)))
         discard;
 #endif
     p.normal = gl_FrontFacing ? p.normal : -p.normal; // a double-sided material's back face
-    if (g.view_mode == GDR_VIEW_OVERDRAW) // fragments that passed the depth test (alpha variants: every one kept)
-        atomicAdd(OverdrawRef(GDR_FRAME.overdraw).items[uint(gl_FragCoord.y) * uint(g.viewport.x) + uint(gl_FragCoord.x)], 1u);
-    out_color = g.view_mode == GDR_VIEW_SHADED ? gdr_shade_material(in_material, p, g)
-                                               : gdr_shade(g.light_direction.xyz, in_normal, in_world_position, in_color.rgb);
+    if (g.value.view_mode == GDR_VIEW_OVERDRAW) // fragments that passed the depth test (alpha variants: every one kept)
+        atomicAdd(OverdrawRef(GDR_FRAME.overdraw).items[uint(gl_FragCoord.y) * uint(g.value.viewport.x) + uint(gl_FragCoord.x)], 1u);
+    out_color = g.value.view_mode == GDR_VIEW_SHADED
+                    ? gdr_shade_material(in_material, p, g)
+                    : gdr_shade(g.value.light_direction.xyz, in_normal, in_world_position, in_color.rgb);
 }

@@ -29,7 +29,7 @@ void main()
     out_world_position = world.xyz;
     out_uv = in_uv;
     out_material = instance.material;
-    out_vertex_color = gdr_vertex_color(g, instance.mesh, gl_VertexIndex); // gl_VertexIndex counts the draw's vertexOffset
+    out_vertex_color = gdr_vertex_color(g.flags, instance.mesh, gl_VertexIndex); // gl_VertexIndex counts the draw's vertexOffset
     out_color = g.view_mode == GDR_VIEW_INSTANCES ? vec4(gdr_id_color(gl_InstanceIndex), 1.0)
               : g.view_mode == GDR_VIEW_LOD    ? vec4(gdr_depth_color(0), 1.0) // full detail: depth 0
                                                : instance.color;

@@ -111,14 +111,14 @@ void main()
         // The visibility buffer's fragments need the attributes only to alpha-test.
         if ((g.flags & GDR_FRAME_ALPHA_TEST) != 0u)
 #endif
-            out_vertex_color[v] = gdr_vertex_color(g, instance.mesh, vertex_index);
+            out_vertex_color[v] = gdr_vertex_color(g.flags, instance.mesh, vertex_index);
         vec2 ndc = clip.xy / clip.w;
         screen[v] = vec3((ndc * 0.5 + 0.5) * g.viewport, clip.w);
     }
     barrier();
 
     bool cull = g.cull_enabled != 0u && (g.flags & GDR_FRAME_TRIANGLE_CULL) != 0u;
-    bool double_sided = gdr_material_double_sided(g, instance.material);
+    bool double_sided = gdr_material_double_sided(g.flags, instance.material);
     uint emitted = 0u, backfacing = 0u, small = 0u;
     for (uint t = lane; t < meshlet.triangle_count; t += GDR_MESH_WORKGROUP_SIZE) {
         uint at = meshlet.triangle_offset + t * 3u;

@@ -28,16 +28,15 @@ layout(location = 6) in vec4 in_vertex_color;
 // faces in scenes with double-sided materials: single-sided ones are dropped here.
 bool kept(GdrGpuFrameGlobals g)
 {
-    if (!gl_FrontFacing && !gdr_material_double_sided(g, in_material))
+    if (!gl_FrontFacing && !gdr_material_double_sided(g.flags, in_material))
         return false;
-    if (!gdr_material_alpha_tested(g, in_material))
+    if (!gdr_material_alpha_tested(g.flags, in_material))
         return true;
-    GdrGpuMaterial m = MaterialsRef(GDR_SCENE.materials).items[in_material];
     GdrGpuRasterCluster entry =
         RasterClustersRef(RasterParamsRef(GDR_FRAME.raster).value.clusters).items[in_visibility_id >> GDR_VISBUFFER_TRIANGLE_BITS];
     vec4 color = in_vertex_color * InstancesRef(GDR_SCENE.instances).items[entry.instance].color;
     GdrSurfacePoint p = GdrSurfacePoint(vec3(0.0), vec3(0.0), in_uv, color, dFdx(in_uv), dFdy(in_uv), vec3(0.0), vec3(0.0));
-    return gdr_material_keeps(m, p, uvec2(gl_FragCoord.xy));
+    return gdr_material_keeps(in_material, p, uvec2(gl_FragCoord.xy));
 }
 #endif
 

@@ -85,16 +85,16 @@ vec4 shade_pixel(FrameGlobalsRef globals, vec2 viewport, vec2 centre, uint id)
     vec3 by = barycentrics(x_row, y_row + (2.0 / viewport.y) * w_row) - b;
     vec4 color = instance.color;
     if ((globals.value.flags & GDR_FRAME_VERTEX_COLORS) != 0u)
-        color *= b.x * gdr_vertex_color(globals.value, instance.mesh, vertex_index[0]) +
-                 b.y * gdr_vertex_color(globals.value, instance.mesh, vertex_index[1]) +
-                 b.z * gdr_vertex_color(globals.value, instance.mesh, vertex_index[2]);
+        color *= b.x * gdr_vertex_color(globals.value.flags, instance.mesh, vertex_index[0]) +
+                 b.y * gdr_vertex_color(globals.value.flags, instance.mesh, vertex_index[1]) +
+                 b.z * gdr_vertex_color(globals.value.flags, instance.mesh, vertex_index[2]);
     // A back face (only double-sided materials draw them) is shaded with the normal reversed; the
     // winding seen from the eye decides, as the rasteriser's facing does.
     vec3 geometric = cross(world[1] - world[0], world[2] - world[0]);
     if (dot(geometric, globals.value.eye_position.xyz - position) < 0.0)
         n = -n;
     GdrSurfacePoint point = GdrSurfacePoint(position, n, uvs * b, color, uvs * bx, uvs * by, world * bx, world * by);
-    return gdr_shade_material(instance.material, point, globals.value);
+    return gdr_shade_material(instance.material, point, globals);
 }
 
 void main()

@@ -124,7 +124,7 @@ GdrClusterResult gdr_cluster_test_command(GdrGpuFrameGlobals g, uint phase, GdrG
     }
     mat3 linear = mat3(model);
     if (!retest && visible && cull && (g.flags & GDR_FRAME_MESHLET_CONE) != 0u && determinant(linear) > 0.0 &&
-        !gdr_material_double_sided(g, instance.material)) {
+        !gdr_material_double_sided(g.flags, instance.material)) {
         vec3 camera = inverse(linear) * (g.camera_position.xyz - model[3].xyz);
         result.cone_culled = gdr_cone_backfacing(meshlet.cone_apex, meshlet.cone_axis, meshlet.cone_cutoff, camera);
         visible = !result.cone_culled;

@@ -36,9 +36,9 @@ struct GdrSurface {
 
 /* The vertex colour of vertex `vertex` (an index into GdrGpuScene.vertices) of mesh `mesh`; white
  * without reading anything in frames of scenes without vertex colours. */
-vec4 gdr_vertex_color(GdrGpuFrameGlobals g, uint mesh, uint vertex)
+vec4 gdr_vertex_color(uint frame_flags, uint mesh, uint vertex)
 {
-    if ((g.flags & GDR_FRAME_VERTEX_COLORS) == 0u)
+    if ((frame_flags & GDR_FRAME_VERTEX_COLORS) == 0u)
         return vec4(1.0);
     uint first = UintsRef(GDR_SCENE.mesh_color_offsets).items[mesh];
     if (first == GDR_GPU_NO_COLORS)
@@ -56,26 +56,34 @@ vec4 gdr_texture_sample(GdrGpuTextureRef t, vec2 uv, vec2 dx, vec2 dy)
                        t.offset + m * uv, m * dx, m * dy);
 }
 
-vec4 gdr_texture_or(GdrGpuTextureRef t, GdrSurfacePoint p, vec4 absent)
+/* Material `i`'s fields are read through the buffer reference one by one, where they are used:
+ * a local copy of the whole GdrGpuMaterial (224 bytes) may cost its full load per pixel. */
+#define GDR_MATERIAL(i) MaterialsRef(GDR_SCENE.materials).items[i]
+
+/* Texture k of material `material` at point p, or `absent` when the material has none. */
+vec4 gdr_material_texture(uint material, int k, GdrSurfacePoint p, vec4 absent)
 {
-    return t.texture == GDR_GPU_NO_TEXTURE ? absent : gdr_texture_sample(t, p.uv, p.duv_dx, p.duv_dy);
+    if (GDR_MATERIAL(material).textures[k].texture == GDR_GPU_NO_TEXTURE)
+        return absent;
+    return gdr_texture_sample(GDR_MATERIAL(material).textures[k], p.uv, p.duv_dx, p.duv_dy);
 }
 
 /* Base colour and alpha only: what the alpha test needs. */
-vec4 gdr_material_base_color(GdrGpuMaterial m, GdrSurfacePoint p)
+vec4 gdr_material_base_color(uint material, GdrSurfacePoint p)
 {
-    return m.base_color * p.color * gdr_texture_or(m.textures[GDR_MATERIAL_BASE_COLOR], p, vec4(1.0));
+    return GDR_MATERIAL(material).base_color * p.color * gdr_material_texture(material, GDR_MATERIAL_BASE_COLOR, p, vec4(1.0));
 }
 
-/* Whether material m keeps point p: MASK keeps alpha >= cutoff; BLEND is drawn as an ordered
- * dither (screen-door transparency: a 4x4 Bayer threshold per pixel), OPAQUE keeps everything. */
-bool gdr_material_keeps(GdrGpuMaterial m, GdrSurfacePoint p, uvec2 pixel)
+/* Whether material `material` keeps point p: MASK keeps alpha >= cutoff; BLEND is drawn as an
+ * ordered dither (screen-door transparency: a 4x4 Bayer threshold per pixel), OPAQUE keeps everything. */
+bool gdr_material_keeps(uint material, GdrSurfacePoint p, uvec2 pixel)
 {
-    if (m.alpha_mode == GDR_ALPHA_MODE_OPAQUE)
+    uint mode = GDR_MATERIAL(material).alpha_mode;
+    if (mode == GDR_ALPHA_MODE_OPAQUE)
         return true;
-    float alpha = gdr_material_base_color(m, p).a;
-    if (m.alpha_mode == GDR_ALPHA_MODE_MASK)
-        return alpha >= m.alpha_cutoff;
+    float alpha = gdr_material_base_color(material, p).a;
+    if (mode == GDR_ALPHA_MODE_MASK)
+        return alpha >= GDR_MATERIAL(material).alpha_cutoff;
     const uint bayer[16] = uint[16](0u, 8u, 2u, 10u, 12u, 4u, 14u, 6u, 3u, 11u, 1u, 9u, 15u, 7u, 13u, 5u);
     return alpha > (float(bayer[(pixel.y & 3u) * 4u + (pixel.x & 3u)]) + 0.5) / 16.0;
 }
@@ -83,10 +91,9 @@ bool gdr_material_keeps(GdrGpuMaterial m, GdrSurfacePoint p, uvec2 pixel)
 /* The per-triangle tangent frame from the derivatives (the tangent along +u, orthogonalised against
  * the normal; the bitangent's sign from the direction of -v, glTF's "up" in the image), and the
  * normal texture's direction in it. Without usable derivatives the normal stays. */
-vec3 gdr_apply_normal_map(GdrGpuMaterial m, GdrSurfacePoint p, vec3 n)
+vec3 gdr_apply_normal_map(uint material, GdrSurfacePoint p, vec3 n)
 {
-    GdrGpuTextureRef t = m.textures[GDR_MATERIAL_NORMAL];
-    if (t.texture == GDR_GPU_NO_TEXTURE)
+    if (GDR_MATERIAL(material).textures[GDR_MATERIAL_NORMAL].texture == GDR_GPU_NO_TEXTURE)
         return n;
     float det = p.duv_dx.x * p.duv_dy.y - p.duv_dx.y * p.duv_dy.x;
     vec3 dp_du = p.dp_dx * p.duv_dy.y - p.dp_dy * p.duv_dx.y;
@@ -98,35 +105,35 @@ vec3 gdr_apply_normal_map(GdrGpuMaterial m, GdrSurfacePoint p, vec3 n)
     vec3 bitangent = cross(n, tangent);
     if (dot(bitangent, dp_dv) * sign(det) > 0.0)
         bitangent = -bitangent;
-    vec3 texel = gdr_texture_sample(t, p.uv, p.duv_dx, p.duv_dy).xyz * 2.0 - 1.0;
-    texel.xy *= m.normal_scale;
+    vec3 texel = gdr_material_texture(material, GDR_MATERIAL_NORMAL, p, vec4(0.5, 0.5, 1.0, 1.0)).xyz * 2.0 - 1.0;
+    texel.xy *= GDR_MATERIAL(material).normal_scale;
     return normalize(mat3(tangent, bitangent, n) * texel);
 }
 
 GdrSurface gdr_material_surface(uint material, GdrSurfacePoint p)
 {
-    GdrGpuMaterial m = MaterialsRef(GDR_SCENE.materials).items[material];
     GdrSurface s;
-    s.base_color = gdr_material_base_color(m, p);
-    vec4 mr = gdr_texture_or(m.textures[GDR_MATERIAL_METALLIC_ROUGHNESS], p, vec4(1.0));
-    s.metallic = clamp(m.metallic * mr.b, 0.0, 1.0);
-    s.roughness = clamp(m.roughness * mr.g, 0.0, 1.0);
-    float occlusion = gdr_texture_or(m.textures[GDR_MATERIAL_OCCLUSION], p, vec4(1.0)).r;
-    s.occlusion = 1.0 + m.occlusion_strength * (occlusion - 1.0);
-    s.emissive = m.emissive * gdr_texture_or(m.textures[GDR_MATERIAL_EMISSIVE], p, vec4(1.0)).rgb;
+    s.base_color = gdr_material_base_color(material, p);
+    vec4 mr = gdr_material_texture(material, GDR_MATERIAL_METALLIC_ROUGHNESS, p, vec4(1.0));
+    s.metallic = clamp(GDR_MATERIAL(material).metallic * mr.b, 0.0, 1.0);
+    s.roughness = clamp(GDR_MATERIAL(material).roughness * mr.g, 0.0, 1.0);
+    float occlusion = gdr_material_texture(material, GDR_MATERIAL_OCCLUSION, p, vec4(1.0)).r;
+    s.occlusion = 1.0 + GDR_MATERIAL(material).occlusion_strength * (occlusion - 1.0);
+    s.emissive = GDR_MATERIAL(material).emissive * gdr_material_texture(material, GDR_MATERIAL_EMISSIVE, p, vec4(1.0)).rgb;
     float length2 = dot(p.normal, p.normal);
     vec3 n = length2 > 0.0 ? p.normal * inversesqrt(length2) : vec3(0.0, 1.0, 0.0);
-    s.normal = gdr_apply_normal_map(m, p, n);
+    s.normal = gdr_apply_normal_map(material, p, n);
     return s;
 }
 
-/* The shaded view's colour of point p with material `material` under frame g's light and camera. */
-vec4 gdr_shade_material(uint material, GdrSurfacePoint p, GdrGpuFrameGlobals g)
+/* The shaded view's colour of point p with material `material` under the frame's light and camera
+ * (read through the reference: a copy of the globals would load all of them per pixel). */
+vec4 gdr_shade_material(uint material, GdrSurfacePoint p, FrameGlobalsRef g)
 {
     GdrSurface s = gdr_material_surface(material, p);
-    vec3 v = normalize(g.eye_position.xyz - p.position);
+    vec3 v = normalize(g.value.eye_position.xyz - p.position);
     return gdr_shade_surface(s.base_color.rgb, s.normal, s.metallic, s.roughness, s.occlusion, s.emissive,
-                             g.light_direction.xyz, v);
+                             g.value.light_direction.xyz, v);
 }
 
 #endif

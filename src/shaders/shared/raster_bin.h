@@ -72,7 +72,7 @@ void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint m
         // fragments sample the mask and whose pipelines then cull back faces per material.
         if (sw && (g.flags & (GDR_FRAME_ALPHA_TEST | GDR_FRAME_DOUBLE_SIDED)) != 0u) {
             uint material = InstancesRef(GDR_SCENE.instances).items[instance].material;
-            sw = !gdr_material_alpha_tested(g, material) && !gdr_material_double_sided(g, material);
+            sw = !gdr_material_alpha_tested(g.flags, material) && !gdr_material_double_sided(g.flags, material);
         }
     }
     bool hw = visible && !sw;
