@@ -410,19 +410,20 @@ static int build_region(const lod_build *b, lod_scratch *s)
     for (size_t i = 0; i < n; i++)
         if (i == 0 || s->region_refs[i] != s->region_refs[i - 1])
             s->region_refs[unique++] = s->region_refs[i];
-    if (!LOD_RESERVE(s, region_positions, unique * 9 + 1) || !LOD_RESERVE(s, region_corners, unique * 3 + 1))
+    /* The triangles' corners as mesh vertex indices, over the mesh's own positions: a group near the
+     * DAG's root gathers most of the mesh, and a copy of its corners' positions would cost each
+     * worker 36 bytes per level-0 triangle. */
+    if (!LOD_RESERVE(s, region_corners, unique * 3 + 1))
         return 0;
     for (size_t i = 0; i < unique; i++) {
         const gdr_cluster *c = &b->clusters[s->region_refs[i] >> 7];
         const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(s->region_refs[i] & 127) * 3;
         const uint32_t *v = gdr_lod_cluster_vertices(b, c);
-        for (int k = 0; k < 3; k++) {
-            memcpy(s->region_positions + i * 9 + (size_t)k * 3, &b->mesh->positions[v[t[k]]], sizeof(gdr_vec3));
-            s->region_corners[i * 3 + (size_t)k] = (uint32_t)(i * 3 + (size_t)k);
-        }
+        for (int k = 0; k < 3; k++)
+            s->region_corners[i * 3 + (size_t)k] = v[t[k]];
     }
     s->region_built = 1;
-    return lod_triangle_grid_build(&s->region_grid, s->region_positions, s->region_corners, (uint32_t)unique);
+    return lod_triangle_grid_build(&s->region_grid, &b->mesh->positions[0].x, s->region_corners, (uint32_t)unique);
 }
 
 /* What probing a group's simplified triangles needs. */

@@ -268,6 +268,5 @@ void gdr_lod_scratch_free(lod_scratch *s)
     lod_triangle_grid_free(&s->region_grid);
     free(s->region_refs);
     free(s->region_corners);
-    free(s->region_positions);
     free(s->coarse_d2);
 }

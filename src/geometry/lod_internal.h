@@ -72,8 +72,6 @@ typedef struct lod_scratch {
     lod_triangle_grid triangle_grid;
     uint32_t *region_refs, *region_corners; /* level-0 triangles around the group's samples */
     size_t region_refs_cap, region_corners_cap;
-    float *region_positions;
-    size_t region_positions_cap;
     lod_triangle_grid region_grid;
     int region_built;
     float *coarse_d2; /* per simplified triangle: its largest coarse probe distance, squared */
