@@ -234,6 +234,26 @@ typedef struct gdr_streaming_stats {
     uint64_t absent_groups;
     uint32_t requests;
     uint32_t requests_dropped;
+    /* A scene set with gdr_renderer_set_scene_streamed (docs/STREAMING.md); zero otherwise. Counts of
+     * the last frame, unless said otherwise. */
+    bool enabled;
+    uint64_t pool_bytes;          /* the page pool: slot_count slots of slot_bytes */
+    uint32_t slot_count, slot_bytes;
+    uint64_t resident_bytes;      /* slots holding a page or planned for one */
+    uint32_t resident_pages;
+    uint32_t groups_used;         /* distinct groups the cut drew (read back a frame or two later) */
+    uint32_t distinct_requests;   /* distinct pages asked for */
+    uint32_t loads;               /* pages planned for loading */
+    uint32_t uploads;             /* pages copied into the pool */
+    uint64_t upload_bytes;        /* bytes copied for them (page data and cluster records) */
+    uint32_t evictions;
+    uint32_t deferred;            /* requests left for later frames (upload budget or no free slot) */
+    uint32_t pending;             /* pages being read or waiting for upload room */
+    uint32_t frames_since_change; /* frames since a page last arrived or left */
+    uint64_t uploads_total, upload_bytes_total, evictions_total; /* since the scene was set */
+    uint64_t evicted_in_use;      /* debug counter: evictions of a page the latest cut used; always 0 */
+    uint32_t pages_refused;       /* damaged pages so far (their groups stay absent) */
+    char refused[GDR_ERROR_MESSAGE_MAX];          /* the last refused page's message (file, mesh, page, why) */
 } gdr_streaming_stats;
 
 /* GPU memory: what the renderer holds from the device (whole blocks), and of what it placed in
@@ -300,6 +320,33 @@ GDR_API void gdr_renderer_destroy(gdr_renderer *renderer);
 /* Uploads the scene's geometry into the geometry pool and its instances into the instance buffer.
  * The renderer keeps no pointer into `scene`. */
 GDR_API gdr_status gdr_renderer_set_scene(gdr_renderer *renderer, const gdr_scene *scene, gdr_error *err);
+
+/* Streaming (docs/STREAMING.md): the clusters' vertices and triangles live in a page pool of fixed
+ * size instead of being uploaded whole; the pages of a paged cache of the same scene are read by a
+ * loader thread as the frames' cuts ask for them and copied into the pool within a per-frame upload
+ * budget; where a group is absent the cut draws the resident group above it (never a hole, never a
+ * crack). Frames must use the mesh pipeline and a LOD cut by error (lod_error_px > 0). */
+typedef struct gdr_streaming_desc {
+    const char *cache_path;         /* the scene's cache, written with gdr_cache_write_options.page_bytes */
+    uint64_t geometry_budget_bytes; /* the page pool; 0: a quarter of the device-local heap; at most 4 GiB */
+    uint64_t upload_budget_bytes;   /* copied into the pool per frame at most (at least one page); 0: 16 MiB */
+    bool wait_for_loads;            /* each frame waits for the pages it planned (deterministic: tests) */
+} gdr_streaming_desc;
+
+#define GDR_GEOMETRY_BUDGET_MAX (4ull << 30)
+#define GDR_UPLOAD_BUDGET_DEFAULT (16ull << 20)
+
+/* gdr_renderer_set_scene with streaming: only the scene's cluster records, LOD hierarchy and page
+ * table are uploaded; geometry arrives page by page. `scene` must be the one the cache at
+ * desc->cache_path was written from (checked: meshes, groups and clusters per page) and must stay
+ * alive, unchanged, until the renderer is destroyed (the renderer reads its LOD hierarchy). */
+GDR_API gdr_status gdr_renderer_set_scene_streamed(gdr_renderer *renderer, const gdr_scene *scene,
+                                                   const gdr_streaming_desc *desc, gdr_error *err);
+
+/* Streaming: which groups of mesh `mesh` the last frame could draw (group_resident[g], one byte per
+ * group of the mesh's clusters.groups). */
+GDR_API gdr_status gdr_renderer_read_residency(gdr_renderer *renderer, uint32_t mesh, uint8_t *group_resident,
+                                               gdr_error *err);
 
 /* Changes an instance's transform and colour; sent to the GPU through the instance ring with the
  * next frame (at most GDR_INSTANCE_UPDATES_PER_FRAME records per frame; more wait for later frames). */

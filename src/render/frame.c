@@ -27,7 +27,8 @@ static GdrGpuFrameBuffers frame_buffers(const gdr_renderer *r, const gdr_frame_s
         .raster = r->vis.params[slot - r->slots].address, .traversal = r->scene.traversal.address,
         .occluded_instances = r->occlusion.occluded_instances.address,
         .occluded_nodes = r->occlusion.occluded_nodes.address, .retest_masks = r->occlusion.retest_masks.address,
-        .stream_requests = r->scene.stream_requests.address};
+        .stream_requests = slot->stream_requests.address,
+        .used_groups = slot->used_groups.address};
 }
 
 static uint32_t frame_flags(const gdr_frame_desc *frame, bool lod, bool occlusion, bool history, bool hierarchy)
@@ -93,6 +94,7 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .min_screen_size = frame->min_screen_size,
         .clip_plane = frame->clip_plane,
         .screen_scale = fmaxf(fabsf(projection.m[0]), fabsf(projection.m[5])),
+        .stream_frame = slot->stream_frame,
         .eye_position = {camera->position.x, camera->position.y, camera->position.z, 1.0f},
     };
     gdr_occlusion_params(r, &projection, camera->znear, &globals.occlusion);
@@ -205,13 +207,19 @@ gdr_status gdr_frame_record_color_readback(gdr_renderer *r, VkCommandBuffer cmd,
     return GDR_OK;
 }
 
-/* Submits the slot's frame and, when `copy_color`, the colour readback after it. */
+/* Submits the slot's frame: streaming's copies before it where it has some, the colour readback
+ * after it when `copy_color`. */
 static gdr_status submit(gdr_renderer *r, gdr_frame_slot *slot, bool copy_color, double *submit_ms, gdr_error *err)
 {
-    VkCommandBufferSubmitInfo cmd_info[2] = {
-        {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO, .commandBuffer = slot->cmd},
-        {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO, .commandBuffer = slot->readback_cmd}};
-    VkSubmitInfo2 submit = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2, .commandBufferInfoCount = copy_color ? 2 : 1,
+    VkCommandBufferSubmitInfo cmd_info[3];
+    uint32_t count = 0;
+    VkCommandBuffer buffers[3] = {slot->stream_copies ? slot->stream_cmd : VK_NULL_HANDLE, slot->cmd,
+                                  copy_color ? slot->readback_cmd : VK_NULL_HANDLE};
+    for (int i = 0; i < 3; i++)
+        if (buffers[i])
+            cmd_info[count++] = (VkCommandBufferSubmitInfo){.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO,
+                                                            .commandBuffer = buffers[i]};
+    VkSubmitInfo2 submit = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2, .commandBufferInfoCount = count,
                             .pCommandBufferInfos = cmd_info};
     uint32_t query_base = (uint32_t)(slot - r->slots) * GDR_FRAME_MAX_TIMESTAMPS;
     vkResetQueryPool(r->ctx->device, r->timestamps, query_base, GDR_FRAME_MAX_TIMESTAMPS);

@@ -189,13 +189,16 @@ void gdr_frame_plan_derive(gdr_frame_plan *plan)
 }
 
 /* The frame's end: the images back in the layouts the next frame and the read-backs expect, the
- * counters' copies visible to the host. */
+ * counters' copies and the lists written with the counters visible to the host. */
 const gdr_pass_template gdr_frame_end_template = {
     .name = "frame_end",
-    .what = "images back in their home layouts; the counters' copies visible to the host",
+    .what = "images back in their home layouts; the counters' copies and the host-read lists visible to the host",
     .uses = {
         {GDR_RES_COLOR, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL},
         {GDR_RES_DEPTH, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL},
         {GDR_RES_READBACK, VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT},
+        /* The lists the host reads in place (streaming's requests and groups used), written with the
+         * counters. */
+        {GDR_RES_DRAW_STATS, VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT},
     },
 };

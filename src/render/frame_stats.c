@@ -77,7 +77,10 @@ static void fill_mesh(const gdr_renderer *r, const gdr_frame_slot *slot, const G
     stats->task_overflow = gpu->task_overflow;
     fill_traversal(slot, gpu, &stats->traversal);
     uint32_t kept = gpu->stream_requests < GDR_STREAM_REQUEST_CAPACITY ? gpu->stream_requests : GDR_STREAM_REQUEST_CAPACITY;
-    stats->streaming = (gdr_streaming_stats){r->scene.absent_groups, kept, gpu->stream_requests - kept};
+    stats->streaming = r->stream.stats;
+    stats->streaming.absent_groups = r->scene.absent_groups;
+    stats->streaming.requests = kept;
+    stats->streaming.requests_dropped = gpu->stream_requests - kept;
     stats->lod.applied = slot->lod_applied;
     stats->lod.meshlets_culled = gpu->meshlets_lod_culled;
     for (uint32_t d = 0; d < GDR_LOD_STATS_DEPTH_COUNT; d++) {

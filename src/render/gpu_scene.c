@@ -113,6 +113,10 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
     if (meshlet_total > UINT32_MAX / 2 || vertex_total > UINT32_MAX / 2 || byte_total > UINT32_MAX / 2)
         return gdr_error_set(err, GDR_ERROR_CAPACITY, "scene: %llu clusters exceed the cluster pool's 32-bit offsets",
                              (unsigned long long)meshlet_total);
+    /* Streamed: the clusters' vertex lists and triangles arrive with their pages (streaming.c), which
+     * set the records' offsets; until then no record is drawn (its group is absent). */
+    if (g->streamed)
+        vertex_total = byte_total = 0;
     uint64_t word_total = (byte_total + 3) / 4;
     GdrGpuMeshlet *meshlets = calloc(meshlet_total ? meshlet_total : 1, sizeof *meshlets);
     uint32_t *vertex_refs = malloc(sizeof(uint32_t) * (vertex_total ? vertex_total : 1));
@@ -133,13 +137,15 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
             meshlets[meshlet_cursor + i] = gpu_meshlet_from(c, i, vertex_cursor, byte_cursor);
         if (c->group_count > 0)
             set_root_shortcut(c, mesh);
+        meshlet_cursor += c->cluster_count;
+        if (g->streamed)
+            continue;
         for (uint32_t v = 0; v < c->vertex_count; v++)
             vertex_refs[vertex_cursor + v] = mesh->vertex_offset + c->vertices[v];
         for (uint32_t b = 0; b < c->triangle_byte_count; b++) {
             uint32_t at = byte_cursor + b;
             words[at / 4] |= (uint32_t)c->triangles[b] << (8 * (at % 4));
         }
-        meshlet_cursor += c->cluster_count;
         vertex_cursor += c->vertex_count;
         byte_cursor += c->triangle_byte_count;
     }
@@ -155,18 +161,18 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
     if (status == GDR_OK)
         status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuMeshlet) * (meshlet_total ? meshlet_total : 1), usage,
                                       GDR_VK_BUFFER_DEVICE, &g->meshlets, err);
-    if (status == GDR_OK)
+    if (status == GDR_OK && !g->streamed)
         status = gdr_vk_buffer_create(&r->allocator, sizeof(uint32_t) * (vertex_total ? vertex_total : 1), usage,
                                       GDR_VK_BUFFER_DEVICE, &g->meshlet_vertices, err);
-    if (status == GDR_OK)
+    if (status == GDR_OK && !g->streamed)
         status = gdr_vk_buffer_create(&r->allocator, sizeof(uint32_t) * (word_total ? word_total : 1), usage,
                                       GDR_VK_BUFFER_DEVICE, &g->meshlet_triangles, err);
     if (status == GDR_OK)
         status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->meshlets, 0, meshlets, sizeof(GdrGpuMeshlet) * meshlet_total, err);
-    if (status == GDR_OK)
+    if (status == GDR_OK && !g->streamed)
         status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->meshlet_vertices, 0, vertex_refs,
                                       sizeof(uint32_t) * vertex_total, err);
-    if (status == GDR_OK)
+    if (status == GDR_OK && !g->streamed)
         status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->meshlet_triangles, 0, words, sizeof(uint32_t) * word_total, err);
     if (status == GDR_OK) {
         g->cpu_meshlets = meshlets; /* kept for references and statistics */
@@ -291,6 +297,8 @@ static void merge_geometry(gdr_renderer *r, const gdr_scene *scene, GdrGpuVertex
         const gdr_mesh *mesh = &scene->meshes[m];
         g->cpu_meshes[m] = (GdrGpuMesh){.vertex_offset = vertex_cursor, .first_index = index_cursor,
                                         .index_count = mesh->index_count, .bounds = mesh->bounds};
+        if (g->streamed) /* no vertex pipeline: the vertices come with the pages */
+            continue;
         for (uint32_t v = 0; v < mesh->vertex_count; v++)
             vertices[vertex_cursor + v] = (GdrGpuVertex){mesh->positions[v], mesh->normals[v], mesh->uvs[v]};
         memcpy(indices + index_cursor, mesh->indices, sizeof(uint32_t) * mesh->index_count);
@@ -315,6 +323,8 @@ gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
         return gdr_error_set(err, GDR_ERROR_CAPACITY, "scene: %llu vertices / %llu indices exceed the geometry pool's "
                              "32-bit offsets", (unsigned long long)vertex_total, (unsigned long long)index_total);
 
+    if (g->streamed)
+        vertex_total = index_total = 0;
     GdrGpuVertex *vertices = malloc(sizeof *vertices * (vertex_total ? vertex_total : 1));
     uint32_t *indices = malloc(sizeof *indices * (index_total ? index_total : 1));
     g->cpu_meshes = calloc(scene->mesh_count ? scene->mesh_count : 1, sizeof *g->cpu_meshes);
@@ -327,10 +337,12 @@ gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
     merge_geometry(r, scene, vertices, indices);
 
     const VkBufferUsageFlags dst = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-    gdr_status status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuVertex) * vertex_total,
-                                             dst | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                             GDR_VK_BUFFER_DEVICE, &g->vertices, err);
-    if (status == GDR_OK)
+    gdr_status status = GDR_OK;
+    if (!g->streamed)
+        status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuVertex) * vertex_total,
+                                      dst | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                      GDR_VK_BUFFER_DEVICE, &g->vertices, err);
+    if (status == GDR_OK && !g->streamed)
         status = gdr_vk_buffer_create(&r->allocator, sizeof(uint32_t) * index_total,
                                       dst | VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                       GDR_VK_BUFFER_DEVICE, &g->indices, err);
@@ -362,9 +374,9 @@ gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
     if (status == GDR_OK)
         status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuInstance) * g->instance_count,
                                       dst | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GDR_VK_BUFFER_DEVICE, &g->instances, err);
-    if (status == GDR_OK)
+    if (status == GDR_OK && !g->streamed)
         status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->vertices, 0, vertices, sizeof(GdrGpuVertex) * vertex_total, err);
-    if (status == GDR_OK)
+    if (status == GDR_OK && !g->streamed)
         status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->indices, 0, indices, sizeof(uint32_t) * index_total, err);
     if (status == GDR_OK)
         status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->meshes, 0, g->cpu_meshes, sizeof(GdrGpuMesh) * g->mesh_count, err);
@@ -379,10 +391,14 @@ gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
 gdr_status gdr_gpu_scene_write_refs(gdr_renderer *r, gdr_error *err)
 {
     gdr_gpu_scene *g = &r->scene;
+    /* Streamed: a page's vertices, vertex list and triangles lie in its pool slot, addressed from the
+     * pool's start by all three references (streaming.c). */
+    VkDeviceAddress pool = r->stream.pool.address;
     GdrGpuScene refs = {.instances = g->instances.address, .meshes = g->meshes.address,
-                        .vertices = g->vertices.address, .meshlets = g->meshlets.address,
-                        .meshlet_vertices = g->meshlet_vertices.address,
-                        .meshlet_triangles = g->meshlet_triangles.address,
+                        .vertices = g->streamed ? pool : g->vertices.address, .meshlets = g->meshlets.address,
+                        .meshlet_vertices = g->streamed ? pool : g->meshlet_vertices.address,
+                        .meshlet_triangles = g->streamed ? pool : g->meshlet_triangles.address,
+                        .group_stamps = g->group_stamps.address,
                         .lod_nodes = g->lod_nodes.address, .page_table = g->page_table.address,
                         .node_absent_refined = g->node_absent_refined.address,
                         .materials = r->materials.buffer.address,
@@ -395,7 +411,7 @@ gdr_status gdr_gpu_scene_write_refs(gdr_renderer *r, gdr_error *err)
         status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->refs, 0, &refs, sizeof refs, err);
     const gdr_vk_buffer *buffers[] = {&g->vertices, &g->indices, &g->meshes, &g->instances, &g->meshlets,
                                       &g->meshlet_vertices, &g->meshlet_triangles, &g->refs, &g->page_table,
-                                      &g->node_absent_refined, &g->stream_requests,
+                                      &g->node_absent_refined, &g->group_stamps, &r->stream.pool,
                                       &r->occlusion.occluded_instances, &r->occlusion.occluded_nodes,
                                       &r->occlusion.retest_masks};
     g->bytes = r->materials.bytes;
@@ -462,6 +478,16 @@ gdr_status gdr_frame_slots_create(gdr_renderer *r, gdr_error *err)
         if (status == GDR_OK)
             status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuDrawStats), VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                           GDR_VK_BUFFER_READBACK, &slot->stats_readback, err);
+        if (status == GDR_OK)
+            status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuStreamRequest) * GDR_STREAM_REQUEST_CAPACITY,
+                                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GDR_VK_BUFFER_READBACK,
+                                          &slot->stream_requests, err);
+        if (status == GDR_OK) /* each group once at most: cannot overflow */
+            status = gdr_vk_buffer_create(&r->allocator, sizeof(uint32_t) * (r->scene.group_total ? r->scene.group_total : 1),
+                                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GDR_VK_BUFFER_READBACK,
+                                          &slot->used_groups, err);
+        if (status == GDR_OK && r->stream.enabled)
+            status = gdr_streaming_slot_create(r, slot, err);
         if (status == GDR_OK) /* every task workgroup of every instance at most: cannot overflow */
             status = gdr_vk_buffer_create(&r->allocator,
                                           sizeof(GdrGpuTaskCommand) * 2 * (r->scene.task_capacity ? r->scene.task_capacity : 1),
@@ -490,6 +516,11 @@ void gdr_frame_slots_destroy(gdr_renderer *r)
         gdr_vk_buffer_destroy(r->ctx, &slot->draw_stats);
         gdr_vk_buffer_destroy(r->ctx, &slot->stats_readback);
         gdr_vk_buffer_destroy(r->ctx, &slot->tasks);
+        gdr_vk_buffer_destroy(r->ctx, &slot->stream_requests);
+        gdr_vk_buffer_destroy(r->ctx, &slot->used_groups);
+        gdr_vk_buffer_destroy(r->ctx, &slot->stream_staging);
+        if (slot->stream_cmd)
+            vkFreeCommandBuffers(r->ctx->device, r->ctx->command_pool, 1, &slot->stream_cmd);
         memset(slot, 0, sizeof *slot);
     }
 }

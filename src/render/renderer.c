@@ -125,6 +125,7 @@ void gdr_renderer_destroy(gdr_renderer *r)
         vkDeviceWaitIdle(r->ctx->device);
         gdr_frame_slots_destroy(r);
         gdr_gpu_scene_destroy(r);
+        gdr_streaming_destroy(r);
         gdr_cpu_path_destroy(r);
         gdr_visbuffer_destroy(r);
         VkDevice device = r->ctx->device;
@@ -147,15 +148,23 @@ void gdr_renderer_destroy(gdr_renderer *r)
     free(r);
 }
 
-gdr_status gdr_renderer_set_scene(gdr_renderer *r, const gdr_scene *scene, gdr_error *err)
+/* The scene's upload, streamed (`stream` not NULL) or whole. */
+static gdr_status set_scene(gdr_renderer *r, const gdr_scene *scene, const gdr_streaming_desc *stream, gdr_error *err)
 {
     /* Device memory is sub-allocated linearly and released with the renderer. */
     if (r->has_scene)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
                              "the renderer already holds a scene: create another renderer for a new scene");
-    gdr_status status = gdr_gpu_scene_upload(r, scene, err);
+    if (stream && !r->ctx->has_mesh_shader)
+        return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "streaming draws with the mesh pipeline, not available on "
+                             "'%s': %s", r->ctx->properties.deviceName, r->ctx->mesh_shader_missing);
+    gdr_status status = stream ? gdr_streaming_open(r, scene, stream, err) : GDR_OK;
+    if (status == GDR_OK)
+        status = gdr_gpu_scene_upload(r, scene, err);
     if (status == GDR_OK)
         status = gdr_materials_upload(r, scene, err);
+    if (stream) /* vertex colours are indexed by the mesh's vertices, which pages repeat per cluster */
+        r->materials.scene_flags &= ~GDR_MATERIALS_VERTEX_COLORS;
     if (status == GDR_OK && (r->materials.scene_flags & (GDR_MATERIALS_MASKED | GDR_MATERIALS_DOUBLE_SIDED)))
         status = gdr_pipelines_for_materials(r->ctx, r->layout, r->materials.scene_flags & GDR_MATERIALS_DOUBLE_SIDED,
                                              r->pipelines, err);
@@ -169,9 +178,24 @@ gdr_status gdr_renderer_set_scene(gdr_renderer *r, const gdr_scene *scene, gdr_e
         status = gdr_occlusion_scene_create(r, err);
     if (status == GDR_OK)
         status = gdr_gpu_scene_write_refs(r, err);
+    if (status == GDR_OK && stream)
+        status = gdr_streaming_start(r, err);
     if (status == GDR_OK)
         r->has_scene = true;
     return status;
+}
+
+gdr_status gdr_renderer_set_scene(gdr_renderer *r, const gdr_scene *scene, gdr_error *err)
+{
+    return set_scene(r, scene, NULL, err);
+}
+
+gdr_status gdr_renderer_set_scene_streamed(gdr_renderer *r, const gdr_scene *scene, const gdr_streaming_desc *desc,
+                                           gdr_error *err)
+{
+    if (!desc)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "set_scene_streamed: no streaming description");
+    return set_scene(r, scene, desc, err);
 }
 
 gdr_status gdr_renderer_update_instance(gdr_renderer *r, uint32_t index, const gdr_mat4 *transform,
@@ -287,6 +311,11 @@ static gdr_status check_frame(gdr_renderer *r, const gdr_frame_desc *frame, uint
         if (!isfinite(plane[i]))
             return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: clip_plane must be finite");
     gdr_status status = resolve_pipeline(r, frame, pipeline, reason, reason_size, err);
+    /* Streamed geometry is drawn only through the LOD cut over resident groups. */
+    if (status == GDR_OK && r->scene.streamed && (*pipeline != GDR_PIPELINE_MESH || frame->lod_fixed_depth ||
+                                                  !(frame->lod_error_px > 0.0f)))
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: a streamed scene draws with the mesh pipeline "
+                             "and a LOD cut by error (lod_error_px > 0)");
     if (status == GDR_OK)
         status = gdr_visbuffer_resolve_mode(r, frame, *pipeline, &r->vis.mode, r->vis.reason, sizeof r->vis.reason, err);
     if (status == GDR_OK && frame->record_visible_meshlets && !r->visible_meshlets.buffer) {
@@ -311,6 +340,8 @@ static gdr_status run_frame(gdr_renderer *r, const gdr_frame_desc *frame, gdr_pi
     double start = gdr_now_ms();
     if (pipeline == GDR_PIPELINE_CPU)
         status = gdr_cpu_path_cull(r, frame, err);
+    if (status == GDR_OK)
+        status = gdr_streaming_begin_frame(r, slot, err);
     if (status == GDR_OK) {
         slot->cpu_visible_count = r->cpu.visible_count;
         slot->cpu_triangles = r->cpu.triangles;

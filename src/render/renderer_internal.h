@@ -48,11 +48,12 @@ typedef struct gdr_gpu_scene {
     gdr_vk_buffer lod_nodes;         /* GdrGpuLodNode[]: every mesh's LOD hierarchy, as gdr_lod_node */
     gdr_vk_buffer page_table;        /* uint32 per group of every mesh (shared/residency.h, page_table.c) */
     gdr_vk_buffer node_absent_refined; /* uint32 per LOD node: clusters below whose refined group is absent */
-    gdr_vk_buffer stream_requests;   /* GdrGpuStreamRequest[GDR_STREAM_REQUEST_CAPACITY]: the last frame's */
+    gdr_vk_buffer group_stamps;      /* uint32 per group of every mesh: the last streaming frame that drew it */
     gdr_vk_buffer refs;              /* GdrGpuScene: the addresses above, for the push constants */
     uint32_t group_total, node_total; /* LOD groups and nodes of every mesh */
     uint64_t absent_groups;          /* groups whose page-table word is GDR_GPU_PAGE_ABSENT */
     uint32_t *cpu_mesh_absent;       /* absent groups per mesh (NULL until a group was marked) */
+    bool streamed;                   /* geometry in the streaming page pool (streaming.c), not uploaded whole */
     uint32_t mesh_count;
     uint32_t instance_count;
     uint32_t meshlet_count;
@@ -90,6 +91,15 @@ typedef struct gdr_frame_slot {
     gdr_vk_buffer draw_stats;    /* GdrGpuDrawStats, device-local */
     gdr_vk_buffer stats_readback;/* GdrGpuDrawStats copied for the CPU */
     gdr_vk_buffer tasks;         /* GdrGpuTaskCommand[2 * task_capacity]: early (or only) phase, late phase */
+    gdr_vk_buffer stream_requests; /* GdrGpuStreamRequest[GDR_STREAM_REQUEST_CAPACITY], host-read */
+    gdr_vk_buffer used_groups;   /* uint32 per group of every mesh (streaming: the groups the cut drew), host-read */
+    /* Streaming: the pages, records and page-table words this frame copies into place, in a command
+     * buffer submitted before `cmd`. */
+    VkCommandBuffer stream_cmd;
+    gdr_vk_buffer stream_staging;
+    bool stream_copies;          /* stream_cmd holds this frame's copies */
+    bool stream_results;         /* the slot's last frame streamed: its lists are to be read */
+    uint32_t stream_frame;       /* the number stamped on the groups the frame drew (0: no list) */
     gdr_pipeline pipeline;       /* of the frame last recorded into this slot */
     bool lod_applied;            /* that frame selected a LOD cut (GDR_FRAME_LOD) */
     bool occlusion_applied;      /* that frame culled in two phases against the depth pyramid */
@@ -97,6 +107,35 @@ typedef struct gdr_frame_slot {
     uint32_t cpu_visible_count;
     uint64_t cpu_triangles;
 } gdr_frame_slot;
+
+/* The renderer's side of streaming (streaming.c, docs/STREAMING.md): the page pool, the residency
+ * deciding what it holds, the loader thread, and the pages read but not yet copied. */
+typedef struct gdr_streaming {
+    bool enabled;
+    bool wait_for_loads;
+    const gdr_scene *scene;             /* the caller's: clusters and LOD hierarchies */
+    struct gdr_paged_cache *cache;
+    struct gdr_residency *residency;
+    struct gdr_page_loader *loader;
+    gdr_vk_buffer pool;                 /* slot_count x slot_bytes: vertices, vertex list, triangles per page */
+    uint32_t slot_count, slot_bytes;
+    uint64_t upload_budget;
+    uint64_t staging_bytes;             /* each frame slot's staging buffer */
+    uint32_t *slot_page;                /* per pool slot: the global page the GPU may read there, or UINT32_MAX */
+    uint32_t *page_base;                /* per mesh + 1: its first global page */
+    uint8_t *mesh_dirty;                /* meshes whose node counts change this frame ... */
+    uint32_t *dirty_list, dirty_count;  /* ... listed */
+    VkBufferCopy *copies;               /* scratch: a frame's copy regions (groups + slots + meshes) */
+    uint32_t *words;                    /* scratch: a frame's page-table words (3 x groups) */
+    uint8_t *resident;                  /* scratch: a group per mesh's group */
+    uint32_t *absent;                   /* scratch: a count per mesh's LOD node */
+    struct gdr_page_result *pending;    /* read and checked, waiting for upload room, in load order */
+    uint32_t pending_count, pending_capacity;
+    struct gdr_stream_request *requests; /* scratch: GDR_STREAM_REQUEST_CAPACITY */
+    struct gdr_stream_load *loads;      /* scratch: slot_count */
+    uint32_t frame;                     /* streaming frames begun */
+    gdr_streaming_stats stats;          /* the last frame's, and the totals */
+} gdr_streaming;
 
 struct gdr_renderer {
     gdr_vk_context *ctx;
@@ -118,6 +157,7 @@ struct gdr_renderer {
     VkQueryPool timestamps;       /* GDR_FRAME_MAX_TIMESTAMPS per frame slot */
     gdr_frame_timings timings;
     gdr_gpu_scene scene;
+    gdr_streaming stream;
     bool has_scene;
     gdr_frame_slot slots[GDR_FRAMES_IN_FLIGHT];
     uint32_t frame_index;
@@ -141,6 +181,18 @@ void gdr_gpu_scene_destroy(gdr_renderer *r);
 gdr_status gdr_page_table_create(gdr_renderer *r, const gdr_mesh_clusters *const *clusters, uint32_t mesh_count,
                                  gdr_error *err);
 void gdr_page_table_destroy(gdr_renderer *r);
+/* Counts mesh `mesh`'s absent groups into the scene's total (GDR_FRAME_PARTIAL_RESIDENCY). */
+gdr_status gdr_page_table_set_absent(gdr_renderer *r, uint32_t mesh, uint32_t absent, gdr_error *err);
+
+/* Streaming (streaming.c): the pool, residency and loader for a scene about to be uploaded
+ * (before gdr_gpu_scene_upload, which then leaves the geometry out), the frame slots' parts, the
+ * work before each frame (read-backs into the residency, loads, evictions, copies recorded into
+ * slot->stream_cmd), statistics, and the end. */
+gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr_streaming_desc *desc, gdr_error *err);
+gdr_status gdr_streaming_start(gdr_renderer *r, gdr_error *err);
+gdr_status gdr_streaming_slot_create(gdr_renderer *r, gdr_frame_slot *slot, gdr_error *err);
+gdr_status gdr_streaming_begin_frame(gdr_renderer *r, gdr_frame_slot *slot, gdr_error *err);
+void gdr_streaming_destroy(gdr_renderer *r);
 gdr_status gdr_frame_slots_create(gdr_renderer *r, gdr_error *err);
 void gdr_frame_slots_destroy(gdr_renderer *r);
 

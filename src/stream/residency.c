@@ -43,9 +43,10 @@ struct gdr_residency {
 
 uint64_t gdr_page_pool_bytes(const gdr_page_info *page)
 {
-    /* As the pool holds it: a GdrGpuMeshlet (128 bytes) per cluster, each vertex (32 bytes) with its
-     * entry in the cluster vertex list (4 bytes), each cluster's triangles padded to 4 bytes. */
-    return (uint64_t)page->cluster_count * 128u + (uint64_t)page->vertex_count * (sizeof(gdr_page_vertex) + 4u) +
+    /* As the pool holds it: each vertex (32 bytes) with its entry in the cluster vertex list (4
+     * bytes), each cluster's triangles padded to 4 bytes. The clusters' records stay resident
+     * outside the pool. */
+    return (uint64_t)page->vertex_count * (sizeof(gdr_page_vertex) + 4u) +
            (((uint64_t)page->triangle_count * 3 + 3u * page->cluster_count) & ~(uint64_t)3);
 }
 
@@ -438,6 +439,12 @@ uint32_t gdr_residency_page_slot(const gdr_residency *res, uint32_t mesh, uint32
 {
     const page_state *ps = &res->pages[res->page_base[mesh] + page];
     return ps->state == PAGE_RESIDENT ? ps->slot : UINT32_MAX;
+}
+
+uint32_t gdr_residency_planned_slot(const gdr_residency *res, uint32_t mesh, uint32_t page)
+{
+    const page_state *ps = &res->pages[res->page_base[mesh] + page];
+    return ps->state == PAGE_PLANNED ? ps->slot : UINT32_MAX;
 }
 
 uint32_t gdr_residency_slot_bytes(const gdr_residency *res) { return res->slot_bytes; }

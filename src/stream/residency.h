@@ -79,11 +79,13 @@ void gdr_residency_failed(gdr_residency *res, uint32_t mesh, uint32_t page);
 int gdr_residency_group_resident(const gdr_residency *res, uint32_t mesh, uint32_t group);
 /* The slot of a resident page, or UINT32_MAX. */
 uint32_t gdr_residency_page_slot(const gdr_residency *res, uint32_t mesh, uint32_t page);
+/* The slot of a page planned and not yet arrived, or UINT32_MAX. */
+uint32_t gdr_residency_planned_slot(const gdr_residency *res, uint32_t mesh, uint32_t page);
 uint32_t gdr_residency_slot_bytes(const gdr_residency *res);
 uint32_t gdr_residency_slot_count(const gdr_residency *res);
 gdr_residency_stats gdr_residency_get_stats(const gdr_residency *res);
 
-/* The decoded size of a page in the pool: cluster records, vertices, triangles. */
+/* The decoded size of a page in the pool: vertices, their cluster vertex list entries, triangles. */
 uint64_t gdr_page_pool_bytes(const gdr_page_info *page);
 
 #endif

@@ -1,11 +1,12 @@
-/* The streaming loop with the GPU in it (docs/STREAMING.md), on the default device (lavapipe in
- * CI), validation on: `unique-field` written with one group a page, a residency pool of a quarter
- * of its pages' bytes and 64 KiB of loads a frame. Each frame the residency (gdr_residency) plans
- * the loads the GPU's requests of the frame before asked for, the loader thread reads them, the
- * page table is updated, and the frame is drawn: every frame's drawn clusters are the CPU's cut
- * over the resident groups (so no hole, no crack), and the frames converge to the image of the
- * scene with every group resident, pixel for pixel. The geometry itself is still uploaded whole:
- * the page pool buffer is not built yet. */
+/* Streaming in the renderer (docs/STREAMING.md) on the default device (lavapipe in CI), validation
+ * on: `unique-field` written with one group a page, drawn by a renderer whose page pool holds a
+ * tenth of the pages' bytes and copies at most 64 KiB a frame. Along still views and a path, every
+ * frame's drawn clusters are the CPU's cut over the groups the renderer reports resident (exactly
+ * one cluster on every DAG path: no hole, no crack), the pool stays within the budget, each frame's
+ * uploads within theirs, no page in use is evicted, and each still view converges to the image of
+ * the scene uploaded whole, pixel for pixel. A budget large enough for everything gives that image
+ * with no eviction; a page damaged on disk is refused by name and its group stays absent while the
+ * frames go on with coarser geometry. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,195 +16,375 @@
 #include "gdr/paged_cache.h"
 #include "geometry/lod_cut.h"
 #include "gpu_test_util.h"
-#include "stream/page_loader.h"
 #include "stream/residency.h"
 
 #define WIDTH 160
 #define HEIGHT 120
 #define FRAMES 40
 #define VIEWS 3
+#define UPLOAD_BUDGET (256u << 10)
 
-typedef struct loop {
-    const gdr_scene *scene;
-    gdr_renderer *renderer;
-    gdr_paged_cache *cache;
-    gdr_residency *res;
-    gdr_page_loader *loader;
-    gdr_stream_request *requests; /* the last frame's, read back */
-    uint32_t request_count;
-    gdr_visible_meshlet *drawn;   /* the last frame's clusters: its page use */
-    uint32_t drawn_count, capacity;
-} loop;
+typedef struct frame_check {
+    bool full;          /* the cut is the fully resident one */
+    uint32_t drawn;     /* clusters */
+    uint32_t absent;    /* groups absent in the frame */
+    /* Per group of every mesh (mesh m's from the sum of the earlier meshes' counts): drawn in the
+     * frame two before this one and in the one before, resident in the one before and in this one.
+     * A frame plans its evictions with the cut of the frame two before it (the latest it has read
+     * back): a group drawn then and resident in the frame before must not have left. */
+    uint8_t *drawn_before[2], *resident_before, *resident;
+    uint32_t evicted_in_use;
+} frame_check;
 
-/* The page table from the residency: resident groups and each node's absent refined count. */
-static bool upload_residency(loop *l)
+static void history_init(const gdr_scene *scene, frame_check *check)
 {
-    gdr_error err = {0};
-    bool ok = true;
-    for (uint32_t m = 0; m < l->scene->mesh_count && ok; m++) {
-        const gdr_mesh_clusters *c = &l->scene->meshes[m].clusters;
-        uint8_t *resident = malloc(c->group_count);
-        uint32_t *absent = malloc(sizeof *absent * c->lod_node_count);
-        ok = resident && absent;
-        for (uint32_t g = 0; ok && g < c->group_count; g++)
-            resident[g] = (uint8_t)gdr_residency_group_resident(l->res, m, g);
-        if (ok)
-            gdr_lod_nodes_count_absent_refined(c, resident, absent);
-        ok = ok && gdr_renderer_debug_set_residency(l->renderer, m, resident, absent, &err) == GDR_OK;
-        free(resident);
-        free(absent);
-    }
-    if (!ok)
-        fprintf(stderr, "residency: %s\n", err.message);
-    return ok;
+    size_t groups = 0;
+    for (uint32_t m = 0; m < scene->mesh_count; m++)
+        groups += scene->meshes[m].clusters.group_count;
+    *check = (frame_check){.drawn_before = {calloc(groups + 1, 1), calloc(groups + 1, 1)},
+                           .resident_before = calloc(groups + 1, 1), .resident = calloc(groups + 1, 1)};
 }
 
-/* The last frame's read-back into the residency (page use, requests), this frame's loads through
- * the loader thread, then the page table. */
-static bool stream(loop *l, uint32_t frame, uint32_t *loads_out, uint32_t *evictions_out)
+static void history_free(frame_check *check)
 {
-    for (uint32_t i = 0; frame && i < l->drawn_count; i++) {
-        uint32_t mesh = l->scene->instances[l->drawn[i].instance].mesh;
-        uint32_t group = l->scene->meshes[mesh].clusters.clusters[l->drawn[i].meshlet].group;
-        gdr_residency_mark_used(l->res, frame - 1, mesh, gdr_paged_cache_mesh(l->cache, mesh)->groups[group].page);
-    }
-    gdr_stream_load loads[256];
-    uint32_t count = 0;
-    gdr_residency_plan(l->res, frame, l->requests, l->request_count, loads, 256, &count);
-    gdr_error err = {0};
-    CHECK(gdr_page_loader_submit(l->loader, loads, count, &err) == GDR_OK);
-    gdr_page_result result;
-    while (gdr_page_loader_collect(l->loader, 1, &result, 1) == 1) {
-        CHECK(result.status == GDR_OK);
-        gdr_residency_loaded(l->res, result.load.mesh, result.load.page);
-        gdr_page_free(&result.page);
-    }
-    gdr_residency_stats st = gdr_residency_get_stats(l->res);
-    CHECK(st.evicted_in_use == 0);
-    *loads_out = count;
-    *evictions_out += st.evictions;
-    return upload_residency(l);
+    free(check->drawn_before[0]), free(check->drawn_before[1]), free(check->resident_before), free(check->resident);
 }
 
-/* Draws the frame; checks its clusters against the CPU's resident cut; reads its requests back.
- * *full: the cut is the fully resident one. */
-static bool draw(loop *l, const gdr_frame_desc *frame, uint8_t *image, bool *full)
+static gdr_frame_desc view_frame(int v)
+{
+    /* The field from far, then nearer its left and its right columns
+     * (the field: 4 columns 3 apart, the front row at z = -4). */
+    static const gdr_vec3 positions[VIEWS] = {{0.0f, 3.0f, 20.0f}, {-4.5f, 2.0f, 8.0f}, {4.5f, 2.0f, 8.0f}};
+    static const float yaws[VIEWS] = {0.0f, 0.0f, 0.0f};
+    return (gdr_frame_desc){.camera = test_look(positions[v], yaws[v], -0.1f, 1.0f, 0.1f),
+                            .pipeline = GDR_PIPELINE_MESH, .cull = GDR_CULL_OFF, .occlusion = GDR_CULL_OFF,
+                            .lod_error_px = 2.0f, .record_visible_meshlets = true, .read_back = true};
+}
+
+/* The pool slots view v's full cut needs: the pages of the groups its clusters belong to, and the
+ * pages of those groups' ancestors (the closure). */
+static uint32_t slots_needed(const gdr_scene *scene, const char *path, const gdr_frame_desc *frame)
+{
+    gdr_paged_cache *cache = NULL;
+    gdr_error err = {0};
+    if (gdr_paged_cache_open(path, &cache, &err) != GDR_OK)
+        return 0;
+    gdr_mat4 projection = gdr_perspective_reverse_z_infinite(frame->camera.yfov, (float)WIDTH / HEIGHT,
+                                                             frame->camera.znear);
+    uint32_t needed = 0;
+    for (uint32_t m = 0; m < scene->mesh_count; m++) {
+        const gdr_mesh_clusters *c = &scene->meshes[m].clusters;
+        const gdr_paged_mesh *pm = gdr_paged_cache_mesh(cache, m);
+        uint8_t *cut = malloc(c->cluster_count), *page = calloc(pm->page_count, 1), *group = calloc(c->group_count, 1);
+        for (uint32_t i = 0; cut && page && group && i < scene->instance_count; i++) {
+            if (scene->instances[i].mesh != m)
+                continue;
+            gdr_lod_view view = {.transform = scene->instances[i].transform, .camera_position = frame->camera.position,
+                                 .projection_y = fabsf(projection.m[5]), .viewport_height = HEIGHT,
+                                 .znear = frame->camera.znear, .threshold = frame->lod_error_px};
+            gdr_lod_cut_select(c, &view, cut);
+            for (uint32_t k = 0; k < c->cluster_count; k++)
+                if (cut[k])
+                    group[c->clusters[k].group] = 1;
+        }
+        /* Parents are deeper groups: walking from the finest depth up closes the set. */
+        for (uint32_t pass = 0; group && pass <= c->dag_depth; pass++)
+            for (uint32_t g = 0; g < c->group_count; g++)
+                for (uint32_t e = 0; group[g] && e < pm->groups[g].parent_count; e++)
+                    group[pm->parents[pm->groups[g].parent_first + e]] = 1;
+        for (uint32_t g = 0; group && page && g < c->group_count; g++)
+            if (group[g] && !page[pm->groups[g].page]) {
+                page[pm->groups[g].page] = 1;
+                needed++;
+            }
+        free(cut), free(page), free(group);
+    }
+    gdr_paged_cache_close(cache);
+    return needed;
+}
+
+/* One frame: its image, and its drawn clusters against the CPU's cut over the groups the renderer
+ * reports resident for that frame. */
+static bool draw(const gdr_scene *scene, gdr_renderer *r, const gdr_frame_desc *frame, uint8_t *image,
+                 gdr_frame_stats *stats, frame_check *out)
 {
     gdr_error err = {0};
-    gdr_frame_stats stats;
-    gdr_frame_desc f = *frame;
-    f.record_visible_meshlets = f.read_back = true;
-    gdr_group_request *gpu = malloc(sizeof *gpu * 4096);
-    uint32_t count = 0, dropped = 0;
-    bool ok = gpu && gdr_renderer_render(l->renderer, &f, 1, &stats, &err) == GDR_OK &&
-              gdr_renderer_read_color(l->renderer, image, &err) == GDR_OK &&
-              gdr_renderer_read_visible_meshlets(l->renderer, l->drawn, l->capacity, &l->drawn_count, &err) == GDR_OK &&
-              gdr_renderer_read_group_requests(l->renderer, gpu, 4096, &count, &dropped, &err) == GDR_OK;
+    uint32_t capacity = 1u << 20, count = 0;
+    gdr_visible_meshlet *drawn = malloc(sizeof *drawn * capacity);
+    bool ok = drawn && gdr_renderer_render(r, frame, 1, stats, &err) == GDR_OK &&
+              gdr_renderer_read_color(r, image, &err) == GDR_OK &&
+              gdr_renderer_read_visible_meshlets(r, drawn, capacity, &count, &err) == GDR_OK;
     if (!ok)
         fprintf(stderr, "render: %s\n", err.message);
-    CHECK(ok && stats.validation_messages == 0 && dropped == 0);
-    qsort(l->drawn, l->drawn_count, sizeof *l->drawn, compare_visible_meshlets);
-    for (uint32_t q = 0; q < count; q++)
-        l->requests[q] = (gdr_stream_request){gpu[q].mesh, gpu[q].group, gpu[q].priority};
-    l->request_count = count;
-    free(gpu);
+    CHECK(ok && stats->validation_messages == 0);
+    if (!ok) {
+        free(drawn);
+        return false;
+    }
+    qsort(drawn, count, sizeof *drawn, compare_visible_meshlets);
     gdr_mat4 projection = gdr_perspective_reverse_z_infinite(frame->camera.yfov, (float)WIDTH / HEIGHT,
                                                              frame->camera.znear);
     uint32_t cursor = 0, wrong = 0;
-    *full = true;
-    for (uint32_t i = 0; ok && i < l->scene->instance_count; i++) {
-        uint32_t m = l->scene->instances[i].mesh;
-        const gdr_mesh_clusters *c = &l->scene->meshes[m].clusters;
-        gdr_lod_view view = {.transform = l->scene->instances[i].transform, .camera_position = frame->camera.position,
+    out->full = true, out->drawn = count, out->absent = 0;
+    size_t *base = malloc(sizeof *base * (scene->mesh_count + 1));
+    for (uint32_t m = 0; base && m <= scene->mesh_count; m++)
+        base[m] = m ? base[m - 1] + scene->meshes[m - 1].clusters.group_count : 0;
+    uint8_t *swap = out->resident_before;
+    out->resident_before = out->resident;
+    out->resident = swap;
+    for (uint32_t m = 0; base && out->resident && m < scene->mesh_count; m++)
+        ok = ok && gdr_renderer_read_residency(r, m, out->resident + base[m], &err) == GDR_OK;
+    uint8_t *older = out->drawn_before[0];
+    for (size_t g = 0; base && older && g < base[scene->mesh_count]; g++) {
+        out->evicted_in_use += older[g] && out->resident_before[g] && !out->resident[g];
+        older[g] = 0;
+    }
+    for (uint32_t i = 0; ok && base && older && i < scene->instance_count; i++) {
+        uint32_t m = scene->instances[i].mesh;
+        const gdr_mesh_clusters *c = &scene->meshes[m].clusters;
+        gdr_lod_view view = {.transform = scene->instances[i].transform, .camera_position = frame->camera.position,
                              .projection_y = fabsf(projection.m[5]), .viewport_height = HEIGHT,
                              .znear = frame->camera.znear, .threshold = frame->lod_error_px};
-        uint8_t *resident = malloc(c->group_count), *cut = malloc(c->cluster_count), *all = malloc(c->cluster_count);
-        for (uint32_t g = 0; resident && g < c->group_count; g++)
-            resident[g] = (uint8_t)(!l->res || gdr_residency_group_resident(l->res, m, g));
-        if (resident && cut && all) {
+        uint8_t *resident = out->resident + base[m], *cut = malloc(c->cluster_count), *all = malloc(c->cluster_count);
+        if (cut && all) {
+            for (uint32_t g = 0; g < c->group_count; g++)
+                out->absent += !resident[g];
             gdr_lod_cut_select_resident(c, &view, resident, cut);
             gdr_lod_cut_select(c, &view, all);
-            *full = *full && memcmp(cut, all, c->cluster_count) == 0;
+            out->full = out->full && memcmp(cut, all, c->cluster_count) == 0;
             for (uint32_t k = 0; k < c->cluster_count; k++) {
-                bool on_gpu = cursor < l->drawn_count && l->drawn[cursor].instance == i && l->drawn[cursor].meshlet == k;
+                bool on_gpu = cursor < count && drawn[cursor].instance == i && drawn[cursor].meshlet == k;
                 cursor += on_gpu;
                 wrong += on_gpu != (cut[k] != 0);
+                if (on_gpu)
+                    older[base[m] + c->clusters[k].group] = 1;
             }
+        } else {
+            wrong++;
         }
-        free(resident), free(cut), free(all);
+        free(cut), free(all);
     }
-    CHECK(cursor == l->drawn_count && wrong == 0);
-    return ok && wrong == 0;
+    /* This frame's drawn groups become the newer history entry. */
+    out->drawn_before[0] = out->drawn_before[1];
+    out->drawn_before[1] = older;
+    free(base);
+    free(drawn);
+    CHECK(cursor == count && wrong == 0);
+    return wrong == 0 && cursor == count;
 }
 
-static uint64_t pool_bytes(const gdr_paged_cache *cache)
+/* The frame's streaming figures against the budgets and the eviction rule. */
+static void check_budgets(const gdr_frame_stats *stats, uint64_t budget)
 {
+    const gdr_streaming_stats *s = &stats->streaming;
+    CHECK(s->enabled && s->pool_bytes <= budget && s->resident_bytes <= s->pool_bytes);
+    CHECK(s->upload_bytes <= UPLOAD_BUDGET || s->uploads == 1);
+    CHECK(s->evicted_in_use == 0);
+    CHECK(stats->streaming.requests_dropped == 0);
+}
+
+static uint64_t pool_bytes(const char *path)
+{
+    gdr_paged_cache *cache = NULL;
+    gdr_error err = {0};
     uint64_t total = 0;
+    if (gdr_paged_cache_open(path, &cache, &err) != GDR_OK)
+        return 0;
     for (uint32_t m = 0; m < gdr_paged_cache_mesh_count(cache); m++)
         for (uint32_t p = 0; p < gdr_paged_cache_mesh(cache, m)->page_count; p++)
             total += gdr_page_pool_bytes(&gdr_paged_cache_mesh(cache, m)->pages[p]);
+    gdr_paged_cache_close(cache);
     return total;
+}
+
+static gdr_renderer *streamed_renderer(const gdr_scene *scene, const char *path, uint64_t budget)
+{
+    gdr_error err = {0};
+    gdr_renderer *r = NULL;
+    gdr_renderer_desc desc = {.width = WIDTH, .height = HEIGHT, .validate = true};
+    gdr_streaming_desc stream = {.cache_path = path, .geometry_budget_bytes = budget,
+                                 .upload_budget_bytes = UPLOAD_BUDGET, .wait_for_loads = true};
+    if (gdr_renderer_create(&desc, &r, &err) != GDR_OK ||
+        gdr_renderer_set_scene_streamed(r, scene, &stream, &err) != GDR_OK) {
+        fprintf(stderr, "streamed renderer: %s\n", err.message);
+        gdr_renderer_destroy(r);
+        return NULL;
+    }
+    return r;
+}
+
+/* Still views one after another, FRAMES frames each: every frame checked, each view converging to
+ * its reference image. Returns the evictions. */
+static uint64_t still_views(const gdr_scene *scene, gdr_renderer *r, uint64_t budget, const uint8_t *reference,
+                            const char *what)
+{
+    uint8_t *image = malloc(WIDTH * HEIGHT * 4);
+    gdr_frame_stats stats = {0};
+    frame_check check;
+    history_init(scene, &check);
+    for (int v = 0; image && v < VIEWS; v++) {
+        gdr_frame_desc frame = view_frame(v);
+        uint32_t converged = UINT32_MAX, partial = 0;
+        for (uint32_t f = 0; f < FRAMES && draw(scene, r, &frame, image, &stats, &check); f++) {
+            check_budgets(&stats, budget);
+            partial += !check.full;
+            bool same = check.full && memcmp(image, reference + (size_t)v * WIDTH * HEIGHT * 4, WIDTH * HEIGHT * 4) == 0;
+            converged = !same ? UINT32_MAX : converged == UINT32_MAX ? f : converged;
+        }
+        printf("%s, view %d: pool %llu bytes (%u slots), %llu pages uploaded and %llu evicted so far, %u frames "
+               "not the full cut, the image the whole upload's from frame %u of %u; last frame %u requests, %u "
+               "resident pages, %u groups absent\n", what, v, (unsigned long long)stats.streaming.pool_bytes,
+               stats.streaming.slot_count, (unsigned long long)stats.streaming.uploads_total,
+               (unsigned long long)stats.streaming.evictions_total, partial, converged, FRAMES,
+               stats.streaming.requests, stats.streaming.resident_pages, check.absent);
+        CHECK(converged < FRAMES && stats.streaming.requests == 0);
+    }
+    CHECK(check.evicted_in_use == 0);
+    history_free(&check);
+    free(image);
+    return stats.streaming.evictions_total;
+}
+
+/* A camera path once around the field, looking at it: every frame checked. */
+static void camera_path(const gdr_scene *scene, gdr_renderer *r, uint64_t budget)
+{
+    uint8_t *image = malloc(WIDTH * HEIGHT * 4);
+    gdr_frame_stats stats = {0};
+    frame_check check;
+    history_init(scene, &check);
+    uint32_t partial = 0;
+    for (uint32_t f = 0; image && f < 30; f++) {
+        float t = (float)f / 29.0f, angle = 6.2832f * t;
+        gdr_frame_desc frame = view_frame(0);
+        frame.camera = test_look((gdr_vec3){14.0f * sinf(angle), 2.5f, -7.0f + 14.0f * cosf(angle)}, angle, -0.1f,
+                                 1.0f, 0.1f);
+        if (!draw(scene, r, &frame, image, &stats, &check))
+            break;
+        check_budgets(&stats, budget);
+        partial += !check.full;
+        if (getenv("GDR_TEST_VERBOSE"))
+            printf("path frame %u: %u drawn, %u requests (%u distinct), %u loads, %u uploads, %u evictions, %u deferred, "
+                   "%u groups used, %u resident\n", f, check.drawn, stats.streaming.requests,
+                   stats.streaming.distinct_requests, stats.streaming.loads, stats.streaming.uploads,
+                   stats.streaming.evictions, stats.streaming.deferred, stats.streaming.groups_used,
+                   stats.streaming.resident_pages);
+    }
+    printf("path: 30 frames around the field, %u not the full cut, %llu pages uploaded and %llu evicted in all\n",
+           partial, (unsigned long long)stats.streaming.uploads_total,
+           (unsigned long long)stats.streaming.evictions_total);
+    CHECK(check.evicted_in_use == 0 && stats.streaming.evictions_total > 0);
+    history_free(&check);
+    free(image);
+}
+
+/* A byte of a page view 0's full cut needs flipped on disk: refused by name, its group stays
+ * absent, every frame's cut stays exact. */
+static void damaged_page(const gdr_scene *scene, const char *path, uint64_t budget)
+{
+    gdr_paged_cache *cache = NULL;
+    gdr_error err = {0};
+    CHECK(gdr_paged_cache_open(path, &cache, &err) == GDR_OK);
+    if (!cache)
+        return;
+    /* The finest group of mesh 0 that view 0 draws: its page. */
+    gdr_frame_desc frame = view_frame(0);
+    gdr_mat4 projection = gdr_perspective_reverse_z_infinite(frame.camera.yfov, (float)WIDTH / HEIGHT, frame.camera.znear);
+    uint32_t instance = 0;
+    while (scene->instances[instance].mesh != 0)
+        instance++;
+    const gdr_mesh_clusters *c = &scene->meshes[0].clusters;
+    gdr_lod_view view = {.transform = scene->instances[instance].transform, .camera_position = frame.camera.position,
+                         .projection_y = fabsf(projection.m[5]), .viewport_height = HEIGHT,
+                         .znear = frame.camera.znear, .threshold = frame.lod_error_px};
+    uint8_t *cut = malloc(c->cluster_count);
+    uint32_t group = UINT32_MAX;
+    gdr_lod_cut_select(c, &view, cut);
+    for (uint32_t k = 0; cut && k < c->cluster_count; k++)
+        if (cut[k] && (group == UINT32_MAX || c->groups[c->clusters[k].group].depth < c->groups[group].depth))
+            group = c->clusters[k].group;
+    free(cut);
+    const gdr_paged_mesh *pm = gdr_paged_cache_mesh(cache, 0);
+    uint32_t page = group == UINT32_MAX ? 0 : pm->groups[group].page;
+    uint64_t offset = pm->pages[page].offset + pm->pages[page].stored_size / 2;
+    gdr_paged_cache_close(cache);
+    CHECK(group != UINT32_MAX && page != 0);
+    FILE *f = fopen(path, "r+b");
+    int byte = EOF;
+    if (f && fseek(f, (long)offset, SEEK_SET) == 0 && (byte = fgetc(f)) != EOF && fseek(f, (long)offset, SEEK_SET) == 0)
+        fputc(byte ^ 0x5a, f);
+    CHECK(f && byte != EOF);
+    if (f)
+        fclose(f);
+
+    gdr_renderer *r = streamed_renderer(scene, path, budget);
+    CHECK(r != NULL);
+    uint8_t *image = malloc(WIDTH * HEIGHT * 4), *resident = malloc(c->group_count);
+    gdr_frame_stats stats = {0};
+    frame_check check;
+    history_init(scene, &check);
+    for (uint32_t i = 0; r && image && i < 20 && draw(scene, r, &frame, image, &stats, &check); i++)
+        check_budgets(&stats, budget);
+    char expected[64];
+    snprintf(expected, sizeof expected, "mesh 0 page %u", page);
+    printf("damaged page %u of mesh 0 (group %u): %u refused, \"%s\"\n", page, group, stats.streaming.pages_refused,
+           stats.streaming.refused);
+    CHECK(stats.streaming.pages_refused >= 1 && strstr(stats.streaming.refused, path) &&
+          strstr(stats.streaming.refused, expected));
+    CHECK(r && resident && gdr_renderer_read_residency(r, 0, resident, &err) == GDR_OK && !resident[group]);
+    CHECK(!check.full && check.drawn > 0 && check.evicted_in_use == 0);
+    history_free(&check);
+    free(image), free(resident);
+    gdr_renderer_destroy(r);
 }
 
 static void run(const gdr_scene *scene, const char *path)
 {
-    gdr_error err = {0};
-    loop l = {.scene = scene, .capacity = 1u << 20};
-    l.drawn = malloc(sizeof *l.drawn * l.capacity);
-    l.requests = malloc(sizeof *l.requests * 4096);
-    uint8_t *image = malloc(WIDTH * HEIGHT * 4), *reference = malloc(VIEWS * WIDTH * HEIGHT * 4);
-    l.renderer = gpu_test_renderer(WIDTH, HEIGHT, scene);
-    CHECK(l.renderer && l.drawn && l.requests && image && reference &&
-          gdr_paged_cache_open(path, &l.cache, &err) == GDR_OK);
-    if (!l.cache)
-        goto done;
-    /* The field from its right, from far, then from its left: the pool holds the pages of one side's
-     * cut, so the third view's loads evict the first view's finer pages. */
-    static const gdr_vec3 positions[VIEWS] = {{7.0f, 1.5f, -4.0f}, {0.0f, 3.0f, 20.0f}, {-7.0f, 1.5f, -4.0f}};
-    static const float yaws[VIEWS] = {1.5708f, 0.0f, -1.5708f};
-    gdr_frame_desc frames[VIEWS];
-    for (int v = 0; v < VIEWS; v++)
-        frames[v] = (gdr_frame_desc){.camera = test_look(positions[v], yaws[v], -0.1f, 1.0f, 0.1f),
-                                     .pipeline = GDR_PIPELINE_MESH, .cull = GDR_CULL_OFF, .occlusion = GDR_CULL_OFF,
-                                     .lod_error_px = 1.0f};
-    bool full = false;
-    /* Every group resident (no residency yet): the references. */
-    for (int v = 0; v < VIEWS; v++)
-        CHECK(draw(&l, &frames[v], reference + (size_t)v * WIDTH * HEIGHT * 4, &full) && full);
-    uint64_t total = pool_bytes(l.cache);
-    gdr_residency_desc desc = {l.cache, total * 7 / 24, 64u << 10};
-    CHECK(gdr_residency_create(&desc, &l.res, &err) == GDR_OK && gdr_page_loader_create(l.cache, &l.loader, &err) == GDR_OK);
-    if (!l.loader)
-        goto done;
-    for (int v = 0; v < VIEWS; v++) {
-        uint32_t converged = UINT32_MAX, partial_frames = 0, loads_total = 0, evictions = 0;
-        for (uint32_t f = 0; f < FRAMES; f++) {
-            uint32_t loads = 0;
-            if (!stream(&l, (uint32_t)v * FRAMES + f, &loads, &evictions) || !draw(&l, &frames[v], image, &full))
-                break;
-            loads_total += loads;
-            partial_frames += !full;
-            if (!full || memcmp(image, reference + (size_t)v * WIDTH * HEIGHT * 4, WIDTH * HEIGHT * 4) != 0)
-                converged = UINT32_MAX;
-            else if (converged == UINT32_MAX)
-                converged = f;
-        }
-        gdr_residency_stats st = gdr_residency_get_stats(l.res);
-        printf("view %d, pool %llu of %llu bytes (%u slots): %u pages loaded, %u evicted, %u frames not the full cut, "
-               "the image equal to the fully resident one from frame %u of %u; last frame %u requests, %u resident "
-               "pages\n", v, (unsigned long long)desc.budget_bytes, (unsigned long long)total,
-               gdr_residency_slot_count(l.res), loads_total, evictions, partial_frames, converged, FRAMES,
-               l.request_count, st.resident_pages);
-        CHECK(converged < FRAMES && l.request_count == 0);
-        CHECK(v == 1 ? partial_frames == 0 : partial_frames > 0); /* the far view needs no new page */
-        CHECK(v < 2 || evictions > 0);
+    uint8_t *reference = malloc(VIEWS * WIDTH * HEIGHT * 4);
+    gdr_renderer *whole = gpu_test_renderer(WIDTH, HEIGHT, scene);
+    CHECK(whole && reference);
+    gdr_frame_stats stats;
+    frame_check check;
+    history_init(scene, &check);
+    for (int v = 0; whole && reference && v < VIEWS; v++) {
+        gdr_frame_desc frame = view_frame(v);
+        CHECK(draw(scene, whole, &frame, reference + (size_t)v * WIDTH * HEIGHT * 4, &stats, &check) && check.full);
     }
-done:
-    gdr_page_loader_destroy(l.loader);
-    gdr_residency_destroy(l.res);
-    gdr_paged_cache_close(l.cache);
-    gdr_renderer_destroy(l.renderer);
-    free(l.drawn), free(l.requests), free(image), free(reference);
+    history_free(&check);
+    gdr_renderer_destroy(whole);
+
+    uint64_t total = pool_bytes(path), budget = total / 10;
+    for (int v = 0; v < VIEWS; v++) {
+        gdr_frame_desc frame = view_frame(v);
+        printf("view %d needs %u slots\n", v, slots_needed(scene, path, &frame));
+    }
+    gdr_renderer *r = streamed_renderer(scene, path, budget);
+    CHECK(r && total > 0);
+    if (r && reference) {
+        uint64_t evictions = still_views(scene, r, budget, reference, "tenth");
+        CHECK(evictions > 0); /* the views need more than the pool holds */
+        camera_path(scene, r, budget);
+    }
+    gdr_renderer_destroy(r);
+
+    /* Room for everything: the same images, nothing evicted. */
+    r = streamed_renderer(scene, path, 2 * total);
+    CHECK(r != NULL);
+    if (r && reference)
+        CHECK(still_views(scene, r, 2 * total, reference, "everything") == 0);
+    gdr_renderer_destroy(r);
+
+    /* A budget below the coarsest pages is refused. */
+    gdr_renderer *small = NULL;
+    gdr_error err = {0};
+    gdr_renderer_desc desc = {.width = WIDTH, .height = HEIGHT, .validate = true};
+    gdr_streaming_desc tiny = {.cache_path = path, .geometry_budget_bytes = 1024};
+    CHECK(gdr_renderer_create(&desc, &small, &err) == GDR_OK &&
+          gdr_renderer_set_scene_streamed(small, scene, &tiny, &err) == GDR_ERROR_CAPACITY);
+    printf("a 1 KiB budget: %s\n", err.message);
+    gdr_renderer_destroy(small);
+
+    damaged_page(scene, path, budget);
+    free(reference);
 }
 
 int main(void)
@@ -211,7 +392,7 @@ int main(void)
     gdr_scene *scene = NULL;
     gdr_error err = {0};
     gdr_load_options load = {.no_progress = 1};
-    CHECK(gdr_scene_load("unique-field:meshes=3,triangles=20000,seed=3", &load, &scene, &err) == GDR_OK);
+    CHECK(gdr_scene_load("unique-field:meshes=12,triangles=20000,seed=3", &load, &scene, &err) == GDR_OK);
     char path[256];
     const char *tmp = getenv("TMPDIR");
     snprintf(path, sizeof path, "%s/gdr_gpu_streaming_%ld.gdrc", tmp ? tmp : "/tmp", (long)getpid());

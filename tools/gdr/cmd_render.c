@@ -101,6 +101,10 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
             ok = o->has_lod_depth = cli_parse_u32(arg, value, 0, 64, &o->lod_depth);
         else if (strcmp(arg, "--device") == 0)
             o->device = value;
+        else if (strcmp(arg, "--geometry-budget") == 0)
+            ok = cli_parse_u32(arg, value, 1, (uint32_t)(GDR_GEOMETRY_BUDGET_MAX >> 20), &o->geometry_budget_mib);
+        else if (strcmp(arg, "--upload-budget") == 0)
+            ok = cli_parse_u32(arg, value, 1, 4096, &o->upload_budget_mib);
         else if (strcmp(arg, "--cache-dir") == 0)
             o->load.cache_dir = value;
         else if (strcmp(arg, "--budget") == 0)
@@ -173,6 +177,21 @@ static gdr_status render_frames(gdr_renderer *renderer, gdr_frame_desc *frame, c
     return status;
 }
 
+/* The scene, streamed from its cache file when a budget is given (the scene must be that file). */
+static gdr_status set_scene(gdr_renderer *renderer, const gdr_scene *scene, const render_options *o, gdr_error *err)
+{
+    if (!o->geometry_budget_mib && !o->upload_budget_mib)
+        return gdr_renderer_set_scene(renderer, scene, err);
+    size_t length = strlen(o->scene);
+    if (length < 5 || strcmp(o->scene + length - 5, ".gdrc") != 0)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "--geometry-budget/--upload-budget stream from a cache: "
+                             "give a .gdrc written with 'gdr build --pages' (not '%s')", o->scene);
+    gdr_streaming_desc stream = {.cache_path = o->scene,
+                                 .geometry_budget_bytes = (uint64_t)o->geometry_budget_mib << 20,
+                                 .upload_budget_bytes = (uint64_t)o->upload_budget_mib << 20};
+    return gdr_renderer_set_scene_streamed(renderer, scene, &stream, err);
+}
+
 int gdr_cmd_render(int argc, char **argv)
 {
     render_options o;
@@ -194,7 +213,7 @@ int gdr_cmd_render(int argc, char **argv)
     uint8_t *pixels = NULL;
     int result = 0;
     gdr_frame_desc frame = render_options_frame(&o, render_options_camera(scene, &o));
-    if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK || gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK ||
+    if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK || set_scene(renderer, scene, &o, &err) != GDR_OK ||
         render_frames(renderer, &frame, &o, &stats, &err) != GDR_OK) {
         result = fail(&err);
         goto done;

@@ -28,6 +28,7 @@ typedef struct render_options {
     const char *device;
     const char *camera_path; /* --camera-path FILE: one pose per frame (docs/VIEWER.md) */
     bool frames_given;
+    uint32_t geometry_budget_mib, upload_budget_mib; /* streaming (docs/STREAMING.md): 0 unless given */
     gdr_load_options load;
 } render_options;
 

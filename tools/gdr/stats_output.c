@@ -78,6 +78,7 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
         fprintf(out, "  gpu_ms.%-16s %.4f\n", s->passes[p].name, s->passes[p].gpu_ms);
     fprintf(out, "gpu_memory_bytes    %llu (scene %llu, frame %llu)\n", (unsigned long long)s->memory.device_bytes,
             (unsigned long long)s->memory.scene_bytes, (unsigned long long)s->memory.frame_bytes);
+    stats_print_streaming(out, &s->streaming);
     fprintf(out, "validation_messages %u\n", s->validation_messages);
 }
 
@@ -147,8 +148,45 @@ void stats_add_traversal_json(cJSON *object, const gdr_frame_stats *s)
     cJSON_AddNumberToObject(object, "traversal_overflow", s->traversal.overflow);
 }
 
+void stats_print_streaming(FILE *out, const gdr_streaming_stats *st)
+{
+    if (!st->enabled)
+        return;
+    fprintf(out, "streaming pool      %llu bytes: %u slots of %u, %u pages resident (%llu bytes), %llu groups absent\n",
+            (unsigned long long)st->pool_bytes, st->slot_count, st->slot_bytes, st->resident_pages,
+            (unsigned long long)st->resident_bytes, (unsigned long long)st->absent_groups);
+    fprintf(out, "streaming frame     %u requests (%u distinct pages), %u loads, %u uploads (%llu bytes), %u evictions, "
+            "%u deferred, %u pending; %u frames since a change\n", st->requests, st->distinct_requests, st->loads,
+            st->uploads, (unsigned long long)st->upload_bytes, st->evictions, st->deferred, st->pending,
+            st->frames_since_change);
+    fprintf(out, "streaming totals    %llu uploads (%llu bytes), %llu evictions, %u pages refused%s%s\n",
+            (unsigned long long)st->uploads_total, (unsigned long long)st->upload_bytes_total,
+            (unsigned long long)st->evictions_total, st->pages_refused, st->pages_refused ? ": " : "",
+            st->pages_refused ? st->refused : "");
+}
+
+static void add_streaming_json(cJSON *object, const gdr_streaming_stats *st)
+{
+    cJSON *o = st->enabled ? cJSON_AddObjectToObject(object, "streaming") : NULL;
+    if (!o)
+        return;
+    const struct { const char *name; double value; } fields[] = {
+        {"pool_bytes", (double)st->pool_bytes}, {"slot_count", st->slot_count}, {"slot_bytes", st->slot_bytes},
+        {"resident_pages", st->resident_pages}, {"resident_bytes", (double)st->resident_bytes},
+        {"absent_groups", (double)st->absent_groups}, {"requests", st->requests},
+        {"distinct_requests", st->distinct_requests}, {"loads", st->loads}, {"uploads", st->uploads},
+        {"upload_bytes", (double)st->upload_bytes}, {"evictions", st->evictions}, {"deferred", st->deferred},
+        {"pending", st->pending}, {"frames_since_change", st->frames_since_change},
+        {"uploads_total", (double)st->uploads_total}, {"upload_bytes_total", (double)st->upload_bytes_total},
+        {"evictions_total", (double)st->evictions_total}, {"evicted_in_use", (double)st->evicted_in_use},
+        {"pages_refused", st->pages_refused}};
+    for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++)
+        cJSON_AddNumberToObject(o, fields[i].name, fields[i].value);
+}
+
 void stats_add_memory_json(cJSON *object, const gdr_frame_stats *s)
 {
+    add_streaming_json(object, &s->streaming);
     cJSON_AddNumberToObject(object, "gpu_memory_bytes", (double)s->memory.device_bytes);
     cJSON_AddNumberToObject(object, "gpu_memory_scene_bytes", (double)s->memory.scene_bytes);
     cJSON_AddNumberToObject(object, "gpu_memory_frame_bytes", (double)s->memory.frame_bytes);

@@ -19,6 +19,8 @@ typedef struct cJSON cJSON;
 /* The occlusion-culling statistics of a frame (per phase) into a JSON object. */
 void stats_add_traversal_json(cJSON *object, const gdr_frame_stats *s);
 void stats_add_memory_json(cJSON *object, const gdr_frame_stats *s);
+/* Streaming's figures (docs/STREAMING.md), where the scene streams. */
+void stats_print_streaming(FILE *out, const gdr_streaming_stats *streaming);
 void stats_add_occlusion_json(cJSON *object, const gdr_frame_stats *s);
 void stats_add_meshlet_json(cJSON *object, const gdr_frame_stats *stats);
 /* Returns a malloc'ed JSON text, or NULL when out of memory. */

@@ -115,6 +115,8 @@ GdrClusterResult gdr_cluster_test_command(GdrGpuFrameGlobals g, uint phase, GdrG
         if (visible && refined_absent && !refined_passes)
             gdr_request_group(g, task.instance, instance.mesh, meshlet.refined_group, meshlet.refined_sphere,
                               meshlet.refined_error, model);
+        if (visible)
+            gdr_mark_group_used(g, instance.mesh, meshlet.group);
         result.lod_culled = !visible;
     }
     bool cull = g.cull_enabled != 0u;

@@ -319,7 +319,7 @@ GDR_STRUCT_BEGIN(GdrGpuDrawStats)
     gdr_uint late_cull_groups_z;
     gdr_uint stream_requests;       /* requests appended (GdrGpuFrameBuffers.stream_requests; may exceed
                                        GDR_STREAM_REQUEST_CAPACITY: the rest were dropped) */
-    gdr_uint reserved_cull1;
+    gdr_uint groups_used;           /* streaming frames: distinct groups the cut drew (GdrGpuFrameBuffers.used_groups) */
     /* The LOD hierarchy traversal: per phase (early or only, then late) and level. Level 0 holds
      * the roots the instance cull queues; the visits of level L + 1 the children of level L's. */
     GdrGpuTraversalLevel traversal[2 * GDR_LOD_TREE_LEVELS];
@@ -365,8 +365,9 @@ GDR_STRUCT_BEGIN(GdrGpuScene)
     GDR_REF(UintsRef) mesh_color_offsets;     /* per mesh: first vertex colour (2 words each), or GDR_GPU_NO_COLORS */
     GDR_REF(UintsRef) page_table;             /* per group of every mesh: GDR_GPU_PAGE_ABSENT or resident (shared/residency.h) */
     GDR_REF(UintsRef) node_absent_refined;    /* per LOD node: clusters below whose refined group is absent */
+    GDR_REF(WritableUintsRef) group_stamps;   /* per group of every mesh: the last streaming frame that drew it */
 GDR_STRUCT_END(GdrGpuScene)
-GDR_ASSERT_SIZE(GdrGpuScene, 96);
+GDR_ASSERT_SIZE(GdrGpuScene, 104);
 
 /* A frame slot's buffers: written once, when the slot is made (and when a buffer made on first use
  * appears). Shaders read it and GdrGpuScene in place (GDR_SCENE, GDR_FRAME), never as a local
@@ -385,9 +386,11 @@ GDR_STRUCT_BEGIN(GdrGpuFrameBuffers)
     GDR_REF(NodeVisitsRef) occluded_nodes;    /* node visits [occluded_node_capacity], level after level */
     GDR_REF(WritableUintsRef) retest_masks;           /* per late task command with GDR_TASK_RETEST: its clusters to
                                                  retest (bit i: cluster meshlet_first + i) [task_capacity] */
-    GDR_REF(StreamRequestsRef) stream_requests; /* GdrGpuStreamRequest[GDR_STREAM_REQUEST_CAPACITY] */
+    GDR_REF(StreamRequestsRef) stream_requests; /* GdrGpuStreamRequest[GDR_STREAM_REQUEST_CAPACITY], read by the host */
+    GDR_REF(WritableUintsRef) used_groups;    /* streaming frames: page-table index of each group the cut drew,
+                                                 once (room for every group), read by the host */
 GDR_STRUCT_END(GdrGpuFrameBuffers)
-GDR_ASSERT_SIZE(GdrGpuFrameBuffers, 96);
+GDR_ASSERT_SIZE(GdrGpuFrameBuffers, 104);
 
 /* Per-frame constants, written by the CPU into its frame's slot. */
 GDR_STRUCT_BEGIN(GdrGpuFrameGlobals)
@@ -421,7 +424,8 @@ GDR_STRUCT_BEGIN(GdrGpuFrameGlobals)
      * viewport height, as gdr/cull.h defines it; screen_scale = max(|P00|, |P11|). */
     gdr_vec4 clip_plane;
     float screen_scale;
-    gdr_uint reserved3;
+    gdr_uint stream_frame;    /* streaming with groups absent: this frame's number (never 0), stamped on
+                                 the groups its cut draws; 0: no group-use list */
     gdr_uint reserved4;
     gdr_uint reserved5;
     gdr_vec4 eye_position;    /* world space: the rendering camera's (camera_position is the culling camera's) */

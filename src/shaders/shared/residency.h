@@ -44,4 +44,18 @@ void gdr_request_group(GdrGpuFrameGlobals g, uint instance, uint mesh, uint grou
         StreamRequestsRef(GDR_FRAME.stream_requests).items[at] = GdrGpuStreamRequest(mesh, group, projected, instance);
 }
 
+// Streaming frames (stream_frame != 0): the first cluster test of the frame that draws a cluster of
+// group `group` lists the group, so that the host never evicts a page the cut draws. The stamp
+// makes each group appear once; the list has room for every group: it cannot overflow.
+void gdr_mark_group_used(GdrGpuFrameGlobals g, uint mesh, uint group)
+{
+    if (g.stream_frame == 0u || group == GDR_GPU_NO_GROUP)
+        return;
+    uint word = MeshesRef(GDR_SCENE.meshes).items[mesh].page_table_offset + group;
+    if (atomicExchange(WritableUintsRef(GDR_SCENE.group_stamps).items[word], g.stream_frame) == g.stream_frame)
+        return;
+    uint at = atomicAdd(DrawStatsRef(GDR_FRAME.draw_stats).value.groups_used, 1u);
+    WritableUintsRef(GDR_FRAME.used_groups).items[at] = word;
+}
+
 #endif

@@ -1,0 +1,597 @@
+/* Streaming in the renderer (docs/STREAMING.md): the clusters' vertices and triangles live in a
+ * page pool of fixed size; the residency (stream/residency.c) decides which pages it holds, the
+ * loader thread (stream/page_loader.c) reads and checks them, and each frame copies what arrived
+ * into the pool within its upload budget, before the frame's own commands.
+ *
+ * Each pool slot holds one page: its vertices (GdrGpuVertex), then its cluster vertex list (one
+ * word per vertex: the vertex's index in the pool), then its triangle bytes. The scene's vertex,
+ * vertex-list and triangle references all point at the pool's start, so a slot's data is addressed
+ * by offsets within it, and the shaders read streamed clusters as they read uploaded ones. The
+ * cluster records (GdrGpuMeshlet) of every cluster stay resident; a page's arrival rewrites the
+ * offsets of its clusters' records and marks its groups resident in the page table; an eviction
+ * marks them absent. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "gdr/paged_cache.h"
+#include "geometry/lod_cut.h"
+#include "render/renderer_internal.h"
+#include "stream/page_loader.h"
+#include "stream/residency.h"
+
+/* What one frame copies: regions into the pool, the records and the node counts, words to fill in the
+ * page table, all staged in the slot's staging buffer. */
+typedef struct stream_copies {
+    VkBufferCopy *pool, *records, *nodes;
+    uint32_t pool_count, record_count, node_count;
+    uint32_t *absent_words, absent_count;       /* page-table words of evicted groups */
+    uint32_t *resident_words, *resident_slots;  /* page-table words of arrived groups, and their slots */
+    uint32_t resident_count;
+    uint64_t staged;                            /* bytes of the staging buffer used */
+} stream_copies;
+
+static const gdr_paged_mesh *paged_mesh(const gdr_streaming *s, uint32_t mesh)
+{
+    return gdr_paged_cache_mesh(s->cache, mesh);
+}
+
+/* The mesh of global page `page`. */
+static uint32_t page_mesh(const gdr_streaming *s, uint32_t mesh_count, uint32_t page)
+{
+    uint32_t lo = 0, hi = mesh_count;
+    while (hi - lo > 1) {
+        uint32_t mid = (lo + hi) / 2;
+        if (s->page_base[mid] <= page)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* The mesh whose page-table words hold word `word`. */
+static uint32_t word_mesh(const gdr_gpu_scene *g, uint32_t word)
+{
+    uint32_t lo = 0, hi = g->mesh_count;
+    while (hi - lo > 1) {
+        uint32_t mid = (lo + hi) / 2;
+        if (g->cpu_meshes[mid].page_table_offset <= word)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* The scene and the cache must describe the same clusters: each mesh's groups, and each page's
+ * clusters as the sum of its groups'. */
+static gdr_status check_cache_matches(const gdr_streaming *s, const gdr_scene *scene, const char *path, gdr_error *err)
+{
+    if (gdr_paged_cache_mesh_count(s->cache) != scene->mesh_count)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: %u meshes, the scene has %u: not its cache", path,
+                             gdr_paged_cache_mesh_count(s->cache), scene->mesh_count);
+    for (uint32_t m = 0; m < scene->mesh_count; m++) {
+        const gdr_mesh_clusters *c = &scene->meshes[m].clusters;
+        const gdr_paged_mesh *pm = paged_mesh(s, m);
+        if (pm->group_count != c->group_count || (c->cluster_count > 0 && c->group_count == 0))
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: mesh %u has %u LOD groups, the scene's %u "
+                                 "(streaming needs every mesh's LOD DAG)", path, m, pm->group_count, c->group_count);
+        for (uint32_t p = 0; p < pm->page_count; p++) {
+            const gdr_page_info *info = &pm->pages[p];
+            uint64_t clusters = 0;
+            for (uint32_t k = info->first; k < info->first + info->group_count; k++)
+                clusters += c->groups[pm->page_groups[k]].cluster_count;
+            if (clusters != info->cluster_count)
+                return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: mesh %u page %u holds %u clusters, the "
+                                     "scene's groups %llu: not its cache", path, m, p, info->cluster_count,
+                                     (unsigned long long)clusters);
+        }
+    }
+    return GDR_OK;
+}
+
+/* The default budget: a quarter of the largest device-local heap, at most GDR_GEOMETRY_BUDGET_MAX. */
+static uint64_t default_budget(const gdr_renderer *r)
+{
+    VkPhysicalDeviceMemoryProperties memory;
+    vkGetPhysicalDeviceMemoryProperties(r->ctx->physical_device, &memory);
+    uint64_t largest = 0;
+    for (uint32_t i = 0; i < memory.memoryHeapCount; i++)
+        if ((memory.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) && memory.memoryHeaps[i].size > largest)
+            largest = memory.memoryHeaps[i].size;
+    uint64_t budget = largest / 4;
+    return budget < GDR_GEOMETRY_BUDGET_MAX ? budget : GDR_GEOMETRY_BUDGET_MAX;
+}
+
+static gdr_status alloc_tables(gdr_streaming *s, const gdr_scene *scene, gdr_error *err)
+{
+    uint32_t meshes = scene->mesh_count, largest_groups = 1, largest_nodes = 1;
+    s->page_base = malloc(sizeof *s->page_base * ((size_t)meshes + 1));
+    s->mesh_dirty = calloc(meshes ? meshes : 1, 1);
+    s->dirty_list = malloc(sizeof *s->dirty_list * (meshes ? meshes : 1));
+    if (!s->page_base || !s->mesh_dirty || !s->dirty_list)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "streaming: out of memory");
+    uint32_t pages = 0;
+    for (uint32_t m = 0; m < meshes; m++) {
+        s->page_base[m] = pages;
+        pages += paged_mesh(s, m)->page_count;
+        const gdr_mesh_clusters *c = &scene->meshes[m].clusters;
+        largest_groups = c->group_count > largest_groups ? c->group_count : largest_groups;
+        largest_nodes = c->lod_node_count > largest_nodes ? c->lod_node_count : largest_nodes;
+    }
+    s->page_base[meshes] = pages;
+    s->slot_page = malloc(sizeof *s->slot_page * (s->slot_count ? s->slot_count : 1));
+    s->resident = malloc(largest_groups);
+    s->absent = malloc(sizeof *s->absent * largest_nodes);
+    s->requests = malloc(sizeof *s->requests * GDR_STREAM_REQUEST_CAPACITY);
+    s->loads = malloc(sizeof *s->loads * (s->slot_count ? s->slot_count : 1));
+    uint64_t groups = 0;
+    for (uint32_t m = 0; m < meshes; m++)
+        groups += scene->meshes[m].clusters.group_count;
+    s->copies = malloc(sizeof *s->copies * (groups + s->slot_count + meshes + 1));
+    s->words = malloc(sizeof *s->words * (3 * groups + 1));
+    if (!s->slot_page || !s->resident || !s->absent || !s->requests || !s->loads || !s->copies || !s->words)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "streaming: out of memory for %u slots", s->slot_count);
+    for (uint32_t i = 0; i < s->slot_count; i++)
+        s->slot_page[i] = UINT32_MAX;
+    return GDR_OK;
+}
+
+/* Each slot's staging: the upload budget plus one page with its cluster records (a frame copies at
+ * least one page), plus every node count of the scene (the meshes whose residency changed). */
+static uint64_t staging_bytes(const gdr_streaming *s, const gdr_scene *scene)
+{
+    uint64_t largest_records = 0, nodes = 0;
+    for (uint32_t m = 0; m < scene->mesh_count; m++) {
+        const gdr_paged_mesh *pm = paged_mesh(s, m);
+        for (uint32_t p = 0; p < pm->page_count; p++) {
+            uint64_t bytes = (uint64_t)pm->pages[p].cluster_count * sizeof(GdrGpuMeshlet);
+            largest_records = bytes > largest_records ? bytes : largest_records;
+        }
+        nodes += scene->meshes[m].clusters.lod_node_count;
+    }
+    return s->upload_budget + s->slot_bytes + largest_records + 4 * nodes;
+}
+
+gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr_streaming_desc *desc, gdr_error *err)
+{
+    gdr_streaming *s = &r->stream;
+    if (!desc || !desc->cache_path)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "streaming: no cache path");
+    if (desc->geometry_budget_bytes > GDR_GEOMETRY_BUDGET_MAX)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "streaming: a geometry budget of %llu MiB is over the "
+                             "%llu MiB the pool's 32-bit offsets reach",
+                             (unsigned long long)(desc->geometry_budget_bytes >> 20),
+                             (unsigned long long)(GDR_GEOMETRY_BUDGET_MAX >> 20));
+    s->enabled = true;
+    s->scene = scene;
+    s->wait_for_loads = desc->wait_for_loads;
+    s->upload_budget = desc->upload_budget_bytes ? desc->upload_budget_bytes : GDR_UPLOAD_BUDGET_DEFAULT;
+    gdr_status status = gdr_paged_cache_open(desc->cache_path, &s->cache, err);
+    if (status == GDR_OK)
+        status = check_cache_matches(s, scene, desc->cache_path, err);
+    gdr_residency_desc res = {.cache = s->cache,
+                              .budget_bytes = desc->geometry_budget_bytes ? desc->geometry_budget_bytes
+                                                                          : default_budget(r),
+                              .upload_budget_bytes = s->upload_budget};
+    if (status == GDR_OK)
+        status = gdr_residency_create(&res, &s->residency, err);
+    if (status == GDR_OK) {
+        s->slot_count = gdr_residency_slot_count(s->residency);
+        s->slot_bytes = gdr_residency_slot_bytes(s->residency);
+        status = alloc_tables(s, scene, err);
+    }
+    if (status == GDR_OK)
+        status = gdr_page_loader_create(s->cache, &s->loader, err);
+    if (status == GDR_OK)
+        status = gdr_vk_buffer_create(&r->allocator, (VkDeviceSize)s->slot_count * s->slot_bytes,
+                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                      GDR_VK_BUFFER_DEVICE, &s->pool, err);
+    s->staging_bytes = staging_bytes(s, scene);
+    s->stats.enabled = true;
+    s->stats.slot_count = s->slot_count;
+    s->stats.slot_bytes = s->slot_bytes;
+    s->stats.pool_bytes = (uint64_t)s->slot_count * s->slot_bytes;
+    r->scene.streamed = true;
+    return status;
+}
+
+gdr_status gdr_streaming_slot_create(gdr_renderer *r, gdr_frame_slot *slot, gdr_error *err)
+{
+    VkCommandBufferAllocateInfo alloc = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
+                                         .commandPool = r->ctx->command_pool,
+                                         .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY, .commandBufferCount = 1};
+    GDR_VK_TRY(err, vkAllocateCommandBuffers(r->ctx->device, &alloc, &slot->stream_cmd));
+    return gdr_vk_buffer_create(&r->allocator, r->stream.staging_bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                GDR_VK_BUFFER_UPLOAD, &slot->stream_staging, err);
+}
+
+void gdr_streaming_destroy(gdr_renderer *r)
+{
+    gdr_streaming *s = &r->stream;
+    gdr_page_loader_destroy(s->loader);
+    for (uint32_t i = 0; i < s->pending_count; i++)
+        gdr_page_free(&s->pending[i].page);
+    gdr_residency_destroy(s->residency);
+    gdr_paged_cache_close(s->cache);
+    if (r->ctx)
+        gdr_vk_buffer_destroy(r->ctx, &s->pool);
+    free(s->pending), free(s->slot_page), free(s->page_base), free(s->mesh_dirty), free(s->resident);
+    free(s->absent), free(s->requests), free(s->loads), free(s->dirty_list), free(s->copies), free(s->words);
+    memset(s, 0, sizeof *s);
+}
+
+/* --- one page into its slot ------------------------------------------------------------------- */
+
+static void mark_dirty(gdr_streaming *s, uint32_t mesh)
+{
+    if (!s->mesh_dirty[mesh])
+        s->dirty_list[s->dirty_count++] = mesh;
+    s->mesh_dirty[mesh] = 1;
+}
+
+static void *stage(gdr_frame_slot *slot, stream_copies *c, uint64_t bytes)
+{
+    void *at = (uint8_t *)slot->stream_staging.mapped + c->staged;
+    c->staged += bytes;
+    return at;
+}
+
+/* The decoded page against what the scene says its groups hold (cluster by cluster) and the slot's
+ * size. NULL when it matches, else what differs. */
+static const char *page_mismatch(const gdr_streaming *s, const gdr_page *page)
+{
+    const gdr_paged_mesh *pm = paged_mesh(s, page->mesh);
+    const gdr_page_info *info = &pm->pages[page->page];
+    const gdr_mesh_clusters *c = &s->scene->meshes[page->mesh].clusters;
+    if ((uint64_t)page->vertex_count * (sizeof(GdrGpuVertex) + 4) + page->triangle_byte_count > s->slot_bytes)
+        return "larger than a pool slot";
+    if (page->cluster_count != info->cluster_count)
+        return "cluster count differs from its index";
+    uint32_t j = 0;
+    for (uint32_t k = info->first; k < info->first + info->group_count; k++) {
+        const gdr_cluster_group *group = &c->groups[pm->page_groups[k]];
+        for (uint32_t i = group->first_cluster; i < group->first_cluster + group->cluster_count; i++, j++) {
+            const gdr_page_cluster *pc = &page->clusters[j];
+            if (pc->group != pm->page_groups[k] || pc->vertex_count != c->clusters[i].vertex_count ||
+                pc->triangle_count != c->clusters[i].triangle_count)
+                return "clusters differ from the scene's";
+        }
+    }
+    return NULL;
+}
+
+/* Bytes a page's copy stages: its data and its clusters' records. */
+static uint64_t page_upload_bytes(const gdr_page *page)
+{
+    return (uint64_t)page->vertex_count * (sizeof(GdrGpuVertex) + 4) + page->triangle_byte_count +
+           (uint64_t)page->cluster_count * sizeof(GdrGpuMeshlet);
+}
+
+/* Stages page `page` for pool slot `pool_slot`: its data, its clusters' records with offsets into the
+ * slot, and its groups' page-table words. */
+static void stage_page(gdr_renderer *r, gdr_frame_slot *slot, stream_copies *c, const gdr_page *page,
+                       uint32_t pool_slot)
+{
+    gdr_streaming *s = &r->stream;
+    gdr_gpu_scene *g = &r->scene;
+    uint64_t base = (uint64_t)pool_slot * s->slot_bytes;
+    uint32_t nv = page->vertex_count;
+    uint64_t data_bytes = (uint64_t)nv * (sizeof(GdrGpuVertex) + 4) + page->triangle_byte_count;
+    uint64_t at = c->staged;
+    uint8_t *data = stage(slot, c, data_bytes);
+    for (uint32_t v = 0; v < nv; v++) {
+        const gdr_page_vertex *pv = &page->vertices[v];
+        GdrGpuVertex gv = {pv->position, pv->normal, pv->uv};
+        memcpy(data + sizeof gv * v, &gv, sizeof gv);
+        uint32_t index = (uint32_t)(base / sizeof(GdrGpuVertex)) + v; /* slots are 256-byte aligned */
+        memcpy(data + sizeof gv * nv + 4 * v, &index, 4);
+    }
+    memcpy(data + (sizeof(GdrGpuVertex) + 4) * nv, page->triangles, page->triangle_byte_count);
+    c->pool[c->pool_count++] = (VkBufferCopy){at, base, data_bytes};
+
+    const gdr_paged_mesh *pm = paged_mesh(s, page->mesh);
+    const gdr_page_info *info = &pm->pages[page->page];
+    const gdr_mesh_clusters *mc = &s->scene->meshes[page->mesh].clusters;
+    uint32_t list_base = (uint32_t)((base + sizeof(GdrGpuVertex) * nv) / 4), triangle_base = (uint32_t)(base + 36ull * nv);
+    uint32_t j = 0;
+    for (uint32_t k = info->first; k < info->first + info->group_count; k++) {
+        uint32_t group = pm->page_groups[k];
+        const gdr_cluster_group *gr = &mc->groups[group];
+        uint32_t first = g->cpu_meshes[page->mesh].meshlet_offset + gr->first_cluster;
+        for (uint32_t i = 0; i < gr->cluster_count; i++, j++) {
+            g->cpu_meshlets[first + i].vertex_offset = list_base + page->clusters[j].vertex_offset;
+            g->cpu_meshlets[first + i].triangle_offset = triangle_base + page->clusters[j].triangle_offset;
+        }
+        uint64_t bytes = sizeof(GdrGpuMeshlet) * (uint64_t)gr->cluster_count;
+        uint64_t from = c->staged;
+        memcpy(stage(slot, c, bytes), &g->cpu_meshlets[first], bytes);
+        c->records[c->record_count++] = (VkBufferCopy){from, sizeof(GdrGpuMeshlet) * (uint64_t)first, bytes};
+        c->resident_words[c->resident_count] = g->cpu_meshes[page->mesh].page_table_offset + group;
+        c->resident_slots[c->resident_count++] = pool_slot;
+    }
+    s->slot_page[pool_slot] = s->page_base[page->mesh] + page->page;
+    mark_dirty(s, page->mesh);
+}
+
+/* --- the frame's work ------------------------------------------------------------------------- */
+
+/* The slot's previous frame, read back: the groups its cut drew (their pages' last use) and the
+ * groups it asked for. Returns the requests' count. */
+static uint32_t read_slot_results(gdr_renderer *r, gdr_frame_slot *slot)
+{
+    gdr_streaming *s = &r->stream;
+    gdr_gpu_scene *g = &r->scene;
+    if (!slot->recorded && !slot->resubmitted && slot->stream_frame == 0 && s->frame == 0)
+        return 0;
+    GdrGpuDrawStats gpu;
+    memcpy(&gpu, slot->stats_readback.mapped, sizeof gpu);
+    uint32_t used = slot->stream_frame ? gpu.groups_used : 0;
+    used = used < g->group_total ? used : g->group_total;
+    const uint32_t *words = slot->used_groups.mapped;
+    for (uint32_t i = 0; i < used; i++) {
+        uint32_t m = word_mesh(g, words[i]);
+        uint32_t group = words[i] - g->cpu_meshes[m].page_table_offset;
+        if (group < paged_mesh(s, m)->group_count)
+            gdr_residency_mark_used(s->residency, slot->stream_frame, m, paged_mesh(s, m)->groups[group].page);
+    }
+    s->stats.groups_used = used;
+    uint32_t n = gpu.stream_requests < GDR_STREAM_REQUEST_CAPACITY ? gpu.stream_requests : GDR_STREAM_REQUEST_CAPACITY;
+    const GdrGpuStreamRequest *q = slot->stream_requests.mapped;
+    for (uint32_t i = 0; i < n; i++)
+        s->requests[i] = (gdr_stream_request){q[i].mesh, q[i].group, q[i].priority};
+    return n;
+}
+
+/* Pages whose slot the residency took back (evicted, or removed with a damaged page): their groups
+ * become absent. Walks the pool, not the scene. */
+static void find_evictions(gdr_renderer *r, stream_copies *c)
+{
+    gdr_streaming *s = &r->stream;
+    for (uint32_t slot = 0; slot < s->slot_count; slot++) {
+        uint32_t page = s->slot_page[slot];
+        if (page == UINT32_MAX)
+            continue;
+        uint32_t m = page_mesh(s, r->scene.mesh_count, page), local = page - s->page_base[m];
+        if (gdr_residency_page_slot(s->residency, m, local) == slot)
+            continue;
+        const gdr_paged_mesh *pm = paged_mesh(s, m);
+        const gdr_page_info *info = &pm->pages[local];
+        for (uint32_t k = info->first; k < info->first + info->group_count; k++)
+            c->absent_words[c->absent_count++] = r->scene.cpu_meshes[m].page_table_offset + pm->page_groups[k];
+        s->slot_page[slot] = UINT32_MAX;
+        mark_dirty(s, m);
+    }
+}
+
+static gdr_status keep_pending(gdr_streaming *s, const gdr_page_result *result, gdr_error *err)
+{
+    if (s->pending_count == s->pending_capacity) {
+        uint32_t capacity = s->pending_capacity ? 2 * s->pending_capacity : 64;
+        gdr_page_result *grown = realloc(s->pending, sizeof *grown * capacity);
+        if (!grown)
+            return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "streaming: out of memory for loaded pages");
+        s->pending = grown;
+        s->pending_capacity = capacity;
+    }
+    s->pending[s->pending_count++] = *result;
+    return GDR_OK;
+}
+
+/* What the loader finished, into the pending list; damaged pages are refused here (their groups
+ * stay absent, and the pages depending on them are taken back). */
+static gdr_status collect_loads(gdr_streaming *s, gdr_error *err)
+{
+    gdr_page_result result;
+    while (gdr_page_loader_collect(s->loader, s->wait_for_loads, &result, 1) == 1) {
+        const char *why = result.status == GDR_OK ? page_mismatch(s, &result.page) : NULL;
+        if (result.status == GDR_OK && !why) {
+            gdr_status status = keep_pending(s, &result, err);
+            if (status != GDR_OK) {
+                gdr_page_free(&result.page);
+                return status;
+            }
+            continue;
+        }
+        if (why)
+            snprintf(s->stats.refused, sizeof s->stats.refused, "mesh %u page %u: %s", result.load.mesh,
+                     result.load.page, why);
+        else
+            snprintf(s->stats.refused, sizeof s->stats.refused, "%s", result.error.message);
+        s->stats.pages_refused++;
+        gdr_residency_failed(s->residency, result.load.mesh, result.load.page);
+        gdr_page_free(&result.page);
+    }
+    return GDR_OK;
+}
+
+/* Pending pages into their slots while the upload budget lasts (at least one a frame); pages the
+ * residency no longer plans (taken back meanwhile) are dropped. */
+static void upload_pending(gdr_renderer *r, gdr_frame_slot *slot, stream_copies *c)
+{
+    gdr_streaming *s = &r->stream;
+    uint32_t done = 0;
+    uint64_t bytes = 0;
+    for (; done < s->pending_count; done++) {
+        gdr_page *page = &s->pending[done].page;
+        uint32_t pool_slot = gdr_residency_planned_slot(s->residency, page->mesh, page->page);
+        if (pool_slot == UINT32_MAX) {
+            gdr_page_free(page);
+            continue;
+        }
+        uint64_t need = page_upload_bytes(page);
+        if (s->stats.uploads > 0 && bytes + need > s->upload_budget)
+            break;
+        stage_page(r, slot, c, page, pool_slot);
+        gdr_residency_loaded(s->residency, page->mesh, page->page);
+        bytes += need;
+        s->stats.uploads++;
+        gdr_page_free(page);
+    }
+    memmove(s->pending, s->pending + done, sizeof *s->pending * (s->pending_count - done));
+    s->pending_count -= done;
+    s->stats.upload_bytes = bytes;
+}
+
+/* The node counts of every mesh whose residency changed, and the scene's absent total. */
+static gdr_status stage_node_counts(gdr_renderer *r, gdr_frame_slot *slot, stream_copies *c, gdr_error *err)
+{
+    gdr_streaming *s = &r->stream;
+    gdr_status status = GDR_OK;
+    for (uint32_t i = 0; i < s->dirty_count && status == GDR_OK; i++) {
+        uint32_t m = s->dirty_list[i];
+        s->mesh_dirty[m] = 0;
+        const gdr_mesh_clusters *mc = &s->scene->meshes[m].clusters;
+        uint32_t absent = 0;
+        for (uint32_t group = 0; group < mc->group_count; group++) {
+            s->resident[group] = (uint8_t)gdr_residency_group_resident(s->residency, m, group);
+            absent += !s->resident[group];
+        }
+        gdr_lod_nodes_count_absent_refined(mc, s->resident, s->absent);
+        uint64_t bytes = 4ull * mc->lod_node_count;
+        uint64_t from = c->staged;
+        memcpy(stage(slot, c, bytes), s->absent, bytes);
+        c->nodes[c->node_count++] = (VkBufferCopy){from, 4ull * r->scene.cpu_meshes[m].lod_node_offset, bytes};
+        status = gdr_page_table_set_absent(r, m, absent, err);
+    }
+    s->dirty_count = 0;
+    return status;
+}
+
+/* The frame's copies into stream_cmd: the evicted groups' words first, then (after a barrier, since
+ * an evicted page may come back in the same frame) the pages, records, node counts and the arrived
+ * groups' words; all after every earlier command's reads and before every later command. */
+static gdr_status record_copies(gdr_renderer *r, gdr_frame_slot *slot, const stream_copies *c, gdr_error *err)
+{
+    gdr_gpu_scene *g = &r->scene;
+    VkCommandBuffer cmd = slot->stream_cmd;
+    GDR_VK_TRY(err, vkResetCommandBuffer(cmd, 0));
+    VkCommandBufferBeginInfo begin = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+                                      .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
+    GDR_VK_TRY(err, vkBeginCommandBuffer(cmd, &begin));
+    const gdr_vk_scope transfer = {VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT};
+    gdr_vk_memory_barrier(cmd, (gdr_vk_scope){VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                                              VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT}, transfer);
+    for (uint32_t i = 0; i < c->absent_count; i++)
+        vkCmdFillBuffer(cmd, g->page_table.buffer, 4ull * c->absent_words[i], 4, GDR_GPU_PAGE_ABSENT);
+    if (c->absent_count)
+        gdr_vk_memory_barrier(cmd, transfer, transfer);
+    VkBuffer staging = slot->stream_staging.buffer;
+    if (c->pool_count)
+        vkCmdCopyBuffer(cmd, staging, r->stream.pool.buffer, c->pool_count, c->pool);
+    if (c->record_count)
+        vkCmdCopyBuffer(cmd, staging, g->meshlets.buffer, c->record_count, c->records);
+    if (c->node_count)
+        vkCmdCopyBuffer(cmd, staging, g->node_absent_refined.buffer, c->node_count, c->nodes);
+    for (uint32_t i = 0; i < c->resident_count; i++)
+        vkCmdFillBuffer(cmd, g->page_table.buffer, 4ull * c->resident_words[i], 4, c->resident_slots[i]);
+    gdr_vk_memory_barrier(cmd, transfer, (gdr_vk_scope){VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                                                        VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT});
+    GDR_VK_TRY(err, vkEndCommandBuffer(cmd));
+    return GDR_OK;
+}
+
+static stream_copies frame_copies(gdr_renderer *r)
+{
+    gdr_streaming *s = &r->stream;
+    uint32_t groups = r->scene.group_total;
+    return (stream_copies){.pool = s->copies, .records = s->copies + s->slot_count,
+                           .nodes = s->copies + s->slot_count + groups, .absent_words = s->words,
+                           .resident_words = s->words + groups, .resident_slots = s->words + 2 * (size_t)groups};
+}
+
+/* The residency's figures into the statistics. */
+static void update_stats(gdr_streaming *s)
+{
+    gdr_residency_stats rs = gdr_residency_get_stats(s->residency);
+    s->stats.resident_bytes = rs.resident_bytes;
+    s->stats.resident_pages = rs.resident_pages;
+    s->stats.distinct_requests = rs.requests;
+    s->stats.loads = rs.loads;
+    s->stats.evictions = rs.evictions;
+    s->stats.deferred = rs.deferred;
+    s->stats.frames_since_change = rs.frames_since_change;
+    s->stats.evicted_in_use = rs.evicted_in_use;
+    s->stats.pending = s->pending_count + gdr_page_loader_pending(s->loader);
+    s->stats.uploads_total += s->stats.uploads;
+    s->stats.upload_bytes_total += s->stats.upload_bytes;
+    s->stats.evictions_total += rs.evictions;
+}
+
+gdr_status gdr_streaming_begin_frame(gdr_renderer *r, gdr_frame_slot *slot, gdr_error *err)
+{
+    gdr_streaming *s = &r->stream;
+    slot->stream_copies = false;
+    if (!s->enabled)
+        return GDR_OK;
+    uint32_t frame = ++s->frame;
+    s->stats.uploads = 0;
+    s->stats.upload_bytes = 0;
+    uint32_t request_count = slot->stream_results ? read_slot_results(r, slot) : 0;
+    uint32_t load_count = 0;
+    gdr_residency_plan(s->residency, frame, s->requests, request_count, s->loads, s->slot_count, &load_count);
+    gdr_status status = gdr_page_loader_submit(s->loader, s->loads, load_count, err);
+    if (status == GDR_OK)
+        status = collect_loads(s, err);
+    stream_copies c = frame_copies(r);
+    if (status == GDR_OK) {
+        find_evictions(r, &c);
+        upload_pending(r, slot, &c);
+        status = stage_node_counts(r, slot, &c, err);
+    }
+    if (status == GDR_OK && (c.absent_count || c.pool_count || c.node_count)) {
+        status = record_copies(r, slot, &c, err);
+        slot->stream_copies = status == GDR_OK;
+    }
+    /* The group-use list only where something can be evicted for a request: some group absent. */
+    slot->stream_frame = r->scene.absent_groups > 0 ? frame : 0;
+    slot->stream_results = true;
+    update_stats(s);
+    return status;
+}
+
+/* Before the first frame: every group absent, then every mesh's coarsest page (pinned) read, checked
+ * and copied, waiting for them: the first frame draws every mesh at its coarsest at least. */
+gdr_status gdr_streaming_start(gdr_renderer *r, gdr_error *err)
+{
+    gdr_streaming *s = &r->stream;
+    gdr_gpu_scene *g = &r->scene;
+    uint32_t *absent = malloc(sizeof *absent * (g->group_total ? g->group_total : 1));
+    if (!absent)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "streaming: out of memory");
+    for (uint32_t i = 0; i < g->group_total; i++)
+        absent[i] = GDR_GPU_PAGE_ABSENT;
+    gdr_status status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->page_table, 0, absent,
+                                             sizeof *absent * g->group_total, err);
+    free(absent);
+    bool wait = s->wait_for_loads;
+    s->wait_for_loads = true;
+    gdr_frame_slot *slot = &r->slots[0];
+    if (status == GDR_OK) {
+        for (uint32_t m = 0; m < g->mesh_count; m++)
+            mark_dirty(s, m);
+        status = gdr_streaming_begin_frame(r, slot, err);
+    }
+    /* The pinned pages come without the upload budget: copy until none is left. */
+    while (status == GDR_OK && slot->stream_copies) {
+        VkCommandBufferSubmitInfo info = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO,
+                                          .commandBuffer = slot->stream_cmd};
+        VkSubmitInfo2 submit = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2, .commandBufferInfoCount = 1,
+                                .pCommandBufferInfos = &info};
+        if (vkQueueSubmit2(r->ctx->queue, 1, &submit, VK_NULL_HANDLE) != VK_SUCCESS ||
+            vkQueueWaitIdle(r->ctx->queue) != VK_SUCCESS)
+            return gdr_error_set(err, GDR_ERROR_VULKAN, "streaming: the first pages' upload failed");
+        slot->stream_copies = false;
+        if (s->pending_count == 0)
+            break;
+        slot->stream_results = false; /* no frame ran: nothing to read back */
+        status = gdr_streaming_begin_frame(r, slot, err);
+    }
+    slot->stream_results = false;
+    s->wait_for_loads = wait;
+    for (uint32_t m = 0; status == GDR_OK && m < g->mesh_count; m++)
+        if (gdr_residency_page_slot(s->residency, m, 0) == UINT32_MAX && paged_mesh(s, m)->page_count)
+            status = gdr_error_set(err, GDR_ERROR_PARSE, "streaming: mesh %u's coarsest page could not be read: %s", m,
+                                   s->stats.refused);
+    return status;
+}
