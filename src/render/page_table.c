@@ -1,8 +1,9 @@
 /* The residency tables the traversal and the cluster tests read (shared/residency.h): a word per
  * group of every mesh (the page table: GDR_GPU_PAGE_ABSENT, or resident) and a count per LOD node
- * of the clusters below whose refined group is absent. The scene is uploaded whole, so every group
- * starts resident; gdr_renderer_debug_set_residency marks groups absent as a streaming residency
- * would, to check the traversal's cut over resident groups against the CPU's. */
+ * of the clusters below whose refined group is absent, and the stamps of the groups a streaming
+ * frame drew. A scene uploaded whole starts with every group resident (gdr_renderer_debug_set_
+ * residency marks groups absent, to check the traversal's cut over resident groups against the
+ * CPU's); a streamed scene's tables come from its residency (streaming.c). */
 #include <stdlib.h>
 #include <string.h>
 
