@@ -1,0 +1,191 @@
+/* Streaming on the GPU (docs/STREAMING.md, "Benchmarks"): a paged cache drawn whole and streamed
+ * through a page pool of --budget MiB, from the scene's camera, then after a jump to the far side
+ * of the scene. Reports the time from the streamed set-up to the first frame, the frames and time
+ * to converge (no request left and residency unchanged for 10 frames), the converged GPU frame
+ * time against the whole upload's (where the whole fits), and the uploads per frame.
+ *     stream_bench SCENE.gdrc --budget MIB [--upload MIB] [--width W] [--height H] [--no-whole]
+ *                  [--json FILE]
+ * SCENE.gdrc: written with pages (gdr build --pages). GPU figures: timestamp queries. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "gdr/gdr.h"
+
+#define MAX_FRAMES 600
+#define SETTLED_FRAMES 10
+#define TIMED_FRAMES 30
+#define WARM_FRAMES 300 /* before the timed frames: the GPU's clocks up after the CPU-only set-up */
+
+static double now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
+}
+
+typedef struct view_result {
+    uint32_t frames_to_converge;
+    double converge_ms;       /* wall time of those frames */
+    double frame_gpu_ms;      /* mean over TIMED_FRAMES converged frames */
+    uint64_t max_upload_bytes; /* the largest frame's uploads */
+    uint64_t uploads, evictions;
+    uint32_t resident_pages, absent_groups;
+    uint64_t triangles;        /* drawn in the last frame */
+    uint32_t clusters;
+} view_result;
+
+/* Frames of one view until it converges, then WARM_FRAMES, then TIMED_FRAMES more, timed. */
+static int converge(gdr_renderer *r, const gdr_frame_desc *frame, view_result *out)
+{
+    gdr_error err = {0};
+    gdr_frame_stats stats;
+    *out = (view_result){0};
+    uint64_t uploads0 = 0, evictions0 = 0;
+    double start = now_ms();
+    uint32_t f = 0;
+    for (; f < MAX_FRAMES; f++) {
+        if (gdr_renderer_render(r, frame, 1, &stats, &err) != GDR_OK) {
+            fprintf(stderr, "stream_bench: %s\n", err.message);
+            return 0;
+        }
+        if (f == 0) {
+            uploads0 = stats.streaming.uploads_total - stats.streaming.uploads;
+            evictions0 = stats.streaming.evictions_total - stats.streaming.evictions;
+        }
+        if (stats.streaming.upload_bytes > out->max_upload_bytes)
+            out->max_upload_bytes = stats.streaming.upload_bytes;
+        if (!stats.streaming.enabled ||
+            (stats.streaming.requests == 0 && stats.streaming.frames_since_change >= SETTLED_FRAMES))
+            break;
+    }
+    out->frames_to_converge = f + 1;
+    out->converge_ms = now_ms() - start;
+    out->uploads = stats.streaming.uploads_total - uploads0;
+    out->evictions = stats.streaming.evictions_total - evictions0;
+    if (gdr_renderer_render(r, frame, WARM_FRAMES, &stats, &err) != GDR_OK ||
+        gdr_renderer_render(r, frame, TIMED_FRAMES, &stats, &err) != GDR_OK) {
+        fprintf(stderr, "stream_bench: %s\n", err.message);
+        return 0;
+    }
+    out->frame_gpu_ms = stats.gpu_ms_per_frame;
+    out->resident_pages = stats.streaming.resident_pages;
+    out->absent_groups = (uint32_t)stats.streaming.absent_groups;
+    out->triangles = stats.triangles;
+    out->clusters = stats.meshlets_visible;
+    return 1;
+}
+
+static void print_view(FILE *out, const char *name, const view_result *v, const char *tail)
+{
+    fprintf(out, "    \"%s\": {\"frames_to_converge\": %u, \"converge_ms\": %.1f, \"frame_gpu_ms\": %.4f, "
+                 "\"max_upload_bytes\": %llu, \"uploads\": %llu, \"evictions\": %llu, \"resident_pages\": %u, "
+                 "\"absent_groups\": %u, \"triangles\": %llu, \"clusters\": %u}%s\n", name, v->frames_to_converge,
+            v->converge_ms, v->frame_gpu_ms, (unsigned long long)v->max_upload_bytes, (unsigned long long)v->uploads,
+            (unsigned long long)v->evictions, v->resident_pages, v->absent_groups,
+            (unsigned long long)v->triangles, v->clusters, tail);
+}
+
+int main(int argc, char **argv)
+{
+    const char *path = NULL, *json = NULL;
+    uint32_t budget_mib = 0, upload_mib = 16, width = 2560, height = 1440;
+    int whole = 1;
+    for (int i = 1; i < argc; i++) {
+        const char *value = i + 1 < argc ? argv[i + 1] : NULL;
+        if (strcmp(argv[i], "--budget") == 0 && value)
+            budget_mib = (uint32_t)strtoul(argv[++i], NULL, 10);
+        else if (strcmp(argv[i], "--upload") == 0 && value)
+            upload_mib = (uint32_t)strtoul(argv[++i], NULL, 10);
+        else if (strcmp(argv[i], "--width") == 0 && value)
+            width = (uint32_t)strtoul(argv[++i], NULL, 10);
+        else if (strcmp(argv[i], "--height") == 0 && value)
+            height = (uint32_t)strtoul(argv[++i], NULL, 10);
+        else if (strcmp(argv[i], "--json") == 0 && value)
+            json = argv[++i];
+        else if (strcmp(argv[i], "--no-whole") == 0)
+            whole = 0;
+        else if (argv[i][0] != '-' && !path)
+            path = argv[i];
+        else {
+            fprintf(stderr, "usage: stream_bench SCENE.gdrc --budget MIB [--upload MIB] [--width W] [--height H] "
+                            "[--no-whole] [--json FILE]\n");
+            return 2;
+        }
+    }
+    if (!path || budget_mib == 0 || budget_mib > 4096 || upload_mib == 0 || !width || !height) {
+        fprintf(stderr, "stream_bench: needs SCENE.gdrc and --budget MIB in [1, 4096]\n");
+        return 2;
+    }
+    gdr_error err = {0};
+    gdr_scene *scene = NULL;
+    gdr_load_options load = {.no_progress = 1};
+    double t_load = now_ms();
+    if (gdr_scene_load(path, &load, &scene, &err) != GDR_OK) {
+        fprintf(stderr, "stream_bench: %s\n", err.message);
+        return 1;
+    }
+    t_load = now_ms() - t_load;
+    /* View A: the scene's camera; view B: the jump to the far side, looking back. */
+    gdr_camera a = scene->camera_count ? scene->cameras[0] : gdr_scene_framing_camera(scene);
+    float centre_z = 0.0f;
+    for (uint32_t i = 0; i < scene->instance_count; i++)
+        centre_z += scene->instances[i].transform.m[14] / (float)scene->instance_count;
+    gdr_camera b = a;
+    b.position.z = 2.0f * centre_z - a.position.z;
+    b.rotation = gdr_quat_mul(gdr_quat_from_axis_angle((gdr_vec3){0, 1, 0}, 3.14159265f), a.rotation);
+    gdr_frame_desc frame = {.camera = a, .pipeline = GDR_PIPELINE_MESH, .lod_error_px = 1.0f};
+    gdr_frame_desc jump = frame;
+    jump.camera = b;
+
+    gdr_renderer_desc desc = {.width = width, .height = height};
+    gdr_renderer *r = NULL;
+    view_result whole_a = {0}, whole_b = {0}, near = {0}, far = {0};
+    gdr_frame_stats stats = {0};
+    gdr_streaming_desc stream = {.cache_path = path, .geometry_budget_bytes = (uint64_t)budget_mib << 20,
+                                 .upload_budget_bytes = (uint64_t)upload_mib << 20};
+    double t_setup = 0, t_first = 0;
+    int ok = gdr_renderer_create(&desc, &r, &err) == GDR_OK;
+    if (ok) {
+        double t0 = now_ms();
+        ok = gdr_renderer_set_scene_streamed(r, scene, &stream, &err) == GDR_OK;
+        t_setup = now_ms() - t0;
+        ok = ok && gdr_renderer_render(r, &frame, 1, &stats, &err) == GDR_OK;
+        t_first = now_ms() - t0;
+        ok = ok && converge(r, &frame, &near) && converge(r, &jump, &far);
+    }
+    if (!ok)
+        fprintf(stderr, "stream_bench: streamed: %s\n", err.message);
+    gdr_renderer_destroy(r);
+    r = NULL;
+    /* The whole upload after the streamed run, whose frames have brought the GPU's clocks up. */
+    if (ok && whole) {
+        ok = gdr_renderer_create(&desc, &r, &err) == GDR_OK && gdr_renderer_set_scene(r, scene, &err) == GDR_OK &&
+             converge(r, &frame, &whole_a) && converge(r, &jump, &whole_b);
+        if (!ok)
+            fprintf(stderr, "stream_bench: whole upload: %s\n", err.message);
+        gdr_renderer_destroy(r);
+        r = NULL;
+    }
+    FILE *out = json ? fopen(json, "w") : stdout;
+    if (ok && out) {
+        fprintf(out, "{\n    \"scene\": \"%s\", \"device\": \"%s\", \"driver\": \"%s\", \"width\": %u, \"height\": %u,\n",
+                path, stats.device, stats.driver, width, height);
+        fprintf(out, "    \"budget_mib\": %u, \"upload_mib\": %u, \"pool_bytes\": %llu, \"slot_bytes\": %u, "
+                     "\"slots\": %u, \"scene_load_ms\": %.1f, \"streamed_setup_ms\": %.1f, \"first_frame_ms\": %.1f,\n",
+                budget_mib, upload_mib, (unsigned long long)stats.streaming.pool_bytes, stats.streaming.slot_bytes,
+                stats.streaming.slot_count, t_load, t_setup, t_first);
+        if (whole) {
+            print_view(out, "whole_view", &whole_a, ",");
+            print_view(out, "whole_jump", &whole_b, ",");
+        }
+        print_view(out, "streamed_view", &near, ",");
+        print_view(out, "streamed_jump", &far, "");
+        fprintf(out, "}\n");
+    }
+    if (out && out != stdout)
+        fclose(out);
+    gdr_scene_destroy(scene);
+    return ok && out ? 0 : 1;
+}
