@@ -182,7 +182,7 @@ gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr
         status = alloc_tables(s, scene, err);
     }
     if (status == GDR_OK)
-        status = gdr_page_loader_create(s->cache, &s->loader, err);
+        status = gdr_page_loader_create(s->cache, 0, &s->loader, err);
     if (status == GDR_OK)
         status = gdr_vk_buffer_create(&r->allocator, (VkDeviceSize)s->slot_count * s->slot_bytes,
                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,

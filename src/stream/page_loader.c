@@ -1,14 +1,16 @@
-/* The page loader thread (page_loader.h): a queue of loads, a worker that decodes them in order,
- * results handed back in submission order. */
+/* The page loader (page_loader.h): a queue of loads, worker threads that each take the next load
+ * and decode it, results handed back in submission order. */
 #include "stream/page_loader.h"
 
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 struct gdr_page_loader {
     gdr_paged_cache *cache;
-    pthread_t thread;
+    pthread_t threads[GDR_PAGE_LOADER_MAX_THREADS];
+    uint32_t thread_count;
     pthread_mutex_t lock;
     pthread_cond_t work, done;
     gdr_page_result *jobs; /* [collected, submitted): queued, being decoded or finished */
@@ -40,7 +42,15 @@ static void *loader_main(void *user)
     return NULL;
 }
 
-gdr_status gdr_page_loader_create(gdr_paged_cache *cache, gdr_page_loader **out, gdr_error *err)
+/* 0: one per processor but the one the frames run on, at least one, at most the maximum. */
+static uint32_t worker_count(uint32_t asked)
+{
+    long processors = sysconf(_SC_NPROCESSORS_ONLN);
+    uint32_t n = asked ? asked : processors > 2 ? (uint32_t)(processors - 1) : 1u;
+    return n < GDR_PAGE_LOADER_MAX_THREADS ? n : GDR_PAGE_LOADER_MAX_THREADS;
+}
+
+gdr_status gdr_page_loader_create(gdr_paged_cache *cache, uint32_t threads, gdr_page_loader **out, gdr_error *err)
 {
     *out = NULL;
     gdr_page_loader *l = calloc(1, sizeof *l);
@@ -50,12 +60,12 @@ gdr_status gdr_page_loader_create(gdr_paged_cache *cache, gdr_page_loader **out,
     pthread_mutex_init(&l->lock, NULL);
     pthread_cond_init(&l->work, NULL);
     pthread_cond_init(&l->done, NULL);
-    if (pthread_create(&l->thread, NULL, loader_main, l) != 0) {
-        pthread_mutex_destroy(&l->lock);
-        pthread_cond_destroy(&l->work);
-        pthread_cond_destroy(&l->done);
-        free(l);
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "page loader: cannot start its thread");
+    uint32_t wanted = worker_count(threads);
+    while (l->thread_count < wanted && pthread_create(&l->threads[l->thread_count], NULL, loader_main, l) == 0)
+        l->thread_count++;
+    if (l->thread_count == 0) {
+        gdr_page_loader_destroy(l);
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "page loader: cannot start a thread");
     }
     *out = l;
     return GDR_OK;
@@ -69,7 +79,8 @@ void gdr_page_loader_destroy(gdr_page_loader *l)
     l->quit = 1;
     pthread_cond_broadcast(&l->work);
     pthread_mutex_unlock(&l->lock);
-    pthread_join(l->thread, NULL);
+    for (uint32_t i = 0; i < l->thread_count; i++)
+        pthread_join(l->threads[i], NULL);
     for (uint32_t i = l->collected; i < l->submitted; i++)
         if (l->finished[i])
             gdr_page_free(&l->jobs[i].page);
@@ -115,7 +126,7 @@ gdr_status gdr_page_loader_submit(gdr_page_loader *l, const gdr_stream_load *loa
         l->finished[l->submitted + i] = 0;
     }
     l->submitted += count;
-    pthread_cond_signal(&l->work);
+    pthread_cond_broadcast(&l->work);
     pthread_mutex_unlock(&l->lock);
     return GDR_OK;
 }

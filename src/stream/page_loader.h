@@ -1,8 +1,8 @@
-/* The page loader: a thread that reads, checks and decodes the pages the residency planned
+/* The page loader: threads that read, check and decode the pages the residency planned
  * (docs/STREAMING.md), so that file reads and decoding never stall the frame. Results come back
  * in the order the loads were submitted (only the completed prefix), so that what a frame
- * applies never depends on which page happened to finish first; collect with wait_all makes
- * the whole sequence deterministic. */
+ * applies never depends on which page happened to finish first or on the thread count; collect
+ * with wait_all makes the whole sequence deterministic. */
 #ifndef GDR_STREAM_PAGE_LOADER_H
 #define GDR_STREAM_PAGE_LOADER_H
 
@@ -18,8 +18,11 @@ typedef struct gdr_page_result {
 
 typedef struct gdr_page_loader gdr_page_loader;
 
-gdr_status gdr_page_loader_create(gdr_paged_cache *cache, gdr_page_loader **out, gdr_error *err);
-/* Waits for the page being decoded, drops the rest. */
+#define GDR_PAGE_LOADER_MAX_THREADS 8
+
+/* `threads` workers (0: one per processor but one, at most GDR_PAGE_LOADER_MAX_THREADS). */
+gdr_status gdr_page_loader_create(gdr_paged_cache *cache, uint32_t threads, gdr_page_loader **out, gdr_error *err);
+/* Waits for the pages being decoded, drops the rest. */
 void gdr_page_loader_destroy(gdr_page_loader *loader);
 /* Queues loads (copied) behind the ones before. Out of memory: GDR_ERROR_OUT_OF_MEMORY, none queued. */
 gdr_status gdr_page_loader_submit(gdr_page_loader *loader, const gdr_stream_load *loads, uint32_t count,

@@ -191,7 +191,7 @@ static uint64_t simulate(const gdr_scene *scene, const char *path, uint64_t budg
     CHECK(s.cache && gdr_residency_create(&desc, &s.res, &err) == GDR_OK);
     if (!s.res)
         fprintf(stderr, "%s\n", err.message);
-    CHECK(s.res && gdr_page_loader_create(s.cache, &s.loader, &err) == GDR_OK);
+    CHECK(s.res && gdr_page_loader_create(s.cache, 3, &s.loader, &err) == GDR_OK);
     s.used = calloc(scene->mesh_count, sizeof *s.used);
     for (uint32_t m = 0; s.cache && m < scene->mesh_count; m++)
         s.used[m] = calloc(gdr_paged_cache_mesh(s.cache, m)->page_count, 1);
