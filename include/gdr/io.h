@@ -81,7 +81,7 @@ GDR_API gdr_status gdr_image_decode(const void *data, size_t size, const char *n
 
 /* --- processed-scene cache ------------------------------------------------------------------ */
 
-#define GDR_CACHE_FORMAT_VERSION 7u
+#define GDR_CACHE_FORMAT_VERSION 8u
 
 /* What a cache was built from: the build options (a string that changes whenever the processing
  * would produce different data, e.g. "import=1") and the source files. */
@@ -126,6 +126,16 @@ GDR_API gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, con
  * naming the section. */
 GDR_API gdr_status gdr_cache_read(const char *path, const char *build_options, gdr_scene **out, gdr_pvs **out_pvs,
                                   gdr_error *err);
+
+/* Reads a cache with geometry pages for streaming (gdr_renderer_set_scene_streamed): the header, the
+ * table and, each with a positioned read and its checksum checked, every section but the geometry
+ * the pages hold too (vertices, indices, vertex colours, cluster vertex lists and triangles, the
+ * pages). The scene has every mesh's counts, bounds, cluster and group records and LOD hierarchy,
+ * the materials, textures, instances and cameras, and scene->geometry_in_pages set: its meshes hold
+ * no vertex or index arrays. Staleness as in gdr_cache_read. A cache without pages is refused
+ * (GDR_ERROR_INVALID_ARGUMENT). out_bytes_read (may be NULL): the bytes read from the file. */
+GDR_API gdr_status gdr_cache_read_for_streaming(const char *path, const char *build_options, gdr_scene **out,
+                                                uint64_t *out_bytes_read, gdr_error *err);
 
 /* Parses a cache from memory without any staleness check (the fuzz target uses this); out_pvs as
  * in gdr_cache_read. */

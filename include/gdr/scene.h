@@ -137,6 +137,11 @@ typedef struct gdr_scene {
     gdr_texture *textures;
     uint32_t texture_count, texture_capacity;
     char *extensions; /* the source's extensionsUsed, comma-separated, or NULL */
+    /* 1: read for streaming (gdr_cache_read_for_streaming, gdr_load_options.geometry_in_pages): every
+     * mesh has its counts, bounds, cluster and group records and hierarchy, but no vertex, index,
+     * colour, cluster vertex or triangle arrays (NULL); those stay in the cache's pages. Such a scene
+     * renders only through gdr_renderer_set_scene_streamed and cannot be written to a cache. */
+    int geometry_in_pages;
 } gdr_scene;
 
 GDR_API gdr_status gdr_scene_create(gdr_scene **out, gdr_error *err);
@@ -149,6 +154,10 @@ GDR_API gdr_status gdr_scene_add_mesh(gdr_scene *scene, const char *name, const 
                                       const gdr_vec3 *normals, const gdr_vec2 *uvs,
                                       uint32_t vertex_count, const uint32_t *indices,
                                       uint32_t index_count, uint32_t *out_index, gdr_error *err);
+/* Adds a mesh of a scene whose geometry stays in a cache's pages (geometry_in_pages): its name,
+ * counts and bounds only. */
+GDR_API gdr_status gdr_scene_add_paged_mesh(gdr_scene *scene, const char *name, uint32_t vertex_count,
+                                            uint32_t index_count, gdr_vec4 bounds, gdr_error *err);
 GDR_API gdr_status gdr_scene_add_material(gdr_scene *scene, const gdr_material *material,
                                           uint32_t *out_index, gdr_error *err);
 GDR_API gdr_status gdr_scene_add_instance(gdr_scene *scene, const gdr_instance *instance,
@@ -321,6 +330,9 @@ typedef struct gdr_load_options {
     gdr_budget budget;      /* limits for untrusted files; zero: the defaults */
     int allow_outside_files; /* 1: a glTF may name buffers and images outside its own folder
                                 (absolute paths, '..', symlinks out); 0: refused */
+    int geometry_in_pages;   /* 1: for streaming, a .gdrc with geometry pages is read without the
+                                geometry its pages hold (gdr_cache_read_for_streaming); any other
+                                scene is refused */
 } gdr_load_options;
 
 /* Loads a scene from a specification, a built-in scene with its level-0 clusters and LOD DAG:

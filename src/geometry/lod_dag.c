@@ -647,6 +647,9 @@ gdr_status gdr_scene_build_lod(gdr_scene *scene, const gdr_lod_options *options,
 {
     if (!scene)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "gdr_scene_build_lod: scene must not be NULL");
+    if (scene->geometry_in_pages)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "LOD DAG: the scene was read for streaming and holds "
+                             "no geometry to build it from");
     if (stats)
         *stats = (gdr_lod_stats){0};
     gdr_lod_options o = {0};

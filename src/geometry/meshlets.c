@@ -559,6 +559,9 @@ static int larger_mesh_first(const void *a, const void *b)
 
 gdr_status gdr_scene_build_clusters(gdr_scene *scene, const gdr_meshlet_options *options, gdr_error *err)
 {
+    if (scene->geometry_in_pages)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "clusters: the scene was read for streaming and holds "
+                             "no geometry to build them from");
     gdr_meshlet_options o;
     gdr_status status = resolve_options(options, &o, err);
     if (status != GDR_OK)

@@ -85,6 +85,9 @@ gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_c
     static const gdr_cache_write_options defaults = {0};
     if (!options)
         options = &defaults;
+    if (scene->geometry_in_pages)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: the scene was read for streaming and holds no "
+                             "geometry: nothing written", path);
     gdr_status limits = check_reader_limits(path, scene, err);
     if (limits != GDR_OK)
         return limits;
@@ -203,77 +206,171 @@ static gdr_status check_coverage(const char *name, const uint8_t *data, size_t s
     return GDR_OK;
 }
 
-static gdr_status parse_container(const char *name, const uint8_t *data, size_t size, cache_view *v, gdr_error *err)
+/* Where the container's bytes come from: the whole file in memory, or the open file, each section
+ * read with a positioned read when it is needed (the read for streaming leaves the geometry there). */
+typedef struct container_source {
+    const char *name;
+    const uint8_t *data; /* the whole file, or NULL: read from fd */
+    int fd;
+    uint64_t size;
+    int paged;           /* sections marked in_pages are not read */
+    uint8_t *owned[CACHE_SECTION_COUNT]; /* sections read from fd, freed with the view */
+    uint64_t bytes_read;
+} container_source;
+
+/* Exactly `length` bytes at `offset` of the source into dst. */
+static gdr_status source_read(container_source *src, void *dst, uint64_t length, uint64_t offset, gdr_error *err)
 {
-    memset(v, 0, sizeof *v);
-    if (size < CACHE_HEADER_SIZE)
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: truncated: %zu bytes, shorter than the header", name, size);
-    if (memcmp(data, CACHE_MAGIC, 8) != 0)
+    if (src->data) {
+        memcpy(dst, src->data + offset, (size_t)length);
+        return GDR_OK;
+    }
+    uint64_t done = 0;
+    while (done < length) {
+        ssize_t n = pread(src->fd, (uint8_t *)dst + done, (size_t)(length - done), (off_t)(offset + done));
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0)
+            return gdr_error_set(err, GDR_ERROR_IO, "%s: %s at offset %llu", src->name,
+                                 n < 0 ? strerror(errno) : "the file ends", (unsigned long long)(offset + done));
+        done += (uint64_t)n;
+    }
+    src->bytes_read += length;
+    return GDR_OK;
+}
+
+/* Section `known` (an index of gdr_cache_sections, or -1 for one this build does not know) into
+ * v, its checksum checked; with the whole file every section's checksum is checked, read from the
+ * file only the known ones the read needs. */
+static gdr_status fetch_section(container_source *src, int known, uint64_t offset, uint64_t length,
+                                uint64_t checksum, cache_view *v, gdr_error *err)
+{
+    char text[5];
+    fourcc_text(known >= 0 ? gdr_cache_sections[known].id : 0, text);
+    const uint8_t *bytes = src->data ? src->data + offset : NULL;
+    if (!src->data) {
+        if (known < 0 || (src->paged && gdr_cache_sections[known].in_pages))
+            return GDR_OK;
+        if (!(src->owned[known] = malloc(length ? (size_t)length : 1)))
+            return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: section '%s': out of memory for %llu bytes",
+                                 src->name, text, (unsigned long long)length);
+        gdr_status status = source_read(src, src->owned[known], length, offset, err);
+        if (status != GDR_OK)
+            return status;
+        bytes = src->owned[known];
+    }
+    if (checksum != gdr_io_hash(bytes, (size_t)length))
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: section '%s' checksum mismatch", src->name, text);
+    if (known >= 0)
+        v->sections[known] = (reader){bytes, (size_t)length, 0, 0};
+    return GDR_OK;
+}
+
+/* The header's checks; the table's entry count out. */
+static gdr_status parse_header(const char *name, const uint8_t *h, uint64_t size, uint32_t *out_count,
+                               uint64_t *out_table_hash, gdr_error *err)
+{
+    if (memcmp(h, CACHE_MAGIC, 8) != 0)
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: not a gdr cache (bad magic)", name);
-    reader h = {data, CACHE_HEADER_SIZE, 8, 0};
-    uint32_t version = get_u32(&h), header_size = get_u32(&h), count = get_u32(&h);
-    (void)get_u32(&h);
-    uint64_t file_size = get_u64(&h), table_hash = get_u64(&h), header_hash = get_u64(&h);
+    reader r = {h, CACHE_HEADER_SIZE, 8, 0};
+    uint32_t version = get_u32(&r), header_size = get_u32(&r), count = get_u32(&r);
+    (void)get_u32(&r);
+    uint64_t file_size = get_u64(&r), table_hash = get_u64(&r), header_hash = get_u64(&r);
     if (version != GDR_CACHE_FORMAT_VERSION)
         return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: cache format version %u, this build reads %u; rebuild it",
                              name, version, GDR_CACHE_FORMAT_VERSION);
-    if (header_hash != gdr_io_hash(data, 40))
+    if (header_hash != gdr_io_hash(h, 40))
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: header checksum mismatch", name);
     if (header_size != CACHE_HEADER_SIZE)
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: header size %u, expected %u", name, header_size,
                              CACHE_HEADER_SIZE);
     if (file_size != size)
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: truncated or extended: %zu bytes, the header says %llu", name,
-                             size, (unsigned long long)file_size);
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: truncated or extended: %llu bytes, the header says %llu", name,
+                             (unsigned long long)size, (unsigned long long)file_size);
     if (count > CACHE_MAX_SECTIONS || CACHE_HEADER_SIZE + (uint64_t)count * CACHE_ENTRY_SIZE > size)
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section table (%u entries) does not fit", name, count);
-    const uint8_t *table = data + CACHE_HEADER_SIZE;
-    if (table_hash != gdr_io_hash(table, (size_t)count * CACHE_ENTRY_SIZE))
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: section table checksum mismatch", name);
     for (unsigned i = 48; i < CACHE_HEADER_SIZE; i++)
-        if (data[i] != 0)
+        if (h[i] != 0)
             return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: reserved header byte %u is not zero", name, i);
+    *out_count = count;
+    *out_table_hash = table_hash;
+    return GDR_OK;
+}
+
+/* One table entry: where it lies, whether this build knows it, its bytes. */
+static gdr_status parse_entry(container_source *src, const uint8_t *e, uint64_t table_end, uint32_t i,
+                              byte_range *range, cache_view *v, gdr_error *err)
+{
+    reader t = {e, CACHE_ENTRY_SIZE, 0, 0};
+    uint32_t id = get_u32(&t), flags = get_u32(&t);
+    uint64_t offset = get_u64(&t), length = get_u64(&t), checksum = get_u64(&t);
+    char text[5];
+    fourcc_text(id, text);
+    if (offset < table_end || offset > src->size || length > src->size - offset)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section %u '%s' (offset %llu, %llu bytes) lies outside "
+                             "the file", src->name, i, text, (unsigned long long)offset, (unsigned long long)length);
+    *range = (byte_range){offset, length, id};
+    int known = -1;
+    for (int k = 0; k < CACHE_SECTION_COUNT; k++)
+        if (gdr_cache_sections[k].id == id)
+            known = k;
+    if (known >= 0 && v->present[known])
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section '%s' appears twice", src->name, text);
+    gdr_status status = fetch_section(src, known, offset, length, checksum, v, err);
+    if (status != GDR_OK)
+        return status;
+    if (known < 0 && (flags & CACHE_SECTION_REQUIRED))
+        return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: requires section '%s', unknown to this build",
+                             src->name, text);
+    if (known >= 0)
+        v->present[known] = 1; /* an unknown optional section belongs to a later version: skipped */
+    return GDR_OK;
+}
+
+/* Header, table and the sections the read needs into v. With the whole file, every byte after the
+ * table is accounted for (check_coverage); read from the file, only the sections read are checked. */
+static gdr_status parse_container(container_source *src, cache_view *v, gdr_error *err)
+{
+    memset(v, 0, sizeof *v);
+    const char *name = src->name;
+    uint8_t h[CACHE_HEADER_SIZE];
+    if (src->size < CACHE_HEADER_SIZE)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: truncated: %llu bytes, shorter than the header", name,
+                             (unsigned long long)src->size);
+    uint32_t count = 0;
+    uint64_t table_hash = 0;
+    gdr_status status = source_read(src, h, CACHE_HEADER_SIZE, 0, err);
+    if (status == GDR_OK)
+        status = parse_header(name, h, src->size, &count, &table_hash, err);
+    uint8_t *table = status == GDR_OK ? malloc((size_t)count * CACHE_ENTRY_SIZE + 1) : NULL;
+    if (status == GDR_OK && !table)
+        status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory for the section table", name);
+    if (status == GDR_OK)
+        status = source_read(src, table, (uint64_t)count * CACHE_ENTRY_SIZE, CACHE_HEADER_SIZE, err);
+    if (status == GDR_OK && table_hash != gdr_io_hash(table, (size_t)count * CACHE_ENTRY_SIZE))
+        status = gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: section table checksum mismatch", name);
     uint64_t table_end = CACHE_HEADER_SIZE + (uint64_t)count * CACHE_ENTRY_SIZE;
     byte_range ranges[CACHE_MAX_SECTIONS];
-    reader t = {table, (size_t)count * CACHE_ENTRY_SIZE, 0, 0};
-    for (uint32_t i = 0; i < count; i++) {
-        uint32_t id = get_u32(&t), flags = get_u32(&t);
-        uint64_t offset = get_u64(&t), length = get_u64(&t), checksum = get_u64(&t);
-        char text[5];
-        fourcc_text(id, text);
-        if (offset < table_end || offset > size || length > size - offset)
-            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section %u '%s' (offset %llu, %llu bytes) lies outside "
-                                 "the file", name, i, text, (unsigned long long)offset, (unsigned long long)length);
-        ranges[i] = (byte_range){offset, length, id};
-        if (checksum != gdr_io_hash(data + offset, (size_t)length))
-            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: section '%s' checksum mismatch", name, text);
-        int known = -1;
-        for (int k = 0; k < CACHE_SECTION_COUNT; k++)
-            if (gdr_cache_sections[k].id == id)
-                known = k;
-        if (known < 0) {
-            if (flags & CACHE_SECTION_REQUIRED)
-                return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: requires section '%s', unknown to this build",
-                                     name, text);
-            continue; /* an optional section of a later version */
-        }
-        if (v->present[known])
-            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section '%s' appears twice", name, text);
-        v->present[known] = 1;
-        v->sections[known] = (reader){data + offset, (size_t)length, 0, 0};
-    }
-    gdr_status coverage = check_coverage(name, data, size, table_end, ranges, count, err);
-    if (coverage != GDR_OK)
-        return coverage;
-    for (int k = 0; k < CACHE_SECTION_COUNT; k++)
+    for (uint32_t i = 0; i < count && status == GDR_OK; i++)
+        status = parse_entry(src, table + (size_t)i * CACHE_ENTRY_SIZE, table_end, i, &ranges[i], v, err);
+    free(table);
+    if (status == GDR_OK && src->data)
+        status = check_coverage(name, src->data, (size_t)src->size, table_end, ranges, count, err);
+    for (int k = 0; k < CACHE_SECTION_COUNT && status == GDR_OK; k++)
         if (!v->present[k] && !gdr_cache_sections[k].optional) {
             char text[5];
             fourcc_text(gdr_cache_sections[k].id, text);
-            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section '%s' is missing", name, text);
+            status = gdr_error_set(err, GDR_ERROR_PARSE, "%s: section '%s' is missing", name, text);
         }
-    v->data = data;
-    v->size = size;
-    return GDR_OK;
+    v->data = src->data;
+    v->size = (size_t)src->size;
+    return status;
+}
+
+static void source_free(container_source *src)
+{
+    for (int k = 0; k < CACHE_SECTION_COUNT; k++)
+        free(src->owned[k]);
 }
 
 gdr_status gdr_cache_read_memory(const void *data, size_t size, const char *name, gdr_scene **out, gdr_pvs **out_pvs,
@@ -283,10 +380,11 @@ gdr_status gdr_cache_read_memory(const void *data, size_t size, const char *name
     if (out_pvs)
         *out_pvs = NULL;
     cache_view v;
-    gdr_status status = parse_container(name ? name : "(memory)", data, size, &v, err);
+    container_source src = {.name = name ? name : "(memory)", .data = data, .size = size};
+    gdr_status status = parse_container(&src, &v, err);
     if (status != GDR_OK)
         return status;
-    return gdr_cache_read_sections(name ? name : "(memory)", &v, out, out_pvs, err);
+    return gdr_cache_read_sections(src.name, &v, 0, out, out_pvs, err);
 }
 
 /* One entry of section 'SRCE': a file the scene was built from, as it was then. */
@@ -467,12 +565,45 @@ gdr_status gdr_io_cache_read_for(const char *path, const char *source, const cha
     if (status != GDR_OK)
         return status;
     cache_view v;
-    status = parse_container(path, data, size, &v, err);
+    container_source src = {.name = path, .data = data, .size = size};
+    status = parse_container(&src, &v, err);
     if (status == GDR_OK)
         status = check_fresh(path, &v, build_options, source, err);
     if (status == GDR_OK)
-        status = gdr_cache_read_sections(path, &v, out, out_pvs, err);
+        status = gdr_cache_read_sections(path, &v, 0, out, out_pvs, err);
     free(data);
+    return status;
+}
+
+gdr_status gdr_cache_read_for_streaming(const char *path, const char *build_options, gdr_scene **out,
+                                        uint64_t *out_bytes_read, gdr_error *err)
+{
+    *out = NULL;
+    if (out_bytes_read)
+        *out_bytes_read = 0;
+    container_source src = {.name = path, .paged = 1};
+    gdr_status status = gdr_io_open_regular(path, &src.fd, err);
+    if (status != GDR_OK)
+        return status;
+    struct stat st;
+    if (fstat(src.fd, &st) != 0) {
+        close(src.fd);
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: cannot stat: %s", path, strerror(errno));
+    }
+    src.size = (uint64_t)st.st_size;
+    cache_view v;
+    status = parse_container(&src, &v, err);
+    if (status == GDR_OK && !v.present[CACHE_PAGES])
+        status = gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: has no geometry pages to stream; build it with "
+                               "pages (gdr build --pages)", path);
+    if (status == GDR_OK)
+        status = check_fresh(path, &v, build_options, NULL, err);
+    if (status == GDR_OK)
+        status = gdr_cache_read_sections(path, &v, 1, out, NULL, err);
+    close(src.fd);
+    source_free(&src);
+    if (out_bytes_read)
+        *out_bytes_read = src.bytes_read;
     return status;
 }
 

@@ -159,7 +159,7 @@ static inline void fourcc_text(uint32_t id, char out[5])
  * the ones before it read). */
 enum {
     CACHE_SOURCE, CACHE_SCENE, CACHE_TEXTURES, CACHE_PIXELS, CACHE_MESHES, CACHE_GEOMETRY, CACHE_COLORS, CACHE_CLUSTERS,
-    CACHE_CLUSTER_DATA, CACHE_HIERARCHY, CACHE_MATERIALS, CACHE_INSTANCES, CACHE_CAMERAS, CACHE_PVS,
+    CACHE_CLUSTER_DATA, CACHE_CLUSTER_GEOMETRY, CACHE_HIERARCHY, CACHE_MATERIALS, CACHE_INSTANCES, CACHE_CAMERAS, CACHE_PVS,
     CACHE_PAGES, CACHE_SECTION_COUNT
 };
 
@@ -185,6 +185,7 @@ typedef struct cache_section {
     /* Reads and checks the whole section into the scene being built; NULL: the container reads it
      * (SRCE, for staleness). */
     gdr_status (*read)(cache_read_state *st, reader *r, gdr_error *err);
+    int in_pages; /* geometry the pages hold too: a read for streaming leaves it in the file */
 } cache_section;
 
 extern const cache_section gdr_cache_sections[CACHE_SECTION_COUNT];
@@ -198,8 +199,10 @@ typedef struct cache_view {
 } cache_view;
 
 /* Builds the scene (and the PVS when out_pvs is not NULL) from the sections, each read and checked
- * by its description, in table order. On failure nothing is returned. */
-gdr_status gdr_cache_read_sections(const char *name, cache_view *v, gdr_scene **out, gdr_pvs **out_pvs,
+ * by its description, in table order. With `paged`, the sections marked in_pages are not read (their
+ * readers are not given their bytes) and the scene's meshes hold no geometry (geometry_in_pages).
+ * On failure nothing is returned. */
+gdr_status gdr_cache_read_sections(const char *name, cache_view *v, int paged, gdr_scene **out, gdr_pvs **out_pvs,
                                    gdr_error *err);
 
 #endif

@@ -32,7 +32,8 @@ struct cache_read_state {
     uint32_t mesh_count, material_count, instance_count, camera_count, texture_count; /* SCNE */
     reader textures;  /* TEXR, read again with TXPX */
     reader meshes;    /* MESH, read again with GEOM */
-    reader clusters;  /* CLUS, read again with CLDT */
+    reader clusters;  /* CLUS, read again with CLDT and CLGM */
+    int paged;        /* the geometry stays in the file's pages: GEOM, VCOL, CLGM and PAGE are not read */
 };
 
 static int all_finite(const float *v, size_t n)
@@ -269,6 +270,8 @@ static void write_colors(writer *w, const cache_write_input *in)
 
 static gdr_status read_colors(cache_read_state *st, reader *r, gdr_error *err)
 {
+    if (st->paged)
+        return GDR_OK; /* streamed meshes draw without vertex colours */
     for (uint32_t i = 0; i < st->scene->mesh_count; i++) {
         uint32_t flag = get_u32(r);
         if (flag > 1)
@@ -292,8 +295,29 @@ static gdr_status read_colors(cache_read_state *st, reader *r, gdr_error *err)
     return expect_end(st, r, "VCOL", err);
 }
 
+/* A scene read for streaming: each mesh from its MESH record alone (counts and bounds, no arrays). */
+static gdr_status add_paged_meshes(cache_read_state *st, gdr_error *err)
+{
+    st->scene->geometry_in_pages = 1;
+    for (uint32_t i = 0; i < st->mesh_count; i++) {
+        char mname[GDR_NAME_MAX];
+        get_name(&st->meshes, mname);
+        uint32_t vertex_count = get_u32(&st->meshes), index_count = get_u32(&st->meshes);
+        gdr_vec4 bounds;
+        get_f32s(&st->meshes, &bounds.x, 4);
+        if (!all_finite(&bounds.x, 4) || !(bounds.w >= 0.0f))
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: mesh %u: bounds are not finite", st->name, i);
+        gdr_status status = gdr_scene_add_paged_mesh(st->scene, mname, vertex_count, index_count, bounds, err);
+        if (status != GDR_OK)
+            return status;
+    }
+    return GDR_OK;
+}
+
 static gdr_status read_geometry(cache_read_state *st, reader *geo, gdr_error *err)
 {
+    if (st->paged)
+        return add_paged_meshes(st, err);
     for (uint32_t i = 0; i < st->mesh_count; i++) {
         gdr_status status = read_one_mesh(st, geo, i, err);
         if (status != GDR_OK)
@@ -324,7 +348,7 @@ static gdr_status read_cluster_counts(cache_read_state *st, reader *r, gdr_error
     return expect_records(st, r, FOURCC('C', 'L', 'U', 'S'), st->mesh_count, CLUSTERS_RECORD, err);
 }
 
-static void write_cluster_data(writer *w, const cache_write_input *in)
+static void write_cluster_records(writer *w, const cache_write_input *in)
 {
     const gdr_scene *s = in->scene;
     for (uint32_t i = 0; i < s->mesh_count; i++) {
@@ -351,6 +375,14 @@ static void write_cluster_data(writer *w, const cache_write_input *in)
             put_u32(w, g->first_cluster);
             put_u32(w, g->cluster_count);
         }
+    }
+}
+
+static void write_cluster_geometry(writer *w, const cache_write_input *in)
+{
+    const gdr_scene *s = in->scene;
+    for (uint32_t i = 0; i < s->mesh_count; i++) {
+        const gdr_mesh_clusters *c = &s->meshes[i].clusters;
         put(w, c->vertices, sizeof(uint32_t) * c->vertex_count);
         put(w, c->triangles, c->triangle_byte_count);
         put_align(w, 4);
@@ -359,43 +391,57 @@ static void write_cluster_data(writer *w, const cache_write_input *in)
 
 static int bad_sphere(const gdr_vec4 *sphere) { return !all_finite(&sphere->x, 4) || !(sphere->w >= 0.0f); }
 
-/* Reads the arrays of one mesh's clusters (counts already set in c, arrays allocated) and checks
- * every offset, count and index against the limits, the arrays and the mesh. */
+#define CLDT(fmt, ...) gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLDT': mesh %u" fmt, name, m, __VA_ARGS__)
+
+/* One cluster record, checked against the limits, the mesh's counts and its groups. */
+static gdr_status read_cluster_record(const char *name, reader *r, uint32_t m, uint32_t k, gdr_mesh_clusters *c,
+                                      gdr_error *err)
+{
+    gdr_cluster *cl = &c->clusters[k];
+    cl->vertex_offset = get_u32(r);
+    cl->triangle_offset = get_u32(r);
+    cl->vertex_count = get_u32(r);
+    cl->triangle_count = get_u32(r);
+    get_f32s(r, &cl->sphere.x, 4);
+    get_f32s(r, &cl->cone_apex.x, 3);
+    get_f32s(r, &cl->cone_axis.x, 3);
+    get_f32s(r, &cl->cone_cutoff, 1);
+    cl->group = get_u32(r);
+    cl->refined_group = get_u32(r);
+    cl->reserved = get_u32(r);
+    if (cl->vertex_count < 1 || cl->vertex_count > GDR_CLUSTER_MAX_VERTICES || cl->triangle_count < 1 ||
+        cl->triangle_count > GDR_CLUSTER_MAX_TRIANGLES)
+        return CLDT(" cluster %u: %u vertices and %u triangles (1 to %u and %u)", k, cl->vertex_count,
+                    cl->triangle_count, GDR_CLUSTER_MAX_VERTICES, GDR_CLUSTER_MAX_TRIANGLES);
+    if ((uint64_t)cl->vertex_offset + cl->vertex_count > c->vertex_count)
+        return CLDT(" cluster %u: vertices %u..%u lie outside the mesh's %u cluster vertices", k, cl->vertex_offset,
+                    cl->vertex_offset + (cl->vertex_count - 1), c->vertex_count);
+    if (cl->triangle_offset % 4 != 0 ||
+        (uint64_t)cl->triangle_offset + 3ull * cl->triangle_count > c->triangle_byte_count)
+        return CLDT(" cluster %u: triangle bytes at %u (%u triangles) are unaligned or lie outside the mesh's %u", k,
+                    cl->triangle_offset, cl->triangle_count, c->triangle_byte_count);
+    if (bad_sphere(&cl->sphere) || !all_finite(&cl->cone_apex.x, 3) || !all_finite(&cl->cone_axis.x, 3) ||
+        !all_finite(&cl->cone_cutoff, 1))
+        return CLDT(" cluster %u: bounds are not finite (or a negative radius)", k);
+    if ((cl->group != GDR_NO_INDEX && cl->group >= c->group_count) ||
+        (cl->refined_group != GDR_NO_INDEX && cl->refined_group >= c->group_count))
+        return CLDT(" cluster %u: group %u / refined group %u does not exist (%u groups)", k, cl->group,
+                    cl->refined_group, c->group_count);
+    return GDR_OK;
+}
+
+/* Reads one mesh's cluster and group records (counts already set in c, arrays allocated) and checks
+ * every offset, count and index against the limits, the counts and the mesh. */
 static gdr_status read_mesh_clusters(const char *name, reader *r, uint32_t m, const gdr_mesh *mesh,
                                      gdr_mesh_clusters *c, gdr_error *err)
 {
-#define CLDT(fmt, ...) gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLDT': mesh %u" fmt, name, m, __VA_ARGS__)
+    uint64_t level0_triangles = 0;
     for (uint32_t k = 0; k < c->cluster_count; k++) {
-        gdr_cluster *cl = &c->clusters[k];
-        cl->vertex_offset = get_u32(r);
-        cl->triangle_offset = get_u32(r);
-        cl->vertex_count = get_u32(r);
-        cl->triangle_count = get_u32(r);
-        get_f32s(r, &cl->sphere.x, 4);
-        get_f32s(r, &cl->cone_apex.x, 3);
-        get_f32s(r, &cl->cone_axis.x, 3);
-        get_f32s(r, &cl->cone_cutoff, 1);
-        cl->group = get_u32(r);
-        cl->refined_group = get_u32(r);
-        cl->reserved = get_u32(r);
-        if (cl->vertex_count < 1 || cl->vertex_count > GDR_CLUSTER_MAX_VERTICES || cl->triangle_count < 1 ||
-            cl->triangle_count > GDR_CLUSTER_MAX_TRIANGLES)
-            return CLDT(" cluster %u: %u vertices and %u triangles (1 to %u and %u)", k, cl->vertex_count,
-                        cl->triangle_count, GDR_CLUSTER_MAX_VERTICES, GDR_CLUSTER_MAX_TRIANGLES);
-        if ((uint64_t)cl->vertex_offset + cl->vertex_count > c->vertex_count)
-            return CLDT(" cluster %u: vertices %u..%u lie outside the mesh's %u cluster vertices", k,
-                        cl->vertex_offset, cl->vertex_offset + (cl->vertex_count - 1), c->vertex_count);
-        if (cl->triangle_offset % 4 != 0 || (uint64_t)cl->triangle_offset + 3ull * cl->triangle_count >
-                                                c->triangle_byte_count)
-            return CLDT(" cluster %u: triangle bytes at %u (%u triangles) are unaligned or lie outside the mesh's %u",
-                        k, cl->triangle_offset, cl->triangle_count, c->triangle_byte_count);
-        if (bad_sphere(&cl->sphere) || !all_finite(&cl->cone_apex.x, 3) || !all_finite(&cl->cone_axis.x, 3) ||
-            !all_finite(&cl->cone_cutoff, 1))
-            return CLDT(" cluster %u: bounds are not finite (or a negative radius)", k);
-        if ((cl->group != GDR_NO_INDEX && cl->group >= c->group_count) ||
-            (cl->refined_group != GDR_NO_INDEX && cl->refined_group >= c->group_count))
-            return CLDT(" cluster %u: group %u / refined group %u does not exist (%u groups)", k, cl->group,
-                        cl->refined_group, c->group_count);
+        gdr_status status = read_cluster_record(name, r, m, k, c, err);
+        if (status != GDR_OK)
+            return status;
+        if (k < c->level0_cluster_count)
+            level0_triangles += c->clusters[k].triangle_count;
     }
     for (uint32_t k = 0; k < c->group_count; k++) {
         gdr_cluster_group *g = &c->groups[k];
@@ -410,78 +456,110 @@ static gdr_status read_mesh_clusters(const char *name, reader *r, uint32_t m, co
             return CLDT(" group %u: clusters %u (+%u) lie outside the mesh's %u", k, g->first_cluster,
                         g->cluster_count, c->cluster_count);
     }
-    const uint8_t *vertices = take(r, sizeof(uint32_t) * (size_t)c->vertex_count);
-    const uint8_t *triangles = take(r, c->triangle_byte_count);
-    take(r, (4 - c->triangle_byte_count % 4) % 4);
     if (r->failed) /* the caller checked the sizes: only a programming error gets here */
         return CLDT(" %s", "runs past the section");
-    memcpy(c->vertices, vertices, sizeof(uint32_t) * (size_t)c->vertex_count);
-    memcpy(c->triangles, triangles, c->triangle_byte_count);
-    for (uint32_t k = 0; k < c->vertex_count; k++)
-        if (c->vertices[k] >= mesh->vertex_count)
-            return CLDT(" cluster vertex %u: mesh vertex %u does not exist (%u vertices)", k, c->vertices[k],
-                        mesh->vertex_count);
-    uint64_t level0_triangles = 0;
-    for (uint32_t k = 0; k < c->cluster_count; k++) {
-        const gdr_cluster *cl = &c->clusters[k];
-        const uint8_t *local = c->triangles + cl->triangle_offset;
-        for (uint32_t t = 0; t < 3 * cl->triangle_count; t++)
-            if (local[t] >= cl->vertex_count)
-                return CLDT(" cluster %u triangle %u: local vertex %u, the cluster has %u", k, t / 3, local[t],
-                            cl->vertex_count);
-        if (k < c->level0_cluster_count)
-            level0_triangles += cl->triangle_count;
-    }
     if (level0_triangles != mesh->index_count / 3)
         return CLDT(": level-0 clusters hold %llu triangles, the mesh %u", (unsigned long long)level0_triangles,
                     mesh->index_count / 3);
+    return GDR_OK;
+}
 #undef CLDT
+
+/* One mesh's counts from section 'CLUS', checked against each other and the mesh. */
+static gdr_status read_mesh_cluster_counts(cache_read_state *st, uint32_t m, gdr_mesh_clusters *c, gdr_error *err)
+{
+    reader *counts = &st->clusters;
+    const gdr_mesh *mesh = &st->scene->meshes[m];
+    c->cluster_count = get_u32(counts);
+    c->level0_cluster_count = get_u32(counts);
+    c->vertex_count = get_u32(counts);
+    c->triangle_byte_count = get_u32(counts);
+    c->group_count = get_u32(counts);
+    c->dag_depth = get_u32(counts);
+    if (c->level0_cluster_count > c->cluster_count ||
+        (c->cluster_count == 0 && (c->vertex_count || c->triangle_byte_count || c->group_count || c->dag_depth)) ||
+        (c->cluster_count > 0 && (c->level0_cluster_count == 0 || mesh->index_count == 0)))
+        return gdr_error_set(err, GDR_ERROR_PARSE,
+                             "%s: section 'CLUS': mesh %u: %u clusters (%u of level 0) for %u indices, %u cluster "
+                             "vertices, %u triangle bytes, %u groups: inconsistent", st->name, m, c->cluster_count,
+                             c->level0_cluster_count, mesh->index_count, c->vertex_count, c->triangle_byte_count,
+                             c->group_count);
     return GDR_OK;
 }
 
 static gdr_status read_cluster_data(cache_read_state *st, reader *data, gdr_error *err)
 {
-    reader *counts = &st->clusters;
     const char *name = st->name;
     for (uint32_t m = 0; m < st->mesh_count; m++) {
-        gdr_mesh *mesh = &st->scene->meshes[m];
-        uint32_t cluster_count = get_u32(counts), level0 = get_u32(counts), vertex_count = get_u32(counts);
-        uint32_t triangle_bytes = get_u32(counts), group_count = get_u32(counts), dag_depth = get_u32(counts);
-        if (level0 > cluster_count || (cluster_count == 0 && (vertex_count || triangle_bytes || group_count ||
-                                                              dag_depth)) ||
-            (cluster_count > 0 && (level0 == 0 || mesh->index_count == 0)))
-            return gdr_error_set(err, GDR_ERROR_PARSE,
-                                 "%s: section 'CLUS': mesh %u: %u clusters (%u of level 0) for %u indices, %u cluster "
-                                 "vertices, %u triangle bytes, %u groups: inconsistent", name, m, cluster_count,
-                                 level0, mesh->index_count, vertex_count, triangle_bytes, group_count);
-        uint64_t need = (uint64_t)cluster_count * CLUSTER_RECORD + (uint64_t)group_count * GROUP_RECORD +
-                        (uint64_t)vertex_count * 4 + ((uint64_t)triangle_bytes + 3) / 4 * 4;
+        gdr_mesh_clusters *c = &st->scene->meshes[m].clusters; /* owned by the scene from here: freed with it */
+        gdr_status status = read_mesh_cluster_counts(st, m, c, err);
+        if (status != GDR_OK)
+            return status;
+        uint64_t need = (uint64_t)c->cluster_count * CLUSTER_RECORD + (uint64_t)c->group_count * GROUP_RECORD;
         if (need > data->size - data->at)
-            return gdr_error_set(err, GDR_ERROR_PARSE,
-                                 "%s: section 'CLDT': mesh %u: %u clusters, %u groups, %u vertices and %u triangle "
-                                 "bytes run past the section", name, m, cluster_count, group_count, vertex_count,
-                                 triangle_bytes);
-        if (cluster_count == 0)
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLDT': mesh %u: %u clusters and %u groups run "
+                                 "past the section", name, m, c->cluster_count, c->group_count);
+        if (c->cluster_count == 0)
             continue;
-        gdr_mesh_clusters *c = &mesh->clusters; /* owned by the scene from here: freed with it */
-        c->clusters = malloc(sizeof(gdr_cluster) * (size_t)cluster_count);
-        c->vertices = malloc(sizeof(uint32_t) * (size_t)vertex_count + 1);
-        c->triangles = malloc((size_t)triangle_bytes + 1);
-        c->groups = group_count ? malloc(sizeof(gdr_cluster_group) * (size_t)group_count) : NULL;
-        if (!c->clusters || !c->vertices || !c->triangles || (group_count && !c->groups))
+        c->clusters = malloc(sizeof(gdr_cluster) * (size_t)c->cluster_count);
+        c->groups = c->group_count ? malloc(sizeof(gdr_cluster_group) * (size_t)c->group_count) : NULL;
+        if (!c->clusters || (c->group_count && !c->groups))
             return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: mesh %u: out of memory for %u clusters", name, m,
-                                 cluster_count);
-        c->cluster_count = cluster_count;
-        c->level0_cluster_count = level0;
-        c->vertex_count = vertex_count;
-        c->triangle_byte_count = triangle_bytes;
-        c->group_count = group_count;
-        c->dag_depth = dag_depth;
-        gdr_status status = read_mesh_clusters(name, data, m, mesh, c, err);
+                                 c->cluster_count);
+        status = read_mesh_clusters(name, data, m, &st->scene->meshes[m], c, err);
         if (status != GDR_OK)
             return status;
     }
     return expect_end(st, data, "CLDT", err);
+}
+
+#define CLGM(fmt, ...) gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLGM': mesh %u" fmt, name, m, __VA_ARGS__)
+
+/* One mesh's cluster vertex list and triangle bytes, each index checked against what it indexes. */
+static gdr_status read_mesh_cluster_geometry(const char *name, reader *r, uint32_t m, const gdr_mesh *mesh,
+                                             gdr_mesh_clusters *c, gdr_error *err)
+{
+    uint64_t need = (uint64_t)c->vertex_count * 4 + ((uint64_t)c->triangle_byte_count + 3) / 4 * 4;
+    if (need > r->size - r->at)
+        return CLGM(": %u cluster vertices and %u triangle bytes run past the section", c->vertex_count,
+                    c->triangle_byte_count);
+    if (c->cluster_count == 0)
+        return GDR_OK;
+    c->vertices = malloc(sizeof(uint32_t) * (size_t)c->vertex_count + 1);
+    c->triangles = malloc((size_t)c->triangle_byte_count + 1);
+    if (!c->vertices || !c->triangles)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: mesh %u: out of memory for %u clusters", name, m,
+                             c->cluster_count);
+    memcpy(c->vertices, take(r, sizeof(uint32_t) * (size_t)c->vertex_count), sizeof(uint32_t) * (size_t)c->vertex_count);
+    memcpy(c->triangles, take(r, c->triangle_byte_count), c->triangle_byte_count);
+    take(r, (4 - c->triangle_byte_count % 4) % 4);
+    for (uint32_t k = 0; k < c->vertex_count; k++)
+        if (c->vertices[k] >= mesh->vertex_count)
+            return CLGM(" cluster vertex %u: mesh vertex %u does not exist (%u vertices)", k, c->vertices[k],
+                        mesh->vertex_count);
+    for (uint32_t k = 0; k < c->cluster_count; k++) {
+        const gdr_cluster *cl = &c->clusters[k];
+        const uint8_t *local = c->triangles + cl->triangle_offset;
+        for (uint32_t t = 0; t < 3 * cl->triangle_count; t++)
+            if (local[t] >= cl->vertex_count)
+                return CLGM(" cluster %u triangle %u: local vertex %u, the cluster has %u", k, t / 3, local[t],
+                            cl->vertex_count);
+    }
+    return GDR_OK;
+}
+#undef CLGM
+
+static gdr_status read_cluster_geometry(cache_read_state *st, reader *data, gdr_error *err)
+{
+    if (st->paged)
+        return GDR_OK; /* the pages hold it */
+    for (uint32_t m = 0; m < st->mesh_count; m++) {
+        gdr_mesh *mesh = &st->scene->meshes[m];
+        gdr_status status = read_mesh_cluster_geometry(st->name, data, m, mesh, &mesh->clusters, err);
+        if (status != GDR_OK)
+            return status;
+    }
+    return expect_end(st, data, "CLGM", err);
 }
 
 /* --- LODH: per mesh, the LOD hierarchy over its clusters ---------------------------------------- */
@@ -777,6 +855,8 @@ static void write_pages(writer *w, const cache_write_input *in) { cache_pages_wr
  * the pages themselves are decoded, and checked, by the paged reader. */
 static gdr_status read_pages(cache_read_state *st, reader *r, gdr_error *err)
 {
+    if (st->paged)
+        return GDR_OK; /* gdr_paged_cache_open reads and checks the index, each page its own checksum */
     uint32_t mesh_count;
     uint64_t index_size, index_hash;
     gdr_status status = cache_pages_parse_header(st->name, r->data, r->size, &mesh_count, &index_size,
@@ -799,31 +879,34 @@ static gdr_status read_pages(cache_read_state *st, reader *r, gdr_error *err)
 
 #define REQUIRED CACHE_SECTION_REQUIRED
 const cache_section gdr_cache_sections[CACHE_SECTION_COUNT] = {
-    [CACHE_SOURCE] = {FOURCC('S', 'R', 'C', 'E'), 0, 1, NULL, NULL, write_source, NULL},
-    [CACHE_SCENE] = {FOURCC('S', 'C', 'N', 'E'), REQUIRED, 0, NULL, NULL, write_scene, read_scene},
+    [CACHE_SOURCE] = {FOURCC('S', 'R', 'C', 'E'), 0, 1, NULL, NULL, write_source, NULL, 0},
+    [CACHE_SCENE] = {FOURCC('S', 'C', 'N', 'E'), REQUIRED, 0, NULL, NULL, write_scene, read_scene, 0},
     [CACHE_TEXTURES] = {FOURCC('T', 'E', 'X', 'R'), REQUIRED, 0, NULL, check_texture_sides, write_textures,
-                        read_textures},
-    [CACHE_PIXELS] = {FOURCC('T', 'X', 'P', 'X'), REQUIRED, 0, NULL, NULL, write_pixels, read_pixels},
-    [CACHE_MESHES] = {FOURCC('M', 'E', 'S', 'H'), REQUIRED, 0, NULL, NULL, write_meshes, read_meshes},
-    [CACHE_GEOMETRY] = {FOURCC('G', 'E', 'O', 'M'), REQUIRED, 0, NULL, NULL, write_geometry, read_geometry},
-    [CACHE_COLORS] = {FOURCC('V', 'C', 'O', 'L'), REQUIRED, 0, NULL, NULL, write_colors, read_colors},
-    [CACHE_CLUSTERS] = {FOURCC('C', 'L', 'U', 'S'), REQUIRED, 0, NULL, NULL, write_cluster_counts, read_cluster_counts},
-    [CACHE_CLUSTER_DATA] = {FOURCC('C', 'L', 'D', 'T'), REQUIRED, 0, NULL, NULL, write_cluster_data, read_cluster_data},
+                        read_textures, 0},
+    [CACHE_PIXELS] = {FOURCC('T', 'X', 'P', 'X'), REQUIRED, 0, NULL, NULL, write_pixels, read_pixels, 0},
+    [CACHE_MESHES] = {FOURCC('M', 'E', 'S', 'H'), REQUIRED, 0, NULL, NULL, write_meshes, read_meshes, 0},
+    [CACHE_GEOMETRY] = {FOURCC('G', 'E', 'O', 'M'), REQUIRED, 0, NULL, NULL, write_geometry, read_geometry, 1},
+    [CACHE_COLORS] = {FOURCC('V', 'C', 'O', 'L'), REQUIRED, 0, NULL, NULL, write_colors, read_colors, 1},
+    [CACHE_CLUSTERS] = {FOURCC('C', 'L', 'U', 'S'), REQUIRED, 0, NULL, NULL, write_cluster_counts, read_cluster_counts, 0},
+    [CACHE_CLUSTER_DATA] = {FOURCC('C', 'L', 'D', 'T'), REQUIRED, 0, NULL, NULL, write_cluster_records,
+                            read_cluster_data, 0},
+    [CACHE_CLUSTER_GEOMETRY] = {FOURCC('C', 'L', 'G', 'M'), REQUIRED, 0, NULL, NULL, write_cluster_geometry,
+                                read_cluster_geometry, 1},
     [CACHE_HIERARCHY] = {FOURCC('L', 'O', 'D', 'H'), REQUIRED, 0, NULL, check_hierarchy_present, write_hierarchy,
-                         read_hierarchy},
-    [CACHE_MATERIALS] = {FOURCC('M', 'A', 'T', 'L'), REQUIRED, 0, NULL, NULL, write_materials, read_materials},
-    [CACHE_INSTANCES] = {FOURCC('I', 'N', 'S', 'T'), REQUIRED, 0, NULL, NULL, write_instances, read_instances},
-    [CACHE_CAMERAS] = {FOURCC('C', 'A', 'M', 'R'), REQUIRED, 0, NULL, NULL, write_cameras, read_cameras},
+                         read_hierarchy, 0},
+    [CACHE_MATERIALS] = {FOURCC('M', 'A', 'T', 'L'), REQUIRED, 0, NULL, NULL, write_materials, read_materials, 0},
+    [CACHE_INSTANCES] = {FOURCC('I', 'N', 'S', 'T'), REQUIRED, 0, NULL, NULL, write_instances, read_instances, 0},
+    [CACHE_CAMERAS] = {FOURCC('C', 'A', 'M', 'R'), REQUIRED, 0, NULL, NULL, write_cameras, read_cameras, 0},
     /* optional: readers that predate it skip it */
-    [CACHE_PVS] = {FOURCC('P', 'V', 'I', 'S'), 0, 1, has_pvs, check_pvs_objects, write_pvs, read_pvs},
-    [CACHE_PAGES] = {FOURCC('P', 'A', 'G', 'E'), 0, 1, has_pages, check_page_bytes, write_pages, read_pages},
+    [CACHE_PVS] = {FOURCC('P', 'V', 'I', 'S'), 0, 1, has_pvs, check_pvs_objects, write_pvs, read_pvs, 0},
+    [CACHE_PAGES] = {FOURCC('P', 'A', 'G', 'E'), 0, 1, has_pages, check_page_bytes, write_pages, read_pages, 1},
 };
 #undef REQUIRED
 
-gdr_status gdr_cache_read_sections(const char *name, cache_view *v, gdr_scene **out, gdr_pvs **out_pvs,
+gdr_status gdr_cache_read_sections(const char *name, cache_view *v, int paged, gdr_scene **out, gdr_pvs **out_pvs,
                                    gdr_error *err)
 {
-    cache_read_state st = {.name = name, .file = v->data, .out_pvs = out_pvs};
+    cache_read_state st = {.name = name, .file = v->data, .out_pvs = out_pvs, .paged = paged};
     gdr_status status = gdr_scene_create(&st.scene, err);
     for (uint32_t k = 0; k < CACHE_SECTION_COUNT && status == GDR_OK; k++)
         if (gdr_cache_sections[k].read && v->present[k])

@@ -102,6 +102,12 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
         *out_pvs = NULL;
     const char *build_options = gdr_cache_build_options();
     gdr_pvs *pvs = NULL;
+    if (options->geometry_in_pages) {
+        if (!gdr_io_has_extension(path, ".gdrc"))
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: streaming reads a .gdrc cache with geometry "
+                                 "pages (gdr build SCENE -o FILE.gdrc --pages), not a source file", path);
+        return gdr_cache_read_for_streaming(path, build_options, out, NULL, err);
+    }
     if (gdr_io_has_extension(path, ".gdrc")) {
         gdr_status status = gdr_cache_read(path, build_options, out, out_pvs ? &pvs : NULL, err);
         return status == GDR_OK ? finish_cache_read(path, out, pvs, out_pvs, err) : status;

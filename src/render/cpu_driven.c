@@ -21,6 +21,13 @@ static gdr_cull_object object_from_instance(const GdrGpuInstance *instance, cons
                              .max_screen_size = instance->max_screen_size};
 }
 
+/* A mesh without its positions (a scene read for streaming): the box around its bounding sphere. */
+static gdr_cull_mesh_bounds sphere_box(gdr_vec4 s)
+{
+    return (gdr_cull_mesh_bounds){.lo = {s.x - s.w, s.y - s.w, s.z - s.w}, .hi = {s.x + s.w, s.y + s.w, s.z + s.w},
+                                  .sphere = s};
+}
+
 /* Keeps only what the instances' bounds need of the scene, per mesh (the renderer holds no pointer
  * into it; the instances' transforms are in r->scene.cpu_instances): the culling structures are
  * built when the pipeline is first used, so a renderer that never draws with it pays O(meshes). */
@@ -33,7 +40,8 @@ gdr_status gdr_cpu_path_create(gdr_renderer *r, const gdr_scene *scene, gdr_erro
                              scene->mesh_count);
     cpu->mesh_count = scene->mesh_count;
     for (uint32_t m = 0; m < scene->mesh_count; m++)
-        cpu->mesh_bounds[m] = gdr_cull_mesh_bounds_of(&scene->meshes[m]);
+        cpu->mesh_bounds[m] = scene->geometry_in_pages ? sphere_box(scene->meshes[m].bounds)
+                                                       : gdr_cull_mesh_bounds_of(&scene->meshes[m]);
     return GDR_OK;
 }
 

@@ -155,6 +155,9 @@ static gdr_status set_scene(gdr_renderer *r, const gdr_scene *scene, const gdr_s
     if (r->has_scene)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
                              "the renderer already holds a scene: create another renderer for a new scene");
+    if (!stream && scene->geometry_in_pages)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "the scene was read for streaming and holds no geometry: "
+                             "render it with gdr_renderer_set_scene_streamed");
     if (stream && !r->ctx->has_mesh_shader)
         return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "streaming draws with the mesh pipeline, not available on "
                              "'%s': %s", r->ctx->properties.deviceName, r->ctx->mesh_shader_missing);

@@ -150,6 +150,25 @@ gdr_status gdr_scene_add_mesh(gdr_scene *scene, const char *name, const gdr_vec3
     return GDR_OK;
 }
 
+gdr_status gdr_scene_add_paged_mesh(gdr_scene *scene, const char *name, uint32_t vertex_count, uint32_t index_count,
+                                    gdr_vec4 bounds, gdr_error *err)
+{
+    if (!scene->geometry_in_pages)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "mesh '%s': a mesh without geometry needs a scene "
+                             "whose geometry is in pages", name ? name : "");
+    if (index_count % 3 != 0)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "mesh '%s': index count %u is not a multiple of 3",
+                             name ? name : "", index_count);
+    gdr_status status = reserve_one((void **)&scene->meshes, &scene->mesh_capacity, scene->mesh_count,
+                                    sizeof(gdr_mesh), err);
+    if (status != GDR_OK)
+        return status;
+    gdr_mesh mesh = {.vertex_count = vertex_count, .index_count = index_count, .bounds = bounds};
+    snprintf(mesh.name, sizeof mesh.name, "%s", name ? name : "");
+    scene->meshes[scene->mesh_count++] = mesh;
+    return GDR_OK;
+}
+
 gdr_material gdr_material_default(void)
 {
     const gdr_texture_ref none = {.texture = GDR_NO_INDEX, .scale = {1.0f, 1.0f}};

@@ -148,6 +148,13 @@ grep -q '^cache: *[1-9][0-9]* bytes, [0-9.]* bytes per source triangle$' "$work/
 expect 0 "info of a cache without pages" "$gdr" info "$work/field.gdrc"
 grep -q '^pages: *none' "$work/stdout" || { echo "FAIL: info no pages: $(cat "$work/stdout")"; failures=$((failures + 1)); }
 expect 2 "page size too small" "$gdr" build unique-field:meshes=1,triangles=1000 -o "$work/bad.gdrc" --pages=1
+# Streaming: a paged cache renders within a budget and reports its pool; anything else is refused.
+expect 0 "render streamed" "$gdr" render "$work/unique.gdrc" $tiny --geometry-budget 1 --upload-budget 1 --frames 4 --validate
+grep -q '^streaming pool' "$work/stdout" || { echo "FAIL: streamed render printed no pool: $(cat "$work/stdout")"; failures=$((failures + 1)); }
+expect 2 "stream a built-in scene" "$gdr" render unique-field:meshes=2,triangles=2000 $tiny --geometry-budget 1
+grep -q 'stream from a cache' "$work/stderr" || { echo "FAIL: stream built-in: $(cat "$work/stderr")"; failures=$((failures + 1)); }
+expect 1 "stream a cache without pages" "$gdr" render "$work/field.gdrc" $tiny --geometry-budget 1
+grep -q 'has no geometry pages' "$work/stderr" || { echo "FAIL: stream without pages: $(cat "$work/stderr")"; failures=$((failures + 1)); }
 expect 2 "unique-field no meshes" "$gdr" info unique-field:meshes=0
 }
 [ ! -e "$work/bad.gdrc" ] || { echo "FAIL: a failed build left a cache"; failures=$((failures + 1)); }

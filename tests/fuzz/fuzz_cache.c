@@ -4,11 +4,19 @@
  * checks and the parsers behind them get exercised. A PVS that loads must match the scene and
  * serialise back to the section's bytes. The seed corpus/cache/pvs.gdrc is a flag byte 1 and
  * the output of `gdr build tri.obj -o a.gdrc --pvs; gdr build a.gdrc -o pvs.gdrc` (corpus/obj;
- * the second build keeps the PVS and drops the source path). */
+ * the second build keeps the PVS and drops the source path). The same bytes are also read as a
+ * file for streaming (gdr_cache_read_for_streaming, through a memfd): what it accepts must agree
+ * with the whole read's cluster records wherever both accept the file. The seeds nodes.gdrc,
+ * quad.gdrc and paged.gdrc come from corpus/gltf/nodes.gltf, corpus/obj/quad.obj and
+ * `gdr build unique-field:meshes=2,triangles=1000 --pages=4` (tests/fuzz/make_cache_seeds.sh). */
+#define _GNU_SOURCE /* memfd_create */
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
+#include <unistd.h>
 
 #include <xxhash.h>
 
@@ -44,6 +52,33 @@ static const uint8_t *pvs_section(const uint8_t *data, size_t *length)
         }
     }
     return NULL;
+}
+
+/* The streaming read of the same bytes, from a file in memory; where the whole read accepted them
+ * too (whole != NULL), every mesh's counts and cluster and group records must be the same. */
+static void read_for_streaming(const uint8_t *data, size_t size, const gdr_scene *whole)
+{
+    int fd = memfd_create("fuzz.gdrc", 0);
+    if (fd < 0)
+        return;
+    char path[64];
+    snprintf(path, sizeof path, "/proc/self/fd/%d", fd);
+    gdr_scene *paged = NULL;
+    gdr_error err;
+    if (write(fd, data, size) == (ssize_t)size && gdr_cache_read_for_streaming(path, NULL, &paged, NULL, &err) == GDR_OK) {
+        if (!paged->geometry_in_pages)
+            __builtin_trap();
+        for (uint32_t m = 0; whole && m < whole->mesh_count; m++) {
+            const gdr_mesh_clusters *a = &whole->meshes[m].clusters, *b = &paged->meshes[m].clusters;
+            if (paged->mesh_count != whole->mesh_count || a->cluster_count != b->cluster_count ||
+                a->group_count != b->group_count || a->lod_node_count != b->lod_node_count ||
+                (a->cluster_count && memcmp(a->clusters, b->clusters, sizeof *a->clusters * a->cluster_count)) ||
+                (a->group_count && memcmp(a->groups, b->groups, sizeof *a->groups * a->group_count)))
+                __builtin_trap();
+        }
+        gdr_scene_destroy(paged);
+    }
+    close(fd);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -85,7 +120,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     gdr_scene *scene = NULL;
     gdr_pvs *pvs = NULL;
     gdr_error err;
-    if (gdr_cache_read_memory(copy, size, "fuzz.gdrc", &scene, &pvs, &err) == GDR_OK) {
+    gdr_status whole = gdr_cache_read_memory(copy, size, "fuzz.gdrc", &scene, &pvs, &err);
+    read_for_streaming(copy, size, whole == GDR_OK ? scene : NULL);
+    if (whole == GDR_OK) {
         if (pvs) {
             size_t n = gdr_pvs_serialized_size(pvs), length = 0;
             const uint8_t *section = pvs_section(copy, &length);

@@ -1,4 +1,4 @@
-/* Clusters in the .gdrc cache (sections CLUS and CLDT): a round trip gives every field and array
+/* Clusters in the .gdrc cache (sections CLUS, CLDT and CLGM): a round trip gives every field and array
  * back bit for bit (LOD groups included) without rebuilding; a cluster section corrupted behind
  * valid checksums is refused with a message naming the file, the section and the record; a
  * version-1 file is refused by version. */
@@ -158,7 +158,7 @@ enum { CLUSTER_BYTES = 72 }; /* docs/CACHE_FORMAT.md: one cluster record in CLDT
 
 typedef struct corruption {
     const char *what;     /* expected in the message */
-    const char *section;  /* "CLUS" or "CLDT" */
+    const char *section;  /* "CLUS", "CLDT", "CLGM" or "LODH" */
     uint32_t at;          /* byte offset in the section */
     uint32_t value;       /* written as u32, or as the low byte when byte is set */
     int byte;
@@ -252,10 +252,10 @@ static void test_corruption(void)
     CHECK(good != NULL && bad != NULL && c->cluster_count >= 2);
     if (!good || !bad || c->cluster_count < 2)
         return;
-    uint32_t vertices_at = c->cluster_count * CLUSTER_BYTES, triangles_at = vertices_at + 4 * c->vertex_count;
+    uint32_t vertices_at = 0, triangles_at = 4 * c->vertex_count; /* in CLGM */
     uint32_t c1 = CLUSTER_BYTES; /* cluster 1 */
     char text[2][160];
-    snprintf(text[0], sizeof text[0], "section 'CLDT': mesh 0 cluster vertex 3: mesh vertex %u does not exist (%u vertices)",
+    snprintf(text[0], sizeof text[0], "section 'CLGM': mesh 0 cluster vertex 3: mesh vertex %u does not exist (%u vertices)",
              s->meshes[0].vertex_count + 5, s->meshes[0].vertex_count);
     snprintf(text[1], sizeof text[1], "section 'CLDT': mesh 0: level-0 clusters hold %u triangles, the mesh %u",
              s->meshes[0].index_count / 3 - 1, s->meshes[0].index_count / 3);
@@ -272,14 +272,14 @@ static void test_corruption(void)
         {"section 'CLDT': mesh 0 cluster 0: group 0 / refined group 4294967295 does not exist (0 groups)", "CLDT",
          60, 0, 0},
         {"section 'CLDT': mesh 0 cluster 1: group 4294967295 / refined group 7 does not exist", "CLDT", c1 + 64, 7, 0},
-        {"section 'CLDT': mesh 0 cluster 0 triangle 0: local vertex 200, the cluster has", "CLDT", triangles_at, 200, 1},
-        {text[0], "CLDT", vertices_at + 12, s->meshes[0].vertex_count + 5, 0},
+        {"section 'CLGM': mesh 0 cluster 0 triangle 0: local vertex 200, the cluster has", "CLGM", triangles_at, 200, 1},
+        {text[0], "CLGM", vertices_at + 12, s->meshes[0].vertex_count + 5, 0},
         {text[1], "CLDT", 12, c->clusters[0].triangle_count - 1, 0},
         {"section 'CLUS': mesh 0: 22 clusters (23 of level 0)", "CLUS", 4, c->cluster_count + 1, 0},
         {"section 'CLUS': mesh 0: 0 clusters (22 of level 0)", "CLUS", 0, 0, 0},
         {"section 'CLUS': mesh 0: 22 clusters (0 of level 0)", "CLUS", 4, 0, 0},
-        {"section 'CLDT': mesh 0: 1000000000 clusters, 0 groups", "CLUS", 0, 1000000000u, 0},
-        {"section 'CLDT': mesh 0: 22 clusters, 1 groups", "CLUS", 16, 1, 0},
+        {"section 'CLDT': mesh 0: 1000000000 clusters and 0 groups run past", "CLUS", 0, 1000000000u, 0},
+        {"section 'CLDT': mesh 0: 22 clusters and 1 groups run past", "CLUS", 16, 1, 0},
         {"section 'CLDT': mesh 0 cluster 21: vertices", "CLUS", 8, c->vertex_count - 1, 0},
         {"section 'CLDT': mesh 0 cluster 21: triangle bytes at", "CLUS", 12, c->triangle_byte_count - 4, 0},
     };

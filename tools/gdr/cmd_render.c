@@ -177,15 +177,24 @@ static gdr_status render_frames(gdr_renderer *renderer, gdr_frame_desc *frame, c
     return status;
 }
 
-/* The scene, streamed from its cache file when a budget is given (the scene must be that file). */
-static gdr_status set_scene(gdr_renderer *renderer, const gdr_scene *scene, const render_options *o, gdr_error *err)
+static bool streamed(const render_options *o) { return o->geometry_budget_mib || o->upload_budget_mib; }
+
+/* A streamed scene is read from its cache without the geometry the pages hold. */
+static gdr_status load_scene(render_options *o, gdr_scene **scene, gdr_error *err)
 {
-    if (!o->geometry_budget_mib && !o->upload_budget_mib)
-        return gdr_renderer_set_scene(renderer, scene, err);
     size_t length = strlen(o->scene);
-    if (length < 5 || strcmp(o->scene + length - 5, ".gdrc") != 0)
+    if (streamed(o) && (length < 5 || strcmp(o->scene + length - 5, ".gdrc") != 0))
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "--geometry-budget/--upload-budget stream from a cache: "
                              "give a .gdrc written with 'gdr build --pages' (not '%s')", o->scene);
+    o->load.geometry_in_pages = streamed(o);
+    return gdr_scene_load(o->scene, &o->load, scene, err);
+}
+
+/* The scene, streamed from its cache file when a budget is given (the scene is that file). */
+static gdr_status set_scene(gdr_renderer *renderer, const gdr_scene *scene, const render_options *o, gdr_error *err)
+{
+    if (!streamed(o))
+        return gdr_renderer_set_scene(renderer, scene, err);
     gdr_streaming_desc stream = {.cache_path = o->scene,
                                  .geometry_budget_bytes = (uint64_t)o->geometry_budget_mib << 20,
                                  .upload_budget_bytes = (uint64_t)o->upload_budget_mib << 20};
@@ -200,7 +209,7 @@ int gdr_cmd_render(int argc, char **argv)
         return usage;
     gdr_error err = {0};
     gdr_scene *scene = NULL;
-    if (gdr_scene_load(o.scene, &o.load, &scene, &err) != GDR_OK)
+    if (load_scene(&o, &scene, &err) != GDR_OK)
         return cli_load_failed(o.scene, &err);
     if (o.has_camera_index && o.camera_index >= scene->camera_count) {
         fprintf(stderr, "gdr: --camera-index %u: the scene has %u camera(s)\n", o.camera_index, scene->camera_count);

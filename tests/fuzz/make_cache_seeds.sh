@@ -1,0 +1,22 @@
+#!/bin/sh
+# Regenerates the cache fuzz target's seeds (corpus/cache) with the current format: a flag byte 1
+# (recompute checksums) and then the cache. Run it whenever the cache format version changes.
+# usage: tests/fuzz/make_cache_seeds.sh GDR_BINARY
+set -eu
+gdr=$1
+here=$(cd "$(dirname "$0")" && pwd)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+seed() { # NAME: the flag byte, then WORK/NAME.gdrc
+    { printf '\001'; cat "$work/$1.gdrc"; } >"$here/corpus/cache/$1.gdrc"
+}
+# A second build from the first cache drops the source paths (the seeds must not name this machine).
+"$gdr" build "$here/corpus/gltf/nodes.gltf" -o "$work/a.gdrc" --no-progress >/dev/null
+"$gdr" build "$work/a.gdrc" -o "$work/nodes.gdrc" --no-progress >/dev/null
+"$gdr" build "$here/corpus/obj/quad.obj" -o "$work/b.gdrc" --no-progress >/dev/null
+"$gdr" build "$work/b.gdrc" -o "$work/quad.gdrc" --no-progress >/dev/null
+"$gdr" build "$here/corpus/obj/tri.obj" -o "$work/c.gdrc" --pvs --no-progress >/dev/null
+"$gdr" build "$work/c.gdrc" -o "$work/pvs.gdrc" --no-progress >/dev/null
+"$gdr" build unique-field:meshes=2,triangles=1000 -o "$work/paged.gdrc" --pages=4 --no-progress >/dev/null
+for name in nodes quad pvs paged; do seed $name; done
+ls -l "$here/corpus/cache"
