@@ -114,6 +114,31 @@ typedef struct gdr_meshlet_options {
 typedef struct gdr_mesh gdr_mesh;   /* gdr/scene.h */
 typedef struct gdr_scene gdr_scene; /* gdr/scene.h */
 
+/* A mesh's vertices on a grid (gdr_scene_quantize_vertices): every position is
+ * position_origin + q * 2^position_exponent with q a 16-bit integer per axis, every uv
+ * uv_origin + q * 2^uv_exponent with q a 20-bit integer per axis, every normal the decoding of a
+ * 10-bit octahedral pair, so that the cache's pages store them as those integers, losslessly
+ * (docs/CACHE_FORMAT.md, "Geometry pages"). enabled 0: plain floats. */
+typedef struct gdr_vertex_quantization {
+    uint32_t enabled;
+    int32_t position_exponent;
+    gdr_vec3 position_origin; /* a multiple of 2^position_exponent */
+    int32_t uv_exponent;
+    gdr_vec2 uv_origin;       /* a multiple of 2^uv_exponent */
+    float max_displacement;   /* the largest distance a position moved onto its grid point */
+} gdr_vertex_quantization;
+
+#define GDR_QUANTIZED_POSITION_BITS 16
+#define GDR_QUANTIZED_UV_BITS 20
+
+/* Moves every mesh's vertices onto its grid (positions, normals, uvs; the grid is chosen per mesh
+ * from its bounds) and keeps every bound honest: the mesh sphere and each cluster's sphere grow by
+ * the largest displacement d, each cluster's normal cone is measured again on the moved triangles,
+ * each LOD group above level 0 states its error plus 2d (both its surface and the full-detail one
+ * moved by at most d), group spheres grow by d and each hierarchy is built again. Meshes already
+ * quantized are left as they are. A scene read for streaming is refused. */
+GDR_API gdr_status gdr_scene_quantize_vertices(gdr_scene *scene, gdr_error *err);
+
 /* Splits `mesh` into level-0 clusters (meshoptimizer), written to `out`, which must be zeroed;
  * on failure `out` stays empty. The mesh needs at least one triangle, indices below vertex_count
  * and finite positions; options (NULL: defaults) need max_vertices in [3, 64] and max_triangles a

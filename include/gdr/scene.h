@@ -32,6 +32,7 @@ typedef struct gdr_mesh {
     uint32_t *indices;
     gdr_vec4 bounds; /* bounding sphere in mesh space: centre xyz, radius w */
     gdr_mesh_clusters clusters; /* meshlets and LOD DAG (gdr/geometry.h); empty until built */
+    gdr_vertex_quantization quantization; /* the grid its vertices lie on, or not enabled (gdr/geometry.h) */
 } gdr_mesh;
 
 /* A texture reference's sampler state (glTF's sampler object), packed in a uint32: zero is glTF's

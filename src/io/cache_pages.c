@@ -9,11 +9,14 @@
 #include <meshoptimizer.h>
 #include <zstd.h>
 
+#include "geometry/vertex_quantize.h"
 #include "io/cache_pages.h"
 #include "io/io_internal.h"
 
 #define PAGE_MAGIC 0x47504447u /* "GDPG" */
 #define PAGE_FLAG_ZSTD 1u
+#define PAGE_FLAG_QUANTIZED 2u /* the vertices as integers on the grid the body gives (gdr_quantized_vertex) */
+#define PAGE_GRID_BLOCK 32u    /* that grid: i32 position exponent, f32 x3 origin, i32 uv exponent, f32 x2 origin, u32 0 */
 /* zstd level of the page bodies: 3 measured as good as 9 here on these bodies (docs/CACHE_FORMAT.md). */
 #define PAGE_ZSTD_LEVEL 3
 /* zstd is kept only when it saves at least this share of the body (else decoding it costs for nothing). */
@@ -162,14 +165,39 @@ static int gather_page(const page_source *src, writer *records, gdr_page_vertex 
     return ok && !records->failed;
 }
 
-/* Encodes `count` vertices and `index_count` indices onto the end of `body`; their sizes in vs, is. */
-static int put_streams(writer *body, const gdr_page_vertex *vertices, uint32_t count, const uint32_t *indices,
+/* The page's vertices as integers on the mesh's grid, or NULL when the mesh is not quantized or a
+ * vertex does not encode exactly (then the page keeps floats). */
+static gdr_quantized_vertex *quantize_page(const gdr_mesh *mesh, const gdr_page_vertex *vertices, uint32_t count)
+{
+    if (!mesh->quantization.enabled)
+        return NULL;
+    gdr_quantized_vertex *q = malloc(sizeof *q * (count ? count : 1));
+    for (uint32_t v = 0; q && v < count; v++)
+        if (!gdr_vertex_encode(&mesh->quantization, vertices[v].position, vertices[v].normal, vertices[v].uv, &q[v])) {
+            free(q);
+            return NULL;
+        }
+    return q;
+}
+
+static void put_grid(writer *w, const gdr_vertex_quantization *q)
+{
+    put_u32(w, (uint32_t)q->position_exponent);
+    put_f32s(w, &q->position_origin.x, 3);
+    put_u32(w, (uint32_t)q->uv_exponent);
+    put_f32s(w, &q->uv_origin.x, 2);
+    put_u32(w, 0);
+}
+
+/* Encodes `count` vertices of `vertex_size` bytes and `index_count` indices onto the end of `body`;
+ * their sizes in vs, is. */
+static int put_streams(writer *body, const void *vertices, size_t vertex_size, uint32_t count, const uint32_t *indices,
                        size_t index_count, size_t *vs, size_t *is)
 {
-    size_t vbound = meshopt_encodeVertexBufferBound(count, sizeof *vertices);
+    size_t vbound = meshopt_encodeVertexBufferBound(count, vertex_size);
     size_t ibound = meshopt_encodeIndexBufferBound(index_count, count);
     uint8_t *vbuf = malloc(vbound), *ibuf = malloc(ibound);
-    *vs = vbuf ? meshopt_encodeVertexBuffer(vbuf, vbound, vertices, count, sizeof *vertices) : 0;
+    *vs = vbuf ? meshopt_encodeVertexBuffer(vbuf, vbound, vertices, count, vertex_size) : 0;
     *is = ibuf ? meshopt_encodeIndexBuffer(ibuf, ibound, indices, index_count) : 0;
     put(body, vbuf, *vs);
     put(body, ibuf, *is);
@@ -178,16 +206,25 @@ static int put_streams(writer *body, const gdr_page_vertex *vertices, uint32_t c
     return *vs > 0 && *is > 0 && !body->failed;
 }
 
-/* Header + body (records, vertex stream, index stream), zstd over the body where it pays. */
+/* Header + body (records, the grid where quantized, vertex stream, index stream), zstd over the body
+ * where it pays. */
 static int encode_page(const page_source *src, encoded_page *e)
 {
     writer body = {0};
     gdr_page_vertex *vertices = NULL;
     uint32_t *indices = NULL;
     size_t vs = 0, is = 0;
-    uint32_t unique = 0;
-    int ok = gather_page(src, &body, &vertices, &indices, e, &unique) &&
-             put_streams(&body, vertices, unique, indices, 3 * (size_t)e->triangle_count, &vs, &is);
+    uint32_t unique = 0, quantized_flag = 0;
+    int ok = gather_page(src, &body, &vertices, &indices, e, &unique);
+    gdr_quantized_vertex *quantized = ok ? quantize_page(src->mesh, vertices, unique) : NULL;
+    if (quantized) {
+        quantized_flag = PAGE_FLAG_QUANTIZED;
+        put_grid(&body, &src->mesh->quantization);
+        ok = put_streams(&body, quantized, sizeof *quantized, unique, indices, 3 * (size_t)e->triangle_count, &vs, &is);
+    } else if (ok) {
+        ok = put_streams(&body, vertices, sizeof *vertices, unique, indices, 3 * (size_t)e->triangle_count, &vs, &is);
+    }
+    free(quantized);
     free(vertices);
     free(indices);
     size_t zbound = ZSTD_compressBound(body.size);
@@ -202,6 +239,7 @@ static int encode_page(const page_source *src, encoded_page *e)
         flags = PAGE_FLAG_ZSTD, body_stored = (uint32_t)z;
     else
         memcpy(stored + CACHE_PAGE_HEADER, body.data, body.size);
+    flags |= quantized_flag;
     uint32_t header[8] = {PAGE_MAGIC, flags, (uint32_t)body.size, e->cluster_count, unique, e->triangle_count,
                           (uint32_t)vs, (uint32_t)is};
     memcpy(stored, header, sizeof header);
@@ -708,9 +746,39 @@ static gdr_status expand_clusters(const char *where, const uint32_t *indices, co
     return status;
 }
 
-/* The vertex stream holds the page's `unique` vertices, the index stream its triangles over them. */
+/* The grid of a quantized page's vertices, checked as the cache's MESH record is. */
+static gdr_status get_grid(const char *where, reader *r, gdr_vertex_quantization *q, gdr_error *err)
+{
+    *q = (gdr_vertex_quantization){.enabled = 1};
+    q->position_exponent = (int32_t)get_u32(r);
+    get_f32s(r, &q->position_origin.x, 3);
+    q->uv_exponent = (int32_t)get_u32(r);
+    get_f32s(r, &q->uv_origin.x, 2);
+    uint32_t reserved = get_u32(r);
+    if (r->failed || reserved != 0 || q->position_exponent < -126 || q->position_exponent > 100 ||
+        q->uv_exponent < -126 || q->uv_exponent > 100 || !finite_floats(&q->position_origin.x, 3) ||
+        !finite_floats(&q->uv_origin.x, 2))
+        return PAGE_ERR("%s: the vertex grid is malformed", where);
+    return GDR_OK;
+}
+
+/* A quantized vertex stream into floats. */
+static int decode_quantized(gdr_page_vertex *vertices, uint32_t unique, const uint8_t *vstream, uint32_t vs,
+                            const gdr_vertex_quantization *grid)
+{
+    gdr_quantized_vertex *q = malloc(sizeof *q * unique);
+    int ok = q && meshopt_decodeVertexBuffer(q, unique, sizeof *q, vstream, vs) == 0;
+    for (uint32_t v = 0; ok && v < unique; v++)
+        gdr_vertex_decode(grid, &q[v], &vertices[v].position, &vertices[v].normal, &vertices[v].uv);
+    free(q);
+    return ok;
+}
+
+/* The vertex stream holds the page's `unique` vertices (floats, or integers on `grid` when it is not
+ * NULL), the index stream its triangles over them. */
 static gdr_status decode_streams(const char *where, reader *r, uint32_t unique, uint32_t vs, uint32_t is,
-                                 const gdr_page_info *pi, gdr_page *out, gdr_error *err)
+                                 const gdr_vertex_quantization *grid, const gdr_page_info *pi, gdr_page *out,
+                                 gdr_error *err)
 {
     const uint8_t *vstream = take(r, vs), *istream = take(r, is);
     gdr_page_vertex *vertices = malloc(sizeof *vertices * unique);
@@ -721,7 +789,8 @@ static gdr_status decode_streams(const char *where, reader *r, uint32_t unique, 
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: %u vertices", where, pi->vertex_count);
     else if (!vstream || !istream || r->at != r->size)
         status = PAGE_ERR("%s: streams of %u and %u bytes do not fill the body", where, vs, is);
-    else if (meshopt_decodeVertexBuffer(vertices, unique, sizeof *vertices, vstream, vs) != 0)
+    else if (grid ? !decode_quantized(vertices, unique, vstream, vs, grid)
+                  : meshopt_decodeVertexBuffer(vertices, unique, sizeof *vertices, vstream, vs) != 0)
         status = PAGE_ERR("%s: vertex stream does not decode", where);
     else if (meshopt_decodeIndexBuffer(indices, 3 * (size_t)pi->triangle_count, 4, istream, is) != 0)
         status = PAGE_ERR("%s: index stream does not decode", where);
@@ -749,12 +818,14 @@ gdr_status cache_page_decode(const char *name, uint32_t mesh, uint32_t page, con
     uint32_t h[8];
     memcpy(h, bytes, sizeof h);
     /* h[4]: the page's own vertices, each shared by the clusters that use it (at most theirs in all). */
-    size_t vbound = meshopt_encodeVertexBufferBound(h[4], sizeof(gdr_page_vertex));
+    int quantized = (h[1] & PAGE_FLAG_QUANTIZED) != 0;
+    size_t vertex_size = quantized ? sizeof(gdr_quantized_vertex) : sizeof(gdr_page_vertex);
+    size_t vbound = meshopt_encodeVertexBufferBound(h[4], vertex_size);
     size_t ibound = meshopt_encodeIndexBufferBound(3 * (size_t)pi->triangle_count, h[4]);
-    if (h[0] != PAGE_MAGIC || h[1] > PAGE_FLAG_ZSTD || h[3] != pi->cluster_count || h[4] == 0 ||
-        h[4] > pi->vertex_count ||
-        h[5] != pi->triangle_count || h[6] > vbound || h[7] > ibound ||
-        (uint64_t)h[2] != (uint64_t)pi->cluster_count * CACHE_PAGE_CLUSTER_RECORD + h[6] + h[7])
+    if (h[0] != PAGE_MAGIC || h[1] > (PAGE_FLAG_ZSTD | PAGE_FLAG_QUANTIZED) || h[3] != pi->cluster_count ||
+        h[4] == 0 || h[4] > pi->vertex_count || h[5] != pi->triangle_count || h[6] > vbound || h[7] > ibound ||
+        (uint64_t)h[2] != (uint64_t)pi->cluster_count * CACHE_PAGE_CLUSTER_RECORD + (quantized ? PAGE_GRID_BLOCK : 0) +
+                              h[6] + h[7])
         return PAGE_ERR("%s: bad page header", where);
     const uint8_t *body = NULL;
     uint8_t *owned = NULL;
@@ -769,8 +840,11 @@ gdr_status cache_page_decode(const char *name, uint32_t mesh, uint32_t page, con
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: %u clusters", where, pi->cluster_count);
     if (status == GDR_OK)
         status = decode_clusters(where, &r, pm, pi, out, err);
+    gdr_vertex_quantization grid;
+    if (status == GDR_OK && quantized)
+        status = get_grid(where, &r, &grid, err);
     if (status == GDR_OK)
-        status = decode_streams(where, &r, h[4], h[6], h[7], pi, out, err);
+        status = decode_streams(where, &r, h[4], h[6], h[7], quantized ? &grid : NULL, pi, out, err);
     free(owned);
     if (status != GDR_OK)
         gdr_page_free(out);

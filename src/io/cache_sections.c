@@ -14,11 +14,11 @@
 #error "the cache reader and writer assume a little-endian host"
 #endif
 
-enum { TEXTURE_REF_RECORD = 4 * 4 + 4 * 4 };
+enum { TEXTURE_REF_RECORD = 4 * 4 + 4 * 4, QUANTIZATION_RECORD = 4 + 4 + 12 + 4 + 8 + 4 };
 
 #define FOURCC(a, b, c, d) ((uint32_t)(a) | (uint32_t)(b) << 8 | (uint32_t)(c) << 16 | (uint32_t)(d) << 24)
 
-enum { MESH_RECORD = 64 + 8 + 16, MATERIAL_RECORD = 64 + 16 + 5 * TEXTURE_REF_RECORD + 12 + 5 * 4 + 8, INSTANCE_RECORD = CACHE_INSTANCE_RECORD,
+enum { MESH_RECORD = 64 + 8 + 16 + QUANTIZATION_RECORD, MATERIAL_RECORD = 64 + 16 + 5 * TEXTURE_REF_RECORD + 12 + 5 * 4 + 8, INSTANCE_RECORD = CACHE_INSTANCE_RECORD,
        CAMERA_RECORD = 64 + 12 + 16 + 16, TEXTURE_RECORD = 64 + 12, CLUSTERS_RECORD = 6 * 4,
        CLUSTER_RECORD = 4 * 4 + 16 + 12 + 12 + 4 + 3 * 4, GROUP_RECORD = 16 + 4 + 3 * 4,
        NODE_RECORD = 16 + 4 + 4 + 4 * 4 + 2 * 4 };
@@ -192,7 +192,43 @@ static void write_meshes(writer *w, const cache_write_input *in)
         put_u32(w, m->vertex_count);
         put_u32(w, m->index_count);
         put_f32s(w, &m->bounds.x, 4);
+        const gdr_vertex_quantization *q = &m->quantization;
+        put_u32(w, q->enabled);
+        put_u32(w, (uint32_t)q->position_exponent);
+        put_f32s(w, &q->position_origin.x, 3);
+        put_u32(w, (uint32_t)q->uv_exponent);
+        put_f32s(w, &q->uv_origin.x, 2);
+        put_f32s(w, &q->max_displacement, 1);
     }
+}
+
+/* One MESH record: name, counts, bounds and the vertex grid, the grid checked. */
+typedef struct mesh_record {
+    char name[GDR_NAME_MAX];
+    uint32_t vertex_count, index_count;
+    gdr_vec4 bounds;
+    gdr_vertex_quantization quantization;
+} mesh_record;
+
+static gdr_status get_mesh_record(cache_read_state *st, uint32_t i, mesh_record *m, gdr_error *err)
+{
+    reader *r = &st->meshes;
+    get_name(r, m->name);
+    m->vertex_count = get_u32(r), m->index_count = get_u32(r);
+    get_f32s(r, &m->bounds.x, 4);
+    gdr_vertex_quantization *q = &m->quantization;
+    q->enabled = get_u32(r);
+    q->position_exponent = (int32_t)get_u32(r);
+    get_f32s(r, &q->position_origin.x, 3);
+    q->uv_exponent = (int32_t)get_u32(r);
+    get_f32s(r, &q->uv_origin.x, 2);
+    get_f32s(r, &q->max_displacement, 1);
+    if (q->enabled > 1 || q->position_exponent < -126 || q->position_exponent > 100 || q->uv_exponent < -126 ||
+        q->uv_exponent > 100 || !all_finite(&q->position_origin.x, 3) || !all_finite(&q->uv_origin.x, 2) ||
+        !(q->max_displacement >= 0.0f && q->max_displacement <= 1e30f))
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'MESH': mesh %u: vertex grid is malformed", st->name,
+                             i);
+    return GDR_OK;
 }
 
 static gdr_status read_meshes(cache_read_state *st, reader *r, gdr_error *err)
@@ -216,12 +252,13 @@ static void write_geometry(writer *w, const cache_write_input *in)
 /* One mesh: its arrays copied (aligned, so gdr_scene_add_mesh can read them as arrays) and added. */
 static gdr_status read_one_mesh(cache_read_state *st, reader *geo, uint32_t i, gdr_error *err)
 {
-    reader *mr = &st->meshes;
-    char mname[GDR_NAME_MAX];
-    get_name(mr, mname);
-    uint32_t vertex_count = get_u32(mr), index_count = get_u32(mr);
-    gdr_vec4 bounds;
-    get_f32s(mr, &bounds.x, 4);
+    mesh_record m;
+    gdr_status status = get_mesh_record(st, i, &m, err);
+    if (status != GDR_OK)
+        return status;
+    const char *mname = m.name;
+    uint32_t vertex_count = m.vertex_count, index_count = m.index_count;
+    gdr_vec4 bounds = m.bounds;
     uint64_t need = (uint64_t)vertex_count * 32 + (uint64_t)index_count * 4;
     if (need > geo->size - geo->at)
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: mesh %u: %u vertices and %u indices run past section 'GEOM'",
@@ -231,7 +268,6 @@ static gdr_status read_one_mesh(cache_read_state *st, reader *geo, uint32_t i, g
     gdr_vec3 *p = malloc((size_t)vertex_count * 12 + 1), *n = malloc((size_t)vertex_count * 12 + 1);
     gdr_vec2 *t = malloc((size_t)vertex_count * 8 + 1);
     uint32_t *idx = malloc((size_t)index_count * 4 + 1);
-    gdr_status status;
     if (p && n && t && idx) {
         memcpy(p, positions, (size_t)vertex_count * 12);
         memcpy(n, normals, (size_t)vertex_count * 12);
@@ -250,8 +286,10 @@ static gdr_status read_one_mesh(cache_read_state *st, reader *geo, uint32_t i, g
     free(n);
     free(t);
     free(idx);
-    if (status == GDR_OK)
+    if (status == GDR_OK) {
         st->scene->meshes[st->scene->mesh_count - 1].bounds = bounds;
+        st->scene->meshes[st->scene->mesh_count - 1].quantization = m.quantization;
+    }
     return status;
 }
 
@@ -300,16 +338,15 @@ static gdr_status add_paged_meshes(cache_read_state *st, gdr_error *err)
 {
     st->scene->geometry_in_pages = 1;
     for (uint32_t i = 0; i < st->mesh_count; i++) {
-        char mname[GDR_NAME_MAX];
-        get_name(&st->meshes, mname);
-        uint32_t vertex_count = get_u32(&st->meshes), index_count = get_u32(&st->meshes);
-        gdr_vec4 bounds;
-        get_f32s(&st->meshes, &bounds.x, 4);
-        if (!all_finite(&bounds.x, 4) || !(bounds.w >= 0.0f))
-            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: mesh %u: bounds are not finite", st->name, i);
-        gdr_status status = gdr_scene_add_paged_mesh(st->scene, mname, vertex_count, index_count, bounds, err);
+        mesh_record m;
+        gdr_status status = get_mesh_record(st, i, &m, err);
+        if (status == GDR_OK && (!all_finite(&m.bounds.x, 4) || !(m.bounds.w >= 0.0f)))
+            status = gdr_error_set(err, GDR_ERROR_PARSE, "%s: mesh %u: bounds are not finite", st->name, i);
+        if (status == GDR_OK)
+            status = gdr_scene_add_paged_mesh(st->scene, m.name, m.vertex_count, m.index_count, m.bounds, err);
         if (status != GDR_OK)
             return status;
+        st->scene->meshes[i].quantization = m.quantization;
     }
     return GDR_OK;
 }

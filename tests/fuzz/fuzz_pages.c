@@ -6,7 +6,8 @@
  * u32 the clusters' vertex count in all (the index's; the header holds the page's shared ones),
  * then the page's bytes. A page that decodes must hold what its index entry says, every triangle
  * inside its cluster. The seed corpus/pages/page0.bin is page 0 of
- * `gdr build unique-field:meshes=1,triangles=1000 -o p.gdrc --pages=4` behind the prefix 0 0 1 0 and its vertex count. */
+ * `gdr build unique-field:meshes=1,triangles=1000 -o p.gdrc --pages=4` behind the prefix 0 0 1 0 and its vertex count,
+ * written with float vertices; page0_quantized.bin the same page now that --pages quantizes them. */
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>

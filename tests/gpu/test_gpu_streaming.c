@@ -431,6 +431,8 @@ int main(void)
     const char *tmp = getenv("TMPDIR");
     snprintf(path, sizeof path, "%s/gdr_gpu_streaming_%ld.gdrc", tmp ? tmp : "/tmp", (long)getpid());
     gdr_cache_write_options write = {.page_bytes = GDR_PAGE_BYTES_MIN}; /* a group a page */
+    /* Quantized, as gdr build --pages writes it: the pages decode to the scene's own vertices. */
+    CHECK(scene && gdr_scene_quantize_vertices(scene, &err) == GDR_OK);
     CHECK(scene && gdr_cache_write(path, scene, &write, &err) == GDR_OK);
     if (scene)
         run(scene, path);

@@ -4,7 +4,7 @@
  * match the clusters; the open reads only the header, table, instances and index; a damaged page
  * (flipped byte, rewritten in place while open) is refused naming the file, mesh and page while
  * the others still read; a truncated file or a damaged index is refused at the open; pages read
- * from several threads decode to the same bytes. */
+ * from several threads decode to the same bytes; quantized vertices decode to the scene's own. */
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -279,6 +279,25 @@ int main(void)
         check_refused_opens(path, bytes, size, pc);
     }
     gdr_paged_cache_close(pc);
+    /* Quantized vertices: the pages store them as integers and decode them to the scene's floats, bit
+     * for bit, in much fewer bytes. */
+    uint64_t float_bytes = 0, quantized_bytes = 0;
+    pc = NULL;
+    if (gdr_paged_cache_open(path, &pc, &err) == GDR_OK)
+        float_bytes = gdr_paged_cache_page_bytes(pc);
+    gdr_paged_cache_close(pc);
+    CHECK(gdr_scene_quantize_vertices(scene, &err) == GDR_OK);
+    CHECK(gdr_cache_write(path, scene, &write, &err) == GDR_OK);
+    pc = NULL;
+    CHECK(gdr_paged_cache_open(path, &pc, &err) == GDR_OK);
+    if (pc) {
+        quantized_bytes = gdr_paged_cache_page_bytes(pc);
+        check_pages_match(pc, scene);
+    }
+    gdr_paged_cache_close(pc);
+    printf("pages: %llu bytes with float vertices, %llu quantized\n", (unsigned long long)float_bytes,
+           (unsigned long long)quantized_bytes);
+    CHECK(quantized_bytes > 0 && quantized_bytes * 10 < float_bytes * 7);
     /* A cache written without pages is refused by the paged reader, saying why. */
     CHECK(gdr_cache_write(path, scene, NULL, &err) == GDR_OK);
     pc = NULL;

@@ -1,5 +1,6 @@
 /* gdr build INPUT -o OUTPUT.gdrc [--pvs]: import a scene (or build the demo), optionally bake its
  * precomputed visibility, and write the cache. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -20,8 +21,26 @@ static void build_usage(void)
           "         'occlusion' or 'unique-field', each with optional ':key=value,...' (see gdr --help)\n"
           "  --pvs: bake precomputed visibility (default options, every processor) into the cache\n"
           "  --pages[=KIB]: also store the geometry in compressed pages of KIB kibibytes (default 128),\n"
-          "         read on demand for streaming (docs/CACHE_FORMAT.md, section 'PAGE')\n",
+          "         read on demand for streaming (docs/CACHE_FORMAT.md, section 'PAGE'); the vertices are\n"
+          "         first moved onto a 16-bit grid per mesh (gdr_scene_quantize_vertices), which the pages\n"
+          "         store as integers\n",
           stderr);
+}
+
+/* The vertices onto their grids before the pages store them; reports the largest move. */
+static gdr_status quantize(gdr_scene *scene, gdr_error *err)
+{
+    gdr_status status = gdr_scene_quantize_vertices(scene, err);
+    float largest = 0.0f, relative = 0.0f;
+    for (uint32_t m = 0; status == GDR_OK && m < scene->mesh_count; m++) {
+        const gdr_mesh *mesh = &scene->meshes[m];
+        largest = fmaxf(largest, mesh->quantization.max_displacement);
+        if (mesh->bounds.w > 0.0f)
+            relative = fmaxf(relative, mesh->quantization.max_displacement / mesh->bounds.w);
+    }
+    if (status == GDR_OK)
+        printf("vertices: on a 16-bit grid per mesh, moved at most %g (%.2g of a mesh's radius)\n", largest, relative);
+    return status;
 }
 
 /* The bake with default options (docs/CULLING.md) on a pool of every processor. */
@@ -116,6 +135,8 @@ int gdr_cmd_build(int argc, char **argv)
                                      .allow_outside_files = allow_outside_files};
         status = gdr_import_file(input, &import, &scene, NULL, &err);
     }
+    if (status == GDR_OK && page_bytes)
+        status = quantize(scene, &err);
     if (status == GDR_OK && pvs_wanted) {
         gdr_pvs_destroy(pvs);
         pvs = NULL;

@@ -1,0 +1,207 @@
+/* Vertices onto a per-mesh grid (gdr_scene_quantize_vertices, gdr/geometry.h): positions and uvs
+ * on power-of-two steps, normals as 10-bit octahedral pairs, and every bound that depends on the
+ * positions made honest again for the moved vertices. */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "geometry/cluster_bounds.h"
+#include "geometry/vertex_quantize.h"
+#include "gdr/scene.h"
+
+#define POSITION_MAX ((1u << GDR_QUANTIZED_POSITION_BITS) - 1u)
+#define UV_MAX ((1u << GDR_QUANTIZED_UV_BITS) - 1u)
+#define NORMAL_MAX 511.0f /* 10-bit octahedral components: within 0.24 degrees */
+
+/* --- the codec ----------------------------------------------------------------------------------- */
+
+static float sign_of(float v) { return v < 0.0f ? -1.0f : 1.0f; }
+
+/* The octahedral map folds the lower hemisphere over the upper one. */
+static void oct_fold(float *x, float *y)
+{
+    float fx = (1.0f - fabsf(*y)) * sign_of(*x), fy = (1.0f - fabsf(*x)) * sign_of(*y);
+    *x = fx, *y = fy;
+}
+
+static void oct_encode(gdr_vec3 n, int16_t out[2])
+{
+    float l1 = fabsf(n.x) + fabsf(n.y) + fabsf(n.z);
+    float x = l1 > 0.0f ? n.x / l1 : 0.0f, y = l1 > 0.0f ? n.y / l1 : 0.0f;
+    if (n.z < 0.0f)
+        oct_fold(&x, &y);
+    out[0] = (int16_t)lrintf(fminf(fmaxf(x, -1.0f), 1.0f) * NORMAL_MAX);
+    out[1] = (int16_t)lrintf(fminf(fmaxf(y, -1.0f), 1.0f) * NORMAL_MAX);
+}
+
+static gdr_vec3 oct_decode(const int16_t in[2])
+{
+    float x = fmaxf((float)in[0] / NORMAL_MAX, -1.0f), y = fmaxf((float)in[1] / NORMAL_MAX, -1.0f);
+    float z = 1.0f - fabsf(x) - fabsf(y);
+    if (z < 0.0f)
+        oct_fold(&x, &y);
+    float length = sqrtf(x * x + y * y + z * z);
+    /* + 0.0f turns -0 into +0, so that every decoded normal encodes to the same pair again. */
+    return (gdr_vec3){x / length + 0.0f, y / length + 0.0f, z / length + 0.0f};
+}
+
+/* One coordinate onto the grid origin + q * 2^exponent, q in [0, max]; -1 when outside. */
+static int64_t grid_index(float v, float origin, int exponent, uint32_t max)
+{
+    double q = nearbyint(ldexp((double)v - (double)origin, -exponent));
+    return q >= 0.0 && q <= (double)max ? (int64_t)q : -1;
+}
+
+static float grid_value(float origin, int exponent, uint32_t q) { return origin + ldexpf((float)q, exponent); }
+
+/* The nearest grid point of each value; 0 when one lies outside the grid's range. */
+static int encode_nearest(const gdr_vertex_quantization *q, gdr_vec3 position, gdr_vec3 normal, gdr_vec2 uv,
+                          gdr_quantized_vertex *out)
+{
+    const float *p = &position.x, *po = &q->position_origin.x, *t = &uv.x, *to = &q->uv_origin.x;
+    *out = (gdr_quantized_vertex){0};
+    for (int i = 0; i < 3; i++) {
+        int64_t k = grid_index(p[i], po[i], q->position_exponent, POSITION_MAX);
+        if (k < 0)
+            return 0;
+        out->position[i] = (uint16_t)k;
+    }
+    for (int i = 0; i < 2; i++) {
+        int64_t k = grid_index(t[i], to[i], q->uv_exponent, UV_MAX);
+        if (k < 0)
+            return 0;
+        out->uv[i] = (uint32_t)k;
+    }
+    oct_encode(normal, out->normal);
+    return 1;
+}
+
+int gdr_vertex_encode(const gdr_vertex_quantization *q, gdr_vec3 position, gdr_vec3 normal, gdr_vec2 uv,
+                      gdr_quantized_vertex *out)
+{
+    if (!encode_nearest(q, position, normal, uv, out))
+        return 0;
+    gdr_vec3 p2, n2;
+    gdr_vec2 t2;
+    gdr_vertex_decode(q, out, &p2, &n2, &t2);
+    return memcmp(&p2, &position, sizeof p2) == 0 && memcmp(&n2, &normal, sizeof n2) == 0 &&
+           memcmp(&t2, &uv, sizeof t2) == 0;
+}
+
+void gdr_vertex_decode(const gdr_vertex_quantization *q, const gdr_quantized_vertex *v, gdr_vec3 *position,
+                       gdr_vec3 *normal, gdr_vec2 *uv)
+{
+    *position = (gdr_vec3){grid_value(q->position_origin.x, q->position_exponent, v->position[0]),
+                           grid_value(q->position_origin.y, q->position_exponent, v->position[1]),
+                           grid_value(q->position_origin.z, q->position_exponent, v->position[2])};
+    *uv = (gdr_vec2){grid_value(q->uv_origin.x, q->uv_exponent, v->uv[0]),
+                     grid_value(q->uv_origin.y, q->uv_exponent, v->uv[1])};
+    *normal = oct_decode(v->normal);
+}
+
+/* --- choosing a mesh's grid ------------------------------------------------------------------------ */
+
+/* The smallest power-of-two step over which `extent` spans at most max - 1 steps, and the origin:
+ * the grid point at or below `lo`. */
+static void choose_grid(const float *lo, const float *hi, int axes, uint32_t max, int *exponent, float *origin)
+{
+    double extent = 0.0;
+    for (int i = 0; i < axes; i++)
+        extent = fmax(extent, (double)hi[i] - (double)lo[i]);
+    int e = -126;
+    if (extent > 0.0) {
+        (void)frexp(extent / (double)(max - 1u), &e); /* extent / (max - 1) < 2^e */
+    }
+    e = e < -126 ? -126 : e > 100 ? 100 : e;
+    *exponent = e;
+    for (int i = 0; i < axes; i++)
+        origin[i] = (float)ldexp(floor(ldexp((double)lo[i], -e)), e);
+}
+
+static gdr_vertex_quantization mesh_grid(const gdr_mesh *mesh)
+{
+    float plo[3] = {INFINITY, INFINITY, INFINITY}, phi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    float tlo[2] = {INFINITY, INFINITY}, thi[2] = {-INFINITY, -INFINITY};
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        const float *p = &mesh->positions[v].x, *t = &mesh->uvs[v].x;
+        for (int i = 0; i < 3; i++)
+            plo[i] = fminf(plo[i], p[i]), phi[i] = fmaxf(phi[i], p[i]);
+        for (int i = 0; i < 2; i++)
+            tlo[i] = fminf(tlo[i], t[i]), thi[i] = fmaxf(thi[i], t[i]);
+    }
+    gdr_vertex_quantization q = {.enabled = 1};
+    if (mesh->vertex_count == 0)
+        return q;
+    choose_grid(plo, phi, 3, POSITION_MAX, &q.position_exponent, &q.position_origin.x);
+    choose_grid(tlo, thi, 2, UV_MAX, &q.uv_exponent, &q.uv_origin.x);
+    return q;
+}
+
+/* --- moving a mesh and its bounds ------------------------------------------------------------------ */
+
+static double distance3(gdr_vec3 a, gdr_vec3 b)
+{
+    double dx = (double)a.x - b.x, dy = (double)a.y - b.y, dz = (double)a.z - b.z;
+    return sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+/* Every vertex onto the grid (through the codec, so that the page reproduces it); the largest
+ * position displacement, rounded up. 0 when some vertex falls outside the grid's range. */
+static int snap_vertices(gdr_mesh *mesh, const gdr_vertex_quantization *q, float *displacement)
+{
+    double largest = 0.0;
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        gdr_quantized_vertex code;
+        gdr_vec3 p, n;
+        gdr_vec2 t;
+        if (!encode_nearest(q, mesh->positions[v], mesh->normals[v], mesh->uvs[v], &code))
+            return 0;
+        gdr_vertex_decode(q, &code, &p, &n, &t);
+        largest = fmax(largest, distance3(p, mesh->positions[v]));
+        mesh->positions[v] = p, mesh->normals[v] = n, mesh->uvs[v] = t;
+    }
+    *displacement = (float)(largest * (1.0 + 1e-6)) + FLT_MIN;
+    return 1;
+}
+
+/* Spheres grow by d, cones are measured on the moved triangles, errors above level 0 grow by 2d, the
+ * hierarchy is built again over the new bounds. */
+static gdr_status fix_bounds(gdr_mesh *mesh, float d, gdr_error *err)
+{
+    gdr_mesh_clusters *c = &mesh->clusters;
+    mesh->bounds.w += d;
+    for (uint32_t k = 0; k < c->cluster_count; k++) {
+        gdr_cluster *cl = &c->clusters[k], moved = *cl;
+        gdr_cluster_compute_bounds(&moved, c->vertices + cl->vertex_offset, c->triangles + cl->triangle_offset, mesh);
+        cl->sphere.w += d;
+        cl->cone_apex = moved.cone_apex, cl->cone_axis = moved.cone_axis, cl->cone_cutoff = moved.cone_cutoff;
+    }
+    for (uint32_t g = 0; g < c->group_count; g++) {
+        c->groups[g].sphere.w += d;
+        if (c->groups[g].depth > 0 && isfinite(c->groups[g].error))
+            c->groups[g].error += 2.0f * d;
+    }
+    return c->cluster_count ? gdr_mesh_clusters_build_hierarchy(c, err) : GDR_OK;
+}
+
+gdr_status gdr_scene_quantize_vertices(gdr_scene *scene, gdr_error *err)
+{
+    if (scene->geometry_in_pages)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "quantize: the scene was read for streaming and holds "
+                             "no vertices");
+    for (uint32_t m = 0; m < scene->mesh_count; m++) {
+        gdr_mesh *mesh = &scene->meshes[m];
+        if (mesh->quantization.enabled)
+            continue;
+        gdr_vertex_quantization q = mesh_grid(mesh);
+        if (!snap_vertices(mesh, &q, &q.max_displacement))
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "quantize: mesh %u ('%s'): a position lies "
+                                 "outside its grid", m, mesh->name);
+        gdr_status status = fix_bounds(mesh, q.max_displacement, err);
+        if (status != GDR_OK)
+            return status;
+        mesh->quantization = q;
+    }
+    return GDR_OK;
+}
