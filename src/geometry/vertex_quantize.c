@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/thread_pool.h"
 #include "geometry/cluster_bounds.h"
 #include "geometry/vertex_quantize.h"
 #include "gdr/scene.h"
@@ -185,23 +186,51 @@ static gdr_status fix_bounds(gdr_mesh *mesh, float d, gdr_error *err)
     return c->cluster_count ? gdr_mesh_clusters_build_hierarchy(c, err) : GDR_OK;
 }
 
+/* One mesh per task; each task's outcome in its own slot, the first failure reported after. */
+typedef struct quantize_job {
+    gdr_scene *scene;
+    gdr_status *status;
+    gdr_error *errors;
+} quantize_job;
+
+static void quantize_mesh_task(void *user, uint32_t m, uint32_t worker)
+{
+    (void)worker;
+    quantize_job *job = user;
+    gdr_mesh *mesh = &job->scene->meshes[m];
+    if (mesh->quantization.enabled)
+        return;
+    gdr_vertex_quantization q = mesh_grid(mesh);
+    if (!snap_vertices(mesh, &q, &q.max_displacement)) {
+        job->status[m] = gdr_error_set(&job->errors[m], GDR_ERROR_INVALID_ARGUMENT, "quantize: mesh %u ('%s'): a "
+                                       "position lies outside its grid", m, mesh->name);
+        return;
+    }
+    job->status[m] = fix_bounds(mesh, q.max_displacement, &job->errors[m]);
+    if (job->status[m] == GDR_OK)
+        mesh->quantization = q;
+}
+
 gdr_status gdr_scene_quantize_vertices(gdr_scene *scene, gdr_error *err)
 {
     if (scene->geometry_in_pages)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "quantize: the scene was read for streaming and holds "
                              "no vertices");
-    for (uint32_t m = 0; m < scene->mesh_count; m++) {
-        gdr_mesh *mesh = &scene->meshes[m];
-        if (mesh->quantization.enabled)
-            continue;
-        gdr_vertex_quantization q = mesh_grid(mesh);
-        if (!snap_vertices(mesh, &q, &q.max_displacement))
-            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "quantize: mesh %u ('%s'): a position lies "
-                                 "outside its grid", m, mesh->name);
-        gdr_status status = fix_bounds(mesh, q.max_displacement, err);
-        if (status != GDR_OK)
-            return status;
-        mesh->quantization = q;
-    }
-    return GDR_OK;
+    uint32_t n = scene->mesh_count ? scene->mesh_count : 1;
+    quantize_job job = {scene, calloc(n, sizeof *job.status), calloc(n, sizeof *job.errors)};
+    gdr_thread_pool *pool = NULL;
+    gdr_status status = job.status && job.errors ? gdr_thread_pool_create(0, &pool, err)
+                                                 : gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "quantize: out of memory");
+    if (status == GDR_OK)
+        gdr_thread_pool_run(pool, scene->mesh_count, quantize_mesh_task, &job);
+    for (uint32_t m = 0; status == GDR_OK && m < scene->mesh_count; m++)
+        if (job.status[m] != GDR_OK) {
+            if (err)
+                *err = job.errors[m];
+            status = job.status[m];
+        }
+    gdr_thread_pool_destroy(pool);
+    free(job.status);
+    free(job.errors);
+    return status;
 }
