@@ -1,6 +1,7 @@
 /* Vertices onto a per-mesh grid (gdr_scene_quantize_vertices, gdr/geometry.h): positions and uvs
  * on power-of-two steps, normals as 10-bit octahedral pairs, and every bound that depends on the
- * positions made honest again for the moved vertices. */
+ * positions made honest again for the moved vertices; one mesh per task on a thread pool (the result
+ * does not depend on it). */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
