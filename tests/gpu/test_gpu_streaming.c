@@ -1,12 +1,14 @@
 /* Streaming in the renderer (docs/STREAMING.md) on the default device (lavapipe in CI), validation
  * on: `unique-field` written with one group a page, drawn by a renderer whose page pool holds a
- * tenth of the pages' bytes and copies at most 64 KiB a frame. Along still views and a path, every
+ * tenth of the pages' bytes and copies at most 256 KiB a frame. Along still views and a path, every
  * frame's drawn clusters are the CPU's cut over the groups the renderer reports resident (exactly
  * one cluster on every DAG path: no hole, no crack), the pool stays within the budget, each frame's
  * uploads within theirs, no page in use is evicted, and each still view converges to the image of
  * the scene uploaded whole, pixel for pixel. A budget large enough for everything gives that image
  * with no eviction; a page damaged on disk is refused by name and its group stays absent while the
- * frames go on with coarser geometry. */
+ * frames go on with coarser geometry, and so are the pages of a file cut short while it streams.
+ * The scene is quantized (as gdr build --pages writes it) and the tenth streams it as read for
+ * streaming, without its geometry. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -337,6 +339,46 @@ static void damaged_page(const gdr_scene *scene, const gdr_scene *paged, const c
     gdr_renderer_destroy(r);
 }
 
+/* The file cut short while the renderer streams from it (after the open, before the views load
+ * their pages): the pages past the end are refused, naming the file and the page, and the frames go
+ * on drawing the exact cut over what is resident. Works on a copy of the cache. */
+static void truncated_while_streaming(const gdr_scene *scene, const gdr_scene *paged, const char *path,
+                                      uint64_t budget)
+{
+    char copy[300];
+    snprintf(copy, sizeof copy, "%s.cut.gdrc", path);
+    FILE *in = fopen(path, "rb"), *out = fopen(copy, "wb");
+    char buffer[65536];
+    size_t n;
+    while (in && out && (n = fread(buffer, 1, sizeof buffer, in)) > 0)
+        CHECK(fwrite(buffer, 1, n, out) == n);
+    long size = out ? ftell(out) : 0;
+    if (in)
+        fclose(in);
+    if (out)
+        fclose(out);
+    gdr_renderer *r = streamed_renderer(paged, copy, budget);
+    CHECK(r != NULL && size > 0);
+    /* The last pages hold the finest groups: half of the page data goes. */
+    CHECK(r && truncate(copy, size - size / 8) == 0);
+    uint8_t *image = malloc(WIDTH * HEIGHT * 4);
+    gdr_frame_stats stats = {0};
+    frame_check check;
+    history_init(scene, &check);
+    gdr_frame_desc frame = view_frame(1);
+    for (uint32_t i = 0; r && image && i < 20 && draw(scene, r, &frame, image, &stats, &check); i++)
+        check_budgets(&stats, budget);
+    printf("file cut short while streaming: %u pages refused, \"%s\"\n", stats.streaming.pages_refused,
+           stats.streaming.refused);
+    CHECK(stats.streaming.pages_refused >= 1 && strstr(stats.streaming.refused, copy) &&
+          strstr(stats.streaming.refused, " page "));
+    CHECK(check.drawn > 0 && check.evicted_in_use == 0);
+    history_free(&check);
+    free(image);
+    gdr_renderer_destroy(r);
+    unlink(copy);
+}
+
 /* The cache read for streaming: what the open reads (a small share of the file), and a scene that
  * the whole-upload path and the cache writer refuse. */
 static gdr_scene *read_for_streaming(const char *path)
@@ -415,6 +457,8 @@ static void run(const gdr_scene *scene, const char *path)
     printf("a 1 KiB budget: %s\n", err.message);
     gdr_renderer_destroy(small);
 
+    if (paged)
+        truncated_while_streaming(scene, paged, path, budget);
     if (paged)
         damaged_page(scene, paged, path, budget);
     gdr_scene_destroy(paged);
