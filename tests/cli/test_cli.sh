@@ -145,6 +145,8 @@ grep -q '^pages: *[1-9][0-9]* pages of [1-9][0-9]* groups, [0-9]* bytes, [0-9.]*
     { echo "FAIL: info pages: $(cat "$work/stdout")"; failures=$((failures + 1)); }
 grep -q '^cache: *[1-9][0-9]* bytes, [0-9.]* bytes per source triangle$' "$work/stdout" ||
     { echo "FAIL: info cache bytes: $(cat "$work/stdout")"; failures=$((failures + 1)); }
+grep -q '^vertices: *3 of 3 meshes on a grid' "$work/stdout" ||
+    { echo "FAIL: build --pages did not quantize: $(cat "$work/stdout")"; failures=$((failures + 1)); }
 expect 0 "info of a cache without pages" "$gdr" info "$work/field.gdrc"
 grep -q '^pages: *none' "$work/stdout" || { echo "FAIL: info no pages: $(cat "$work/stdout")"; failures=$((failures + 1)); }
 expect 2 "page size too small" "$gdr" build unique-field:meshes=1,triangles=1000 -o "$work/bad.gdrc" --pages=1

@@ -22,6 +22,23 @@ static void count_warning(void *user, const char *message)
     fprintf(stderr, "gdr: warning: %s\n", message);
 }
 
+/* How many meshes have their vertices on a grid (gdr build --pages), and the largest move. */
+static void print_quantization(const gdr_scene *scene)
+{
+    uint32_t quantized = 0;
+    float largest = 0.0f;
+    for (uint32_t m = 0; m < scene->mesh_count; m++) {
+        const gdr_vertex_quantization *q = &scene->meshes[m].quantization;
+        quantized += q->enabled != 0;
+        largest = q->enabled && q->max_displacement > largest ? q->max_displacement : largest;
+    }
+    if (quantized)
+        printf("vertices:    %u of %u meshes on a grid (16-bit positions), moved at most %g\n", quantized,
+               scene->mesh_count, largest);
+    else
+        printf("vertices:    floats\n");
+}
+
 /* The cache's size per source triangle (the LOD DAG's input), whole and its pages alone. */
 static void print_cache_bytes(const char *path, uint64_t source_triangles)
 {
@@ -121,6 +138,7 @@ int gdr_cmd_info(int argc, char **argv)
     printf("textures:    %u\n", scene->texture_count);
     printf("cameras:     %u\n", scene->camera_count);
     printf("extensions:  %s\n", scene->extensions ? scene->extensions : "(none)");
+    print_quantization(scene);
     if (pvs)
         printf("pvs:         %u cells, %u objects (%zu bytes)\n", gdr_pvs_cell_count(pvs), gdr_pvs_object_count(pvs),
                gdr_pvs_serialized_size(pvs));
