@@ -221,6 +221,128 @@ static void tri_choose_cells(lod_triangle_grid *g, uint32_t n)
     memcpy(g->dim, shape.dim, sizeof g->dim);
 }
 
+/* --- listing a triangle in the cells it crosses ------------------------------------------------ */
+
+/* Listing a long triangle in every cell of its bounding box would fill cells it never comes near
+ * (a coarse group's diagonal triangles cover most of its box), and a query gives each cell only
+ * GRID_CELL_LIMIT triangles: the nearest triangle would be missed. So a triangle is listed in the
+ * cells it crosses, found by clipping it to each slab of cells along z, then each row along y; the
+ * clipped polygon's x extent is the run of cells it crosses in that row. Slabs, rows and runs are
+ * widened by CLIP_MARGIN of a cell so that rounding can only add cells, never drop one. */
+#define CLIP_MARGIN 1e-3
+#define CLIP_MAX 10 /* a triangle clipped by four planes has at most 7 corners; rounding may add */
+
+typedef struct clip_polygon {
+    double p[CLIP_MAX][3]; /* in cell units from the grid's corner */
+    int n;
+    int overflow; /* too many corners from rounding: use the unclipped extent */
+} clip_polygon;
+
+/* The part of `in` where sign * (x[k] - at) >= 0 (Sutherland–Hodgman, one plane). */
+static void clip_plane(const clip_polygon *in, int k, double at, double sign, clip_polygon *out)
+{
+    out->n = 0;
+    out->overflow = in->overflow;
+    for (int i = 0; i < in->n && !out->overflow; i++) {
+        const double *a = in->p[i], *b = in->p[(i + 1) % in->n];
+        double da = sign * (a[k] - at), db = sign * (b[k] - at);
+        int crosses = (da >= 0.0) != (db >= 0.0);
+        if (out->n + (da >= 0.0) + crosses > CLIP_MAX) {
+            out->overflow = 1;
+            break;
+        }
+        if (da >= 0.0)
+            memcpy(out->p[out->n++], a, sizeof out->p[0]);
+        if (crosses) {
+            double t = da / (da - db), *q = out->p[out->n++];
+            for (int j = 0; j < 3; j++)
+                q[j] = a[j] + t * (b[j] - a[j]);
+            q[k] = at;
+        }
+    }
+    if (out->overflow)
+        *out = *in; /* unclipped: larger, so only more cells */
+}
+
+/* `in` clipped to cell `i`'s slab along axis k, widened by the margin; the grid's first and last
+ * slabs are open outwards (queries outside the grid fall into them). */
+static void clip_slab(const lod_triangle_grid *g, const clip_polygon *in, int k, uint32_t i, clip_polygon *out)
+{
+    clip_polygon half;
+    if (i > 0)
+        clip_plane(in, k, (double)i - CLIP_MARGIN, 1.0, &half);
+    else
+        half = *in;
+    if (i + 1 < g->dim[k])
+        clip_plane(&half, k, (double)i + 1.0 + CLIP_MARGIN, -1.0, out);
+    else
+        *out = half;
+}
+
+/* The cells along axis k that the polygon reaches (widened by the margin); 0 when it is empty. */
+static int clip_extent(const lod_triangle_grid *g, const clip_polygon *c, int k, uint32_t *lo, uint32_t *hi)
+{
+    if (c->n == 0)
+        return 0;
+    double a = c->p[0][k], b = a;
+    for (int i = 1; i < c->n; i++) {
+        a = c->p[i][k] < a ? c->p[i][k] : a;
+        b = c->p[i][k] > b ? c->p[i][k] : b;
+    }
+    double top = (double)g->dim[k] - 1.0;
+    a = floor(a - CLIP_MARGIN);
+    b = floor(b + CLIP_MARGIN);
+    *lo = a > 0.0 ? (a < top ? (uint32_t)a : (uint32_t)top) : 0;
+    *hi = b > 0.0 ? (b < top ? (uint32_t)b : (uint32_t)top) : 0;
+    return 1;
+}
+
+/* Counts (store == 0) or stores triangle t in cells x0 .. x1 of row (y, z). */
+static void list_run(lod_triangle_grid *g, uint32_t t, uint32_t x0, uint32_t x1, uint32_t y, uint32_t z, int store)
+{
+    size_t row = ((size_t)z * g->dim[1] + y) * g->dim[0];
+    for (uint32_t x = x0; x <= x1; x++) {
+        if (store)
+            g->items[g->start[row + x]++] = t;
+        else
+            g->start[row + x + 1]++;
+    }
+}
+
+/* Lists triangle t in the cells it crosses (see CLIP_MARGIN). A triangle whose box spans at most two
+ * cells along each axis is listed in its whole box instead: at most a few cells it does not cross,
+ * all next to it, and clipping would cost more than those save (most level-0 triangles are such). */
+static void list_triangle(lod_triangle_grid *g, uint32_t t, int store)
+{
+    uint32_t lo[3], hi[3];
+    tri_box(g, t, lo, hi);
+    if (hi[0] - lo[0] <= 1 && hi[1] - lo[1] <= 1 && hi[2] - lo[2] <= 1) {
+        for (uint32_t z = lo[2]; z <= hi[2]; z++)
+            for (uint32_t y = lo[1]; y <= hi[1]; y++)
+                list_run(g, t, lo[0], hi[0], y, z, store);
+        return;
+    }
+    clip_polygon tri = {.n = 3}, slab, row;
+    for (int j = 0; j < 3; j++) {
+        gdr_vec3 p = corner(g, t, j);
+        const float *x = &p.x;
+        for (int k = 0; k < 3; k++)
+            tri.p[j][k] = ((double)x[k] - (double)g->lo[k]) * (double)g->inv_cell;
+    }
+    uint32_t z0, z1, y0, y1, x0, x1;
+    clip_extent(g, &tri, 2, &z0, &z1);
+    for (uint32_t z = z0; z <= z1; z++) {
+        clip_slab(g, &tri, 2, z, &slab);
+        if (!clip_extent(g, &slab, 1, &y0, &y1))
+            continue;
+        for (uint32_t y = y0; y <= y1; y++) {
+            clip_slab(g, &slab, 1, y, &row);
+            if (clip_extent(g, &row, 0, &x0, &x1))
+                list_run(g, t, x0, x1, y, z, store);
+        }
+    }
+}
+
 int lod_triangle_grid_build(lod_triangle_grid *g, const float *positions, const uint32_t *corners, uint32_t n)
 {
     g->positions = positions;
@@ -230,28 +352,15 @@ int lod_triangle_grid_build(lod_triangle_grid *g, const float *positions, const 
     if (!grid_reserve(&g->start, &g->start_cap, cells + 1))
         return 0;
     memset(g->start, 0, (cells + 1) * sizeof *g->start);
-    for (int pass = 0; pass < 2; pass++) {
-        for (uint32_t t = 0; t < n; t++) {
-            uint32_t lo[3], hi[3];
-            tri_box(g, t, lo, hi);
-            for (uint32_t z = lo[2]; z <= hi[2]; z++)
-                for (uint32_t y = lo[1]; y <= hi[1]; y++)
-                    for (uint32_t x = lo[0]; x <= hi[0]; x++) {
-                        size_t c = ((size_t)z * g->dim[1] + y) * g->dim[0] + x;
-                        if (pass == 0)
-                            g->start[c + 1]++;
-                        else
-                            g->items[g->start[c]++] = t;
-                    }
-        }
-        if (pass == 0) {
-            for (size_t c = 0; c < cells; c++)
-                g->start[c + 1] += g->start[c];
-            if (!grid_reserve(&g->items, &g->items_cap, (size_t)g->start[cells] + 1))
-                return 0;
-        }
-    }
-    for (size_t c = cells; c > 0; c--)
+    for (uint32_t t = 0; t < n; t++)
+        list_triangle(g, t, 0);
+    for (size_t c = 0; c < cells; c++)
+        g->start[c + 1] += g->start[c];
+    if (!grid_reserve(&g->items, &g->items_cap, (size_t)g->start[cells] + 1))
+        return 0;
+    for (uint32_t t = 0; t < n; t++)
+        list_triangle(g, t, 1);
+    for (size_t c = cells; c > 0; c--) /* start[c] now holds the end of cell c: shift back */
         g->start[c] = g->start[c - 1];
     g->start[0] = 0;
     return 1;
