@@ -7,6 +7,7 @@
 #include <string.h>
 
 #define GRID_MAX_DIM 1024
+#define GRID_MIN_CELLS 32768.0
 
 static int grid_reserve(uint32_t **p, size_t *cap, size_t need)
 {
@@ -32,23 +33,28 @@ static uint32_t cell_coordinate(const lod_grid *g, float x, int k)
 }
 
 /* The points lie on a surface: about two per occupied cell when the cell edge is about twice the
- * largest extent over the square root of the count (a sphere's or a square's spacing), with at
- * most 4n + 64 cells in all (larger cells for the few groups that span most of a mesh). */
-static void choose_cells(lod_grid *g, const float hi[3], uint32_t n)
+ * largest extent over the square root of the count (a sphere's or a square's spacing). Triangles
+ * pass their mean edge scale (`spacing`: the mean square root of their areas), taken instead when
+ * smaller: a strip or a curved band has far less area than its largest extent squared, and cells
+ * sized by the extent would hold a hundred of its triangles. At most max_cells cells in all (larger
+ * cells for the groups that span most of a mesh). */
+static void choose_cells(lod_grid *g, const float hi[3], uint32_t n, double spacing, double max_cells)
 {
     float extent[3], largest = 0.0f;
     for (int k = 0; k < 3; k++) {
         extent[k] = hi[k] - g->lo[k];
         largest = extent[k] > largest ? extent[k] : largest;
     }
-    float cell = 2.0f * largest / sqrtf((float)n + 1.0f);
+    float cell = 2.0f * largest / sqrtf((float)n + 1.0f), by_spacing = (float)(2.0 * spacing);
+    if (by_spacing > 0.0f && by_spacing < cell)
+        cell = by_spacing;
     if (!(cell > 0.0f))
         cell = 1.0f;
     for (int attempt = 0; attempt < 64; attempt++) {
         double cells = 1.0;
         for (int k = 0; k < 3; k++)
             cells *= fmin(floor(extent[k] / cell) + 1.0, GRID_MAX_DIM);
-        if (cells <= 4.0 * n + 64.0)
+        if (cells <= max_cells)
             break;
         cell *= 1.25f;
     }
@@ -77,7 +83,7 @@ int lod_grid_build(lod_grid *g, const gdr_vec3 *points, uint32_t n)
             hi[k] = p[k] > hi[k] ? p[k] : hi[k];
         }
     }
-    choose_cells(g, hi, n);
+    choose_cells(g, hi, n, 0.0, 4.0 * n + 64.0);
     size_t cells = (size_t)g->dim[0] * g->dim[1] * g->dim[2];
     if (!grid_reserve(&g->start, &g->start_cap, cells + 1) || !grid_reserve(&g->items, &g->items_cap, n) ||
         !grid_reserve(&g->cell_of, &g->cell_of_cap, n))
@@ -200,12 +206,24 @@ static void tri_box(const lod_triangle_grid *g, uint32_t t, uint32_t lo[3], uint
     }
 }
 
-/* Cells about as large as the triangles: the grid of the corners' box with about n / 2 cells. */
+/* The square root of triangle t's area: its edge scale (0 when degenerate). */
+static double triangle_scale(const lod_triangle_grid *g, uint32_t t)
+{
+    gdr_vec3 a = corner(g, t, 0), b = corner(g, t, 1), c = corner(g, t, 2);
+    double u[3] = {b.x - a.x, b.y - a.y, b.z - a.z}, v[3] = {c.x - a.x, c.y - a.y, c.z - a.z};
+    double x = u[1] * v[2] - u[2] * v[1], y = u[2] * v[0] - u[0] * v[2], z = u[0] * v[1] - u[1] * v[0];
+    return sqrt(0.5 * sqrt(x * x + y * y + z * z));
+}
+
+/* Cells about as large as the triangles, over the corners' box. A group's triangles often lie on a
+ * curved band whose box is mostly empty: 4n + 64 cells would force cells of dozens of triangles, so
+ * a small grid may have up to GRID_MIN_CELLS (128 KiB of cell starts, kept between builds). */
 static void tri_choose_cells(lod_triangle_grid *g, uint32_t n)
 {
     float hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
     g->lo[0] = g->lo[1] = g->lo[2] = FLT_MAX;
-    for (uint32_t t = 0; t < n; t++)
+    double scale = 0.0;
+    for (uint32_t t = 0; t < n; t++) {
         for (int j = 0; j < 3; j++) {
             gdr_vec3 p = corner(g, t, j);
             const float *x = &p.x;
@@ -214,8 +232,10 @@ static void tri_choose_cells(lod_triangle_grid *g, uint32_t n)
                 hi[k] = x[k] > hi[k] ? x[k] : hi[k];
             }
         }
+        scale += triangle_scale(g, t);
+    }
     lod_grid shape = {.lo = {g->lo[0], g->lo[1], g->lo[2]}};
-    choose_cells(&shape, hi, n);
+    choose_cells(&shape, hi, n, scale / n, fmax(4.0 * n + 64.0, GRID_MIN_CELLS));
     g->cell = shape.cell;
     g->inv_cell = shape.inv_cell;
     memcpy(g->dim, shape.dim, sizeof g->dim);
