@@ -121,15 +121,31 @@ static void visit_cell(const lod_grid *g, uint32_t x, uint32_t y, uint32_t z, co
     }
 }
 
-/* The largest Chebyshev distance a search of a grid of `dim` cells may need. */
-static int32_t search_radius(const uint32_t dim[3])
+/* Distance from q to the nearest cell the search has not reached once every cell within Chebyshev
+ * distance r of cell `at` is searched: to the nearest face of that block of cells beyond which the
+ * grid has more cells (at least r cell edges, up to r + 1). INFINITY when none is left. */
+static float unsearched_reach(const float lo[3], float cell, const uint32_t dim[3], const int32_t at[3], int32_t r,
+                              const float q[3])
 {
-    uint32_t largest = dim[0] > dim[1] ? dim[0] : dim[1];
-    return (int32_t)(dim[2] > largest ? dim[2] : largest);
+    float reach = INFINITY;
+    for (int k = 0; k < 3; k++) {
+        if (at[k] - r > 0)
+            reach = fminf(reach, q[k] - (lo[k] + (float)(at[k] - r) * cell));
+        if (at[k] + r + 1 < (int32_t)dim[k])
+            reach = fminf(reach, lo[k] + (float)(at[k] + r + 1) * cell - q[k]);
+    }
+    return reach > 0.0f ? reach : 0.0f; /* rounding may put q just outside its cell */
 }
 
-/* Cells at Chebyshev distance r from the query's cell are at least (r - 1) cell edges away, so
- * the search stops once the best distance is within that. */
+/* The search has found best_d2 and reached every cell within Chebyshev distance r: done when no
+ * cell left can hold anything nearer. */
+static int search_done(const float lo[3], float cell, const uint32_t dim[3], const int32_t at[3], int32_t r,
+                       const float q[3], float best_d2)
+{
+    float reach = unsearched_reach(lo, cell, dim, at, r, q);
+    return reach == INFINITY || reach * reach >= best_d2;
+}
+
 uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squared)
 {
     const float q[3] = {point.x, point.y, point.z};
@@ -138,13 +154,7 @@ uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squ
         at[k] = (int32_t)cell_coordinate(g, q[k], k);
     uint32_t best = UINT32_MAX;
     float best_d2 = INFINITY;
-    int32_t max_r = search_radius(g->dim);
-    for (int32_t r = 0; r <= max_r; r++) {
-        if (best != UINT32_MAX) {
-            float reach = (float)(r - 1) * g->cell;
-            if (r > 0 && reach * reach >= best_d2)
-                break;
-        }
+    for (int32_t r = 0;; r++) {
         for (int32_t z = at[2] - r; z <= at[2] + r; z++) {
             if (z < 0 || z >= (int32_t)g->dim[2])
                 continue;
@@ -160,6 +170,8 @@ uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squ
                 }
             }
         }
+        if (search_done(g->lo, g->cell, g->dim, at, r, q, best_d2))
+            break;
     }
     *distance_squared = best_d2;
     return best;
@@ -387,8 +399,43 @@ int lod_triangle_grid_build(lod_triangle_grid *g, const float *positions, const 
 }
 
 /* A cell's triangles are looked at up to this many (the centre of a fan lies in cells of thousands):
- * the nearest of fewer triangles is farther, so the distance found stays an upper bound. */
+ * the nearest of fewer triangles is farther, so the distance found stays an upper bound. Cells sized
+ * by the triangles and triangles listed only where they cross keep sound meshes below it (the blob's
+ * groups: no query reaches it), so there the distance is exact. */
 #define GRID_CELL_LIMIT 64u
+
+/* Squared distance from q to cell c: no triangle listed there comes nearer than this. */
+static float cell_d2(const lod_triangle_grid *g, const int32_t c[3], const float q[3])
+{
+    float d2 = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        float a = g->lo[k] + (float)c[k] * g->cell, gap = a - q[k];
+        if (gap <= 0.0f)
+            gap = q[k] - (a + g->cell);
+        d2 += gap > 0.0f ? gap * gap : 0.0f;
+    }
+    return d2;
+}
+
+/* The nearest of cell c's triangles (up to GRID_CELL_LIMIT) into best, unless the cell is farther
+ * than best already: a triangle listed there whose nearest point is nearer lies in a nearer cell too,
+ * where it is listed as well. Ties: the lowest triangle index. */
+static void visit_triangle_cell(const lod_triangle_grid *g, const int32_t c[3], gdr_vec3 point, const float q[3],
+                                lod_point_triangle_fn *distance, uint32_t *best, float *best_d2)
+{
+    if (cell_d2(g, c, q) > *best_d2)
+        return;
+    size_t k = ((size_t)c[2] * g->dim[1] + (uint32_t)c[1]) * g->dim[0] + (uint32_t)c[0];
+    uint32_t end = g->start[k + 1] - g->start[k] > GRID_CELL_LIMIT ? g->start[k] + GRID_CELL_LIMIT : g->start[k + 1];
+    for (uint32_t i = g->start[k]; i < end; i++) {
+        uint32_t t = g->items[i];
+        float d = distance(point, corner(g, t, 0), corner(g, t, 1), corner(g, t, 2));
+        if (d < *best_d2 || (d == *best_d2 && t < *best)) {
+            *best_d2 = d;
+            *best = t;
+        }
+    }
+}
 
 uint32_t lod_triangle_grid_nearest(const lod_triangle_grid *g, gdr_vec3 point, lod_point_triangle_fn *distance,
                                    float *distance_squared)
@@ -399,11 +446,7 @@ uint32_t lod_triangle_grid_nearest(const lod_triangle_grid *g, gdr_vec3 point, l
         at[k] = (int32_t)tri_cell(g, q[k], k);
     uint32_t best = UINT32_MAX;
     float best_d2 = INFINITY;
-    int32_t max_r = search_radius(g->dim);
-    for (int32_t r = 0; r <= max_r; r++) {
-        float reach = (float)(r - 1) * g->cell;
-        if (r > 0 && best != UINT32_MAX && reach * reach >= best_d2)
-            break;
+    for (int32_t r = 0;; r++) {
         for (int32_t z = at[2] - r; z <= at[2] + r; z++) {
             if (z < 0 || z >= (int32_t)g->dim[2])
                 continue;
@@ -412,22 +455,14 @@ uint32_t lod_triangle_grid_nearest(const lod_triangle_grid *g, gdr_vec3 point, l
                     continue;
                 int shell = r == 0 || z == at[2] - r || z == at[2] + r || y == at[1] - r || y == at[1] + r;
                 for (int32_t x = at[0] - r; x <= at[0] + r; x += shell ? 1 : 2 * r) {
-                    if (x < 0 || x >= (int32_t)g->dim[0])
-                        continue;
-                    size_t c = ((size_t)z * g->dim[1] + (uint32_t)y) * g->dim[0] + (uint32_t)x;
-                    uint32_t end = g->start[c + 1] - g->start[c] > GRID_CELL_LIMIT ? g->start[c] + GRID_CELL_LIMIT
-                                                                                   : g->start[c + 1];
-                    for (uint32_t i = g->start[c]; i < end; i++) {
-                        uint32_t t = g->items[i];
-                        float d = distance(point, corner(g, t, 0), corner(g, t, 1), corner(g, t, 2));
-                        if (d < best_d2 || (d == best_d2 && t < best)) {
-                            best_d2 = d;
-                            best = t;
-                        }
-                    }
+                    const int32_t c[3] = {x, y, z};
+                    if (x >= 0 && x < (int32_t)g->dim[0])
+                        visit_triangle_cell(g, c, point, q, distance, &best, &best_d2);
                 }
             }
         }
+        if (search_done(g->lo, g->cell, g->dim, at, r, q, best_d2))
+            break;
     }
     *distance_squared = best_d2;
     return best;
