@@ -149,6 +149,57 @@ static void test_needles_exact(void)
     free(queries);
 }
 
+#define BAND_STEPS 150u
+#define BAND_ROWS 6u
+#define BAND_QUERY_COUNT 2000
+
+/* A point of the unit sphere at arc position u (radians) and row offset v along a wavy path. */
+static gdr_vec3 band_point(float u, float v)
+{
+    float latitude = 0.7f * sinf(6.0f * u) + v;
+    return (gdr_vec3){cosf(latitude) * cosf(u), cosf(latitude) * sinf(u), sinf(latitude)};
+}
+
+/* A band a few triangles wide, winding over a sphere, as a group of a coarse DAG level often is: its
+ * box is mostly empty, and cells sized to keep the box's cell count near the triangle count hold
+ * dozens of its triangles each, past the per-cell limit. Queries on either side of the band. */
+static void test_band_exact(void)
+{
+    soup s = {0};
+    uint32_t triangles = BAND_STEPS * BAND_ROWS * 2;
+    s.positions = malloc((size_t)triangles * 9 * sizeof *s.positions);
+    s.corners = malloc((size_t)triangles * 3 * sizeof *s.corners);
+    gdr_vec3 *queries = malloc(BAND_QUERY_COUNT * sizeof *queries);
+    CHECK(s.positions && s.corners && queries);
+    if (!s.positions || !s.corners || !queries)
+        return;
+    const float step = 0.012f, length = step * (float)BAND_STEPS, width = step * (float)BAND_ROWS;
+    for (uint32_t i = 0; i < BAND_STEPS; i++)
+        for (uint32_t j = 0; j < BAND_ROWS; j++) {
+            gdr_vec3 p[4];
+            for (uint32_t k = 0; k < 4; k++)
+                p[k] = band_point(step * (float)(i + (k & 1)), step * (float)(j + k / 2));
+            add_triangle(&s, p[0], p[1], p[3]);
+            add_triangle(&s, p[0], p[3], p[2]);
+        }
+    unsigned state = 777;
+    for (int q = 0; q < BAND_QUERY_COUNT; q++) {
+        gdr_vec3 p = band_point(test_random_range(&state, 0.0f, length), test_random_range(&state, -0.01f, width + 0.01f));
+        float r = test_random_range(&state, 0.99f, 1.01f);
+        queries[q] = (gdr_vec3){r * p.x, r * p.y, r * p.z};
+    }
+    lod_triangle_grid g = {0};
+    CHECK(lod_triangle_grid_build(&g, s.positions, s.corners, s.triangle_count));
+    int misses = count_misses(&g, &s, queries, BAND_QUERY_COUNT);
+    if (misses)
+        fprintf(stderr, "band: %d of %d queries missed the nearest triangle\n", misses, BAND_QUERY_COUNT);
+    CHECK(misses == 0);
+    lod_triangle_grid_free(&g);
+    free(s.positions);
+    free(s.corners);
+    free(queries);
+}
+
 /* A fan of thousands of triangles around one vertex: the hub's cells are given up to a limit, so
  * answers there may be farther than the nearest triangle, but never nearer. */
 static void test_fan_bounded(void)
@@ -184,6 +235,7 @@ static void test_fan_bounded(void)
 int main(void)
 {
     test_needles_exact();
+    test_band_exact();
     test_fan_bounded();
     return test_finish("test_lod_grid");
 }
