@@ -400,8 +400,8 @@ int lod_triangle_grid_build(lod_triangle_grid *g, const float *positions, const 
 
 /* A cell's triangles are looked at up to this many (the centre of a fan lies in cells of thousands):
  * the nearest of fewer triangles is farther, so the distance found stays an upper bound. Cells sized
- * by the triangles and triangles listed only where they cross keep sound meshes below it (the blob's
- * groups: no query reaches it), so there the distance is exact. */
+ * by the triangles and triangles listed only where they cross keep sound meshes below it (no query
+ * of the blob's, the knot's or a 1 M-triangle torus's build meets a full cell): there it is exact. */
 #define GRID_CELL_LIMIT 64u
 
 /* Squared distance from q to cell c: no triangle listed there comes nearer than this. */
