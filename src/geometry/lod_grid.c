@@ -7,6 +7,7 @@
 #include <string.h>
 
 #define GRID_MAX_DIM 1024
+#define GRID_MIN_CELLS 32768.0
 
 static int grid_reserve(uint32_t **p, size_t *cap, size_t need)
 {
@@ -32,23 +33,28 @@ static uint32_t cell_coordinate(const lod_grid *g, float x, int k)
 }
 
 /* The points lie on a surface: about two per occupied cell when the cell edge is about twice the
- * largest extent over the square root of the count (a sphere's or a square's spacing), with at
- * most 4n + 64 cells in all (larger cells for the few groups that span most of a mesh). */
-static void choose_cells(lod_grid *g, const float hi[3], uint32_t n)
+ * largest extent over the square root of the count (a sphere's or a square's spacing). Triangles
+ * pass their mean edge scale (`spacing`: the mean square root of their areas), taken instead when
+ * smaller: a strip or a curved band has far less area than its largest extent squared, and cells
+ * sized by the extent would hold a hundred of its triangles. At most max_cells cells in all (larger
+ * cells for the groups that span most of a mesh). */
+static void choose_cells(lod_grid *g, const float hi[3], uint32_t n, double spacing, double max_cells)
 {
     float extent[3], largest = 0.0f;
     for (int k = 0; k < 3; k++) {
         extent[k] = hi[k] - g->lo[k];
         largest = extent[k] > largest ? extent[k] : largest;
     }
-    float cell = 2.0f * largest / sqrtf((float)n + 1.0f);
+    float cell = 2.0f * largest / sqrtf((float)n + 1.0f), by_spacing = (float)(2.0 * spacing);
+    if (by_spacing > 0.0f && by_spacing < cell)
+        cell = by_spacing;
     if (!(cell > 0.0f))
         cell = 1.0f;
     for (int attempt = 0; attempt < 64; attempt++) {
         double cells = 1.0;
         for (int k = 0; k < 3; k++)
             cells *= fmin(floor(extent[k] / cell) + 1.0, GRID_MAX_DIM);
-        if (cells <= 4.0 * n + 64.0)
+        if (cells <= max_cells)
             break;
         cell *= 1.25f;
     }
@@ -77,7 +83,7 @@ int lod_grid_build(lod_grid *g, const gdr_vec3 *points, uint32_t n)
             hi[k] = p[k] > hi[k] ? p[k] : hi[k];
         }
     }
-    choose_cells(g, hi, n);
+    choose_cells(g, hi, n, 0.0, 4.0 * n + 64.0);
     size_t cells = (size_t)g->dim[0] * g->dim[1] * g->dim[2];
     if (!grid_reserve(&g->start, &g->start_cap, cells + 1) || !grid_reserve(&g->items, &g->items_cap, n) ||
         !grid_reserve(&g->cell_of, &g->cell_of_cap, n))
@@ -115,15 +121,31 @@ static void visit_cell(const lod_grid *g, uint32_t x, uint32_t y, uint32_t z, co
     }
 }
 
-/* The largest Chebyshev distance a search of a grid of `dim` cells may need. */
-static int32_t search_radius(const uint32_t dim[3])
+/* Distance from q to the nearest cell the search has not reached once every cell within Chebyshev
+ * distance r of cell `at` is searched: to the nearest face of that block of cells beyond which the
+ * grid has more cells (at least r cell edges, up to r + 1). INFINITY when none is left. */
+static float unsearched_reach(const float lo[3], float cell, const uint32_t dim[3], const int32_t at[3], int32_t r,
+                              const float q[3])
 {
-    uint32_t largest = dim[0] > dim[1] ? dim[0] : dim[1];
-    return (int32_t)(dim[2] > largest ? dim[2] : largest);
+    float reach = INFINITY;
+    for (int k = 0; k < 3; k++) {
+        if (at[k] - r > 0)
+            reach = fminf(reach, q[k] - (lo[k] + (float)(at[k] - r) * cell));
+        if (at[k] + r + 1 < (int32_t)dim[k])
+            reach = fminf(reach, lo[k] + (float)(at[k] + r + 1) * cell - q[k]);
+    }
+    return reach > 0.0f ? reach : 0.0f; /* rounding may put q just outside its cell */
 }
 
-/* Cells at Chebyshev distance r from the query's cell are at least (r - 1) cell edges away, so
- * the search stops once the best distance is within that. */
+/* The search has found best_d2 and reached every cell within Chebyshev distance r: done when no
+ * cell left can hold anything nearer. */
+static int search_done(const float lo[3], float cell, const uint32_t dim[3], const int32_t at[3], int32_t r,
+                       const float q[3], float best_d2)
+{
+    float reach = unsearched_reach(lo, cell, dim, at, r, q);
+    return reach == INFINITY || reach * reach >= best_d2;
+}
+
 uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squared)
 {
     const float q[3] = {point.x, point.y, point.z};
@@ -132,13 +154,7 @@ uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squ
         at[k] = (int32_t)cell_coordinate(g, q[k], k);
     uint32_t best = UINT32_MAX;
     float best_d2 = INFINITY;
-    int32_t max_r = search_radius(g->dim);
-    for (int32_t r = 0; r <= max_r; r++) {
-        if (best != UINT32_MAX) {
-            float reach = (float)(r - 1) * g->cell;
-            if (r > 0 && reach * reach >= best_d2)
-                break;
-        }
+    for (int32_t r = 0;; r++) {
         for (int32_t z = at[2] - r; z <= at[2] + r; z++) {
             if (z < 0 || z >= (int32_t)g->dim[2])
                 continue;
@@ -154,6 +170,8 @@ uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squ
                 }
             }
         }
+        if (search_done(g->lo, g->cell, g->dim, at, r, q, best_d2))
+            break;
     }
     *distance_squared = best_d2;
     return best;
@@ -200,12 +218,24 @@ static void tri_box(const lod_triangle_grid *g, uint32_t t, uint32_t lo[3], uint
     }
 }
 
-/* Cells about as large as the triangles: the grid of the corners' box with about n / 2 cells. */
+/* The square root of triangle t's area: its edge scale (0 when degenerate). */
+static double triangle_scale(const lod_triangle_grid *g, uint32_t t)
+{
+    gdr_vec3 a = corner(g, t, 0), b = corner(g, t, 1), c = corner(g, t, 2);
+    double u[3] = {b.x - a.x, b.y - a.y, b.z - a.z}, v[3] = {c.x - a.x, c.y - a.y, c.z - a.z};
+    double x = u[1] * v[2] - u[2] * v[1], y = u[2] * v[0] - u[0] * v[2], z = u[0] * v[1] - u[1] * v[0];
+    return sqrt(0.5 * sqrt(x * x + y * y + z * z));
+}
+
+/* Cells about as large as the triangles, over the corners' box. A group's triangles often lie on a
+ * curved band whose box is mostly empty: 4n + 64 cells would force cells of dozens of triangles, so
+ * a small grid may have up to GRID_MIN_CELLS (128 KiB of cell starts, kept between builds). */
 static void tri_choose_cells(lod_triangle_grid *g, uint32_t n)
 {
     float hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
     g->lo[0] = g->lo[1] = g->lo[2] = FLT_MAX;
-    for (uint32_t t = 0; t < n; t++)
+    double scale = 0.0;
+    for (uint32_t t = 0; t < n; t++) {
         for (int j = 0; j < 3; j++) {
             gdr_vec3 p = corner(g, t, j);
             const float *x = &p.x;
@@ -214,11 +244,135 @@ static void tri_choose_cells(lod_triangle_grid *g, uint32_t n)
                 hi[k] = x[k] > hi[k] ? x[k] : hi[k];
             }
         }
+        scale += triangle_scale(g, t);
+    }
     lod_grid shape = {.lo = {g->lo[0], g->lo[1], g->lo[2]}};
-    choose_cells(&shape, hi, n);
+    choose_cells(&shape, hi, n, scale / n, fmax(4.0 * n + 64.0, GRID_MIN_CELLS));
     g->cell = shape.cell;
     g->inv_cell = shape.inv_cell;
     memcpy(g->dim, shape.dim, sizeof g->dim);
+}
+
+/* --- listing a triangle in the cells it crosses ------------------------------------------------ */
+
+/* Listing a long triangle in every cell of its bounding box would fill cells it never comes near
+ * (a coarse group's diagonal triangles cover most of its box), and a query gives each cell only
+ * GRID_CELL_LIMIT triangles: the nearest triangle would be missed. So a triangle is listed in the
+ * cells it crosses, found by clipping it to each slab of cells along z, then each row along y; the
+ * clipped polygon's x extent is the run of cells it crosses in that row. Slabs, rows and runs are
+ * widened by CLIP_MARGIN of a cell so that rounding can only add cells, never drop one. */
+#define CLIP_MARGIN 1e-3
+#define CLIP_MAX 10 /* a triangle clipped by four planes has at most 7 corners; rounding may add */
+
+typedef struct clip_polygon {
+    double p[CLIP_MAX][3]; /* in cell units from the grid's corner */
+    int n;
+    int overflow; /* too many corners from rounding: use the unclipped extent */
+} clip_polygon;
+
+/* The part of `in` where sign * (x[k] - at) >= 0 (Sutherland–Hodgman, one plane). */
+static void clip_plane(const clip_polygon *in, int k, double at, double sign, clip_polygon *out)
+{
+    out->n = 0;
+    out->overflow = in->overflow;
+    for (int i = 0; i < in->n && !out->overflow; i++) {
+        const double *a = in->p[i], *b = in->p[(i + 1) % in->n];
+        double da = sign * (a[k] - at), db = sign * (b[k] - at);
+        int crosses = (da >= 0.0) != (db >= 0.0);
+        if (out->n + (da >= 0.0) + crosses > CLIP_MAX) {
+            out->overflow = 1;
+            break;
+        }
+        if (da >= 0.0)
+            memcpy(out->p[out->n++], a, sizeof out->p[0]);
+        if (crosses) {
+            double t = da / (da - db), *q = out->p[out->n++];
+            for (int j = 0; j < 3; j++)
+                q[j] = a[j] + t * (b[j] - a[j]);
+            q[k] = at;
+        }
+    }
+    if (out->overflow)
+        *out = *in; /* unclipped: larger, so only more cells */
+}
+
+/* `in` clipped to cell `i`'s slab along axis k, widened by the margin; the grid's first and last
+ * slabs are open outwards (queries outside the grid fall into them). */
+static void clip_slab(const lod_triangle_grid *g, const clip_polygon *in, int k, uint32_t i, clip_polygon *out)
+{
+    clip_polygon half;
+    if (i > 0)
+        clip_plane(in, k, (double)i - CLIP_MARGIN, 1.0, &half);
+    else
+        half = *in;
+    if (i + 1 < g->dim[k])
+        clip_plane(&half, k, (double)i + 1.0 + CLIP_MARGIN, -1.0, out);
+    else
+        *out = half;
+}
+
+/* The cells along axis k that the polygon reaches (widened by the margin); 0 when it is empty. */
+static int clip_extent(const lod_triangle_grid *g, const clip_polygon *c, int k, uint32_t *lo, uint32_t *hi)
+{
+    if (c->n == 0)
+        return 0;
+    double a = c->p[0][k], b = a;
+    for (int i = 1; i < c->n; i++) {
+        a = c->p[i][k] < a ? c->p[i][k] : a;
+        b = c->p[i][k] > b ? c->p[i][k] : b;
+    }
+    double top = (double)g->dim[k] - 1.0;
+    a = floor(a - CLIP_MARGIN);
+    b = floor(b + CLIP_MARGIN);
+    *lo = a > 0.0 ? (a < top ? (uint32_t)a : (uint32_t)top) : 0;
+    *hi = b > 0.0 ? (b < top ? (uint32_t)b : (uint32_t)top) : 0;
+    return 1;
+}
+
+/* Counts (store == 0) or stores triangle t in cells x0 .. x1 of row (y, z). */
+static void list_run(lod_triangle_grid *g, uint32_t t, uint32_t x0, uint32_t x1, uint32_t y, uint32_t z, int store)
+{
+    size_t row = ((size_t)z * g->dim[1] + y) * g->dim[0];
+    for (uint32_t x = x0; x <= x1; x++) {
+        if (store)
+            g->items[g->start[row + x]++] = t;
+        else
+            g->start[row + x + 1]++;
+    }
+}
+
+/* Lists triangle t in the cells it crosses (see CLIP_MARGIN). A triangle whose box spans at most two
+ * cells along each axis is listed in its whole box instead: at most a few cells it does not cross,
+ * all next to it, and clipping would cost more than those save (most level-0 triangles are such). */
+static void list_triangle(lod_triangle_grid *g, uint32_t t, int store)
+{
+    uint32_t lo[3], hi[3];
+    tri_box(g, t, lo, hi);
+    if (hi[0] - lo[0] <= 1 && hi[1] - lo[1] <= 1 && hi[2] - lo[2] <= 1) {
+        for (uint32_t z = lo[2]; z <= hi[2]; z++)
+            for (uint32_t y = lo[1]; y <= hi[1]; y++)
+                list_run(g, t, lo[0], hi[0], y, z, store);
+        return;
+    }
+    clip_polygon tri = {.n = 3}, slab, row;
+    for (int j = 0; j < 3; j++) {
+        gdr_vec3 p = corner(g, t, j);
+        const float *x = &p.x;
+        for (int k = 0; k < 3; k++)
+            tri.p[j][k] = ((double)x[k] - (double)g->lo[k]) * (double)g->inv_cell;
+    }
+    uint32_t z0, z1, y0, y1, x0, x1;
+    clip_extent(g, &tri, 2, &z0, &z1);
+    for (uint32_t z = z0; z <= z1; z++) {
+        clip_slab(g, &tri, 2, z, &slab);
+        if (!clip_extent(g, &slab, 1, &y0, &y1))
+            continue;
+        for (uint32_t y = y0; y <= y1; y++) {
+            clip_slab(g, &slab, 1, y, &row);
+            if (clip_extent(g, &row, 0, &x0, &x1))
+                list_run(g, t, x0, x1, y, z, store);
+        }
+    }
 }
 
 int lod_triangle_grid_build(lod_triangle_grid *g, const float *positions, const uint32_t *corners, uint32_t n)
@@ -230,36 +384,58 @@ int lod_triangle_grid_build(lod_triangle_grid *g, const float *positions, const 
     if (!grid_reserve(&g->start, &g->start_cap, cells + 1))
         return 0;
     memset(g->start, 0, (cells + 1) * sizeof *g->start);
-    for (int pass = 0; pass < 2; pass++) {
-        for (uint32_t t = 0; t < n; t++) {
-            uint32_t lo[3], hi[3];
-            tri_box(g, t, lo, hi);
-            for (uint32_t z = lo[2]; z <= hi[2]; z++)
-                for (uint32_t y = lo[1]; y <= hi[1]; y++)
-                    for (uint32_t x = lo[0]; x <= hi[0]; x++) {
-                        size_t c = ((size_t)z * g->dim[1] + y) * g->dim[0] + x;
-                        if (pass == 0)
-                            g->start[c + 1]++;
-                        else
-                            g->items[g->start[c]++] = t;
-                    }
-        }
-        if (pass == 0) {
-            for (size_t c = 0; c < cells; c++)
-                g->start[c + 1] += g->start[c];
-            if (!grid_reserve(&g->items, &g->items_cap, (size_t)g->start[cells] + 1))
-                return 0;
-        }
-    }
-    for (size_t c = cells; c > 0; c--)
+    for (uint32_t t = 0; t < n; t++)
+        list_triangle(g, t, 0);
+    for (size_t c = 0; c < cells; c++)
+        g->start[c + 1] += g->start[c];
+    if (!grid_reserve(&g->items, &g->items_cap, (size_t)g->start[cells] + 1))
+        return 0;
+    for (uint32_t t = 0; t < n; t++)
+        list_triangle(g, t, 1);
+    for (size_t c = cells; c > 0; c--) /* start[c] now holds the end of cell c: shift back */
         g->start[c] = g->start[c - 1];
     g->start[0] = 0;
     return 1;
 }
 
 /* A cell's triangles are looked at up to this many (the centre of a fan lies in cells of thousands):
- * the nearest of fewer triangles is farther, so the distance found stays an upper bound. */
+ * the nearest of fewer triangles is farther, so the distance found stays an upper bound. Cells sized
+ * by the triangles and triangles listed only where they cross keep sound meshes below it (no query
+ * of the blob's, the knot's or a 1 M-triangle torus's build meets a full cell): there it is exact. */
 #define GRID_CELL_LIMIT 64u
+
+/* Squared distance from q to cell c: no triangle listed there comes nearer than this. */
+static float cell_d2(const lod_triangle_grid *g, const int32_t c[3], const float q[3])
+{
+    float d2 = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        float a = g->lo[k] + (float)c[k] * g->cell, gap = a - q[k];
+        if (gap <= 0.0f)
+            gap = q[k] - (a + g->cell);
+        d2 += gap > 0.0f ? gap * gap : 0.0f;
+    }
+    return d2;
+}
+
+/* The nearest of cell c's triangles (up to GRID_CELL_LIMIT) into best, unless the cell is farther
+ * than best already: a triangle listed there whose nearest point is nearer lies in a nearer cell too,
+ * where it is listed as well. Ties: the lowest triangle index. */
+static void visit_triangle_cell(const lod_triangle_grid *g, const int32_t c[3], gdr_vec3 point, const float q[3],
+                                lod_point_triangle_fn *distance, uint32_t *best, float *best_d2)
+{
+    if (cell_d2(g, c, q) > *best_d2)
+        return;
+    size_t k = ((size_t)c[2] * g->dim[1] + (uint32_t)c[1]) * g->dim[0] + (uint32_t)c[0];
+    uint32_t end = g->start[k + 1] - g->start[k] > GRID_CELL_LIMIT ? g->start[k] + GRID_CELL_LIMIT : g->start[k + 1];
+    for (uint32_t i = g->start[k]; i < end; i++) {
+        uint32_t t = g->items[i];
+        float d = distance(point, corner(g, t, 0), corner(g, t, 1), corner(g, t, 2));
+        if (d < *best_d2 || (d == *best_d2 && t < *best)) {
+            *best_d2 = d;
+            *best = t;
+        }
+    }
+}
 
 uint32_t lod_triangle_grid_nearest(const lod_triangle_grid *g, gdr_vec3 point, lod_point_triangle_fn *distance,
                                    float *distance_squared)
@@ -270,11 +446,7 @@ uint32_t lod_triangle_grid_nearest(const lod_triangle_grid *g, gdr_vec3 point, l
         at[k] = (int32_t)tri_cell(g, q[k], k);
     uint32_t best = UINT32_MAX;
     float best_d2 = INFINITY;
-    int32_t max_r = search_radius(g->dim);
-    for (int32_t r = 0; r <= max_r; r++) {
-        float reach = (float)(r - 1) * g->cell;
-        if (r > 0 && best != UINT32_MAX && reach * reach >= best_d2)
-            break;
+    for (int32_t r = 0;; r++) {
         for (int32_t z = at[2] - r; z <= at[2] + r; z++) {
             if (z < 0 || z >= (int32_t)g->dim[2])
                 continue;
@@ -283,22 +455,14 @@ uint32_t lod_triangle_grid_nearest(const lod_triangle_grid *g, gdr_vec3 point, l
                     continue;
                 int shell = r == 0 || z == at[2] - r || z == at[2] + r || y == at[1] - r || y == at[1] + r;
                 for (int32_t x = at[0] - r; x <= at[0] + r; x += shell ? 1 : 2 * r) {
-                    if (x < 0 || x >= (int32_t)g->dim[0])
-                        continue;
-                    size_t c = ((size_t)z * g->dim[1] + (uint32_t)y) * g->dim[0] + (uint32_t)x;
-                    uint32_t end = g->start[c + 1] - g->start[c] > GRID_CELL_LIMIT ? g->start[c] + GRID_CELL_LIMIT
-                                                                                   : g->start[c + 1];
-                    for (uint32_t i = g->start[c]; i < end; i++) {
-                        uint32_t t = g->items[i];
-                        float d = distance(point, corner(g, t, 0), corner(g, t, 1), corner(g, t, 2));
-                        if (d < best_d2 || (d == best_d2 && t < best)) {
-                            best_d2 = d;
-                            best = t;
-                        }
-                    }
+                    const int32_t c[3] = {x, y, z};
+                    if (x >= 0 && x < (int32_t)g->dim[0])
+                        visit_triangle_cell(g, c, point, q, distance, &best, &best_d2);
                 }
             }
         }
+        if (search_done(g->lo, g->cell, g->dim, at, r, q, best_d2))
+            break;
     }
     *distance_squared = best_d2;
     return best;

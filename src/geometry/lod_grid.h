@@ -26,7 +26,7 @@ uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squ
 void lod_grid_free(lod_grid *g);
 
 /* A uniform grid over triangles (corner k of triangle t: positions[3 * corners[3t + k]] .. + 3),
- * each listed in every cell its bounding box overlaps. */
+ * each listed in the cells it crosses (a small one: in every cell of its bounding box). */
 typedef struct lod_triangle_grid {
     const float *positions; /* not owned */
     const uint32_t *corners;
