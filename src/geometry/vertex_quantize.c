@@ -167,6 +167,38 @@ static int snap_vertices(gdr_mesh *mesh, const gdr_vertex_quantization *q, float
     return 1;
 }
 
+static gdr_vertex_bytes vertex_bytes(const gdr_mesh *mesh, uint32_t v)
+{
+    return (gdr_vertex_bytes){mesh->positions[v], mesh->normals[v], mesh->uvs[v]};
+}
+
+/* Every triangle of cluster k into its canonical rotation (gdr_triangle_first_corner), then the
+ * cluster's vertex list renumbered in the order its triangles first use them, as every cluster
+ * builder lists them. */
+static void canonical_cluster(gdr_mesh *mesh, uint32_t k)
+{
+    gdr_mesh_clusters *c = &mesh->clusters;
+    const gdr_cluster *cl = &c->clusters[k];
+    uint32_t *list = c->vertices + cl->vertex_offset, old[GDR_CLUSTER_MAX_VERTICES];
+    uint8_t *tri = c->triangles + cl->triangle_offset, local_of[GDR_CLUSTER_MAX_VERTICES], seen = 0;
+    memcpy(old, list, sizeof *old * cl->vertex_count);
+    memset(local_of, 0xff, sizeof local_of);
+    for (uint32_t t = 0; t < cl->triangle_count; t++) {
+        uint8_t *corners = tri + 3 * t, was[3] = {corners[0], corners[1], corners[2]};
+        gdr_vertex_bytes v[3] = {vertex_bytes(mesh, old[was[0]]), vertex_bytes(mesh, old[was[1]]),
+                                 vertex_bytes(mesh, old[was[2]])};
+        uint32_t first = gdr_triangle_first_corner(&v[0], &v[1], &v[2]);
+        for (uint32_t i = 0; i < 3; i++) {
+            uint8_t local = was[(first + i) % 3];
+            if (local_of[local] == 0xff) {
+                local_of[local] = seen;
+                list[seen++] = old[local];
+            }
+            corners[i] = local_of[local];
+        }
+    }
+}
+
 /* Spheres grow by d, cones are measured on the moved triangles, errors above level 0 grow by 2d, the
  * hierarchy is built again over the new bounds. */
 static gdr_status fix_bounds(gdr_mesh *mesh, float d, gdr_error *err)
@@ -174,6 +206,7 @@ static gdr_status fix_bounds(gdr_mesh *mesh, float d, gdr_error *err)
     gdr_mesh_clusters *c = &mesh->clusters;
     mesh->bounds.w += d;
     for (uint32_t k = 0; k < c->cluster_count; k++) {
+        canonical_cluster(mesh, k);
         gdr_cluster *cl = &c->clusters[k], moved = *cl;
         gdr_cluster_compute_bounds(&moved, c->vertices + cl->vertex_offset, c->triangles + cl->triangle_offset, mesh);
         cl->sphere.w += d;

@@ -6,6 +6,7 @@
 #define GDR_GEOMETRY_VERTEX_QUANTIZE_H
 
 #include <stdint.h>
+#include <string.h>
 
 #include "gdr/geometry.h"
 
@@ -22,6 +23,28 @@ typedef struct gdr_quantized_vertex {
  * or does not decode back to exactly these floats (then the page stores floats). */
 int gdr_vertex_encode(const gdr_vertex_quantization *q, gdr_vec3 position, gdr_vec3 normal, gdr_vec2 uv,
                       gdr_quantized_vertex *out);
+
+/* A vertex as a page decodes it and the renderer reads it: position, normal, uv (32 bytes). */
+typedef struct gdr_vertex_bytes {
+    gdr_vec3 position, normal;
+    gdr_vec2 uv;
+} gdr_vertex_bytes;
+
+/* The corner (0, 1 or 2) a triangle starts with in its canonical rotation: the one whose vertex
+ * bytes compare lowest (memcmp), the earliest on a tie. The pages' index codec may rotate a
+ * triangle's corners; a quantized mesh's triangles are stored in this rotation and a page's are
+ * put back into it when decoded, so both draw the same corners in the same order (the rasteriser's
+ * interpolation depends on it). */
+static inline uint32_t gdr_triangle_first_corner(const gdr_vertex_bytes *a, const gdr_vertex_bytes *b,
+                                                 const gdr_vertex_bytes *c)
+{
+    const gdr_vertex_bytes *corner[3] = {a, b, c};
+    uint32_t first = 0;
+    for (uint32_t k = 1; k < 3; k++)
+        if (memcmp(corner[k], corner[first], sizeof *a) < 0)
+            first = k;
+    return first;
+}
 
 /* The floats of an encoded vertex. Any integers decode to finite floats and a unit normal. */
 void gdr_vertex_decode(const gdr_vertex_quantization *q, const gdr_quantized_vertex *v, gdr_vec3 *position,

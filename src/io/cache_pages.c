@@ -3,6 +3,7 @@
  * (meshoptimizer's vertex codec) and triangles (its index codec), then zstd over the three where
  * that pays; the page index with every group's header. Layout: docs/CACHE_FORMAT.md, 'PAGE'. */
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -14,6 +15,10 @@
 #include "io/io_internal.h"
 
 #define PAGE_MAGIC 0x47504447u /* "GDPG" */
+_Static_assert(sizeof(gdr_page_vertex) == sizeof(gdr_vertex_bytes) &&
+                   offsetof(gdr_page_vertex, normal) == offsetof(gdr_vertex_bytes, normal) &&
+                   offsetof(gdr_page_vertex, uv) == offsetof(gdr_vertex_bytes, uv),
+               "a decoded page vertex is compared as gdr_vertex_bytes");
 #define PAGE_FLAG_ZSTD 1u
 #define PAGE_FLAG_QUANTIZED 2u /* the vertices as integers on the grid the body gives (gdr_quantized_vertex) */
 #define PAGE_GRID_BLOCK 32u    /* that grid: i32 position exponent, f32 x3 origin, i32 uv exponent, f32 x2 origin, u32 0 */
@@ -711,9 +716,14 @@ static gdr_status expand_cluster(const char *where, uint32_t c, const uint32_t *
     const gdr_page_cluster *pc = &out->clusters[c];
     uint32_t seen = 0;
     for (uint32_t i = 0; i < 3 * pc->triangle_count; i++) {
-        uint32_t u = indices[i];
-        if (u >= unique_count)
-            return PAGE_ERR("%s: cluster %u triangle %u: vertex %u of %u", where, c, i / 3, u, unique_count);
+        const uint32_t *corners = indices + i / 3 * 3;
+        if (corners[0] >= unique_count || corners[1] >= unique_count || corners[2] >= unique_count)
+            return PAGE_ERR("%s: cluster %u triangle %u: a vertex beyond the page's %u", where, c, i / 3, unique_count);
+        /* The canonical rotation, whatever rotation the index codec chose. */
+        uint32_t first = gdr_triangle_first_corner((const gdr_vertex_bytes *)&unique[corners[0]],
+                                                   (const gdr_vertex_bytes *)&unique[corners[1]],
+                                                   (const gdr_vertex_bytes *)&unique[corners[2]]);
+        uint32_t u = corners[(first + i % 3) % 3];
         if (stamp[u] != c + 1) {
             if (seen == pc->vertex_count)
                 return PAGE_ERR("%s: cluster %u: its triangles use more than its %u vertices", where, c,
