@@ -379,6 +379,7 @@ int lod_triangle_grid_build(lod_triangle_grid *g, const float *positions, const 
 {
     g->positions = positions;
     g->corners = corners;
+    g->count = n;
     tri_choose_cells(g, n);
     size_t cells = (size_t)g->dim[0] * g->dim[1] * g->dim[2];
     if (!grid_reserve(&g->start, &g->start_cap, cells + 1))
@@ -437,10 +438,28 @@ static void visit_triangle_cell(const lod_triangle_grid *g, const int32_t c[3], 
     }
 }
 
+/* Every triangle, the nearest into best: what a query falls back to once its search has visited as
+ * many cells as a grid of 4n + 64 would hold (a sparse soup of tiny triangles makes cells tiny and
+ * most of them empty), so that no query costs more than the grid's size or the triangles' count. */
+static void visit_all_triangles(const lod_triangle_grid *g, gdr_vec3 point, lod_point_triangle_fn *distance,
+                                uint32_t *best, float *best_d2)
+{
+    *best = UINT32_MAX;
+    *best_d2 = INFINITY;
+    for (uint32_t t = 0; t < g->count; t++) {
+        float d = distance(point, corner(g, t, 0), corner(g, t, 1), corner(g, t, 2));
+        if (d < *best_d2) {
+            *best_d2 = d;
+            *best = t;
+        }
+    }
+}
+
 uint32_t lod_triangle_grid_nearest(const lod_triangle_grid *g, gdr_vec3 point, lod_point_triangle_fn *distance,
                                    float *distance_squared)
 {
     const float q[3] = {point.x, point.y, point.z};
+    uint64_t visited = 0, budget = 4ull * g->count + 64u;
     int32_t at[3];
     for (int k = 0; k < 3; k++)
         at[k] = (int32_t)tri_cell(g, q[k], k);
@@ -458,11 +477,16 @@ uint32_t lod_triangle_grid_nearest(const lod_triangle_grid *g, gdr_vec3 point, l
                     const int32_t c[3] = {x, y, z};
                     if (x >= 0 && x < (int32_t)g->dim[0])
                         visit_triangle_cell(g, c, point, q, distance, &best, &best_d2);
+                    visited++;
                 }
             }
         }
         if (search_done(g->lo, g->cell, g->dim, at, r, q, best_d2))
             break;
+        if (visited > budget) {
+            visit_all_triangles(g, point, distance, &best, &best_d2);
+            break;
+        }
     }
     *distance_squared = best_d2;
     return best;

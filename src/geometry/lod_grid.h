@@ -33,6 +33,7 @@ typedef struct lod_triangle_grid {
     float lo[3];
     float cell, inv_cell;
     uint32_t dim[3];
+    uint32_t count; /* triangles */
     uint32_t *start, *items;
     size_t start_cap, items_cap;
 } lod_triangle_grid;
