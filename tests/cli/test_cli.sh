@@ -155,6 +155,8 @@ expect 0 "render streamed" "$gdr" render "$work/unique.gdrc" $tiny --geometry-bu
 grep -q '^streaming pool' "$work/stdout" || { echo "FAIL: streamed render printed no pool: $(cat "$work/stdout")"; failures=$((failures + 1)); }
 expect 2 "stream a built-in scene" "$gdr" render unique-field:meshes=2,triangles=2000 $tiny --geometry-budget 1
 grep -q 'stream from a cache' "$work/stderr" || { echo "FAIL: stream built-in: $(cat "$work/stderr")"; failures=$((failures + 1)); }
+expect 2 "stream in the viewer" "$gdr" view "$work/unique.gdrc" --geometry-budget 1
+grep -q "gdr render's" "$work/stderr" || { echo "FAIL: view --geometry-budget: $(cat "$work/stderr")"; failures=$((failures + 1)); }
 expect 1 "stream a cache without pages" "$gdr" render "$work/field.gdrc" $tiny --geometry-budget 1
 grep -q 'has no geometry pages' "$work/stderr" || { echo "FAIL: stream without pages: $(cat "$work/stderr")"; failures=$((failures + 1)); }
 expect 2 "unique-field no meshes" "$gdr" info unique-field:meshes=0

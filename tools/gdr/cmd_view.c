@@ -373,6 +373,11 @@ int gdr_cmd_view(int argc, char **argv)
         fprintf(stderr, "gdr view: --out and --stats are gdr render's; use --screenshot FILE\n");
         return 2;
     }
+    if (o.geometry_budget_mib || o.upload_budget_mib) {
+        fprintf(stderr, "gdr view: --geometry-budget and --upload-budget are gdr render's: the viewer uploads the "
+                "scene whole (docs/STREAMING.md)\n");
+        return 2;
+    }
     view_app app = {.o = &o, .v = &v};
     gdr_error err = {0};
     gdr_scene *scene = NULL;
