@@ -304,7 +304,7 @@ static float samples_to_simplified(lod_scratch *s, uint32_t local_count)
             memcpy(&s->vertex_points[used], s->positions + (size_t)l * 3, sizeof(gdr_vec3));
             s->vertex_local[used++] = l;
         }
-    if (!lod_grid_build(&s->grid, s->vertex_points, used) ||
+    if (!lod_grid_build(&s->grid, s->vertex_points, used, 4.0) ||
         !lod_triangle_grid_build(&s->triangle_grid, s->positions, s->out_corners, s->out_triangle_count))
         return -1.0f;
     float worst = 0.0f;
@@ -357,14 +357,16 @@ static float position_d2(const lod_build *b, uint32_t position, gdr_vec3 p)
 }
 
 /* Walks over level-0 positions from `start`, to a neighbour nearer to p while there is one: the
- * walk ends at a position nearest to p among its neighbours (on a surface, next to p's foot). */
-static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p)
+ * walk ends at a position nearest to p among its neighbours (on a surface, next to p's foot).
+ * *stopped_short is set when the walk was cut off by the step limit while still moving. */
+static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p, int *stopped_short)
 {
     uint32_t at = start;
     float best = position_d2(b, at, p);
+    *stopped_short = 0;
     /* At most LOD_WALK_LIMIT steps: on a strip or a fan's rim a walk would cross the whole mesh one
      * neighbour at a time. Where it stops short, the distance from there is only larger (a bound
-     * still), and a bound too loose sends the probe to the exact measure (probe_d2). */
+     * still), and probe_d2 starts it again nearer to p. */
     for (uint32_t steps = 0; steps < LOD_WALK_LIMIT; steps++) {
         uint32_t from = at;
         for (uint32_t k = b->adjacency_start[from]; k < ring_end(b, from); k++) {
@@ -383,6 +385,7 @@ static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p)
         if (at == from)
             return at;
     }
+    *stopped_short = 1;
     return at;
 }
 
@@ -434,16 +437,57 @@ typedef struct probe_state {
     int failed;   /* out of memory */
 } probe_state;
 
+/* The group's sample nearest to p; UINT32_MAX when out of memory. The point grid, which indexed the
+ * simplified vertices for samples_to_simplified (done by now), is rebuilt over the samples on first
+ * use: one grid's arrays per worker rather than two. A group near the root holds most of the mesh's
+ * positions and few queries come here, so its cells are fewer (one per sample, not four). */
+static uint32_t nearest_sample(lod_scratch *s, gdr_vec3 p)
+{
+    if (!s->grid_holds_samples) {
+        if (!lod_grid_build(&s->grid, s->sample_points, s->gathered, 1.0))
+            return UINT32_MAX;
+        s->grid_holds_samples = 1;
+    }
+    float d2;
+    return s->sample_ids[lod_grid_nearest(&s->grid, p, &d2)];
+}
+
+/* Where a walk towards p ends: from *at, and again from the group's sample nearest to p where the
+ * first walk's bound could raise the largest distance and was cut off by the step limit, or would
+ * send p to the exact measure. On a coarse group a simplified triangle spans more level-0 edges
+ * than the limit, and the bound from where a cut-off walk stops is several times the distance (on
+ * the 1 M-triangle torus up to 13x); a walk can also end at a nearest position of one side of a
+ * thin part while p is nearer the other. Returns the bound (squared) from where it ended. */
+static float walk_bound_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
+{
+    int stopped_short;
+    *at = walk_towards(ps->b, *at, p, &stopped_short);
+    float d = to_full_detail_d2(ps->b, *at, p);
+    int suspect = (stopped_short && d > ps->worst) || d > 4.0f * ps->worst;
+    if (!suspect || ps->s->gathered == 0)
+        return d;
+    uint32_t start = nearest_sample(ps->s, p);
+    if (start == UINT32_MAX) {
+        ps->failed = 1;
+        return d;
+    }
+    uint32_t again = walk_towards(ps->b, start, p, &stopped_short);
+    float d_again = to_full_detail_d2(ps->b, again, p);
+    if (d_again >= d)
+        return d;
+    *at = again;
+    return d_again;
+}
+
 /* Upper bound (squared) of the distance from p to S0: to the level-0 triangles around the position
- * a walk from *at ends at (the position nearest to p among its neighbours; on a regular surface
- * the triangle nearest to p is among these). Where that bound is more than twice the largest
- * distance so far, the exact distance to the level-0 triangles around the group's samples is
- * taken instead (the walk can stop far away on meshes of long thin triangles). *at receives where the
- * walk ended (the next probe of the triangle starts there). */
+ * a walk ends at (the position nearest to p among its neighbours; on a regular surface the triangle
+ * nearest to p is among these). Where that bound is more than twice the largest distance so far,
+ * the exact distance to the level-0 triangles around the group's samples is taken instead (the
+ * walk can stop far away on meshes of long thin triangles). *at receives where the walk ended (the
+ * next probe of the triangle starts there). */
 static float probe_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
 {
-    *at = walk_towards(ps->b, *at, p);
-    float d = to_full_detail_d2(ps->b, *at, p);
+    float d = walk_bound_d2(ps, at, p);
     if (d <= 4.0f * ps->worst || ps->failed) /* squared: up to twice the largest so far */
         return d;
     if (!ps->s->region_built && !build_region(ps->b, ps->s)) {
@@ -490,6 +534,7 @@ static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor)
 {
     probe_state ps = {b, s, floor * floor, 0};
     s->region_built = 0;
+    s->grid_holds_samples = 0;
     if (!LOD_RESERVE(s, coarse_d2, (size_t)s->out_triangle_count + 1))
         return -1.0f;
     for (uint32_t t = 0; t < s->out_triangle_count; t++) {

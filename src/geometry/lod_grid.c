@@ -70,7 +70,7 @@ static void choose_cells(lod_grid *g, const float hi[3], uint32_t n, double spac
     g->inv_cell = 1.0f / cell;
 }
 
-int lod_grid_build(lod_grid *g, const gdr_vec3 *points, uint32_t n)
+int lod_grid_build(lod_grid *g, const gdr_vec3 *points, uint32_t n, double cells_per_point)
 {
     g->points = points;
     g->count = n;
@@ -83,7 +83,7 @@ int lod_grid_build(lod_grid *g, const gdr_vec3 *points, uint32_t n)
             hi[k] = p[k] > hi[k] ? p[k] : hi[k];
         }
     }
-    choose_cells(g, hi, n, 0.0, 4.0 * n + 64.0);
+    choose_cells(g, hi, n, 0.0, cells_per_point * n + 64.0);
     size_t cells = (size_t)g->dim[0] * g->dim[1] * g->dim[2];
     if (!grid_reserve(&g->start, &g->start_cap, cells + 1) || !grid_reserve(&g->items, &g->items_cap, n) ||
         !grid_reserve(&g->cell_of, &g->cell_of_cap, n))

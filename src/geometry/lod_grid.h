@@ -18,9 +18,10 @@ typedef struct lod_grid {
     size_t start_cap, items_cap, cell_of_cap;
 } lod_grid;
 
-/* Indexes points[0 .. n), n > 0 (kept by pointer until the next build). Returns 0 when out of
- * memory. */
-int lod_grid_build(lod_grid *g, const gdr_vec3 *points, uint32_t n);
+/* Indexes points[0 .. n), n > 0 (kept by pointer until the next build), in at most
+ * cells_per_point * n + 64 cells (fewer cells: less memory, more points a query looks at). Returns
+ * 0 when out of memory. */
+int lod_grid_build(lod_grid *g, const gdr_vec3 *points, uint32_t n, double cells_per_point);
 /* The index of the point nearest to `point` (the lowest index on ties) and its squared distance. */
 uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squared);
 void lod_grid_free(lod_grid *g);

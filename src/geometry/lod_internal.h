@@ -74,6 +74,7 @@ typedef struct lod_scratch {
     size_t region_refs_cap, region_corners_cap;
     lod_triangle_grid region_grid;
     int region_built;
+    int grid_holds_samples; /* `grid` was rebuilt over sample_points (lod_error.c, nearest_sample) */
     float *coarse_d2; /* per simplified triangle: its largest coarse probe distance, squared */
     size_t coarse_d2_cap;
     uint8_t edge_count[64 * 64];

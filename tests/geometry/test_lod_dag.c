@@ -773,6 +773,25 @@ static double one_sided(const gdr_mesh *m, const uint32_t *from, size_t from_cou
     return worst;
 }
 
+/* The cut at threshold t as mesh-vertex corners into `cut`; returns the corner count and the largest
+ * error of the groups its clusters were made from in *stated. */
+static size_t gather_cut(const gdr_mesh_clusters *mc, float t, uint32_t *cut, double *stated)
+{
+    size_t n = 0;
+    *stated = 0;
+    for (uint32_t i = 0; i < mc->cluster_count; i++) {
+        const gdr_cluster *c = &mc->clusters[i];
+        float refined = c->refined_group == GDR_NO_INDEX ? 0.0f : mc->groups[c->refined_group].error;
+        float own = c->group == GDR_NO_INDEX ? INFINITY : mc->groups[c->group].error;
+        if (!(refined <= t && !(own <= t)))
+            continue;
+        *stated = fmax(*stated, refined);
+        for (uint32_t j = 0; j < c->triangle_count * 3; j++)
+            cut[n++] = mc->vertices[c->vertex_offset + mc->triangles[c->triangle_offset + j]];
+    }
+    return n;
+}
+
 /* Every cut at a range of thresholds deviates from full detail (both ways) by at most the largest
  * error of the groups its clusters were made from. */
 static void check_error_bounds_cuts(const gdr_mesh *m)
@@ -783,18 +802,8 @@ static void check_error_bounds_cuts(const gdr_mesh *m)
     double worst_ratio = 0;
     for (int step = 0; step < 7; step++) {
         float t = m->bounds.w * 1e-4f * powf(4.0f, (float)step);
-        size_t n = 0;
         double stated = 0;
-        for (uint32_t i = 0; i < mc->cluster_count; i++) {
-            const gdr_cluster *c = &mc->clusters[i];
-            float refined = c->refined_group == GDR_NO_INDEX ? 0.0f : mc->groups[c->refined_group].error;
-            float own = c->group == GDR_NO_INDEX ? INFINITY : mc->groups[c->group].error;
-            if (!(refined <= t && !(own <= t)))
-                continue;
-            stated = fmax(stated, refined);
-            for (uint32_t j = 0; j < c->triangle_count * 3; j++)
-                cut[n++] = mc->vertices[c->vertex_offset + mc->triangles[c->triangle_offset + j]];
-        }
+        size_t n = gather_cut(mc, t, cut, &stated);
         double a = one_sided(m, cut, n / 3, m->indices, m->index_count / 3);
         double b = one_sided(m, m->indices, m->index_count / 3, cut, n / 3);
         double deviation = fmax(a, b), slack = 1e-5 * m->bounds.w;
@@ -830,11 +839,45 @@ static void test_error_bounds_deviation(void)
     gdr_scene_destroy(s);
 }
 
+/* The coarsest cut (the root's members) of a torus of 512 x 8 quads: each coarse triangle spans more
+ * level-0 positions along the ring than a walk over them takes steps, and bounds from where such walks
+ * were cut off made the coarse groups state 3-4x their true deviation. The stated error must stay
+ * within 2x the true one (and never below it). */
+static void test_coarse_error_tight(void)
+{
+    gdr_scene *s = new_scene();
+    gdr_error err = {0};
+    uint32_t torus;
+    check_ok(gdr_procedural_torus(s, 1.0f, 0.3f, 512, 8, &torus, &err), &err, "torus");
+    gdr_mesh *m = &s->meshes[torus];
+    build_level0(m);
+    gdr_lod_options o = {.thread_count = 1, .no_progress = 1};
+    check_ok(gdr_mesh_build_lod_dag(m, &o, NULL, &err), &err, m->name);
+    const gdr_mesh_clusters *mc = &m->clusters;
+    float coarsest = 0.0f;
+    for (uint32_t g = 0; g < mc->group_count; g++)
+        if (mc->groups[g].error < INFINITY && mc->groups[g].error > coarsest)
+            coarsest = mc->groups[g].error;
+    uint32_t *cut = malloc((size_t)m->index_count * 4 * sizeof *cut);
+    double stated = 0;
+    size_t n = gather_cut(mc, coarsest, cut, &stated);
+    double a = one_sided(m, cut, n / 3, m->indices, m->index_count / 3);
+    double b = one_sided(m, m->indices, m->index_count / 3, cut, n / 3);
+    double deviation = fmax(a, b);
+    printf("torus 512x8: coarsest cut of %zu triangles states %g, deviates %g (%.2fx)\n", n / 3, stated, deviation,
+           stated / deviation);
+    CHECK(n > 0 && deviation <= stated + 1e-5 * m->bounds.w);
+    CHECK(stated <= 2.0 * deviation);
+    free(cut);
+    gdr_scene_destroy(s);
+}
+
 int main(void)
 {
     test_meshes();
     test_determinism();
     test_error_bounds_deviation();
+    test_coarse_error_tight();
     test_scene();
     test_bad_input();
     return test_finish("test_lod_dag");
