@@ -207,7 +207,9 @@ static uint64_t simulate(const gdr_scene *scene, const char *path, uint64_t budg
     printf("last frame: %u requests, %u resident pages of %u slots, %u deferred; %u evictions in all\n",
            s.request_count, st.resident_pages, s.res ? gdr_residency_slot_count(s.res) : 0, st.deferred,
            s.evictions);
-    CHECK(s.evictions > 0);
+    /* The path needs more than the pool holds; with a damaged page the groups past it never load
+     * and the rest may fit. */
+    CHECK(s.evictions > 0 || s.failed_pages > 0);
     CHECK(s.same_walk);
     printf("traversal: %llu nodes and %llu clusters tested\n", (unsigned long long)s.traversal.nodes_tested,
            (unsigned long long)s.traversal.clusters_tested);
