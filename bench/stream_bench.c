@@ -89,39 +89,77 @@ static void print_view(FILE *out, const char *name, const view_result *v, const 
             (unsigned long long)v->triangles, v->clusters, tail);
 }
 
-int main(int argc, char **argv)
+typedef struct bench_options {
+    const char *path, *json;
+    uint32_t budget_mib, upload_mib, width, height;
+    int whole;
+} bench_options;
+
+/* 0, or 2 after the usage. */
+static int parse_options(int argc, char **argv, bench_options *o)
 {
-    const char *path = NULL, *json = NULL;
-    uint32_t budget_mib = 0, upload_mib = 16, width = 2560, height = 1440;
-    int whole = 1;
+    *o = (bench_options){.upload_mib = 16, .width = 2560, .height = 1440, .whole = 1};
     for (int i = 1; i < argc; i++) {
         const char *value = i + 1 < argc ? argv[i + 1] : NULL;
         if (strcmp(argv[i], "--budget") == 0 && value)
-            budget_mib = (uint32_t)strtoul(argv[++i], NULL, 10);
+            o->budget_mib = (uint32_t)strtoul(argv[++i], NULL, 10);
         else if (strcmp(argv[i], "--upload") == 0 && value)
-            upload_mib = (uint32_t)strtoul(argv[++i], NULL, 10);
+            o->upload_mib = (uint32_t)strtoul(argv[++i], NULL, 10);
         else if (strcmp(argv[i], "--width") == 0 && value)
-            width = (uint32_t)strtoul(argv[++i], NULL, 10);
+            o->width = (uint32_t)strtoul(argv[++i], NULL, 10);
         else if (strcmp(argv[i], "--height") == 0 && value)
-            height = (uint32_t)strtoul(argv[++i], NULL, 10);
+            o->height = (uint32_t)strtoul(argv[++i], NULL, 10);
         else if (strcmp(argv[i], "--json") == 0 && value)
-            json = argv[++i];
+            o->json = argv[++i];
         else if (strcmp(argv[i], "--no-whole") == 0)
-            whole = 0;
-        else if (argv[i][0] != '-' && !path)
-            path = argv[i];
+            o->whole = 0;
+        else if (argv[i][0] != '-' && !o->path)
+            o->path = argv[i];
         else {
             fprintf(stderr, "usage: stream_bench SCENE.gdrc --budget MIB [--upload MIB] [--width W] [--height H] "
                             "[--no-whole] [--json FILE]\n");
             return 2;
         }
     }
-    if (!path || budget_mib == 0 || budget_mib > 4096 || upload_mib == 0 || !width || !height) {
+    if (!o->path || o->budget_mib == 0 || o->budget_mib > 4096 || o->upload_mib == 0 || !o->width || !o->height) {
         fprintf(stderr, "stream_bench: needs SCENE.gdrc and --budget MIB in [1, 4096]\n");
         return 2;
     }
+    return 0;
+}
+
+/* The scene loaded whole and uploaded whole, the same two views; *load_ms: the load's time. */
+static int run_whole(const bench_options *o, const gdr_frame_desc *frame, const gdr_frame_desc *jump,
+                     view_result *a, view_result *b, double *load_ms)
+{
     gdr_error err = {0};
-    gdr_scene *scene = NULL, *whole_scene = NULL;
+    gdr_scene *scene = NULL;
+    gdr_renderer *r = NULL;
+    gdr_load_options load = {.no_progress = 1};
+    gdr_renderer_desc desc = {.width = o->width, .height = o->height};
+    *load_ms = now_ms();
+    int ok = gdr_scene_load(o->path, &load, &scene, &err) == GDR_OK;
+    *load_ms = now_ms() - *load_ms;
+    ok = ok && gdr_renderer_create(&desc, &r, &err) == GDR_OK && gdr_renderer_set_scene(r, scene, &err) == GDR_OK &&
+         converge(r, frame, a) && converge(r, jump, b);
+    if (!ok)
+        fprintf(stderr, "stream_bench: whole upload: %s\n", err.message);
+    gdr_renderer_destroy(r);
+    gdr_scene_destroy(scene);
+    return ok;
+}
+
+int main(int argc, char **argv)
+{
+    bench_options o;
+    int usage = parse_options(argc, argv, &o);
+    if (usage)
+        return usage;
+    const char *path = o.path, *json = o.json;
+    uint32_t budget_mib = o.budget_mib, upload_mib = o.upload_mib, width = o.width, height = o.height;
+    int whole = o.whole;
+    gdr_error err = {0};
+    gdr_scene *scene = NULL;
     /* The open: the cache without the geometry its pages hold. */
     uint64_t open_bytes = 0;
     double t_open = now_ms();
@@ -161,21 +199,9 @@ int main(int argc, char **argv)
     if (!ok)
         fprintf(stderr, "stream_bench: streamed: %s\n", err.message);
     gdr_renderer_destroy(r);
-    r = NULL;
     /* The whole upload after the streamed run, whose frames have brought the GPU's clocks up. */
-    if (ok && whole) {
-        gdr_load_options load = {.no_progress = 1};
-        t_load = now_ms();
-        ok = gdr_scene_load(path, &load, &whole_scene, &err) == GDR_OK;
-        t_load = now_ms() - t_load;
-        ok = ok && gdr_renderer_create(&desc, &r, &err) == GDR_OK &&
-             gdr_renderer_set_scene(r, whole_scene, &err) == GDR_OK && converge(r, &frame, &whole_a) &&
-             converge(r, &jump, &whole_b);
-        if (!ok)
-            fprintf(stderr, "stream_bench: whole upload: %s\n", err.message);
-        gdr_renderer_destroy(r);
-        r = NULL;
-    }
+    if (ok && whole)
+        ok = run_whole(&o, &frame, &jump, &whole_a, &whole_b, &t_load);
     FILE *out = json ? fopen(json, "w") : stdout;
     if (ok && out) {
         fprintf(out, "{\n    \"scene\": \"%s\", \"device\": \"%s\", \"driver\": \"%s\", \"width\": %u, \"height\": %u,\n",
@@ -196,6 +222,5 @@ int main(int argc, char **argv)
     if (out && out != stdout)
         fclose(out);
     gdr_scene_destroy(scene);
-    gdr_scene_destroy(whole_scene);
     return ok && out ? 0 : 1;
 }

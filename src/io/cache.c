@@ -20,10 +20,6 @@
 #error "the cache reader and writer assume a little-endian host"
 #endif
 
-#define CACHE_MAGIC "GDRCACHE"
-#define CACHE_HEADER_SIZE 64u
-#define CACHE_ENTRY_SIZE 32u
-#define CACHE_MAX_SECTIONS 1024u
 
 const char *gdr_cache_build_options(void)
 {
@@ -58,12 +54,15 @@ static void write_sections(writer *w, const cache_write_input *in, section_entry
 static void store_u32(uint8_t *p, uint32_t v) { memcpy(p, &v, 4); }
 static void store_u64(uint8_t *p, uint64_t v) { memcpy(p, &v, 8); }
 
-/* The writer refuses what the reader would refuse, before serialising: a file over the reader's
- * size limit (counted here from the raw arrays alone, a lower bound of the file), and textures
+/* The writer refuses what the reader would refuse, before serialising: a scene read for streaming
+ * (its meshes have no arrays to write), a file over the reader's size limit (counted here from the raw arrays alone, a lower bound of the file), and textures
  * larger than it reads (the TEXR section's check). A cache that cannot be read back is never
  * written. */
 static gdr_status check_reader_limits(const char *path, const gdr_scene *s, gdr_error *err)
 {
+    if (s->geometry_in_pages)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: the scene was read for streaming and holds no "
+                             "geometry: nothing written", path);
     uint64_t bytes = CACHE_HEADER_SIZE;
     for (uint32_t i = 0; i < s->texture_count; i++)
         bytes += (uint64_t)s->textures[i].width * s->textures[i].height * 4;
@@ -85,9 +84,6 @@ gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_c
     static const gdr_cache_write_options defaults = {0};
     if (!options)
         options = &defaults;
-    if (scene->geometry_in_pages)
-        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: the scene was read for streaming and holds no "
-                             "geometry: nothing written", path);
     gdr_status limits = check_reader_limits(path, scene, err);
     if (limits != GDR_OK)
         return limits;
@@ -225,16 +221,10 @@ static gdr_status source_read(container_source *src, void *dst, uint64_t length,
         memcpy(dst, src->data + offset, (size_t)length);
         return GDR_OK;
     }
-    uint64_t done = 0;
-    while (done < length) {
-        ssize_t n = pread(src->fd, (uint8_t *)dst + done, (size_t)(length - done), (off_t)(offset + done));
-        if (n < 0 && errno == EINTR)
-            continue;
-        if (n <= 0)
-            return gdr_error_set(err, GDR_ERROR_IO, "%s: %s at offset %llu", src->name,
-                                 n < 0 ? strerror(errno) : "the file ends", (unsigned long long)(offset + done));
-        done += (uint64_t)n;
-    }
+    size_t done = gdr_io_pread_exact(src->fd, dst, (size_t)length, offset);
+    if (done < length)
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: %s at offset %llu", src->name,
+                             errno ? strerror(errno) : "the file ends", (unsigned long long)(offset + done));
     src->bytes_read += length;
     return GDR_OK;
 }
@@ -266,8 +256,7 @@ static gdr_status fetch_section(container_source *src, int known, uint64_t offse
     return GDR_OK;
 }
 
-/* The header's checks; the table's entry count out. */
-static gdr_status parse_header(const char *name, const uint8_t *h, uint64_t size, uint32_t *out_count,
+gdr_status cache_parse_header(const char *name, const uint8_t *h, uint64_t size, uint32_t *out_count,
                                uint64_t *out_table_hash, gdr_error *err)
 {
     if (memcmp(h, CACHE_MAGIC, 8) != 0)
@@ -341,7 +330,7 @@ static gdr_status parse_container(container_source *src, cache_view *v, gdr_erro
     uint64_t table_hash = 0;
     gdr_status status = source_read(src, h, CACHE_HEADER_SIZE, 0, err);
     if (status == GDR_OK)
-        status = parse_header(name, h, src->size, &count, &table_hash, err);
+        status = cache_parse_header(name, h, src->size, &count, &table_hash, err);
     uint8_t *table = status == GDR_OK ? malloc((size_t)count * CACHE_ENTRY_SIZE + 1) : NULL;
     if (status == GDR_OK && !table)
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory for the section table", name);

@@ -12,6 +12,10 @@
 #include "gdr/cull.h"
 #include "gdr/io.h"
 
+#define CACHE_MAGIC "GDRCACHE"
+#define CACHE_HEADER_SIZE 64u
+#define CACHE_ENTRY_SIZE 32u
+#define CACHE_MAX_SECTIONS 1024u
 #define CACHE_SECTION_REQUIRED 1u /* table flag: a reader that does not know the section must refuse the file */
 #define CACHE_MAX_TEXTURE_SIDE 32768u /* the largest texture side the reader accepts (and the writer writes) */
 
@@ -197,6 +201,12 @@ typedef struct cache_view {
     reader sections[CACHE_SECTION_COUNT];
     int present[CACHE_SECTION_COUNT];
 } cache_view;
+
+/* The checks of the header's CACHE_HEADER_SIZE bytes `h` of a file of `size` bytes (magic, version,
+ * checksum, size, reserved bytes; the table fits): the whole-file, the streaming and the paged
+ * readers share them. Out: the table's entry count and checksum. */
+gdr_status cache_parse_header(const char *name, const uint8_t *h, uint64_t size, uint32_t *out_count,
+                              uint64_t *out_table_hash, gdr_error *err);
 
 /* Builds the scene (and the PVS when out_pvs is not NULL) from the sections, each read and checked
  * by its description, in table order. With `paged`, the sections marked in_pages are not read (their

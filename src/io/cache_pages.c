@@ -715,24 +715,26 @@ static gdr_status expand_cluster(const char *where, uint32_t c, const uint32_t *
 {
     const gdr_page_cluster *pc = &out->clusters[c];
     uint32_t seen = 0;
-    for (uint32_t i = 0; i < 3 * pc->triangle_count; i++) {
-        const uint32_t *corners = indices + i / 3 * 3;
+    for (uint32_t t = 0; t < pc->triangle_count; t++) {
+        const uint32_t *corners = indices + 3 * t;
         if (corners[0] >= unique_count || corners[1] >= unique_count || corners[2] >= unique_count)
-            return PAGE_ERR("%s: cluster %u triangle %u: a vertex beyond the page's %u", where, c, i / 3, unique_count);
+            return PAGE_ERR("%s: cluster %u triangle %u: a vertex beyond the page's %u", where, c, t, unique_count);
         /* The canonical rotation, whatever rotation the index codec chose. */
         uint32_t first = gdr_triangle_first_corner((const gdr_vertex_bytes *)&unique[corners[0]],
                                                    (const gdr_vertex_bytes *)&unique[corners[1]],
                                                    (const gdr_vertex_bytes *)&unique[corners[2]]);
-        uint32_t u = corners[(first + i % 3) % 3];
-        if (stamp[u] != c + 1) {
-            if (seen == pc->vertex_count)
-                return PAGE_ERR("%s: cluster %u: its triangles use more than its %u vertices", where, c,
-                                pc->vertex_count);
-            stamp[u] = c + 1;
-            local_of[u] = seen;
-            out->vertices[pc->vertex_offset + seen++] = unique[u];
+        for (uint32_t k = 0; k < 3; k++) {
+            uint32_t u = corners[(first + k) % 3];
+            if (stamp[u] != c + 1) {
+                if (seen == pc->vertex_count)
+                    return PAGE_ERR("%s: cluster %u: its triangles use more than its %u vertices", where, c,
+                                    pc->vertex_count);
+                stamp[u] = c + 1;
+                local_of[u] = seen;
+                out->vertices[pc->vertex_offset + seen++] = unique[u];
+            }
+            out->triangles[pc->triangle_offset + 3 * t + k] = (uint8_t)local_of[u];
         }
-        out->triangles[pc->triangle_offset + i] = (uint8_t)local_of[u];
     }
     if (seen != pc->vertex_count)
         return PAGE_ERR("%s: cluster %u: its triangles use %u of its %u vertices", where, c, seen, pc->vertex_count);

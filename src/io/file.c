@@ -78,6 +78,23 @@ gdr_status gdr_io_open_regular(const char *path, int *out_fd, gdr_error *err)
     return GDR_OK;
 }
 
+size_t gdr_io_pread_exact(int fd, void *dst, size_t size, uint64_t offset)
+{
+    size_t done = 0;
+    while (done < size) {
+        ssize_t n = pread(fd, (uint8_t *)dst + done, size - done, (off_t)(offset + done));
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0) {
+            if (n == 0)
+                errno = 0;
+            break;
+        }
+        done += (size_t)n;
+    }
+    return done;
+}
+
 gdr_status gdr_io_read_file(const char *path, uint8_t **out_data, size_t *out_size, gdr_source_list *sources,
                             gdr_error *err)
 {

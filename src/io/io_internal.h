@@ -24,6 +24,11 @@
  * again), or -1 on failure. */
 gdr_status gdr_io_open_regular(const char *path, int *out_fd, gdr_error *err);
 
+/* Exactly `size` bytes at `offset` of fd into dst (pread, again after EINTR and short reads).
+ * Returns the bytes read: `size`, or fewer when the file ends or a read fails (errno set then,
+ * 0 when it ended). */
+size_t gdr_io_pread_exact(int fd, void *dst, size_t size, uint64_t offset);
+
 /* Reads a whole file into a malloc'ed buffer (one extra NUL byte after the data). When sources
  * is not NULL, the file's identity is appended to it. */
 gdr_status gdr_io_read_file(const char *path, uint8_t **out_data, size_t *out_size, gdr_source_list *sources,

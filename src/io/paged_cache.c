@@ -15,9 +15,6 @@
 #include "io/cache_pages.h"
 #include "io/io_internal.h"
 
-#define HEADER_SIZE 64u
-#define ENTRY_SIZE 32u
-#define MAX_SECTIONS 1024u
 #define FOURCC(a, b, c, d) ((uint32_t)(a) | (uint32_t)(b) << 8 | (uint32_t)(c) << 16 | (uint32_t)(d) << 24)
 
 struct gdr_paged_cache {
@@ -40,17 +37,11 @@ typedef struct section_ref {
 static gdr_status read_at(gdr_paged_cache *pc, void *dst, size_t size, uint64_t offset, const char *what,
                           gdr_error *err)
 {
-    size_t done = 0;
-    while (done < size) {
-        ssize_t n = pread(pc->fd, (uint8_t *)dst + done, size - done, (off_t)(offset + done));
-        if (n < 0 && errno == EINTR)
-            continue;
-        if (n <= 0)
-            return gdr_error_set(err, GDR_ERROR_IO, "%s: %s: %s at offset %llu (%zu of %zu bytes)", pc->name, what,
-                                 n < 0 ? strerror(errno) : "the file ends", (unsigned long long)(offset + done),
-                                 done, size);
-        done += (size_t)n;
-    }
+    size_t done = gdr_io_pread_exact(pc->fd, dst, size, offset);
+    if (done < size)
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: %s: %s at offset %llu (%zu of %zu bytes)", pc->name, what,
+                             errno ? strerror(errno) : "the file ends", (unsigned long long)(offset + done), done,
+                             size);
     atomic_fetch_add(&pc->bytes_read, size);
     return GDR_OK;
 }
@@ -62,34 +53,25 @@ static uint64_t load_u64(const uint8_t *p) { uint64_t v; memcpy(&v, p, 8); retur
 static gdr_status read_table(gdr_paged_cache *pc, section_ref *scne, section_ref *inst, section_ref *page,
                              gdr_error *err)
 {
-    uint8_t h[HEADER_SIZE];
-    if (pc->file_size < HEADER_SIZE)
+    uint8_t h[CACHE_HEADER_SIZE];
+    if (pc->file_size < CACHE_HEADER_SIZE)
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: truncated: %llu bytes, shorter than the header", pc->name,
                              (unsigned long long)pc->file_size);
-    gdr_status status = read_at(pc, h, HEADER_SIZE, 0, "header", err);
+    uint32_t count = 0;
+    uint64_t table_hash = 0;
+    gdr_status status = read_at(pc, h, CACHE_HEADER_SIZE, 0, "header", err);
+    if (status == GDR_OK)
+        status = cache_parse_header(pc->name, h, pc->file_size, &count, &table_hash, err);
     if (status != GDR_OK)
         return status;
-    uint32_t version = load_u32(h + 8), count = load_u32(h + 16);
-    if (memcmp(h, "GDRCACHE", 8) != 0)
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: not a gdr cache (bad magic)", pc->name);
-    if (version != GDR_CACHE_FORMAT_VERSION)
-        return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: cache format version %u, this build reads %u; rebuild it",
-                             pc->name, version, GDR_CACHE_FORMAT_VERSION);
-    if (load_u64(h + 40) != gdr_io_hash(h, 40) || load_u32(h + 12) != HEADER_SIZE)
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: header checksum mismatch", pc->name);
-    if (load_u64(h + 24) != pc->file_size)
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: truncated or extended: %llu bytes, the header says %llu",
-                             pc->name, (unsigned long long)pc->file_size, (unsigned long long)load_u64(h + 24));
-    if (count > MAX_SECTIONS || HEADER_SIZE + (uint64_t)count * ENTRY_SIZE > pc->file_size)
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section table (%u entries) does not fit", pc->name, count);
-    uint8_t *table = malloc((size_t)count * ENTRY_SIZE + 1);
+    uint8_t *table = malloc((size_t)count * CACHE_ENTRY_SIZE + 1);
     if (!table)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: section table", pc->name);
-    status = read_at(pc, table, (size_t)count * ENTRY_SIZE, HEADER_SIZE, "section table", err);
-    if (status == GDR_OK && load_u64(h + 32) != gdr_io_hash(table, (size_t)count * ENTRY_SIZE))
+    status = read_at(pc, table, (size_t)count * CACHE_ENTRY_SIZE, CACHE_HEADER_SIZE, "section table", err);
+    if (status == GDR_OK && table_hash != gdr_io_hash(table, (size_t)count * CACHE_ENTRY_SIZE))
         status = gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: section table checksum mismatch", pc->name);
     for (uint32_t i = 0; i < count && status == GDR_OK; i++) {
-        const uint8_t *e = table + (size_t)i * ENTRY_SIZE;
+        const uint8_t *e = table + (size_t)i * CACHE_ENTRY_SIZE;
         uint32_t id = load_u32(e);
         section_ref ref = {load_u64(e + 8), load_u64(e + 16), load_u64(e + 24), 1};
         if (ref.offset > pc->file_size || ref.size > pc->file_size - ref.offset)

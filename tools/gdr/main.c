@@ -79,7 +79,7 @@ static void print_help(FILE *out)
           "  --allow-outside-files   let a glTF name buffers and images outside its own folder\n"
           "                          (absolute paths, '..', links pointing out; default: refused)\n"
           "\n"
-          "view options (and the render options above but --out and --stats):\n"
+          "view options (and the render options above but --out, --stats and the two budgets):\n"
           "  --frames N              present N frames, then exit (default: until closed or Escape)\n"
           "  --screenshot FILE.png   write the last presented image (what the window shows)\n"
           "  --screenshot-dir DIR    where F12 writes gdr-view-NNNN.png (default .)\n"
