@@ -23,15 +23,17 @@
 /* Meshes with fewer triangles are built side by side, one per task, by gdr_scene_build_lod. */
 #define LOD_SMALL_MESH_TRIANGLES 65536u
 
-/* Grows *p to hold at least `need` elements of `size` bytes; returns 0 when out of memory. */
+/* Grows *p to hold at least `need` elements of `size` bytes; returns 0 when out of memory. An eighth
+ * more than asked, not the next power of two: the workers' scratch arrays reach their largest size
+ * on the groups near the DAG's root, which gather most of the mesh, and doubling would leave up to
+ * half of that unused at the build's peak. */
 int gdr_lod_reserve(void *pp, size_t *cap, size_t need, size_t size)
 {
     void **p = pp;
     if (need <= *cap)
         return 1;
-    size_t n = *cap ? *cap : 16;
-    while (n < need)
-        n *= 2;
+    size_t n = need + need / 8;
+    n = n < 16 ? 16 : n;
     void *q = realloc(*p, n * size);
     if (!q)
         return 0;
