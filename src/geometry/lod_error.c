@@ -350,42 +350,43 @@ static float to_full_detail_d2(const lod_build *b, uint32_t position, gdr_vec3 p
     return best;
 }
 
-/* Squared distance between p and the position of position id `position`. */
-static float position_d2(const lod_build *b, uint32_t position, gdr_vec3 p)
+static float distance2(gdr_vec3 q, gdr_vec3 p)
 {
-    gdr_vec3 q = b->mesh->positions[b->sample_vertex[position]];
     float dx = q.x - p.x, dy = q.y - p.y, dz = q.z - p.z;
     return dx * dx + dy * dy + dz * dz;
 }
 
 /* Walks over level-0 positions from `start`, to a neighbour nearer to p while there is one: the
  * walk ends at a position nearest to p among its neighbours (on a surface, next to p's foot).
- * *stopped_short is set when the walk was cut off by the step limit while still moving. */
+ * *stopped_short is set when the walk was cut off by the step limit while still moving. A
+ * neighbour is compared by its mesh vertex (all vertices of a position have its coordinates); the
+ * position id is looked up only for the one the walk moves to. */
 static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p, int *stopped_short)
 {
-    uint32_t at = start;
-    float best = position_d2(b, at, p);
+    const gdr_vec3 *x = b->mesh->positions;
+    uint32_t at = start, to = UINT32_MAX;
+    float best = distance2(x[b->sample_vertex[at]], p);
     *stopped_short = 0;
     /* At most LOD_WALK_LIMIT steps: on a strip or a fan's rim a walk would cross the whole mesh one
      * neighbour at a time. Where it stops short, the distance from there is only larger (a bound
      * still), and probe_d2 starts it again nearer to p. */
     for (uint32_t steps = 0; steps < LOD_WALK_LIMIT; steps++) {
-        uint32_t from = at;
-        for (uint32_t k = b->adjacency_start[from]; k < ring_end(b, from); k++) {
+        for (uint32_t k = b->adjacency_start[at]; k < ring_end(b, at); k++) {
             const gdr_cluster *c = &b->clusters[b->adjacency[k] >> 7];
             const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(b->adjacency[k] & 127) * 3;
             const uint32_t *v = gdr_lod_cluster_vertices(b, c);
             for (int j = 0; j < 3; j++) {
-                uint32_t q = b->position_id[v[t[j]]];
-                float d = position_d2(b, q, p);
+                float d = distance2(x[v[t[j]]], p);
                 if (d < best) { /* strictly nearer: the walk ends */
                     best = d;
-                    at = q;
+                    to = v[t[j]];
                 }
             }
         }
-        if (at == from)
+        if (to == UINT32_MAX)
             return at;
+        at = b->position_id[to];
+        to = UINT32_MAX;
     }
     *stopped_short = 1;
     return at;
