@@ -148,6 +148,48 @@ static int search_done(const float lo[3], float cell, const uint32_t dim[3], con
     return reach == INFINITY || reach * reach >= best_d2;
 }
 
+/* The cells along axis k within `reach` of q[k], clamped to [at - r, at + r]: a point farther than
+ * reach from q along one axis is farther than reach from q. `reach` is widened a little so that
+ * a point at exactly the best distance so far (a tie, which the lowest index wins) is never left
+ * out by rounding. */
+static void reach_range(const lod_grid *g, const float q[3], float reach, int k, int32_t at, int32_t r,
+                        int32_t *lo, int32_t *hi)
+{
+    *lo = at - r;
+    *hi = at + r;
+    if (reach == INFINITY)
+        return;
+    float margin = reach * 1.001f + 1e-18f;
+    int32_t a = (int32_t)cell_coordinate(g, q[k] - margin, k), b = (int32_t)cell_coordinate(g, q[k] + margin, k);
+    *lo = a > *lo ? a : *lo;
+    *hi = b < *hi ? b : *hi;
+}
+
+/* Searches the cells at Chebyshev distance r from `at` (its shell) that lie within the best
+ * distance so far of q along every axis; the others hold nothing nearer. */
+static void visit_shell(const lod_grid *g, const int32_t at[3], int32_t r, const float q[3], uint32_t *best,
+                        float *best_d2)
+{
+    int32_t lo[3], hi[3];
+    float reach = sqrtf(*best_d2);
+    for (int k = 0; k < 3; k++) {
+        reach_range(g, q, reach, k, at[k], r, &lo[k], &hi[k]);
+        lo[k] = lo[k] > 0 ? lo[k] : 0;
+        hi[k] = hi[k] < (int32_t)g->dim[k] - 1 ? hi[k] : (int32_t)g->dim[k] - 1;
+    }
+    for (int32_t z = lo[2]; z <= hi[2]; z++)
+        for (int32_t y = lo[1]; y <= hi[1]; y++) {
+            int shell = z == at[2] - r || z == at[2] + r || y == at[1] - r || y == at[1] + r;
+            for (int32_t x = lo[0]; x <= hi[0]; x++) {
+                if (!shell && x != at[0] - r && x != at[0] + r) {
+                    x = at[0] + r - 1; /* inside the shell: jump to its far face */
+                    continue;
+                }
+                visit_cell(g, (uint32_t)x, (uint32_t)y, (uint32_t)z, q, best, best_d2);
+            }
+        }
+}
+
 uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squared)
 {
     const float q[3] = {point.x, point.y, point.z};
@@ -157,21 +199,7 @@ uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squ
     uint32_t best = UINT32_MAX;
     float best_d2 = INFINITY;
     for (int32_t r = 0;; r++) {
-        for (int32_t z = at[2] - r; z <= at[2] + r; z++) {
-            if (z < 0 || z >= (int32_t)g->dim[2])
-                continue;
-            for (int32_t y = at[1] - r; y <= at[1] + r; y++) {
-                if (y < 0 || y >= (int32_t)g->dim[1])
-                    continue;
-                int shell = z == at[2] - r || z == at[2] + r || y == at[1] - r || y == at[1] + r;
-                for (int32_t x = at[0] - r; x <= at[0] + r; x += shell ? 1 : 2 * r) {
-                    if (x >= 0 && x < (int32_t)g->dim[0])
-                        visit_cell(g, (uint32_t)x, (uint32_t)y, (uint32_t)z, q, &best, &best_d2);
-                    if (r == 0)
-                        break;
-                }
-            }
-        }
+        visit_shell(g, at, r, q, &best, &best_d2);
         if (search_done(g->lo, g->cell, g->dim, at, r, q, best_d2))
             break;
     }
