@@ -95,7 +95,8 @@ static int reserve_cluster_samples(lod_build *b, size_t need)
     return 1;
 }
 
-/* Level-0 triangles around each position (by position id), as (cluster << 7 | triangle). */
+/* Level-0 triangles around each position (by position id), as cluster << 9 | triangle << 2 | the
+ * corner that is the position (a walk looks only at the other two). */
 static int build_adjacency(lod_build *b, uint32_t level0)
 {
     size_t corners = 0;
@@ -119,12 +120,19 @@ static int build_adjacency(lod_build *b, uint32_t level0)
         const uint8_t *t = gdr_lod_cluster_triangles(b, k);
         const uint32_t *v = gdr_lod_cluster_vertices(b, k);
         for (uint32_t i = 0; i < k->triangle_count * 3; i++)
-            b->adjacency[b->adjacency_start[b->position_id[v[t[i]]]]++] = c << 7 | (i / 3);
+            b->adjacency[b->adjacency_start[b->position_id[v[t[i]]]]++] = c << 9 | (i / 3) << 2 | (i % 3);
     }
     for (uint32_t p = b->position_count; p > 0; p--) /* start[p] now holds the end of p: shift back */
         b->adjacency_start[p] = b->adjacency_start[p - 1];
     b->adjacency_start[0] = 0;
     return 1;
+}
+
+/* An adjacency entry's cluster, and its triangle's first byte in the cluster's triangles. */
+static const gdr_cluster *ring_cluster(const lod_build *b, uint32_t entry) { return &b->clusters[entry >> 9]; }
+static const uint8_t *ring_triangle(const lod_build *b, const gdr_cluster *c, uint32_t entry)
+{
+    return gdr_lod_cluster_triangles(b, c) + (size_t)(entry >> 2 & 127) * 3;
 }
 
 /* Each position used by level 0 is owned by the first level-0 cluster that uses it. */
@@ -157,7 +165,7 @@ int gdr_lod_error_setup(lod_build *b)
 {
     uint32_t level0 = b->mesh->clusters.level0_cluster_count;
     b->sample_vertex = malloc(((size_t)b->position_count + 1) * sizeof *b->sample_vertex);
-    if (!b->sample_vertex || level0 >= (1u << 25))
+    if (!b->sample_vertex || level0 >= (1u << 23)) /* adjacency entries hold the cluster in 23 bits */
         return 0;
     return build_adjacency(b, level0) && assign_level0_samples(b, level0);
 }
@@ -341,8 +349,8 @@ static float to_full_detail_d2(const lod_build *b, uint32_t position, gdr_vec3 p
     float best = INFINITY;
     const gdr_vec3 *x = b->mesh->positions;
     for (uint32_t k = b->adjacency_start[position]; k < ring_end(b, position) && !(best <= enough); k++) {
-        const gdr_cluster *c = &b->clusters[b->adjacency[k] >> 7];
-        const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(b->adjacency[k] & 127) * 3;
+        const gdr_cluster *c = ring_cluster(b, b->adjacency[k]);
+        const uint8_t *t = ring_triangle(b, c, b->adjacency[k]);
         const uint32_t *v = gdr_lod_cluster_vertices(b, c);
         float d = point_triangle_d2(p, x[v[t[0]]], x[v[t[1]]], x[v[t[2]]]);
         best = d < best ? d : best;
@@ -372,14 +380,16 @@ static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p, int
      * still), and probe_d2 starts it again nearer to p. */
     for (uint32_t steps = 0; steps < LOD_WALK_LIMIT; steps++) {
         for (uint32_t k = b->adjacency_start[at]; k < ring_end(b, at); k++) {
-            const gdr_cluster *c = &b->clusters[b->adjacency[k] >> 7];
-            const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(b->adjacency[k] & 127) * 3;
+            const gdr_cluster *c = ring_cluster(b, b->adjacency[k]);
+            const uint8_t *t = ring_triangle(b, c, b->adjacency[k]);
             const uint32_t *v = gdr_lod_cluster_vertices(b, c);
-            for (int j = 0; j < 3; j++) {
-                float d = distance2(x[v[t[j]]], p);
+            uint32_t own = b->adjacency[k] & 3; /* the corner at `at`: no nearer than `best` */
+            const uint32_t other[2] = {v[t[own == 0 ? 1 : 0]], v[t[own == 2 ? 1 : 2]]};
+            for (int j = 0; j < 2; j++) {
+                float d = distance2(x[other[j]], p);
                 if (d < best) { /* strictly nearer: the walk ends */
                     best = d;
-                    to = v[t[j]];
+                    to = other[j];
                 }
             }
         }
@@ -410,7 +420,7 @@ static int build_region(const lod_build *b, lod_scratch *s)
     n = 0;
     for (uint32_t i = 0; i < s->gathered; i++)
         for (uint32_t k = b->adjacency_start[s->sample_ids[i]]; k < b->adjacency_start[s->sample_ids[i] + 1]; k++)
-            s->region_refs[n++] = b->adjacency[k];
+            s->region_refs[n++] = b->adjacency[k] >> 2; /* the triangle, whichever corner */
     qsort(s->region_refs, n, sizeof *s->region_refs, compare_u32);
     size_t unique = 0;
     for (size_t i = 0; i < n; i++)
@@ -422,8 +432,8 @@ static int build_region(const lod_build *b, lod_scratch *s)
     if (!LOD_RESERVE(s, region_corners, unique * 3 + 1))
         return 0;
     for (size_t i = 0; i < unique; i++) {
-        const gdr_cluster *c = &b->clusters[s->region_refs[i] >> 7];
-        const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(s->region_refs[i] & 127) * 3;
+        const gdr_cluster *c = ring_cluster(b, s->region_refs[i] << 2);
+        const uint8_t *t = ring_triangle(b, c, s->region_refs[i] << 2);
         const uint32_t *v = gdr_lod_cluster_vertices(b, c);
         for (int k = 0; k < 3; k++)
             s->region_corners[i * 3 + (size_t)k] = v[t[k]];
