@@ -342,13 +342,14 @@ static uint32_t ring_end(const lod_build *b, uint32_t position)
     return end - start > LOD_RING_LIMIT ? start + LOD_RING_LIMIT : end;
 }
 
-/* Stops at the first triangle within `enough` (squared): the caller has no use for a smaller bound
- * (probe_state.enough). */
-static float to_full_detail_d2(const lod_build *b, uint32_t position, gdr_vec3 p, float enough)
+/* Stops at the first triangle that brings the distance to at most `at_most` or below `below`
+ * (squared): the caller has no use for a smaller bound (probe_state). */
+static float to_full_detail_d2(const lod_build *b, uint32_t position, gdr_vec3 p, float at_most, float below)
 {
     float best = INFINITY;
     const gdr_vec3 *x = b->mesh->positions;
-    for (uint32_t k = b->adjacency_start[position]; k < ring_end(b, position) && !(best <= enough); k++) {
+    for (uint32_t k = b->adjacency_start[position];
+         k < ring_end(b, position) && !(best <= at_most) && !(best < below); k++) {
         const gdr_cluster *c = ring_cluster(b, b->adjacency[k]);
         const uint8_t *t = ring_triangle(b, c, b->adjacency[k]);
         const uint32_t *v = gdr_lod_cluster_vertices(b, c);
@@ -447,7 +448,7 @@ typedef struct probe_state {
     const lod_build *b;
     lod_scratch *s;
     float worst;  /* squared: the largest distance so far (at least the samples' largest) */
-    float enough; /* squared: a probe bound at or below this changes nothing (set per probe) */
+    float at_most, below; /* squared: a probe bound at most / below these changes nothing (per probe) */
     int failed;   /* out of memory */
 } probe_state;
 
@@ -476,7 +477,7 @@ static float walk_bound_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
 {
     int stopped_short;
     *at = walk_towards(ps->b, *at, p, &stopped_short);
-    float d = to_full_detail_d2(ps->b, *at, p, ps->enough);
+    float d = to_full_detail_d2(ps->b, *at, p, ps->at_most, ps->below);
     int suspect = (stopped_short && d > ps->worst) || d > 4.0f * ps->worst;
     if (!suspect || ps->s->gathered == 0)
         return d;
@@ -486,7 +487,7 @@ static float walk_bound_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
         return d;
     }
     uint32_t again = walk_towards(ps->b, start, p, &stopped_short);
-    float d_again = to_full_detail_d2(ps->b, again, p, ps->enough);
+    float d_again = to_full_detail_d2(ps->b, again, p, ps->at_most, ps->below);
     if (d_again >= d)
         return d;
     *at = again;
@@ -520,11 +521,11 @@ static float refine_share(float coarse_worst) { return 0.49f * coarse_worst; }
 /* The largest probe distance over the points of a barycentric grid of n steps on triangle v, corners
  * left out (they are level-0 vertices: distance 0); walks start at *at. A probe's bound is the
  * smallest over some level-0 triangles, and how small it is matters only while it could raise
- * something: once a triangle brings it to `enough` the rest are skipped, which leaves every
- * decision as if all were measured (docs/GEOMETRY.md, "The error"). `enough` is at most the largest
- * so far, so the walks' checks against it come out the same; on the refining grid (`refine`) only
- * the largest so far is used; on the coarse grid, also this triangle's largest and whether it stays
- * below refine_share of the largest, which can only grow. */
+ * something: once a triangle brings it to at most `at_most` or below `below` the rest are skipped,
+ * which leaves every decision as if all were measured (docs/GEOMETRY.md, "The error"). Both are at
+ * most the largest so far, so the walks' checks against that come out the same; on the refining
+ * grid (`refine`) only the largest so far is used; on the coarse grid, also this triangle's largest
+ * and whether it stays below refine_share of the largest, which can only grow. */
 static float probe_triangle(probe_state *ps, uint32_t *at, const gdr_vec3 v[3], int n, int refine)
 {
     float largest = 0.0f;
@@ -535,7 +536,8 @@ static float probe_triangle(probe_state *ps, uint32_t *at, const gdr_vec3 v[3], 
             float u = (float)i / (float)n, w = (float)j / (float)n, z = 1.0f - u - w;
             gdr_vec3 p = {z * v[0].x + u * v[1].x + w * v[2].x, z * v[0].y + u * v[1].y + w * v[2].y,
                           z * v[0].z + u * v[1].z + w * v[2].z};
-            ps->enough = refine ? ps->worst : fmaxf(largest, nextafterf(refine_share(ps->worst), 0.0f));
+            ps->at_most = refine ? ps->worst : largest;
+            ps->below = refine ? 0.0f : refine_share(ps->worst);
             float d = probe_d2(ps, at, p);
             largest = d > largest ? d : largest;
             ps->worst = d > ps->worst ? d : ps->worst;
@@ -557,7 +559,7 @@ static void triangle_corners(const lod_scratch *s, uint32_t t, gdr_vec3 v[3])
  * out of memory. */
 static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor)
 {
-    probe_state ps = {b, s, floor * floor, 0.0f, 0};
+    probe_state ps = {b, s, floor * floor, 0.0f, 0.0f, 0};
     s->region_built = 0;
     s->grid_holds_samples = 0;
     if (!LOD_RESERVE(s, coarse_d2, (size_t)s->out_triangle_count + 1))

@@ -131,10 +131,15 @@ static float unsearched_reach(const float lo[3], float cell, const uint32_t dim[
 {
     float reach = INFINITY;
     for (int k = 0; k < 3; k++) {
-        if (at[k] - r > 0)
-            reach = fminf(reach, q[k] - (lo[k] + (float)(at[k] - r) * cell));
-        if (at[k] + r + 1 < (int32_t)dim[k])
-            reach = fminf(reach, lo[k] + (float)(at[k] + r + 1) * cell - q[k]);
+        /* (not fminf: a library call at -O3; the same result, NaN included) */
+        if (at[k] - r > 0) {
+            float d = q[k] - (lo[k] + (float)(at[k] - r) * cell);
+            reach = d < reach ? d : reach;
+        }
+        if (at[k] + r + 1 < (int32_t)dim[k]) {
+            float d = lo[k] + (float)(at[k] + r + 1) * cell - q[k];
+            reach = d < reach ? d : reach;
+        }
     }
     return reach > 0.0f ? reach : 0.0f; /* rounding may put q just outside its cell */
 }
