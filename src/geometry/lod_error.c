@@ -342,18 +342,26 @@ static uint32_t ring_end(const lod_build *b, uint32_t position)
     return end - start > LOD_RING_LIMIT ? start + LOD_RING_LIMIT : end;
 }
 
-/* Stops at the first triangle that brings the distance to at most `at_most` or below `below`
- * (squared): the caller has no use for a smaller bound (probe_state). */
-static float to_full_detail_d2(const lod_build *b, uint32_t position, gdr_vec3 p, float at_most, float below)
+static float ring_entry_d2(const lod_build *b, uint32_t entry, gdr_vec3 p)
 {
-    float best = INFINITY;
     const gdr_vec3 *x = b->mesh->positions;
+    const gdr_cluster *c = ring_cluster(b, entry);
+    const uint8_t *t = ring_triangle(b, c, entry);
+    const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+    return point_triangle_d2(p, x[v[t[0]]], x[v[t[1]]], x[v[t[2]]]);
+}
+
+/* Stops at the first triangle that brings the distance to at most `at_most` or below `below`
+ * (squared): the caller has no use for a smaller bound (probe_state). Adjacency entry `first` (of
+ * this position's, or UINT32_MAX), the triangle a walk ending here guessed nearest, is looked at
+ * first: the smallest distance is the same in any order. */
+static float to_full_detail_d2(const lod_build *b, uint32_t position, gdr_vec3 p, uint32_t first, float at_most,
+                               float below)
+{
+    float best = first == UINT32_MAX ? INFINITY : ring_entry_d2(b, b->adjacency[first], p);
     for (uint32_t k = b->adjacency_start[position];
          k < ring_end(b, position) && !(best <= at_most) && !(best < below); k++) {
-        const gdr_cluster *c = ring_cluster(b, b->adjacency[k]);
-        const uint8_t *t = ring_triangle(b, c, b->adjacency[k]);
-        const uint32_t *v = gdr_lod_cluster_vertices(b, c);
-        float d = point_triangle_d2(p, x[v[t[0]]], x[v[t[1]]], x[v[t[2]]]);
+        float d = k == first ? best : ring_entry_d2(b, b->adjacency[k], p);
         best = d < best ? d : best;
     }
     return best;
@@ -369,8 +377,10 @@ static float distance2(gdr_vec3 q, gdr_vec3 p)
  * walk ends at a position nearest to p among its neighbours (on a surface, next to p's foot).
  * *stopped_short is set when the walk was cut off by the step limit while still moving. A
  * neighbour is compared by its mesh vertex (all vertices of a position have its coordinates); the
- * position id is looked up only for the one the walk moves to. */
-static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p, int *stopped_short)
+ * position id is looked up only for the one the walk moves to. *nearest receives the adjacency
+ * entry of the end's triangle whose other two corners are nearest to p (summed), the likeliest
+ * to hold p's foot (UINT32_MAX when stopped short). */
+static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p, int *stopped_short, uint32_t *nearest)
 {
     const gdr_vec3 *x = b->mesh->positions;
     uint32_t at = start, to = UINT32_MAX;
@@ -380,18 +390,26 @@ static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p, int
      * neighbour at a time. Where it stops short, the distance from there is only larger (a bound
      * still), and probe_d2 starts it again nearer to p. */
     for (uint32_t steps = 0; steps < LOD_WALK_LIMIT; steps++) {
+        float nearest_sum = INFINITY;
+        *nearest = UINT32_MAX;
         for (uint32_t k = b->adjacency_start[at]; k < ring_end(b, at); k++) {
             const gdr_cluster *c = ring_cluster(b, b->adjacency[k]);
             const uint8_t *t = ring_triangle(b, c, b->adjacency[k]);
             const uint32_t *v = gdr_lod_cluster_vertices(b, c);
             uint32_t own = b->adjacency[k] & 3; /* the corner at `at`: no nearer than `best` */
             const uint32_t other[2] = {v[t[own == 0 ? 1 : 0]], v[t[own == 2 ? 1 : 2]]};
+            float sum = 0.0f;
             for (int j = 0; j < 2; j++) {
                 float d = distance2(x[other[j]], p);
+                sum += d;
                 if (d < best) { /* strictly nearer: the walk ends */
                     best = d;
                     to = other[j];
                 }
+            }
+            if (sum < nearest_sum) {
+                nearest_sum = sum;
+                *nearest = k;
             }
         }
         if (to == UINT32_MAX)
@@ -400,6 +418,7 @@ static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p, int
         to = UINT32_MAX;
     }
     *stopped_short = 1;
+    *nearest = UINT32_MAX; /* of the ring it left */
     return at;
 }
 
@@ -476,8 +495,9 @@ static uint32_t nearest_sample(lod_scratch *s, gdr_vec3 p)
 static float walk_bound_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
 {
     int stopped_short;
-    *at = walk_towards(ps->b, *at, p, &stopped_short);
-    float d = to_full_detail_d2(ps->b, *at, p, ps->at_most, ps->below);
+    uint32_t first;
+    *at = walk_towards(ps->b, *at, p, &stopped_short, &first);
+    float d = to_full_detail_d2(ps->b, *at, p, first, ps->at_most, ps->below);
     int suspect = (stopped_short && d > ps->worst) || d > 4.0f * ps->worst;
     if (!suspect || ps->s->gathered == 0)
         return d;
@@ -486,8 +506,8 @@ static float walk_bound_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
         ps->failed = 1;
         return d;
     }
-    uint32_t again = walk_towards(ps->b, start, p, &stopped_short);
-    float d_again = to_full_detail_d2(ps->b, again, p, ps->at_most, ps->below);
+    uint32_t again = walk_towards(ps->b, start, p, &stopped_short, &first);
+    float d_again = to_full_detail_d2(ps->b, again, p, first, ps->at_most, ps->below);
     if (d_again >= d)
         return d;
     *at = again;
