@@ -359,8 +359,8 @@ static float to_full_detail_d2(const lod_build *b, uint32_t position, gdr_vec3 p
                                float below)
 {
     float best = first == UINT32_MAX ? INFINITY : ring_entry_d2(b, b->adjacency[first], p);
-    for (uint32_t k = b->adjacency_start[position];
-         k < ring_end(b, position) && !(best <= at_most) && !(best < below); k++) {
+    for (uint32_t k = b->adjacency_start[position], end = ring_end(b, position);
+         k < end && !(best <= at_most) && !(best < below); k++) {
         float d = k == first ? best : ring_entry_d2(b, b->adjacency[k], p);
         best = d < best ? d : best;
     }
@@ -389,15 +389,17 @@ static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p, int
     /* At most LOD_WALK_LIMIT steps: on a strip or a fan's rim a walk would cross the whole mesh one
      * neighbour at a time. Where it stops short, the distance from there is only larger (a bound
      * still), and probe_d2 starts it again nearer to p. */
+    static const uint8_t other_corners[4][2] = {{1, 2}, {0, 2}, {0, 1}, {0, 1}}; /* in order, for ties */
     for (uint32_t steps = 0; steps < LOD_WALK_LIMIT; steps++) {
         float nearest_sum = INFINITY;
-        *nearest = UINT32_MAX;
-        for (uint32_t k = b->adjacency_start[at]; k < ring_end(b, at); k++) {
-            const gdr_cluster *c = ring_cluster(b, b->adjacency[k]);
-            const uint8_t *t = ring_triangle(b, c, b->adjacency[k]);
+        uint32_t nearest_entry = UINT32_MAX;
+        for (uint32_t k = b->adjacency_start[at], end = ring_end(b, at); k < end; k++) {
+            uint32_t entry = b->adjacency[k];
+            const gdr_cluster *c = ring_cluster(b, entry);
+            const uint8_t *t = ring_triangle(b, c, entry);
             const uint32_t *v = gdr_lod_cluster_vertices(b, c);
-            uint32_t own = b->adjacency[k] & 3; /* the corner at `at`: no nearer than `best` */
-            const uint32_t other[2] = {v[t[own == 0 ? 1 : 0]], v[t[own == 2 ? 1 : 2]]};
+            const uint8_t *o = other_corners[entry & 3]; /* not the corner at `at`: no nearer than `best` */
+            const uint32_t other[2] = {v[t[o[0]]], v[t[o[1]]]};
             float sum = 0.0f;
             for (int j = 0; j < 2; j++) {
                 float d = distance2(x[other[j]], p);
@@ -409,16 +411,18 @@ static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p, int
             }
             if (sum < nearest_sum) {
                 nearest_sum = sum;
-                *nearest = k;
+                nearest_entry = k;
             }
         }
-        if (to == UINT32_MAX)
+        if (to == UINT32_MAX) {
+            *nearest = nearest_entry;
             return at;
+        }
         at = b->position_id[to];
         to = UINT32_MAX;
     }
     *stopped_short = 1;
-    *nearest = UINT32_MAX; /* of the ring it left */
+    *nearest = UINT32_MAX;
     return at;
 }
 
