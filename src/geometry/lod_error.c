@@ -490,18 +490,33 @@ static uint32_t nearest_sample(lod_scratch *s, gdr_vec3 p)
     return s->sample_ids[lod_grid_nearest(&s->grid, p, &d2)];
 }
 
+/* Where the last walk of a triangle's probes ended: the position, and the adjacency entry of its
+ * triangle guessed nearest to the next probe (UINT32_MAX: none). */
+typedef struct walk_end {
+    uint32_t position, entry;
+} walk_end;
+
 /* Where a walk towards p ends: from *at, and again from the group's sample nearest to p where the
  * first walk's bound could raise the largest distance and was cut off by the step limit, or would
  * send p to the exact measure. On a coarse group a simplified triangle spans more level-0 edges
  * than the limit, and the bound from where a cut-off walk stops is several times the distance (on
  * the 1 M-triangle torus up to 13x); a walk can also end at a nearest position of one side of a
- * thin part while p is nearer the other. Returns the bound (squared) from where it ended. */
-static float walk_bound_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
+ * thin part while p is nearer the other. Returns the bound (squared) from where it ended.
+ *
+ * No walk is taken where the level-0 triangle the last walk guessed nearest to its probe already
+ * brings p's bound within what changes nothing (probe_state): most probes lie close to the last,
+ * and their bound matters only where it is large. *at then stays, and the next walk starts there
+ * (so later walks may end elsewhere than they would have: still a bound, not the same DAG). */
+static float walk_bound_d2(probe_state *ps, walk_end *at, gdr_vec3 p)
 {
+    if (at->entry != UINT32_MAX) {
+        float d = ring_entry_d2(ps->b, ps->b->adjacency[at->entry], p);
+        if (d <= ps->at_most || d < ps->below)
+            return d;
+    }
     int stopped_short;
-    uint32_t first;
-    *at = walk_towards(ps->b, *at, p, &stopped_short, &first);
-    float d = to_full_detail_d2(ps->b, *at, p, first, ps->at_most, ps->below);
+    at->position = walk_towards(ps->b, at->position, p, &stopped_short, &at->entry);
+    float d = to_full_detail_d2(ps->b, at->position, p, at->entry, ps->at_most, ps->below);
     int suspect = (stopped_short && d > ps->worst) || d > 4.0f * ps->worst;
     if (!suspect || ps->s->gathered == 0)
         return d;
@@ -510,8 +525,9 @@ static float walk_bound_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
         ps->failed = 1;
         return d;
     }
-    uint32_t again = walk_towards(ps->b, start, p, &stopped_short, &first);
-    float d_again = to_full_detail_d2(ps->b, again, p, first, ps->at_most, ps->below);
+    walk_end again;
+    again.position = walk_towards(ps->b, start, p, &stopped_short, &again.entry);
+    float d_again = to_full_detail_d2(ps->b, again.position, p, again.entry, ps->at_most, ps->below);
     if (d_again >= d)
         return d;
     *at = again;
@@ -524,7 +540,7 @@ static float walk_bound_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
  * the exact distance to the level-0 triangles around the group's samples is taken instead (the
  * walk can stop far away on meshes of long thin triangles). *at receives where the walk ended (the
  * next probe of the triangle starts there). */
-static float probe_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
+static float probe_d2(probe_state *ps, walk_end *at, gdr_vec3 p)
 {
     float d = walk_bound_d2(ps, at, p);
     if (d <= 4.0f * ps->worst || ps->failed) /* squared: up to twice the largest so far */
@@ -550,7 +566,7 @@ static float refine_share(float coarse_worst) { return 0.49f * coarse_worst; }
  * most the largest so far, so the walks' checks against that come out the same; on the refining
  * grid (`refine`) only the largest so far is used; on the coarse grid, also this triangle's largest
  * and whether it stays below refine_share of the largest, which can only grow. */
-static float probe_triangle(probe_state *ps, uint32_t *at, const gdr_vec3 v[3], int n, int refine)
+static float probe_triangle(probe_state *ps, walk_end *at, const gdr_vec3 v[3], int n, int refine)
 {
     float largest = 0.0f;
     for (int i = 0; i <= n; i++)
@@ -591,7 +607,7 @@ static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor)
     for (uint32_t t = 0; t < s->out_triangle_count; t++) {
         gdr_vec3 v[3];
         triangle_corners(s, t, v);
-        uint32_t at = b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]];
+        walk_end at = {b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]], UINT32_MAX};
         s->coarse_d2[t] = probe_triangle(&ps, &at, v, 3, 0);
     }
     float coarse_worst = ps.worst;
@@ -600,7 +616,7 @@ static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor)
             continue;
         gdr_vec3 v[3];
         triangle_corners(s, t, v);
-        uint32_t at = b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]];
+        walk_end at = {b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]], UINT32_MAX};
         probe_triangle(&ps, &at, v, 8, 1);
     }
     return ps.failed ? -1.0f : sqrtf(ps.worst);
