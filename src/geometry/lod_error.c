@@ -558,20 +558,35 @@ static float probe_d2(probe_state *ps, walk_end *at, gdr_vec3 p)
  * share of the largest coarse probe of the group (squared: 70%). */
 static float refine_share(float coarse_worst) { return 0.49f * coarse_worst; }
 
+/* Which edge of triangle v's barycentric grid point (i, j) of n steps lies on: edge k joins corners
+ * k and k + 1 (mod 3); 3 inside. */
+static int grid_edge(int i, int j, int n)
+{
+    if (j == 0)
+        return 0;
+    if (i + j == n)
+        return 1;
+    return i == 0 ? 2 : 3;
+}
+
 /* The largest probe distance over the points of a barycentric grid of n steps on triangle v, corners
- * left out (they are level-0 vertices: distance 0); walks start at *at. A probe's bound is the
+ * left out (they are level-0 vertices: distance 0), and of each edge k's points into edge_d2[k];
+ * the points of an edge whose bit is set in `skip` are left out (a neighbour probed them). Walks
+ * start at *at. `largest` starts at `floor` (what the skipped edges gave). A probe's bound is the
  * smallest over some level-0 triangles, and how small it is matters only while it could raise
  * something: once a triangle brings it to at most `at_most` or below `below` the rest are skipped,
  * which leaves every decision as if all were measured (docs/GEOMETRY.md, "The error"). Both are at
  * most the largest so far, so the walks' checks against that come out the same; on the refining
  * grid (`refine`) only the largest so far is used; on the coarse grid, also this triangle's largest
  * and whether it stays below refine_share of the largest, which can only grow. */
-static float probe_triangle(probe_state *ps, walk_end *at, const gdr_vec3 v[3], int n, int refine)
+static float probe_triangle(probe_state *ps, walk_end *at, const gdr_vec3 v[3], int n, int refine, unsigned skip,
+                            float floor, float edge_d2[3])
 {
-    float largest = 0.0f;
+    float largest = floor;
     for (int i = 0; i <= n; i++)
         for (int j = 0; i + j <= n; j++) {
-            if (i == n || j == n || i + j == 0)
+            int edge = grid_edge(i, j, n);
+            if (i == n || j == n || i + j == 0 || (edge < 3 && (skip >> edge & 1)))
                 continue;
             float u = (float)i / (float)n, w = (float)j / (float)n, z = 1.0f - u - w;
             gdr_vec3 p = {z * v[0].x + u * v[1].x + w * v[2].x, z * v[0].y + u * v[1].y + w * v[2].y,
@@ -581,6 +596,8 @@ static float probe_triangle(probe_state *ps, walk_end *at, const gdr_vec3 v[3], 
             float d = probe_d2(ps, at, p);
             largest = d > largest ? d : largest;
             ps->worst = d > ps->worst ? d : ps->worst;
+            if (edge < 3)
+                edge_d2[edge] = d > edge_d2[edge] ? d : edge_d2[edge];
         }
     return largest;
 }
@@ -591,34 +608,64 @@ static void triangle_corners(const lod_scratch *s, uint32_t t, gdr_vec3 v[3])
         v[k] = load3(s->positions + (size_t)s->out_corners[(size_t)t * 3 + k] * 3);
 }
 
+/* The edge (3u + j: corners j and j + 1 of triangle u) of a triangle u before t that joins the same
+ * two group vertices as t's edge k; UINT32_MAX when none. */
+static uint32_t earlier_edge(const lod_scratch *s, uint32_t t, int k)
+{
+    uint32_t a = s->out_corners[(size_t)t * 3 + k], b = s->out_corners[(size_t)t * 3 + (k + 1) % 3];
+    for (uint32_t i = s->ring_start[a]; i < s->ring_start[a + 1] && s->ring[i] < t; i++) {
+        const uint32_t *u = s->out_corners + (size_t)s->ring[i] * 3;
+        for (int j = 0; j < 3; j++)
+            if ((u[j] == a && u[(j + 1) % 3] == b) || (u[j] == b && u[(j + 1) % 3] == a))
+                return s->ring[i] * 3 + (uint32_t)j;
+    }
+    return UINT32_MAX;
+}
+
+/* Probes triangle t on a grid of n steps, leaving out the edges an earlier triangle probed on the
+ * same grid (edge_d2 >= 0: the coarse grid, whose largest counts towards t's; refined: -1 once
+ * probed); records its own edges'. Returns its largest (coarse). */
+static float probe_shared(probe_state *ps, lod_scratch *s, uint32_t t, int n, int refine)
+{
+    unsigned skip = 0;
+    float floor = 0.0f, edge_d2[3] = {0.0f, 0.0f, 0.0f};
+    for (int k = 0; k < 3; k++) {
+        uint32_t e = earlier_edge(s, t, k);
+        if (e == UINT32_MAX || (refine ? s->edge_d2[e] >= 0.0f : s->edge_d2[e] < 0.0f))
+            continue;
+        skip |= 1u << k;
+        floor = s->edge_d2[e] > floor ? s->edge_d2[e] : floor;
+    }
+    gdr_vec3 v[3];
+    triangle_corners(s, t, v);
+    walk_end at = {ps->b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]], UINT32_MAX};
+    float largest = probe_triangle(ps, &at, v, n, refine, skip, refine ? 0.0f : floor, edge_d2);
+    for (int k = 0; k < 3; k++)
+        s->edge_d2[(size_t)t * 3 + k] = refine ? -1.0f : edge_d2[k];
+    return largest;
+}
+
 /* Largest distance from the simplified triangles to S0, or `floor` when that is larger (the
  * samples' largest distance: probes below it cannot change the group's deviation). Every triangle
  * is probed on a barycentric grid of 3 steps an edge (6 points on the edges, the centroid); those
  * whose probes come within 70% of the largest then, on a grid of 8 steps (the deviation of a
- * simplified triangle peaks inside it or on an edge, between the coarse points). Returns -1 when
- * out of memory. */
+ * simplified triangle peaks inside it or on an edge, between the coarse points). An edge two
+ * triangles share is probed once on each grid (by the first; the second counts its probes as its
+ * own). Returns -1 when out of memory. */
 static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor)
 {
     probe_state ps = {b, s, floor * floor, 0.0f, 0.0f, 0};
     s->region_built = 0;
     s->grid_holds_samples = 0;
-    if (!LOD_RESERVE(s, coarse_d2, (size_t)s->out_triangle_count + 1))
+    if (!LOD_RESERVE(s, coarse_d2, (size_t)s->out_triangle_count + 1) ||
+        !LOD_RESERVE(s, edge_d2, (size_t)s->out_triangle_count * 3 + 1))
         return -1.0f;
-    for (uint32_t t = 0; t < s->out_triangle_count; t++) {
-        gdr_vec3 v[3];
-        triangle_corners(s, t, v);
-        walk_end at = {b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]], UINT32_MAX};
-        s->coarse_d2[t] = probe_triangle(&ps, &at, v, 3, 0);
-    }
+    for (uint32_t t = 0; t < s->out_triangle_count; t++)
+        s->coarse_d2[t] = probe_shared(&ps, s, t, 3, 0);
     float coarse_worst = ps.worst;
-    for (uint32_t t = 0; t < s->out_triangle_count; t++) {
-        if (s->coarse_d2[t] < refine_share(coarse_worst))
-            continue;
-        gdr_vec3 v[3];
-        triangle_corners(s, t, v);
-        walk_end at = {b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]], UINT32_MAX};
-        probe_triangle(&ps, &at, v, 8, 1);
-    }
+    for (uint32_t t = 0; t < s->out_triangle_count; t++)
+        if (!(s->coarse_d2[t] < refine_share(coarse_worst)))
+            probe_shared(&ps, s, t, 8, 1);
     return ps.failed ? -1.0f : sqrtf(ps.worst);
 }
 
