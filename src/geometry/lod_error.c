@@ -19,52 +19,43 @@
 
 #define NO_SOURCE UINT32_MAX
 
-/* Squared distance from p to triangle (a, b, c), by the region of the closest point. */
-static float point_triangle_d2(gdr_vec3 P, gdr_vec3 A, gdr_vec3 B, gdr_vec3 C)
+static gdr_vec3 sub3(gdr_vec3 x, gdr_vec3 y) { return (gdr_vec3){x.x - y.x, x.y - y.y, x.z - y.z}; }
+static float dot3(gdr_vec3 x, gdr_vec3 y) { return x.x * y.x + x.y * y.y + x.z * y.z; }
+/* o + t * d */
+static gdr_vec3 along(gdr_vec3 o, float t, gdr_vec3 d) { return (gdr_vec3){o.x + t * d.x, o.y + t * d.y, o.z + t * d.z}; }
+
+/* Squared distance from p to triangle (a, b, c), by the region of the closest point q. Any corner
+ * bounds the distance too (d(p, a), the smaller is returned): that guards the degenerate cases. In
+ * scalars, not arrays, so that the compiler keeps them in registers. */
+static float point_triangle_d2(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3 c)
 {
-    const float p[3] = {P.x, P.y, P.z}, a[3] = {A.x, A.y, A.z}, b[3] = {B.x, B.y, B.z}, c[3] = {C.x, C.y, C.z};
-    float ab[3], ac[3], ap[3], q[3];
-    for (int k = 0; k < 3; k++) {
-        ab[k] = b[k] - a[k];
-        ac[k] = c[k] - a[k];
-        ap[k] = p[k] - a[k];
-    }
-#define DOT(x, y) ((x)[0] * (y)[0] + (x)[1] * (y)[1] + (x)[2] * (y)[2])
-    float d1 = DOT(ab, ap), d2 = DOT(ac, ap);
-    float bp[3] = {p[0] - b[0], p[1] - b[1], p[2] - b[2]}, cp[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
-    float d3 = DOT(ab, bp), d4 = DOT(ac, bp), d5 = DOT(ab, cp), d6 = DOT(ac, cp);
-#undef DOT
+    gdr_vec3 ab = sub3(b, a), ac = sub3(c, a), ap = sub3(p, a);
+    float d1 = dot3(ab, ap), d2 = dot3(ac, ap), da = dot3(ap, ap);
+    if (d1 <= 0.0f && d2 <= 0.0f)
+        return da; /* q = a */
+    gdr_vec3 bp = sub3(p, b), cp = sub3(p, c);
+    float d3 = dot3(ab, bp), d4 = dot3(ac, bp), d5 = dot3(ab, cp), d6 = dot3(ac, cp);
     float va = d3 * d6 - d5 * d4, vb = d5 * d2 - d1 * d6, vc = d1 * d4 - d3 * d2;
-    if (d1 <= 0.0f && d2 <= 0.0f) {
-        memcpy(q, a, sizeof q);
-    } else if (d3 >= 0.0f && d4 <= d3) {
-        memcpy(q, b, sizeof q);
+    gdr_vec3 q;
+    if (d3 >= 0.0f && d4 <= d3) {
+        q = b;
     } else if (d6 >= 0.0f && d5 <= d6) {
-        memcpy(q, c, sizeof q);
+        q = c;
     } else if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) {
-        float v = d1 / (d1 - d3);
-        for (int k = 0; k < 3; k++)
-            q[k] = a[k] + v * ab[k];
+        q = along(a, d1 / (d1 - d3), ab);
     } else if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) {
-        float w = d2 / (d2 - d6);
-        for (int k = 0; k < 3; k++)
-            q[k] = a[k] + w * ac[k];
+        q = along(a, d2 / (d2 - d6), ac);
     } else if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f) {
-        float w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        for (int k = 0; k < 3; k++)
-            q[k] = b[k] + w * (c[k] - b[k]);
+        q = along(b, (d4 - d3) / ((d4 - d3) + (d5 - d6)), sub3(c, b));
     } else {
         float denom = va + vb + vc;
         float v = vb / denom, w = vc / denom;
         if (!(denom > 0.0f)) /* degenerate: nearest corner */
             v = w = 0.0f;
-        for (int k = 0; k < 3; k++)
-            q[k] = a[k] + ab[k] * v + ac[k] * w;
+        q = (gdr_vec3){a.x + ab.x * v + ac.x * w, a.y + ab.y * v + ac.y * w, a.z + ab.z * v + ac.z * w};
     }
-    float dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
-    float d = dx * dx + dy * dy + dz * dz;
-    /* Any corner bounds the distance too: guards the degenerate cases above. */
-    float da = (p[0] - a[0]) * (p[0] - a[0]) + (p[1] - a[1]) * (p[1] - a[1]) + (p[2] - a[2]) * (p[2] - a[2]);
+    gdr_vec3 pq = sub3(p, q);
+    float d = dot3(pq, pq);
     return d < da ? d : da;
 }
 
