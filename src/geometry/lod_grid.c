@@ -111,16 +111,20 @@ int lod_grid_build(lod_grid *g, const gdr_vec3 *points, uint32_t n, double cells
 static void visit_cell(const lod_grid *g, uint32_t x, uint32_t y, uint32_t z, const float q[3], uint32_t *best,
                        float *best_d2)
 {
-    uint32_t c = (z * g->dim[1] + y) * g->dim[0] + x;
-    for (uint32_t i = g->start[c]; i < g->start[c + 1]; i++) {
-        const gdr_vec3 p = g->points[g->items[i]];
+    uint32_t c = (z * g->dim[1] + y) * g->dim[0] + x, found = *best;
+    float found_d2 = *best_d2; /* in locals: through the pointers, every store would be reloaded */
+    for (uint32_t i = g->start[c], end = g->start[c + 1]; i < end; i++) {
+        uint32_t item = g->items[i];
+        const gdr_vec3 p = g->points[item];
         float dx = p.x - q[0], dy = p.y - q[1], dz = p.z - q[2];
         float d2 = dx * dx + dy * dy + dz * dz;
-        if (d2 < *best_d2 || (d2 == *best_d2 && g->items[i] < *best)) {
-            *best_d2 = d2;
-            *best = g->items[i];
+        if (d2 < found_d2 || (d2 == found_d2 && item < found)) {
+            found_d2 = d2;
+            found = item;
         }
     }
+    *best = found;
+    *best_d2 = found_d2;
 }
 
 /* Distance from q to the nearest cell the search has not reached once every cell within Chebyshev
