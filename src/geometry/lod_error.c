@@ -19,52 +19,43 @@
 
 #define NO_SOURCE UINT32_MAX
 
-/* Squared distance from p to triangle (a, b, c), by the region of the closest point. */
-static float point_triangle_d2(gdr_vec3 P, gdr_vec3 A, gdr_vec3 B, gdr_vec3 C)
+static gdr_vec3 sub3(gdr_vec3 x, gdr_vec3 y) { return (gdr_vec3){x.x - y.x, x.y - y.y, x.z - y.z}; }
+static float dot3(gdr_vec3 x, gdr_vec3 y) { return x.x * y.x + x.y * y.y + x.z * y.z; }
+/* o + t * d */
+static gdr_vec3 along(gdr_vec3 o, float t, gdr_vec3 d) { return (gdr_vec3){o.x + t * d.x, o.y + t * d.y, o.z + t * d.z}; }
+
+/* Squared distance from p to triangle (a, b, c), by the region of the closest point q. Any corner
+ * bounds the distance too (d(p, a), the smaller is returned): that guards the degenerate cases. In
+ * scalars, not arrays, so that the compiler keeps them in registers. */
+static float point_triangle_d2(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3 c)
 {
-    const float p[3] = {P.x, P.y, P.z}, a[3] = {A.x, A.y, A.z}, b[3] = {B.x, B.y, B.z}, c[3] = {C.x, C.y, C.z};
-    float ab[3], ac[3], ap[3], q[3];
-    for (int k = 0; k < 3; k++) {
-        ab[k] = b[k] - a[k];
-        ac[k] = c[k] - a[k];
-        ap[k] = p[k] - a[k];
-    }
-#define DOT(x, y) ((x)[0] * (y)[0] + (x)[1] * (y)[1] + (x)[2] * (y)[2])
-    float d1 = DOT(ab, ap), d2 = DOT(ac, ap);
-    float bp[3] = {p[0] - b[0], p[1] - b[1], p[2] - b[2]}, cp[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
-    float d3 = DOT(ab, bp), d4 = DOT(ac, bp), d5 = DOT(ab, cp), d6 = DOT(ac, cp);
-#undef DOT
+    gdr_vec3 ab = sub3(b, a), ac = sub3(c, a), ap = sub3(p, a);
+    float d1 = dot3(ab, ap), d2 = dot3(ac, ap), da = dot3(ap, ap);
+    if (d1 <= 0.0f && d2 <= 0.0f)
+        return da; /* q = a */
+    gdr_vec3 bp = sub3(p, b), cp = sub3(p, c);
+    float d3 = dot3(ab, bp), d4 = dot3(ac, bp), d5 = dot3(ab, cp), d6 = dot3(ac, cp);
     float va = d3 * d6 - d5 * d4, vb = d5 * d2 - d1 * d6, vc = d1 * d4 - d3 * d2;
-    if (d1 <= 0.0f && d2 <= 0.0f) {
-        memcpy(q, a, sizeof q);
-    } else if (d3 >= 0.0f && d4 <= d3) {
-        memcpy(q, b, sizeof q);
+    gdr_vec3 q;
+    if (d3 >= 0.0f && d4 <= d3) {
+        q = b;
     } else if (d6 >= 0.0f && d5 <= d6) {
-        memcpy(q, c, sizeof q);
+        q = c;
     } else if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) {
-        float v = d1 / (d1 - d3);
-        for (int k = 0; k < 3; k++)
-            q[k] = a[k] + v * ab[k];
+        q = along(a, d1 / (d1 - d3), ab);
     } else if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) {
-        float w = d2 / (d2 - d6);
-        for (int k = 0; k < 3; k++)
-            q[k] = a[k] + w * ac[k];
+        q = along(a, d2 / (d2 - d6), ac);
     } else if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f) {
-        float w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        for (int k = 0; k < 3; k++)
-            q[k] = b[k] + w * (c[k] - b[k]);
+        q = along(b, (d4 - d3) / ((d4 - d3) + (d5 - d6)), sub3(c, b));
     } else {
         float denom = va + vb + vc;
         float v = vb / denom, w = vc / denom;
         if (!(denom > 0.0f)) /* degenerate: nearest corner */
             v = w = 0.0f;
-        for (int k = 0; k < 3; k++)
-            q[k] = a[k] + ab[k] * v + ac[k] * w;
+        q = (gdr_vec3){a.x + ab.x * v + ac.x * w, a.y + ab.y * v + ac.y * w, a.z + ab.z * v + ac.z * w};
     }
-    float dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
-    float d = dx * dx + dy * dy + dz * dz;
-    /* Any corner bounds the distance too: guards the degenerate cases above. */
-    float da = (p[0] - a[0]) * (p[0] - a[0]) + (p[1] - a[1]) * (p[1] - a[1]) + (p[2] - a[2]) * (p[2] - a[2]);
+    gdr_vec3 pq = sub3(p, q);
+    float d = dot3(pq, pq);
     return d < da ? d : da;
 }
 
@@ -95,7 +86,8 @@ static int reserve_cluster_samples(lod_build *b, size_t need)
     return 1;
 }
 
-/* Level-0 triangles around each position (by position id), as (cluster << 7 | triangle). */
+/* Level-0 triangles around each position (by position id), as cluster << 9 | triangle << 2 | the
+ * corner that is the position (a walk looks only at the other two). */
 static int build_adjacency(lod_build *b, uint32_t level0)
 {
     size_t corners = 0;
@@ -119,12 +111,19 @@ static int build_adjacency(lod_build *b, uint32_t level0)
         const uint8_t *t = gdr_lod_cluster_triangles(b, k);
         const uint32_t *v = gdr_lod_cluster_vertices(b, k);
         for (uint32_t i = 0; i < k->triangle_count * 3; i++)
-            b->adjacency[b->adjacency_start[b->position_id[v[t[i]]]]++] = c << 7 | (i / 3);
+            b->adjacency[b->adjacency_start[b->position_id[v[t[i]]]]++] = c << 9 | (i / 3) << 2 | (i % 3);
     }
     for (uint32_t p = b->position_count; p > 0; p--) /* start[p] now holds the end of p: shift back */
         b->adjacency_start[p] = b->adjacency_start[p - 1];
     b->adjacency_start[0] = 0;
     return 1;
+}
+
+/* An adjacency entry's cluster, and its triangle's first byte in the cluster's triangles. */
+static const gdr_cluster *ring_cluster(const lod_build *b, uint32_t entry) { return &b->clusters[entry >> 9]; }
+static const uint8_t *ring_triangle(const lod_build *b, const gdr_cluster *c, uint32_t entry)
+{
+    return gdr_lod_cluster_triangles(b, c) + (size_t)(entry >> 2 & 127) * 3;
 }
 
 /* Each position used by level 0 is owned by the first level-0 cluster that uses it. */
@@ -157,7 +156,7 @@ int gdr_lod_error_setup(lod_build *b)
 {
     uint32_t level0 = b->mesh->clusters.level0_cluster_count;
     b->sample_vertex = malloc(((size_t)b->position_count + 1) * sizeof *b->sample_vertex);
-    if (!b->sample_vertex || level0 >= (1u << 25))
+    if (!b->sample_vertex || level0 >= (1u << 23)) /* adjacency entries hold the cluster in 23 bits */
         return 0;
     return build_adjacency(b, level0) && assign_level0_samples(b, level0);
 }
@@ -334,58 +333,87 @@ static uint32_t ring_end(const lod_build *b, uint32_t position)
     return end - start > LOD_RING_LIMIT ? start + LOD_RING_LIMIT : end;
 }
 
-static float to_full_detail_d2(const lod_build *b, uint32_t position, gdr_vec3 p)
+static float ring_entry_d2(const lod_build *b, uint32_t entry, gdr_vec3 p)
 {
-    float best = INFINITY;
     const gdr_vec3 *x = b->mesh->positions;
-    for (uint32_t k = b->adjacency_start[position]; k < ring_end(b, position); k++) {
-        const gdr_cluster *c = &b->clusters[b->adjacency[k] >> 7];
-        const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(b->adjacency[k] & 127) * 3;
-        const uint32_t *v = gdr_lod_cluster_vertices(b, c);
-        float d = point_triangle_d2(p, x[v[t[0]]], x[v[t[1]]], x[v[t[2]]]);
+    const gdr_cluster *c = ring_cluster(b, entry);
+    const uint8_t *t = ring_triangle(b, c, entry);
+    const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+    return point_triangle_d2(p, x[v[t[0]]], x[v[t[1]]], x[v[t[2]]]);
+}
+
+/* Stops at the first triangle that brings the distance to at most `at_most` or below `below`
+ * (squared): the caller has no use for a smaller bound (probe_state). Adjacency entry `first` (of
+ * this position's, or UINT32_MAX), the triangle a walk ending here guessed nearest, is looked at
+ * first: the smallest distance is the same in any order. */
+static float to_full_detail_d2(const lod_build *b, uint32_t position, gdr_vec3 p, uint32_t first, float at_most,
+                               float below)
+{
+    float best = first == UINT32_MAX ? INFINITY : ring_entry_d2(b, b->adjacency[first], p);
+    for (uint32_t k = b->adjacency_start[position], end = ring_end(b, position);
+         k < end && !(best <= at_most) && !(best < below); k++) {
+        float d = k == first ? best : ring_entry_d2(b, b->adjacency[k], p);
         best = d < best ? d : best;
     }
     return best;
 }
 
-/* Squared distance between p and the position of position id `position`. */
-static float position_d2(const lod_build *b, uint32_t position, gdr_vec3 p)
+static float distance2(gdr_vec3 q, gdr_vec3 p)
 {
-    gdr_vec3 q = b->mesh->positions[b->sample_vertex[position]];
     float dx = q.x - p.x, dy = q.y - p.y, dz = q.z - p.z;
     return dx * dx + dy * dy + dz * dz;
 }
 
 /* Walks over level-0 positions from `start`, to a neighbour nearer to p while there is one: the
  * walk ends at a position nearest to p among its neighbours (on a surface, next to p's foot).
- * *stopped_short is set when the walk was cut off by the step limit while still moving. */
-static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p, int *stopped_short)
+ * *stopped_short is set when the walk was cut off by the step limit while still moving. A
+ * neighbour is compared by its mesh vertex (all vertices of a position have its coordinates); the
+ * position id is looked up only for the one the walk moves to. *nearest receives the adjacency
+ * entry of the end's triangle whose other two corners are nearest to p (summed), the likeliest
+ * to hold p's foot (UINT32_MAX when stopped short). */
+static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p, int *stopped_short, uint32_t *nearest)
 {
-    uint32_t at = start;
-    float best = position_d2(b, at, p);
+    const gdr_vec3 *x = b->mesh->positions;
+    uint32_t at = start, to = UINT32_MAX;
+    float best = distance2(x[b->sample_vertex[at]], p);
     *stopped_short = 0;
     /* At most LOD_WALK_LIMIT steps: on a strip or a fan's rim a walk would cross the whole mesh one
      * neighbour at a time. Where it stops short, the distance from there is only larger (a bound
      * still), and probe_d2 starts it again nearer to p. */
+    static const uint8_t other_corners[4][2] = {{1, 2}, {0, 2}, {0, 1}, {0, 1}}; /* in order, for ties */
     for (uint32_t steps = 0; steps < LOD_WALK_LIMIT; steps++) {
-        uint32_t from = at;
-        for (uint32_t k = b->adjacency_start[from]; k < ring_end(b, from); k++) {
-            const gdr_cluster *c = &b->clusters[b->adjacency[k] >> 7];
-            const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(b->adjacency[k] & 127) * 3;
+        float nearest_sum = INFINITY;
+        uint32_t nearest_entry = UINT32_MAX;
+        for (uint32_t k = b->adjacency_start[at], end = ring_end(b, at); k < end; k++) {
+            uint32_t entry = b->adjacency[k];
+            const gdr_cluster *c = ring_cluster(b, entry);
+            const uint8_t *t = ring_triangle(b, c, entry);
             const uint32_t *v = gdr_lod_cluster_vertices(b, c);
-            for (int j = 0; j < 3; j++) {
-                uint32_t q = b->position_id[v[t[j]]];
-                float d = position_d2(b, q, p);
+            const uint8_t *o = other_corners[entry & 3]; /* not the corner at `at`: no nearer than `best` */
+            const uint32_t other[2] = {v[t[o[0]]], v[t[o[1]]]};
+            float sum = 0.0f;
+            for (int j = 0; j < 2; j++) {
+                float d = distance2(x[other[j]], p);
+                sum += d;
                 if (d < best) { /* strictly nearer: the walk ends */
                     best = d;
-                    at = q;
+                    to = other[j];
                 }
             }
+            if (sum < nearest_sum) {
+                nearest_sum = sum;
+                nearest_entry = k;
+            }
         }
-        if (at == from)
+        if (to == UINT32_MAX) {
+            *nearest = nearest_entry;
             return at;
+        }
+        at = b->position_id[to];
+        to = UINT32_MAX;
     }
     *stopped_short = 1;
+    *nearest = UINT32_MAX;
     return at;
 }
 
@@ -407,7 +435,7 @@ static int build_region(const lod_build *b, lod_scratch *s)
     n = 0;
     for (uint32_t i = 0; i < s->gathered; i++)
         for (uint32_t k = b->adjacency_start[s->sample_ids[i]]; k < b->adjacency_start[s->sample_ids[i] + 1]; k++)
-            s->region_refs[n++] = b->adjacency[k];
+            s->region_refs[n++] = b->adjacency[k] >> 2; /* the triangle, whichever corner */
     qsort(s->region_refs, n, sizeof *s->region_refs, compare_u32);
     size_t unique = 0;
     for (size_t i = 0; i < n; i++)
@@ -419,8 +447,8 @@ static int build_region(const lod_build *b, lod_scratch *s)
     if (!LOD_RESERVE(s, region_corners, unique * 3 + 1))
         return 0;
     for (size_t i = 0; i < unique; i++) {
-        const gdr_cluster *c = &b->clusters[s->region_refs[i] >> 7];
-        const uint8_t *t = gdr_lod_cluster_triangles(b, c) + (size_t)(s->region_refs[i] & 127) * 3;
+        const gdr_cluster *c = ring_cluster(b, s->region_refs[i] << 2);
+        const uint8_t *t = ring_triangle(b, c, s->region_refs[i] << 2);
         const uint32_t *v = gdr_lod_cluster_vertices(b, c);
         for (int k = 0; k < 3; k++)
             s->region_corners[i * 3 + (size_t)k] = v[t[k]];
@@ -434,6 +462,7 @@ typedef struct probe_state {
     const lod_build *b;
     lod_scratch *s;
     float worst;  /* squared: the largest distance so far (at least the samples' largest) */
+    float at_most, below; /* squared: a probe bound at most / below these changes nothing (per probe) */
     int failed;   /* out of memory */
 } probe_state;
 
@@ -452,17 +481,33 @@ static uint32_t nearest_sample(lod_scratch *s, gdr_vec3 p)
     return s->sample_ids[lod_grid_nearest(&s->grid, p, &d2)];
 }
 
+/* Where the last walk of a triangle's probes ended: the position, and the adjacency entry of its
+ * triangle guessed nearest to the next probe (UINT32_MAX: none). */
+typedef struct walk_end {
+    uint32_t position, entry;
+} walk_end;
+
 /* Where a walk towards p ends: from *at, and again from the group's sample nearest to p where the
  * first walk's bound could raise the largest distance and was cut off by the step limit, or would
  * send p to the exact measure. On a coarse group a simplified triangle spans more level-0 edges
  * than the limit, and the bound from where a cut-off walk stops is several times the distance (on
  * the 1 M-triangle torus up to 13x); a walk can also end at a nearest position of one side of a
- * thin part while p is nearer the other. Returns the bound (squared) from where it ended. */
-static float walk_bound_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
+ * thin part while p is nearer the other. Returns the bound (squared) from where it ended.
+ *
+ * No walk is taken where the level-0 triangle the last walk guessed nearest to its probe already
+ * brings p's bound within what changes nothing (probe_state): most probes lie close to the last,
+ * and their bound matters only where it is large. *at then stays, and the next walk starts there
+ * (so later walks may end elsewhere than they would have: still a bound, not the same DAG). */
+static float walk_bound_d2(probe_state *ps, walk_end *at, gdr_vec3 p)
 {
+    if (at->entry != UINT32_MAX) {
+        float d = ring_entry_d2(ps->b, ps->b->adjacency[at->entry], p);
+        if (d <= ps->at_most || d < ps->below)
+            return d;
+    }
     int stopped_short;
-    *at = walk_towards(ps->b, *at, p, &stopped_short);
-    float d = to_full_detail_d2(ps->b, *at, p);
+    at->position = walk_towards(ps->b, at->position, p, &stopped_short, &at->entry);
+    float d = to_full_detail_d2(ps->b, at->position, p, at->entry, ps->at_most, ps->below);
     int suspect = (stopped_short && d > ps->worst) || d > 4.0f * ps->worst;
     if (!suspect || ps->s->gathered == 0)
         return d;
@@ -471,8 +516,9 @@ static float walk_bound_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
         ps->failed = 1;
         return d;
     }
-    uint32_t again = walk_towards(ps->b, start, p, &stopped_short);
-    float d_again = to_full_detail_d2(ps->b, again, p);
+    walk_end again;
+    again.position = walk_towards(ps->b, start, p, &stopped_short, &again.entry);
+    float d_again = to_full_detail_d2(ps->b, again.position, p, again.entry, ps->at_most, ps->below);
     if (d_again >= d)
         return d;
     *at = again;
@@ -485,7 +531,7 @@ static float walk_bound_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
  * the exact distance to the level-0 triangles around the group's samples is taken instead (the
  * walk can stop far away on meshes of long thin triangles). *at receives where the walk ended (the
  * next probe of the triangle starts there). */
-static float probe_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
+static float probe_d2(probe_state *ps, walk_end *at, gdr_vec3 p)
 {
     float d = walk_bound_d2(ps, at, p);
     if (d <= 4.0f * ps->worst || ps->failed) /* squared: up to twice the largest so far */
@@ -499,21 +545,50 @@ static float probe_d2(probe_state *ps, uint32_t *at, gdr_vec3 p)
     return exact < d ? exact : d;
 }
 
-/* The largest probe distance over the points of a barycentric grid of n steps on triangle v, corners
- * left out (they are level-0 vertices: distance 0); walks start at *at. */
-static float probe_triangle(probe_state *ps, uint32_t *at, const gdr_vec3 v[3], int n)
+/* A triangle's coarse probes decide whether it is refined: refined unless its largest is below this
+ * share of the largest coarse probe of the group (squared: 70%). */
+static float refine_share(float coarse_worst) { return 0.49f * coarse_worst; }
+
+/* Which edge of triangle v's barycentric grid point (i, j) of n steps lies on: edge k joins corners
+ * k and k + 1 (mod 3); 3 inside. */
+static int grid_edge(int i, int j, int n)
 {
-    float largest = 0.0f;
+    if (j == 0)
+        return 0;
+    if (i + j == n)
+        return 1;
+    return i == 0 ? 2 : 3;
+}
+
+/* The largest probe distance over the points of a barycentric grid of n steps on triangle v, corners
+ * left out (they are level-0 vertices: distance 0), and of each edge k's points into edge_d2[k];
+ * the points of an edge whose bit is set in `skip` are left out (a neighbour probed them). Walks
+ * start at *at. `largest` starts at `floor` (what the skipped edges gave). A probe's bound is the
+ * smallest over some level-0 triangles, and how small it is matters only while it could raise
+ * something: once a triangle brings it to at most `at_most` or below `below` the rest are skipped,
+ * which leaves every decision as if all were measured (docs/GEOMETRY.md, "The error"). Both are at
+ * most the largest so far, so the walks' checks against that come out the same; on the refining
+ * grid (`refine`) only the largest so far is used; on the coarse grid, also this triangle's largest
+ * and whether it stays below refine_share of the largest, which can only grow. */
+static float probe_triangle(probe_state *ps, walk_end *at, const gdr_vec3 v[3], int n, int refine, unsigned skip,
+                            float floor, float edge_d2[3])
+{
+    float largest = floor;
     for (int i = 0; i <= n; i++)
         for (int j = 0; i + j <= n; j++) {
-            if (i == n || j == n || i + j == 0)
+            int edge = grid_edge(i, j, n);
+            if (i == n || j == n || i + j == 0 || (edge < 3 && (skip >> edge & 1)))
                 continue;
             float u = (float)i / (float)n, w = (float)j / (float)n, z = 1.0f - u - w;
             gdr_vec3 p = {z * v[0].x + u * v[1].x + w * v[2].x, z * v[0].y + u * v[1].y + w * v[2].y,
                           z * v[0].z + u * v[1].z + w * v[2].z};
+            ps->at_most = refine ? ps->worst : largest;
+            ps->below = refine ? 0.0f : refine_share(ps->worst);
             float d = probe_d2(ps, at, p);
             largest = d > largest ? d : largest;
             ps->worst = d > ps->worst ? d : ps->worst;
+            if (edge < 3)
+                edge_d2[edge] = d > edge_d2[edge] ? d : edge_d2[edge];
         }
     return largest;
 }
@@ -524,34 +599,64 @@ static void triangle_corners(const lod_scratch *s, uint32_t t, gdr_vec3 v[3])
         v[k] = load3(s->positions + (size_t)s->out_corners[(size_t)t * 3 + k] * 3);
 }
 
+/* The edge (3u + j: corners j and j + 1 of triangle u) of a triangle u before t that joins the same
+ * two group vertices as t's edge k; UINT32_MAX when none. */
+static uint32_t earlier_edge(const lod_scratch *s, uint32_t t, int k)
+{
+    uint32_t a = s->out_corners[(size_t)t * 3 + k], b = s->out_corners[(size_t)t * 3 + (k + 1) % 3];
+    for (uint32_t i = s->ring_start[a]; i < s->ring_start[a + 1] && s->ring[i] < t; i++) {
+        const uint32_t *u = s->out_corners + (size_t)s->ring[i] * 3;
+        for (int j = 0; j < 3; j++)
+            if ((u[j] == a && u[(j + 1) % 3] == b) || (u[j] == b && u[(j + 1) % 3] == a))
+                return s->ring[i] * 3 + (uint32_t)j;
+    }
+    return UINT32_MAX;
+}
+
+/* Probes triangle t on a grid of n steps, leaving out the edges an earlier triangle probed on the
+ * same grid (edge_d2 >= 0: the coarse grid, whose largest counts towards t's; refined: -1 once
+ * probed); records its own edges'. Returns its largest (coarse). */
+static float probe_shared(probe_state *ps, lod_scratch *s, uint32_t t, int n, int refine)
+{
+    unsigned skip = 0;
+    float floor = 0.0f, edge_d2[3] = {0.0f, 0.0f, 0.0f};
+    for (int k = 0; k < 3; k++) {
+        uint32_t e = earlier_edge(s, t, k);
+        if (e == UINT32_MAX || (refine ? s->edge_d2[e] >= 0.0f : s->edge_d2[e] < 0.0f))
+            continue;
+        skip |= 1u << k;
+        floor = s->edge_d2[e] > floor ? s->edge_d2[e] : floor;
+    }
+    gdr_vec3 v[3];
+    triangle_corners(s, t, v);
+    walk_end at = {ps->b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]], UINT32_MAX};
+    float largest = probe_triangle(ps, &at, v, n, refine, skip, refine ? 0.0f : floor, edge_d2);
+    for (int k = 0; k < 3; k++)
+        s->edge_d2[(size_t)t * 3 + k] = refine ? -1.0f : edge_d2[k];
+    return largest;
+}
+
 /* Largest distance from the simplified triangles to S0, or `floor` when that is larger (the
  * samples' largest distance: probes below it cannot change the group's deviation). Every triangle
  * is probed on a barycentric grid of 3 steps an edge (6 points on the edges, the centroid); those
  * whose probes come within 70% of the largest then, on a grid of 8 steps (the deviation of a
- * simplified triangle peaks inside it or on an edge, between the coarse points). Returns -1 when
- * out of memory. */
+ * simplified triangle peaks inside it or on an edge, between the coarse points). An edge two
+ * triangles share is probed once on each grid (by the first; the second counts its probes as its
+ * own). Returns -1 when out of memory. */
 static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor)
 {
-    probe_state ps = {b, s, floor * floor, 0};
+    probe_state ps = {b, s, floor * floor, 0.0f, 0.0f, 0};
     s->region_built = 0;
     s->grid_holds_samples = 0;
-    if (!LOD_RESERVE(s, coarse_d2, (size_t)s->out_triangle_count + 1))
+    if (!LOD_RESERVE(s, coarse_d2, (size_t)s->out_triangle_count + 1) ||
+        !LOD_RESERVE(s, edge_d2, (size_t)s->out_triangle_count * 3 + 1))
         return -1.0f;
-    for (uint32_t t = 0; t < s->out_triangle_count; t++) {
-        gdr_vec3 v[3];
-        triangle_corners(s, t, v);
-        uint32_t at = b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]];
-        s->coarse_d2[t] = probe_triangle(&ps, &at, v, 3);
-    }
+    for (uint32_t t = 0; t < s->out_triangle_count; t++)
+        s->coarse_d2[t] = probe_shared(&ps, s, t, 3, 0);
     float coarse_worst = ps.worst;
-    for (uint32_t t = 0; t < s->out_triangle_count; t++) {
-        if (s->coarse_d2[t] < 0.49f * coarse_worst) /* squared: below 70% */
-            continue;
-        gdr_vec3 v[3];
-        triangle_corners(s, t, v);
-        uint32_t at = b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]];
-        probe_triangle(&ps, &at, v, 8);
-    }
+    for (uint32_t t = 0; t < s->out_triangle_count; t++)
+        if (!(s->coarse_d2[t] < refine_share(coarse_worst)))
+            probe_shared(&ps, s, t, 8, 1);
     return ps.failed ? -1.0f : sqrtf(ps.worst);
 }
 

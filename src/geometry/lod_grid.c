@@ -70,6 +70,12 @@ static void choose_cells(lod_grid *g, const float hi[3], uint32_t n, double spac
     g->inv_cell = 1.0f / cell;
 }
 
+static uint32_t point_cell(const lod_grid *g, gdr_vec3 p)
+{
+    return (cell_coordinate(g, p.z, 2) * g->dim[1] + cell_coordinate(g, p.y, 1)) * g->dim[0] +
+           cell_coordinate(g, p.x, 0);
+}
+
 int lod_grid_build(lod_grid *g, const gdr_vec3 *points, uint32_t n, double cells_per_point)
 {
     g->points = points;
@@ -85,21 +91,17 @@ int lod_grid_build(lod_grid *g, const gdr_vec3 *points, uint32_t n, double cells
     }
     choose_cells(g, hi, n, 0.0, cells_per_point * n + 64.0);
     size_t cells = (size_t)g->dim[0] * g->dim[1] * g->dim[2];
-    if (!grid_reserve(&g->start, &g->start_cap, cells + 1) || !grid_reserve(&g->items, &g->items_cap, n) ||
-        !grid_reserve(&g->cell_of, &g->cell_of_cap, n))
+    if (!grid_reserve(&g->start, &g->start_cap, cells + 1) || !grid_reserve(&g->items, &g->items_cap, n))
         return 0;
     memset(g->start, 0, (cells + 1) * sizeof *g->start);
-    for (uint32_t i = 0; i < n; i++) {
-        const float *p = &points[i].x;
-        uint32_t c = (cell_coordinate(g, p[2], 2) * g->dim[1] + cell_coordinate(g, p[1], 1)) * g->dim[0] +
-                     cell_coordinate(g, p[0], 0);
-        g->cell_of[i] = c;
-        g->start[c + 1]++;
-    }
+    /* Each point's cell is found twice (to count, then to store) rather than kept: 4 bytes a point
+     * less, and a group near the DAG's root indexes most of the mesh's positions. */
+    for (uint32_t i = 0; i < n; i++)
+        g->start[point_cell(g, points[i]) + 1]++;
     for (size_t c = 0; c < cells; c++)
         g->start[c + 1] += g->start[c];
     for (uint32_t i = 0; i < n; i++)
-        g->items[g->start[g->cell_of[i]]++] = i;
+        g->items[g->start[point_cell(g, points[i])]++] = i;
     for (size_t c = cells; c > 0; c--) /* start[c] now holds the end of cell c: shift back */
         g->start[c] = g->start[c - 1];
     g->start[0] = 0;
@@ -109,16 +111,20 @@ int lod_grid_build(lod_grid *g, const gdr_vec3 *points, uint32_t n, double cells
 static void visit_cell(const lod_grid *g, uint32_t x, uint32_t y, uint32_t z, const float q[3], uint32_t *best,
                        float *best_d2)
 {
-    uint32_t c = (z * g->dim[1] + y) * g->dim[0] + x;
-    for (uint32_t i = g->start[c]; i < g->start[c + 1]; i++) {
-        const gdr_vec3 p = g->points[g->items[i]];
+    uint32_t c = (z * g->dim[1] + y) * g->dim[0] + x, found = *best;
+    float found_d2 = *best_d2; /* in locals: through the pointers, every store would be reloaded */
+    for (uint32_t i = g->start[c], end = g->start[c + 1]; i < end; i++) {
+        uint32_t item = g->items[i];
+        const gdr_vec3 p = g->points[item];
         float dx = p.x - q[0], dy = p.y - q[1], dz = p.z - q[2];
         float d2 = dx * dx + dy * dy + dz * dz;
-        if (d2 < *best_d2 || (d2 == *best_d2 && g->items[i] < *best)) {
-            *best_d2 = d2;
-            *best = g->items[i];
+        if (d2 < found_d2 || (d2 == found_d2 && item < found)) {
+            found_d2 = d2;
+            found = item;
         }
     }
+    *best = found;
+    *best_d2 = found_d2;
 }
 
 /* Distance from q to the nearest cell the search has not reached once every cell within Chebyshev
@@ -129,10 +135,15 @@ static float unsearched_reach(const float lo[3], float cell, const uint32_t dim[
 {
     float reach = INFINITY;
     for (int k = 0; k < 3; k++) {
-        if (at[k] - r > 0)
-            reach = fminf(reach, q[k] - (lo[k] + (float)(at[k] - r) * cell));
-        if (at[k] + r + 1 < (int32_t)dim[k])
-            reach = fminf(reach, lo[k] + (float)(at[k] + r + 1) * cell - q[k]);
+        /* (not fminf: a library call at -O3; the same result, NaN included) */
+        if (at[k] - r > 0) {
+            float d = q[k] - (lo[k] + (float)(at[k] - r) * cell);
+            reach = d < reach ? d : reach;
+        }
+        if (at[k] + r + 1 < (int32_t)dim[k]) {
+            float d = lo[k] + (float)(at[k] + r + 1) * cell - q[k];
+            reach = d < reach ? d : reach;
+        }
     }
     return reach > 0.0f ? reach : 0.0f; /* rounding may put q just outside its cell */
 }
@@ -146,6 +157,48 @@ static int search_done(const float lo[3], float cell, const uint32_t dim[3], con
     return reach == INFINITY || reach * reach >= best_d2;
 }
 
+/* The cells along axis k within `reach` of q[k], clamped to [at - r, at + r]: a point farther than
+ * reach from q along one axis is farther than reach from q. `reach` is widened a little so that
+ * a point at exactly the best distance so far (a tie, which the lowest index wins) is never left
+ * out by rounding. */
+static void reach_range(const lod_grid *g, const float q[3], float reach, int k, int32_t at, int32_t r,
+                        int32_t *lo, int32_t *hi)
+{
+    *lo = at - r;
+    *hi = at + r;
+    if (reach == INFINITY)
+        return;
+    float margin = reach * 1.001f + 1e-18f;
+    int32_t a = (int32_t)cell_coordinate(g, q[k] - margin, k), b = (int32_t)cell_coordinate(g, q[k] + margin, k);
+    *lo = a > *lo ? a : *lo;
+    *hi = b < *hi ? b : *hi;
+}
+
+/* Searches the cells at Chebyshev distance r from `at` (its shell) that lie within the best
+ * distance so far of q along every axis; the others hold nothing nearer. */
+static void visit_shell(const lod_grid *g, const int32_t at[3], int32_t r, const float q[3], uint32_t *best,
+                        float *best_d2)
+{
+    int32_t lo[3], hi[3];
+    float reach = sqrtf(*best_d2);
+    for (int k = 0; k < 3; k++) {
+        reach_range(g, q, reach, k, at[k], r, &lo[k], &hi[k]);
+        lo[k] = lo[k] > 0 ? lo[k] : 0;
+        hi[k] = hi[k] < (int32_t)g->dim[k] - 1 ? hi[k] : (int32_t)g->dim[k] - 1;
+    }
+    for (int32_t z = lo[2]; z <= hi[2]; z++)
+        for (int32_t y = lo[1]; y <= hi[1]; y++) {
+            int shell = z == at[2] - r || z == at[2] + r || y == at[1] - r || y == at[1] + r;
+            for (int32_t x = lo[0]; x <= hi[0]; x++) {
+                if (!shell && x != at[0] - r && x != at[0] + r) {
+                    x = at[0] + r - 1; /* inside the shell: jump to its far face */
+                    continue;
+                }
+                visit_cell(g, (uint32_t)x, (uint32_t)y, (uint32_t)z, q, best, best_d2);
+            }
+        }
+}
+
 uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squared)
 {
     const float q[3] = {point.x, point.y, point.z};
@@ -155,21 +208,7 @@ uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squ
     uint32_t best = UINT32_MAX;
     float best_d2 = INFINITY;
     for (int32_t r = 0;; r++) {
-        for (int32_t z = at[2] - r; z <= at[2] + r; z++) {
-            if (z < 0 || z >= (int32_t)g->dim[2])
-                continue;
-            for (int32_t y = at[1] - r; y <= at[1] + r; y++) {
-                if (y < 0 || y >= (int32_t)g->dim[1])
-                    continue;
-                int shell = z == at[2] - r || z == at[2] + r || y == at[1] - r || y == at[1] + r;
-                for (int32_t x = at[0] - r; x <= at[0] + r; x += shell ? 1 : 2 * r) {
-                    if (x >= 0 && x < (int32_t)g->dim[0])
-                        visit_cell(g, (uint32_t)x, (uint32_t)y, (uint32_t)z, q, &best, &best_d2);
-                    if (r == 0)
-                        break;
-                }
-            }
-        }
+        visit_shell(g, at, r, q, &best, &best_d2);
         if (search_done(g->lo, g->cell, g->dim, at, r, q, best_d2))
             break;
     }
@@ -181,7 +220,6 @@ void lod_grid_free(lod_grid *g)
 {
     free(g->start);
     free(g->items);
-    free(g->cell_of);
     memset(g, 0, sizeof *g);
 }
 

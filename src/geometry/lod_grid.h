@@ -14,8 +14,8 @@ typedef struct lod_grid {
     float lo[3];
     float cell, inv_cell;
     uint32_t dim[3];
-    uint32_t *start, *items, *cell_of; /* cell c holds items[start[c] .. start[c + 1]) */
-    size_t start_cap, items_cap, cell_of_cap;
+    uint32_t *start, *items; /* cell c holds items[start[c] .. start[c + 1]) */
+    size_t start_cap, items_cap;
 } lod_grid;
 
 /* Indexes points[0 .. n), n > 0 (kept by pointer until the next build), in at most

@@ -77,6 +77,8 @@ typedef struct lod_scratch {
     int grid_holds_samples; /* `grid` was rebuilt over sample_points (lod_error.c, nearest_sample) */
     float *coarse_d2; /* per simplified triangle: its largest coarse probe distance, squared */
     size_t coarse_d2_cap;
+    float *edge_d2; /* per simplified triangle edge: its largest coarse probe (squared), -1 once refined */
+    size_t edge_d2_cap;
     uint8_t edge_count[64 * 64];
 } lod_scratch;
 

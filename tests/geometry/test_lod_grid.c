@@ -1,5 +1,6 @@
 /* The LOD builder's nearest-triangle grid (src/geometry/lod_grid.h): its answer must be the exact
- * nearest distance on sound meshes, checked against brute force. The builder's error bound is only
+ * nearest distance on sound meshes, checked against brute force; its nearest-point grid's answer,
+ * the exact nearest point (the lowest index on ties). The builder's error bound is only
  * as tight as these queries: a query that misses the nearest triangle overstates a group's error. */
 #include <math.h>
 #include <stdint.h>
@@ -232,8 +233,81 @@ static void test_fan_bounded(void)
     free(s.corners);
 }
 
+/* The point nearest to p by brute force, the lowest index on ties, computed as the grid does. */
+static uint32_t brute_force_point(const gdr_vec3 *points, uint32_t n, gdr_vec3 p, float *best_d2)
+{
+    uint32_t best = UINT32_MAX;
+    *best_d2 = INFINITY;
+    for (uint32_t i = 0; i < n; i++) {
+        float dx = points[i].x - p.x, dy = points[i].y - p.y, dz = points[i].z - p.z;
+        float d2 = dx * dx + dy * dy + dz * dz;
+        if (d2 < *best_d2) {
+            *best_d2 = d2;
+            best = i;
+        }
+    }
+    return best;
+}
+
+/* Points on a bumpy sphere (a surface, as the builder's are), each written twice so that every
+ * query near one meets a tie, and queries near the surface, far off it and on the points: the
+ * grid's answer is brute force's, index and distance. Its search looks only at cells within the
+ * best distance so far along every axis, so it is checked where a tie sits on a cell's face too
+ * (points on a lattice of the cell size). */
+static void test_points_exact(void)
+{
+    const uint32_t n = 6000;
+    gdr_vec3 *points = malloc((size_t)n * sizeof *points);
+    CHECK(points != NULL);
+    if (!points)
+        return;
+    unsigned state = 7;
+    for (uint32_t i = 0; i < n; i += 2) {
+        float u = test_random_range(&state, 0.0f, 6.2831853f), v = test_random_range(&state, -1.0f, 1.0f);
+        float r = 1.0f + 0.05f * sinf(7.0f * u), h = sqrtf(1.0f - v * v);
+        points[i] = points[i + 1] = (gdr_vec3){r * h * cosf(u), r * h * sinf(u), r * v};
+    }
+    for (int pass = 0; pass < 2; pass++) {
+        lod_grid g = {0};
+        CHECK(lod_grid_build(&g, points, n, pass == 0 ? 4.0 : 1.0));
+        for (int i = 0; i < 3000; i++) {
+            float scale = i % 3 == 0 ? 1.02f : i % 3 == 1 ? 1.6f : 1.0f;
+            gdr_vec3 p = i % 3 == 2 ? points[(uint32_t)i % n]
+                                    : (gdr_vec3){scale * test_random_range(&state, -1.0f, 1.0f),
+                                                 scale * test_random_range(&state, -1.0f, 1.0f),
+                                                 scale * test_random_range(&state, -1.0f, 1.0f)};
+            float d2, want_d2;
+            uint32_t got = lod_grid_nearest(&g, p, &d2), want = brute_force_point(points, n, p, &want_d2);
+            CHECK(got == want);
+            CHECK(d2 == want_d2);
+        }
+        lod_grid_free(&g);
+    }
+    /* A lattice: points on the cells' corners, queries midway between two (exact ties). */
+    uint32_t m = 0;
+    for (int x = 0; x < 10; x++)
+        for (int y = 0; y < 10; y++)
+            for (int z = 0; z < 10 && m < n; z++)
+                points[m++] = (gdr_vec3){0.25f * (float)x, 0.25f * (float)y, 0.25f * (float)z};
+    lod_grid g = {0};
+    CHECK(lod_grid_build(&g, points, m, 1.0));
+    for (int i = 0; i < 2000; i++) {
+        gdr_vec3 p = points[(uint32_t)i % m];
+        int axis = i % 3;
+        float *c = axis == 0 ? &p.x : axis == 1 ? &p.y : &p.z;
+        *c += 0.125f * (float)(i % 2 ? 1 : -1);
+        float d2, want_d2;
+        uint32_t got = lod_grid_nearest(&g, p, &d2), want = brute_force_point(points, m, p, &want_d2);
+        CHECK(got == want);
+        CHECK(d2 == want_d2);
+    }
+    lod_grid_free(&g);
+    free(points);
+}
+
 int main(void)
 {
+    test_points_exact();
     test_needles_exact();
     test_band_exact();
     test_fan_bounded();
