@@ -210,9 +210,7 @@ static build_figures build_gdr(gdr_mesh *mesh, int repeat)
             gdr_mesh_clusters_free(&mesh->clusters);
             long long before = heap_peak_reset();
             double level0, t = build_once(mesh, threads, &level0, &f.stats);
-            /* The first build only: a rebuild starts from a mesh that already holds the last
-             * build's DAG, whose arrays it reuses, so its peak above that start is smaller. */
-            if (threads == 1 && k == 0)
+            if (threads == 1)
                 f.peak_heap = (double)(heap_peak() - before);
             if (t < f.seconds[threads]) {
                 f.seconds[threads] = t;
