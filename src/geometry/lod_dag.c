@@ -5,7 +5,9 @@
  *
  * Determinism: the groups of one step are simplified in parallel, each task writing only its own
  * result; results are appended in group order by the calling thread, and METIS runs with a fixed
- * seed on the calling thread. The bytes produced do not depend on the thread count. */
+ * seed on the calling thread. A step's only group measures its samples in parallel ranges whose
+ * results are then taken in sample order, as one thread would. The bytes produced do not depend on
+ * the thread count. */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -224,7 +226,13 @@ static gdr_status lod_step(lod_build *b, uint32_t depth, uint32_t *next, uint32_
     b->members = members;
     b->member_start = start;
     mark_shared(b, groups, 0);
-    gdr_thread_pool_run(b->pool, groups, gdr_lod_simplify_group_task, b);
+    /* A lone group runs on this thread, outside any job, so that it may hand its samples to the
+     * pool (lod_error.c, samples_to_simplified). */
+    b->lone_group = groups == 1;
+    if (b->lone_group)
+        gdr_lod_simplify_group_task(b, 0, 0);
+    else
+        gdr_thread_pool_run(b->pool, groups, gdr_lod_simplify_group_task, b);
     mark_shared(b, groups, 1);
     for (uint32_t g = 0; g < groups; g++) {
         if (b->results[g].out_of_memory)

@@ -269,4 +269,6 @@ void gdr_lod_scratch_free(lod_scratch *s)
     free(s->region_refs);
     free(s->region_corners);
     free(s->coarse_d2);
+    free(s->ring_d2);
+    free(s->exact_d2);
 }

@@ -77,6 +77,8 @@ typedef struct lod_scratch {
     int grid_holds_samples; /* `grid` was rebuilt over sample_points (lod_error.c, nearest_sample) */
     float *coarse_d2; /* per simplified triangle: its largest coarse probe distance, squared */
     size_t coarse_d2_cap;
+    float *ring_d2, *exact_d2; /* per sample, when one group's samples are measured in ranges */
+    size_t ring_d2_cap, exact_d2_cap;
     uint8_t edge_count[64 * 64];
 } lod_scratch;
 
@@ -138,6 +140,7 @@ typedef struct lod_build {
     const uint32_t *members;      /* frontier cluster ids ordered by group */
     const uint32_t *member_start; /* group g: members[member_start[g] .. member_start[g + 1]) */
     group_result *results;
+    int lone_group; /* the step has one group: its task runs on the calling thread, outside a job */
     const uint32_t *frontier;
     uint32_t frontier_count;
     key_record *edge_records;      /* boundary edges of frontier clusters, per chunk */
