@@ -70,27 +70,34 @@ static int push_cluster(lod_build *b, gdr_cluster c)
     return 1;
 }
 
-/* Appends a formed group's clusters, made from group `group`. */
-static int append_result(lod_build *b, const group_result *r, uint32_t result, uint32_t group, uint32_t *frontier,
-                         uint32_t *frontier_count)
+/* Appends a formed group's clusters, made from group `group`, to the build (from
+ * r->first_cluster on) and frees r's copy of them. */
+static int append_result(lod_build *b, group_result *r, uint32_t group, uint32_t *frontier, uint32_t *frontier_count)
 {
     if (!gdr_lod_reserve(&b->vertices, &b->vertex_cap, b->vertex_count + r->vertex_count, sizeof *b->vertices) ||
         !gdr_lod_reserve(&b->triangles, &b->triangle_cap, b->triangle_bytes + r->triangle_bytes, 1) ||
         b->vertex_count + r->vertex_count > UINT32_MAX || b->triangle_bytes + r->triangle_bytes > UINT32_MAX)
         return 0;
+    r->first_cluster = (uint32_t)b->cluster_count;
     for (uint32_t i = 0; i < r->cluster_count; i++) {
         gdr_cluster c = r->clusters[i];
         c.vertex_offset += (uint32_t)b->vertex_count;
         c.triangle_offset += (uint32_t)b->triangle_bytes;
         c.refined_group = group;
         frontier[(*frontier_count)++] = (uint32_t)b->cluster_count;
-        if (!gdr_lod_error_adopt(b, (uint32_t)b->cluster_count, result, r, i) || !push_cluster(b, c))
+        if (!push_cluster(b, c))
             return 0;
     }
     memcpy(b->vertices + b->vertex_count, r->vertices, (size_t)r->vertex_count * sizeof *b->vertices);
     memcpy(b->triangles + b->triangle_bytes, r->triangles, r->triangle_bytes);
     b->vertex_count += r->vertex_count;
     b->triangle_bytes += r->triangle_bytes;
+    free(r->clusters);
+    free(r->vertices);
+    free(r->triangles);
+    r->clusters = NULL;
+    r->vertices = NULL;
+    r->triangles = NULL;
     return 1;
 }
 
@@ -148,12 +155,34 @@ static uint32_t group_members(const lod_build *b, int32_t *part, uint32_t parts,
     return groups;
 }
 
-/* Marks in b->owner the positions that more than one group of the step uses (clear: resets them). */
-static void mark_shared(lod_build *b, uint32_t groups, int clear)
+/* One step's groups, from their partition until their errors are set. */
+typedef struct lod_stage {
+    uint32_t depth;
+    uint32_t parts, groups;
+    uint32_t *members, *start; /* group g: members[start[g] .. start[g + 1]) */
+    group_result *results;     /* parts entries */
+    uint32_t *measured;        /* the groups that formed, in order: their deviation is measured */
+    uint32_t measured_count;
+} lod_stage;
+
+static void stage_free(lod_stage *st)
 {
-    for (uint32_t g = 0; g < groups; g++)
-        for (uint32_t i = b->member_start[g]; i < b->member_start[g + 1]; i++) {
-            const gdr_cluster *c = &b->clusters[b->members[i]];
+    if (st->results)
+        for (uint32_t g = 0; g < st->parts; g++)
+            gdr_lod_result_free(&st->results[g]);
+    free(st->results);
+    free(st->members);
+    free(st->start);
+    free(st->measured);
+    memset(st, 0, sizeof *st);
+}
+
+/* Marks in b->owner the positions that more than one group of the step uses (clear: resets them). */
+static void mark_shared(lod_build *b, const lod_stage *st, int clear)
+{
+    for (uint32_t g = 0; g < st->groups; g++)
+        for (uint32_t i = st->start[g]; i < st->start[g + 1]; i++) {
+            const gdr_cluster *c = &b->clusters[st->members[i]];
             const uint32_t *v = gdr_lod_cluster_vertices(b, c);
             for (uint32_t j = 0; j < c->vertex_count; j++) {
                 uint32_t *o = &b->owner[b->position_id[v[j]]];
@@ -162,39 +191,107 @@ static void mark_shared(lod_build *b, uint32_t groups, int clear)
         }
 }
 
-/* Forms the groups that simplified (and, at step 0, the others as pass-through groups), in group
- * order; next receives the next frontier. Returns 0 when out of memory. */
-static int take_results(lod_build *b, uint32_t depth, uint32_t groups, uint32_t *next, uint32_t *next_count)
+/* Partitions the frontier into the step's groups. */
+static gdr_status begin_step(lod_build *b, uint32_t depth, lod_stage *st, gdr_error *err)
+{
+    uint32_t n = b->frontier_count;
+    int32_t *part = malloc((size_t)n * sizeof *part);
+    st->depth = depth;
+    st->members = malloc((size_t)n * sizeof *st->members);
+    gdr_status status = GDR_OK;
+    if (!part || !st->members)
+        goto oom;
+    status = gdr_lod_partition(b, part, &st->parts, err);
+    if (status != GDR_OK)
+        goto done;
+    st->start = malloc(((size_t)st->parts + 1) * sizeof *st->start);
+    st->results = calloc(st->parts, sizeof *st->results);
+    st->measured = malloc((size_t)st->parts * sizeof *st->measured);
+    if (!st->start || !st->results || !st->measured)
+        goto oom;
+    st->groups = group_members(b, part, st->parts, st->members, st->start);
+    goto done;
+oom:
+    status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for the LOD DAG", b->mesh->name);
+done:
+    free(part);
+    return status;
+}
+
+static void step_task(void *user, uint32_t i, uint32_t worker)
+{
+    lod_build *b = user;
+    if (i < b->measured_count)
+        gdr_lod_measure_group_task(b, i, worker);
+    else
+        gdr_lod_simplify_group_task(b, i - b->measured_count, worker);
+}
+
+/* One job on the pool: the deviation of the groups `measured` formed (NULL: none) and the
+ * simplification of the groups of `simplified` (NULL: none), which depends only on the geometry
+ * `measured` made. A lone measured group runs on this thread after the others, outside any job,
+ * so that it may hand its samples to the pool (lod_error.c, samples_to_simplified). */
+static void run_job(lod_build *b, const lod_stage *measured, lod_stage *simplified)
+{
+    uint32_t groups = simplified ? simplified->groups : 0;
+    b->members = simplified ? simplified->members : NULL;
+    b->member_start = simplified ? simplified->start : NULL;
+    b->results = simplified ? simplified->results : NULL;
+    b->measured = measured ? measured->measured : NULL;
+    b->measured_count = measured ? measured->measured_count : 0;
+    b->measured_members = measured ? measured->members : NULL;
+    b->measured_member_start = measured ? measured->start : NULL;
+    b->measured_results = measured ? measured->results : NULL;
+    b->lone_group = b->measured_count == 1;
+    if (simplified)
+        mark_shared(b, simplified, 0);
+    if (b->lone_group) {
+        b->measured_count = 0;
+        gdr_thread_pool_run(b->pool, groups, step_task, b);
+        gdr_lod_measure_group_task(b, 0, 0);
+    } else {
+        gdr_thread_pool_run(b->pool, b->measured_count + groups, step_task, b);
+    }
+    if (simplified)
+        mark_shared(b, simplified, 1);
+    b->lone_group = 0;
+}
+
+/* Takes in the groups of the step that simplified (and, at step 0, the others as pass-through
+ * groups), in group order: their records (sphere and error set later by finish_errors) and their
+ * new clusters; next receives the next frontier. Returns 0 when out of memory. */
+static int take_geometry(lod_build *b, lod_stage *st, uint32_t *next, uint32_t *next_count)
 {
     *next_count = 0;
-    for (uint32_t g = 0; g < groups; g++) {
-        const group_result *r = &b->results[g];
-        uint32_t first = b->member_start[g], end = b->member_start[g + 1];
-        if (!r->formed && depth > 0) {
+    for (uint32_t g = 0; g < st->groups; g++) {
+        group_result *r = &st->results[g];
+        uint32_t first = st->start[g], end = st->start[g + 1];
+        if (!r->formed && st->depth > 0) {
             /* Regrouped at the next step with other neighbours. */
             for (uint32_t i = first; i < end; i++)
-                next[(*next_count)++] = b->members[i];
+                next[(*next_count)++] = st->members[i];
             continue;
         }
-        uint32_t id = (uint32_t)b->group_count;
-        float error = r->error > b->min_error ? r->error : b->min_error;
-        if (!push_group(b, (gdr_cluster_group){.sphere = r->sphere, .error = error, .depth = depth}))
+        r->group = (uint32_t)b->group_count;
+        if (!push_group(b, (gdr_cluster_group){.depth = st->depth}))
             return 0;
         for (uint32_t i = first; i < end; i++)
-            b->clusters[b->members[i]].group = id;
+            b->clusters[st->members[i]].group = r->group;
         if (r->formed) {
-            if (!append_result(b, r, g, id, next, next_count))
+            st->measured[st->measured_count++] = g;
+            if (!append_result(b, r, r->group, next, next_count))
                 return 0;
             continue;
         }
         /* Step 0: the members pass through unchanged, sharing their data, so that level-0
          * clusters only ever belong to step-0 groups (and stay contiguous). */
+        r->first_cluster = (uint32_t)b->cluster_count;
         for (uint32_t i = first; i < end; i++) {
-            gdr_cluster c = b->clusters[b->members[i]];
+            gdr_cluster c = b->clusters[st->members[i]];
             c.group = GDR_NO_INDEX;
-            c.refined_group = id;
+            c.refined_group = r->group;
             next[(*next_count)++] = (uint32_t)b->cluster_count;
-            if (!gdr_lod_error_inherit(b, (uint32_t)b->cluster_count, b->members[i]) || !push_cluster(b, c))
+            if (!push_cluster(b, c))
                 return 0;
         }
         b->stats.passthrough_clusters += end - first;
@@ -202,60 +299,43 @@ static int take_results(lod_build *b, uint32_t depth, uint32_t groups, uint32_t 
     return 1;
 }
 
-/* One step over the frontier: partition, simplify the groups, form those that simplified. Sets
- * *progress when at least one group was formed; next receives the next frontier. */
-static gdr_status lod_step(lod_build *b, uint32_t depth, uint32_t *next, uint32_t *next_count, int *progress,
-                           gdr_error *err)
+/* The step's errors, once every deviation of its groups is measured: each group's sphere and error
+ * (its deviation, or the largest error of the groups its members came from where that is larger),
+ * its new clusters' samples, and the samples of `frontier` (the one the step made) packed into one
+ * array. Returns 0 when out of memory. */
+static int finish_errors(lod_build *b, const lod_stage *st, const uint32_t *frontier, uint32_t frontier_count)
 {
-    uint32_t n = b->frontier_count, parts = 0, groups = 0;
-    int32_t *part = malloc((size_t)n * sizeof *part);
-    uint32_t *members = malloc((size_t)n * sizeof *members);
-    uint32_t *start = NULL;
-    gdr_status status = GDR_OK;
-    *progress = 0;
-    if (!part || !members)
-        goto oom;
-    status = gdr_lod_partition(b, part, &parts, err);
-    if (status != GDR_OK)
-        goto done;
-    start = malloc(((size_t)parts + 1) * sizeof *start);
-    b->results = calloc(parts, sizeof *b->results);
-    if (!start || !b->results)
-        goto oom;
-    groups = group_members(b, part, parts, members, start);
-    b->members = members;
-    b->member_start = start;
-    mark_shared(b, groups, 0);
-    /* A lone group runs on this thread, outside any job, so that it may hand its samples to the
-     * pool (lod_error.c, samples_to_simplified). */
-    b->lone_group = groups == 1;
-    if (b->lone_group)
-        gdr_lod_simplify_group_task(b, 0, 0);
-    else
-        gdr_thread_pool_run(b->pool, groups, gdr_lod_simplify_group_task, b);
-    mark_shared(b, groups, 1);
-    for (uint32_t g = 0; g < groups; g++) {
-        if (b->results[g].out_of_memory)
-            goto oom;
-        *progress |= b->results[g].formed;
-        b->stats.stuck_groups += !b->results[g].formed;
-        b->stats.border_rejects += (uint64_t)b->results[g].border_reject;
+    lod_scratch *s = &b->scratch[0];
+    for (uint32_t g = 0; g < st->groups; g++) {
+        group_result *r = &st->results[g];
+        const uint32_t *members = st->members + st->start[g];
+        uint32_t count = st->start[g + 1] - st->start[g];
+        if (!r->formed && st->depth > 0)
+            continue;
+        if (!LOD_RESERVE(s, spheres, (size_t)count * 2))
+            return 0;
+        float child_error = gdr_lod_group_bounds(b, s, members, count, r);
+        float error = r->deviation > child_error ? r->deviation : child_error;
+        b->groups[r->group].sphere = r->sphere;
+        b->groups[r->group].error = error > b->min_error ? error : b->min_error;
+        for (uint32_t i = 0; i < (r->formed ? r->cluster_count : count); i++)
+            if (!(r->formed ? gdr_lod_error_adopt(b, r->first_cluster + i, g, r, i)
+                            : gdr_lod_error_inherit(b, r->first_cluster + i, members[i])))
+                return 0;
     }
-    if (*progress && (!take_results(b, depth, groups, next, next_count) || !gdr_lod_error_gather(b, next, *next_count)))
-        goto oom;
-    goto done;
-oom:
-    status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for the LOD DAG", b->mesh->name);
-done:
-    if (b->results)
-        for (uint32_t g = 0; g < parts; g++)
-            gdr_lod_result_free(&b->results[g]);
-    free(b->results);
+    b->results = st->results; /* where the gathered samples come from */
+    int ok = gdr_lod_error_gather(b, frontier, frontier_count);
     b->results = NULL;
-    free(part);
-    free(members);
-    free(start);
-    return status;
+    return ok;
+}
+
+/* Whether the job left any group of these out of memory. */
+static int stage_out_of_memory(const lod_stage *st)
+{
+    for (uint32_t g = 0; g < st->parts; g++)
+        if (st->results[g].out_of_memory)
+            return 1;
+    return 0;
 }
 
 static int compare_by_data(const void *a, const void *b)
@@ -425,11 +505,18 @@ static int setup(lod_build *b)
 }
 
 /* Steps from level 0 until one cluster is left, a step makes no progress or the level limit;
- * leaves the last frontier in *frontier (b->frontier) and the step count in *depth. */
+ * leaves the last frontier in *frontier (b->frontier) and the step count in *depth.
+ *
+ * A step's simplification and its errors are taken apart: which groups form, and so the next
+ * frontier, its partition and simplification, depend only on the geometry, while measuring a
+ * group's deviation needs its members' samples as the step before handed them on. So the job of
+ * step k measures the deviations of step k - 1 beside simplifying the groups of step k; then step
+ * k - 1's errors are set (finish_errors) and step k's geometry is taken in. */
 static gdr_status run_steps(lod_build *b, uint32_t **frontier, uint32_t *depth, gdr_lod_stop *stop, gdr_error *err)
 {
     uint32_t level0 = b->mesh->clusters.level0_cluster_count;
     uint32_t *current = malloc((size_t)level0 * sizeof *current), *next = NULL;
+    lod_stage prev = {0}, cur = {0}; /* prev: simplified, deviations not yet measured */
     gdr_status status = GDR_OK;
     if (!current)
         goto oom;
@@ -455,24 +542,51 @@ static gdr_status run_steps(lod_build *b, uint32_t **frontier, uint32_t *depth, 
         next = malloc(bound * sizeof *next);
         if (!next)
             goto oom;
-        uint32_t next_count = 0;
-        int progressed = 0;
-        status = lod_step(b, *depth, next, &next_count, &progressed, err);
+        status = begin_step(b, *depth, &cur, err);
         if (status != GDR_OK)
             goto done;
+        run_job(b, &prev, &cur);
+        if (stage_out_of_memory(&prev) || stage_out_of_memory(&cur))
+            goto oom;
+        int progressed = 0;
+        for (uint32_t g = 0; g < cur.groups; g++) {
+            progressed |= cur.results[g].formed;
+            b->stats.stuck_groups += !cur.results[g].formed;
+            b->stats.border_rejects += (uint64_t)cur.results[g].border_reject;
+        }
+        /* Every deviation of the step before is measured here; its errors are not yet set. */
+        if (prev.groups && !finish_errors(b, &prev, current, b->frontier_count))
+            goto oom;
+        stage_free(&prev);
         if (!progressed) {
             *stop = GDR_LOD_STOP_NO_PROGRESS;
             break;
         }
+        uint32_t next_count = 0;
+        if (!take_geometry(b, &cur, next, &next_count))
+            goto oom;
+        prev = cur;
+        memset(&cur, 0, sizeof cur);
         uint32_t *t = current;
         current = next;
         next = t;
         b->frontier_count = next_count;
+        b->frontier = current;
+    }
+    if (prev.groups) { /* the last step's deviations */
+        run_job(b, &prev, NULL);
+        if (stage_out_of_memory(&prev))
+            goto oom;
+        /* Every deviation of the last step is measured here; its errors are not yet set. */
+        if (!finish_errors(b, &prev, current, b->frontier_count))
+            goto oom;
     }
     goto done;
 oom:
     status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for the LOD DAG", b->mesh->name);
 done:
+    stage_free(&prev);
+    stage_free(&cur);
     free(next);
     *frontier = current;
     return status;

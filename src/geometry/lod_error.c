@@ -252,17 +252,17 @@ static int output_triangles(lod_scratch *s, const group_result *r, uint32_t loca
 }
 
 /* The members' samples, gathered in member order, with their coordinates. */
-static int gather_samples(lod_build *b, lod_scratch *s, uint32_t first, uint32_t count)
+static int gather_samples(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count)
 {
     size_t n = 0;
     for (uint32_t i = 0; i < count; i++)
-        n += b->cluster_sample_count[b->members[first + i]];
+        n += b->cluster_sample_count[members[i]];
     if (!LOD_RESERVE(s, sample_ids, n + 1) || !LOD_RESERVE(s, sample_points, n + 1) ||
         !LOD_RESERVE(s, sample_cluster, n + 1))
         return 0;
     n = 0;
     for (uint32_t i = 0; i < count; i++) {
-        uint32_t c = b->members[first + i];
+        uint32_t c = members[i];
         const uint32_t *ids = b->samples + b->cluster_sample_first[c];
         for (uint32_t j = 0; j < b->cluster_sample_count[c]; j++) {
             s->sample_ids[n] = ids[j];
@@ -653,10 +653,10 @@ static int hand_samples_to_clusters(lod_scratch *s, group_result *r)
     return 1;
 }
 
-int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, uint32_t first, uint32_t count, uint32_t local_count,
-                            group_result *r)
+int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count,
+                            uint32_t local_count, group_result *r)
 {
-    if (!output_triangles(s, r, local_count) || !gather_samples(b, s, first, count))
+    if (!output_triangles(s, r, local_count) || !gather_samples(b, s, members, count))
         return 0;
     float to_simplified = s->gathered ? samples_to_simplified(b, s, local_count, r) : 0.0f;
     float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified);
