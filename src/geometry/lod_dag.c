@@ -159,6 +159,7 @@ static uint32_t group_members(const lod_build *b, int32_t *part, uint32_t parts,
 typedef struct lod_stage {
     uint32_t depth;
     uint32_t parts, groups;
+    int32_t *part;             /* frontier cluster -> part, until grouped */
     uint32_t *members, *start; /* group g: members[start[g] .. start[g + 1]) */
     group_result *results;     /* parts entries */
     uint32_t *measured;        /* the groups that formed, in order: their deviation is measured */
@@ -171,6 +172,7 @@ static void stage_free(lod_stage *st)
         for (uint32_t g = 0; g < st->parts; g++)
             gdr_lod_result_free(&st->results[g]);
     free(st->results);
+    free(st->part);
     free(st->members);
     free(st->start);
     free(st->measured);
@@ -191,49 +193,83 @@ static void mark_shared(lod_build *b, const lod_stage *st, int clear)
         }
 }
 
-/* Partitions the frontier into the step's groups. */
-static gdr_status begin_step(lod_build *b, uint32_t depth, lod_stage *st, gdr_error *err)
+/* The arrays of a step over the frontier (b->frontier); returns 0 when out of memory. */
+static int stage_alloc(lod_build *b, uint32_t depth, lod_stage *st)
 {
     uint32_t n = b->frontier_count;
-    int32_t *part = malloc((size_t)n * sizeof *part);
     st->depth = depth;
+    st->parts = gdr_lod_part_count(b);
+    st->part = malloc((size_t)n * sizeof *st->part);
     st->members = malloc((size_t)n * sizeof *st->members);
-    gdr_status status = GDR_OK;
-    if (!part || !st->members)
-        goto oom;
-    status = gdr_lod_partition(b, part, &st->parts, err);
-    if (status != GDR_OK)
-        goto done;
     st->start = malloc(((size_t)st->parts + 1) * sizeof *st->start);
     st->results = calloc(st->parts, sizeof *st->results);
     st->measured = malloc((size_t)st->parts * sizeof *st->measured);
-    if (!st->start || !st->results || !st->measured)
-        goto oom;
-    st->groups = group_members(b, part, st->parts, st->members, st->start);
-    goto done;
-oom:
-    status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for the LOD DAG", b->mesh->name);
-done:
-    free(part);
-    return status;
+    return st->part && st->members && st->start && st->results && st->measured;
 }
 
+/* Partitions the frontier into the step's groups and marks the positions they share; the cluster
+ * graph is built on `pool`, or (NULL) on this thread as `worker`. */
+static gdr_status stage_partition(lod_build *b, lod_stage *st, gdr_thread_pool *pool, uint32_t worker,
+                                  gdr_error *err)
+{
+    gdr_status status = gdr_lod_partition(b, pool, worker, st->part, st->parts, err);
+    if (status != GDR_OK)
+        return status;
+    st->groups = group_members(b, st->part, st->parts, st->members, st->start);
+    free(st->part);
+    st->part = NULL;
+    mark_shared(b, st, 0);
+    return GDR_OK;
+}
+
+/* Task 0 of a job that also partitions the next step: the others' simplification waits for it. */
+static void partition_task(lod_build *b, uint32_t worker)
+{
+    gdr_error err = {0};
+    gdr_status status = stage_partition(b, b->partitioning, NULL, worker, &err);
+    pthread_mutex_lock(&b->partition_lock);
+    b->partition_status = status;
+    b->partition_error = err;
+    b->partitioned = 1;
+    pthread_cond_broadcast(&b->partition_cond);
+    pthread_mutex_unlock(&b->partition_lock);
+}
+
+/* Whether group g of the step being partitioned in this job is there to simplify, once the
+ * partition is done. (Tasks are taken in order, so the partition has started by then.) */
+static int partitioned_group(lod_build *b, uint32_t g)
+{
+    pthread_mutex_lock(&b->partition_lock);
+    while (!b->partitioned)
+        pthread_cond_wait(&b->partition_cond, &b->partition_lock);
+    pthread_mutex_unlock(&b->partition_lock);
+    return b->partition_status == GDR_OK && g < b->partitioning->groups;
+}
+
+/* The tasks of a job, in order: the partition of the next step (when it runs here), the
+ * deviations, the simplifications. */
 static void step_task(void *user, uint32_t i, uint32_t worker)
 {
     lod_build *b = user;
+    if (b->partitioning && i-- == 0) {
+        partition_task(b, worker);
+        return;
+    }
     if (i < b->measured_count)
         gdr_lod_measure_group_task(b, i, worker);
-    else
+    else if (!b->partitioning || partitioned_group(b, i - b->measured_count))
         gdr_lod_simplify_group_task(b, i - b->measured_count, worker);
 }
 
 /* One job on the pool: the deviation of the groups `measured` formed (NULL: none) and the
  * simplification of the groups of `simplified` (NULL: none), which depends only on the geometry
- * `measured` made. A lone measured group runs on this thread after the others, outside any job,
- * so that it may hand its samples to the pool (lod_error.c, samples_to_simplified). */
-static void run_job(lod_build *b, const lod_stage *measured, lod_stage *simplified)
+ * `measured` made. With `partition` set, the job partitions `simplified` first, beside the
+ * deviations (in task 0: the simplification tasks, parts of them, wait for it). A lone measured
+ * group runs on this thread after the others, outside any job, so that it may hand its samples to
+ * the pool (lod_error.c, samples_to_simplified). */
+static void run_job(lod_build *b, const lod_stage *measured, lod_stage *simplified, int partition)
 {
-    uint32_t groups = simplified ? simplified->groups : 0;
+    uint32_t tasks = simplified ? (partition ? simplified->parts : simplified->groups) : 0;
     b->members = simplified ? simplified->members : NULL;
     b->member_start = simplified ? simplified->start : NULL;
     b->results = simplified ? simplified->results : NULL;
@@ -242,19 +278,20 @@ static void run_job(lod_build *b, const lod_stage *measured, lod_stage *simplifi
     b->measured_members = measured ? measured->members : NULL;
     b->measured_member_start = measured ? measured->start : NULL;
     b->measured_results = measured ? measured->results : NULL;
+    b->partitioning = partition ? simplified : NULL;
+    b->partitioned = 0;
     b->lone_group = b->measured_count == 1;
-    if (simplified)
-        mark_shared(b, simplified, 0);
-    if (b->lone_group) {
+    if (b->lone_group) { /* never with the partition: that runs beside several */
         b->measured_count = 0;
-        gdr_thread_pool_run(b->pool, groups, step_task, b);
+        gdr_thread_pool_run(b->pool, tasks, step_task, b);
         gdr_lod_measure_group_task(b, 0, 0);
     } else {
-        gdr_thread_pool_run(b->pool, b->measured_count + groups, step_task, b);
+        gdr_thread_pool_run(b->pool, (partition != 0) + b->measured_count + tasks, step_task, b);
     }
-    if (simplified)
+    if (simplified && (!partition || b->partition_status == GDR_OK))
         mark_shared(b, simplified, 1);
     b->lone_group = 0;
+    b->partitioning = NULL;
 }
 
 /* Takes in the groups of the step that simplified (and, at step 0, the others as pass-through
@@ -542,10 +579,19 @@ static gdr_status run_steps(lod_build *b, uint32_t **frontier, uint32_t *depth, 
         next = malloc(bound * sizeof *next);
         if (!next)
             goto oom;
-        status = begin_step(b, *depth, &cur, err);
-        if (status != GDR_OK)
+        if (!stage_alloc(b, *depth, &cur))
+            goto oom;
+        /* The partition runs beside the deviations of the step before where there are several. */
+        int partition_in_job = prev.measured_count > 1;
+        if (!partition_in_job && (status = stage_partition(b, &cur, b->pool, 0, err)) != GDR_OK)
             goto done;
-        run_job(b, &prev, &cur);
+        run_job(b, &prev, &cur, partition_in_job);
+        if (partition_in_job && b->partition_status != GDR_OK) {
+            status = b->partition_status;
+            if (err)
+                *err = b->partition_error;
+            goto done;
+        }
         if (stage_out_of_memory(&prev) || stage_out_of_memory(&cur))
             goto oom;
         int progressed = 0;
@@ -574,7 +620,7 @@ static gdr_status run_steps(lod_build *b, uint32_t **frontier, uint32_t *depth, 
         b->frontier = current;
     }
     if (prev.groups) { /* the last step's deviations */
-        run_job(b, &prev, NULL);
+        run_job(b, &prev, NULL, 0);
         if (stage_out_of_memory(&prev))
             goto oom;
         /* Every deviation of the last step is measured here; its errors are not yet set. */
@@ -647,6 +693,8 @@ static gdr_status build_mesh(lod_build *b, gdr_error *err)
     uint32_t *frontier = NULL, depth = 0;
     gdr_lod_stop stop = GDR_LOD_STOP_NONE;
     gdr_status status = GDR_OK;
+    pthread_mutex_init(&b->partition_lock, NULL);
+    pthread_cond_init(&b->partition_cond, NULL);
     if (!setup(b))
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for the LOD DAG",
                                b->mesh->name);
@@ -671,6 +719,8 @@ static gdr_status build_mesh(lod_build *b, gdr_error *err)
         for (uint32_t w = 0; w < b->scratch_count; w++)
             gdr_lod_scratch_free(&b->scratch[w]);
     free(b->scratch);
+    pthread_cond_destroy(&b->partition_cond);
+    pthread_mutex_destroy(&b->partition_lock);
     return status;
 }
 

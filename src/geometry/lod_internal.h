@@ -3,6 +3,7 @@
 #ifndef GDR_GEOMETRY_LOD_INTERNAL_H
 #define GDR_GEOMETRY_LOD_INTERNAL_H
 
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -149,6 +150,14 @@ typedef struct lod_build {
     const uint32_t *measured_members, *measured_member_start;
     group_result *measured_results;
     int lone_group; /* one group is measured, on the calling thread outside any job */
+    /* the next step's partition, when it runs as task 0 of the job: the simplification tasks wait
+     * for it (partitioned set under partition_lock) */
+    struct lod_stage *partitioning;
+    pthread_mutex_t partition_lock;
+    pthread_cond_t partition_cond;
+    int partitioned;
+    gdr_status partition_status;
+    gdr_error partition_error;
     const uint32_t *frontier;
     uint32_t frontier_count;
     key_record *edge_records;      /* boundary edges of frontier clusters, per chunk */
@@ -173,9 +182,12 @@ static inline const uint32_t *gdr_lod_cluster_vertices(const lod_build *b, const
 /* Adds to the shared progress; only worker 0 of the calling thread draws. */
 void gdr_lod_progress_add(lod_build *b, uint64_t amount, uint32_t worker);
 
-/* lod_graph.c: partitions the frontier (b->frontier) into `*parts` groups of neighbours; part[f]
- * in [0, *parts). */
-gdr_status gdr_lod_partition(lod_build *b, int32_t *part, uint32_t *parts, gdr_error *err);
+/* lod_graph.c: the number of parts of the frontier (b->frontier), and its partition into them,
+ * groups of neighbours: part[f] in [0, parts). The cluster graph is built on `pool`, or (NULL) on
+ * this thread as `worker` (inside a job). */
+uint32_t gdr_lod_part_count(const lod_build *b);
+gdr_status gdr_lod_partition(lod_build *b, gdr_thread_pool *pool, uint32_t worker, int32_t *part, uint32_t parts,
+                             gdr_error *err);
 
 /* lod_group.c: a thread-pool task that simplifies group g of the step into b->results[g] (and
  * splits it into clusters); one that measures the deviation of group measured[i]. */
