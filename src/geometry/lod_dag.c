@@ -336,25 +336,38 @@ static int take_geometry(lod_build *b, lod_stage *st, uint32_t *next, uint32_t *
     return 1;
 }
 
-/* The step's errors, once every deviation of its groups is measured: each group's sphere and error
- * (its deviation, or the largest error of the groups its members came from where that is larger),
- * its new clusters' samples, and the samples of `frontier` (the one the step made) packed into one
- * array. Returns 0 when out of memory. */
-static int finish_errors(lod_build *b, const lod_stage *st, const uint32_t *frontier, uint32_t frontier_count)
+/* Each group's sphere and error (its deviation, or the largest error of the groups its members
+ * came from where that is larger) into its result, once every deviation of the step is measured
+ * and the errors of the steps before are set. Returns 0 when out of memory. */
+static int stage_bounds(lod_build *b, lod_stage *st)
 {
     lod_scratch *s = &b->scratch[0];
     for (uint32_t g = 0; g < st->groups; g++) {
         group_result *r = &st->results[g];
-        const uint32_t *members = st->members + st->start[g];
         uint32_t count = st->start[g + 1] - st->start[g];
         if (!r->formed && st->depth > 0)
             continue;
         if (!LOD_RESERVE(s, spheres, (size_t)count * 2))
             return 0;
-        float child_error = gdr_lod_group_bounds(b, s, members, count, r);
-        float error = r->deviation > child_error ? r->deviation : child_error;
+        float child_error = gdr_lod_group_bounds(b, s, st->members + st->start[g], count, r);
+        r->error = r->deviation > child_error ? r->deviation : child_error;
+    }
+    return 1;
+}
+
+/* The step's results into the build: each group's sphere and error, its new clusters' samples, and
+ * the samples of `frontier` (the one the step made) packed into one array. Returns 0 when out of
+ * memory. */
+static int set_errors(lod_build *b, const lod_stage *st, const uint32_t *frontier, uint32_t frontier_count)
+{
+    for (uint32_t g = 0; g < st->groups; g++) {
+        const group_result *r = &st->results[g];
+        const uint32_t *members = st->members + st->start[g];
+        uint32_t count = st->start[g + 1] - st->start[g];
+        if (!r->formed && st->depth > 0)
+            continue;
         b->groups[r->group].sphere = r->sphere;
-        b->groups[r->group].error = error > b->min_error ? error : b->min_error;
+        b->groups[r->group].error = r->error > b->min_error ? r->error : b->min_error;
         for (uint32_t i = 0; i < (r->formed ? r->cluster_count : count); i++)
             if (!(r->formed ? gdr_lod_error_adopt(b, r->first_cluster + i, g, r, i)
                             : gdr_lod_error_inherit(b, r->first_cluster + i, members[i])))
@@ -364,6 +377,15 @@ static int finish_errors(lod_build *b, const lod_stage *st, const uint32_t *fron
     int ok = gdr_lod_error_gather(b, frontier, frontier_count);
     b->results = NULL;
     return ok;
+}
+
+/* The step's errors, once every deviation of its groups is measured (the job after its own has
+ * run): here, between stage_bounds and set_errors, each result holds its group's deviation,
+ * error, sphere and samples by new cluster, and nothing of them is in the build yet. Returns 0
+ * when out of memory. */
+static int finish_errors(lod_build *b, lod_stage *st, const uint32_t *frontier, uint32_t frontier_count)
+{
+    return stage_bounds(b, st) && set_errors(b, st, frontier, frontier_count);
 }
 
 /* Whether the job left any group of these out of memory. */
@@ -600,7 +622,6 @@ static gdr_status run_steps(lod_build *b, uint32_t **frontier, uint32_t *depth, 
             b->stats.stuck_groups += !cur.results[g].formed;
             b->stats.border_rejects += (uint64_t)cur.results[g].border_reject;
         }
-        /* Every deviation of the step before is measured here; its errors are not yet set. */
         if (prev.groups && !finish_errors(b, &prev, current, b->frontier_count))
             goto oom;
         stage_free(&prev);
@@ -623,7 +644,6 @@ static gdr_status run_steps(lod_build *b, uint32_t **frontier, uint32_t *depth, 
         run_job(b, &prev, NULL, 0);
         if (stage_out_of_memory(&prev))
             goto oom;
-        /* Every deviation of the last step is measured here; its errors are not yet set. */
         if (!finish_errors(b, &prev, current, b->frontier_count))
             goto oom;
     }
