@@ -563,6 +563,44 @@ static int setup(lod_build *b)
     return 1;
 }
 
+static gdr_status out_of_memory(const lod_build *b, gdr_error *err)
+{
+    return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for the LOD DAG", b->mesh->name);
+}
+
+/* Step cur over the frontier (b->frontier): its partition, the job that measures prev's groups
+ * (none at step 0) and simplifies cur's, then prev's errors; prev is freed. Sets *progressed when
+ * cur formed a group. */
+static gdr_status step(lod_build *b, lod_stage *prev, lod_stage *cur, uint32_t depth, int *progressed,
+                       gdr_error *err)
+{
+    if (!stage_alloc(b, depth, cur))
+        return out_of_memory(b, err);
+    /* The partition runs beside the deviations of the step before where there are several. */
+    int partition_in_job = prev->measured_count > 1;
+    gdr_status status = partition_in_job ? GDR_OK : stage_partition(b, cur, b->pool, 0, err);
+    if (status != GDR_OK)
+        return status;
+    run_job(b, prev, cur, partition_in_job);
+    if (partition_in_job && b->partition_status != GDR_OK) {
+        if (err)
+            *err = b->partition_error;
+        return b->partition_status;
+    }
+    if (stage_out_of_memory(prev) || stage_out_of_memory(cur))
+        return out_of_memory(b, err);
+    *progressed = 0;
+    for (uint32_t g = 0; g < cur->groups; g++) {
+        *progressed |= cur->results[g].formed;
+        b->stats.stuck_groups += !cur->results[g].formed;
+        b->stats.border_rejects += (uint64_t)cur->results[g].border_reject;
+    }
+    if (prev->groups && !finish_errors(b, prev, b->frontier, b->frontier_count))
+        return out_of_memory(b, err);
+    stage_free(prev);
+    return GDR_OK;
+}
+
 /* Steps from level 0 until one cluster is left, a step makes no progress or the level limit;
  * leaves the last frontier in *frontier (b->frontier) and the step count in *depth.
  *
@@ -584,12 +622,8 @@ static gdr_status run_steps(lod_build *b, uint32_t **frontier, uint32_t *depth, 
     b->frontier_count = level0;
     for (*depth = 0;; ++*depth) {
         b->frontier = current;
-        if (b->frontier_count == 1) {
-            *stop = GDR_LOD_STOP_SINGLE_CLUSTER;
-            break;
-        }
-        if (*depth >= GDR_LOD_MAX_LEVELS) {
-            *stop = GDR_LOD_STOP_LEVEL_LIMIT;
+        if (b->frontier_count == 1 || *depth >= GDR_LOD_MAX_LEVELS) {
+            *stop = b->frontier_count == 1 ? GDR_LOD_STOP_SINGLE_CLUSTER : GDR_LOD_STOP_LEVEL_LIMIT;
             break;
         }
         /* The next frontier: members carried or passed through, plus new clusters, of which a
@@ -601,30 +635,9 @@ static gdr_status run_steps(lod_build *b, uint32_t **frontier, uint32_t *depth, 
         next = malloc(bound * sizeof *next);
         if (!next)
             goto oom;
-        if (!stage_alloc(b, *depth, &cur))
-            goto oom;
-        /* The partition runs beside the deviations of the step before where there are several. */
-        int partition_in_job = prev.measured_count > 1;
-        if (!partition_in_job && (status = stage_partition(b, &cur, b->pool, 0, err)) != GDR_OK)
-            goto done;
-        run_job(b, &prev, &cur, partition_in_job);
-        if (partition_in_job && b->partition_status != GDR_OK) {
-            status = b->partition_status;
-            if (err)
-                *err = b->partition_error;
-            goto done;
-        }
-        if (stage_out_of_memory(&prev) || stage_out_of_memory(&cur))
-            goto oom;
         int progressed = 0;
-        for (uint32_t g = 0; g < cur.groups; g++) {
-            progressed |= cur.results[g].formed;
-            b->stats.stuck_groups += !cur.results[g].formed;
-            b->stats.border_rejects += (uint64_t)cur.results[g].border_reject;
-        }
-        if (prev.groups && !finish_errors(b, &prev, current, b->frontier_count))
-            goto oom;
-        stage_free(&prev);
+        if ((status = step(b, &prev, &cur, *depth, &progressed, err)) != GDR_OK)
+            goto done;
         if (!progressed) {
             *stop = GDR_LOD_STOP_NO_PROGRESS;
             break;
@@ -638,18 +651,15 @@ static gdr_status run_steps(lod_build *b, uint32_t **frontier, uint32_t *depth, 
         current = next;
         next = t;
         b->frontier_count = next_count;
-        b->frontier = current;
     }
     if (prev.groups) { /* the last step's deviations */
         run_job(b, &prev, NULL, 0);
-        if (stage_out_of_memory(&prev))
-            goto oom;
-        if (!finish_errors(b, &prev, current, b->frontier_count))
+        if (stage_out_of_memory(&prev) || !finish_errors(b, &prev, current, b->frontier_count))
             goto oom;
     }
     goto done;
 oom:
-    status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for the LOD DAG", b->mesh->name);
+    status = out_of_memory(b, err);
 done:
     stage_free(&prev);
     stage_free(&cur);
@@ -716,14 +726,12 @@ static gdr_status build_mesh(lod_build *b, gdr_error *err)
     pthread_mutex_init(&b->partition_lock, NULL);
     pthread_cond_init(&b->partition_cond, NULL);
     if (!setup(b))
-        status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for the LOD DAG",
-                               b->mesh->name);
+        status = out_of_memory(b, err);
     if (status == GDR_OK)
         status = run_steps(b, &frontier, &depth, &stop, err);
     b->frontier = frontier;
     if (status == GDR_OK && (!form_root(b, depth) || !order_by_group(b)))
-        status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for the LOD DAG",
-                               b->mesh->name);
+        status = out_of_memory(b, err);
     if (status == GDR_OK) {
         hand_over(b, depth, stop);
         uint64_t given = atomic_load(&b->progress_given);
