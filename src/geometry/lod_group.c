@@ -255,16 +255,20 @@ static uint32_t restore_group(lod_build *b, lod_scratch *s, const uint32_t *memb
         vertices += b->clusters[r->first_cluster + i].vertex_count;
         bytes += (size_t)b->clusters[r->first_cluster + i].triangle_count * 3;
     }
-    if (!reserve_group(s, r->input_triangles, count) || !LOD_RESERVE(s, meshlets, r->cluster_count) ||
-        !LOD_RESERVE(s, meshlet_vertices, vertices) || !LOD_RESERVE(s, meshlet_triangles, bytes))
+    size_t index_count = (size_t)r->input_triangles * 3; /* bounds the local vertex count */
+    if (!LOD_RESERVE(s, local_to_mesh, index_count) || !LOD_RESERVE(s, positions, index_count * 3) ||
+        !LOD_RESERVE(s, meshlets, r->cluster_count) || !LOD_RESERVE(s, meshlet_vertices, vertices) ||
+        !LOD_RESERVE(s, meshlet_triangles, bytes))
         return 0;
     uint32_t local_count = merge_members(b, s, members, count, 0);
     size_t vo = 0, to = 0;
     for (uint32_t i = 0; i < r->cluster_count; i++) {
         const gdr_cluster *c = &b->clusters[r->first_cluster + i];
         const uint32_t *v = gdr_lod_cluster_vertices(b, c);
-        s->meshlets[i] = (struct meshopt_Meshlet){.vertex_offset = (unsigned int)vo, .triangle_offset = (unsigned int)to,
-                                                  .vertex_count = c->vertex_count, .triangle_count = c->triangle_count};
+        s->meshlets[i] = (struct meshopt_Meshlet){.vertex_offset = (unsigned int)vo,
+                                                  .triangle_offset = (unsigned int)to,
+                                                  .vertex_count = c->vertex_count,
+                                                  .triangle_count = c->triangle_count};
         for (uint32_t k = 0; k < c->vertex_count; k++)
             s->meshlet_vertices[vo + k] = s->map[v[k]];
         memcpy(s->meshlet_triangles + to, gdr_lod_cluster_triangles(b, c), (size_t)c->triangle_count * 3);
