@@ -5,7 +5,9 @@
  *
  * Determinism: the groups of one step are simplified in parallel, each task writing only its own
  * result; results are appended in group order by the calling thread, and METIS runs with a fixed
- * seed on the calling thread. The bytes produced do not depend on the thread count. */
+ * seed on the calling thread. A step's only group measures its samples in parallel ranges whose
+ * results are then taken in sample order, as one thread would. The bytes produced do not depend on
+ * the thread count. */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -70,27 +72,34 @@ static int push_cluster(lod_build *b, gdr_cluster c)
     return 1;
 }
 
-/* Appends a formed group's clusters, made from group `group`. */
-static int append_result(lod_build *b, const group_result *r, uint32_t result, uint32_t group, uint32_t *frontier,
-                         uint32_t *frontier_count)
+/* Appends a formed group's clusters, made from group `group`, to the build (from
+ * r->first_cluster on) and frees r's copy of them. */
+static int append_result(lod_build *b, group_result *r, uint32_t group, uint32_t *frontier, uint32_t *frontier_count)
 {
     if (!gdr_lod_reserve(&b->vertices, &b->vertex_cap, b->vertex_count + r->vertex_count, sizeof *b->vertices) ||
         !gdr_lod_reserve(&b->triangles, &b->triangle_cap, b->triangle_bytes + r->triangle_bytes, 1) ||
         b->vertex_count + r->vertex_count > UINT32_MAX || b->triangle_bytes + r->triangle_bytes > UINT32_MAX)
         return 0;
+    r->first_cluster = (uint32_t)b->cluster_count;
     for (uint32_t i = 0; i < r->cluster_count; i++) {
         gdr_cluster c = r->clusters[i];
         c.vertex_offset += (uint32_t)b->vertex_count;
         c.triangle_offset += (uint32_t)b->triangle_bytes;
         c.refined_group = group;
         frontier[(*frontier_count)++] = (uint32_t)b->cluster_count;
-        if (!gdr_lod_error_adopt(b, (uint32_t)b->cluster_count, result, r, i) || !push_cluster(b, c))
+        if (!push_cluster(b, c))
             return 0;
     }
     memcpy(b->vertices + b->vertex_count, r->vertices, (size_t)r->vertex_count * sizeof *b->vertices);
     memcpy(b->triangles + b->triangle_bytes, r->triangles, r->triangle_bytes);
     b->vertex_count += r->vertex_count;
     b->triangle_bytes += r->triangle_bytes;
+    free(r->clusters);
+    free(r->vertices);
+    free(r->triangles);
+    r->clusters = NULL;
+    r->vertices = NULL;
+    r->triangles = NULL;
     return 1;
 }
 
@@ -148,12 +157,36 @@ static uint32_t group_members(const lod_build *b, int32_t *part, uint32_t parts,
     return groups;
 }
 
-/* Marks in b->owner the positions that more than one group of the step uses (clear: resets them). */
-static void mark_shared(lod_build *b, uint32_t groups, int clear)
+/* One step's groups, from their partition until their errors are set. */
+typedef struct lod_stage {
+    uint32_t depth;
+    uint32_t parts, groups;
+    int32_t *part;             /* frontier cluster -> part, until grouped */
+    uint32_t *members, *start; /* group g: members[start[g] .. start[g + 1]) */
+    group_result *results;     /* parts entries */
+    uint32_t *measured;        /* the groups that formed, in order: their deviation is measured */
+    uint32_t measured_count;
+} lod_stage;
+
+static void stage_free(lod_stage *st)
 {
-    for (uint32_t g = 0; g < groups; g++)
-        for (uint32_t i = b->member_start[g]; i < b->member_start[g + 1]; i++) {
-            const gdr_cluster *c = &b->clusters[b->members[i]];
+    if (st->results)
+        for (uint32_t g = 0; g < st->parts; g++)
+            gdr_lod_result_free(&st->results[g]);
+    free(st->results);
+    free(st->part);
+    free(st->members);
+    free(st->start);
+    free(st->measured);
+    memset(st, 0, sizeof *st);
+}
+
+/* Marks in b->owner the positions that more than one group of the step uses (clear: resets them). */
+static void mark_shared(lod_build *b, const lod_stage *st, int clear)
+{
+    for (uint32_t g = 0; g < st->groups; g++)
+        for (uint32_t i = st->start[g]; i < st->start[g + 1]; i++) {
+            const gdr_cluster *c = &b->clusters[st->members[i]];
             const uint32_t *v = gdr_lod_cluster_vertices(b, c);
             for (uint32_t j = 0; j < c->vertex_count; j++) {
                 uint32_t *o = &b->owner[b->position_id[v[j]]];
@@ -162,39 +195,142 @@ static void mark_shared(lod_build *b, uint32_t groups, int clear)
         }
 }
 
-/* Forms the groups that simplified (and, at step 0, the others as pass-through groups), in group
- * order; next receives the next frontier. Returns 0 when out of memory. */
-static int take_results(lod_build *b, uint32_t depth, uint32_t groups, uint32_t *next, uint32_t *next_count)
+/* The arrays of a step over the frontier (b->frontier); returns 0 when out of memory. */
+static int stage_alloc(lod_build *b, uint32_t depth, lod_stage *st)
+{
+    uint32_t n = b->frontier_count;
+    st->depth = depth;
+    st->parts = gdr_lod_part_count(b);
+    st->part = malloc((size_t)n * sizeof *st->part);
+    st->members = malloc((size_t)n * sizeof *st->members);
+    st->start = malloc(((size_t)st->parts + 1) * sizeof *st->start);
+    st->results = calloc(st->parts, sizeof *st->results);
+    st->measured = malloc((size_t)st->parts * sizeof *st->measured);
+    return st->part && st->members && st->start && st->results && st->measured;
+}
+
+/* Partitions the frontier into the step's groups and marks the positions they share; the cluster
+ * graph is built on `pool`, or (NULL) on this thread as `worker`. */
+static gdr_status stage_partition(lod_build *b, lod_stage *st, gdr_thread_pool *pool, uint32_t worker,
+                                  gdr_error *err)
+{
+    gdr_status status = gdr_lod_partition(b, pool, worker, st->part, st->parts, err);
+    if (status != GDR_OK)
+        return status;
+    st->groups = group_members(b, st->part, st->parts, st->members, st->start);
+    free(st->part);
+    st->part = NULL;
+    mark_shared(b, st, 0);
+    return GDR_OK;
+}
+
+/* Task 0 of a job that also partitions the next step: the others' simplification waits for it. */
+static void partition_task(lod_build *b, uint32_t worker)
+{
+    gdr_error err = {0};
+    gdr_status status = stage_partition(b, b->partitioning, NULL, worker, &err);
+    pthread_mutex_lock(&b->partition_lock);
+    b->partition_status = status;
+    b->partition_error = err;
+    b->partitioned = 1;
+    pthread_cond_broadcast(&b->partition_cond);
+    pthread_mutex_unlock(&b->partition_lock);
+}
+
+/* Whether group g of the step being partitioned in this job is there to simplify, once the
+ * partition is done. (Tasks are taken in order, so the partition has started by then.) */
+static int partitioned_group(lod_build *b, uint32_t g)
+{
+    pthread_mutex_lock(&b->partition_lock);
+    while (!b->partitioned)
+        pthread_cond_wait(&b->partition_cond, &b->partition_lock);
+    pthread_mutex_unlock(&b->partition_lock);
+    return b->partition_status == GDR_OK && g < b->partitioning->groups;
+}
+
+/* The tasks of a job, in order: the partition of the next step (when it runs here), the
+ * deviations, the simplifications. */
+static void step_task(void *user, uint32_t i, uint32_t worker)
+{
+    lod_build *b = user;
+    if (b->partitioning && i-- == 0) {
+        partition_task(b, worker);
+        return;
+    }
+    if (i < b->measured_count)
+        gdr_lod_measure_group_task(b, i, worker);
+    else if (!b->partitioning || partitioned_group(b, i - b->measured_count))
+        gdr_lod_simplify_group_task(b, i - b->measured_count, worker);
+}
+
+/* One job on the pool: the deviation of the groups `measured` formed (NULL: none) and the
+ * simplification of the groups of `simplified` (NULL: none), which depends only on the geometry
+ * `measured` made. With `partition` set, the job partitions `simplified` first, beside the
+ * deviations (in task 0: the simplification tasks, parts of them, wait for it). A lone measured
+ * group runs on this thread after the others, outside any job, so that it may hand its samples to
+ * the pool (lod_error.c, samples_to_simplified). */
+static void run_job(lod_build *b, const lod_stage *measured, lod_stage *simplified, int partition)
+{
+    uint32_t tasks = simplified ? (partition ? simplified->parts : simplified->groups) : 0;
+    b->members = simplified ? simplified->members : NULL;
+    b->member_start = simplified ? simplified->start : NULL;
+    b->results = simplified ? simplified->results : NULL;
+    b->measured = measured ? measured->measured : NULL;
+    b->measured_count = measured ? measured->measured_count : 0;
+    b->measured_members = measured ? measured->members : NULL;
+    b->measured_member_start = measured ? measured->start : NULL;
+    b->measured_results = measured ? measured->results : NULL;
+    b->partitioning = partition ? simplified : NULL;
+    b->partitioned = 0;
+    b->lone_group = b->measured_count == 1;
+    if (b->lone_group) { /* never with the partition: that runs beside several */
+        b->measured_count = 0;
+        gdr_thread_pool_run(b->pool, tasks, step_task, b);
+        gdr_lod_measure_group_task(b, 0, 0);
+    } else {
+        gdr_thread_pool_run(b->pool, (partition != 0) + b->measured_count + tasks, step_task, b);
+    }
+    if (simplified && (!partition || b->partition_status == GDR_OK))
+        mark_shared(b, simplified, 1);
+    b->lone_group = 0;
+    b->partitioning = NULL;
+}
+
+/* Takes in the groups of the step that simplified (and, at step 0, the others as pass-through
+ * groups), in group order: their records (sphere and error set later by finish_errors) and their
+ * new clusters; next receives the next frontier. Returns 0 when out of memory. */
+static int take_geometry(lod_build *b, lod_stage *st, uint32_t *next, uint32_t *next_count)
 {
     *next_count = 0;
-    for (uint32_t g = 0; g < groups; g++) {
-        const group_result *r = &b->results[g];
-        uint32_t first = b->member_start[g], end = b->member_start[g + 1];
-        if (!r->formed && depth > 0) {
+    for (uint32_t g = 0; g < st->groups; g++) {
+        group_result *r = &st->results[g];
+        uint32_t first = st->start[g], end = st->start[g + 1];
+        if (!r->formed && st->depth > 0) {
             /* Regrouped at the next step with other neighbours. */
             for (uint32_t i = first; i < end; i++)
-                next[(*next_count)++] = b->members[i];
+                next[(*next_count)++] = st->members[i];
             continue;
         }
-        uint32_t id = (uint32_t)b->group_count;
-        float error = r->error > b->min_error ? r->error : b->min_error;
-        if (!push_group(b, (gdr_cluster_group){.sphere = r->sphere, .error = error, .depth = depth}))
+        r->group = (uint32_t)b->group_count;
+        if (!push_group(b, (gdr_cluster_group){.depth = st->depth}))
             return 0;
         for (uint32_t i = first; i < end; i++)
-            b->clusters[b->members[i]].group = id;
+            b->clusters[st->members[i]].group = r->group;
         if (r->formed) {
-            if (!append_result(b, r, g, id, next, next_count))
+            st->measured[st->measured_count++] = g;
+            if (!append_result(b, r, r->group, next, next_count))
                 return 0;
             continue;
         }
         /* Step 0: the members pass through unchanged, sharing their data, so that level-0
          * clusters only ever belong to step-0 groups (and stay contiguous). */
+        r->first_cluster = (uint32_t)b->cluster_count;
         for (uint32_t i = first; i < end; i++) {
-            gdr_cluster c = b->clusters[b->members[i]];
+            gdr_cluster c = b->clusters[st->members[i]];
             c.group = GDR_NO_INDEX;
-            c.refined_group = id;
+            c.refined_group = r->group;
             next[(*next_count)++] = (uint32_t)b->cluster_count;
-            if (!gdr_lod_error_inherit(b, (uint32_t)b->cluster_count, b->members[i]) || !push_cluster(b, c))
+            if (!push_cluster(b, c))
                 return 0;
         }
         b->stats.passthrough_clusters += end - first;
@@ -202,54 +338,65 @@ static int take_results(lod_build *b, uint32_t depth, uint32_t groups, uint32_t 
     return 1;
 }
 
-/* One step over the frontier: partition, simplify the groups, form those that simplified. Sets
- * *progress when at least one group was formed; next receives the next frontier. */
-static gdr_status lod_step(lod_build *b, uint32_t depth, uint32_t *next, uint32_t *next_count, int *progress,
-                           gdr_error *err)
+/* Each group's sphere and error (its deviation, or the largest error of the groups its members
+ * came from where that is larger) into its result, once every deviation of the step is measured
+ * and the errors of the steps before are set. Returns 0 when out of memory. */
+static int stage_bounds(lod_build *b, lod_stage *st)
 {
-    uint32_t n = b->frontier_count, parts = 0, groups = 0;
-    int32_t *part = malloc((size_t)n * sizeof *part);
-    uint32_t *members = malloc((size_t)n * sizeof *members);
-    uint32_t *start = NULL;
-    gdr_status status = GDR_OK;
-    *progress = 0;
-    if (!part || !members)
-        goto oom;
-    status = gdr_lod_partition(b, part, &parts, err);
-    if (status != GDR_OK)
-        goto done;
-    start = malloc(((size_t)parts + 1) * sizeof *start);
-    b->results = calloc(parts, sizeof *b->results);
-    if (!start || !b->results)
-        goto oom;
-    groups = group_members(b, part, parts, members, start);
-    b->members = members;
-    b->member_start = start;
-    mark_shared(b, groups, 0);
-    gdr_thread_pool_run(b->pool, groups, gdr_lod_simplify_group_task, b);
-    mark_shared(b, groups, 1);
-    for (uint32_t g = 0; g < groups; g++) {
-        if (b->results[g].out_of_memory)
-            goto oom;
-        *progress |= b->results[g].formed;
-        b->stats.stuck_groups += !b->results[g].formed;
-        b->stats.border_rejects += (uint64_t)b->results[g].border_reject;
+    lod_scratch *s = &b->scratch[0];
+    for (uint32_t g = 0; g < st->groups; g++) {
+        group_result *r = &st->results[g];
+        uint32_t count = st->start[g + 1] - st->start[g];
+        if (!r->formed && st->depth > 0)
+            continue;
+        if (!LOD_RESERVE(s, spheres, (size_t)count * 2))
+            return 0;
+        float child_error = gdr_lod_group_bounds(b, s, st->members + st->start[g], count, r);
+        r->error = r->deviation > child_error ? r->deviation : child_error;
     }
-    if (*progress && (!take_results(b, depth, groups, next, next_count) || !gdr_lod_error_gather(b, next, *next_count)))
-        goto oom;
-    goto done;
-oom:
-    status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for the LOD DAG", b->mesh->name);
-done:
-    if (b->results)
-        for (uint32_t g = 0; g < parts; g++)
-            gdr_lod_result_free(&b->results[g]);
-    free(b->results);
+    return 1;
+}
+
+/* The step's results into the build: each group's sphere and error, its new clusters' samples, and
+ * the samples of `frontier` (the one the step made) packed into one array. Returns 0 when out of
+ * memory. */
+static int set_errors(lod_build *b, const lod_stage *st, const uint32_t *frontier, uint32_t frontier_count)
+{
+    for (uint32_t g = 0; g < st->groups; g++) {
+        const group_result *r = &st->results[g];
+        const uint32_t *members = st->members + st->start[g];
+        uint32_t count = st->start[g + 1] - st->start[g];
+        if (!r->formed && st->depth > 0)
+            continue;
+        b->groups[r->group].sphere = r->sphere;
+        b->groups[r->group].error = r->error > b->min_error ? r->error : b->min_error;
+        for (uint32_t i = 0; i < (r->formed ? r->cluster_count : count); i++)
+            if (!(r->formed ? gdr_lod_error_adopt(b, r->first_cluster + i, g, r, i)
+                            : gdr_lod_error_inherit(b, r->first_cluster + i, members[i])))
+                return 0;
+    }
+    b->results = st->results; /* where the gathered samples come from */
+    int ok = gdr_lod_error_gather(b, frontier, frontier_count);
     b->results = NULL;
-    free(part);
-    free(members);
-    free(start);
-    return status;
+    return ok;
+}
+
+/* The step's errors, once every deviation of its groups is measured (the job after its own has
+ * run): here, between stage_bounds and set_errors, each result holds its group's deviation,
+ * error, sphere and samples by new cluster, and nothing of them is in the build yet. Returns 0
+ * when out of memory. */
+static int finish_errors(lod_build *b, lod_stage *st, const uint32_t *frontier, uint32_t frontier_count)
+{
+    return stage_bounds(b, st) && set_errors(b, st, frontier, frontier_count);
+}
+
+/* Whether the job left any group of these out of memory. */
+static int stage_out_of_memory(const lod_stage *st)
+{
+    for (uint32_t g = 0; g < st->parts; g++)
+        if (st->results[g].out_of_memory)
+            return 1;
+    return 0;
 }
 
 static int compare_by_data(const void *a, const void *b)
@@ -418,12 +565,57 @@ static int setup(lod_build *b)
     return 1;
 }
 
+static gdr_status out_of_memory(const lod_build *b, gdr_error *err)
+{
+    return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for the LOD DAG", b->mesh->name);
+}
+
+/* Step cur over the frontier (b->frontier): its partition, the job that measures prev's groups
+ * (none at step 0) and simplifies cur's, then prev's errors; prev is freed. Sets *progressed when
+ * cur formed a group. */
+static gdr_status step(lod_build *b, lod_stage *prev, lod_stage *cur, uint32_t depth, int *progressed,
+                       gdr_error *err)
+{
+    if (!stage_alloc(b, depth, cur))
+        return out_of_memory(b, err);
+    /* The partition runs beside the deviations of the step before where there are several. */
+    int partition_in_job = prev->measured_count > 1;
+    gdr_status status = partition_in_job ? GDR_OK : stage_partition(b, cur, b->pool, 0, err);
+    if (status != GDR_OK)
+        return status;
+    run_job(b, prev, cur, partition_in_job);
+    if (partition_in_job && b->partition_status != GDR_OK) {
+        if (err)
+            *err = b->partition_error;
+        return b->partition_status;
+    }
+    if (stage_out_of_memory(prev) || stage_out_of_memory(cur))
+        return out_of_memory(b, err);
+    *progressed = 0;
+    for (uint32_t g = 0; g < cur->groups; g++) {
+        *progressed |= cur->results[g].formed;
+        b->stats.stuck_groups += !cur->results[g].formed;
+        b->stats.border_rejects += (uint64_t)cur->results[g].border_reject;
+    }
+    if (prev->groups && !finish_errors(b, prev, b->frontier, b->frontier_count))
+        return out_of_memory(b, err);
+    stage_free(prev);
+    return GDR_OK;
+}
+
 /* Steps from level 0 until one cluster is left, a step makes no progress or the level limit;
- * leaves the last frontier in *frontier (b->frontier) and the step count in *depth. */
+ * leaves the last frontier in *frontier (b->frontier) and the step count in *depth.
+ *
+ * A step's simplification and its errors are taken apart: which groups form, and so the next
+ * frontier, its partition and simplification, depend only on the geometry, while measuring a
+ * group's deviation needs its members' samples as the step before handed them on. So the job of
+ * step k measures the deviations of step k - 1 beside simplifying the groups of step k; then step
+ * k - 1's errors are set (finish_errors) and step k's geometry is taken in. */
 static gdr_status run_steps(lod_build *b, uint32_t **frontier, uint32_t *depth, gdr_lod_stop *stop, gdr_error *err)
 {
     uint32_t level0 = b->mesh->clusters.level0_cluster_count;
     uint32_t *current = malloc((size_t)level0 * sizeof *current), *next = NULL;
+    lod_stage prev = {0}, cur = {0}; /* prev: simplified, deviations not yet measured */
     gdr_status status = GDR_OK;
     if (!current)
         goto oom;
@@ -432,12 +624,8 @@ static gdr_status run_steps(lod_build *b, uint32_t **frontier, uint32_t *depth, 
     b->frontier_count = level0;
     for (*depth = 0;; ++*depth) {
         b->frontier = current;
-        if (b->frontier_count == 1) {
-            *stop = GDR_LOD_STOP_SINGLE_CLUSTER;
-            break;
-        }
-        if (*depth >= GDR_LOD_MAX_LEVELS) {
-            *stop = GDR_LOD_STOP_LEVEL_LIMIT;
+        if (b->frontier_count == 1 || *depth >= GDR_LOD_MAX_LEVELS) {
+            *stop = b->frontier_count == 1 ? GDR_LOD_STOP_SINGLE_CLUSTER : GDR_LOD_STOP_LEVEL_LIMIT;
             break;
         }
         /* The next frontier: members carried or passed through, plus new clusters, of which a
@@ -449,24 +637,34 @@ static gdr_status run_steps(lod_build *b, uint32_t **frontier, uint32_t *depth, 
         next = malloc(bound * sizeof *next);
         if (!next)
             goto oom;
-        uint32_t next_count = 0;
         int progressed = 0;
-        status = lod_step(b, *depth, next, &next_count, &progressed, err);
-        if (status != GDR_OK)
+        if ((status = step(b, &prev, &cur, *depth, &progressed, err)) != GDR_OK)
             goto done;
         if (!progressed) {
             *stop = GDR_LOD_STOP_NO_PROGRESS;
             break;
         }
+        uint32_t next_count = 0;
+        if (!take_geometry(b, &cur, next, &next_count))
+            goto oom;
+        prev = cur;
+        memset(&cur, 0, sizeof cur);
         uint32_t *t = current;
         current = next;
         next = t;
         b->frontier_count = next_count;
     }
+    if (prev.groups) { /* the last step's deviations */
+        run_job(b, &prev, NULL, 0);
+        if (stage_out_of_memory(&prev) || !finish_errors(b, &prev, current, b->frontier_count))
+            goto oom;
+    }
     goto done;
 oom:
-    status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for the LOD DAG", b->mesh->name);
+    status = out_of_memory(b, err);
 done:
+    stage_free(&prev);
+    stage_free(&cur);
     free(next);
     *frontier = current;
     return status;
@@ -527,15 +725,15 @@ static gdr_status build_mesh(lod_build *b, gdr_error *err)
     uint32_t *frontier = NULL, depth = 0;
     gdr_lod_stop stop = GDR_LOD_STOP_NONE;
     gdr_status status = GDR_OK;
+    pthread_mutex_init(&b->partition_lock, NULL);
+    pthread_cond_init(&b->partition_cond, NULL);
     if (!setup(b))
-        status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for the LOD DAG",
-                               b->mesh->name);
+        status = out_of_memory(b, err);
     if (status == GDR_OK)
         status = run_steps(b, &frontier, &depth, &stop, err);
     b->frontier = frontier;
     if (status == GDR_OK && (!form_root(b, depth) || !order_by_group(b)))
-        status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory for the LOD DAG",
-                               b->mesh->name);
+        status = out_of_memory(b, err);
     if (status == GDR_OK) {
         hand_over(b, depth, stop);
         uint64_t given = atomic_load(&b->progress_given);
@@ -551,6 +749,8 @@ static gdr_status build_mesh(lod_build *b, gdr_error *err)
         for (uint32_t w = 0; w < b->scratch_count; w++)
             gdr_lod_scratch_free(&b->scratch[w]);
     free(b->scratch);
+    pthread_cond_destroy(&b->partition_cond);
+    pthread_mutex_destroy(&b->partition_lock);
     return status;
 }
 

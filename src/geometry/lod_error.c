@@ -251,17 +251,17 @@ static int output_triangles(lod_scratch *s, const group_result *r, uint32_t loca
 }
 
 /* The members' samples, gathered in member order, with their coordinates. */
-static int gather_samples(lod_build *b, lod_scratch *s, uint32_t first, uint32_t count)
+static int gather_samples(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count)
 {
     size_t n = 0;
     for (uint32_t i = 0; i < count; i++)
-        n += b->cluster_sample_count[b->members[first + i]];
+        n += b->cluster_sample_count[members[i]];
     if (!LOD_RESERVE(s, sample_ids, n + 1) || !LOD_RESERVE(s, sample_points, n + 1) ||
         !LOD_RESERVE(s, sample_cluster, n + 1))
         return 0;
     n = 0;
     for (uint32_t i = 0; i < count; i++) {
-        uint32_t c = b->members[first + i];
+        uint32_t c = members[i];
         const uint32_t *ids = b->samples + b->cluster_sample_first[c];
         for (uint32_t j = 0; j < b->cluster_sample_count[c]; j++) {
             s->sample_ids[n] = ids[j];
@@ -289,11 +289,94 @@ static float ring_d2(const lod_scratch *s, uint32_t l, gdr_vec3 p, uint32_t *nea
     return best;
 }
 
+/* Samples measured per task when one group's samples are measured in parallel. */
+#define LOD_SAMPLE_RANGE 2048u
+
+/* Distance (squared) from sample i to the simplified triangles around its nearest simplified
+ * vertex (an upper bound), and the nearest of them. */
+static float sample_ring_d2(const lod_scratch *s, uint32_t i, uint32_t *nearest)
+{
+    float d2;
+    uint32_t l = s->vertex_local[lod_grid_nearest(&s->grid, s->sample_points[i], &d2)];
+    return ring_d2(s, l, s->sample_points[i], nearest);
+}
+
+/* Samples [first, end) in order: only a sample whose ring bound exceeds the largest distance so far
+ * is measured exactly (grid of the triangles). Returns the largest distance, squared. */
+static float measure_samples(lod_scratch *s, uint32_t first, uint32_t end)
+{
+    float worst = 0.0f;
+    for (uint32_t i = first; i < end; i++) {
+        uint32_t nearest;
+        float d = sample_ring_d2(s, i, &nearest);
+        if (d > worst)
+            nearest = lod_triangle_grid_nearest(&s->triangle_grid, s->sample_points[i], point_triangle_d2, &d);
+        s->sample_cluster[i] = s->out_cluster[nearest];
+        worst = d > worst ? d : worst;
+    }
+    return worst;
+}
+
+/* One range of the samples, measured as measure_samples would with the largest distance of the
+ * range so far: that is at most the largest distance over all earlier samples, so every sample the
+ * sequential order measures exactly is measured exactly here too. Keeps for each sample its ring
+ * bound (ring_d2), its exact distance (exact_d2; -1: not measured) and both nearest clusters
+ * (sample_cluster: ring's | exact's << 16) for replay_samples. */
+static void sample_range_task(void *user, uint32_t range, uint32_t worker)
+{
+    lod_scratch *s = user;
+    (void)worker;
+    uint32_t first = range * LOD_SAMPLE_RANGE, end = first + LOD_SAMPLE_RANGE;
+    end = end < s->gathered ? end : s->gathered;
+    float worst = 0.0f;
+    for (uint32_t i = first; i < end; i++) {
+        uint32_t nearest, exact_nearest;
+        float d = sample_ring_d2(s, i, &nearest), exact = d;
+        s->exact_d2[i] = -1.0f;
+        s->ring_d2[i] = d;
+        exact_nearest = nearest;
+        if (d > worst) {
+            exact_nearest = lod_triangle_grid_nearest(&s->triangle_grid, s->sample_points[i], point_triangle_d2,
+                                                      &exact);
+            s->exact_d2[i] = exact;
+            worst = exact > worst ? exact : worst;
+        }
+        s->sample_cluster[i] = s->out_cluster[nearest] | s->out_cluster[exact_nearest] << 16;
+    }
+}
+
+/* The sequential order over the ranges' results: the same decisions, distances and clusters as
+ * measure_samples over all samples. Returns the largest distance, squared. */
+static float replay_samples(lod_scratch *s)
+{
+    float worst = 0.0f;
+    for (uint32_t i = 0; i < s->gathered; i++) {
+        float d = s->ring_d2[i];
+        uint32_t cluster = s->sample_cluster[i] & 0xffff;
+        if (d > worst) { /* measured exactly in its range too */
+            d = s->exact_d2[i];
+            cluster = s->sample_cluster[i] >> 16;
+        }
+        s->sample_cluster[i] = cluster;
+        worst = d > worst ? d : worst;
+    }
+    return worst;
+}
+
+/* Whether this group's samples are measured by the pool's workers: the step's only group (its task
+ * runs on the calling thread, outside any job), with enough samples and few enough clusters. */
+static int measure_in_parallel(const lod_build *b, const lod_scratch *s, const group_result *r)
+{
+    return b->lone_group && gdr_thread_pool_thread_count(b->pool) > 1 && s->gathered >= 2 * LOD_SAMPLE_RANGE &&
+           r->cluster_count <= 0xffff;
+}
+
 /* Largest distance from a sample to the simplified triangles; each sample's nearest cluster. The
  * triangles around the nearest simplified vertex give an upper bound quickly; only a sample whose
  * bound exceeds the largest distance so far is measured exactly (grid of the triangles), so the
- * result is the exact maximum and every sample lies within it of the cluster it passes to. */
-static float samples_to_simplified(lod_scratch *s, uint32_t local_count)
+ * result is the exact maximum and every sample lies within it of the cluster it passes to. The
+ * step's only group measures its samples in ranges on the pool, with the same result. */
+static float samples_to_simplified(const lod_build *b, lod_scratch *s, uint32_t local_count, const group_result *r)
 {
     uint32_t used = 0;
     if (!LOD_RESERVE(s, vertex_points, local_count) || !LOD_RESERVE(s, vertex_local, local_count))
@@ -306,17 +389,12 @@ static float samples_to_simplified(lod_scratch *s, uint32_t local_count)
     if (!lod_grid_build(&s->grid, s->vertex_points, used, 4.0) ||
         !lod_triangle_grid_build(&s->triangle_grid, s->positions, s->out_corners, s->out_triangle_count))
         return -1.0f;
-    float worst = 0.0f;
-    for (uint32_t i = 0; i < s->gathered; i++) {
-        float d2;
-        uint32_t l = s->vertex_local[lod_grid_nearest(&s->grid, s->sample_points[i], &d2)], nearest;
-        float d = ring_d2(s, l, s->sample_points[i], &nearest);
-        if (d > worst)
-            nearest = lod_triangle_grid_nearest(&s->triangle_grid, s->sample_points[i], point_triangle_d2, &d);
-        s->sample_cluster[i] = s->out_cluster[nearest];
-        worst = d > worst ? d : worst;
-    }
-    return sqrtf(worst);
+    if (!measure_in_parallel(b, s, r))
+        return sqrtf(measure_samples(s, 0, s->gathered));
+    if (!LOD_RESERVE(s, ring_d2, s->gathered) || !LOD_RESERVE(s, exact_d2, s->gathered))
+        return -1.0f;
+    gdr_thread_pool_run(b->pool, (s->gathered + LOD_SAMPLE_RANGE - 1) / LOD_SAMPLE_RANGE, sample_range_task, s);
+    return sqrtf(replay_samples(s));
 }
 
 /* Distance (squared) from p to the level-0 triangles around position `position`: an upper bound of
@@ -680,12 +758,12 @@ static int hand_samples_to_clusters(lod_scratch *s, group_result *r)
     return 1;
 }
 
-int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, uint32_t first, uint32_t count, uint32_t local_count,
-                            group_result *r)
+int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count,
+                            uint32_t local_count, group_result *r)
 {
-    if (!output_triangles(s, r, local_count) || !gather_samples(b, s, first, count))
+    if (!output_triangles(s, r, local_count) || !gather_samples(b, s, members, count))
         return 0;
-    float to_simplified = s->gathered ? samples_to_simplified(s, local_count) : 0.0f;
+    float to_simplified = s->gathered ? samples_to_simplified(b, s, local_count, r) : 0.0f;
     float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified);
     if (to_simplified < 0.0f || to_full < 0.0f || !hand_samples_to_clusters(s, r))
         return 0;

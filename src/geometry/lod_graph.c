@@ -85,13 +85,23 @@ static void graph_free(cluster_graph *g)
     free(g->adjwgt);
 }
 
-static int build_graph(lod_build *b, cluster_graph *g)
+/* boundary_edges_task over the frontier: on `pool`, or (NULL) on this thread as `worker`. */
+static void boundary_edges(lod_build *b, gdr_thread_pool *pool, uint32_t worker)
+{
+    if (pool)
+        gdr_thread_pool_run(pool, b->frontier_count, boundary_edges_task, b);
+    else
+        for (uint32_t f = 0; f < b->frontier_count; f++)
+            boundary_edges_task(b, f, worker);
+}
+
+static int build_graph(lod_build *b, gdr_thread_pool *pool, uint32_t worker, cluster_graph *g)
 {
     uint32_t n = b->frontier_count;
     b->edge_record_counts = malloc((size_t)n * sizeof *b->edge_record_counts);
     if (!b->edge_record_counts)
         return 0;
-    gdr_thread_pool_run(b->pool, n, boundary_edges_task, b);
+    boundary_edges(b, pool, worker);
     size_t total = 0;
     for (uint32_t f = 0; f < n; f++) {
         uint32_t c = b->edge_record_counts[f];
@@ -101,7 +111,7 @@ static int build_graph(lod_build *b, cluster_graph *g)
     b->edge_records = malloc((total ? total : 1) * sizeof *b->edge_records);
     if (!b->edge_records)
         return 0;
-    gdr_thread_pool_run(b->pool, n, boundary_edges_task, b);
+    boundary_edges(b, pool, worker);
     key_record *edges = b->edge_records;
     key_record *tmp = malloc((total ? total : 1) * sizeof *tmp);
     if (!tmp)
@@ -170,12 +180,8 @@ static int build_graph(lod_build *b, cluster_graph *g)
 /* METIS keeps its random state in globals: one partition at a time, always from the same seed. */
 static pthread_mutex_t metis_lock = PTHREAD_MUTEX_INITIALIZER;
 
-/* Partitions the frontier into groups of neighbours holding about as many triangles as
- * group_size level-0 clusters (METIS balances triangle counts): part[f] in [0, parts). Weighing by
- * triangles keeps groups large when simplified clusters come out smaller than level-0 ones, so the
- * share of locked border in a group does not grow from step to step. Recursive bisection: with
- * parts of four clusters it cuts fewer edges than METIS_PartGraphKway here and runs 4x faster. */
-gdr_status gdr_lod_partition(lod_build *b, int32_t *part, uint32_t *out_parts, gdr_error *err)
+/* Groups of about as many triangles as group_size level-0 clusters, at most one per two clusters. */
+uint32_t gdr_lod_part_count(const lod_build *b)
 {
     uint32_t n = b->frontier_count;
     uint64_t triangles = 0;
@@ -183,13 +189,24 @@ gdr_status gdr_lod_partition(lod_build *b, int32_t *part, uint32_t *out_parts, g
         triangles += b->clusters[b->frontier[f]].triangle_count;
     uint64_t parts64 = (triangles + b->group_triangles - 1) / b->group_triangles;
     uint32_t parts = (uint32_t)(parts64 < (n + 1) / 2 ? parts64 : (n + 1) / 2);
+    return parts > 1 ? parts : 1;
+}
+
+/* Partitions the frontier into `parts` (gdr_lod_part_count) groups of neighbours holding about as
+ * many triangles each (METIS balances triangle counts): part[f] in [0, parts). Weighing by
+ * triangles keeps groups large when simplified clusters come out smaller than level-0 ones, so the
+ * share of locked border in a group does not grow from step to step. Recursive bisection: with
+ * parts of four clusters it cuts fewer edges than METIS_PartGraphKway here and runs 4x faster. */
+gdr_status gdr_lod_partition(lod_build *b, gdr_thread_pool *pool, uint32_t worker, int32_t *part, uint32_t parts,
+                             gdr_error *err)
+{
+    uint32_t n = b->frontier_count;
     if (parts <= 1) {
         memset(part, 0, n * sizeof *part);
-        *out_parts = 1;
         return GDR_OK;
     }
     cluster_graph g = {0};
-    int built = build_graph(b, &g);
+    int built = build_graph(b, pool, worker, &g);
     free(b->edge_records);
     free(b->edge_record_counts);
     b->edge_records = NULL;
@@ -226,6 +243,5 @@ gdr_status gdr_lod_partition(lod_build *b, int32_t *part, uint32_t *out_parts, g
         if (part[f] < 0 || (uint32_t)part[f] >= parts)
             return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "mesh '%s': METIS returned part %d of %u",
                                  b->mesh->name, (int)part[f], parts);
-    *out_parts = parts;
     return GDR_OK;
 }

@@ -60,13 +60,14 @@ static int contains_u64(const uint64_t *sorted, size_t n, uint64_t key)
     return lo < n && sorted[lo] == key;
 }
 
-/* The sphere and error that group g would have: over its members and the groups they came from. */
-static void group_bounds(lod_build *b, lod_scratch *s, uint32_t first, uint32_t count, group_result *r)
+/* The sphere of a group over `members` (count clusters) and the groups they came from, into r;
+ * returns the largest error of those groups. Read once the errors of the earlier steps are set. */
+float gdr_lod_group_bounds(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count, group_result *r)
 {
     uint32_t n = 0;
     float child_error = 0.0f;
     for (uint32_t i = 0; i < count; i++) {
-        const gdr_cluster *c = &b->clusters[b->members[first + i]];
+        const gdr_cluster *c = &b->clusters[members[i]];
         s->spheres[n++] = c->sphere;
         if (c->refined_group != GDR_NO_INDEX) {
             const gdr_cluster_group *from = &b->groups[c->refined_group];
@@ -75,7 +76,7 @@ static void group_bounds(lod_build *b, lod_scratch *s, uint32_t first, uint32_t 
         }
     }
     r->sphere = gdr_lod_enclosing_sphere(s->spheres, n);
-    r->error = child_error;
+    return child_error;
 }
 
 /* Every border edge of the input (an edge between two locked positions that no other input
@@ -151,6 +152,40 @@ static int split_into_clusters(lod_build *b, lod_scratch *s, size_t index_count,
     return 1;
 }
 
+/* The members' triangles over a compact local vertex list, numbered in the order the members'
+ * triangles first use them: fills s->local_to_mesh and s->map (mesh vertex -> local; the caller
+ * clears it), and s->indices when `indices` is set. Returns the local vertex count. */
+static uint32_t merge_members(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count, int indices)
+{
+    uint32_t local_count = 0;
+    size_t k = 0;
+    for (uint32_t i = 0; i < count; i++) {
+        const gdr_cluster *c = &b->clusters[members[i]];
+        const uint8_t *t = gdr_lod_cluster_triangles(b, c);
+        const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+        for (uint32_t j = 0; j < c->triangle_count * 3; j++) {
+            uint32_t mv = v[t[j]];
+            if (s->map[mv] == UINT32_MAX) {
+                s->map[mv] = local_count;
+                s->local_to_mesh[local_count++] = mv;
+            }
+            if (indices)
+                s->indices[k++] = s->map[mv];
+        }
+    }
+    return local_count;
+}
+
+/* Reserves the scratch for a group of `triangles` input triangles and `count` members. */
+static int reserve_group(lod_scratch *s, size_t triangles, uint32_t count)
+{
+    size_t index_count = triangles * 3;
+    return LOD_RESERVE(s, spheres, (size_t)count * 2) && LOD_RESERVE(s, indices, index_count) &&
+           LOD_RESERVE(s, simplified, index_count) && LOD_RESERVE(s, local_to_mesh, index_count) &&
+           LOD_RESERVE(s, locked, index_count) && LOD_RESERVE(s, edges_in, index_count) &&
+           LOD_RESERVE(s, edges_out, index_count) && LOD_RESERVE(s, positions, index_count * 9);
+}
+
 void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker)
 {
     lod_build *b = user;
@@ -164,31 +199,11 @@ void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker)
         triangles += b->clusters[b->members[first + i]].triangle_count;
     r->input_triangles = (uint32_t)triangles;
     size_t index_count = triangles * 3;
-    if (!LOD_RESERVE(s, spheres, (size_t)count * 2) || !LOD_RESERVE(s, indices, index_count) ||
-        !LOD_RESERVE(s, simplified, index_count) || !LOD_RESERVE(s, local_to_mesh, index_count) ||
-        !LOD_RESERVE(s, locked, index_count) || !LOD_RESERVE(s, edges_in, index_count) ||
-        !LOD_RESERVE(s, edges_out, index_count) || !LOD_RESERVE(s, positions, index_count * 9)) {
+    if (!reserve_group(s, triangles, count)) {
         r->out_of_memory = 1;
         return;
     }
-    group_bounds(b, s, first, count, r);
-
-    /* Merge: the members' triangles over a compact local vertex list. */
-    uint32_t local_count = 0;
-    size_t k = 0;
-    for (uint32_t i = 0; i < count; i++) {
-        const gdr_cluster *c = &b->clusters[b->members[first + i]];
-        const uint8_t *t = gdr_lod_cluster_triangles(b, c);
-        const uint32_t *v = gdr_lod_cluster_vertices(b, c);
-        for (uint32_t j = 0; j < c->triangle_count * 3; j++) {
-            uint32_t mv = v[t[j]];
-            if (s->map[mv] == UINT32_MAX) {
-                s->map[mv] = local_count;
-                s->local_to_mesh[local_count++] = mv;
-            }
-            s->indices[k++] = s->map[mv];
-        }
-    }
+    uint32_t local_count = merge_members(b, s, b->members + first, count, 1);
     /* Lock what other groups share. meshoptimizer 0.18 can only lock topological borders, which
      * would also freeze the mesh's own open edges; instead each shared vertex gets two unused
      * copies of its position, and the simplifier never moves a position held by more than two
@@ -221,13 +236,64 @@ void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker)
     gdr_lod_progress_add(b, triangles / 2, worker);
     if (!enough)
         return;
-    if (!split_into_clusters(b, s, out_count, local_count, r) ||
-        !gdr_lod_group_deviation(b, s, first, count, local_count, r)) {
+    if (!split_into_clusters(b, s, out_count, local_count, r)) {
         r->out_of_memory = 1;
         return;
     }
-    r->error = r->deviation > r->error ? r->deviation : r->error;
     r->formed = 1;
+}
+
+/* Puts back into the scratch what simplifying group g left there and measuring its deviation
+ * reads: the local vertex numbering and positions, and its new clusters (taken into b by now, from
+ * r->first_cluster on) as meshlets over local vertices. Returns the local vertex count, 0 when out
+ * of memory. */
+static uint32_t restore_group(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count,
+                              const group_result *r)
+{
+    size_t vertices = 0, bytes = 0;
+    for (uint32_t i = 0; i < r->cluster_count; i++) {
+        vertices += b->clusters[r->first_cluster + i].vertex_count;
+        bytes += (size_t)b->clusters[r->first_cluster + i].triangle_count * 3;
+    }
+    size_t index_count = (size_t)r->input_triangles * 3; /* bounds the local vertex count */
+    if (!LOD_RESERVE(s, local_to_mesh, index_count) || !LOD_RESERVE(s, positions, index_count * 3) ||
+        !LOD_RESERVE(s, meshlets, r->cluster_count) || !LOD_RESERVE(s, meshlet_vertices, vertices) ||
+        !LOD_RESERVE(s, meshlet_triangles, bytes))
+        return 0;
+    uint32_t local_count = merge_members(b, s, members, count, 0);
+    size_t vo = 0, to = 0;
+    for (uint32_t i = 0; i < r->cluster_count; i++) {
+        const gdr_cluster *c = &b->clusters[r->first_cluster + i];
+        const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+        s->meshlets[i] = (struct meshopt_Meshlet){.vertex_offset = (unsigned int)vo,
+                                                  .triangle_offset = (unsigned int)to,
+                                                  .vertex_count = c->vertex_count,
+                                                  .triangle_count = c->triangle_count};
+        for (uint32_t k = 0; k < c->vertex_count; k++)
+            s->meshlet_vertices[vo + k] = s->map[v[k]];
+        memcpy(s->meshlet_triangles + to, gdr_lod_cluster_triangles(b, c), (size_t)c->triangle_count * 3);
+        vo += c->vertex_count;
+        to += (size_t)c->triangle_count * 3;
+    }
+    for (uint32_t l = 0; l < local_count; l++) {
+        uint32_t mv = s->local_to_mesh[l];
+        s->map[mv] = UINT32_MAX;
+        memcpy(s->positions + (size_t)l * 3, &b->mesh->positions[mv], sizeof(gdr_vec3));
+    }
+    return local_count;
+}
+
+void gdr_lod_measure_group_task(void *user, uint32_t i, uint32_t worker)
+{
+    lod_build *b = user;
+    lod_scratch *s = &b->scratch[worker];
+    uint32_t g = b->measured[i];
+    group_result *r = &b->measured_results[g];
+    const uint32_t *members = b->measured_members + b->measured_member_start[g];
+    uint32_t count = b->measured_member_start[g + 1] - b->measured_member_start[g];
+    uint32_t local_count = restore_group(b, s, members, count, r);
+    if (!local_count || !gdr_lod_group_deviation(b, s, members, count, local_count, r))
+        r->out_of_memory = 1;
 }
 
 void gdr_lod_result_free(group_result *r)
@@ -270,4 +336,6 @@ void gdr_lod_scratch_free(lod_scratch *s)
     free(s->region_corners);
     free(s->coarse_d2);
     free(s->edge_d2);
+    free(s->ring_d2);
+    free(s->exact_d2);
 }

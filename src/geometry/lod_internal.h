@@ -3,6 +3,7 @@
 #ifndef GDR_GEOMETRY_LOD_INTERNAL_H
 #define GDR_GEOMETRY_LOD_INTERNAL_H
 
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -79,6 +80,8 @@ typedef struct lod_scratch {
     size_t coarse_d2_cap;
     float *edge_d2; /* per simplified triangle edge: its largest coarse probe (squared), -1 once refined */
     size_t edge_d2_cap;
+    float *ring_d2, *exact_d2; /* per sample, when one group's samples are measured in ranges */
+    size_t ring_d2_cap, exact_d2_cap;
     uint8_t edge_count[64 * 64];
 } lod_scratch;
 
@@ -91,7 +94,9 @@ typedef struct group_result {
     float deviation;   /* measured against the full-detail surface (lod_error.c) */
     gdr_vec4 sphere;
     uint32_t input_triangles;
-    gdr_cluster *clusters; /* offsets relative to the arrays below */
+    uint32_t group;         /* its id among the DAG's groups, once formed (or passed through) */
+    uint32_t first_cluster; /* where its new clusters went in lod_build.clusters */
+    gdr_cluster *clusters; /* offsets relative to the arrays below; freed once taken into the build */
     uint32_t cluster_count;
     uint32_t *vertices;
     uint32_t vertex_count;
@@ -140,6 +145,21 @@ typedef struct lod_build {
     const uint32_t *members;      /* frontier cluster ids ordered by group */
     const uint32_t *member_start; /* group g: members[member_start[g] .. member_start[g + 1]) */
     group_result *results;
+    /* the groups whose deviation is measured: measured_results[measured[i]], i < measured_count, of
+     * the step before (its members and results; its new clusters are in `clusters` by now) */
+    const uint32_t *measured;
+    uint32_t measured_count;
+    const uint32_t *measured_members, *measured_member_start;
+    group_result *measured_results;
+    int lone_group; /* one group is measured, on the calling thread outside any job */
+    /* the next step's partition, when it runs as task 0 of the job: the simplification tasks wait
+     * for it (partitioned set under partition_lock) */
+    struct lod_stage *partitioning;
+    pthread_mutex_t partition_lock;
+    pthread_cond_t partition_cond;
+    int partitioned;
+    gdr_status partition_status;
+    gdr_error partition_error;
     const uint32_t *frontier;
     uint32_t frontier_count;
     key_record *edge_records;      /* boundary edges of frontier clusters, per chunk */
@@ -164,20 +184,29 @@ static inline const uint32_t *gdr_lod_cluster_vertices(const lod_build *b, const
 /* Adds to the shared progress; only worker 0 of the calling thread draws. */
 void gdr_lod_progress_add(lod_build *b, uint64_t amount, uint32_t worker);
 
-/* lod_graph.c: partitions the frontier (b->frontier) into `*parts` groups of neighbours; part[f]
- * in [0, *parts). */
-gdr_status gdr_lod_partition(lod_build *b, int32_t *part, uint32_t *parts, gdr_error *err);
+/* lod_graph.c: the number of parts of the frontier (b->frontier), and its partition into them,
+ * groups of neighbours: part[f] in [0, parts). The cluster graph is built on `pool`, or (NULL) on
+ * this thread as `worker` (inside a job). */
+uint32_t gdr_lod_part_count(const lod_build *b);
+gdr_status gdr_lod_partition(lod_build *b, gdr_thread_pool *pool, uint32_t worker, int32_t *part, uint32_t parts,
+                             gdr_error *err);
 
-/* lod_group.c: a thread-pool task that simplifies group g of the step into b->results[g]. */
+/* lod_group.c: a thread-pool task that simplifies group g of the step into b->results[g] (and
+ * splits it into clusters); one that measures the deviation of group measured[i]. */
 void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker);
+void gdr_lod_measure_group_task(void *user, uint32_t i, uint32_t worker);
+/* A group's sphere (into r), over its members and the groups they came from; returns the largest
+ * error of those groups. */
+float gdr_lod_group_bounds(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count, group_result *r);
 void gdr_lod_result_free(group_result *r);
 
 /* lod_error.c: the samples of the full-detail surface and the groups' measured deviation. */
 int gdr_lod_error_setup(lod_build *b); /* after position ids and the owner table; 0: out of memory */
 void gdr_lod_error_free(lod_build *b);
-/* Sets r->deviation and r's samples by new cluster, after the split into clusters. */
-int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, uint32_t first, uint32_t count, uint32_t local_count,
-                            group_result *r);
+/* Sets r->deviation and r's samples by new cluster, after the split into clusters (members: the
+ * group's count member clusters). */
+int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count,
+                            uint32_t local_count, group_result *r);
 /* New cluster `cluster` owns the samples of `from` (pass-through) / of r's new cluster `index`. */
 int gdr_lod_error_inherit(lod_build *b, uint32_t cluster, uint32_t from);
 int gdr_lod_error_adopt(lod_build *b, uint32_t cluster, uint32_t group, const group_result *r, uint32_t index);
