@@ -233,6 +233,8 @@ static gdr_status lod_step(lod_build *b, uint32_t depth, uint32_t *next, uint32_
         b->stats.stuck_groups += !b->results[g].formed;
         b->stats.border_rejects += (uint64_t)b->results[g].border_reject;
     }
+    if (*progress && !gdr_lod_redirect_samples(b, groups))
+        goto oom;
     if (*progress && (!take_results(b, depth, groups, next, next_count) || !gdr_lod_error_gather(b, next, *next_count)))
         goto oom;
     goto done;

@@ -10,7 +10,9 @@
  *    walk ends at, or where that looks far off, to all level-0 triangles around the group's
  *    samples (a distance to some triangles of S0 is never below the distance to S0).
  * The group's error is the larger of its deviation and the errors of the groups its members came
- * from. Every level-0 position stays a sample at every step (that is what the proof needs). */
+ * from. Every level-0 position stays a sample at every step (that is what the proof needs). The
+ * group's farthest samples (above its floor: members' errors and D2) are listed for lod_redirect.c,
+ * which may pass them to a neighbouring group's cluster. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -290,7 +292,30 @@ static float ring_d2(const lod_scratch *s, uint32_t l, gdr_vec3 p, uint32_t *nea
     return best;
 }
 
-/* Largest distance from a sample to the simplified triangles; each sample's nearest cluster. The
+/* Keeps the LOD_EXCESS_LIMIT + 1 largest sample distance bounds seen (squared, ascending, with
+ * their sample): all other samples lie within the smallest of them of their cluster. */
+static void keep_largest(lod_scratch *s, float d, uint32_t sample)
+{
+    uint32_t at;
+    if (s->top_count < LOD_EXCESS_LIMIT + 1) { /* not full: insert from the end */
+        for (at = s->top_count++; at > 0 && s->top_d2[at - 1] > d; at--) {
+            s->top_d2[at] = s->top_d2[at - 1];
+            s->top_sample[at] = s->top_sample[at - 1];
+        }
+    } else if (d > s->top_d2[0]) { /* full: drop the smallest, insert from the start */
+        for (at = 0; at + 1 < s->top_count && s->top_d2[at + 1] < d; at++) {
+            s->top_d2[at] = s->top_d2[at + 1];
+            s->top_sample[at] = s->top_sample[at + 1];
+        }
+    } else {
+        return;
+    }
+    s->top_d2[at] = d;
+    s->top_sample[at] = sample;
+}
+
+/* Largest distance from a sample to the simplified triangles; each sample's nearest cluster, and
+ * the samples of the largest distance bounds (keep_largest). The
  * triangles around the nearest simplified vertex give an upper bound quickly; only a sample whose
  * bound exceeds the largest distance so far is measured exactly (grid of the triangles), so the
  * result is the exact maximum and every sample lies within it of the cluster it passes to. */
@@ -308,6 +333,7 @@ static float samples_to_simplified(lod_scratch *s, uint32_t local_count)
         !lod_triangle_grid_build(&s->triangle_grid, s->positions, s->out_corners, s->out_triangle_count))
         return -1.0f;
     float worst = 0.0f;
+    s->top_count = 0;
     for (uint32_t i = 0; i < s->gathered; i++) {
         float d2;
         uint32_t l = s->vertex_local[lod_grid_nearest(&s->grid, s->sample_points[i], &d2)], nearest;
@@ -315,6 +341,7 @@ static float samples_to_simplified(lod_scratch *s, uint32_t local_count)
         if (d > worst)
             nearest = lod_triangle_grid_nearest(&s->triangle_grid, s->sample_points[i], point_triangle_d2, &d);
         s->sample_cluster[i] = s->out_cluster[nearest];
+        keep_largest(s, d, i);
         worst = d > worst ? d : worst;
     }
     return sqrtf(worst);
@@ -575,6 +602,39 @@ static int hand_samples_to_clusters(lod_scratch *s, group_result *r)
     return 1;
 }
 
+/* The samples farther from the simplified triangles than `floor` (the group's error without D1, at
+ * least the smallest kept bound), with their exact distance, into r->excess (docs/GEOMETRY.md,
+ * "Samples that pass to a neighbour"); the exact query also hands such a sample to its nearest
+ * cluster. Only kept samples can be farther than the floor. */
+static int collect_excess(lod_scratch *s, group_result *r, float floor)
+{
+    float floor2 = floor * floor;
+    uint32_t over[LOD_EXCESS_LIMIT + 1], n = 0;
+    for (uint32_t k = 0; k < s->top_count; k++)
+        if (s->top_d2[k] > floor2)
+            over[n++] = s->top_sample[k];
+    r->floor = floor;
+    r->excess_count = 0;
+    if (n == 0 || n > LOD_EXCESS_LIMIT)
+        return 1;
+    qsort(over, n, sizeof *over, compare_u32); /* in sample order */
+    r->excess = malloc(n * sizeof *r->excess);
+    r->excess_distance = malloc(n * sizeof *r->excess_distance);
+    if (!r->excess || !r->excess_distance)
+        return 0;
+    for (uint32_t k = 0; k < n; k++) {
+        uint32_t i = over[k];
+        float d;
+        uint32_t nearest = lod_triangle_grid_nearest(&s->triangle_grid, s->sample_points[i], point_triangle_d2, &d);
+        s->sample_cluster[i] = s->out_cluster[nearest];
+        if (!(d > floor2))
+            continue;
+        r->excess[r->excess_count] = s->sample_ids[i];
+        r->excess_distance[r->excess_count++] = sqrtf(d);
+    }
+    return 1;
+}
+
 int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, uint32_t first, uint32_t count, uint32_t local_count,
                             group_result *r)
 {
@@ -582,8 +642,20 @@ int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, uint32_t first, uint32
         return 0;
     float to_simplified = s->gathered ? samples_to_simplified(s, local_count) : 0.0f;
     float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified);
-    if (to_simplified < 0.0f || to_full < 0.0f || !hand_samples_to_clusters(s, r))
+    /* Where D1 is set by the few samples (at most LOD_EXCESS_LIMIT) farther than all others and the
+     * members' errors, D2 is measured again down to that level: the group's floor, the part of its
+     * error that no redirection of samples can lower. Both measures bound D2: the smaller counts. */
+    float rest = s->top_count == LOD_EXCESS_LIMIT + 1 ? sqrtf(s->top_d2[0]) : 0.0f;
+    float floor = r->error > rest ? r->error : rest;
+    if (to_simplified > floor && to_full >= 0.0f) {
+        float again = simplified_to_full(b, s, floor);
+        to_full = again < to_full ? again : to_full;
+    }
+    floor = to_full > floor ? to_full : floor;
+    if (to_simplified < 0.0f || to_full < 0.0f || !collect_excess(s, r, floor) || !hand_samples_to_clusters(s, r))
         return 0;
     r->deviation = to_simplified > to_full ? to_simplified : to_full;
     return 1;
 }
+
+float gdr_lod_point_triangle_d2(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3 c) { return point_triangle_d2(p, a, b, c); }

@@ -237,6 +237,8 @@ void gdr_lod_result_free(group_result *r)
     free(r->triangles);
     free(r->samples);
     free(r->cluster_sample_first);
+    free(r->excess);
+    free(r->excess_distance);
     memset(r, 0, sizeof *r);
 }
 
