@@ -555,23 +555,24 @@ static void triangle_corners(const lod_scratch *s, uint32_t t, gdr_vec3 v[3])
  * samples' largest distance: probes below it cannot change the group's deviation). Every triangle
  * is probed on a barycentric grid of 3 steps an edge (6 points on the edges, the centroid); those
  * whose probes come within 70% of the largest then, on a grid of 8 steps (the deviation of a
- * simplified triangle peaks inside it or on an edge, between the coarse points). Returns -1 when
- * out of memory. */
-static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor)
+ * simplified triangle peaks inside it or on an edge, between the coarse points). Returns INFINITY
+ * as soon as the largest exceeds `cap` (no bound then), -1 when out of memory. */
+static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor, float cap)
 {
     probe_state ps = {b, s, floor * floor, 0};
+    float cap2 = cap * cap;
     s->region_built = 0;
     s->grid_holds_samples = 0;
     if (!LOD_RESERVE(s, coarse_d2, (size_t)s->out_triangle_count + 1))
         return -1.0f;
-    for (uint32_t t = 0; t < s->out_triangle_count; t++) {
+    for (uint32_t t = 0; t < s->out_triangle_count && !(ps.worst > cap2); t++) {
         gdr_vec3 v[3];
         triangle_corners(s, t, v);
         uint32_t at = b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]];
         s->coarse_d2[t] = probe_triangle(&ps, &at, v, 3);
     }
     float coarse_worst = ps.worst;
-    for (uint32_t t = 0; t < s->out_triangle_count; t++) {
+    for (uint32_t t = 0; t < s->out_triangle_count && !(ps.worst > cap2); t++) {
         if (s->coarse_d2[t] < 0.49f * coarse_worst) /* squared: below 70% */
             continue;
         gdr_vec3 v[3];
@@ -579,7 +580,7 @@ static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor)
         uint32_t at = b->position_id[s->local_to_mesh[s->out_corners[(size_t)t * 3]]];
         probe_triangle(&ps, &at, v, 8);
     }
-    return ps.failed ? -1.0f : sqrtf(ps.worst);
+    return ps.failed ? -1.0f : ps.worst > cap2 ? INFINITY : sqrtf(ps.worst);
 }
 
 /* The samples in order of the new cluster they pass to, into r. */
@@ -641,14 +642,16 @@ int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, uint32_t first, uint32
     if (!output_triangles(s, r, local_count) || !gather_samples(b, s, first, count))
         return 0;
     float to_simplified = s->gathered ? samples_to_simplified(s, local_count) : 0.0f;
-    float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified);
+    float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified, INFINITY);
     /* Where D1 is set by the few samples (at most LOD_EXCESS_LIMIT) farther than all others and the
      * members' errors, D2 is measured again down to that level: the group's floor, the part of its
-     * error that no redirection of samples can lower. Both measures bound D2: the smaller counts. */
+     * error that no redirection of samples can lower. Both measures bound D2: the smaller counts.
+     * Not where that level is above LOD_REDIRECT_GAIN of the error, and no further once D2 is: no
+     * redirection would pay. */
     float rest = s->top_count == LOD_EXCESS_LIMIT + 1 ? sqrtf(s->top_d2[0]) : 0.0f;
     float floor = r->error > rest ? r->error : rest;
-    if (to_simplified > floor && to_full >= 0.0f) {
-        float again = simplified_to_full(b, s, floor);
+    if (to_simplified > floor && to_full >= 0.0f && floor <= LOD_REDIRECT_GAIN * to_full) {
+        float again = simplified_to_full(b, s, floor, LOD_REDIRECT_GAIN * to_full);
         to_full = again < to_full ? again : to_full;
     }
     floor = to_full > floor ? to_full : floor;

@@ -20,6 +20,8 @@
 #define LOD_CONE_WEIGHT 0.25f
 /* A group with more samples than this farther than its floor keeps them (lod_redirect.c). */
 #define LOD_EXCESS_LIMIT 64u
+/* A group passes samples only when that at least halves its error: its sphere may grow by half. */
+#define LOD_REDIRECT_GAIN 0.5f
 
 /* lod_build.owner: a position no group of the step uses, or that two groups share. */
 #define OWNER_NONE UINT32_MAX

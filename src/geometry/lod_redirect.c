@@ -19,8 +19,6 @@
 
 /* A sphere grows by at most half for redirections (measured against 2x: docs/PERFORMANCE.md). */
 #define LOD_SPHERE_GROWTH 1.5f
-/* A group passes samples only when that at least halves its error: its sphere may grow by half. */
-#define LOD_REDIRECT_GAIN 0.5f
 #define NONE UINT32_MAX
 
 _Static_assert(sizeof(gdr_vec3) == 3 * sizeof(float), "positions are read as a float array");
@@ -243,7 +241,6 @@ static uint32_t find_root(uint32_t *parent, uint32_t x)
  * of the offending set to pass samples and returns 0; -1 when out of memory. */
 static int settle_spheres(redirect *rd)
 {
-
     const group_result *results = rd->b->results;
     uint32_t n = rd->groups;
     for (uint32_t g = 0; g < n; g++) {
