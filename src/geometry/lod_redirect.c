@@ -208,14 +208,16 @@ static void settle_errors(redirect *rd)
 }
 
 /* Forbids groups whose settled error is not at most LOD_REDIRECT_GAIN of their own to pass
- * samples: a small gain is not worth a larger sphere. Returns whether any was forbidden (their
- * errors go back up: settle again). */
+ * samples: a small gain is not worth a larger sphere. Errors count from the smallest error a group
+ * is given (flat parts gain nothing). Returns whether any was forbidden (their errors go back up:
+ * settle again). */
 static int forbid_small_gains(redirect *rd)
 {
     int any = 0;
+    float least = rd->b->min_error;
     for (uint32_t g = 0; g < rd->groups; g++)
         if (rd->first[g + 1] > rd->first[g] && !rd->forbidden[g] &&
-            !(rd->error[g] <= LOD_REDIRECT_GAIN * rd->b->results[g].error)) {
+            !(fmaxf(rd->error[g], least) <= LOD_REDIRECT_GAIN * fmaxf(rd->b->results[g].error, least))) {
             rd->forbidden[g] = 1;
             any = 1;
         }
