@@ -333,7 +333,6 @@ static float samples_to_simplified(lod_scratch *s, uint32_t local_count)
         !lod_triangle_grid_build(&s->triangle_grid, s->positions, s->out_corners, s->out_triangle_count))
         return -1.0f;
     float worst = 0.0f;
-    s->top_count = 0;
     for (uint32_t i = 0; i < s->gathered; i++) {
         float d2;
         uint32_t l = s->vertex_local[lod_grid_nearest(&s->grid, s->sample_points[i], &d2)], nearest;
@@ -641,6 +640,7 @@ int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, uint32_t first, uint32
 {
     if (!output_triangles(s, r, local_count) || !gather_samples(b, s, first, count))
         return 0;
+    s->top_count = 0; /* a group without samples keeps none */
     float to_simplified = s->gathered ? samples_to_simplified(s, local_count) : 0.0f;
     float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified, INFINITY);
     /* Where D1 is set by the few samples (at most LOD_EXCESS_LIMIT) farther than all others and the
@@ -661,4 +661,7 @@ int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, uint32_t first, uint32
     return 1;
 }
 
-float gdr_lod_point_triangle_d2(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3 c) { return point_triangle_d2(p, a, b, c); }
+float gdr_lod_point_triangle_d2(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3 c)
+{
+    return point_triangle_d2(p, a, b, c);
+}

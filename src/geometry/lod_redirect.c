@@ -132,7 +132,8 @@ static int collect_triangles(const redirect *rd, step_triangles *t)
             if (!t->near[clusters++])
                 continue;
             for (uint32_t j = 0; j < c->triangle_count * 3; j++)
-                t->corners[(size_t)t->count * 3 + j] = r->vertices[c->vertex_offset + r->triangles[c->triangle_offset + j]];
+                t->corners[(size_t)t->count * 3 + j] =
+                    r->vertices[c->vertex_offset + r->triangles[c->triangle_offset + j]];
             for (uint32_t j = 0; j < c->triangle_count; j++) {
                 t->group[t->count + j] = g;
                 t->cluster[t->count + j] = i;
@@ -332,7 +333,8 @@ static int apply(redirect *rd)
         return 1;
     uint8_t *moved = calloc((size_t)b->position_count + 1, 1);
     uint32_t *in_start = calloc((size_t)n + 1, sizeof *in_start);
-    uint32_t *in_sample = malloc((size_t)moves * sizeof *in_sample), *in_cluster = malloc((size_t)moves * sizeof *in_cluster);
+    uint32_t *in_sample = malloc((size_t)moves * sizeof *in_sample);
+    uint32_t *in_cluster = malloc((size_t)moves * sizeof *in_cluster);
     int ok = moved && in_start && in_sample && in_cluster;
     for (uint32_t g = 0; ok && g < n; g++)
         for (uint32_t k = rd->first[g]; k < rd->first[g + 1]; k++)
