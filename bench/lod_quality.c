@@ -4,7 +4,8 @@
  * count, its true deviation (symmetric Hausdorff distance to the full-detail mesh, from dense
  * samples of both surfaces) and the error the DAG states for it (the largest error of the groups
  * the drawn clusters were made from). From the curve: the fewest triangles of a cut whose true
- * deviation is within 0.1% and 1% of the radius.
+ * deviation is within 0.1% and 1% of the radius. Also the run-time cut's triangles (projected
+ * error, so group spheres count) for cameras at 1.5 to 30 radii.
  *
  * Another builder's DAG can be measured the same way: for mesh NAME, this program writes the
  * input to DIR/NAME.mesh, and reads DIR/NAME.dag when present (written by a program outside the
@@ -34,6 +35,7 @@
 
 #include "heap_count.h"
 #include "surface_distance.h"
+#include "geometry/lod_cut.h"
 #include "gdr/geometry.h"
 #include "gdr/io.h"
 #include "gdr/scene.h"
@@ -396,6 +398,38 @@ static double worst_understatement(const curve_point *c)
     return worst;
 }
 
+/* --- cuts for views ---------------------------------------------------------------------------------- */
+
+/* Triangles of the run-time cut (projected error, so group spheres count too) for a camera at
+ * 1.5, 3, 10 and 30 radii from the centre, along three directions each, summed per distance:
+ * 1 px at 1080 lines, 60 degrees vertical field of view. */
+static void print_views(const gdr_mesh *m)
+{
+    static const float distances[] = {1.5f, 3.0f, 10.0f, 30.0f};
+    static const gdr_vec3 directions[] = {{0.8f, 0.5f, 0.33f}, {-0.3f, 0.2f, 0.93f}, {0.1f, -0.99f, 0.1f}};
+    const gdr_mesh_clusters *mc = &m->clusters;
+    uint8_t *selected = xmalloc(mc->cluster_count + 1);
+    printf("  views (1 px, 1080 lines, 60 deg):");
+    for (size_t i = 0; i < sizeof distances / sizeof distances[0]; i++) {
+        uint64_t total = 0;
+        for (size_t j = 0; j < sizeof directions / sizeof directions[0]; j++) {
+            gdr_vec3 d = gdr_vec3_normalize(directions[j]);
+            float r = m->bounds.w * distances[i];
+            gdr_lod_view v = {.transform = gdr_mat4_identity(),
+                              .camera_position = {m->bounds.x + d.x * r, m->bounds.y + d.y * r, m->bounds.z + d.z * r},
+                              .projection_y = 1.0f / tanf(0.5f * 1.0471976f),
+                              .viewport_height = 1080.0f,
+                              .znear = 1e-3f * m->bounds.w,
+                              .threshold = 1.0f};
+            gdr_lod_cut_select(mc, &v, selected);
+            for (uint32_t c = 0; c < mc->cluster_count; c++)
+                total += selected[c] ? mc->clusters[c].triangle_count : 0;
+        }
+        printf(" %.1f R %llu%s", (double)distances[i], (unsigned long long)total, i + 1 < 4 ? "," : " triangles\n");
+    }
+    free(selected);
+}
+
 /* --- report ------------------------------------------------------------------------------------------ */
 
 static void print_curve(const char *builder, const curve_point *c)
@@ -429,6 +463,7 @@ static void measure_mesh(const char *name, const char *dir, int repeat, int do_s
            triangles / f.seconds[2] / 1e6, f.seconds[1] / f.seconds[2], f.peak_heap / triangles,
            (unsigned long long)f.stats.cluster_count, f.half_full * 100, f.stats.max_depth,
            (double)f.stats.dag_triangles / triangles);
+    print_views(m);
     flat_dag other = {0};
     int has_other = dir && read_dag(dir, m, &other);
     if (has_other) {

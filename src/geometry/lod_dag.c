@@ -387,7 +387,12 @@ static int set_errors(lod_build *b, const lod_stage *st, const uint32_t *frontie
  * when out of memory. */
 static int finish_errors(lod_build *b, lod_stage *st, const uint32_t *frontier, uint32_t frontier_count)
 {
-    return stage_bounds(b, st) && set_errors(b, st, frontier, frontier_count);
+    if (!stage_bounds(b, st))
+        return 0;
+    b->results = st->results;
+    int redirected = gdr_lod_redirect_samples(b, st->groups);
+    b->results = NULL;
+    return redirected && set_errors(b, st, frontier, frontier_count);
 }
 
 /* Whether the job left any group of these out of memory. */

@@ -10,7 +10,9 @@
  *    walk ends at, or where that looks far off, to all level-0 triangles around the group's
  *    samples (a distance to some triangles of S0 is never below the distance to S0).
  * The group's error is the larger of its deviation and the errors of the groups its members came
- * from. Every level-0 position stays a sample at every step (that is what the proof needs). */
+ * from. Every level-0 position stays a sample at every step (that is what the proof needs). The
+ * group's farthest samples (above its floor: members' errors and D2) are listed for lod_redirect.c,
+ * which may pass them to a neighbouring group's cluster. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -289,6 +291,28 @@ static float ring_d2(const lod_scratch *s, uint32_t l, gdr_vec3 p, uint32_t *nea
     return best;
 }
 
+/* Keeps the LOD_EXCESS_LIMIT + 1 largest sample distance bounds seen (squared, ascending, with
+ * their sample): all other samples lie within the smallest of them of their cluster. */
+static void keep_largest(lod_scratch *s, float d, uint32_t sample)
+{
+    uint32_t at;
+    if (s->top_count < LOD_EXCESS_LIMIT + 1) { /* not full: insert from the end */
+        for (at = s->top_count++; at > 0 && s->top_d2[at - 1] > d; at--) {
+            s->top_d2[at] = s->top_d2[at - 1];
+            s->top_sample[at] = s->top_sample[at - 1];
+        }
+    } else if (d > s->top_d2[0]) { /* full: drop the smallest, insert from the start */
+        for (at = 0; at + 1 < s->top_count && s->top_d2[at + 1] < d; at++) {
+            s->top_d2[at] = s->top_d2[at + 1];
+            s->top_sample[at] = s->top_sample[at + 1];
+        }
+    } else {
+        return;
+    }
+    s->top_d2[at] = d;
+    s->top_sample[at] = sample;
+}
+
 /* Samples measured per task when one group's samples are measured in parallel. */
 #define LOD_SAMPLE_RANGE 2048u
 
@@ -312,6 +336,7 @@ static float measure_samples(lod_scratch *s, uint32_t first, uint32_t end)
         if (d > worst)
             nearest = lod_triangle_grid_nearest(&s->triangle_grid, s->sample_points[i], point_triangle_d2, &d);
         s->sample_cluster[i] = s->out_cluster[nearest];
+        keep_largest(s, d, i);
         worst = d > worst ? d : worst;
     }
     return worst;
@@ -358,6 +383,7 @@ static float replay_samples(lod_scratch *s)
             cluster = s->sample_cluster[i] >> 16;
         }
         s->sample_cluster[i] = cluster;
+        keep_largest(s, d, i);
         worst = d > worst ? d : worst;
     }
     return worst;
@@ -371,7 +397,8 @@ static int measure_in_parallel(const lod_build *b, const lod_scratch *s, const g
            r->cluster_count <= 0xffff;
 }
 
-/* Largest distance from a sample to the simplified triangles; each sample's nearest cluster. The
+/* Largest distance from a sample to the simplified triangles; each sample's nearest cluster, and
+ * the samples of the largest distance bounds (keep_largest). The
  * triangles around the nearest simplified vertex give an upper bound quickly; only a sample whose
  * bound exceeds the largest distance so far is measured exactly (grid of the triangles), so the
  * result is the exact maximum and every sample lies within it of the cluster it passes to. The
@@ -720,22 +747,24 @@ static float probe_shared(probe_state *ps, lod_scratch *s, uint32_t t, int n, in
  * whose probes come within 70% of the largest then, on a grid of 8 steps (the deviation of a
  * simplified triangle peaks inside it or on an edge, between the coarse points). An edge two
  * triangles share is probed once on each grid (by the first; the second counts its probes as its
- * own). Returns -1 when out of memory. */
-static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor)
+ * own). Returns INFINITY as soon as the largest exceeds `cap` (no bound then), -1 when out of
+ * memory. */
+static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor, float cap)
 {
     probe_state ps = {b, s, floor * floor, 0.0f, 0.0f, 0};
+    float cap2 = cap * cap;
     s->region_built = 0;
     s->grid_holds_samples = 0;
     if (!LOD_RESERVE(s, coarse_d2, (size_t)s->out_triangle_count + 1) ||
         !LOD_RESERVE(s, edge_d2, (size_t)s->out_triangle_count * 3 + 1))
         return -1.0f;
-    for (uint32_t t = 0; t < s->out_triangle_count; t++)
+    for (uint32_t t = 0; t < s->out_triangle_count && !(ps.worst > cap2); t++)
         s->coarse_d2[t] = probe_shared(&ps, s, t, 3, 0);
     float coarse_worst = ps.worst;
-    for (uint32_t t = 0; t < s->out_triangle_count; t++)
+    for (uint32_t t = 0; t < s->out_triangle_count && !(ps.worst > cap2); t++)
         if (!(s->coarse_d2[t] < refine_share(coarse_worst)))
             probe_shared(&ps, s, t, 8, 1);
-    return ps.failed ? -1.0f : sqrtf(ps.worst);
+    return ps.failed ? -1.0f : ps.worst > cap2 ? INFINITY : sqrtf(ps.worst);
 }
 
 /* The samples in order of the new cluster they pass to, into r. */
@@ -758,15 +787,66 @@ static int hand_samples_to_clusters(lod_scratch *s, group_result *r)
     return 1;
 }
 
+/* The samples farther from the simplified triangles than `floor` (the group's error without D1, at
+ * least the smallest kept bound), with their exact distance, into r->excess (docs/GEOMETRY.md,
+ * "Samples that pass to a neighbour"); the exact query also hands such a sample to its nearest
+ * cluster. Only kept samples can be farther than the floor. */
+static int collect_excess(lod_scratch *s, group_result *r, float floor)
+{
+    float floor2 = floor * floor;
+    uint32_t over[LOD_EXCESS_LIMIT + 1], n = 0;
+    for (uint32_t k = 0; k < s->top_count; k++)
+        if (s->top_d2[k] > floor2)
+            over[n++] = s->top_sample[k];
+    r->floor = floor;
+    r->excess_count = 0;
+    if (n == 0 || n > LOD_EXCESS_LIMIT)
+        return 1;
+    qsort(over, n, sizeof *over, compare_u32); /* in sample order */
+    r->excess = malloc(n * sizeof *r->excess);
+    r->excess_distance = malloc(n * sizeof *r->excess_distance);
+    if (!r->excess || !r->excess_distance)
+        return 0;
+    for (uint32_t k = 0; k < n; k++) {
+        uint32_t i = over[k];
+        float d;
+        uint32_t nearest = lod_triangle_grid_nearest(&s->triangle_grid, s->sample_points[i], point_triangle_d2, &d);
+        s->sample_cluster[i] = s->out_cluster[nearest];
+        if (!(d > floor2))
+            continue;
+        r->excess[r->excess_count] = s->sample_ids[i];
+        r->excess_distance[r->excess_count++] = sqrtf(d);
+    }
+    return 1;
+}
+
 int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count,
                             uint32_t local_count, group_result *r)
 {
     if (!output_triangles(s, r, local_count) || !gather_samples(b, s, members, count))
         return 0;
+    s->top_count = 0; /* a group without samples keeps none */
     float to_simplified = s->gathered ? samples_to_simplified(b, s, local_count, r) : 0.0f;
-    float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified);
-    if (to_simplified < 0.0f || to_full < 0.0f || !hand_samples_to_clusters(s, r))
+    float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified, INFINITY);
+    /* Where D1 is set by the few samples (at most LOD_EXCESS_LIMIT) farther than all others and the
+     * members' errors, D2 is measured again down to that level: the group's floor, the part of its
+     * error that no redirection of samples can lower. Both measures bound D2: the smaller counts.
+     * Not where that level is above LOD_REDIRECT_GAIN of the error, and no further once D2 is: no
+     * redirection would pay. */
+    float rest = s->top_count == LOD_EXCESS_LIMIT + 1 ? sqrtf(s->top_d2[0]) : 0.0f;
+    float floor = r->error > rest ? r->error : rest;
+    if (to_simplified > floor && to_full >= 0.0f && floor <= LOD_REDIRECT_GAIN * to_full) {
+        float again = simplified_to_full(b, s, floor, LOD_REDIRECT_GAIN * to_full);
+        to_full = again < to_full ? again : to_full;
+    }
+    floor = to_full > floor ? to_full : floor;
+    if (to_simplified < 0.0f || to_full < 0.0f || !collect_excess(s, r, floor) || !hand_samples_to_clusters(s, r))
         return 0;
     r->deviation = to_simplified > to_full ? to_simplified : to_full;
     return 1;
+}
+
+float gdr_lod_point_triangle_d2(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3 c)
+{
+    return point_triangle_d2(p, a, b, c);
 }

@@ -283,6 +283,19 @@ static uint32_t restore_group(lod_build *b, lod_scratch *s, const uint32_t *memb
     return local_count;
 }
 
+/* The largest error of the groups the members came from (set once the steps before had all their
+ * deviations measured, before this job). */
+static float members_error(const lod_build *b, const uint32_t *members, uint32_t count)
+{
+    float error = 0.0f;
+    for (uint32_t i = 0; i < count; i++) {
+        uint32_t from = b->clusters[members[i]].refined_group;
+        if (from != GDR_NO_INDEX && b->groups[from].error > error)
+            error = b->groups[from].error;
+    }
+    return error;
+}
+
 void gdr_lod_measure_group_task(void *user, uint32_t i, uint32_t worker)
 {
     lod_build *b = user;
@@ -292,6 +305,7 @@ void gdr_lod_measure_group_task(void *user, uint32_t i, uint32_t worker)
     const uint32_t *members = b->measured_members + b->measured_member_start[g];
     uint32_t count = b->measured_member_start[g + 1] - b->measured_member_start[g];
     uint32_t local_count = restore_group(b, s, members, count, r);
+    r->error = members_error(b, members, count); /* the part of the floor the deviation needs */
     if (!local_count || !gdr_lod_group_deviation(b, s, members, count, local_count, r))
         r->out_of_memory = 1;
 }
@@ -303,6 +317,8 @@ void gdr_lod_result_free(group_result *r)
     free(r->triangles);
     free(r->samples);
     free(r->cluster_sample_first);
+    free(r->excess);
+    free(r->excess_distance);
     memset(r, 0, sizeof *r);
 }
 

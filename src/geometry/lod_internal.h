@@ -19,6 +19,10 @@
 /* A group is formed only when simplification keeps at most this share of its triangles. */
 #define LOD_MAX_KEPT_SHARE 0.85
 #define LOD_CONE_WEIGHT 0.25f
+/* A group with more samples than this farther than its floor keeps them (lod_redirect.c). */
+#define LOD_EXCESS_LIMIT 64u
+/* A group passes samples only when that at least halves its error: its sphere may grow by half. */
+#define LOD_REDIRECT_GAIN 0.5f
 
 /* lod_build.owner: a position no group of the step uses, or that two groups share. */
 #define OWNER_NONE UINT32_MAX
@@ -64,6 +68,8 @@ typedef struct lod_scratch {
     uint32_t *out_corners, *out_cluster, *ring_start, *ring;
     size_t out_corners_cap, out_cluster_cap, ring_start_cap, ring_cap;
     uint32_t out_triangle_count;
+    float top_d2[LOD_EXCESS_LIMIT + 1]; /* the largest sample distance bounds (squared, ascending) */
+    uint32_t top_sample[LOD_EXCESS_LIMIT + 1], top_count; /* ... and their gathered samples */
     uint32_t *sample_ids, *sample_cluster, *vertex_local;
     size_t sample_ids_cap, sample_cluster_cap, vertex_local_cap;
     gdr_vec3 *sample_points, *vertex_points;
@@ -104,6 +110,10 @@ typedef struct group_result {
     uint32_t triangle_bytes;
     uint32_t *samples;              /* the group's samples, by the new cluster they pass to */
     uint32_t *cluster_sample_first; /* new cluster i: samples[first[i] .. first[i + 1]) */
+    float floor;                    /* the error without D1: members' errors and D2 (lod_redirect.c) */
+    uint32_t *excess;               /* samples farther than `floor` from the new clusters, */
+    float *excess_distance;         /* with their distance to them */
+    uint32_t excess_count;
 } group_result;
 
 typedef struct lod_build {
@@ -210,6 +220,11 @@ int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *member
 /* New cluster `cluster` owns the samples of `from` (pass-through) / of r's new cluster `index`. */
 int gdr_lod_error_inherit(lod_build *b, uint32_t cluster, uint32_t from);
 int gdr_lod_error_adopt(lod_build *b, uint32_t cluster, uint32_t group, const group_result *r, uint32_t index);
+/* lod_redirect.c: after a step's groups are measured, samples that set a group's error may pass to
+ * a neighbouring group's new cluster; lowers errors and grows spheres (docs/GEOMETRY.md). */
+int gdr_lod_redirect_samples(lod_build *b, uint32_t groups);
+/* Squared distance from p to triangle (a, b, c) (lod_error.c). */
+float gdr_lod_point_triangle_d2(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3 c);
 /* Packs the samples of the next frontier into one array (before the step's results are freed). */
 int gdr_lod_error_gather(lod_build *b, const uint32_t *frontier, uint32_t count);
 void gdr_lod_scratch_free(lod_scratch *s);

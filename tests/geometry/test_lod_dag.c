@@ -872,12 +872,76 @@ static void test_coarse_error_tight(void)
     gdr_scene_destroy(s);
 }
 
+/* Distance from p to the ideal torus around the y axis. */
+static double torus_distance(dvec3 p, double major, double minor)
+{
+    double q = sqrt(p.x * p.x + p.z * p.z) - major;
+    return fabs(sqrt(q * q + p.y * p.y) - minor);
+}
+
+/* Per group: the largest distance from points of its new clusters (a grid of 4 steps an edge) to
+ * the ideal torus, into own[]. */
+static void clusters_to_torus(const gdr_mesh *m, double *own)
+{
+    const gdr_mesh_clusters *mc = &m->clusters;
+    for (uint32_t i = 0; i < mc->cluster_count; i++) {
+        const gdr_cluster *k = &mc->clusters[i];
+        for (uint32_t t = 0; k->refined_group != GDR_NO_INDEX && t < k->triangle_count; t++) {
+            dvec3 v[3];
+            for (int j = 0; j < 3; j++)
+                v[j] = d3(m->positions[mc->vertices[k->vertex_offset + mc->triangles[k->triangle_offset + 3 * t + j]]]);
+            for (int u = 0; u <= 4; u++)
+                for (int w = 0; u + w <= 4; w++) {
+                    double x = u / 4.0, y = w / 4.0, z = 1 - x - y;
+                    dvec3 p = {z * v[0].x + x * v[1].x + y * v[2].x, z * v[0].y + x * v[1].y + y * v[2].y,
+                               z * v[0].z + x * v[1].z + y * v[2].z};
+                    own[k->refined_group] = fmax(own[k->refined_group], torus_distance(p, 1.0, 0.35));
+                }
+        }
+    }
+}
+
+/* A torus of 360 x 180 quads has open seams (positions not bit-equal) and groups that drop a
+ * border sliver their neighbour keeps: samples there lie far from their own group's new clusters
+ * but on a neighbour's. Without passing them to the neighbour a group stated 5.2x the larger of
+ * its children's errors and its clusters' distance to the torus (the deviation the rest of it
+ * shows); every group must now state at most 2x that. */
+static void test_samples_pass_to_neighbours(void)
+{
+    gdr_scene *s = new_scene();
+    gdr_error err = {0};
+    uint32_t torus;
+    check_ok(gdr_procedural_torus(s, 1.0f, 0.35f, 360, 180, &torus, &err), &err, "torus");
+    gdr_mesh *m = &s->meshes[torus];
+    build_level0(m);
+    gdr_lod_options o = {.thread_count = 1, .no_progress = 1};
+    check_ok(gdr_mesh_build_lod_dag(m, &o, NULL, &err), &err, m->name);
+    const gdr_mesh_clusters *mc = &m->clusters;
+    double *own = calloc(mc->group_count, sizeof *own), *child = calloc(mc->group_count, sizeof *child);
+    clusters_to_torus(m, own);
+    for (uint32_t i = 0; i < mc->cluster_count; i++) {
+        const gdr_cluster *k = &mc->clusters[i];
+        if (k->group != GDR_NO_INDEX && k->refined_group != GDR_NO_INDEX)
+            child[k->group] = fmax(child[k->group], mc->groups[k->refined_group].error);
+    }
+    double worst = 0;
+    for (uint32_t g = 0; g < mc->group_count; g++)
+        if (mc->groups[g].error < INFINITY)
+            worst = fmax(worst, mc->groups[g].error / fmax(fmax(own[g], child[g]), 1e-6 * m->bounds.w));
+    printf("torus 360x180: a group states at most %.2fx its children's errors and its clusters' distance\n", worst);
+    CHECK(worst <= 2.0);
+    free(own);
+    free(child);
+    gdr_scene_destroy(s);
+}
+
 int main(void)
 {
     test_meshes();
     test_determinism();
     test_error_bounds_deviation();
     test_coarse_error_tight();
+    test_samples_pass_to_neighbours();
     test_scene();
     test_bad_input();
     return test_finish("test_lod_dag");
