@@ -185,17 +185,23 @@ static void check_budgets(const gdr_frame_stats *stats, uint64_t budget)
     CHECK(stats->streaming.requests_dropped == 0);
 }
 
-static uint64_t pool_bytes(const char *path)
+/* The pool bytes of every page together; *slot receives a slot's size (the largest page's, rounded
+ * up to 256 bytes as the residency does). */
+static uint64_t pool_bytes(const char *path, uint64_t *slot)
 {
     gdr_paged_cache *cache = NULL;
     gdr_error err = {0};
-    uint64_t total = 0;
+    uint64_t total = 0, largest = 0;
     if (gdr_paged_cache_open(path, &cache, &err) != GDR_OK)
         return 0;
     for (uint32_t m = 0; m < gdr_paged_cache_mesh_count(cache); m++)
-        for (uint32_t p = 0; p < gdr_paged_cache_mesh(cache, m)->page_count; p++)
-            total += gdr_page_pool_bytes(&gdr_paged_cache_mesh(cache, m)->pages[p]);
+        for (uint32_t p = 0; p < gdr_paged_cache_mesh(cache, m)->page_count; p++) {
+            uint64_t bytes = gdr_page_pool_bytes(&gdr_paged_cache_mesh(cache, m)->pages[p]);
+            total += bytes;
+            largest = bytes > largest ? bytes : largest;
+        }
     gdr_paged_cache_close(cache);
+    *slot = (largest + 255) & ~(uint64_t)255;
     return total;
 }
 
@@ -423,18 +429,24 @@ static void run(const gdr_scene *scene, const char *path)
     history_free(&check);
     gdr_renderer_destroy(whole);
 
-    uint64_t total = pool_bytes(path), budget = total / 10;
+    /* A pool one slot larger than the view that needs most (at most a tenth of the pages): each view
+     * fits, the three together do not, so the still views evict. */
+    uint64_t slot = 0, total = pool_bytes(path, &slot);
+    uint32_t most = 0;
     for (int v = 0; v < VIEWS; v++) {
         gdr_frame_desc frame = view_frame(v);
-        printf("view %d needs %u slots\n", v, slots_needed(scene, path, &frame));
+        uint32_t needed = slots_needed(scene, path, &frame);
+        printf("view %d needs %u slots\n", v, needed);
+        most = needed > most ? needed : most;
     }
-    /* The tenth streams a scene read without its geometry; the run with room for everything streams
+    uint64_t budget = (most + 1) * slot < total / 10 ? (most + 1) * slot : total / 10;
+    /* The small pool streams a scene read without its geometry; the run with room for everything streams
      * the whole scene. */
     gdr_scene *paged = read_for_streaming(path);
     gdr_renderer *r = paged ? streamed_renderer(paged, path, budget) : NULL;
     CHECK(r && total > 0);
     if (r && reference) {
-        uint64_t evictions = still_views(scene, r, budget, reference, "tenth");
+        uint64_t evictions = still_views(scene, r, budget, reference, "small pool");
         CHECK(evictions > 0); /* the views need more than the pool holds */
         camera_path(scene, r, budget);
     }
