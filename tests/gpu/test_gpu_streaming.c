@@ -1,14 +1,15 @@
 /* Streaming in the renderer (docs/STREAMING.md) on the default device (lavapipe in CI), validation
- * on: `unique-field` written with one group a page, drawn by a renderer whose page pool holds a
- * tenth of the pages' bytes and copies at most 256 KiB a frame. Along still views and a path, every
+ * on: `unique-field` written with one group a page, drawn by a renderer whose page pool holds one
+ * slot more than the view that needs most (at most a tenth of the pages' bytes) and copies at most
+ * 256 KiB a frame. Along still views and a path, every
  * frame's drawn clusters are the CPU's cut over the groups the renderer reports resident (exactly
  * one cluster on every DAG path: no hole, no crack), the pool stays within the budget, each frame's
  * uploads within theirs, no page in use is evicted, and each still view converges to the image of
  * the scene uploaded whole, pixel for pixel. A budget large enough for everything gives that image
  * with no eviction; a page damaged on disk is refused by name and its group stays absent while the
  * frames go on with coarser geometry, and so are the pages of a file cut short while it streams.
- * The scene is quantized (as gdr build --pages writes it) and the tenth streams it as read for
- * streaming, without its geometry. */
+ * The scene is quantized (as gdr build --pages writes it) and the small pool streams it as read
+ * for streaming, without its geometry. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
