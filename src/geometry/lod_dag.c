@@ -339,8 +339,9 @@ static int take_geometry(lod_build *b, lod_stage *st, uint32_t *next, uint32_t *
 }
 
 /* Each group's sphere and error (its deviation, or the largest error of the groups its members
- * came from where that is larger) into its result, once every deviation of the step is measured
- * and the errors of the steps before are set. Returns 0 when out of memory. */
+ * came from where that is larger: r->error, which the measuring task set, 0 for a group passed
+ * through at step 0) into its result, once every deviation of the step is measured. Returns 0
+ * when out of memory. */
 static int stage_bounds(lod_build *b, lod_stage *st)
 {
     lod_scratch *s = &b->scratch[0];
@@ -351,15 +352,15 @@ static int stage_bounds(lod_build *b, lod_stage *st)
             continue;
         if (!LOD_RESERVE(s, spheres, (size_t)count * 2))
             return 0;
-        float child_error = gdr_lod_group_bounds(b, s, st->members + st->start[g], count, r);
-        r->error = r->deviation > child_error ? r->deviation : child_error;
+        gdr_lod_group_sphere(b, s, st->members + st->start[g], count, r);
+        r->error = r->deviation > r->error ? r->deviation : r->error;
     }
     return 1;
 }
 
 /* The step's results into the build: each group's sphere and error, its new clusters' samples, and
- * the samples of `frontier` (the one the step made) packed into one array. Returns 0 when out of
- * memory. */
+ * the samples of `frontier` (the one the step made) packed into one array (b->results is st's: the
+ * gather reads the samples there). Returns 0 when out of memory. */
 static int set_errors(lod_build *b, const lod_stage *st, const uint32_t *frontier, uint32_t frontier_count)
 {
     for (uint32_t g = 0; g < st->groups; g++) {
@@ -375,10 +376,7 @@ static int set_errors(lod_build *b, const lod_stage *st, const uint32_t *frontie
                             : gdr_lod_error_inherit(b, r->first_cluster + i, members[i])))
                 return 0;
     }
-    b->results = st->results; /* where the gathered samples come from */
-    int ok = gdr_lod_error_gather(b, frontier, frontier_count);
-    b->results = NULL;
-    return ok;
+    return gdr_lod_error_gather(b, frontier, frontier_count);
 }
 
 /* The step's errors, once every deviation of its groups is measured (the job after its own has
@@ -389,10 +387,10 @@ static int finish_errors(lod_build *b, lod_stage *st, const uint32_t *frontier, 
 {
     if (!stage_bounds(b, st))
         return 0;
-    b->results = st->results;
-    int redirected = gdr_lod_redirect_samples(b, st->groups);
+    b->results = st->results; /* what the redirection and the gather read */
+    int ok = gdr_lod_redirect_samples(b, st->groups) && set_errors(b, st, frontier, frontier_count);
     b->results = NULL;
-    return redirected && set_errors(b, st, frontier, frontier_count);
+    return ok;
 }
 
 /* Whether the job left any group of these out of memory. */

@@ -95,6 +95,56 @@ static void boundary_edges(lod_build *b, gdr_thread_pool *pool, uint32_t worker)
             boundary_edges_task(b, f, worker);
 }
 
+/* The pairs of distinct clusters that share an edge, from the edge records sorted by edge, both
+ * ways, into pairs (NULL: only counted); returns how many. */
+static size_t sharing_pairs(const key_record *edges, size_t total, key_record *pairs)
+{
+    size_t p = 0;
+    for (size_t i = 0; i < total;) {
+        size_t j = i + 1;
+        while (j < total && edges[j].key == edges[i].key)
+            j++;
+        for (size_t x = i; x < j; x++)
+            for (size_t y = x + 1; y < j; y++) {
+                if (edges[x].value == edges[y].value)
+                    continue;
+                if (pairs) {
+                    pairs[p] = (key_record){.key = (uint64_t)edges[x].value << 32 | edges[y].value};
+                    pairs[p + 1] = (key_record){.key = (uint64_t)edges[y].value << 32 | edges[x].value};
+                }
+                p += 2;
+            }
+        i = j;
+    }
+    return p;
+}
+
+/* The graph over n clusters from the sorted pairs: a pair's weight is how many edges the two
+ * share. Returns 0 when out of memory. */
+static int graph_from_pairs(cluster_graph *g, uint32_t n, const key_record *pairs, size_t pair_count)
+{
+    g->xadj = calloc((size_t)n + 1, sizeof *g->xadj);
+    g->adjncy = malloc((pair_count ? pair_count : 1) * sizeof *g->adjncy);
+    g->adjwgt = malloc((pair_count ? pair_count : 1) * sizeof *g->adjwgt);
+    if (!g->xadj || !g->adjncy || !g->adjwgt)
+        return 0;
+    size_t m = 0;
+    for (size_t i = 0; i < pair_count;) {
+        size_t j = i + 1;
+        while (j < pair_count && pairs[j].key == pairs[i].key)
+            j++;
+        uint32_t from = (uint32_t)(pairs[i].key >> 32), to = (uint32_t)pairs[i].key;
+        g->adjncy[m] = (idx_t)to;
+        g->adjwgt[m] = (idx_t)(j - i);
+        g->xadj[from + 1]++;
+        m++;
+        i = j;
+    }
+    for (uint32_t f = 0; f < n; f++)
+        g->xadj[f + 1] += g->xadj[f];
+    return 1;
+}
+
 static int build_graph(lod_build *b, gdr_thread_pool *pool, uint32_t worker, cluster_graph *g)
 {
     uint32_t n = b->frontier_count;
@@ -117,64 +167,19 @@ static int build_graph(lod_build *b, gdr_thread_pool *pool, uint32_t worker, clu
     if (!tmp)
         return 0;
     radix_sort(edges, tmp, total);
-    /* Pairs of distinct clusters that share an edge, both ways. */
-    size_t pair_count = 0;
-    for (size_t i = 0; i < total;) {
-        size_t j = i + 1;
-        while (j < total && edges[j].key == edges[i].key)
-            j++;
-        for (size_t x = i; x < j; x++)
-            for (size_t y = x + 1; y < j; y++)
-                pair_count += edges[x].value != edges[y].value ? 2 : 0;
-        i = j;
-    }
+    free(tmp);
+    size_t pair_count = sharing_pairs(edges, total, NULL);
     key_record *pairs = malloc((pair_count ? pair_count : 1) * sizeof *pairs);
     key_record *pairs_tmp = malloc((pair_count ? pair_count : 1) * sizeof *pairs_tmp);
-    if (!pairs || !pairs_tmp) {
-        free(tmp);
-        free(pairs);
-        free(pairs_tmp);
-        return 0;
+    int ok = pairs && pairs_tmp;
+    if (ok) {
+        sharing_pairs(edges, total, pairs);
+        radix_sort(pairs, pairs_tmp, pair_count);
+        ok = graph_from_pairs(g, n, pairs, pair_count);
     }
-    size_t p = 0;
-    for (size_t i = 0; i < total;) {
-        size_t j = i + 1;
-        while (j < total && edges[j].key == edges[i].key)
-            j++;
-        for (size_t x = i; x < j; x++)
-            for (size_t y = x + 1; y < j; y++)
-                if (edges[x].value != edges[y].value) {
-                    pairs[p++] = (key_record){.key = (uint64_t)edges[x].value << 32 | edges[y].value};
-                    pairs[p++] = (key_record){.key = (uint64_t)edges[y].value << 32 | edges[x].value};
-                }
-        i = j;
-    }
-    free(tmp);
-    radix_sort(pairs, pairs_tmp, pair_count);
-    free(pairs_tmp);
-    g->xadj = calloc((size_t)n + 1, sizeof *g->xadj);
-    g->adjncy = malloc((pair_count ? pair_count : 1) * sizeof *g->adjncy);
-    g->adjwgt = malloc((pair_count ? pair_count : 1) * sizeof *g->adjwgt);
-    if (!g->xadj || !g->adjncy || !g->adjwgt) {
-        free(pairs);
-        return 0;
-    }
-    size_t m = 0;
-    for (size_t i = 0; i < pair_count;) {
-        size_t j = i + 1;
-        while (j < pair_count && pairs[j].key == pairs[i].key)
-            j++;
-        uint32_t from = (uint32_t)(pairs[i].key >> 32), to = (uint32_t)pairs[i].key;
-        g->adjncy[m] = (idx_t)to;
-        g->adjwgt[m] = (idx_t)(j - i);
-        g->xadj[from + 1]++;
-        m++;
-        i = j;
-    }
-    for (uint32_t f = 0; f < n; f++)
-        g->xadj[f + 1] += g->xadj[f];
     free(pairs);
-    return 1;
+    free(pairs_tmp);
+    return ok;
 }
 
 /* METIS keeps its random state in globals: one partition at a time, always from the same seed. */

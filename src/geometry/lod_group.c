@@ -60,23 +60,18 @@ static int contains_u64(const uint64_t *sorted, size_t n, uint64_t key)
     return lo < n && sorted[lo] == key;
 }
 
-/* The sphere of a group over `members` (count clusters) and the groups they came from, into r;
- * returns the largest error of those groups. Read once the errors of the earlier steps are set. */
-float gdr_lod_group_bounds(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count, group_result *r)
+/* The sphere of a group over `members` (count clusters) and the spheres of the groups they came
+ * from, into r. Read once the spheres of the earlier steps are set. */
+void gdr_lod_group_sphere(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count, group_result *r)
 {
     uint32_t n = 0;
-    float child_error = 0.0f;
     for (uint32_t i = 0; i < count; i++) {
         const gdr_cluster *c = &b->clusters[members[i]];
         s->spheres[n++] = c->sphere;
-        if (c->refined_group != GDR_NO_INDEX) {
-            const gdr_cluster_group *from = &b->groups[c->refined_group];
-            s->spheres[n++] = from->sphere;
-            child_error = from->error > child_error ? from->error : child_error;
-        }
+        if (c->refined_group != GDR_NO_INDEX)
+            s->spheres[n++] = b->groups[c->refined_group].sphere;
     }
     r->sphere = gdr_lod_enclosing_sphere(s->spheres, n);
-    return child_error;
 }
 
 /* Every border edge of the input (an edge between two locked positions that no other input
@@ -305,7 +300,7 @@ void gdr_lod_measure_group_task(void *user, uint32_t i, uint32_t worker)
     const uint32_t *members = b->measured_members + b->measured_member_start[g];
     uint32_t count = b->measured_member_start[g + 1] - b->measured_member_start[g];
     uint32_t local_count = restore_group(b, s, members, count, r);
-    r->error = members_error(b, members, count); /* the part of the floor the deviation needs */
+    r->error = members_error(b, members, count); /* the deviation's floor starts from it */
     if (!local_count || !gdr_lod_group_deviation(b, s, members, count, local_count, r))
         r->out_of_memory = 1;
 }

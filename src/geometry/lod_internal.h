@@ -205,9 +205,8 @@ gdr_status gdr_lod_partition(lod_build *b, gdr_thread_pool *pool, uint32_t worke
  * splits it into clusters); one that measures the deviation of group measured[i]. */
 void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker);
 void gdr_lod_measure_group_task(void *user, uint32_t i, uint32_t worker);
-/* A group's sphere (into r), over its members and the groups they came from; returns the largest
- * error of those groups. */
-float gdr_lod_group_bounds(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count, group_result *r);
+/* A group's sphere (into r), over its members and the groups they came from. */
+void gdr_lod_group_sphere(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count, group_result *r);
 void gdr_lod_result_free(group_result *r);
 
 /* lod_error.c: the samples of the full-detail surface and the groups' measured deviation. */
