@@ -325,28 +325,53 @@ static float sample_ring_d2(const lod_scratch *s, uint32_t i, uint32_t *nearest)
     return ring_d2(s, l, s->sample_points[i], nearest);
 }
 
-/* Samples [first, end) in order: only a sample whose ring bound exceeds the largest distance so far
- * is measured exactly (grid of the triangles). Returns the largest distance, squared. */
-static float measure_samples(lod_scratch *s, uint32_t first, uint32_t end)
+/* Squared distance from sample i to simplified triangle t. */
+static float sample_triangle_d2(const lod_scratch *s, uint32_t i, uint32_t t)
+{
+    const uint32_t *c = s->out_corners + (size_t)t * 3;
+    return point_triangle_d2(s->sample_points[i], load3(s->positions + (size_t)c[0] * 3),
+                             load3(s->positions + (size_t)c[1] * 3), load3(s->positions + (size_t)c[2] * 3));
+}
+
+/* Whether sample i is settled by triangle `last` (the one the last measured sample passed to, or
+ * UINT32_MAX): it lies within the smallest kept bound of it, once LOD_EXCESS_LIMIT + 1 are kept.
+ * Such a sample can change neither the largest distance nor the kept bounds (its own bound is at
+ * most this distance), so it passes to `last`'s cluster unmeasured (docs/GEOMETRY.md, "Measuring
+ * the samples cheaply"). Consecutive samples are neighbours on S0: mostly near the same triangle. */
+static int settled_by_last(const lod_scratch *s, uint32_t i, uint32_t last)
+{
+    return last != UINT32_MAX && s->top_count == LOD_EXCESS_LIMIT + 1 && sample_triangle_d2(s, i, last) <= s->top_d2[0];
+}
+
+/* Samples in order: a sample settled by the last one's triangle is not measured; of the others,
+ * only one whose ring bound exceeds the largest distance so far is measured exactly (grid of the
+ * triangles). Returns the largest distance, squared. */
+static float measure_samples(lod_scratch *s)
 {
     float worst = 0.0f;
-    for (uint32_t i = first; i < end; i++) {
+    uint32_t last = UINT32_MAX;
+    for (uint32_t i = 0; i < s->gathered; i++) {
+        if (settled_by_last(s, i, last)) {
+            s->sample_cluster[i] = s->out_cluster[last];
+            continue;
+        }
         uint32_t nearest;
         float d = sample_ring_d2(s, i, &nearest);
         if (d > worst)
             nearest = lod_triangle_grid_nearest(&s->triangle_grid, s->sample_points[i], point_triangle_d2, &d);
         s->sample_cluster[i] = s->out_cluster[nearest];
+        last = nearest;
         keep_largest(s, d, i);
         worst = d > worst ? d : worst;
     }
     return worst;
 }
 
-/* One range of the samples, measured as measure_samples would with the largest distance of the
- * range so far: that is at most the largest distance over all earlier samples, so every sample the
- * sequential order measures exactly is measured exactly here too. Keeps for each sample its ring
- * bound (ring_d2), its exact distance (exact_d2; -1: not measured) and both nearest clusters
- * (sample_cluster: ring's | exact's << 16) for replay_samples. */
+/* One range of the samples, each measured as measure_samples would measure it with the largest
+ * distance of the range so far: that is at most the largest distance over all earlier samples, so
+ * every sample the sequential order measures exactly is measured exactly here too. Keeps for each
+ * sample its ring bound and nearest triangle (ring_d2) and its exact distance and nearest triangle
+ * (exact_d2; -1: not measured) for replay_samples. */
 static void sample_range_task(void *user, uint32_t range, uint32_t worker)
 {
     lod_scratch *s = user;
@@ -355,46 +380,47 @@ static void sample_range_task(void *user, uint32_t range, uint32_t worker)
     end = end < s->gathered ? end : s->gathered;
     float worst = 0.0f;
     for (uint32_t i = first; i < end; i++) {
-        uint32_t nearest, exact_nearest;
-        float d = sample_ring_d2(s, i, &nearest), exact = d;
-        s->exact_d2[i] = -1.0f;
-        s->ring_d2[i] = d;
-        exact_nearest = nearest;
-        if (d > worst) {
-            exact_nearest = lod_triangle_grid_nearest(&s->triangle_grid, s->sample_points[i], point_triangle_d2,
-                                                      &exact);
-            s->exact_d2[i] = exact;
-            worst = exact > worst ? exact : worst;
+        lod_sample_bound *ring = &s->ring_d2[i], *exact = &s->exact_d2[i];
+        ring->d2 = sample_ring_d2(s, i, &ring->triangle);
+        *exact = (lod_sample_bound){-1.0f, ring->triangle};
+        if (ring->d2 > worst) {
+            exact->triangle = lod_triangle_grid_nearest(&s->triangle_grid, s->sample_points[i], point_triangle_d2,
+                                                        &exact->d2);
+            worst = exact->d2 > worst ? exact->d2 : worst;
+        } else {
+            worst = ring->d2 > worst ? ring->d2 : worst;
         }
-        s->sample_cluster[i] = s->out_cluster[nearest] | s->out_cluster[exact_nearest] << 16;
     }
 }
 
 /* The sequential order over the ranges' results: the same decisions, distances and clusters as
- * measure_samples over all samples. Returns the largest distance, squared. */
+ * measure_samples (a sample it settles would have had a ring bound at most the largest so far).
+ * Returns the largest distance, squared. */
 static float replay_samples(lod_scratch *s)
 {
     float worst = 0.0f;
+    uint32_t last = UINT32_MAX;
     for (uint32_t i = 0; i < s->gathered; i++) {
-        float d = s->ring_d2[i];
-        uint32_t cluster = s->sample_cluster[i] & 0xffff;
-        if (d > worst) { /* measured exactly in its range too */
-            d = s->exact_d2[i];
-            cluster = s->sample_cluster[i] >> 16;
+        if (settled_by_last(s, i, last)) {
+            s->sample_cluster[i] = s->out_cluster[last];
+            continue;
         }
-        s->sample_cluster[i] = cluster;
-        keep_largest(s, d, i);
-        worst = d > worst ? d : worst;
+        lod_sample_bound m = s->ring_d2[i];
+        if (m.d2 > worst) /* measured exactly in its range too */
+            m = s->exact_d2[i];
+        s->sample_cluster[i] = s->out_cluster[m.triangle];
+        last = m.triangle;
+        keep_largest(s, m.d2, i);
+        worst = m.d2 > worst ? m.d2 : worst;
     }
     return worst;
 }
 
 /* Whether this group's samples are measured by the pool's workers: the step's only group (its task
- * runs on the calling thread, outside any job), with enough samples and few enough clusters. */
-static int measure_in_parallel(const lod_build *b, const lod_scratch *s, const group_result *r)
+ * runs on the calling thread, outside any job), with enough samples. */
+static int measure_in_parallel(const lod_build *b, const lod_scratch *s)
 {
-    return b->lone_group && gdr_thread_pool_thread_count(b->pool) > 1 && s->gathered >= 2 * LOD_SAMPLE_RANGE &&
-           r->cluster_count <= 0xffff;
+    return b->lone_group && gdr_thread_pool_thread_count(b->pool) > 1 && s->gathered >= 2 * LOD_SAMPLE_RANGE;
 }
 
 /* Largest distance from a sample to the simplified triangles; each sample's nearest cluster, and
@@ -403,7 +429,7 @@ static int measure_in_parallel(const lod_build *b, const lod_scratch *s, const g
  * bound exceeds the largest distance so far is measured exactly (grid of the triangles), so the
  * result is the exact maximum and every sample lies within it of the cluster it passes to. The
  * step's only group measures its samples in ranges on the pool, with the same result. */
-static float samples_to_simplified(const lod_build *b, lod_scratch *s, uint32_t local_count, const group_result *r)
+static float samples_to_simplified(const lod_build *b, lod_scratch *s, uint32_t local_count)
 {
     uint32_t used = 0;
     if (!LOD_RESERVE(s, vertex_points, local_count) || !LOD_RESERVE(s, vertex_local, local_count))
@@ -416,8 +442,8 @@ static float samples_to_simplified(const lod_build *b, lod_scratch *s, uint32_t 
     if (!lod_grid_build(&s->grid, s->vertex_points, used, 4.0) ||
         !lod_triangle_grid_build(&s->triangle_grid, s->positions, s->out_corners, s->out_triangle_count))
         return -1.0f;
-    if (!measure_in_parallel(b, s, r))
-        return sqrtf(measure_samples(s, 0, s->gathered));
+    if (!measure_in_parallel(b, s))
+        return sqrtf(measure_samples(s));
     if (!LOD_RESERVE(s, ring_d2, s->gathered) || !LOD_RESERVE(s, exact_d2, s->gathered))
         return -1.0f;
     gdr_thread_pool_run(b->pool, (s->gathered + LOD_SAMPLE_RANGE - 1) / LOD_SAMPLE_RANGE, sample_range_task, s);
@@ -826,7 +852,7 @@ int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *member
     if (!output_triangles(s, r, local_count) || !gather_samples(b, s, members, count))
         return 0;
     s->top_count = 0; /* a group without samples keeps none */
-    float to_simplified = s->gathered ? samples_to_simplified(b, s, local_count, r) : 0.0f;
+    float to_simplified = s->gathered ? samples_to_simplified(b, s, local_count) : 0.0f;
     float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified, INFINITY);
     /* Where D1 is set by the few samples (at most LOD_EXCESS_LIMIT) farther than all others and the
      * members' errors, D2 is measured again down to that level: the group's floor, the part of its

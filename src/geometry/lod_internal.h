@@ -43,6 +43,12 @@ typedef struct lod_progress {
     atomic_uint_fast64_t done;
 } lod_progress;
 
+/* A sample's distance bound (squared) to a group's simplified triangles, and the nearest of them. */
+typedef struct lod_sample_bound {
+    float d2;
+    uint32_t triangle;
+} lod_sample_bound;
+
 /* Per-worker scratch, reused from task to task. */
 typedef struct lod_scratch {
     uint32_t *map; /* mesh vertex -> local vertex, UINT32_MAX when unused (mesh vertex_count entries) */
@@ -86,7 +92,7 @@ typedef struct lod_scratch {
     size_t coarse_d2_cap;
     float *edge_d2; /* per simplified triangle edge: its largest coarse probe (squared), -1 once refined */
     size_t edge_d2_cap;
-    float *ring_d2, *exact_d2; /* per sample, when one group's samples are measured in ranges */
+    lod_sample_bound *ring_d2, *exact_d2; /* per sample, when one group's samples are measured in ranges */
     size_t ring_d2_cap, exact_d2_cap;
     uint8_t edge_count[64 * 64];
 } lod_scratch;
