@@ -286,6 +286,8 @@ static float ring_d2(const lod_scratch *s, uint32_t l, gdr_vec3 p, uint32_t *nea
         if (d < best) {
             best = d;
             *nearest = s->ring[k];
+            if (best == 0.0f) /* p is a corner: nothing comes nearer */
+                break;
         }
     }
     return best;
