@@ -7,6 +7,7 @@
 #include <string.h>
 
 #define GRID_MAX_DIM 1024
+_Static_assert(GRID_MAX_DIM <= 65536, "a kept run holds cell coordinates in 16 bits");
 #define GRID_MIN_CELLS 32768.0
 
 static int grid_reserve(uint32_t **p, size_t *cap, size_t need)
@@ -239,20 +240,21 @@ static uint32_t tri_cell(const lod_triangle_grid *g, float x, int k)
     return c >= (float)(g->dim[k] - 1) ? g->dim[k] - 1 : (uint32_t)c;
 }
 
+/* Triangle t's box in cells: each axis's smallest and largest coordinate, then their cells (the
+ * cell of a coordinate never decreases with it, so these are the smallest and largest corner cells). */
 static void tri_box(const lod_triangle_grid *g, uint32_t t, uint32_t lo[3], uint32_t hi[3])
 {
+    const float *p[3];
+    for (int j = 0; j < 3; j++)
+        p[j] = g->positions + (size_t)g->corners[(size_t)t * 3 + j] * 3;
     for (int k = 0; k < 3; k++) {
-        lo[k] = UINT32_MAX;
-        hi[k] = 0;
-    }
-    for (int j = 0; j < 3; j++) {
-        gdr_vec3 p = corner(g, t, j);
-        const float *x = &p.x;
-        for (int k = 0; k < 3; k++) {
-            uint32_t c = tri_cell(g, x[k], k);
-            lo[k] = c < lo[k] ? c : lo[k];
-            hi[k] = c > hi[k] ? c : hi[k];
-        }
+        float a = p[0][k], b = p[0][k];
+        a = p[1][k] < a ? p[1][k] : a;
+        b = p[1][k] > b ? p[1][k] : b;
+        a = p[2][k] < a ? p[2][k] : a;
+        b = p[2][k] > b ? p[2][k] : b;
+        lo[k] = tri_cell(g, a, k);
+        hi[k] = tri_cell(g, b, k);
     }
 }
 
@@ -379,19 +381,25 @@ static void list_run(lod_triangle_grid *g, uint32_t t, uint32_t x0, uint32_t x1,
     }
 }
 
-/* Lists triangle t in the cells it crosses (see CLIP_MARGIN). A triangle whose box spans at most two
- * cells along each axis is listed in its whole box instead: at most a few cells it does not cross,
- * all next to it, and clipping would cost more than those save (most level-0 triangles are such). */
-static void list_triangle(lod_triangle_grid *g, uint32_t t, int store)
+/* Remembers run x0 .. x1 of row (y, z) of triangle t for the storing pass; 0 when out of memory. */
+static int keep_run(lod_triangle_grid *g, uint32_t t, uint32_t x0, uint32_t x1, uint32_t y, uint32_t z)
 {
-    uint32_t lo[3], hi[3];
-    tri_box(g, t, lo, hi);
-    if (hi[0] - lo[0] <= 1 && hi[1] - lo[1] <= 1 && hi[2] - lo[2] <= 1) {
-        for (uint32_t z = lo[2]; z <= hi[2]; z++)
-            for (uint32_t y = lo[1]; y <= hi[1]; y++)
-                list_run(g, t, lo[0], hi[0], y, z, store);
-        return;
+    if (g->run_count == g->runs_cap) {
+        size_t n = g->runs_cap ? g->runs_cap * 2 : 256;
+        lod_grid_run *r = realloc(g->runs, n * sizeof *r);
+        if (!r)
+            return 0;
+        g->runs = r;
+        g->runs_cap = n;
     }
+    g->runs[g->run_count++] = (lod_grid_run){t, (uint16_t)x0, (uint16_t)x1, (uint16_t)y, (uint16_t)z};
+    return 1;
+}
+
+/* Counts triangle t's runs of the cells it crosses (clipped, see CLIP_MARGIN) and keeps them for
+ * the storing pass. Returns 0 when out of memory. */
+static int count_clipped(lod_triangle_grid *g, uint32_t t)
+{
     clip_polygon tri = {.n = 3}, slab, row;
     for (int j = 0; j < 3; j++) {
         gdr_vec3 p = corner(g, t, j);
@@ -407,10 +415,38 @@ static void list_triangle(lod_triangle_grid *g, uint32_t t, int store)
             continue;
         for (uint32_t y = y0; y <= y1; y++) {
             clip_slab(g, &slab, 1, y, &row);
-            if (clip_extent(g, &row, 0, &x0, &x1))
-                list_run(g, t, x0, x1, y, z, store);
+            if (!clip_extent(g, &row, 0, &x0, &x1))
+                continue;
+            list_run(g, t, x0, x1, y, z, 0);
+            if (!keep_run(g, t, x0, x1, y, z))
+                return 0;
         }
     }
+    return 1;
+}
+
+/* Lists triangle t in the cells it crosses (see CLIP_MARGIN). A triangle whose box spans at most two
+ * cells along each axis is listed in its whole box instead: at most a few cells it does not cross,
+ * all next to it, and clipping would cost more than those save (most level-0 triangles are such).
+ * The counting pass (store == 0) clips and keeps the runs; the storing pass takes them from there
+ * (the triangles in the same order). Returns 0 when out of memory. */
+static int list_triangle(lod_triangle_grid *g, uint32_t t, int store)
+{
+    uint32_t lo[3], hi[3];
+    tri_box(g, t, lo, hi);
+    if (hi[0] - lo[0] <= 1 && hi[1] - lo[1] <= 1 && hi[2] - lo[2] <= 1) {
+        for (uint32_t z = lo[2]; z <= hi[2]; z++)
+            for (uint32_t y = lo[1]; y <= hi[1]; y++)
+                list_run(g, t, lo[0], hi[0], y, z, store);
+        return 1;
+    }
+    if (!store)
+        return count_clipped(g, t);
+    for (; g->run_next < g->run_count && g->runs[g->run_next].t == t; g->run_next++) {
+        const lod_grid_run *r = &g->runs[g->run_next];
+        list_run(g, t, r->x0, r->x1, r->y, r->z, 1);
+    }
+    return 1;
 }
 
 int lod_triangle_grid_build(lod_triangle_grid *g, const float *positions, const uint32_t *corners, uint32_t n)
@@ -423,8 +459,10 @@ int lod_triangle_grid_build(lod_triangle_grid *g, const float *positions, const 
     if (!grid_reserve(&g->start, &g->start_cap, cells + 1))
         return 0;
     memset(g->start, 0, (cells + 1) * sizeof *g->start);
+    g->run_count = g->run_next = 0;
     for (uint32_t t = 0; t < n; t++)
-        list_triangle(g, t, 0);
+        if (!list_triangle(g, t, 0))
+            return 0;
     for (size_t c = 0; c < cells; c++)
         g->start[c + 1] += g->start[c];
     if (!grid_reserve(&g->items, &g->items_cap, (size_t)g->start[cells] + 1))
@@ -534,5 +572,6 @@ void lod_triangle_grid_free(lod_triangle_grid *g)
 {
     free(g->start);
     free(g->items);
+    free(g->runs);
     memset(g, 0, sizeof *g);
 }

@@ -26,6 +26,13 @@ int lod_grid_build(lod_grid *g, const gdr_vec3 *points, uint32_t n, double cells
 uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squared);
 void lod_grid_free(lod_grid *g);
 
+/* Cells x0 .. x1 of row (y, z) that triangle t crosses: kept from the counting pass of a build to
+ * its storing pass for the triangles that are clipped (lod_grid.c). */
+typedef struct lod_grid_run {
+    uint32_t t;
+    uint16_t x0, x1, y, z;
+} lod_grid_run;
+
 /* A uniform grid over triangles (corner k of triangle t: positions[3 * corners[3t + k]] .. + 3),
  * each listed in the cells it crosses (a small one: in every cell of its bounding box). */
 typedef struct lod_triangle_grid {
@@ -37,6 +44,8 @@ typedef struct lod_triangle_grid {
     uint32_t count; /* triangles */
     uint32_t *start, *items;
     size_t start_cap, items_cap;
+    lod_grid_run *runs; /* scratch of a build, kept between builds */
+    size_t run_count, run_next, runs_cap;
 } lod_triangle_grid;
 
 int lod_triangle_grid_build(lod_triangle_grid *g, const float *positions, const uint32_t *corners, uint32_t n);
