@@ -274,8 +274,9 @@ static int gather_samples(lod_build *b, lod_scratch *s, const uint32_t *members,
     return 1;
 }
 
-/* Distance (squared) from p to the triangles around local vertex l, and the nearest of them. */
-static float ring_d2(const lod_scratch *s, uint32_t l, gdr_vec3 p, uint32_t *nearest)
+/* Distance (squared) from p to the triangles around local vertex l, and the nearest of them; the
+ * search stops at the first triangle that brings it to at most `enough` (0: none but a corner). */
+static float ring_d2(const lod_scratch *s, uint32_t l, gdr_vec3 p, uint32_t *nearest, float enough)
 {
     float best = INFINITY;
     *nearest = s->ring[s->ring_start[l]];
@@ -286,7 +287,7 @@ static float ring_d2(const lod_scratch *s, uint32_t l, gdr_vec3 p, uint32_t *nea
         if (d < best) {
             best = d;
             *nearest = s->ring[k];
-            if (best == 0.0f) /* p is a corner: nothing comes nearer */
+            if (best <= enough) /* at most what is enough, or 0 (p is a corner) */
                 break;
         }
     }
@@ -319,12 +320,12 @@ static void keep_largest(lod_scratch *s, float d, uint32_t sample)
 #define LOD_SAMPLE_RANGE 2048u
 
 /* Distance (squared) from sample i to the simplified triangles around its nearest simplified
- * vertex (an upper bound), and the nearest of them. */
-static float sample_ring_d2(const lod_scratch *s, uint32_t i, uint32_t *nearest)
+ * vertex (an upper bound), and the nearest of them (the first at most `enough`: ring_d2). */
+static float sample_ring_d2(const lod_scratch *s, uint32_t i, uint32_t *nearest, float enough)
 {
     float d2;
     uint32_t l = s->vertex_local[lod_grid_nearest(&s->grid, s->sample_points[i], &d2)];
-    return ring_d2(s, l, s->sample_points[i], nearest);
+    return ring_d2(s, l, s->sample_points[i], nearest, enough);
 }
 
 /* Squared distance from sample i to simplified triangle t. */
@@ -347,8 +348,10 @@ static int settled_by_last(const lod_scratch *s, uint32_t i, uint32_t last)
 
 /* Samples in order: a sample settled by the last one's triangle is not measured; of the others,
  * only one whose ring bound exceeds the largest distance so far is measured exactly (grid of the
- * triangles). Returns the largest distance, squared. */
-static float measure_samples(lod_scratch *s)
+ * triangles). With `stop_early`, a ring's search stops at the first triangle within the smallest
+ * kept bound (once LOD_EXCESS_LIMIT + 1 are kept): such a sample is settled by that triangle (the
+ * same rule). Returns the largest distance, squared. */
+static float measure_samples(lod_scratch *s, int stop_early)
 {
     float worst = 0.0f;
     uint32_t last = UINT32_MAX;
@@ -358,7 +361,8 @@ static float measure_samples(lod_scratch *s)
             continue;
         }
         uint32_t nearest;
-        float d = sample_ring_d2(s, i, &nearest);
+        float enough = stop_early && s->top_count == LOD_EXCESS_LIMIT + 1 ? s->top_d2[0] : 0.0f;
+        float d = sample_ring_d2(s, i, &nearest, enough);
         if (d > worst)
             nearest = lod_triangle_grid_nearest(&s->triangle_grid, s->sample_points[i], point_triangle_d2, &d);
         s->sample_cluster[i] = s->out_cluster[nearest];
@@ -383,7 +387,7 @@ static void sample_range_task(void *user, uint32_t range, uint32_t worker)
     float worst = 0.0f;
     for (uint32_t i = first; i < end; i++) {
         lod_sample_bound *ring = &s->ring_d2[i], *exact = &s->exact_d2[i];
-        ring->d2 = sample_ring_d2(s, i, &ring->triangle);
+        ring->d2 = sample_ring_d2(s, i, &ring->triangle, 0.0f);
         *exact = (lod_sample_bound){-1.0f, ring->triangle};
         if (ring->d2 > worst) {
             exact->triangle = lod_triangle_grid_nearest(&s->triangle_grid, s->sample_points[i], point_triangle_d2,
@@ -444,8 +448,8 @@ static float samples_to_simplified(const lod_build *b, lod_scratch *s, uint32_t 
     if (!lod_grid_build(&s->grid, s->vertex_points, used, 4.0) ||
         !lod_triangle_grid_build(&s->triangle_grid, s->positions, s->out_corners, s->out_triangle_count))
         return -1.0f;
-    if (!measure_in_parallel(b, s))
-        return sqrtf(measure_samples(s));
+    if (!measure_in_parallel(b, s)) /* the step's only group as its ranges would: for any thread count */
+        return sqrtf(measure_samples(s, !b->lone_group));
     if (!LOD_RESERVE(s, ring_d2, s->gathered) || !LOD_RESERVE(s, exact_d2, s->gathered))
         return -1.0f;
     gdr_thread_pool_run(b->pool, (s->gathered + LOD_SAMPLE_RANGE - 1) / LOD_SAMPLE_RANGE, sample_range_task, s);
