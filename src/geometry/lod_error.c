@@ -338,9 +338,10 @@ static float sample_triangle_d2(const lod_scratch *s, uint32_t i, uint32_t t)
 
 /* Whether sample i is settled by triangle `last` (the one the last measured sample passed to, or
  * UINT32_MAX): it lies within the smallest kept bound of it, once LOD_EXCESS_LIMIT + 1 are kept.
- * Such a sample can change neither the largest distance nor the kept bounds (its own bound is at
- * most this distance), so it passes to `last`'s cluster unmeasured (docs/GEOMETRY.md, "Measuring
- * the samples cheaply"). Consecutive samples are neighbours on S0: mostly near the same triangle. */
+ * Such a sample cannot raise the largest distance (its exact distance is at most that bound) and
+ * lies within the smallest kept bound of `last`'s cluster, all that a sample not kept is promised:
+ * it passes there unmeasured (docs/GEOMETRY.md, "Measuring the samples cheaply"). Consecutive
+ * samples are neighbours on S0: mostly near the same triangle. */
 static int settled_by_last(const lod_scratch *s, uint32_t i, uint32_t last)
 {
     return last != UINT32_MAX && s->top_count == LOD_EXCESS_LIMIT + 1 && sample_triangle_d2(s, i, last) <= s->top_d2[0];
