@@ -296,28 +296,36 @@ static float ring_d2(const lod_scratch *s, uint32_t l, gdr_vec3 p, uint32_t *nea
 
 /* Keeps the LOD_EXCESS_LIMIT + 1 largest sample distance bounds seen (squared, ascending, with
  * their sample): all other samples lie within the smallest of them of their cluster. */
-static void keep_largest(lod_scratch *s, float d, uint32_t sample)
+static void keep_largest(lod_kept *k, float d, uint32_t sample)
 {
     uint32_t at;
-    if (s->top_count < LOD_EXCESS_LIMIT + 1) { /* not full: insert from the end */
-        for (at = s->top_count++; at > 0 && s->top_d2[at - 1] > d; at--) {
-            s->top_d2[at] = s->top_d2[at - 1];
-            s->top_sample[at] = s->top_sample[at - 1];
+    if (k->count < LOD_EXCESS_LIMIT + 1) { /* not full: insert from the end */
+        for (at = k->count++; at > 0 && k->d2[at - 1] > d; at--) {
+            k->d2[at] = k->d2[at - 1];
+            k->sample[at] = k->sample[at - 1];
         }
-    } else if (d > s->top_d2[0]) { /* full: drop the smallest, insert from the start */
-        for (at = 0; at + 1 < s->top_count && s->top_d2[at + 1] < d; at++) {
-            s->top_d2[at] = s->top_d2[at + 1];
-            s->top_sample[at] = s->top_sample[at + 1];
+    } else if (d > k->d2[0]) { /* full: drop the smallest, insert from the start */
+        for (at = 0; at + 1 < k->count && k->d2[at + 1] < d; at++) {
+            k->d2[at] = k->d2[at + 1];
+            k->sample[at] = k->sample[at + 1];
         }
     } else {
         return;
     }
-    s->top_d2[at] = d;
-    s->top_sample[at] = sample;
+    k->d2[at] = d;
+    k->sample[at] = sample;
 }
 
-/* Samples measured per task when one group's samples are measured in parallel. */
-#define LOD_SAMPLE_RANGE 2048u
+/* The smallest kept bound once LOD_EXCESS_LIMIT + 1 are kept (what every other sample lies within
+ * of its cluster); -1 before. */
+static float kept_bound(const lod_kept *k) { return k->count == LOD_EXCESS_LIMIT + 1 ? k->d2[0] : -1.0f; }
+
+/* The step's only group measures its samples in this many ranges (fewer where a range would hold
+ * fewer than LOD_SAMPLE_RANGE_MIN): a fixed count, so that the result does not depend on the
+ * thread count. A range settles samples within its own smallest kept bound, the 65th largest of
+ * its samples': the larger the range, the more it settles. */
+#define LOD_SAMPLE_RANGES 8u
+#define LOD_SAMPLE_RANGE_MIN 2048u
 
 /* Distance (squared) from sample i to the simplified triangles around its nearest simplified
  * vertex (an upper bound), and the nearest of them (the first at most `enough`: ring_d2). */
@@ -337,105 +345,87 @@ static float sample_triangle_d2(const lod_scratch *s, uint32_t i, uint32_t t)
 }
 
 /* Whether sample i is settled by triangle `last` (the one the last measured sample passed to, or
- * UINT32_MAX): it lies within the smallest kept bound of it, once LOD_EXCESS_LIMIT + 1 are kept.
- * Such a sample cannot raise the largest distance (its exact distance is at most that bound) and
- * lies within the smallest kept bound of `last`'s cluster, all that a sample not kept is promised:
- * it passes there unmeasured (docs/GEOMETRY.md, "Measuring the samples cheaply"). Consecutive
- * samples are neighbours on S0: mostly near the same triangle. */
-static int settled_by_last(const lod_scratch *s, uint32_t i, uint32_t last)
+ * UINT32_MAX): it lies within `bound`, the smallest kept bound (kept_bound), of it. Such a sample
+ * cannot raise the largest distance (its exact distance is at most that bound) and lies within the
+ * smallest kept bound of `last`'s cluster, all that a sample not kept is promised: it passes there
+ * unmeasured (docs/GEOMETRY.md, "Measuring the samples cheaply"). Consecutive samples are
+ * neighbours on S0: mostly near the same triangle. */
+static int settled_by_last(const lod_scratch *s, uint32_t i, uint32_t last, float bound)
 {
-    return last != UINT32_MAX && s->top_count == LOD_EXCESS_LIMIT + 1 && sample_triangle_d2(s, i, last) <= s->top_d2[0];
+    return last != UINT32_MAX && bound >= 0.0f && sample_triangle_d2(s, i, last) <= bound;
 }
 
-/* Samples in order: a sample settled by the last one's triangle is not measured; of the others,
- * only one whose ring bound exceeds the largest distance so far is measured exactly (grid of the
- * triangles). With `stop_early`, a ring's search stops at the first triangle within the smallest
- * kept bound (once LOD_EXCESS_LIMIT + 1 are kept): such a sample is settled by that triangle (the
- * same rule). Returns the largest distance, squared. */
-static float measure_samples(lod_scratch *s, int stop_early)
+/* Samples [first, end) in order, into `kept` (empty at first): a sample settled by the last
+ * measured one's triangle is not measured; of the others, the ring's search stops at the first
+ * triangle within the smallest kept bound (the sample is then settled by that triangle, the same
+ * rule), and only a sample whose ring bound exceeds the largest distance so far is measured
+ * exactly (grid of the triangles). kept->worst: the largest distance, squared. */
+static void measure_samples(lod_scratch *s, uint32_t first, uint32_t end, lod_kept *kept)
 {
-    float worst = 0.0f;
     uint32_t last = UINT32_MAX;
-    for (uint32_t i = 0; i < s->gathered; i++) {
-        if (settled_by_last(s, i, last)) {
+    kept->count = 0;
+    kept->worst = 0.0f;
+    for (uint32_t i = first; i < end; i++) {
+        float bound = kept_bound(kept);
+        if (settled_by_last(s, i, last, bound)) {
             s->sample_cluster[i] = s->out_cluster[last];
             continue;
         }
         uint32_t nearest;
-        float enough = stop_early && s->top_count == LOD_EXCESS_LIMIT + 1 ? s->top_d2[0] : 0.0f;
-        float d = sample_ring_d2(s, i, &nearest, enough);
-        if (d > worst)
+        float d = sample_ring_d2(s, i, &nearest, bound > 0.0f ? bound : 0.0f);
+        if (d > kept->worst)
             nearest = lod_triangle_grid_nearest(&s->triangle_grid, s->sample_points[i], point_triangle_d2, &d);
         s->sample_cluster[i] = s->out_cluster[nearest];
         last = nearest;
-        keep_largest(s, d, i);
-        worst = d > worst ? d : worst;
+        keep_largest(kept, d, i);
+        kept->worst = d > kept->worst ? d : kept->worst;
     }
-    return worst;
 }
 
-/* One range of the samples, each measured as measure_samples would measure it with the largest
- * distance of the range so far: that is at most the largest distance over all earlier samples, so
- * every sample the sequential order measures exactly is measured exactly here too. Keeps for each
- * sample its ring bound and nearest triangle (ring_d2) and its exact distance and nearest triangle
- * (exact_d2; -1: not measured) for replay_samples. */
+/* One range of the step's only group's samples, measured as measure_samples measures a group. */
 static void sample_range_task(void *user, uint32_t range, uint32_t worker)
 {
     lod_scratch *s = user;
     (void)worker;
-    uint32_t first = range * LOD_SAMPLE_RANGE, end = first + LOD_SAMPLE_RANGE;
-    end = end < s->gathered ? end : s->gathered;
-    float worst = 0.0f;
-    for (uint32_t i = first; i < end; i++) {
-        lod_sample_bound *ring = &s->ring_d2[i], *exact = &s->exact_d2[i];
-        ring->d2 = sample_ring_d2(s, i, &ring->triangle, 0.0f);
-        *exact = (lod_sample_bound){-1.0f, ring->triangle};
-        if (ring->d2 > worst) {
-            exact->triangle = lod_triangle_grid_nearest(&s->triangle_grid, s->sample_points[i], point_triangle_d2,
-                                                        &exact->d2);
-            worst = exact->d2 > worst ? exact->d2 : worst;
-        } else {
-            worst = ring->d2 > worst ? ring->d2 : worst;
-        }
-    }
+    uint32_t first = range * s->range_size, end = first + s->range_size;
+    measure_samples(s, first, end < s->gathered ? end : s->gathered, &s->range_kept[range]);
 }
 
-/* The sequential order over the ranges' results: the same decisions, distances and clusters as
- * measure_samples (a sample it settles would have had a ring bound at most the largest so far).
- * Returns the largest distance, squared. */
-static float replay_samples(lod_scratch *s)
+/* The step's only group (its task runs on the calling thread, outside any job) measures its samples
+ * in ranges (LOD_SAMPLE_RANGES), each with its own kept bounds, on the pool's workers where there
+ * are several: the same result for any thread count. The group keeps the largest of all ranges'
+ * kept bounds. A sample a range settled lies within that range's smallest kept bound, which is at
+ * most the group's (the range's own kept bounds are among those the group's are chosen from), and
+ * a bound a range kept but the group did not is at most the group's smallest: every promise holds.
+ * The largest distance is the largest of the ranges'. Returns 0 when out of memory. */
+static int measure_in_ranges(const lod_build *b, lod_scratch *s)
 {
-    float worst = 0.0f;
-    uint32_t last = UINT32_MAX;
-    for (uint32_t i = 0; i < s->gathered; i++) {
-        if (settled_by_last(s, i, last)) {
-            s->sample_cluster[i] = s->out_cluster[last];
-            continue;
-        }
-        lod_sample_bound m = s->ring_d2[i];
-        if (m.d2 > worst) /* measured exactly in its range too */
-            m = s->exact_d2[i];
-        s->sample_cluster[i] = s->out_cluster[m.triangle];
-        last = m.triangle;
-        keep_largest(s, m.d2, i);
-        worst = m.d2 > worst ? m.d2 : worst;
+    uint32_t size = (s->gathered + LOD_SAMPLE_RANGES - 1) / LOD_SAMPLE_RANGES;
+    s->range_size = size > LOD_SAMPLE_RANGE_MIN ? size : LOD_SAMPLE_RANGE_MIN;
+    uint32_t ranges = (s->gathered + s->range_size - 1) / s->range_size;
+    if (!LOD_RESERVE(s, range_kept, ranges))
+        return 0;
+    if (gdr_thread_pool_thread_count(b->pool) > 1 && ranges > 1)
+        gdr_thread_pool_run(b->pool, ranges, sample_range_task, s);
+    else
+        for (uint32_t r = 0; r < ranges; r++)
+            sample_range_task(s, r, 0);
+    s->top.count = 0;
+    s->top.worst = 0.0f;
+    for (uint32_t r = 0; r < ranges; r++) {
+        const lod_kept *k = &s->range_kept[r];
+        for (uint32_t j = 0; j < k->count; j++)
+            keep_largest(&s->top, k->d2[j], k->sample[j]);
+        s->top.worst = k->worst > s->top.worst ? k->worst : s->top.worst;
     }
-    return worst;
-}
-
-/* Whether this group's samples are measured by the pool's workers: the step's only group (its task
- * runs on the calling thread, outside any job), with enough samples. */
-static int measure_in_parallel(const lod_build *b, const lod_scratch *s)
-{
-    return b->lone_group && gdr_thread_pool_thread_count(b->pool) > 1 && s->gathered >= 2 * LOD_SAMPLE_RANGE;
+    return 1;
 }
 
 /* Largest distance from a sample to the simplified triangles; each sample's nearest cluster, and
- * the samples of the largest distance bounds (keep_largest). The
- * triangles around the nearest simplified vertex give an upper bound quickly; only a sample whose
- * bound exceeds the largest distance so far is measured exactly (grid of the triangles), so the
- * result is the exact maximum and every sample lies within it of the cluster it passes to. The
- * step's only group measures its samples in ranges on the pool, with the same result. */
+ * the samples of the largest distance bounds (keep_largest). The triangles around the nearest
+ * simplified vertex give an upper bound quickly; only a sample whose bound exceeds the largest
+ * distance so far is measured exactly (grid of the triangles), so the result is the exact maximum
+ * and every sample lies within it of the cluster it passes to. */
 static float samples_to_simplified(const lod_build *b, lod_scratch *s, uint32_t local_count)
 {
     uint32_t used = 0;
@@ -449,12 +439,11 @@ static float samples_to_simplified(const lod_build *b, lod_scratch *s, uint32_t 
     if (!lod_grid_build(&s->grid, s->vertex_points, used, 4.0) ||
         !lod_triangle_grid_build(&s->triangle_grid, s->positions, s->out_corners, s->out_triangle_count))
         return -1.0f;
-    if (!measure_in_parallel(b, s)) /* the step's only group as its ranges would: for any thread count */
-        return sqrtf(measure_samples(s, !b->lone_group));
-    if (!LOD_RESERVE(s, ring_d2, s->gathered) || !LOD_RESERVE(s, exact_d2, s->gathered))
+    if (!b->lone_group)
+        measure_samples(s, 0, s->gathered, &s->top);
+    else if (!measure_in_ranges(b, s))
         return -1.0f;
-    gdr_thread_pool_run(b->pool, (s->gathered + LOD_SAMPLE_RANGE - 1) / LOD_SAMPLE_RANGE, sample_range_task, s);
-    return sqrtf(replay_samples(s));
+    return sqrtf(s->top.worst);
 }
 
 /* Distance (squared) from p to the level-0 triangles around position `position`: an upper bound of
@@ -828,9 +817,9 @@ static int collect_excess(lod_scratch *s, group_result *r, float floor)
 {
     float floor2 = floor * floor;
     uint32_t over[LOD_EXCESS_LIMIT + 1], n = 0;
-    for (uint32_t k = 0; k < s->top_count; k++)
-        if (s->top_d2[k] > floor2)
-            over[n++] = s->top_sample[k];
+    for (uint32_t k = 0; k < s->top.count; k++)
+        if (s->top.d2[k] > floor2)
+            over[n++] = s->top.sample[k];
     r->floor = floor;
     r->excess_count = 0;
     if (n == 0 || n > LOD_EXCESS_LIMIT)
@@ -858,7 +847,7 @@ int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *member
 {
     if (!output_triangles(s, r, local_count) || !gather_samples(b, s, members, count))
         return 0;
-    s->top_count = 0; /* a group without samples keeps none */
+    s->top.count = 0; /* a group without samples keeps none */
     float to_simplified = s->gathered ? samples_to_simplified(b, s, local_count) : 0.0f;
     float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified, INFINITY);
     /* Where D1 is set by the few samples (at most LOD_EXCESS_LIMIT) farther than all others and the
@@ -866,7 +855,7 @@ int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *member
      * error that no redirection of samples can lower. Both measures bound D2: the smaller counts.
      * Not where that level is above LOD_REDIRECT_GAIN of the error, and no further once D2 is: no
      * redirection would pay. */
-    float rest = s->top_count == LOD_EXCESS_LIMIT + 1 ? sqrtf(s->top_d2[0]) : 0.0f;
+    float rest = s->top.count == LOD_EXCESS_LIMIT + 1 ? sqrtf(s->top.d2[0]) : 0.0f;
     float floor = r->error > rest ? r->error : rest;
     if (to_simplified > floor && to_full >= 0.0f && floor <= LOD_REDIRECT_GAIN * to_full) {
         float again = simplified_to_full(b, s, floor, LOD_REDIRECT_GAIN * to_full);

@@ -347,6 +347,5 @@ void gdr_lod_scratch_free(lod_scratch *s)
     free(s->region_corners);
     free(s->coarse_d2);
     free(s->edge_d2);
-    free(s->ring_d2);
-    free(s->exact_d2);
+    free(s->range_kept);
 }

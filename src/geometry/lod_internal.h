@@ -43,11 +43,13 @@ typedef struct lod_progress {
     atomic_uint_fast64_t done;
 } lod_progress;
 
-/* A sample's distance bound (squared) to a group's simplified triangles, and the nearest of them. */
-typedef struct lod_sample_bound {
-    float d2;
-    uint32_t triangle;
-} lod_sample_bound;
+/* The LOD_EXCESS_LIMIT + 1 largest sample distance bounds of a group, or of a range of its samples
+ * (squared, ascending, with their gathered samples), and the largest distance (squared). */
+typedef struct lod_kept {
+    float d2[LOD_EXCESS_LIMIT + 1];
+    uint32_t sample[LOD_EXCESS_LIMIT + 1], count;
+    float worst;
+} lod_kept;
 
 /* Per-worker scratch, reused from task to task. */
 typedef struct lod_scratch {
@@ -74,8 +76,7 @@ typedef struct lod_scratch {
     uint32_t *out_corners, *out_cluster, *ring_start, *ring;
     size_t out_corners_cap, out_cluster_cap, ring_start_cap, ring_cap;
     uint32_t out_triangle_count;
-    float top_d2[LOD_EXCESS_LIMIT + 1]; /* the largest sample distance bounds (squared, ascending) */
-    uint32_t top_sample[LOD_EXCESS_LIMIT + 1], top_count; /* ... and their gathered samples */
+    lod_kept top; /* the group's largest sample distance bounds */
     uint32_t *sample_ids, *sample_cluster, *vertex_local;
     size_t sample_ids_cap, sample_cluster_cap, vertex_local_cap;
     gdr_vec3 *sample_points, *vertex_points;
@@ -92,8 +93,9 @@ typedef struct lod_scratch {
     size_t coarse_d2_cap;
     float *edge_d2; /* per simplified triangle edge: its largest coarse probe (squared), -1 once refined */
     size_t edge_d2_cap;
-    lod_sample_bound *ring_d2, *exact_d2; /* per sample, when one group's samples are measured in ranges */
-    size_t ring_d2_cap, exact_d2_cap;
+    lod_kept *range_kept; /* per range, when one group's samples are measured in ranges */
+    size_t range_kept_cap;
+    uint32_t range_size; /* samples per range */
     uint8_t edge_count[64 * 64];
 } lod_scratch;
 
