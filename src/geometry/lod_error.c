@@ -28,9 +28,11 @@ static gdr_vec3 along(gdr_vec3 o, float t, gdr_vec3 d) { return (gdr_vec3){o.x +
 
 /* Squared distance from p to triangle (a, b, c), by the region of the closest point q. Any corner
  * bounds the distance too (d(p, a), the smaller is returned): that guards the degenerate cases. In
- * scalars, not arrays, so that the compiler keeps them in registers. */
-static float point_triangle_d2(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3 c)
+ * scalars, not arrays, so that the compiler keeps them in registers. *inside is set where q lies
+ * inside the triangle (p's foot on its plane), else cleared. */
+static float point_triangle_foot_d2(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3 c, int *inside)
 {
+    *inside = 0;
     gdr_vec3 ab = sub3(b, a), ac = sub3(c, a), ap = sub3(p, a);
     float d1 = dot3(ab, ap), d2 = dot3(ac, ap), da = dot3(ap, ap);
     if (d1 <= 0.0f && d2 <= 0.0f)
@@ -52,6 +54,7 @@ static float point_triangle_d2(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3 c)
     } else {
         float denom = va + vb + vc;
         float v = vb / denom, w = vc / denom;
+        *inside = denom > 0.0f;
         if (!(denom > 0.0f)) /* degenerate: nearest corner */
             v = w = 0.0f;
         q = (gdr_vec3){a.x + ab.x * v + ac.x * w, a.y + ab.y * v + ac.y * w, a.z + ab.z * v + ac.z * w};
@@ -59,6 +62,12 @@ static float point_triangle_d2(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3 c)
     gdr_vec3 pq = sub3(p, q);
     float d = dot3(pq, pq);
     return d < da ? d : da;
+}
+
+static float point_triangle_d2(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3 c)
+{
+    int inside;
+    return point_triangle_foot_d2(p, a, b, c, &inside);
 }
 
 static gdr_vec3 load3(const float *f) { return (gdr_vec3){f[0], f[1], f[2]}; }
@@ -275,19 +284,22 @@ static int gather_samples(lod_build *b, lod_scratch *s, const uint32_t *members,
 }
 
 /* Distance (squared) from p to the triangles around local vertex l, and the nearest of them; the
- * search stops at the first triangle that brings it to at most `enough` (0: none but a corner). */
+ * search stops at distance 0 (p is a corner) and at the first triangle that holds p's foot and
+ * brings it to at most `enough` (the nearest there, on a surface). */
 static float ring_d2(const lod_scratch *s, uint32_t l, gdr_vec3 p, uint32_t *nearest, float enough)
 {
     float best = INFINITY;
     *nearest = s->ring[s->ring_start[l]];
     for (uint32_t k = s->ring_start[l]; k < s->ring_start[l + 1]; k++) {
         const uint32_t *t = s->out_corners + (size_t)s->ring[k] * 3;
-        float d = point_triangle_d2(p, load3(s->positions + (size_t)t[0] * 3), load3(s->positions + (size_t)t[1] * 3),
-                                    load3(s->positions + (size_t)t[2] * 3));
+        int inside;
+        float d = point_triangle_foot_d2(p, load3(s->positions + (size_t)t[0] * 3),
+                                         load3(s->positions + (size_t)t[1] * 3), load3(s->positions + (size_t)t[2] * 3),
+                                         &inside);
         if (d < best) {
             best = d;
             *nearest = s->ring[k];
-            if (best <= enough) /* at most what is enough, or 0 (p is a corner) */
+            if (best == 0.0f || (inside && best <= enough))
                 break;
         }
     }
@@ -336,23 +348,30 @@ static float sample_ring_d2(const lod_scratch *s, uint32_t i, uint32_t *nearest,
     return ring_d2(s, l, s->sample_points[i], nearest, enough);
 }
 
-/* Squared distance from sample i to simplified triangle t. */
-static float sample_triangle_d2(const lod_scratch *s, uint32_t i, uint32_t t)
+/* Squared distance from sample i to simplified triangle t; *inside: whether its foot is inside t. */
+static float sample_triangle_d2(const lod_scratch *s, uint32_t i, uint32_t t, int *inside)
 {
     const uint32_t *c = s->out_corners + (size_t)t * 3;
-    return point_triangle_d2(s->sample_points[i], load3(s->positions + (size_t)c[0] * 3),
-                             load3(s->positions + (size_t)c[1] * 3), load3(s->positions + (size_t)c[2] * 3));
+    return point_triangle_foot_d2(s->sample_points[i], load3(s->positions + (size_t)c[0] * 3),
+                                  load3(s->positions + (size_t)c[1] * 3), load3(s->positions + (size_t)c[2] * 3),
+                                  inside);
 }
 
 /* Whether sample i is settled by triangle `last` (the one the last measured sample passed to, or
- * UINT32_MAX): it lies within `bound`, the smallest kept bound (kept_bound), of it. Such a sample
- * cannot raise the largest distance (its exact distance is at most that bound) and lies within the
- * smallest kept bound of `last`'s cluster, all that a sample not kept is promised: it passes there
- * unmeasured (docs/GEOMETRY.md, "Measuring the samples cheaply"). Consecutive samples are
- * neighbours on S0: mostly near the same triangle. */
+ * UINT32_MAX): it lies within `bound`, the smallest kept bound (kept_bound), of it, and its foot is
+ * inside it. Such a sample cannot raise the largest distance (its exact distance is at most that
+ * bound) and lies within the smallest kept bound of `last`'s cluster, all that a sample not kept
+ * is promised: it passes there unmeasured (docs/GEOMETRY.md, "Measuring the samples cheaply").
+ * The foot inside keeps it with its nearest triangle on a surface: a sample handed to a farther
+ * cluster is measured against that cluster's group at the next step (on the 1 M-triangle torus
+ * without it, the groups' mean error rose 14%). Consecutive samples are neighbours on S0: mostly
+ * near the same triangle. */
 static int settled_by_last(const lod_scratch *s, uint32_t i, uint32_t last, float bound)
 {
-    return last != UINT32_MAX && bound >= 0.0f && sample_triangle_d2(s, i, last) <= bound;
+    if (last == UINT32_MAX || bound < 0.0f)
+        return 0;
+    int inside;
+    return sample_triangle_d2(s, i, last, &inside) <= bound && inside;
 }
 
 /* Samples [first, end) in order, into `kept` (empty at first): a sample settled by the last
