@@ -28,11 +28,14 @@ static gdr_vec3 along(gdr_vec3 o, float t, gdr_vec3 d) { return (gdr_vec3){o.x +
 
 /* Squared distance from p to triangle (a, b, c), by the region of the closest point q. Any corner
  * bounds the distance too (d(p, a), the smaller is returned): that guards the degenerate cases. In
- * scalars, not arrays, so that the compiler keeps them in registers. *inside is set where q lies
- * inside the triangle (p's foot on its plane), else cleared. */
-static float point_triangle_foot_d2(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3 c, int *inside)
+ * scalars, not arrays, so that the compiler keeps them in registers. *where: FOOT_INSIDE where q
+ * lies inside the triangle (p's foot on its plane), the edge k (joining corners k and k + 1 mod 3)
+ * where q lies on it, FOOT_CORNER at a corner. */
+#define FOOT_INSIDE 3
+#define FOOT_CORNER 4
+static float point_triangle_foot_d2(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3 c, int *where)
 {
-    *inside = 0;
+    *where = FOOT_CORNER;
     gdr_vec3 ab = sub3(b, a), ac = sub3(c, a), ap = sub3(p, a);
     float d1 = dot3(ab, ap), d2 = dot3(ac, ap), da = dot3(ap, ap);
     if (d1 <= 0.0f && d2 <= 0.0f)
@@ -47,14 +50,17 @@ static float point_triangle_foot_d2(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3
         q = c;
     } else if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) {
         q = along(a, d1 / (d1 - d3), ab);
+        *where = 0;
     } else if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) {
         q = along(a, d2 / (d2 - d6), ac);
+        *where = 2;
     } else if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f) {
         q = along(b, (d4 - d3) / ((d4 - d3) + (d5 - d6)), sub3(c, b));
+        *where = 1;
     } else {
         float denom = va + vb + vc;
         float v = vb / denom, w = vc / denom;
-        *inside = denom > 0.0f;
+        *where = denom > 0.0f ? FOOT_INSIDE : FOOT_CORNER;
         if (!(denom > 0.0f)) /* degenerate: nearest corner */
             v = w = 0.0f;
         q = (gdr_vec3){a.x + ab.x * v + ac.x * w, a.y + ab.y * v + ac.y * w, a.z + ab.z * v + ac.z * w};
@@ -66,8 +72,8 @@ static float point_triangle_foot_d2(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3
 
 static float point_triangle_d2(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3 c)
 {
-    int inside;
-    return point_triangle_foot_d2(p, a, b, c, &inside);
+    int where;
+    return point_triangle_foot_d2(p, a, b, c, &where);
 }
 
 static gdr_vec3 load3(const float *f) { return (gdr_vec3){f[0], f[1], f[2]}; }
@@ -292,14 +298,14 @@ static float ring_d2(const lod_scratch *s, uint32_t l, gdr_vec3 p, uint32_t *nea
     *nearest = s->ring[s->ring_start[l]];
     for (uint32_t k = s->ring_start[l]; k < s->ring_start[l + 1]; k++) {
         const uint32_t *t = s->out_corners + (size_t)s->ring[k] * 3;
-        int inside;
+        int where;
         float d = point_triangle_foot_d2(p, load3(s->positions + (size_t)t[0] * 3),
                                          load3(s->positions + (size_t)t[1] * 3), load3(s->positions + (size_t)t[2] * 3),
-                                         &inside);
+                                         &where);
         if (d < best) {
             best = d;
             *nearest = s->ring[k];
-            if (best == 0.0f || (inside && best <= enough))
+            if (best == 0.0f || (where == FOOT_INSIDE && best <= enough))
                 break;
         }
     }
@@ -348,34 +354,57 @@ static float sample_ring_d2(const lod_scratch *s, uint32_t i, uint32_t *nearest,
     return ring_d2(s, l, s->sample_points[i], nearest, enough);
 }
 
-/* Squared distance from sample i to simplified triangle t; *inside: whether its foot is inside t. */
-static float sample_triangle_d2(const lod_scratch *s, uint32_t i, uint32_t t, int *inside)
+/* Squared distance from sample i to simplified triangle t; *where: where its foot is (FOOT_INSIDE,
+ * an edge or FOOT_CORNER). */
+static float sample_triangle_d2(const lod_scratch *s, uint32_t i, uint32_t t, int *where)
 {
     const uint32_t *c = s->out_corners + (size_t)t * 3;
     return point_triangle_foot_d2(s->sample_points[i], load3(s->positions + (size_t)c[0] * 3),
                                   load3(s->positions + (size_t)c[1] * 3), load3(s->positions + (size_t)c[2] * 3),
-                                  inside);
+                                  where);
 }
 
-/* Whether sample i is settled by triangle `last` (the one the last measured sample passed to, or
- * UINT32_MAX): it lies within `bound`, the smallest kept bound (kept_bound), of it, and its foot is
- * inside it. Such a sample cannot raise the largest distance (its exact distance is at most that
- * bound) and lies within the smallest kept bound of `last`'s cluster, all that a sample not kept
- * is promised: it passes there unmeasured (docs/GEOMETRY.md, "Measuring the samples cheaply").
- * The foot inside keeps it with its nearest triangle on a surface: a sample handed to a farther
- * cluster is measured against that cluster's group at the next step (on the 1 M-triangle torus
- * without it, the groups' mean error rose 14%). Consecutive samples are neighbours on S0: mostly
- * near the same triangle. */
-static int settled_by_last(const lod_scratch *s, uint32_t i, uint32_t last, float bound)
+/* The simplified triangle other than t that shares t's edge k (corners k and k + 1 mod 3), the
+ * first in output order; UINT32_MAX when none. */
+static uint32_t across_edge(const lod_scratch *s, uint32_t t, int k)
+{
+    uint32_t a = s->out_corners[(size_t)t * 3 + k], b = s->out_corners[(size_t)t * 3 + (k + 1) % 3];
+    for (uint32_t i = s->ring_start[a]; i < s->ring_start[a + 1]; i++) {
+        const uint32_t *u = s->out_corners + (size_t)s->ring[i] * 3;
+        if (s->ring[i] != t && (u[0] == b || u[1] == b || u[2] == b))
+            return s->ring[i];
+    }
+    return UINT32_MAX;
+}
+
+/* The triangle that settles sample i, UINT32_MAX when none: `last` (the one the last measured
+ * sample passed to, or UINT32_MAX) or, where i's foot lies beyond one of its edges, the triangle
+ * across that edge, if the sample lies within `bound`, the smallest kept bound (kept_bound), of it and its
+ * foot is inside it. Such a sample cannot raise the largest distance (its exact distance is at
+ * most that bound) and lies within the smallest kept bound of the triangle's cluster, all that a
+ * sample not kept is promised: it passes there unmeasured (docs/GEOMETRY.md, "Measuring the
+ * samples cheaply"). The foot inside keeps it with its nearest triangle on a surface: a sample
+ * handed to a farther cluster is measured against that cluster's group at the next step (on the
+ * 1 M-triangle torus without it, the groups' mean error rose 14%). Consecutive samples are
+ * neighbours on S0: mostly over the same triangle or the next. (Moving `last` to the settling
+ * triangle settles more, but on that torus raised the mean error 9%: not done.) */
+static uint32_t settling_triangle(const lod_scratch *s, uint32_t i, uint32_t last, float bound)
 {
     if (last == UINT32_MAX || bound < 0.0f)
-        return 0;
-    int inside;
-    return sample_triangle_d2(s, i, last, &inside) <= bound && inside;
+        return UINT32_MAX;
+    int where;
+    float d = sample_triangle_d2(s, i, last, &where);
+    if (where == FOOT_INSIDE)
+        return d <= bound ? last : UINT32_MAX;
+    uint32_t next = where < FOOT_INSIDE ? across_edge(s, last, where) : UINT32_MAX;
+    if (next == UINT32_MAX)
+        return UINT32_MAX;
+    d = sample_triangle_d2(s, i, next, &where);
+    return where == FOOT_INSIDE && d <= bound ? next : UINT32_MAX;
 }
 
 /* Samples [first, end) in order, into `kept` (empty at first): a sample settled by the last
- * measured one's triangle is not measured; of the others, the ring's search stops at the first
+ * one's triangle or the next (settling_triangle) is not measured; of the others, the ring's search stops at the first
  * triangle within the smallest kept bound (the sample is then settled by that triangle, the same
  * rule), and only a sample whose ring bound exceeds the largest distance so far is measured
  * exactly (grid of the triangles). kept->worst: the largest distance, squared. */
@@ -386,8 +415,9 @@ static void measure_samples(lod_scratch *s, uint32_t first, uint32_t end, lod_ke
     kept->worst = 0.0f;
     for (uint32_t i = first; i < end; i++) {
         float bound = kept_bound(kept);
-        if (settled_by_last(s, i, last, bound)) {
-            s->sample_cluster[i] = s->out_cluster[last];
+        uint32_t settled = settling_triangle(s, i, last, bound);
+        if (settled != UINT32_MAX) {
+            s->sample_cluster[i] = s->out_cluster[settled];
             continue;
         }
         uint32_t nearest;
