@@ -379,8 +379,8 @@ static uint32_t across_edge(const lod_scratch *s, uint32_t t, int k)
 
 /* The triangle that settles sample i, UINT32_MAX when none: `last` (the one the last measured
  * sample passed to, or UINT32_MAX) or, where i's foot lies beyond one of its edges, the triangle
- * across that edge, if the sample lies within `bound`, the smallest kept bound (kept_bound), of it and its
- * foot is inside it. Such a sample cannot raise the largest distance (its exact distance is at
+ * across that edge, if the sample lies within `bound`, the smallest kept bound (kept_bound), of it
+ * and its foot is inside it. Such a sample cannot raise the largest distance (its exact distance is at
  * most that bound) and lies within the smallest kept bound of the triangle's cluster, all that a
  * sample not kept is promised: it passes there unmeasured (docs/GEOMETRY.md, "Measuring the
  * samples cheaply"). The foot inside keeps it with its nearest triangle on a surface: a sample
@@ -404,10 +404,11 @@ static uint32_t settling_triangle(const lod_scratch *s, uint32_t i, uint32_t las
 }
 
 /* Samples [first, end) in order, into `kept` (empty at first): a sample settled by the last
- * one's triangle or the next (settling_triangle) is not measured; of the others, the ring's search stops at the first
- * triangle within the smallest kept bound (the sample is then settled by that triangle, the same
- * rule), and only a sample whose ring bound exceeds the largest distance so far is measured
- * exactly (grid of the triangles). kept->worst: the largest distance, squared. */
+ * measured one's triangle or the next (settling_triangle) is not measured; of the others, the
+ * ring's search stops at the first triangle that holds the sample's foot within the smallest kept
+ * bound (the sample is then settled by that triangle, the same rule), and only a sample whose ring
+ * bound exceeds the largest distance so far is measured exactly (grid of the triangles).
+ * kept->worst: the largest distance, squared. */
 static void measure_samples(lod_scratch *s, uint32_t first, uint32_t end, lod_kept *kept)
 {
     uint32_t last = UINT32_MAX;
