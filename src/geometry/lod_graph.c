@@ -1,6 +1,7 @@
 /* The cluster graph of one DAG step and its partition into groups (METIS). Two clusters are
  * neighbours when they share edges (by position, so attribute seams do not cut them apart); the
  * edge weight is the number of shared edges. */
+#include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
@@ -36,7 +37,7 @@ static void radix_sort(key_record *a, key_record *tmp, size_t n)
 /* Key of the undirected edge between two positions. */
 static uint64_t edge_key(uint32_t a, uint32_t b) { return a < b ? (uint64_t)a << 32 | b : (uint64_t)b << 32 | a; }
 
-/* The edges of frontier cluster f that no other triangle of the cluster shares, as position keys;
+/* The edges of frontier cluster f that no other triangle of the cluster shares, as (welded) position keys;
  * edges between equal positions are left out. First counted (b->edge_records NULL) into
  * b->edge_record_counts[f], then written from b->edge_record_counts[f] on. */
 static void boundary_edges_task(void *user, uint32_t f, uint32_t worker)
@@ -59,7 +60,7 @@ static void boundary_edges_task(void *user, uint32_t f, uint32_t worker)
         uint32_t a = t[i], e = t[i - i % 3 + (i % 3 + 1) % 3];
         uint32_t lo = a < e ? a : e, hi = a < e ? e : a;
         if (s->edge_count[lo * 64 + hi] == 1) {
-            uint32_t pa = b->position_id[v[a]], pe = b->position_id[v[e]];
+            uint32_t pa = gdr_lod_weld_id(b, v[a]), pe = gdr_lod_weld_id(b, v[e]);
             if (pa != pe && out)
                 out[count] = (key_record){.key = edge_key(pa, pe), .value = f};
             count += pa != pe;
@@ -249,4 +250,125 @@ gdr_status gdr_lod_partition(lod_build *b, gdr_thread_pool *pool, uint32_t worke
             return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "mesh '%s': METIS returned part %d of %u",
                                  b->mesh->name, (int)part[f], parts);
     return GDR_OK;
+}
+
+/* --- near-equal positions ---------------------------------------------------------------------- */
+
+/* A position in cells of the weld distance, relative to the mesh's centre. */
+typedef struct weld_entry {
+    int32_t cell[3];
+    uint32_t position;
+} weld_entry;
+
+static int compare_weld_entries(const void *pa, const void *pb)
+{
+    const weld_entry *a = pa, *b = pb;
+    for (int k = 0; k < 3; k++)
+        if (a->cell[k] != b->cell[k])
+            return a->cell[k] < b->cell[k] ? -1 : 1;
+    return a->position < b->position ? -1 : a->position > b->position;
+}
+
+static uint32_t cell_hash(const int32_t *c, uint32_t mask)
+{
+    uint32_t h = (uint32_t)c[0] * 73856093u ^ (uint32_t)c[1] * 19349663u ^ (uint32_t)c[2] * 83492791u;
+    return (h ^ h >> 15) & mask;
+}
+
+/* Root of position p (union-find; the root is the smallest position id of its set). */
+static uint32_t weld_root(uint32_t *parent, uint32_t p)
+{
+    while (parent[p] != p)
+        p = parent[p] = parent[parent[p]];
+    return p;
+}
+
+/* Entries of each cell are contiguous in `e` (sorted); table maps a cell to its first entry + 1. */
+static uint32_t find_cell(const weld_entry *e, const uint32_t *table, uint32_t mask, const int32_t *c)
+{
+    for (uint32_t h = cell_hash(c, mask);; h = (h + 1) & mask) {
+        uint32_t i = table[h];
+        if (i == 0 || !memcmp(e[i - 1].cell, c, sizeof e->cell))
+            return i;
+    }
+}
+
+/* Joins every two positions of cells next to each other (or the same) that lie within `eps` on
+ * every axis. At most 64 entries of a cell are compared with each position: a cluster of more
+ * positions that close (a hostile mesh) is welded partly, which only leaves seams open. */
+static int weld_pairs(const lod_build *b, const weld_entry *e, uint32_t n, uint32_t *parent, double eps)
+{
+    uint32_t mask = 1;
+    while (mask < 2 * n)
+        mask <<= 1;
+    uint32_t *table = calloc(mask--, sizeof *table);
+    if (!table)
+        return 0;
+    for (uint32_t i = 0; i < n; i++)
+        if (i == 0 || memcmp(e[i].cell, e[i - 1].cell, sizeof e->cell))
+            for (uint32_t h = cell_hash(e[i].cell, mask);; h = (h + 1) & mask)
+                if (!table[h]) {
+                    table[h] = i + 1;
+                    break;
+                }
+    const gdr_vec3 *x = b->mesh->positions;
+    for (uint32_t i = 0; i < n; i++)
+        for (int d = 0; d < 27; d++) {
+            int32_t c[3] = {e[i].cell[0] + d % 3 - 1, e[i].cell[1] + d / 3 % 3 - 1, e[i].cell[2] + d / 9 - 1};
+            uint32_t j = find_cell(e, table, mask, c);
+            for (uint32_t k = j ? j - 1 : n, end = k + 64; k < n && k < end && !memcmp(e[k].cell, c, sizeof c); k++) {
+                gdr_vec3 p = x[b->weld_vertex[e[i].position]], q = x[b->weld_vertex[e[k].position]];
+                if (e[k].position > e[i].position && fabs((double)p.x - q.x) <= eps &&
+                    fabs((double)p.y - q.y) <= eps && fabs((double)p.z - q.z) <= eps) {
+                    uint32_t ri = weld_root(parent, e[i].position), rk = weld_root(parent, e[k].position);
+                    parent[ri > rk ? ri : rk] = ri < rk ? ri : rk;
+                }
+            }
+        }
+    free(table);
+    return 1;
+}
+
+/* Positions within LOD_WELD_SCALE of the radius of each other (on every axis; chains of them
+ * too) become one to grouping and simplification: b->weld_vertex[p] = a vertex of the set's
+ * smallest position id. Left NULL when no two positions are that close. Deterministic: it
+ * depends on the positions alone. */
+int gdr_lod_weld_setup(lod_build *b)
+{
+    const gdr_mesh *mesh = b->mesh;
+    uint32_t n = b->position_count;
+    double eps = (double)mesh->bounds.w * LOD_WELD_SCALE;
+    if (n < 2 || !(eps > 0.0))
+        return 1;
+    b->weld_vertex = malloc((size_t)n * sizeof *b->weld_vertex);
+    uint32_t *parent = malloc((size_t)n * sizeof *parent);
+    weld_entry *e = malloc((size_t)n * sizeof *e);
+    int ok = b->weld_vertex && parent && e;
+    for (uint32_t v = mesh->vertex_count; ok && v-- > 0;)
+        b->weld_vertex[b->position_id[v]] = v; /* the first vertex of each position */
+    for (uint32_t p = 0; ok && p < n; p++) {
+        gdr_vec3 x = mesh->positions[b->weld_vertex[p]];
+        double rel[3] = {(double)x.x - mesh->bounds.x, (double)x.y - mesh->bounds.y, (double)x.z - mesh->bounds.z};
+        for (int k = 0; k < 3; k++) /* within the bounding sphere: |rel| / eps <= 1e6 */
+            e[p].cell[k] = (int32_t)fmax(fmin(floor(rel[k] / eps), 2e9), -2e9);
+        e[p].position = p;
+        parent[p] = p;
+    }
+    if (ok) {
+        qsort(e, n, sizeof *e, compare_weld_entries);
+        ok = weld_pairs(b, e, n, parent, eps);
+    }
+    int welded = 0;
+    for (uint32_t p = 0; ok && p < n; p++) {
+        uint32_t r = weld_root(parent, p);
+        welded |= r != p;
+        b->weld_vertex[p] = b->weld_vertex[r]; /* r <= p: already final */
+    }
+    free(parent);
+    free(e);
+    if (!ok || !welded) {
+        free(b->weld_vertex);
+        b->weld_vertex = NULL;
+    }
+    return ok;
 }
