@@ -189,7 +189,7 @@ static void mark_shared(lod_build *b, const lod_stage *st, int clear)
             const gdr_cluster *c = &b->clusters[st->members[i]];
             const uint32_t *v = gdr_lod_cluster_vertices(b, c);
             for (uint32_t j = 0; j < c->vertex_count; j++) {
-                uint32_t *o = &b->owner[gdr_lod_weld_id(b, v[j])];
+                uint32_t *o = &b->owner[b->position_id[v[j]]];
                 *o = clear ? OWNER_NONE : *o == OWNER_NONE || *o == g ? g : OWNER_SHARED;
             }
         }
@@ -747,7 +747,6 @@ static gdr_status build_mesh(lod_build *b, gdr_error *err)
     free(frontier);
     gdr_lod_error_free(b);
     free(b->position_id);
-    free(b->weld_vertex);
     free(b->owner);
     if (b->scratch)
         for (uint32_t w = 0; w < b->scratch_count; w++)

@@ -37,7 +37,7 @@ static void radix_sort(key_record *a, key_record *tmp, size_t n)
 /* Key of the undirected edge between two positions. */
 static uint64_t edge_key(uint32_t a, uint32_t b) { return a < b ? (uint64_t)a << 32 | b : (uint64_t)b << 32 | a; }
 
-/* The edges of frontier cluster f that no other triangle of the cluster shares, as (welded) position keys;
+/* The edges of frontier cluster f that no other triangle of the cluster shares, as position keys;
  * edges between equal positions are left out. First counted (b->edge_records NULL) into
  * b->edge_record_counts[f], then written from b->edge_record_counts[f] on. */
 static void boundary_edges_task(void *user, uint32_t f, uint32_t worker)
@@ -60,7 +60,7 @@ static void boundary_edges_task(void *user, uint32_t f, uint32_t worker)
         uint32_t a = t[i], e = t[i - i % 3 + (i % 3 + 1) % 3];
         uint32_t lo = a < e ? a : e, hi = a < e ? e : a;
         if (s->edge_count[lo * 64 + hi] == 1) {
-            uint32_t pa = gdr_lod_weld_id(b, v[a]), pe = gdr_lod_weld_id(b, v[e]);
+            uint32_t pa = b->position_id[v[a]], pe = b->position_id[v[e]];
             if (pa != pe && out)
                 out[count] = (key_record){.key = edge_key(pa, pe), .value = f};
             count += pa != pe;
@@ -294,9 +294,11 @@ static uint32_t find_cell(const weld_entry *e, const uint32_t *table, uint32_t m
 }
 
 /* Joins every two positions of cells next to each other (or the same) that lie within `eps` on
- * every axis. At most 64 entries of a cell are compared with each position: a cluster of more
- * positions that close (a hostile mesh) is welded partly, which only leaves seams open. */
-static int weld_pairs(const lod_build *b, const weld_entry *e, uint32_t n, uint32_t *parent, double eps)
+ * every axis (first[p]: a vertex of position p). At most 64 entries of a cell are compared with
+ * each position: a cluster of more positions that close (a hostile mesh) is joined partly, which
+ * only leaves some seams open. */
+static int weld_pairs(const lod_build *b, const weld_entry *e, uint32_t n, const uint32_t *first, uint32_t *parent,
+                      double eps)
 {
     uint32_t mask = 1;
     while (mask < 2 * n)
@@ -317,7 +319,7 @@ static int weld_pairs(const lod_build *b, const weld_entry *e, uint32_t n, uint3
             int32_t c[3] = {e[i].cell[0] + d % 3 - 1, e[i].cell[1] + d / 3 % 3 - 1, e[i].cell[2] + d / 9 - 1};
             uint32_t j = find_cell(e, table, mask, c);
             for (uint32_t k = j ? j - 1 : n, end = k + 64; k < n && k < end && !memcmp(e[k].cell, c, sizeof c); k++) {
-                gdr_vec3 p = x[b->weld_vertex[e[i].position]], q = x[b->weld_vertex[e[k].position]];
+                gdr_vec3 p = x[first[e[i].position]], q = x[first[e[k].position]];
                 if (e[k].position > e[i].position && fabs((double)p.x - q.x) <= eps &&
                     fabs((double)p.y - q.y) <= eps && fabs((double)p.z - q.z) <= eps) {
                     uint32_t ri = weld_root(parent, e[i].position), rk = weld_root(parent, e[k].position);
@@ -329,10 +331,9 @@ static int weld_pairs(const lod_build *b, const weld_entry *e, uint32_t n, uint3
     return 1;
 }
 
-/* Positions within LOD_WELD_SCALE of the radius of each other (on every axis; chains of them
- * too) become one to grouping and simplification: b->weld_vertex[p] = a vertex of the set's
- * smallest position id. Left NULL when no two positions are that close. Deterministic: it
- * depends on the positions alone. */
+/* Positions within LOD_WELD_SCALE of the radius of each other on every axis (and chains of them)
+ * get one position id, the smallest of theirs; the ids they leave are used by no vertex.
+ * Deterministic: it depends on the positions alone. */
 int gdr_lod_weld_setup(lod_build *b)
 {
     const gdr_mesh *mesh = b->mesh;
@@ -340,14 +341,13 @@ int gdr_lod_weld_setup(lod_build *b)
     double eps = (double)mesh->bounds.w * LOD_WELD_SCALE;
     if (n < 2 || !(eps > 0.0))
         return 1;
-    b->weld_vertex = malloc((size_t)n * sizeof *b->weld_vertex);
-    uint32_t *parent = malloc((size_t)n * sizeof *parent);
+    uint32_t *first = malloc((size_t)n * sizeof *first), *parent = malloc((size_t)n * sizeof *parent);
     weld_entry *e = malloc((size_t)n * sizeof *e);
-    int ok = b->weld_vertex && parent && e;
+    int ok = first && parent && e;
     for (uint32_t v = mesh->vertex_count; ok && v-- > 0;)
-        b->weld_vertex[b->position_id[v]] = v; /* the first vertex of each position */
+        first[b->position_id[v]] = v;
     for (uint32_t p = 0; ok && p < n; p++) {
-        gdr_vec3 x = mesh->positions[b->weld_vertex[p]];
+        gdr_vec3 x = first[p] < mesh->vertex_count ? mesh->positions[first[p]] : (gdr_vec3){0};
         double rel[3] = {(double)x.x - mesh->bounds.x, (double)x.y - mesh->bounds.y, (double)x.z - mesh->bounds.z};
         for (int k = 0; k < 3; k++) /* within the bounding sphere: |rel| / eps <= 1e6 */
             e[p].cell[k] = (int32_t)fmax(fmin(floor(rel[k] / eps), 2e9), -2e9);
@@ -356,19 +356,12 @@ int gdr_lod_weld_setup(lod_build *b)
     }
     if (ok) {
         qsort(e, n, sizeof *e, compare_weld_entries);
-        ok = weld_pairs(b, e, n, parent, eps);
+        ok = weld_pairs(b, e, n, first, parent, eps);
     }
-    int welded = 0;
-    for (uint32_t p = 0; ok && p < n; p++) {
-        uint32_t r = weld_root(parent, p);
-        welded |= r != p;
-        b->weld_vertex[p] = b->weld_vertex[r]; /* r <= p: already final */
-    }
+    for (uint32_t v = 0; ok && v < mesh->vertex_count; v++)
+        b->position_id[v] = weld_root(parent, b->position_id[v]);
+    free(first);
     free(parent);
     free(e);
-    if (!ok || !welded) {
-        free(b->weld_vertex);
-        b->weld_vertex = NULL;
-    }
     return ok;
 }

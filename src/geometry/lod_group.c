@@ -89,8 +89,8 @@ static int border_kept(lod_build *b, lod_scratch *s, size_t in_count, size_t out
         for (size_t i = 0; i < count; i++) {
             unsigned int a = idx[i], e = idx[i - i % 3 + (i % 3 + 1) % 3];
             if (s->locked[a] && s->locked[e])
-                keys[k++] = (uint64_t)gdr_lod_weld_id(b, s->local_to_mesh[a]) << 32 |
-                            gdr_lod_weld_id(b, s->local_to_mesh[e]);
+                keys[k++] = (uint64_t)b->position_id[s->local_to_mesh[a]] << 32 |
+                            b->position_id[s->local_to_mesh[e]];
         }
         qsort(keys, k, sizeof *keys, compare_u64);
         *(pass ? &nb : &na) = k;
@@ -207,9 +207,10 @@ void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker)
     for (uint32_t l = 0; l < local_count; l++) {
         uint32_t mv = s->local_to_mesh[l];
         s->map[mv] = UINT32_MAX;
-        const gdr_vec3 p = mesh_positions[gdr_lod_weld_vertex(b, mv)];
+        /* one vertex's coordinates for each position id: near-equal positions are one */
+        const gdr_vec3 p = mesh_positions[b->sample_vertex[b->position_id[mv]]];
         memcpy(s->positions + (size_t)l * 3, &p, sizeof p);
-        s->locked[l] = b->owner[gdr_lod_weld_id(b, mv)] == OWNER_SHARED;
+        s->locked[l] = b->owner[b->position_id[mv]] == OWNER_SHARED;
     }
     for (uint32_t l = 0; l < local_count; l++)
         if (s->locked[l])

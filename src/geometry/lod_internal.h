@@ -24,9 +24,10 @@
 /* A group passes samples only when that at least halves its error: its sphere may grow by half. */
 #define LOD_REDIRECT_GAIN 0.5f
 
-/* Positions closer than this share of the mesh's bounding radius on every axis are one position to
- * grouping and simplification (lod_graph.c, gdr_lod_weld_setup): seams whose two sides differ by
- * rounding (sinf(2 pi) != 0) then close like bit-equal ones instead of being open borders. */
+/* Positions closer than this share of the mesh's bounding radius on every axis are one position
+ * (lod_graph.c, gdr_lod_weld_setup): to grouping, simplification and the error's samples and walks.
+ * Seams whose two sides differ by rounding (sinf(2 pi) != 0) then close like bit-equal ones
+ * instead of being open borders. */
 #define LOD_WELD_SCALE 1e-6
 
 /* lod_build.owner: a position no group of the step uses, or that two groups share. */
@@ -128,10 +129,9 @@ typedef struct lod_build {
     uint32_t worker_base; /* worker index offset of this build's scratch (0: draws progress) */
     lod_scratch *scratch;
     uint32_t scratch_count;
-    uint32_t *position_id; /* mesh vertex -> id of its position (vertices with equal coordinates share it) */
+    uint32_t *position_id; /* mesh vertex -> id of its position (vertices with equal coordinates share it,
+                              and those within LOD_WELD_SCALE of each other) */
     uint32_t position_count;
-    uint32_t *weld_vertex; /* position id -> the mesh vertex whose position grouping and simplification
-                              use for it (LOD_WELD_SCALE); NULL where no position is welded */
     uint32_t *owner;       /* position id -> group using it in this step, OWNER_SHARED or OWNER_NONE */
     /* samples of the full-detail surface (lod_error.c): position ids, owned by frontier clusters */
     uint32_t *sample_vertex;   /* position id -> a mesh vertex at that position */
@@ -201,19 +201,8 @@ static inline const uint32_t *gdr_lod_cluster_vertices(const lod_build *b, const
 /* Adds to the shared progress; only worker 0 of the calling thread draws. */
 void gdr_lod_progress_add(lod_build *b, uint64_t amount, uint32_t worker);
 
-/* The position of mesh vertex v to grouping and simplification, as a position id / a mesh vertex
- * at that position: near-equal positions are one (LOD_WELD_SCALE). The error uses positions as
- * they are. */
-static inline uint32_t gdr_lod_weld_vertex(const lod_build *b, uint32_t v)
-{
-    return b->weld_vertex ? b->weld_vertex[b->position_id[v]] : v;
-}
-static inline uint32_t gdr_lod_weld_id(const lod_build *b, uint32_t v)
-{
-    return b->position_id[gdr_lod_weld_vertex(b, v)];
-}
-
-/* lod_graph.c: sets b->weld_vertex (after the position ids); 0: out of memory. */
+/* lod_graph.c: gives near-equal positions (LOD_WELD_SCALE) one position id, after
+ * meshoptimizer's remap gave bit-equal ones one; 0: out of memory. */
 int gdr_lod_weld_setup(lod_build *b);
 
 /* lod_graph.c: the number of parts of the frontier (b->frontier), and its partition into them,
