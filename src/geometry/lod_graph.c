@@ -332,8 +332,10 @@ static int weld_pairs(const lod_build *b, const weld_entry *e, uint32_t n, const
 }
 
 /* Positions within LOD_WELD_SCALE of the radius of each other on every axis (and chains of them)
- * get one position id, the smallest of theirs; the ids they leave are used by no vertex.
- * Deterministic: it depends on the positions alone. */
+ * get one position id, the smallest of theirs; the ids they leave are used by no vertex. Sets
+ * b->weld_slack, the largest distance between two vertices of one id (0: nothing welded), which
+ * every group's error gets added (the error's samples are one vertex per id). Deterministic: it
+ * depends on the positions alone. */
 int gdr_lod_weld_setup(lod_build *b)
 {
     const gdr_mesh *mesh = b->mesh;
@@ -358,8 +360,15 @@ int gdr_lod_weld_setup(lod_build *b)
         qsort(e, n, sizeof *e, compare_weld_entries);
         ok = weld_pairs(b, e, n, first, parent, eps);
     }
-    for (uint32_t v = 0; ok && v < mesh->vertex_count; v++)
+    double slack = 0.0; /* the largest distance from a vertex to the first vertex of its new id */
+    for (uint32_t v = 0; ok && v < mesh->vertex_count; v++) {
         b->position_id[v] = weld_root(parent, b->position_id[v]);
+        gdr_vec3 p = mesh->positions[v], q = mesh->positions[first[b->position_id[v]]];
+        double dx = (double)p.x - q.x, dy = (double)p.y - q.y, dz = (double)p.z - q.z;
+        slack = fmax(slack, sqrt(dx * dx + dy * dy + dz * dz));
+    }
+    /* Two vertices of one id are at most twice that apart (rounded up to a float). */
+    b->weld_slack = slack > 0.0 ? nextafterf((float)(2.0 * slack), INFINITY) : 0.0f;
     free(first);
     free(parent);
     free(e);

@@ -132,6 +132,8 @@ typedef struct lod_build {
     uint32_t *position_id; /* mesh vertex -> id of its position (vertices with equal coordinates share it,
                               and those within LOD_WELD_SCALE of each other) */
     uint32_t position_count;
+    float weld_slack;      /* the largest distance between two vertices of one position id: added to
+                              every group's error at the end (0 where no positions were welded) */
     uint32_t *owner;       /* position id -> group using it in this step, OWNER_SHARED or OWNER_NONE */
     /* samples of the full-detail surface (lod_error.c): position ids, owned by frontier clusters */
     uint32_t *sample_vertex;   /* position id -> a mesh vertex at that position */
