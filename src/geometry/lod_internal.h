@@ -20,7 +20,7 @@
 #define LOD_MAX_KEPT_SHARE 0.85
 #define LOD_CONE_WEIGHT 0.25f
 /* A group with more samples than this farther than its floor keeps them (lod_redirect.c). */
-#define LOD_EXCESS_LIMIT 64u
+#define LOD_EXCESS_LIMIT 1024u
 /* A group passes samples only when that at least halves its error: its sphere may grow by half. */
 #define LOD_REDIRECT_GAIN 0.5f
 
