@@ -14,7 +14,7 @@
  * usage: lod_quality [--dir DIR] [--only NAME] [--repeat R] [--no-sweep] [--big] [--models DIR]
  *                    [--group-size N]
  *   --dir DIR   where NAME.mesh is written and NAME.dag read (default: no files)
- *   --only NAME one mesh of the set
+ *   --only NAME one mesh of the set, or torus-UxV (torus-1m's shape with U x V quads)
  *   --repeat R  builds per thread count, the fastest counts (default 3)
  *   --no-sweep  times and fill only
  *   --big       adds the 1 M-triangle torus (slow to measure)
@@ -146,7 +146,7 @@ static gdr_scene *load_mesh(const char *name)
 {
     gdr_scene *scene = NULL;
     gdr_error err = {0};
-    uint32_t m = 0;
+    uint32_t m = 0, seg_u = 0, seg_v = 0;
     if (gdr_scene_create(&scene, &err) != GDR_OK)
         die(name, err.message);
     gdr_status s = GDR_OK;
@@ -156,6 +156,8 @@ static gdr_scene *load_mesh(const char *name)
         s = gdr_procedural_torus_knot(scene, 500, 100, &m, &err);
     else if (!strcmp(name, "torus-1m"))
         s = gdr_procedural_torus(scene, 1.0f, 0.35f, 1000, 500, &m, &err);
+    else if (sscanf(name, "torus-%ux%u", &seg_u, &seg_v) == 2) /* torus-1m's shape, smaller */
+        s = gdr_procedural_torus(scene, 1.0f, 0.35f, seg_u, seg_v, &m, &err);
     else {
         static const char *const files[][2] = {
             {"wuson", "WusonOBJ.obj"}, {"spider", "spider.obj"}, {"regr01", "regr01.obj"}};
@@ -534,5 +536,7 @@ int main(int argc, char **argv)
         if (only ? !strcmp(only, set[i]) : (!is_big || big))
             measure_mesh(set[i], dir, repeat, do_sweep);
     }
+    if (only && !strncmp(only, "torus-", 6) && strcmp(only, "torus-1m"))
+        measure_mesh(only, dir, repeat, do_sweep);
     return 0;
 }

@@ -554,7 +554,7 @@ static int setup(lod_build *b)
     b->position_count = (uint32_t)meshopt_generateVertexRemap(b->position_id, NULL, mesh->vertex_count,
                                                               mesh->positions, mesh->vertex_count, sizeof(gdr_vec3));
     b->owner = malloc((size_t)b->position_count * sizeof *b->owner);
-    if (!b->owner)
+    if (!b->owner || !gdr_lod_weld_setup(b))
         return 0;
     memset(b->owner, 0xff, (size_t)b->position_count * sizeof *b->owner);
     if (!gdr_lod_error_setup(b))
@@ -676,6 +676,11 @@ done:
 /* Gives the result to the mesh (arrays sized exactly) and fills the stats. */
 static void hand_over(lod_build *b, uint32_t depth, gdr_lod_stop stop)
 {
+    /* A sample stands for every vertex of its position id, up to weld_slack away: each error
+     * gets it added (the same to all, so errors stay monotonic along DAG edges). */
+    for (uint32_t g = 0; g < b->group_count && b->weld_slack > 0.0f; g++)
+        if (isfinite(b->groups[g].error))
+            b->groups[g].error = nextafterf(b->groups[g].error + b->weld_slack, INFINITY);
     gdr_mesh_clusters *mc = &b->mesh->clusters;
     gdr_cluster *cl = realloc(b->clusters, b->cluster_count * sizeof *cl);
     uint32_t *vx = realloc(b->vertices, (b->vertex_count ? b->vertex_count : 1) * sizeof *vx);

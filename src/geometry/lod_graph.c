@@ -1,6 +1,7 @@
 /* The cluster graph of one DAG step and its partition into groups (METIS). Two clusters are
  * neighbours when they share edges (by position, so attribute seams do not cut them apart); the
  * edge weight is the number of shared edges. */
+#include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
@@ -249,4 +250,127 @@ gdr_status gdr_lod_partition(lod_build *b, gdr_thread_pool *pool, uint32_t worke
             return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "mesh '%s': METIS returned part %d of %u",
                                  b->mesh->name, (int)part[f], parts);
     return GDR_OK;
+}
+
+/* --- near-equal positions ---------------------------------------------------------------------- */
+
+/* A position in cells of the weld distance, relative to the mesh's centre. */
+typedef struct weld_entry {
+    int32_t cell[3];
+    uint32_t position;
+} weld_entry;
+
+static int compare_weld_entries(const void *pa, const void *pb)
+{
+    const weld_entry *a = pa, *b = pb;
+    for (int k = 0; k < 3; k++)
+        if (a->cell[k] != b->cell[k])
+            return a->cell[k] < b->cell[k] ? -1 : 1;
+    return a->position < b->position ? -1 : a->position > b->position;
+}
+
+static uint32_t cell_hash(const int32_t *c, uint32_t mask)
+{
+    uint32_t h = (uint32_t)c[0] * 73856093u ^ (uint32_t)c[1] * 19349663u ^ (uint32_t)c[2] * 83492791u;
+    return (h ^ h >> 15) & mask;
+}
+
+/* Root of position p (union-find; the root is the smallest position id of its set). */
+static uint32_t weld_root(uint32_t *parent, uint32_t p)
+{
+    while (parent[p] != p)
+        p = parent[p] = parent[parent[p]];
+    return p;
+}
+
+/* Entries of each cell are contiguous in `e` (sorted); table maps a cell to its first entry + 1. */
+static uint32_t find_cell(const weld_entry *e, const uint32_t *table, uint32_t mask, const int32_t *c)
+{
+    for (uint32_t h = cell_hash(c, mask);; h = (h + 1) & mask) {
+        uint32_t i = table[h];
+        if (i == 0 || !memcmp(e[i - 1].cell, c, sizeof e->cell))
+            return i;
+    }
+}
+
+/* Joins every two positions of cells next to each other (or the same) that lie within `eps` on
+ * every axis (first[p]: a vertex of position p). At most 64 entries of a cell are compared with
+ * each position: a cluster of more positions that close (a hostile mesh) is joined partly, which
+ * only leaves some seams open. */
+static int weld_pairs(const lod_build *b, const weld_entry *e, uint32_t n, const uint32_t *first, uint32_t *parent,
+                      double eps)
+{
+    uint32_t mask = 1;
+    while (mask < 2 * n)
+        mask <<= 1;
+    uint32_t *table = calloc(mask--, sizeof *table);
+    if (!table)
+        return 0;
+    for (uint32_t i = 0; i < n; i++)
+        if (i == 0 || memcmp(e[i].cell, e[i - 1].cell, sizeof e->cell))
+            for (uint32_t h = cell_hash(e[i].cell, mask);; h = (h + 1) & mask)
+                if (!table[h]) {
+                    table[h] = i + 1;
+                    break;
+                }
+    const gdr_vec3 *x = b->mesh->positions;
+    for (uint32_t i = 0; i < n; i++)
+        for (int d = 0; d < 27; d++) {
+            int32_t c[3] = {e[i].cell[0] + d % 3 - 1, e[i].cell[1] + d / 3 % 3 - 1, e[i].cell[2] + d / 9 - 1};
+            uint32_t j = find_cell(e, table, mask, c);
+            for (uint32_t k = j ? j - 1 : n, end = k + 64; k < n && k < end && !memcmp(e[k].cell, c, sizeof c); k++) {
+                gdr_vec3 p = x[first[e[i].position]], q = x[first[e[k].position]];
+                if (e[k].position > e[i].position && fabs((double)p.x - q.x) <= eps &&
+                    fabs((double)p.y - q.y) <= eps && fabs((double)p.z - q.z) <= eps) {
+                    uint32_t ri = weld_root(parent, e[i].position), rk = weld_root(parent, e[k].position);
+                    parent[ri > rk ? ri : rk] = ri < rk ? ri : rk;
+                }
+            }
+        }
+    free(table);
+    return 1;
+}
+
+/* Positions within LOD_WELD_SCALE of the radius of each other on every axis (and chains of them)
+ * get one position id, the smallest of theirs; the ids they leave are used by no vertex. Sets
+ * b->weld_slack, the largest distance between two vertices of one id (0: nothing welded), which
+ * every group's error gets added (the error's samples are one vertex per id). Deterministic: it
+ * depends on the positions alone. */
+int gdr_lod_weld_setup(lod_build *b)
+{
+    const gdr_mesh *mesh = b->mesh;
+    uint32_t n = b->position_count;
+    double eps = (double)mesh->bounds.w * LOD_WELD_SCALE;
+    if (n < 2 || !(eps > 0.0))
+        return 1;
+    uint32_t *first = malloc((size_t)n * sizeof *first), *parent = malloc((size_t)n * sizeof *parent);
+    weld_entry *e = malloc((size_t)n * sizeof *e);
+    int ok = first && parent && e;
+    for (uint32_t v = mesh->vertex_count; ok && v-- > 0;)
+        first[b->position_id[v]] = v;
+    for (uint32_t p = 0; ok && p < n; p++) {
+        gdr_vec3 x = first[p] < mesh->vertex_count ? mesh->positions[first[p]] : (gdr_vec3){0};
+        double rel[3] = {(double)x.x - mesh->bounds.x, (double)x.y - mesh->bounds.y, (double)x.z - mesh->bounds.z};
+        for (int k = 0; k < 3; k++) /* within the bounding sphere: |rel| / eps <= 1e6 */
+            e[p].cell[k] = (int32_t)fmax(fmin(floor(rel[k] / eps), 2e9), -2e9);
+        e[p].position = p;
+        parent[p] = p;
+    }
+    if (ok) {
+        qsort(e, n, sizeof *e, compare_weld_entries);
+        ok = weld_pairs(b, e, n, first, parent, eps);
+    }
+    double slack = 0.0; /* the largest distance from a vertex to the first vertex of its new id */
+    for (uint32_t v = 0; ok && v < mesh->vertex_count; v++) {
+        b->position_id[v] = weld_root(parent, b->position_id[v]);
+        gdr_vec3 p = mesh->positions[v], q = mesh->positions[first[b->position_id[v]]];
+        double dx = (double)p.x - q.x, dy = (double)p.y - q.y, dz = (double)p.z - q.z;
+        slack = fmax(slack, sqrt(dx * dx + dy * dy + dz * dz));
+    }
+    /* Two vertices of one id are at most twice that apart (rounded up to a float). */
+    b->weld_slack = slack > 0.0 ? nextafterf((float)(2.0 * slack), INFINITY) : 0.0f;
+    free(first);
+    free(parent);
+    free(e);
+    return ok;
 }

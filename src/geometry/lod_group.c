@@ -207,7 +207,8 @@ void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker)
     for (uint32_t l = 0; l < local_count; l++) {
         uint32_t mv = s->local_to_mesh[l];
         s->map[mv] = UINT32_MAX;
-        const gdr_vec3 p = mesh_positions[mv];
+        /* one vertex's coordinates for each position id: near-equal positions are one */
+        const gdr_vec3 p = mesh_positions[b->sample_vertex[b->position_id[mv]]];
         memcpy(s->positions + (size_t)l * 3, &p, sizeof p);
         s->locked[l] = b->owner[b->position_id[mv]] == OWNER_SHARED;
     }

@@ -20,9 +20,15 @@
 #define LOD_MAX_KEPT_SHARE 0.85
 #define LOD_CONE_WEIGHT 0.25f
 /* A group with more samples than this farther than its floor keeps them (lod_redirect.c). */
-#define LOD_EXCESS_LIMIT 64u
+#define LOD_EXCESS_LIMIT 1024u
 /* A group passes samples only when that at least halves its error: its sphere may grow by half. */
 #define LOD_REDIRECT_GAIN 0.5f
+
+/* Positions closer than this share of the mesh's bounding radius on every axis are one position
+ * (lod_graph.c, gdr_lod_weld_setup): to grouping, simplification and the error's samples and walks.
+ * Seams whose two sides differ by rounding (sinf(2 pi) != 0) then close like bit-equal ones
+ * instead of being open borders. */
+#define LOD_WELD_SCALE 1e-6
 
 /* lod_build.owner: a position no group of the step uses, or that two groups share. */
 #define OWNER_NONE UINT32_MAX
@@ -131,8 +137,11 @@ typedef struct lod_build {
     uint32_t worker_base; /* worker index offset of this build's scratch (0: draws progress) */
     lod_scratch *scratch;
     uint32_t scratch_count;
-    uint32_t *position_id; /* mesh vertex -> id of its position (vertices with equal coordinates share it) */
+    uint32_t *position_id; /* mesh vertex -> id of its position (vertices with equal coordinates share it,
+                              and those within LOD_WELD_SCALE of each other) */
     uint32_t position_count;
+    float weld_slack;      /* the largest distance between two vertices of one position id: added to
+                              every group's error at the end (0 where no positions were welded) */
     uint32_t *owner;       /* position id -> group using it in this step, OWNER_SHARED or OWNER_NONE */
     /* samples of the full-detail surface (lod_error.c): position ids, owned by frontier clusters */
     uint32_t *sample_vertex;   /* position id -> a mesh vertex at that position */
@@ -201,6 +210,10 @@ static inline const uint32_t *gdr_lod_cluster_vertices(const lod_build *b, const
 
 /* Adds to the shared progress; only worker 0 of the calling thread draws. */
 void gdr_lod_progress_add(lod_build *b, uint64_t amount, uint32_t worker);
+
+/* lod_graph.c: gives near-equal positions (LOD_WELD_SCALE) one position id, after
+ * meshoptimizer's remap gave bit-equal ones one; 0: out of memory. */
+int gdr_lod_weld_setup(lod_build *b);
 
 /* lod_graph.c: the number of parts of the frontier (b->frontier), and its partition into them,
  * groups of neighbours: part[f] in [0, parts). The cluster graph is built on `pool`, or (NULL) on
