@@ -254,20 +254,23 @@ gdr_status gdr_lod_partition(lod_build *b, gdr_thread_pool *pool, uint32_t worke
 
 /* --- near-equal positions ---------------------------------------------------------------------- */
 
-/* A position in cells of the weld distance, relative to the mesh's centre. */
+/* Cells are this many weld distances wide: a position looks into a neighbouring cell only where it
+ * lies within the weld distance of the face between them, so mostly into its own cell alone. */
+#define WELD_CELL_SPAN 64.0
+
+/* Position p's cell of WELD_CELL_SPAN weld distances, relative to the mesh's centre, and on each
+ * axis which neighbouring cell may hold a position within the weld distance (bit 2k: the one below
+ * along axis k, bit 2k + 1: above). */
 typedef struct weld_entry {
     int32_t cell[3];
-    uint32_t position;
+    uint32_t sides;
 } weld_entry;
 
-static int compare_weld_entries(const void *pa, const void *pb)
-{
-    const weld_entry *a = pa, *b = pb;
-    for (int k = 0; k < 3; k++)
-        if (a->cell[k] != b->cell[k])
-            return a->cell[k] < b->cell[k] ? -1 : 1;
-    return a->position < b->position ? -1 : a->position > b->position;
-}
+/* The positions of each cell: a hash table from a cell to its last position + 1 (0: empty), and
+ * each position's previous one of the same cell (UINT32_MAX: none). */
+typedef struct weld_cells {
+    uint32_t *table, *previous, mask;
+} weld_cells;
 
 static uint32_t cell_hash(const int32_t *c, uint32_t mask)
 {
@@ -283,52 +286,87 @@ static uint32_t weld_root(uint32_t *parent, uint32_t p)
     return p;
 }
 
-/* Entries of each cell are contiguous in `e` (sorted); table maps a cell to its first entry + 1. */
-static uint32_t find_cell(const weld_entry *e, const uint32_t *table, uint32_t mask, const int32_t *c)
+/* The table slot of cell c: the one holding it, or the empty one where it would go. */
+static uint32_t *cell_slot(const weld_entry *e, const weld_cells *cells, const int32_t *c)
 {
-    for (uint32_t h = cell_hash(c, mask);; h = (h + 1) & mask) {
-        uint32_t i = table[h];
+    for (uint32_t h = cell_hash(c, cells->mask);; h = (h + 1) & cells->mask) {
+        uint32_t i = cells->table[h];
         if (i == 0 || !memcmp(e[i - 1].cell, c, sizeof e->cell))
-            return i;
+            return &cells->table[h];
     }
 }
 
-/* Joins every two positions of cells next to each other (or the same) that lie within `eps` on
- * every axis (first[p]: a vertex of position p). At most 64 entries of a cell are compared with
- * each position: a cluster of more positions that close (a hostile mesh) is joined partly, which
- * only leaves some seams open. */
-static int weld_pairs(const lod_build *b, const weld_entry *e, uint32_t n, const uint32_t *first, uint32_t *parent,
-                      double eps)
+/* Lists every position in its cell. Returns 0 when out of memory. */
+static int fill_cells(const weld_entry *e, uint32_t n, weld_cells *cells)
 {
     uint32_t mask = 1;
     while (mask < 2 * n)
         mask <<= 1;
-    uint32_t *table = calloc(mask--, sizeof *table);
-    if (!table)
+    cells->table = calloc(mask, sizeof *cells->table);
+    cells->previous = malloc((size_t)n * sizeof *cells->previous);
+    cells->mask = mask - 1;
+    if (!cells->table || !cells->previous)
         return 0;
-    for (uint32_t i = 0; i < n; i++)
-        if (i == 0 || memcmp(e[i].cell, e[i - 1].cell, sizeof e->cell))
-            for (uint32_t h = cell_hash(e[i].cell, mask);; h = (h + 1) & mask)
-                if (!table[h]) {
-                    table[h] = i + 1;
-                    break;
-                }
-    const gdr_vec3 *x = b->mesh->positions;
-    for (uint32_t i = 0; i < n; i++)
-        for (int d = 0; d < 27; d++) {
-            int32_t c[3] = {e[i].cell[0] + d % 3 - 1, e[i].cell[1] + d / 3 % 3 - 1, e[i].cell[2] + d / 9 - 1};
-            uint32_t j = find_cell(e, table, mask, c);
-            for (uint32_t k = j ? j - 1 : n, end = k + 64; k < n && k < end && !memcmp(e[k].cell, c, sizeof c); k++) {
-                gdr_vec3 p = x[first[e[i].position]], q = x[first[e[k].position]];
-                if (e[k].position > e[i].position && fabs((double)p.x - q.x) <= eps &&
-                    fabs((double)p.y - q.y) <= eps && fabs((double)p.z - q.z) <= eps) {
-                    uint32_t ri = weld_root(parent, e[i].position), rk = weld_root(parent, e[k].position);
-                    parent[ri > rk ? ri : rk] = ri < rk ? ri : rk;
-                }
-            }
-        }
-    free(table);
+    for (uint32_t p = 0; p < n; p++) {
+        uint32_t *slot = cell_slot(e, cells, e[p].cell);
+        cells->previous[p] = *slot ? *slot - 1 : UINT32_MAX;
+        *slot = p + 1;
+    }
     return 1;
+}
+
+/* The steps (-1, 0, 1) to the cells along axis k that may hold a position within the weld distance
+ * of an entry with these sides: its own cell first. Returns how many. */
+static int side_steps(uint32_t sides, int k, int *steps)
+{
+    int n = 0;
+    steps[n++] = 0;
+    if (sides & 1u << 2 * k)
+        steps[n++] = -1;
+    if (sides & 2u << 2 * k)
+        steps[n++] = 1;
+    return n;
+}
+
+/* Joins position p with every position of cell c that lies within `eps` on every axis (first[q]: a
+ * vertex of position q). At most 64 positions of a cell are compared: a cluster of more positions
+ * that close (a hostile mesh) is joined partly, which only leaves some seams open. */
+static void weld_in_cell(const lod_build *b, const weld_entry *e, const weld_cells *cells, const uint32_t *first,
+                         uint32_t *parent, double eps, uint32_t p, const int32_t *c)
+{
+    const gdr_vec3 *x = b->mesh->positions;
+    uint32_t q = *cell_slot(e, cells, c);
+    q = q ? q - 1 : UINT32_MAX;
+    for (int seen = 0; q != UINT32_MAX && seen < 64; q = cells->previous[q], seen++) {
+        gdr_vec3 u = x[first[p]], v = x[first[q]];
+        if (q > p && fabs((double)u.x - v.x) <= eps && fabs((double)u.y - v.y) <= eps &&
+            fabs((double)u.z - v.z) <= eps) {
+            uint32_t rp = weld_root(parent, p), rq = weld_root(parent, q);
+            parent[rp > rq ? rp : rq] = rp < rq ? rp : rq;
+        }
+    }
+}
+
+/* Joins every two positions within `eps` of each other on every axis, looking into the cells each
+ * position's sides allow. Returns 0 when out of memory. */
+static int weld_pairs(const lod_build *b, const weld_entry *e, uint32_t n, const uint32_t *first, uint32_t *parent,
+                      double eps)
+{
+    weld_cells cells;
+    int ok = fill_cells(e, n, &cells);
+    for (uint32_t p = 0; ok && p < n; p++) {
+        int steps[3][3], counts[3];
+        for (int k = 0; k < 3; k++)
+            counts[k] = side_steps(e[p].sides, k, steps[k]);
+        for (int d = 0; d < counts[0] * counts[1] * counts[2]; d++) {
+            int32_t c[3] = {e[p].cell[0] + steps[0][d % counts[0]], e[p].cell[1] + steps[1][d / counts[0] % counts[1]],
+                            e[p].cell[2] + steps[2][d / (counts[0] * counts[1])]};
+            weld_in_cell(b, e, &cells, first, parent, eps, p, c);
+        }
+    }
+    free(cells.table);
+    free(cells.previous);
+    return ok;
 }
 
 /* Positions within LOD_WELD_SCALE of the radius of each other on every axis (and chains of them)
@@ -351,15 +389,18 @@ int gdr_lod_weld_setup(lod_build *b)
     for (uint32_t p = 0; ok && p < n; p++) {
         gdr_vec3 x = first[p] < mesh->vertex_count ? mesh->positions[first[p]] : (gdr_vec3){0};
         double rel[3] = {(double)x.x - mesh->bounds.x, (double)x.y - mesh->bounds.y, (double)x.z - mesh->bounds.z};
-        for (int k = 0; k < 3; k++) /* within the bounding sphere: |rel| / eps <= 1e6 */
-            e[p].cell[k] = (int32_t)fmax(fmin(floor(rel[k] / eps), 2e9), -2e9);
-        e[p].position = p;
+        e[p].sides = 0;
+        for (int k = 0; k < 3; k++) { /* within the bounding sphere: |rel| / eps <= 1e6 */
+            double at = fmax(fmin(rel[k] / (WELD_CELL_SPAN * eps), 2e9), -2e9), cell = floor(at);
+            e[p].cell[k] = (int32_t)cell;
+            /* Within eps (a 1/WELD_CELL_SPAN of a cell) of a face, the cell across it may hold a
+             * position within eps; the margin covers the rounding of the division. */
+            double near = (1.0 + 1e-3) / WELD_CELL_SPAN;
+            e[p].sides |= (at - cell <= near ? 1u : 0u) << 2 * k | (cell + 1.0 - at <= near ? 2u : 0u) << 2 * k;
+        }
         parent[p] = p;
     }
-    if (ok) {
-        qsort(e, n, sizeof *e, compare_weld_entries);
-        ok = weld_pairs(b, e, n, first, parent, eps);
-    }
+    ok = ok && weld_pairs(b, e, n, first, parent, eps);
     double slack = 0.0; /* the largest distance from a vertex to the first vertex of its new id */
     for (uint32_t v = 0; ok && v < mesh->vertex_count; v++) {
         b->position_id[v] = weld_root(parent, b->position_id[v]);
