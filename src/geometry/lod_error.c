@@ -312,12 +312,12 @@ static float ring_d2(const lod_scratch *s, uint32_t l, gdr_vec3 p, uint32_t *nea
     return best;
 }
 
-/* Keeps the LOD_EXCESS_LIMIT + 1 largest sample distance bounds seen (squared, ascending, with
- * their sample): all other samples lie within the smallest of them of their cluster. */
+/* Keeps the k->limit largest sample distance bounds seen (squared, ascending, with their sample):
+ * all other samples lie within the smallest of them of their cluster. */
 static void keep_largest(lod_kept *k, float d, uint32_t sample)
 {
     uint32_t at;
-    if (k->count < LOD_EXCESS_LIMIT + 1) { /* not full: insert from the end */
+    if (k->count < k->limit) { /* not full: insert from the end */
         for (at = k->count++; at > 0 && k->d2[at - 1] > d; at--) {
             k->d2[at] = k->d2[at - 1];
             k->sample[at] = k->sample[at - 1];
@@ -334,9 +334,9 @@ static void keep_largest(lod_kept *k, float d, uint32_t sample)
     k->sample[at] = sample;
 }
 
-/* The smallest kept bound once LOD_EXCESS_LIMIT + 1 are kept (what every other sample lies within
- * of its cluster); -1 before. */
-static float kept_bound(const lod_kept *k) { return k->count == LOD_EXCESS_LIMIT + 1 ? k->d2[0] : -1.0f; }
+/* The smallest kept bound once k->limit are kept (what every other sample lies within of its
+ * cluster); -1 before. */
+static float kept_bound(const lod_kept *k) { return k->count == k->limit ? k->d2[0] : -1.0f; }
 
 /* The step's only group measures its samples in this many ranges (fewer where a range would hold
  * fewer than LOD_SAMPLE_RANGE_MIN): a fixed count, so that the result does not depend on the
@@ -438,6 +438,7 @@ static void sample_range_task(void *user, uint32_t range, uint32_t worker)
     lod_scratch *s = user;
     (void)worker;
     uint32_t first = range * s->range_size, end = first + s->range_size;
+    s->range_kept[range].limit = s->top.limit;
     measure_samples(s, first, end < s->gathered ? end : s->gathered, &s->range_kept[range]);
 }
 
@@ -471,6 +472,18 @@ static int measure_in_ranges(const lod_build *b, lod_scratch *s)
     return 1;
 }
 
+/* Every sample of the group measured (the grids built), keeping `limit` largest bounds in s->top:
+ * the largest distance, or -1 when out of memory. */
+static float measure_all_samples(const lod_build *b, lod_scratch *s, uint32_t limit)
+{
+    s->top.limit = limit;
+    if (!b->lone_group)
+        measure_samples(s, 0, s->gathered, &s->top);
+    else if (!measure_in_ranges(b, s))
+        return -1.0f;
+    return sqrtf(s->top.worst);
+}
+
 /* Largest distance from a sample to the simplified triangles; each sample's nearest cluster, and
  * the samples of the largest distance bounds (keep_largest). The triangles around the nearest
  * simplified vertex give an upper bound quickly; only a sample whose bound exceeds the largest
@@ -489,11 +502,7 @@ static float samples_to_simplified(const lod_build *b, lod_scratch *s, uint32_t 
     if (!lod_grid_build(&s->grid, s->vertex_points, used, 4.0) ||
         !lod_triangle_grid_build(&s->triangle_grid, s->positions, s->out_corners, s->out_triangle_count))
         return -1.0f;
-    if (!b->lone_group)
-        measure_samples(s, 0, s->gathered, &s->top);
-    else if (!measure_in_ranges(b, s))
-        return -1.0f;
-    return sqrtf(s->top.worst);
+    return measure_all_samples(b, s, LOD_KEPT_FIRST);
 }
 
 /* Distance (squared) from p to the level-0 triangles around position `position`: an upper bound of
@@ -892,26 +901,50 @@ static int collect_excess(lod_scratch *s, group_result *r, float floor)
     return 1;
 }
 
+/* The group's floor (docs/GEOMETRY.md, "Samples that pass to a neighbour"): its members' errors,
+ * D2, and the smallest kept bound once the kept bounds are full. Where D1 is set by the few samples
+ * farther than all others and the members' errors, D2 is measured again down to that level: the
+ * part of its error that no redirection of samples can lower. Both measures bound D2: the smaller
+ * is left in *to_full. Not where that level is above LOD_REDIRECT_GAIN of the error, and no
+ * further once D2 is: no redirection would pay. */
+static float group_floor(const lod_build *b, lod_scratch *s, const group_result *r, float to_simplified,
+                         float *to_full)
+{
+    float rest = s->top.count == s->top.limit ? sqrtf(s->top.d2[0]) : 0.0f;
+    float floor = r->error > rest ? r->error : rest;
+    if (to_simplified > floor && *to_full >= 0.0f && floor <= LOD_REDIRECT_GAIN * *to_full) {
+        float again = simplified_to_full(b, s, floor, LOD_REDIRECT_GAIN * *to_full);
+        *to_full = again < *to_full ? again : *to_full;
+    }
+    return *to_full > floor ? *to_full : floor;
+}
+
+/* Whether the group's floor is set by its kept bounds (more samples lie above the rest of its
+ * floor than were kept) while the rest is low enough for a redirection to pay: then its samples
+ * are measured again keeping LOD_EXCESS_LIMIT + 1 bounds, so that a band of samples a neighbour's
+ * triangles keep (more than LOD_KEPT_FIRST) may pass there. Few groups: most have D2 near D1. */
+static int keep_more(const lod_scratch *s, const group_result *r, float to_simplified, float to_full)
+{
+    float lower = r->error > to_full ? r->error : to_full;
+    return s->top.limit < LOD_EXCESS_LIMIT + 1 && s->top.count == s->top.limit &&
+           sqrtf(s->top.d2[0]) > lower && lower <= LOD_REDIRECT_GAIN * to_simplified;
+}
+
 int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count,
                             uint32_t local_count, group_result *r)
 {
     if (!output_triangles(s, r, local_count) || !gather_samples(b, s, members, count))
         return 0;
     s->top.count = 0; /* a group without samples keeps none */
+    s->top.limit = LOD_KEPT_FIRST;
     float to_simplified = s->gathered ? samples_to_simplified(b, s, local_count) : 0.0f;
     float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified, INFINITY);
-    /* Where D1 is set by the few samples (at most LOD_EXCESS_LIMIT) farther than all others and the
-     * members' errors, D2 is measured again down to that level: the group's floor, the part of its
-     * error that no redirection of samples can lower. Both measures bound D2: the smaller counts.
-     * Not where that level is above LOD_REDIRECT_GAIN of the error, and no further once D2 is: no
-     * redirection would pay. */
-    float rest = s->top.count == LOD_EXCESS_LIMIT + 1 ? sqrtf(s->top.d2[0]) : 0.0f;
-    float floor = r->error > rest ? r->error : rest;
-    if (to_simplified > floor && to_full >= 0.0f && floor <= LOD_REDIRECT_GAIN * to_full) {
-        float again = simplified_to_full(b, s, floor, LOD_REDIRECT_GAIN * to_full);
-        to_full = again < to_full ? again : to_full;
+    float floor = to_simplified < 0.0f ? 0.0f : group_floor(b, s, r, to_simplified, &to_full);
+    if (to_simplified >= 0.0f && to_full >= 0.0f && keep_more(s, r, to_simplified, to_full)) {
+        if (measure_all_samples(b, s, LOD_EXCESS_LIMIT + 1) < 0.0f) /* the same largest distance */
+            return 0;
+        floor = group_floor(b, s, r, to_simplified, &to_full);
     }
-    floor = to_full > floor ? to_full : floor;
     if (to_simplified < 0.0f || to_full < 0.0f || !collect_excess(s, r, floor) || !hand_samples_to_clusters(s, r))
         return 0;
     r->deviation = to_simplified > to_full ? to_simplified : to_full;

@@ -49,11 +49,18 @@ typedef struct lod_progress {
     atomic_uint_fast64_t done;
 } lod_progress;
 
-/* The LOD_EXCESS_LIMIT + 1 largest sample distance bounds of a group, or of a range of its samples
- * (squared, ascending, with their gathered samples), and the largest distance (squared). */
+/* A group's samples are measured keeping this many of their largest distance bounds (the samples a
+ * redirection may pass, plus one); a group whose floor that leaves too high for a redirection is
+ * measured again keeping LOD_EXCESS_LIMIT + 1 (lod_error.c, gdr_lod_group_deviation). Fewer kept
+ * bounds settle more samples unmeasured: the smallest of them is larger. */
+#define LOD_KEPT_FIRST 65u
+
+/* The `limit` (at most LOD_EXCESS_LIMIT + 1) largest sample distance bounds of a group, or of a
+ * range of its samples (squared, ascending, with their gathered samples), and the largest distance
+ * (squared). */
 typedef struct lod_kept {
     float d2[LOD_EXCESS_LIMIT + 1];
-    uint32_t sample[LOD_EXCESS_LIMIT + 1], count;
+    uint32_t sample[LOD_EXCESS_LIMIT + 1], count, limit;
     float worst;
 } lod_kept;
 
