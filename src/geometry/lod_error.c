@@ -484,6 +484,22 @@ static float measure_all_samples(const lod_build *b, lod_scratch *s, uint32_t li
     return sqrtf(s->top.worst);
 }
 
+/* The point grid over the simplified vertices that have triangles (s->grid; the probes may rebuild
+ * it over the samples later: nearest_sample). Returns 0 when out of memory. */
+static int build_vertex_grid(lod_scratch *s, uint32_t local_count)
+{
+    uint32_t used = 0;
+    if (!LOD_RESERVE(s, vertex_points, local_count) || !LOD_RESERVE(s, vertex_local, local_count))
+        return 0;
+    for (uint32_t l = 0; l < local_count; l++)
+        if (s->ring_start[l + 1] > s->ring_start[l]) {
+            memcpy(&s->vertex_points[used], s->positions + (size_t)l * 3, sizeof(gdr_vec3));
+            s->vertex_local[used++] = l;
+        }
+    s->grid_holds_samples = 0;
+    return lod_grid_build(&s->grid, s->vertex_points, used, 4.0);
+}
+
 /* Largest distance from a sample to the simplified triangles; each sample's nearest cluster, and
  * the samples of the largest distance bounds (keep_largest). The triangles around the nearest
  * simplified vertex give an upper bound quickly; only a sample whose bound exceeds the largest
@@ -491,15 +507,7 @@ static float measure_all_samples(const lod_build *b, lod_scratch *s, uint32_t li
  * and every sample lies within it of the cluster it passes to. */
 static float samples_to_simplified(const lod_build *b, lod_scratch *s, uint32_t local_count)
 {
-    uint32_t used = 0;
-    if (!LOD_RESERVE(s, vertex_points, local_count) || !LOD_RESERVE(s, vertex_local, local_count))
-        return -1.0f;
-    for (uint32_t l = 0; l < local_count; l++)
-        if (s->ring_start[l + 1] > s->ring_start[l]) {
-            memcpy(&s->vertex_points[used], s->positions + (size_t)l * 3, sizeof(gdr_vec3));
-            s->vertex_local[used++] = l;
-        }
-    if (!lod_grid_build(&s->grid, s->vertex_points, used, 4.0) ||
+    if (!build_vertex_grid(s, local_count) ||
         !lod_triangle_grid_build(&s->triangle_grid, s->positions, s->out_corners, s->out_triangle_count))
         return -1.0f;
     return measure_all_samples(b, s, LOD_KEPT_FIRST);
@@ -919,15 +927,16 @@ static float group_floor(const lod_build *b, lod_scratch *s, const group_result 
     return *to_full > floor ? *to_full : floor;
 }
 
-/* Whether the group's floor is set by its kept bounds (more samples lie above the rest of its
- * floor than were kept) while the rest is low enough for a redirection to pay: then its samples
- * are measured again keeping LOD_EXCESS_LIMIT + 1 bounds, so that a band of samples a neighbour's
- * triangles keep (more than LOD_KEPT_FIRST) may pass there. Few groups: most have D2 near D1. */
+/* Whether the floor from LOD_EXCESS_LIMIT + 1 kept bounds could differ from the one from the bounds
+ * kept: the smallest kept bound is above the members' errors, and D2 (`to_full`, measured down to
+ * D1) is not above D1, where it would set the floor, and those errors leave room for measuring D2
+ * below D1 (group_floor). Then the samples are measured again keeping LOD_EXCESS_LIMIT + 1 bounds,
+ * so that a band of samples a neighbour's triangles keep may pass there as a few farthest samples
+ * do; elsewhere the floor is the same either way. */
 static int keep_more(const lod_scratch *s, const group_result *r, float to_simplified, float to_full)
 {
-    float lower = r->error > to_full ? r->error : to_full;
     return s->top.limit < LOD_EXCESS_LIMIT + 1 && s->top.count == s->top.limit &&
-           sqrtf(s->top.d2[0]) > lower && lower <= LOD_REDIRECT_GAIN * to_simplified;
+           sqrtf(s->top.d2[0]) > r->error && r->error <= LOD_REDIRECT_GAIN * to_full && to_full <= to_simplified;
 }
 
 int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count,
@@ -939,12 +948,11 @@ int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *member
     s->top.limit = LOD_KEPT_FIRST;
     float to_simplified = s->gathered ? samples_to_simplified(b, s, local_count) : 0.0f;
     float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified, INFINITY);
+    /* Measured again (the same largest distance), over the vertex grid the probes may have taken. */
+    if (to_simplified >= 0.0f && to_full >= 0.0f && keep_more(s, r, to_simplified, to_full) &&
+        (!build_vertex_grid(s, local_count) || measure_all_samples(b, s, LOD_EXCESS_LIMIT + 1) < 0.0f))
+        return 0;
     float floor = to_simplified < 0.0f ? 0.0f : group_floor(b, s, r, to_simplified, &to_full);
-    if (to_simplified >= 0.0f && to_full >= 0.0f && keep_more(s, r, to_simplified, to_full)) {
-        if (measure_all_samples(b, s, LOD_EXCESS_LIMIT + 1) < 0.0f) /* the same largest distance */
-            return 0;
-        floor = group_floor(b, s, r, to_simplified, &to_full);
-    }
     if (to_simplified < 0.0f || to_full < 0.0f || !collect_excess(s, r, floor) || !hand_samples_to_clusters(s, r))
         return 0;
     r->deviation = to_simplified > to_full ? to_simplified : to_full;
