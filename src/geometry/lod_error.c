@@ -918,7 +918,7 @@ static int collect_excess(lod_scratch *s, group_result *r, float floor)
 static float group_floor(const lod_build *b, lod_scratch *s, const group_result *r, float to_simplified,
                          float *to_full)
 {
-    float rest = s->top.count == s->top.limit ? sqrtf(s->top.d2[0]) : 0.0f;
+    float kept = kept_bound(&s->top), rest = kept > 0.0f ? sqrtf(kept) : 0.0f;
     float floor = r->error > rest ? r->error : rest;
     if (to_simplified > floor && *to_full >= 0.0f && floor <= LOD_REDIRECT_GAIN * *to_full) {
         float again = simplified_to_full(b, s, floor, LOD_REDIRECT_GAIN * *to_full);
@@ -935,8 +935,9 @@ static float group_floor(const lod_build *b, lod_scratch *s, const group_result 
  * do; elsewhere the floor is the same either way. */
 static int keep_more(const lod_scratch *s, const group_result *r, float to_simplified, float to_full)
 {
-    return s->top.limit < LOD_EXCESS_LIMIT + 1 && s->top.count == s->top.limit &&
-           sqrtf(s->top.d2[0]) > r->error && r->error <= LOD_REDIRECT_GAIN * to_full && to_full <= to_simplified;
+    float kept = kept_bound(&s->top);
+    return s->top.limit < LOD_EXCESS_LIMIT + 1 && kept >= 0.0f && sqrtf(kept) > r->error &&
+           r->error <= LOD_REDIRECT_GAIN * to_full && to_full <= to_simplified;
 }
 
 int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count,

@@ -49,10 +49,9 @@ typedef struct lod_progress {
     atomic_uint_fast64_t done;
 } lod_progress;
 
-/* A group's samples are measured keeping this many of their largest distance bounds (the samples a
- * redirection may pass, plus one); a group whose floor that leaves too high for a redirection is
- * measured again keeping LOD_EXCESS_LIMIT + 1 (lod_error.c, gdr_lod_group_deviation). Fewer kept
- * bounds settle more samples unmeasured: the smallest of them is larger. */
+/* A group's samples are measured keeping this many of their largest distance bounds; a group whose
+ * floor LOD_EXCESS_LIMIT + 1 kept bounds could lower is measured again keeping those (lod_error.c,
+ * keep_more). Fewer kept bounds settle more samples unmeasured: the smallest of them is larger. */
 #define LOD_KEPT_FIRST 65u
 
 /* The `limit` (at most LOD_EXCESS_LIMIT + 1) largest sample distance bounds of a group, or of a

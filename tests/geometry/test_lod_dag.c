@@ -271,19 +271,12 @@ static int cone_is_conservative(const gdr_mesh *mesh, const gdr_mesh_clusters *m
     return 1;
 }
 
-/* Everything gdr/geometry.h promises about a built DAG; returns 1 when it all holds. */
-static int check_dag(const gdr_mesh *mesh, const gdr_lod_stats *st)
+/* Every cluster in range (4-byte aligned triangles, indices within it and the mesh), its cone
+ * conservative, level 0 first, and up the DAG error, depth and spheres only grow. Returns 0 where a
+ * cluster is out of range (nothing more can be read safely). */
+static int check_clusters(const gdr_mesh *mesh, uint32_t root)
 {
     const gdr_mesh_clusters *mc = &mesh->clusters;
-    int failures = test_failure_count;
-    CHECK(mc->group_count >= 1 && mc->groups && mc->cluster_count >= mc->level0_cluster_count);
-    if (test_failure_count != failures)
-        return 0;
-    CHECK(level0_covers_input(mesh));
-    uint32_t root = mc->group_count - 1;
-    CHECK(isinf(mc->groups[root].error) && mc->groups[root].error > 0);
-    CHECK(mc->groups[root].depth == mc->dag_depth);
-    /* Layout: every cluster in range, 4-byte aligned triangles, its sphere reaching its vertices. */
     for (uint32_t i = 0; i < mc->cluster_count; i++) {
         const gdr_cluster *c = &mc->clusters[i];
         int in_range = c->vertex_count >= 1 && c->vertex_count <= GDR_CLUSTER_MAX_VERTICES &&
@@ -316,8 +309,39 @@ static int check_dag(const gdr_mesh *mesh, const gdr_lod_stats *st)
         }
         CHECK(sphere_contains(mc->groups[c->group].sphere, c->sphere));
     }
-    CHECK(check_cluster_spheres(mesh, mc)); /* every vertex inside its cluster's sphere */
-    /* Groups: contiguous clusters, finite positive errors below the root, triangles reduced. */
+    return 1;
+}
+
+/* Group g's new clusters: a step-0 group that did not simplify passed its clusters on unchanged;
+ * any other kept at most 85% of its triangles; the root made none. */
+static void check_group_outputs(const gdr_mesh_clusters *mc, uint32_t g, uint32_t root)
+{
+    const gdr_cluster_group *gr = &mc->groups[g];
+    uint32_t next = gr->first_cluster + gr->cluster_count;
+    uint64_t in = triangles_of(mc, gr->first_cluster, gr->cluster_count), out = 0;
+    uint32_t outputs = 0, passthrough = 0;
+    for (uint32_t i = mc->level0_cluster_count; i < mc->cluster_count; i++)
+        if (mc->clusters[i].refined_group == g) {
+            out += mc->clusters[i].triangle_count;
+            outputs++;
+            for (uint32_t j = gr->first_cluster; j < next; j++)
+                passthrough += mc->clusters[j].triangle_offset == mc->clusters[i].triangle_offset &&
+                               mc->clusters[j].vertex_offset == mc->clusters[i].vertex_offset;
+        }
+    if (g == root) {
+        CHECK(outputs == 0);
+    } else if (passthrough) {
+        CHECK(gr->depth == 0 && passthrough == outputs && outputs == gr->cluster_count && out == in);
+    } else {
+        CHECK(outputs >= 1 && (double)out <= 0.85 * (double)in);
+    }
+}
+
+/* Groups: contiguous clusters, finite positive errors below the root, depths in order, triangles
+ * reduced, and each step reducing what it formed groups over. Returns 0 where a group's clusters
+ * run past the array. */
+static int check_groups(const gdr_mesh_clusters *mc, uint32_t root)
+{
     uint32_t next = 0;
     for (uint32_t g = 0; g < mc->group_count; g++) {
         const gdr_cluster_group *gr = &mc->groups[g];
@@ -331,27 +355,9 @@ static int check_dag(const gdr_mesh *mesh, const gdr_lod_stats *st)
             CHECK(isfinite(gr->error) && gr->error > 0.0f);
         if (g > 0)
             CHECK(gr->depth >= mc->groups[g - 1].depth);
-        uint64_t in = triangles_of(mc, gr->first_cluster, gr->cluster_count), out = 0;
-        uint32_t outputs = 0, passthrough = 0;
-        for (uint32_t i = mc->level0_cluster_count; i < mc->cluster_count; i++)
-            if (mc->clusters[i].refined_group == g) {
-                out += mc->clusters[i].triangle_count;
-                outputs++;
-                for (uint32_t j = gr->first_cluster; j < next; j++)
-                    passthrough += mc->clusters[j].triangle_offset == mc->clusters[i].triangle_offset &&
-                                   mc->clusters[j].vertex_offset == mc->clusters[i].vertex_offset;
-            }
-        if (g == root) {
-            CHECK(outputs == 0);
-        } else if (passthrough) {
-            /* A step-0 group that did not simplify: its clusters passed on unchanged. */
-            CHECK(gr->depth == 0 && passthrough == outputs && outputs == gr->cluster_count && out == in);
-        } else {
-            CHECK(outputs >= 1 && (double)out <= 0.85 * (double)in);
-        }
+        check_group_outputs(mc, g, root);
     }
     CHECK(next == mc->cluster_count);
-    /* Each step reduces the triangle count of what it formed groups over. */
     for (uint32_t d = 0; d < mc->dag_depth; d++) {
         uint64_t in = 0, out = 0;
         for (uint32_t g = 0; g < root; g++)
@@ -362,7 +368,13 @@ static int check_dag(const gdr_mesh *mesh, const gdr_lod_stats *st)
             }
         CHECK(in > 0 && out < in);
     }
-    /* The stats agree with the data. */
+    return 1;
+}
+
+/* The stats agree with the data. */
+static void check_stats(const gdr_mesh *mesh, const gdr_lod_stats *st, uint32_t root)
+{
+    const gdr_mesh_clusters *mc = &mesh->clusters;
     uint64_t total = triangles_of(mc, 0, mc->cluster_count);
     uint32_t stops = 0;
     for (int i = 0; i < GDR_LOD_STOP_COUNT; i++)
@@ -375,6 +387,26 @@ static int check_dag(const gdr_mesh *mesh, const gdr_lod_stats *st)
     CHECK(st->max_depth == mc->dag_depth);
     if (st->stop_counts[GDR_LOD_STOP_SINGLE_CLUSTER])
         CHECK(mc->groups[root].cluster_count == 1);
+}
+
+/* Everything gdr/geometry.h promises about a built DAG; returns 1 when it all holds. */
+static int check_dag(const gdr_mesh *mesh, const gdr_lod_stats *st)
+{
+    const gdr_mesh_clusters *mc = &mesh->clusters;
+    int failures = test_failure_count;
+    CHECK(mc->group_count >= 1 && mc->groups && mc->cluster_count >= mc->level0_cluster_count);
+    if (test_failure_count != failures)
+        return 0;
+    CHECK(level0_covers_input(mesh));
+    uint32_t root = mc->group_count - 1;
+    CHECK(isinf(mc->groups[root].error) && mc->groups[root].error > 0);
+    CHECK(mc->groups[root].depth == mc->dag_depth);
+    if (!check_clusters(mesh, root))
+        return 0;
+    CHECK(check_cluster_spheres(mesh, mc)); /* every vertex inside its cluster's sphere */
+    if (!check_groups(mc, root))
+        return 0;
+    check_stats(mesh, st, root);
     return test_failure_count == failures;
 }
 
