@@ -379,6 +379,20 @@ static int set_errors(lod_build *b, const lod_stage *st, const uint32_t *frontie
     return gdr_lod_error_gather(b, frontier, frontier_count);
 }
 
+/* Shows an observer (a test) the step st (NULL: level 0, before the first step) once its errors
+ * are set. */
+static void observe(const lod_build *b, const lod_stage *st, const uint32_t *frontier, uint32_t frontier_count)
+{
+    if (!b->observer)
+        return;
+    lod_step_view v = {.frontier = frontier, .frontier_count = frontier_count};
+    if (st)
+        v = (lod_step_view){.depth = st->depth, .groups = st->groups, .members = st->members,
+                            .member_start = st->start, .results = st->results, .frontier = frontier,
+                            .frontier_count = frontier_count};
+    b->observer->step(b->observer->user, b, &v);
+}
+
 /* The step's errors, once every deviation of its groups is measured (the job after its own has
  * run): here, between stage_bounds and set_errors, each result holds its group's deviation,
  * error, sphere and samples by new cluster, and nothing of them is in the build yet. Returns 0
@@ -390,6 +404,8 @@ static int finish_errors(lod_build *b, lod_stage *st, const uint32_t *frontier, 
     b->results = st->results; /* what the redirection and the gather read */
     int ok = gdr_lod_redirect_samples(b, st->groups) && set_errors(b, st, frontier, frontier_count);
     b->results = NULL;
+    if (ok)
+        observe(b, st, frontier, frontier_count);
     return ok;
 }
 
@@ -625,6 +641,7 @@ static gdr_status run_steps(lod_build *b, uint32_t **frontier, uint32_t *depth, 
     for (uint32_t i = 0; i < level0; i++)
         current[i] = i;
     b->frontier_count = level0;
+    observe(b, NULL, current, level0);
     for (*depth = 0;; ++*depth) {
         b->frontier = current;
         if (b->frontier_count == 1 || *depth >= GDR_LOD_MAX_LEVELS) {
@@ -781,7 +798,8 @@ static void stats_add(gdr_lod_stats *sum, const gdr_lod_stats *s)
 
 /* Builds one mesh's DAG with `pool` (NULL: on the calling thread, as worker `worker`). */
 static gdr_status build_one(gdr_mesh *mesh, const gdr_lod_options *o, gdr_thread_pool *pool, uint32_t worker,
-                            lod_progress *progress, gdr_lod_stats *stats, gdr_error *err)
+                            lod_progress *progress, const lod_observer *observer, gdr_lod_stats *stats,
+                            gdr_error *err)
 {
     const gdr_mesh_clusters *c = &mesh->clusters;
     if (c->level0_cluster_count == 0 || c->level0_cluster_count > c->cluster_count || !c->clusters)
@@ -791,8 +809,8 @@ static gdr_status build_one(gdr_mesh *mesh, const gdr_lod_options *o, gdr_thread
     gdr_status status = check_level0(mesh, err);
     if (status != GDR_OK)
         return status;
-    lod_build b = {.mesh = mesh, .opt = *o, .pool = pool, .worker_base = worker, .progress = progress,
-                   .scratch_count = gdr_thread_pool_thread_count(pool)};
+    lod_build b = {.mesh = mesh, .opt = *o, .observer = observer, .pool = pool, .worker_base = worker,
+                   .progress = progress, .scratch_count = gdr_thread_pool_thread_count(pool)};
     status = build_mesh(&b, err);
     if (status == GDR_OK && (status = gdr_mesh_clusters_build_hierarchy(&mesh->clusters, err)) != GDR_OK)
         truncate_to_level0(&mesh->clusters);
@@ -805,6 +823,12 @@ static gdr_status build_one(gdr_mesh *mesh, const gdr_lod_options *o, gdr_thread
 
 gdr_status gdr_mesh_build_lod_dag(gdr_mesh *mesh, const gdr_lod_options *options, gdr_lod_stats *stats,
                                   gdr_error *err)
+{
+    return gdr_lod_build_observed(mesh, options, NULL, stats, err);
+}
+
+gdr_status gdr_lod_build_observed(gdr_mesh *mesh, const gdr_lod_options *options, const lod_observer *observer,
+                                  gdr_lod_stats *stats, gdr_error *err)
 {
     if (!mesh)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "gdr_mesh_build_lod_dag: mesh must not be NULL");
@@ -824,7 +848,7 @@ gdr_status gdr_mesh_build_lod_dag(gdr_mesh *mesh, const gdr_lod_options *options
     gdr_progress_begin(&progress.bar, "LOD DAG", mesh->clusters.level0_cluster_count ? mesh->index_count / 3 : 1,
                        o.no_progress);
     atomic_init(&progress.done, 0);
-    status = build_one(mesh, &o, pool, 0, &progress, stats, err);
+    status = build_one(mesh, &o, pool, 0, &progress, observer, stats, err);
     gdr_progress_end(&progress.bar);
     gdr_thread_pool_destroy(pool);
     return status;
@@ -846,8 +870,8 @@ static void small_mesh_task(void *user, uint32_t i, uint32_t worker)
 {
     scene_job *job = user;
     uint32_t m = job->small[i];
-    job->status[m] = build_one(&job->scene->meshes[m], job->opt, NULL, worker, job->progress, &job->stats[m],
-                               &job->errors[m]);
+    job->status[m] = build_one(&job->scene->meshes[m], job->opt, NULL, worker, job->progress, NULL,
+                               &job->stats[m], &job->errors[m]);
 }
 
 static int needs_dag(const gdr_mesh *m) { return m->clusters.level0_cluster_count > 0 && m->clusters.group_count == 0; }
@@ -904,7 +928,7 @@ gdr_status gdr_scene_build_lod(gdr_scene *scene, const gdr_lod_options *options,
     gdr_thread_pool_run(pool, small_count, small_mesh_task, &job);
     for (uint32_t m = 0; m < n; m++)
         if (built[m] && scene->meshes[m].index_count / 3 >= LOD_SMALL_MESH_TRIANGLES)
-            statuses[m] = build_one(&scene->meshes[m], &o, pool, 0, &progress, &mesh_stats[m], &errors[m]);
+            statuses[m] = build_one(&scene->meshes[m], &o, pool, 0, &progress, NULL, &mesh_stats[m], &errors[m]);
     gdr_progress_end(&progress.bar);
     for (uint32_t m = 0; m < n && status == GDR_OK; m++)
         if (built[m] && statuses[m] != GDR_OK)

@@ -940,6 +940,24 @@ static int keep_more(const lod_scratch *s, const group_result *r, float to_simpl
            r->error <= LOD_REDIRECT_GAIN * to_full && to_full <= to_simplified;
 }
 
+/* D1 and the smallest kept bound into r, and for an observer (a test) the kept samples. Returns 0
+ * when out of memory. */
+static int record_kept(const lod_build *b, const lod_scratch *s, group_result *r, float to_simplified)
+{
+    float kept = kept_bound(&s->top);
+    r->d1 = to_simplified;
+    r->kept_bound = kept >= 0.0f ? sqrtf(kept) : -1.0f;
+    if (!b->observer)
+        return 1;
+    r->kept = malloc(((size_t)s->top.count + 1) * sizeof *r->kept);
+    if (!r->kept)
+        return 0;
+    for (uint32_t k = 0; k < s->top.count; k++)
+        r->kept[k] = s->sample_ids[s->top.sample[k]];
+    r->kept_count = s->top.count;
+    return 1;
+}
+
 int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count,
                             uint32_t local_count, group_result *r)
 {
@@ -954,7 +972,8 @@ int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *member
         (!build_vertex_grid(s, local_count) || measure_all_samples(b, s, LOD_EXCESS_LIMIT + 1) < 0.0f))
         return 0;
     float floor = to_simplified < 0.0f ? 0.0f : group_floor(b, s, r, to_simplified, &to_full);
-    if (to_simplified < 0.0f || to_full < 0.0f || !collect_excess(s, r, floor) || !hand_samples_to_clusters(s, r))
+    if (to_simplified < 0.0f || to_full < 0.0f || !collect_excess(s, r, floor) || !hand_samples_to_clusters(s, r) ||
+        !record_kept(b, s, r, to_simplified))
         return 0;
     r->deviation = to_simplified > to_full ? to_simplified : to_full;
     return 1;

@@ -315,6 +315,7 @@ void gdr_lod_result_free(group_result *r)
     free(r->cluster_sample_first);
     free(r->excess);
     free(r->excess_distance);
+    free(r->kept);
     memset(r, 0, sizeof *r);
 }
 

@@ -134,11 +134,39 @@ typedef struct group_result {
     uint32_t *excess;               /* samples farther than `floor` from the new clusters, */
     float *excess_distance;         /* with their distance to them */
     uint32_t excess_count;
+    float d1;                       /* D1: the largest distance from a sample to the new clusters */
+    float kept_bound;               /* the smallest kept bound (not squared); every sample not kept lies
+                                       within it of the cluster it passes to; -1: every sample was kept */
+    uint32_t *kept;                 /* the kept samples (kept_count), recorded only for an observer */
+    uint32_t kept_count;
 } group_result;
+
+struct lod_build;
+
+/* One step's groups, as an observer sees them once their errors are set: group g's members are
+ * members[member_start[g] .. member_start[g + 1]) and its result results[g]; the samples are packed
+ * (lod_build.samples) over the clusters of `frontier`, the frontier the step made. Before the first
+ * step: no groups, level 0's frontier. */
+typedef struct lod_step_view {
+    uint32_t depth, groups;
+    const uint32_t *members, *member_start;
+    const group_result *results;
+    const uint32_t *frontier;
+    uint32_t frontier_count;
+} lod_step_view;
+
+/* What a test may ask the build to show it (NULL in every other build: nothing recorded): `step`
+ * is called on the building thread at each step, with the build as it stands, so that a test can
+ * check every sample against the cluster it was handed to. */
+typedef struct lod_observer {
+    void (*step)(void *user, const struct lod_build *b, const lod_step_view *view);
+    void *user;
+} lod_observer;
 
 typedef struct lod_build {
     gdr_mesh *mesh;
     gdr_lod_options opt;
+    const lod_observer *observer; /* NULL but in tests */
     gdr_thread_pool *pool;
     uint32_t worker_base; /* worker index offset of this build's scratch (0: draws progress) */
     lod_scratch *scratch;
@@ -198,6 +226,10 @@ typedef struct lod_build {
     key_record *edge_records;      /* boundary edges of frontier clusters, per chunk */
     uint32_t *edge_record_counts;  /* per frontier cluster */
 } lod_build;
+
+/* gdr_mesh_build_lod_dag with an observer (NULL: the same), for tests. */
+gdr_status gdr_lod_build_observed(gdr_mesh *mesh, const gdr_lod_options *options, const lod_observer *observer,
+                                  gdr_lod_stats *stats, gdr_error *err);
 
 /* Grows *p (a pointer to an array) to hold at least `need` elements of `size` bytes; returns 0 when
  * out of memory. */
