@@ -142,7 +142,14 @@ static int collect_triangles(const redirect *rd, step_triangles *t)
             t->count += c->triangle_count;
         }
     }
-    return t->count == 0 || lod_triangle_grid_build(&t->grid, (const float *)b->mesh->positions, t->corners, t->count);
+    if (t->count > 0 && !lod_triangle_grid_build(&t->grid, (const float *)b->mesh->positions, t->corners, t->count))
+        return 0;
+    /* Every triangle of a cell is looked at: the listed clusters lie around excess samples anywhere
+     * on the mesh, so the grid's box is the mesh's and its cells are coarse for the triangles (on the
+     * 1 M-triangle torus up to 109 a cell); a cut-off cell can hide the neighbour's triangle a
+     * sample lies on. The queries are few (the excess samples). */
+    t->grid.cell_limit = UINT32_MAX;
+    return 1;
 }
 
 static void step_triangles_free(step_triangles *t)
