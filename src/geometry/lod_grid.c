@@ -449,11 +449,18 @@ static int list_triangle(lod_triangle_grid *g, uint32_t t, int store)
     return 1;
 }
 
+/* A cell's triangles are looked at up to this many (the centre of a fan lies in cells of thousands):
+ * the nearest of fewer triangles is farther, so the distance found stays an upper bound. Cells sized
+ * by the triangles and triangles listed only where they cross keep sound meshes below it (no query
+ * of the blob's, the knot's or a 1 M-triangle torus's build meets a full cell): there it is exact. */
+#define GRID_CELL_LIMIT 64u
+
 int lod_triangle_grid_build(lod_triangle_grid *g, const float *positions, const uint32_t *corners, uint32_t n)
 {
     g->positions = positions;
     g->corners = corners;
     g->count = n;
+    g->cell_limit = GRID_CELL_LIMIT;
     tri_choose_cells(g, n);
     size_t cells = (size_t)g->dim[0] * g->dim[1] * g->dim[2];
     if (!grid_reserve(&g->start, &g->start_cap, cells + 1))
@@ -475,11 +482,6 @@ int lod_triangle_grid_build(lod_triangle_grid *g, const float *positions, const 
     return 1;
 }
 
-/* A cell's triangles are looked at up to this many (the centre of a fan lies in cells of thousands):
- * the nearest of fewer triangles is farther, so the distance found stays an upper bound. Cells sized
- * by the triangles and triangles listed only where they cross keep sound meshes below it (no query
- * of the blob's, the knot's or a 1 M-triangle torus's build meets a full cell): there it is exact. */
-#define GRID_CELL_LIMIT 64u
 
 /* Squared distance from q to cell c: no triangle listed there comes nearer than this. */
 static float cell_d2(const lod_triangle_grid *g, const int32_t c[3], const float q[3])
@@ -494,7 +496,7 @@ static float cell_d2(const lod_triangle_grid *g, const int32_t c[3], const float
     return d2;
 }
 
-/* The nearest of cell c's triangles (up to GRID_CELL_LIMIT) into best, unless the cell is farther
+/* The nearest of cell c's triangles (up to g->cell_limit) into best, unless the cell is farther
  * than best already: a triangle listed there whose nearest point is nearer lies in a nearer cell too,
  * where it is listed as well. Ties: the lowest triangle index. */
 static void visit_triangle_cell(const lod_triangle_grid *g, const int32_t c[3], gdr_vec3 point, const float q[3],
@@ -503,7 +505,7 @@ static void visit_triangle_cell(const lod_triangle_grid *g, const int32_t c[3], 
     if (cell_d2(g, c, q) > *best_d2)
         return;
     size_t k = ((size_t)c[2] * g->dim[1] + (uint32_t)c[1]) * g->dim[0] + (uint32_t)c[0];
-    uint32_t end = g->start[k + 1] - g->start[k] > GRID_CELL_LIMIT ? g->start[k] + GRID_CELL_LIMIT : g->start[k + 1];
+    uint32_t end = g->start[k + 1] - g->start[k] > g->cell_limit ? g->start[k] + g->cell_limit : g->start[k + 1];
     for (uint32_t i = g->start[k]; i < end; i++) {
         uint32_t t = g->items[i];
         float d = distance(point, corner(g, t, 0), corner(g, t, 1), corner(g, t, 2));

@@ -42,6 +42,8 @@ typedef struct lod_triangle_grid {
     float cell, inv_cell;
     uint32_t dim[3];
     uint32_t count; /* triangles */
+    uint32_t cell_limit; /* a query looks at up to this many triangles of a cell (set by the build;
+                            a caller with few queries may lift it: exact, see lod_grid.c) */
     uint32_t *start, *items;
     size_t start_cap, items_cap;
     lod_grid_run *runs; /* scratch of a build, kept between builds */

@@ -9,8 +9,8 @@
  * error need only cover h's error instead of that distance; for the cut, "g passes" must imply
  * "h passes", so g's error stays at least h's and g's sphere encloses h's (equal spheres where
  * errors tie, since ties may form cycles). A redirection that would grow a sphere past
- * LOD_SPHERE_GROWTH times its members' largest is not made. Runs on the building thread, in group
- * order: the result does not depend on the thread count. */
+ * LOD_SPHERE_GROWTH times the largest of its own and its targets' is not made. Runs on the
+ * building thread, in group order: the result does not depend on the thread count. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -142,7 +142,14 @@ static int collect_triangles(const redirect *rd, step_triangles *t)
             t->count += c->triangle_count;
         }
     }
-    return t->count == 0 || lod_triangle_grid_build(&t->grid, (const float *)b->mesh->positions, t->corners, t->count);
+    if (t->count > 0 && !lod_triangle_grid_build(&t->grid, (const float *)b->mesh->positions, t->corners, t->count))
+        return 0;
+    /* Every triangle of a cell is looked at: the listed clusters lie around excess samples anywhere
+     * on the mesh, so the grid's box is the mesh's and its cells are coarse for the triangles (on the
+     * 1 M-triangle torus up to 109 a cell); a cut-off cell can hide the neighbour's triangle a
+     * sample lies on. The queries are few (the excess samples). */
+    t->grid.cell_limit = UINT32_MAX;
+    return 1;
 }
 
 static void step_triangles_free(step_triangles *t)
@@ -241,8 +248,12 @@ static uint32_t find_root(uint32_t *parent, uint32_t x)
 
 /* The spheres once settled: a group encloses the settled spheres of the groups its samples pass
  * to; groups of equal error joined by redirections share one sphere. Groups are visited by error
- * (their targets first). Returns 1 when no sphere grew past the limit, else forbids the groups
- * of the offending set to pass samples and returns 0; -1 when out of memory. */
+ * (their targets first). The limit is LOD_SPHERE_GROWTH times the largest own sphere of the set
+ * and of the groups it passes samples to: enclosing a neighbour larger than itself makes a group
+ * about as large as that neighbour, which the cut already tests (where a level-0 cluster's
+ * triangles lie far apart, every group above it is large). Returns 1 when no sphere grew past the
+ * limit, else forbids the groups of the offending set to pass samples and returns 0; -1 when out
+ * of memory. */
 static int settle_spheres(redirect *rd)
 {
     const group_result *results = rd->b->results;
@@ -274,8 +285,11 @@ static int settle_spheres(redirect *rd)
             list[m++] = results[g].sphere;
             largest = results[g].sphere.w > largest ? results[g].sphere.w : largest;
             for (uint32_t k = rd->first[g]; k < rd->first[g + 1]; k++)
-                if (passes(rd, g, k))
-                    list[m++] = rd->sphere[rd->target[k]];
+                if (passes(rd, g, k)) {
+                    uint32_t h = rd->target[k];
+                    list[m++] = rd->sphere[h];
+                    largest = results[h].sphere.w > largest ? results[h].sphere.w : largest;
+                }
         }
         if (m == 1)
             continue;

@@ -202,7 +202,9 @@ static void test_band_exact(void)
 }
 
 /* A fan of thousands of triangles around one vertex: the hub's cells are given up to a limit, so
- * answers there may be farther than the nearest triangle, but never nearer. */
+ * answers there may be farther than the nearest triangle, but never nearer (some are: the limit
+ * binds). With the limit lifted (cell_limit, as the step's grid of lod_redirect.c has it), every
+ * answer is the nearest. */
 static void test_fan_bounded(void)
 {
     const uint32_t n = 4000;
@@ -220,6 +222,7 @@ static void test_fan_bounded(void)
     lod_triangle_grid g = {0};
     CHECK(lod_triangle_grid_build(&g, s.positions, s.corners, s.triangle_count));
     unsigned state = 99;
+    gdr_vec3 queries[200];
     for (int i = 0; i < 200; i++) {
         gdr_vec3 p = {test_random_range(&state, -1.2f, 1.2f), test_random_range(&state, -1.2f, 1.2f),
                       test_random_range(&state, -0.3f, 0.5f)};
@@ -227,7 +230,14 @@ static void test_fan_bounded(void)
         uint32_t t = lod_triangle_grid_nearest(&g, p, test_point_triangle_d2, &d2);
         CHECK(t < n);
         CHECK(d2 >= brute_force_d2(&s, p));
+        queries[i] = p;
     }
+    int bounded = count_misses(&g, &s, queries, 200);
+    g.cell_limit = UINT32_MAX;
+    int lifted = count_misses(&g, &s, queries, 200);
+    printf("fan: %d of 200 answers farther than the nearest with cells limited, %d lifted\n", bounded, lifted);
+    CHECK(bounded > 0);
+    CHECK(lifted == 0);
     lod_triangle_grid_free(&g);
     free(s.positions);
     free(s.corners);
