@@ -539,16 +539,22 @@ static float ring_entry_d2(const lod_build *b, uint32_t entry, gdr_vec3 p)
 /* Stops at the first triangle that brings the distance to at most `at_most` or below `below`
  * (squared): the caller has no use for a smaller bound (probe_state). Adjacency entry `first` (of
  * this position's, or UINT32_MAX), the triangle a walk ending here guessed nearest, is looked at
- * first: the smallest distance is the same in any order. */
+ * first: the smallest distance is the same in any order. *triangle receives the level-0 triangle
+ * (its adjacency entry without the corner) the bound is the distance to. */
 static float to_full_detail_d2(const lod_build *b, uint32_t position, gdr_vec3 p, uint32_t first, float at_most,
-                               float below)
+                               float below, uint32_t *triangle)
 {
     float best = first == UINT32_MAX ? INFINITY : ring_entry_d2(b, b->adjacency[first], p);
+    uint32_t best_entry = first == UINT32_MAX ? b->adjacency[b->adjacency_start[position]] : b->adjacency[first];
     for (uint32_t k = b->adjacency_start[position], end = ring_end(b, position);
          k < end && !(best <= at_most) && !(best < below); k++) {
         float d = k == first ? best : ring_entry_d2(b, b->adjacency[k], p);
-        best = d < best ? d : best;
+        if (d < best) {
+            best = d;
+            best_entry = b->adjacency[k];
+        }
     }
+    *triangle = best_entry >> 2;
     return best;
 }
 
@@ -692,16 +698,17 @@ typedef struct walk_end {
  * brings p's bound within what changes nothing (probe_state): most probes lie close to the last,
  * and their bound matters only where it is large. *at then stays, and the next walk starts there
  * (so later walks may end elsewhere than they would have: still a bound, not the same DAG). */
-static float walk_bound_d2(probe_state *ps, walk_end *at, gdr_vec3 p)
+static float walk_bound_d2(probe_state *ps, walk_end *at, gdr_vec3 p, uint32_t *triangle)
 {
     if (at->entry != UINT32_MAX) {
         float d = ring_entry_d2(ps->b, ps->b->adjacency[at->entry], p);
+        *triangle = ps->b->adjacency[at->entry] >> 2;
         if (d <= ps->at_most || d < ps->below)
             return d;
     }
     int stopped_short;
     at->position = walk_towards(ps->b, at->position, p, &stopped_short, &at->entry);
-    float d = to_full_detail_d2(ps->b, at->position, p, at->entry, ps->at_most, ps->below);
+    float d = to_full_detail_d2(ps->b, at->position, p, at->entry, ps->at_most, ps->below, triangle);
     int suspect = (stopped_short && d > ps->worst) || d > 4.0f * ps->worst;
     if (!suspect || ps->s->gathered == 0)
         return d;
@@ -711,11 +718,13 @@ static float walk_bound_d2(probe_state *ps, walk_end *at, gdr_vec3 p)
         return d;
     }
     walk_end again;
+    uint32_t triangle_again;
     again.position = walk_towards(ps->b, start, p, &stopped_short, &again.entry);
-    float d_again = to_full_detail_d2(ps->b, again.position, p, again.entry, ps->at_most, ps->below);
+    float d_again = to_full_detail_d2(ps->b, again.position, p, again.entry, ps->at_most, ps->below, &triangle_again);
     if (d_again >= d)
         return d;
     *at = again;
+    *triangle = triangle_again;
     return d_again;
 }
 
@@ -725,9 +734,9 @@ static float walk_bound_d2(probe_state *ps, walk_end *at, gdr_vec3 p)
  * the exact distance to the level-0 triangles around the group's samples is taken instead (the
  * walk can stop far away on meshes of long thin triangles). *at receives where the walk ended (the
  * next probe of the triangle starts there). */
-static float probe_d2(probe_state *ps, walk_end *at, gdr_vec3 p)
+static float probe_d2(probe_state *ps, walk_end *at, gdr_vec3 p, uint32_t *triangle)
 {
-    float d = walk_bound_d2(ps, at, p);
+    float d = walk_bound_d2(ps, at, p, triangle);
     if (d <= 4.0f * ps->worst || ps->failed) /* squared: up to twice the largest so far */
         return d;
     if (!ps->s->region_built && !build_region(ps->b, ps->s)) {
@@ -735,8 +744,11 @@ static float probe_d2(probe_state *ps, walk_end *at, gdr_vec3 p)
         return d;
     }
     float exact;
-    lod_triangle_grid_nearest(&ps->s->region_grid, p, point_triangle_d2, &exact);
-    return exact < d ? exact : d;
+    uint32_t nearest = lod_triangle_grid_nearest(&ps->s->region_grid, p, point_triangle_d2, &exact);
+    if (!(exact < d))
+        return d;
+    *triangle = ps->s->region_refs[nearest];
+    return exact;
 }
 
 /* A triangle's coarse probes decide whether it is refined: refined unless its largest is below this
@@ -754,6 +766,115 @@ static int grid_edge(int i, int j, int n)
     return i == 0 ? 2 : 3;
 }
 
+/* The finest probe grid's steps an edge. */
+#define LOD_FINE_STEPS 8
+
+/* A simplified triangle's probe grid: each point, its bound (squared) and the level-0 triangle
+ * that bound is the distance to (UINT32_MAX where the point was not probed here). */
+typedef struct probe_lattice {
+    gdr_vec3 point[LOD_FINE_STEPS + 1][LOD_FINE_STEPS + 1];
+    float d2[LOD_FINE_STEPS + 1][LOD_FINE_STEPS + 1];
+    uint32_t triangle[LOD_FINE_STEPS + 1][LOD_FINE_STEPS + 1];
+} probe_lattice;
+
+/* The plane of level-0 triangle `triangle` (an adjacency entry without its corner); w NaN when it
+ * has no area. */
+static gdr_vec4 level0_plane(const lod_build *b, uint32_t triangle)
+{
+    const gdr_vec3 *x = b->mesh->positions;
+    const gdr_cluster *c = ring_cluster(b, triangle << 2);
+    const uint8_t *t = ring_triangle(b, c, triangle << 2);
+    const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+    gdr_vec3 a = x[v[t[0]]], e1 = sub3(x[v[t[1]]], a), e2 = sub3(x[v[t[2]]], a);
+    gdr_vec3 n = {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x};
+    float length = sqrtf(dot3(n, n));
+    if (!(length > 0.0f))
+        return (gdr_vec4){0.0f, 0.0f, 0.0f, NAN};
+    n = (gdr_vec3){n.x / length, n.y / length, n.z / length};
+    return (gdr_vec4){n.x, n.y, n.z, dot3(n, a)};
+}
+
+static float plane_distance(gdr_vec4 plane, gdr_vec3 p)
+{
+    return plane.x * p.x + plane.y * p.y + plane.z * p.z - plane.w;
+}
+
+/* Probes p (probe_triangle's rules for what a bound must settle), raising *largest and the group's
+ * largest; returns the bound (squared) and the level-0 triangle it is the distance to. On the
+ * refining grid a bound is looked for until it is below 70% of the group's largest (not only below
+ * the largest): a point that may border a ridge then has its nearest level-0 triangle, whose plane
+ * probe_ridges needs. */
+static float probe_at(probe_state *ps, walk_end *at, gdr_vec3 p, int refine, float *largest, uint32_t *triangle)
+{
+    ps->at_most = refine ? refine_share(ps->worst) : *largest;
+    ps->below = refine ? 0.0f : refine_share(ps->worst);
+    float d = probe_d2(ps, at, p, triangle);
+    *largest = d > *largest ? d : *largest;
+    ps->worst = d > ps->worst ? d : ps->worst;
+    return d;
+}
+
+/* Where, between grid points a and b, the distances to the planes of their level-0 triangles meet
+ * while one rises from a and the other falls towards b: the top of a ridge of the distance to S0
+ * (the larger of two plane distances' minimum) that neither point sees. Returns its fraction of the
+ * way from a, and the predicted distance there in *top; -1 when there is none. */
+static float ridge_between(gdr_vec3 a, gdr_vec4 plane_a, gdr_vec3 b, gdr_vec4 plane_b, float *top)
+{
+    float fa0 = plane_distance(plane_a, a), fa1 = plane_distance(plane_a, b);
+    float fb0 = plane_distance(plane_b, a), fb1 = plane_distance(plane_b, b);
+    if (fa0 < 0.0f) /* distances on a's side of its plane (b's of its) count as positive */
+        fa0 = -fa0, fa1 = -fa1;
+    if (fb1 < 0.0f)
+        fb0 = -fb0, fb1 = -fb1;
+    float rise = fa1 - fa0, fall = fb0 - fb1;
+    if (!(rise > 0.0f && fall > 0.0f && fa1 >= 0.0f && fb0 >= 0.0f))
+        return -1.0f;
+    float t = (fb0 - fa0) / (rise + fall);
+    if (!(t > 0.0f && t < 1.0f))
+        return -1.0f;
+    *top = fa0 + t * rise;
+    return t;
+}
+
+/* The grid's neighbouring point pairs: (i, j) with (i + 1, j), (i, j + 1) and (i + 1, j) with
+ * (i, j + 1). */
+static const int8_t lattice_steps[3][4] = {{0, 0, 1, 0}, {0, 0, 0, 1}, {1, 0, 0, 1}};
+
+/* On the refining grid, probes the ridge tops between neighbouring grid points (one of them at
+ * least 70% of the group's largest) whose level-0 planes predict one above 90% of the group's
+ * largest. The distance from a simplified triangle to S0 peaks on such ridges (where two facets of
+ * S0 are seen from inside a fold, the nearer of the two planes changes), between the grid's points:
+ * on the knot a grid of 8 steps missed one by 7.8% of the bound. A distance to a plane bounds
+ * nothing (the plane extends past its triangle), so the prediction only says where to probe; the
+ * probe's bound is a distance to a level-0 triangle like every other. Returns the triangle's
+ * largest. */
+static float probe_ridges(probe_state *ps, walk_end *at, const probe_lattice *l, int n, float largest,
+                          float edge_d2[3])
+{
+    for (int i = 0; i < n; i++)
+        for (int j = 0; i + j < n; j++)
+            for (int k = 0; k < 3; k++) {
+                int ai = i + lattice_steps[k][0], aj = j + lattice_steps[k][1];
+                int bi = i + lattice_steps[k][2], bj = j + lattice_steps[k][3];
+                uint32_t ta = l->triangle[ai][aj], tb = l->triangle[bi][bj];
+                if (ta == UINT32_MAX || tb == UINT32_MAX || ta == tb ||
+                    !(fmaxf(l->d2[ai][aj], l->d2[bi][bj]) >= refine_share(ps->worst)))
+                    continue;
+                float wanted = 0.81f * ps->worst;
+                float top, t = ridge_between(l->point[ai][aj], level0_plane(ps->b, ta), l->point[bi][bj],
+                                             level0_plane(ps->b, tb), &top);
+                if (t < 0.0f || !(top * top > wanted))
+                    continue;
+                gdr_vec3 a = l->point[ai][aj], p = along(a, t, sub3(l->point[bi][bj], a));
+                uint32_t triangle;
+                float d = probe_at(ps, at, p, 1, &largest, &triangle);
+                int edge = grid_edge(ai, aj, n);
+                if (edge < 3 && edge == grid_edge(bi, bj, n))
+                    edge_d2[edge] = d > edge_d2[edge] ? d : edge_d2[edge];
+            }
+    return largest;
+}
+
 /* The largest probe distance over the points of a barycentric grid of n steps on triangle v, corners
  * left out (they are level-0 vertices: distance 0), and of each edge k's points into edge_d2[k];
  * the points of an edge whose bit is set in `skip` are left out (a neighbour probed them). Walks
@@ -762,29 +883,30 @@ static int grid_edge(int i, int j, int n)
  * something: once a triangle brings it to at most `at_most` or below `below` the rest are skipped,
  * which leaves every decision as if all were measured (docs/GEOMETRY.md, "The error"). Both are at
  * most the largest so far, so the walks' checks against that come out the same; on the refining
- * grid (`refine`) only the largest so far is used; on the coarse grid, also this triangle's largest
- * and whether it stays below refine_share of the largest, which can only grow. */
+ * grid (`refine`) the search goes on to refine_share of the largest so far (probe_at), and its
+ * ridges are probed (probe_ridges); on the coarse grid, this triangle's largest and whether it stays
+ * below refine_share of the largest, which can only grow. */
 static float probe_triangle(probe_state *ps, walk_end *at, const gdr_vec3 v[3], int n, int refine, unsigned skip,
                             float floor, float edge_d2[3])
 {
+    probe_lattice lattice;
     float largest = floor;
     for (int i = 0; i <= n; i++)
         for (int j = 0; i + j <= n; j++) {
             int edge = grid_edge(i, j, n);
-            if (i == n || j == n || i + j == 0 || (edge < 3 && (skip >> edge & 1)))
-                continue;
             float u = (float)i / (float)n, w = (float)j / (float)n, z = 1.0f - u - w;
             gdr_vec3 p = {z * v[0].x + u * v[1].x + w * v[2].x, z * v[0].y + u * v[1].y + w * v[2].y,
                           z * v[0].z + u * v[1].z + w * v[2].z};
-            ps->at_most = refine ? ps->worst : largest;
-            ps->below = refine ? 0.0f : refine_share(ps->worst);
-            float d = probe_d2(ps, at, p);
-            largest = d > largest ? d : largest;
-            ps->worst = d > ps->worst ? d : ps->worst;
+            lattice.point[i][j] = p;
+            lattice.triangle[i][j] = UINT32_MAX;
+            if (i == n || j == n || i + j == 0 || (edge < 3 && (skip >> edge & 1)))
+                continue;
+            float d = probe_at(ps, at, p, refine, &largest, &lattice.triangle[i][j]);
+            lattice.d2[i][j] = d;
             if (edge < 3)
                 edge_d2[edge] = d > edge_d2[edge] ? d : edge_d2[edge];
         }
-    return largest;
+    return refine ? probe_ridges(ps, at, &lattice, n, largest, edge_d2) : largest;
 }
 
 static void triangle_corners(const lod_scratch *s, uint32_t t, gdr_vec3 v[3])
@@ -852,7 +974,7 @@ static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor,
     float coarse_worst = ps.worst;
     for (uint32_t t = 0; t < s->out_triangle_count && !(ps.worst > cap2); t++)
         if (!(s->coarse_d2[t] < refine_share(coarse_worst)))
-            probe_shared(&ps, s, t, 8, 1);
+            probe_shared(&ps, s, t, LOD_FINE_STEPS, 1);
     return ps.failed ? -1.0f : ps.worst > cap2 ? INFINITY : sqrtf(ps.worst);
 }
 
