@@ -144,11 +144,13 @@ static int collect_triangles(const redirect *rd, step_triangles *t)
     }
     if (t->count > 0 && !lod_triangle_grid_build(&t->grid, (const float *)b->mesh->positions, t->corners, t->count))
         return 0;
-    /* Every triangle of a cell is looked at: the listed clusters lie around excess samples anywhere
-     * on the mesh, so the grid's box is the mesh's and its cells are coarse for the triangles (on the
-     * 1 M-triangle torus up to 109 a cell); a cut-off cell can hide the neighbour's triangle a
-     * sample lies on. The queries are few (the excess samples). */
-    t->grid.cell_limit = UINT32_MAX;
+    /* Up to 4,096 triangles of a cell are looked at, not 64: the listed clusters lie around excess
+     * samples anywhere on the mesh, so the grid's box is the mesh's and its cells are coarse for the
+     * triangles (on the 1 M-triangle torus up to 109 a cell); a cut-off cell can hide the
+     * neighbour's triangle a sample lies on. The queries are few (the excess samples); the limit
+     * keeps a hostile mesh (every triangle in one cell) from making each cost the whole step. A
+     * cell cut off only misses a target: the sample stays, its error a bound as before. */
+    t->grid.cell_limit = 4096u;
     return 1;
 }
 

@@ -203,8 +203,8 @@ static void test_band_exact(void)
 
 /* A fan of thousands of triangles around one vertex: the hub's cells are given up to a limit, so
  * answers there may be farther than the nearest triangle, but never nearer (some are: the limit
- * binds). With the limit lifted (cell_limit, as the step's grid of lod_redirect.c has it), every
- * answer is the nearest. */
+ * binds). With the limit lifted (cell_limit; the step's grid of lod_redirect.c raises it to 4,096),
+ * every answer is the nearest. */
 static void test_fan_bounded(void)
 {
     const uint32_t n = 4000;
