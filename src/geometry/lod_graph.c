@@ -48,28 +48,27 @@ static void boundary_edges_task(void *user, uint32_t f, uint32_t worker)
     const uint8_t *t = gdr_lod_cluster_triangles(b, c);
     const uint32_t *v = gdr_lod_cluster_vertices(b, c);
     uint32_t n = c->triangle_count * 3;
-    for (uint32_t i = 0; i < n; i++) {
-        uint32_t a = t[i], e = t[i - i % 3 + (i % 3 + 1) % 3];
-        uint32_t lo = a < e ? a : e, hi = a < e ? e : a;
-        if (s->edge_count[lo * 64 + hi] < 255)
-            s->edge_count[lo * 64 + hi]++;
-    }
+    uint16_t edge[GDR_CLUSTER_MAX_TRIANGLES * 3]; /* corner i's edge to the next corner: lo * 64 + hi */
+    for (uint32_t i = 0; i < n; i += 3)
+        for (uint32_t k = 0; k < 3; k++) {
+            uint32_t a = t[i + k], e = t[i + (k == 2 ? 0 : k + 1)];
+            edge[i + k] = (uint16_t)(a < e ? a * 64 + e : e * 64 + a);
+        }
+    for (uint32_t i = 0; i < n; i++)
+        if (s->edge_count[edge[i]] < 255)
+            s->edge_count[edge[i]]++;
     key_record *out = b->edge_records ? b->edge_records + b->edge_record_counts[f] : NULL;
     uint32_t count = 0;
     for (uint32_t i = 0; i < n; i++) {
-        uint32_t a = t[i], e = t[i - i % 3 + (i % 3 + 1) % 3];
-        uint32_t lo = a < e ? a : e, hi = a < e ? e : a;
-        if (s->edge_count[lo * 64 + hi] == 1) {
-            uint32_t pa = b->position_id[v[a]], pe = b->position_id[v[e]];
-            if (pa != pe && out)
-                out[count] = (key_record){.key = edge_key(pa, pe), .value = f};
-            count += pa != pe;
-        }
+        if (s->edge_count[edge[i]] != 1)
+            continue;
+        uint32_t pa = b->position_id[v[edge[i] >> 6]], pe = b->position_id[v[edge[i] & 63]];
+        if (pa != pe && out)
+            out[count] = (key_record){.key = edge_key(pa, pe), .value = f};
+        count += pa != pe;
     }
-    for (uint32_t i = 0; i < n; i++) {
-        uint32_t a = t[i], e = t[i - i % 3 + (i % 3 + 1) % 3];
-        s->edge_count[(a < e ? a : e) * 64 + (a < e ? e : a)] = 0;
-    }
+    for (uint32_t i = 0; i < n; i++)
+        s->edge_count[edge[i]] = 0;
     if (!out)
         b->edge_record_counts[f] = count;
 }
