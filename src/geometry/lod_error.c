@@ -894,13 +894,13 @@ static float probe_triangle(probe_state *ps, walk_end *at, const gdr_vec3 v[3], 
     for (int i = 0; i <= n; i++)
         for (int j = 0; i + j <= n; j++) {
             int edge = grid_edge(i, j, n);
+            lattice.triangle[i][j] = UINT32_MAX; /* not probed here: never read */
+            if (i == n || j == n || i + j == 0 || (edge < 3 && (skip >> edge & 1)))
+                continue;
             float u = (float)i / (float)n, w = (float)j / (float)n, z = 1.0f - u - w;
             gdr_vec3 p = {z * v[0].x + u * v[1].x + w * v[2].x, z * v[0].y + u * v[1].y + w * v[2].y,
                           z * v[0].z + u * v[1].z + w * v[2].z};
             lattice.point[i][j] = p;
-            lattice.triangle[i][j] = UINT32_MAX;
-            if (i == n || j == n || i + j == 0 || (edge < 3 && (skip >> edge & 1)))
-                continue;
             float d = probe_at(ps, at, p, refine, &largest, &lattice.triangle[i][j]);
             lattice.d2[i][j] = d;
             if (edge < 3)

@@ -482,7 +482,6 @@ int lod_triangle_grid_build(lod_triangle_grid *g, const float *positions, const 
     return 1;
 }
 
-
 /* Squared distance from q to cell c: no triangle listed there comes nearer than this. */
 static float cell_d2(const lod_triangle_grid *g, const int32_t c[3], const float q[3])
 {

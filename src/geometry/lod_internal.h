@@ -1,5 +1,6 @@
-/* Internals of the LOD DAG build (lod_dag.c drives it, lod_graph.c partitions a step's clusters,
- * lod_group.c simplifies one group). Not part of the public API. */
+/* Internals of the LOD DAG build (lod_dag.c drives it, lod_weld.c joins near-equal positions,
+ * lod_graph.c partitions a step's clusters, lod_group.c simplifies one group). Not part of the
+ * public API. */
 #ifndef GDR_GEOMETRY_LOD_INTERNAL_H
 #define GDR_GEOMETRY_LOD_INTERNAL_H
 
@@ -25,7 +26,7 @@
 #define LOD_REDIRECT_GAIN 0.5f
 
 /* Positions closer than this share of the mesh's bounding radius on every axis are one position
- * (lod_graph.c, gdr_lod_weld_setup): to grouping, simplification and the error's samples and walks.
+ * (lod_weld.c, gdr_lod_weld_setup): to grouping, simplification and the error's samples and walks.
  * Seams whose two sides differ by rounding (sinf(2 pi) != 0) then close like bit-equal ones
  * instead of being open borders. */
 #define LOD_WELD_SCALE 1e-6
@@ -237,6 +238,13 @@ int gdr_lod_reserve(void *p, size_t *cap, size_t need, size_t size);
 #define LOD_RESERVE(s, field, need) gdr_lod_reserve(&(s)->field, &(s)->field##_cap, (need), sizeof *(s)->field)
 
 static inline size_t gdr_lod_align4(size_t n) { return (n + 3) & ~(size_t)3; }
+/* The root of x in a union-find forest over parent[] (halving the path on the way). */
+static inline uint32_t gdr_lod_find_root(uint32_t *parent, uint32_t x)
+{
+    while (parent[x] != x)
+        x = parent[x] = parent[parent[x]];
+    return x;
+}
 static inline const uint8_t *gdr_lod_cluster_triangles(const lod_build *b, const gdr_cluster *c)
 {
     return b->triangles + c->triangle_offset;
@@ -249,7 +257,7 @@ static inline const uint32_t *gdr_lod_cluster_vertices(const lod_build *b, const
 /* Adds to the shared progress; only worker 0 of the calling thread draws. */
 void gdr_lod_progress_add(lod_build *b, uint64_t amount, uint32_t worker);
 
-/* lod_graph.c: gives near-equal positions (LOD_WELD_SCALE) one position id, after
+/* lod_weld.c: gives near-equal positions (LOD_WELD_SCALE) one position id, after
  * meshoptimizer's remap gave bit-equal ones one; 0: out of memory. */
 int gdr_lod_weld_setup(lod_build *b);
 

@@ -241,13 +241,6 @@ static int passes(const redirect *rd, uint32_t g, uint32_t k)
     return !rd->forbidden[g] && rd->target[k] != NONE && rd->error[rd->target[k]] < rd->distance[k];
 }
 
-static uint32_t find_root(uint32_t *parent, uint32_t x)
-{
-    while (parent[x] != x)
-        x = parent[x] = parent[parent[x]];
-    return x;
-}
-
 /* The spheres once settled: a group encloses the settled spheres of the groups its samples pass
  * to; groups of equal error joined by redirections share one sphere. Groups are visited by error
  * (their targets first). The limit is LOD_SPHERE_GROWTH times the largest own sphere of the set
@@ -267,9 +260,9 @@ static int settle_spheres(redirect *rd)
     for (uint32_t g = 0; g < n; g++)
         for (uint32_t k = rd->first[g]; k < rd->first[g + 1]; k++)
             if (passes(rd, g, k) && rd->error[rd->target[k]] == rd->error[g])
-                rd->parent[find_root(rd->parent, g)] = find_root(rd->parent, rd->target[k]);
+                rd->parent[gdr_lod_find_root(rd->parent, g)] = gdr_lod_find_root(rd->parent, rd->target[k]);
     for (uint32_t g = 0; g < n; g++)
-        rd->order[g] = (group_key){rd->error[g], find_root(rd->parent, g), g};
+        rd->order[g] = (group_key){rd->error[g], gdr_lod_find_root(rd->parent, g), g};
     qsort(rd->order, n, sizeof *rd->order, compare_keys);
     int ok = 1;
     gdr_vec4 *list = NULL;
