@@ -187,6 +187,8 @@ gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr
         status = gdr_vk_buffer_create(&r->allocator, (VkDeviceSize)s->slot_count * s->slot_bytes,
                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                       GDR_VK_BUFFER_DEVICE, &s->pool, err);
+    if (status != GDR_OK) /* a cache that failed to open or to match has no pages to size anything by */
+        return status;
     s->staging_bytes = staging_bytes(s, scene);
     s->stats.enabled = true;
     s->stats.slot_count = s->slot_count;

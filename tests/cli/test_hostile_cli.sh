@@ -3,7 +3,7 @@
 # and the documented exit status; --out/--stats/-o onto links, devices and FIFOs.
 # usage: test_hostile_cli.sh GDR_BINARY WORK_DIR
 set -u
-gdr=$1
+gdr=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
 work=$2
 rm -rf "$work" && mkdir -p "$work/scene" "$work/outside"
 failures=0
@@ -80,6 +80,44 @@ expect 1 "URI outside the folder" "leaves the scene's folder.*--allow-outside-fi
 check "no cache written for the refused scene" test ! -e "$work/scene/escape.gltf.gdrc"
 expect 0 "URI outside the folder, allowed" "" "$gdr" info "$work/scene/escape.gltf" --allow-outside-files --no-cache
 check "one mesh" grep -q '^meshes: *1 ' "$work/stdout"
+
+# Results files travel between machines: their strings reach gnuplot only as data. A pipeline name
+# and pass names written as gnuplot code must neither run (no file made) nor stop the plot.
+cat > "$work/evil.json" <<'EOF'
+[{"pipeline":"mesh'.system('touch PWNED-pipeline').'","lod_error_px":1,"instances_total":10,
+  "gpu_ms":{"cull'.system('touch PWNED-pass').'":0.5,"raster\"\n!touch PWNED-newline\n":0.25}},
+ {"pipeline":"mesh'.system('touch PWNED-pipeline').'","lod_error_px":1,"instances_total":100,
+  "gpu_ms":{"cull'.system('touch PWNED-pass').'":0.75,"raster\"\n!touch PWNED-newline\n":0.5}}]
+EOF
+cd "$work" || exit 1 # where gnuplot's system() would make its files
+expect 0 "plot of a results file with code in its strings" "" \
+    "$gdr" bench --plot-from "$work/evil.json" --plot "$work/evil.svg"
+cd "$OLDPWD" || exit 1
+check "no command ran from the results file" sh -c "! ls '$work' | grep -q PWNED"
+check "the plot was drawn with the titles as text" grep -q 'system' "$work/evil.svg"
+
+# A damaged page index: streaming refuses the cache as gdr info does, for a byte flipped in each of
+# the index's first fields.
+expect 0 "a paged cache" "" "$gdr" build demo:instances=4 -o "$work/paged.gdrc" --pages
+# The PAGE section's offset, from the section table (32-byte entries after the 64-byte header).
+sections=$(od -An -t u4 -j 16 -N 4 "$work/paged.gdrc" | tr -d ' ')
+page_offset=""
+i=0
+while [ "$i" -lt "${sections:-0}" ]; do
+    # shellcheck disable=SC2046
+    set -- $(od -An -t u4 -j $((64 + 32 * i)) -N 12 "$work/paged.gdrc")
+    [ "$1" = 1162297680 ] && page_offset=$3 # 'PAGE' as a little-endian u32; the offset's low half
+    i=$((i + 1))
+done
+check "the paged cache has a PAGE section" test -n "$page_offset"
+for at in 0 4 8 12 20 36; do
+    cp "$work/paged.gdrc" "$work/mutant.gdrc"
+    printf '\377' | dd of="$work/mutant.gdrc" bs=1 seek=$((${page_offset:-0} + 32 + at)) conv=notrunc 2>/dev/null
+    # shellcheck disable=SC2086
+    expect 1 "page index byte $at flipped, streamed" "mutant.gdrc.*PAGE" \
+        "$gdr" render "$work/mutant.gdrc" --geometry-budget 8 $tiny --out "$work/mutant.png"
+    check "no image for the damaged cache (index byte $at)" test ! -e "$work/mutant.png"
+done
 
 echo "test_hostile_cli: $failures failure(s)"
 [ "$failures" = 0 ]

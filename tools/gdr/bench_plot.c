@@ -22,13 +22,23 @@ static void run_label(const cJSON *row, char *out, size_t size)
              cJSON_IsNumber(lod) ? lod->valuedouble : 0.0, cJSON_IsTrue(occlusion) ? " occl" : "");
 }
 
-/* One gnuplot data block per (run, pass): "x ms" lines; the blocks' titles in `titles`. */
-static int write_blocks(FILE *f, const cJSON *rows, const char *x_key, char titles[][96])
+/* A legend title fit for a data file's quoted column header: the rows may come from a results file
+ * made elsewhere, so only letters, digits and a few punctuation marks are kept (no quote, backslash,
+ * newline, dollar or at sign); anything else becomes '?'. */
+static void legend_title(const char *run, const char *pass, char *out, size_t size)
 {
-    int series = 0;
-    const cJSON *first = cJSON_GetArrayItem(rows, 0);
-    const cJSON *passes = cJSON_GetObjectItem(first, "gpu_ms");
-    char runs[PLOT_MAX_SERIES][64];
+    snprintf(out, size, "%.40s: %.40s", run, pass);
+    for (char *c = out; *c; c++) {
+        bool plain = (*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') ||
+                     strchr(" _.:,+-()/", *c) != NULL;
+        if (!plain)
+            *c = '?';
+    }
+}
+
+/* The distinct runs of the rows, in order of first appearance (at most PLOT_MAX_SERIES). */
+static int distinct_runs(const cJSON *rows, char runs[][64])
+{
     int run_count = 0;
     for (const cJSON *row = rows->child; row; row = row->next) {
         char label[64];
@@ -37,45 +47,70 @@ static int write_blocks(FILE *f, const cJSON *rows, const char *x_key, char titl
         for (int r = 0; r < run_count; r++)
             known |= strcmp(runs[r], label) == 0;
         if (!known && run_count < PLOT_MAX_SERIES)
-            snprintf(runs[run_count++], sizeof runs[0], "%s", label);
+            snprintf(runs[run_count++], 64, "%s", label);
     }
+    return run_count;
+}
+
+/* One series' data file: its legend title as a quoted column header, then "x ms" lines. */
+static bool write_series(const char *file, const cJSON *rows, const char *x_key, const char *run, const char *pass)
+{
+    FILE *f = fopen(file, "w");
+    if (!f)
+        return false;
+    char title[96];
+    legend_title(run, pass, title, sizeof title);
+    fprintf(f, "\"%s\" \"ms\"\n", title);
+    for (const cJSON *row = rows->child; row; row = row->next) {
+        char label[64];
+        run_label(row, label, sizeof label);
+        const cJSON *x = cJSON_GetObjectItem(row, x_key);
+        const cJSON *ms = cJSON_GetObjectItem(cJSON_GetObjectItem(row, "gpu_ms"), pass);
+        if (strcmp(label, run) == 0 && cJSON_IsNumber(x) && cJSON_IsNumber(ms))
+            fprintf(f, "%.17g %.9g\n", x->valuedouble, ms->valuedouble);
+    }
+    bool ok = !ferror(f);
+    return fclose(f) == 0 && ok;
+}
+
+/* One data file per (run, pass) in `dir`, named series0.dat, series1.dat, ...; returns how many, or
+ * -1 when one could not be written. */
+static int write_series_files(const char *dir, const cJSON *rows, const char *x_key)
+{
+    char runs[PLOT_MAX_SERIES][64];
+    int run_count = distinct_runs(rows, runs), series = 0;
+    const cJSON *passes = cJSON_GetObjectItem(cJSON_GetArrayItem(rows, 0), "gpu_ms");
     for (int r = 0; r < run_count; r++) {
         for (const cJSON *pass = passes ? passes->child : NULL; pass && series < PLOT_MAX_SERIES; pass = pass->next) {
-            snprintf(titles[series++], 96, "%.40s: %.40s", runs[r], pass->string);
-            fprintf(f, "$block%d << EOD\n", series - 1);
-            for (const cJSON *row = rows->child; row; row = row->next) {
-                char label[64];
-                run_label(row, label, sizeof label);
-                const cJSON *x = cJSON_GetObjectItem(row, x_key);
-                const cJSON *ms = cJSON_GetObjectItem(cJSON_GetObjectItem(row, "gpu_ms"), pass->string);
-                if (strcmp(label, runs[r]) == 0 && cJSON_IsNumber(x) && cJSON_IsNumber(ms))
-                    fprintf(f, "%.17g %.9g\n", x->valuedouble, ms->valuedouble);
-            }
-            fprintf(f, "EOD\n");
+            char file[96];
+            snprintf(file, sizeof file, "%s/series%d.dat", dir, series);
+            if (!pass->string || !write_series(file, rows, x_key, runs[r], pass->string))
+                return -1;
+            series++;
         }
     }
     return series;
 }
 
-static gdr_status write_script(const char *script, const char *svg, const cJSON *rows, bool along_path,
-                               gdr_error *err)
+/* The script holds no text from the rows: every title and number reaches gnuplot as data, from the
+ * series files, whose first line is the legend title (`title columnheader`). */
+static gdr_status write_script(const char *dir, int series, bool along_path, gdr_error *err)
 {
+    char script[96];
+    snprintf(script, sizeof script, "%s/plot.gp", dir);
     FILE *f = fopen(script, "w");
     if (!f)
         return gdr_error_set(err, GDR_ERROR_IO, "--plot: cannot write %s", script);
-    static char titles[PLOT_MAX_SERIES][96];
-    int series = write_blocks(f, rows, along_path ? "frame" : "instances_total", titles);
-    fprintf(f, "set terminal svg size 960,600 dynamic noenhanced background rgb 'white'\nset output '%s'\n", svg);
+    fprintf(f, "set terminal svg size 960,600 dynamic noenhanced background rgb 'white'\nset output '%s/plot.svg'\n",
+            dir);
     fprintf(f, "set title 'GPU ms per pass%s'\nset xlabel '%s'\nset ylabel 'GPU ms'\nset key outside right\n"
                "set grid\n%s",
             along_path ? " along the camera path" : " against scene size", along_path ? "frame" : "instances",
             along_path ? "" : "set logscale x\n");
-    for (int s = 0; s < series; s++)
-        fprintf(f, "%s $block%d using 1:2 with linespoints title '%s'%s", s ? "    " : "plot", s, titles[s],
-                s + 1 < series ? ", \\\n" : "\n");
-    bool ok = series > 0 && !ferror(f);
-    fclose(f);
-    return ok ? GDR_OK : gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "--plot: no GPU timings to plot");
+    fprintf(f, "plot for [i=0:%d] sprintf('%s/series%%d.dat', i) using 1:2 with linespoints title columnheader(1)\n",
+            series - 1, dir);
+    bool ok = !ferror(f);
+    return fclose(f) == 0 && ok ? GDR_OK : gdr_error_set(err, GDR_ERROR_IO, "--plot: cannot write %s", script);
 }
 
 /* Runs gnuplot on the script; its messages go to stderr. */
@@ -170,16 +205,28 @@ gdr_status bench_plot_svg(const char *path, const cJSON *rows, bool along_path, 
     char dir[] = "/tmp/gdr-plot-XXXXXX";
     if (!mkdtemp(dir))
         return gdr_error_set(err, GDR_ERROR_IO, "--plot: cannot make a temporary folder");
-    char script[64], svg[64];
+    int series = write_series_files(dir, rows, along_path ? "frame" : "instances_total");
+    gdr_status status = GDR_OK;
+    if (series < 0)
+        status = gdr_error_set(err, GDR_ERROR_IO, "--plot: cannot write the data files in %s", dir);
+    else if (series == 0)
+        status = gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "--plot: no GPU timings to plot");
+    if (status == GDR_OK)
+        status = write_script(dir, series, along_path, err);
+    char script[96], svg[96];
     snprintf(script, sizeof script, "%s/plot.gp", dir);
     snprintf(svg, sizeof svg, "%s/plot.svg", dir);
-    gdr_status status = write_script(script, svg, rows, along_path, err);
     if (status == GDR_OK)
         status = run_gnuplot(script, err);
     if (status == GDR_OK)
         status = copy_out(svg, path, err);
     remove(script);
     remove(svg);
+    for (int s = 0; s < PLOT_MAX_SERIES; s++) { /* those written, also when one failed */
+        char file[96];
+        snprintf(file, sizeof file, "%s/series%d.dat", dir, s);
+        remove(file);
+    }
     rmdir(dir);
     return status;
 }
