@@ -5,7 +5,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "core/thread_pool.h"
+#include "gdr/thread_pool.h"
 #include "gdr/cull.h"
 
 static unsigned rng_state = 2024;

@@ -12,6 +12,7 @@
 #include <time.h>
 
 #include "gdr/renderer.h"
+#include "gdr/io.h"
 #include "gdr/scene.h"
 
 static double now_ms(void)

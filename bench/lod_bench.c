@@ -27,7 +27,7 @@
 #include "gdr/geometry.h"
 #include "gdr/io.h"
 #include "gdr/scene.h"
-#include "scene/procedural_meshes.h"
+#include "procedural/procedural_meshes.h"
 
 /* --- helpers -------------------------------------------------------------------------------------- */
 

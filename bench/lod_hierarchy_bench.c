@@ -17,6 +17,7 @@
 #include <time.h>
 
 #include "gdr/geometry.h"
+#include "gdr/io.h"
 #include "gdr/scene.h"
 #include "geometry/lod_cut.h"
 

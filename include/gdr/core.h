@@ -8,6 +8,7 @@
 #include <stdarg.h>
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -26,6 +27,9 @@ typedef enum gdr_status {
     GDR_ERROR_VULKAN,           /* a Vulkan call failed */
     GDR_ERROR_CAPACITY,         /* a fixed-size list would overflow */
 } gdr_status;
+
+/* Marks "none" in every index field (a mesh's material, a cluster's group, ...). */
+#define GDR_NO_INDEX UINT32_MAX
 
 #define GDR_ERROR_MESSAGE_MAX 512
 

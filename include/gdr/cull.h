@@ -27,7 +27,7 @@
 extern "C" {
 #endif
 
-/* The pool type of src/core/thread_pool.h (gdr_thread_pool_create / _destroy). Every function
+/* The pool type of gdr/thread_pool.h (gdr_thread_pool_create / _destroy). Every function
  * here that takes one accepts NULL (run on the calling thread). */
 typedef struct gdr_thread_pool gdr_thread_pool;
 

@@ -1,11 +1,20 @@
-/* gdr: a GPU-driven renderer on Vulkan. One include for the whole public API. */
+/* gdr: a GPU-driven renderer on Vulkan. One include for the whole public API, bottom layer first
+ * (docs/ARCHITECTURE.md). */
 #ifndef GDR_GDR_H
 #define GDR_GDR_H
 
 #include "gdr/core.h"
-#include "gdr/geometry.h"
+#include "gdr/thread_pool.h"
 #include "gdr/math.h"
-#include "gdr/renderer.h"
 #include "gdr/scene.h"
+#include "gdr/mesh_clusters.h"
+#include "gdr/geometry.h"
+#include "gdr/cull.h"
+#include "gdr/procedural.h"
+#include "gdr/io.h"
+#include "gdr/paged_cache.h"
+#include "gdr/renderer.h"
+#include "gdr/renderer_vulkan.h"
+#include "gdr/present.h"
 
 #endif

@@ -21,6 +21,48 @@
 extern "C" {
 #endif
 
+/* --- Options shared by every loader ------------------------------------------------------ */
+
+/* Warnings from importers (a file that loads, but not entirely as written): `message` names the
+ * file and the place, e.g. "box.gltf: meshes[0].primitives[1]: mode 1 (lines) skipped". */
+typedef void (*gdr_warning_fn)(void *user, const char *message);
+
+/* Limits on what one untrusted scene or cache file may make gdr do (docs/SECURITY.md). Each is
+ * checked before the memory it bounds is allocated; a file over one is refused with an error that
+ * names the budget and the option that raises it. Zero-initialise: 0 takes the default below. */
+typedef struct gdr_budget {
+    uint64_t triangles;      /* triangles over all meshes as read (before duplicates are dropped);
+                                0: GDR_DEFAULT_MAX_TRIANGLES */
+    uint64_t instances;      /* instances the file creates; 0: GDR_DEFAULT_MAX_INSTANCES */
+    uint64_t texture_pixels; /* pixels over all decoded images; 0: GDR_DEFAULT_MAX_TEXTURE_PIXELS */
+    uint64_t decoded_bytes;  /* bytes made by decoding (base64 data: URIs, EXT_meshopt_compression
+                                views, accessors without a bufferView); 0: GDR_DEFAULT_MAX_DECODED_BYTES */
+} gdr_budget;
+
+#define GDR_DEFAULT_MAX_TRIANGLES (1ull << 26)      /* 67,108,864 */
+#define GDR_DEFAULT_MAX_INSTANCES (1ull << 22)      /* 4,194,304 */
+#define GDR_DEFAULT_MAX_TEXTURE_PIXELS (1ull << 27) /* 134,217,728: 512 MiB of RGBA8 */
+#define GDR_DEFAULT_MAX_DECODED_BYTES (1ull << 31)  /* 2 GiB */
+
+/* The budget with every 0 replaced by its default. */
+GDR_API gdr_budget gdr_budget_resolve(const gdr_budget *budget);
+
+/* Options of gdr_scene_load; zero-initialise, every field has a default. */
+typedef struct gdr_load_options {
+    int no_cache;          /* 1: import the source, never read or write a .gdrc cache */
+    const char *cache_dir; /* NULL: next to the source (FILE.gdrc), falling back to
+                              $XDG_CACHE_HOME/gdr or ~/.cache/gdr when that is not writable */
+    int no_progress;       /* 1: never draw a progress bar (default: on a terminal only) */
+    gdr_warning_fn warning; /* NULL: warnings go to stderr as "gdr: warning: ..." */
+    void *warning_user;
+    gdr_budget budget;      /* limits for untrusted files; zero: the defaults */
+    int allow_outside_files; /* 1: a glTF may name buffers and images outside its own folder
+                                (absolute paths, '..', symlinks out); 0: refused */
+    int geometry_in_pages;   /* 1: for streaming, a .gdrc with geometry pages is read without the
+                                geometry its pages hold (gdr_cache_read_for_streaming); any other
+                                scene is refused */
+} gdr_load_options;
+
 /* --- source files -------------------------------------------------------------------------- */
 
 /* A file an import read: its identity is what makes a cache stale. */
@@ -163,6 +205,23 @@ GDR_API gdr_status gdr_import_file(const char *path, const gdr_import_options *o
  * one). A stale cache is rebuilt from the source without it (the bake is not redone). */
 GDR_API gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options, gdr_scene **out,
                                        gdr_pvs **out_pvs, gdr_error *err);
+
+/* --- Loading: the one way from a name to a scene -------------------------------------------- */
+
+/* True when `spec` names a built-in scene ("demo", "lod-field", "occlusion", "unique-field", alone or followed by
+ * ":options"), which gdr_scene_load builds instead of reading a file. */
+GDR_API bool gdr_scene_spec_is_builtin(const char *spec);
+
+/* Loads a scene from a specification, a built-in scene with its level-0 clusters and LOD DAG:
+ *     "demo[:instances=N,seed=S,spacing=X]"                 gdr_scene_create_demo
+ *     "lod-field[:instances=N,seed=S,triangles=T,spacing=X]" gdr_scene_create_lod_field
+ *     "occlusion[:seed=S,hidden=N,visible=N]"               gdr_scene_create_occlusion
+ *     "unique-field[:meshes=M,seed=S,triangles=T,spacing=X]" gdr_scene_create_unique_field
+ * (options in any order, each at most once; values as in the desc, 0 refused), or a file path of
+ * a supported format. Source files (.gltf, .glb, .obj) go through the processed-scene cache unless
+ * options->no_cache; a .gdrc file is read directly. options: NULL for the defaults. */
+GDR_API gdr_status gdr_scene_load(const char *spec, const gdr_load_options *options, gdr_scene **out,
+                                  gdr_error *err);
 
 #ifdef __cplusplus
 }

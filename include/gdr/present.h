@@ -28,27 +28,11 @@
 #include <vulkan/vulkan.h>
 
 #include "gdr/renderer.h"
+#include "gdr/renderer_vulkan.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-/* The renderer's Vulkan objects, for an application that records its own commands. The image is
- * `color_format`, usage includes TRANSFER_SRC, and between gdr_renderer_render calls it is in
- * `color_layout`; commands that use it must leave it in that layout again. */
-typedef struct gdr_vulkan_handles {
-    VkInstance instance;
-    VkPhysicalDevice physical_device;
-    VkDevice device;
-    VkQueue queue;
-    uint32_t queue_family;
-    VkImage color_image;
-    VkFormat color_format;
-    VkImageLayout color_layout;
-    uint32_t width, height;
-} gdr_vulkan_handles;
-
-GDR_API gdr_vulkan_handles gdr_renderer_vulkan(const gdr_renderer *renderer);
 
 typedef struct gdr_presenter gdr_presenter;
 

@@ -8,15 +8,14 @@
 #include <stdint.h>
 
 #include "gdr/core.h"
-#include "gdr/geometry.h"
 #include "gdr/math.h"
+#include "gdr/mesh_clusters.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
 #define GDR_NAME_MAX 64
-#define GDR_NO_INDEX UINT32_MAX
 /* Largest magnitude of a mesh-space coordinate (metres) gdr accepts anywhere: far beyond any real
  * scene, small enough that squared distances and areas stay finite in float. */
 #define GDR_MAX_COORDINATE 1e12f
@@ -31,8 +30,8 @@ typedef struct gdr_mesh {
     uint32_t index_count; /* a multiple of 3: a triangle list, counter-clockwise front faces */
     uint32_t *indices;
     gdr_vec4 bounds; /* bounding sphere in mesh space: centre xyz, radius w */
-    gdr_mesh_clusters clusters; /* meshlets and LOD DAG (gdr/geometry.h); empty until built */
-    gdr_vertex_quantization quantization; /* the grid its vertices lie on, or not enabled (gdr/geometry.h) */
+    gdr_mesh_clusters clusters; /* meshlets and LOD DAG (gdr/mesh_clusters.h, built by gdr/geometry.h); empty until built */
+    gdr_vertex_quantization quantization; /* the grid its vertices lie on, or not enabled (gdr/mesh_clusters.h) */
 } gdr_mesh;
 
 /* A texture reference's sampler state (glTF's sampler object), packed in a uint32: zero is glTF's
@@ -184,168 +183,6 @@ GDR_API gdr_camera gdr_scene_framing_camera(const gdr_scene *scene);
 
 /* Total triangles over all instances. */
 GDR_API uint64_t gdr_scene_triangle_count(const gdr_scene *scene);
-
-/* The built-in procedural scene: procedural meshes (sphere, torus, box, a dense displaced shape)
- * instanced on a square grid over a ground plane, with a camera inside the grid. */
-typedef struct gdr_demo_desc {
-    uint32_t instances; /* 0: 10000 */
-    uint32_t seed;      /* 0: 1 */
-    float spacing;      /* grid spacing in metres; 0: 4 */
-    uint32_t textures;  /* 1: every shape and the ground get a textured material (base colour, normal and
-                         * metallic-roughness maps, generated); 0: plain colours */
-} gdr_demo_desc;
-
-GDR_API gdr_status gdr_scene_create_demo(const gdr_demo_desc *desc, gdr_scene **out, gdr_error *err);
-
-/* --- LOD field: many copies of one dense mesh, from near to far -------------------------------
- *
- * One dense closed mesh, a bumpy (2, 3) torus knot named "torus_knot" (a welded tube: watertight,
- * every edge shared by exactly two triangles; bounding radius about 1 m), instanced `instances`
- * times in randomly rotated copies on a jittered grid of `spacing` metres that fills a wedge
- * in front of the camera (half-angle 40 degrees around -Z), nearest first: instance i is never
- * nearer to the camera than instance i - 1's grid row. Copies never overlap (their bounding
- * spheres are disjoint); every other row is shifted by half a cell. With the defaults the field
- * runs from 4 m to about 100 m in front of the origin (rows from z = -4 on), so the LOD cut varies
- * along it. No ground, no materials (per-instance colours). Camera 0, at (0, 4.5, 1) looking down
- * -Z and 17 degrees down, sees the field from its near end to the horizon; yfov 60 degrees, znear
- * 0.1, infinite far. Deterministic: the same desc gives the same bytes.
- * gdr_scene_create_lod_field builds level-0 clusters; gdr_scene_load("lod-field...") also builds
- * the LOD DAG. */
-typedef struct gdr_lod_field_desc {
-    uint32_t instances; /* 0: 1000; at most 16000000 */
-    uint32_t seed;      /* 0: 1 */
-    uint32_t triangles; /* triangles of the mesh, approximately (the tube's lattice rounds it);
-                           0: 100000; in [1000, 16000000] */
-    float spacing;      /* grid spacing in metres; 0: 3; in [2.5, 1000] */
-} gdr_lod_field_desc;
-
-GDR_API gdr_status gdr_scene_create_lod_field(const gdr_lod_field_desc *desc, gdr_scene **out, gdr_error *err);
-
-/* --- Unique field: many different dense meshes, one copy each ---------------------------------
- *
- * `meshes` different closed meshes (tori whose tube radius follows waves of the mesh's own
- * frequencies and phases, named "unique_M"; about `triangles` triangles each, welded: every edge
- * has exactly two triangles; within 0.95 m of the mesh origin), one instance each, on a square
- * grid of `spacing` metres in the XZ plane (rows from z = -4 along -Z, centres at y = 1), each
- * turned randomly about Y and tilted a little. The processed geometry grows with meshes x
- * triangles and no instance shares another's: the scene for geometry streaming. Camera 0 at
- * (0, 3.5, 0), 20 degrees down, looks along the field. Deterministic: the same desc gives the same
- * bytes. gdr_scene_create_unique_field builds level-0 clusters; gdr_scene_load("unique-field...")
- * also builds the LOD DAG. */
-typedef struct gdr_unique_field_desc {
-    uint32_t meshes;    /* 0: 100; at most 100000 */
-    uint32_t seed;      /* 0: 1 */
-    uint32_t triangles; /* per mesh, approximately (the lattice rounds it); 0: 100000; in [1000, 16000000] */
-    float spacing;      /* grid spacing in metres; 0: 3; in [2.5, 1000] */
-} gdr_unique_field_desc;
-
-GDR_API gdr_status gdr_scene_create_unique_field(const gdr_unique_field_desc *desc, gdr_scene **out,
-                                                 gdr_error *err);
-
-/* --- Occlusion scene: a wall of buildings in front of many small objects -----------------------
- *
- * Right-handed, Y up; the default camera stands at (0, 1.7, 0) looking down -Z. Instances, in
- * this order:
- *   [0]                       the ground, a 260 m square at y = 0 (mesh "ground")
- *   [1, 1 + buildings)        the wall: a row of tall boxes (mesh "building", scaled; 10 to 24 m
- *                             high, 6 to 10 m deep) from x = -70 to 70 with its front at z = -20
- *                             to -21.5, open at two fixed gaps, x in [-9, -6] and [7, 10.5], through
- *                             which the default camera sees some hidden objects, and at a few
- *                             random narrower ones further out; x in [-6, 7] is always a building
- *   [.., + visible)           small objects (meshes "sphere", "torus", "box") resting on the
- *                             ground in front of the wall, x in [-40, 40], z in [-17, -3]: visible
- *   [.., + hidden)            the last `hidden` instances: small objects behind the wall, x in
- *                             [-60, 60], z in [-100, -36], up to 4 m above the ground: hidden from
- *                             the default camera except through the gaps
- * Small objects get smaller as they get denser (radius up to 0.6 m, 0.35 of the grid cell) and
- * never overlap anything. The extents do not depend on the desc, only the density and the random
- * details do; gdr_scene_occlusion_camera_path holds for every desc. The cameras are frames of
- * that path: 0 "front" (frame 0, the default camera), 1 "behind" (70), 2 "past-end" (159),
- * 3 "above" (199), 4 "close" (200), 5 "gap" (228). Deterministic: the same desc gives the same
- * bytes. gdr_scene_create_occlusion builds level-0 clusters; gdr_scene_load("occlusion...") also
- * builds the LOD DAG. */
-typedef struct gdr_occlusion_scene_desc {
-    uint32_t seed;    /* 0: 1 */
-    uint32_t hidden;  /* objects behind the wall; 0: 4000; at most 1000000 */
-    uint32_t visible; /* objects in front of the wall; 0: 300; at most 1000000 */
-} gdr_occlusion_scene_desc;
-
-GDR_API gdr_status gdr_scene_create_occlusion(const gdr_occlusion_scene_desc *desc, gdr_scene **out,
-                                              gdr_error *err);
-
-/* Length of the occlusion scene's camera path; frames past it repeat it (frame % length). */
-#define GDR_OCCLUSION_PATH_FRAMES 240u
-
-/* The camera of `frame` on the occlusion scene's path, for tests that render a sequence with
- * occlusion culling on and off. *camera_cut (may be NULL) is set to true on the first frame of each
- * shot, where the camera jumps (no usable history), false elsewhere. The shots:
- *     0 ..  39  dolly from the default camera towards the wall, swaying a little
- *    40 ..  69  turns in place: left by 75 degrees, then right to 30 degrees
- *    70 .. 109  cut behind the wall, 5 m up, looking back at it over the hidden objects, moving closer
- *   110 .. 159  cut to a strafe in front of the wall past its end (x 40 -> 95) while turning
- *               left: hidden objects come out from behind the wall's end
- *   160 .. 199  cut to a crane shot rising from 1.7 m to 45 m and tilting down: hidden objects
- *               come out above the wall
- *   200 .. 215  cut to 1.5 m in front of the wall, spinning 22.5 degrees a frame
- *   216 .. 239  cut to a strafe in front of the gap at x in [-9, -6]: hidden objects appear
- *               through it and disappear again
- * The camera never enters a building or an object; yfov 60 degrees, znear 0.1, infinite far. */
-GDR_API gdr_camera gdr_scene_occlusion_camera_path(uint32_t frame, bool *camera_cut);
-
-/* True when `spec` names a built-in scene ("demo", "lod-field", "occlusion", "unique-field", alone or followed by
- * ":options"), which gdr_scene_load builds instead of reading a file. */
-GDR_API bool gdr_scene_spec_is_builtin(const char *spec);
-
-/* Warnings from importers (a file that loads, but not entirely as written): `message` names the
- * file and the place, e.g. "box.gltf: meshes[0].primitives[1]: mode 1 (lines) skipped". */
-typedef void (*gdr_warning_fn)(void *user, const char *message);
-
-/* Limits on what one untrusted scene or cache file may make gdr do (docs/SECURITY.md). Each is
- * checked before the memory it bounds is allocated; a file over one is refused with an error that
- * names the budget and the option that raises it. Zero-initialise: 0 takes the default below. */
-typedef struct gdr_budget {
-    uint64_t triangles;      /* triangles over all meshes as read (before duplicates are dropped);
-                                0: GDR_DEFAULT_MAX_TRIANGLES */
-    uint64_t instances;      /* instances the file creates; 0: GDR_DEFAULT_MAX_INSTANCES */
-    uint64_t texture_pixels; /* pixels over all decoded images; 0: GDR_DEFAULT_MAX_TEXTURE_PIXELS */
-    uint64_t decoded_bytes;  /* bytes made by decoding (base64 data: URIs, EXT_meshopt_compression
-                                views, accessors without a bufferView); 0: GDR_DEFAULT_MAX_DECODED_BYTES */
-} gdr_budget;
-
-#define GDR_DEFAULT_MAX_TRIANGLES (1ull << 26)      /* 67,108,864 */
-#define GDR_DEFAULT_MAX_INSTANCES (1ull << 22)      /* 4,194,304 */
-#define GDR_DEFAULT_MAX_TEXTURE_PIXELS (1ull << 27) /* 134,217,728: 512 MiB of RGBA8 */
-#define GDR_DEFAULT_MAX_DECODED_BYTES (1ull << 31)  /* 2 GiB */
-
-/* The budget with every 0 replaced by its default. */
-GDR_API gdr_budget gdr_budget_resolve(const gdr_budget *budget);
-
-/* Options of gdr_scene_load; zero-initialise, every field has a default. */
-typedef struct gdr_load_options {
-    int no_cache;          /* 1: import the source, never read or write a .gdrc cache */
-    const char *cache_dir; /* NULL: next to the source (FILE.gdrc), falling back to
-                              $XDG_CACHE_HOME/gdr or ~/.cache/gdr when that is not writable */
-    int no_progress;       /* 1: never draw a progress bar (default: on a terminal only) */
-    gdr_warning_fn warning; /* NULL: warnings go to stderr as "gdr: warning: ..." */
-    void *warning_user;
-    gdr_budget budget;      /* limits for untrusted files; zero: the defaults */
-    int allow_outside_files; /* 1: a glTF may name buffers and images outside its own folder
-                                (absolute paths, '..', symlinks out); 0: refused */
-    int geometry_in_pages;   /* 1: for streaming, a .gdrc with geometry pages is read without the
-                                geometry its pages hold (gdr_cache_read_for_streaming); any other
-                                scene is refused */
-} gdr_load_options;
-
-/* Loads a scene from a specification, a built-in scene with its level-0 clusters and LOD DAG:
- *     "demo[:instances=N,seed=S,spacing=X]"                 gdr_scene_create_demo
- *     "lod-field[:instances=N,seed=S,triangles=T,spacing=X]" gdr_scene_create_lod_field
- *     "occlusion[:seed=S,hidden=N,visible=N]"               gdr_scene_create_occlusion
- *     "unique-field[:meshes=M,seed=S,triangles=T,spacing=X]" gdr_scene_create_unique_field
- * (options in any order, each at most once; values as in the desc, 0 refused), or a file path of
- * a supported format. Source files (.gltf, .glb, .obj) go through the processed-scene cache unless
- * options->no_cache; a .gdrc file is read directly. options: NULL for the defaults. */
-GDR_API gdr_status gdr_scene_load(const char *spec, const gdr_load_options *options, gdr_scene **out,
-                                  gdr_error *err);
 
 #ifdef __cplusplus
 }

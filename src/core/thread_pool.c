@@ -1,4 +1,4 @@
-#include "core/thread_pool.h"
+#include "gdr/thread_pool.h"
 
 #include <pthread.h>
 #include <stdatomic.h>

@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/thread_pool.h"
+#include "gdr/thread_pool.h"
 #include "cull/cull_internal.h"
 
 #define CULL_DEFAULT_WORDS_PER_TASK 64u

@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/thread_pool.h"
+#include "gdr/thread_pool.h"
 #include "cull/cull_internal.h"
 
 typedef struct octree_builder {

@@ -7,7 +7,7 @@
 #include <string.h>
 #include <zstd.h>
 
-#include "core/thread_pool.h"
+#include "gdr/thread_pool.h"
 #include "cull/cull_internal.h"
 
 enum { CELL_UNTOUCHED = 0, CELL_BAKED = 1, CELL_OCCUPIED = 2 };

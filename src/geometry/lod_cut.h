@@ -1,10 +1,10 @@
 /* The LOD cut on the CPU: the reference the GPU selection (meshlet.task) is checked against.
- * The per-group math is shared with the shaders (src/shaders/shared/lod_math.h); the
+ * The per-group math is shared with the shaders (src/gpu_shared/lod_math.h); the
  * rule itself is documented in gdr/geometry.h ("The cut"). */
 #ifndef GDR_GEOMETRY_LOD_CUT_H
 #define GDR_GEOMETRY_LOD_CUT_H
 
-#include "shaders/shared/lod_math.h"
+#include "gpu_shared/lod_math.h"
 
 #include <stdint.h>
 

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gdr/geometry.h"
 #include "geometry/cluster_bounds.h"
 #include "geometry/lod_internal.h"
 

@@ -8,7 +8,7 @@
 
 #include "gdr/geometry.h"
 #include "geometry/lod_internal.h"
-#include "shaders/shared/gpu_types.h"
+#include "gpu_shared/gpu_types.h"
 
 _Static_assert(sizeof(gdr_lod_node) == offsetof(GdrGpuLodNode, bounds) &&
                    offsetof(gdr_lod_node, max_error) == offsetof(GdrGpuLodNode, max_error) &&

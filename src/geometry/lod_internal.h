@@ -12,7 +12,7 @@
 #include <meshoptimizer.h>
 
 #include "core/progress.h"
-#include "core/thread_pool.h"
+#include "gdr/thread_pool.h"
 #include "geometry/lod_grid.h"
 #include "gdr/geometry.h"
 #include "gdr/scene.h"

@@ -7,7 +7,7 @@
 
 #include <meshoptimizer.h>
 
-#include "core/thread_pool.h"
+#include "gdr/thread_pool.h"
 #include "geometry/cluster_bounds.h"
 #include "geometry/meshlet_chunks.h"
 #include "gdr/geometry.h"

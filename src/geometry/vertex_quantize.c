@@ -7,9 +7,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/thread_pool.h"
+#include "gdr/thread_pool.h"
 #include "geometry/cluster_bounds.h"
 #include "geometry/vertex_quantize.h"
+#include "gdr/geometry.h"
 #include "gdr/scene.h"
 
 #define POSITION_MAX ((1u << GDR_QUANTIZED_POSITION_BITS) - 1u)

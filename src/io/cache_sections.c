@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gdr/geometry.h"
 #include "io/cache_internal.h"
 #include "io/cache_pages.h"
 #include "io/io_internal.h"

@@ -8,7 +8,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "gdr/io.h"
 #include "gdr/cull.h"
+#include "gdr/geometry.h"
 #include "io/io_internal.h"
 
 /* Builds the clusters of every mesh that has none (all of them after an import; none, normally,

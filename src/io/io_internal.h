@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "gdr/geometry.h"
 #include "core/progress.h"
 #include "gdr/io.h"
 

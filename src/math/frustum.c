@@ -1,7 +1,7 @@
 #include <math.h>
 
 #include "gdr/math.h"
-#include "shaders/shared/cull_math.h"
+#include "math/cull_math.h"
 
 gdr_vec4 gdr_frustum_symmetric(gdr_mat4 projection)
 {

@@ -2,7 +2,7 @@
 #include <string.h>
 
 #include "gdr/math.h"
-#include "shaders/shared/cull_math.h"
+#include "math/cull_math.h"
 
 #define AT(a, row, col) ((a).m[(col) * 4 + (row)])
 

@@ -12,7 +12,7 @@
 #include <stdio.h>
 
 #include "gdr/renderer.h"
-#include "shaders/shared/gpu_config.h"
+#include "gpu_shared/gpu_config.h"
 #include "vk/vk_image.h"
 
 /* Two-phase occlusion culling's phases; the culling shaders' specialisation constant PHASE. */

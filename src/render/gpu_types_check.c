@@ -5,7 +5,7 @@
 
 #include "gdr/geometry.h"
 #include "gdr/renderer.h"
-#include "shaders/shared/gpu_types.h"
+#include "gpu_shared/gpu_types.h"
 
 _Static_assert(GDR_MESH_MAX_VERTICES == GDR_CLUSTER_MAX_VERTICES && GDR_MESH_MAX_TRIANGLES == GDR_CLUSTER_MAX_TRIANGLES,
                "the mesh shader's limits are gdr/geometry.h's");

@@ -6,7 +6,7 @@
  * odd and non-power-of-two depth sizes lose no row or column.
  *
  * Built by compute, one dispatch per GDR_HZB_LEVELS_PER_DISPATCH levels (depthreduce.comp.glsl). Sampling it for the occlusion
- * test: src/shaders/shared/occlusion_math.h.
+ * test: src/gpu_shared/occlusion_math.h.
  *
  * Synchronization contract of gdr_hzb_record_build:
  *  - Before: the depth image is in desc.depth_layout and its writes are visible to
@@ -23,7 +23,7 @@
 #ifndef GDR_HZB_H
 #define GDR_HZB_H
 
-#include "shaders/shared/occlusion_math.h"
+#include "gpu_shared/occlusion_math.h"
 #include "vk/vk_image.h"
 
 #define GDR_HZB_FORMAT VK_FORMAT_R32_SFLOAT

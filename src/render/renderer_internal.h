@@ -7,7 +7,7 @@
 #include "render/materials.h"
 #include "render/occlusion.h"
 #include "render/pipelines.h"
-#include "shaders/shared/gpu_types.h"
+#include "gpu_shared/gpu_types.h"
 #include "vk/vk_buffer.h"
 #include "vk/vk_context.h"
 #include "vk/vk_image.h"

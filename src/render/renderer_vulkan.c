@@ -1,5 +1,5 @@
 /* The renderer's Vulkan objects for applications that present or copy its image themselves. */
-#include "gdr/present.h"
+#include "gdr/renderer_vulkan.h"
 #include "render/renderer_internal.h"
 
 gdr_vulkan_handles gdr_renderer_vulkan(const gdr_renderer *r)

@@ -22,7 +22,7 @@
 #define GDR_VISBUFFER_H
 
 #include "gdr/renderer.h"
-#include "shaders/shared/gpu_types.h"
+#include "gpu_shared/gpu_types.h"
 #include "vk/vk_buffer.h"
 
 struct gdr_frame_slot;

@@ -19,7 +19,7 @@
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 
-#include "shared/occlusion_math.h"
+#include "gpu_shared/occlusion_math.h"
 
 #define TILE 16u
 

@@ -9,14 +9,14 @@
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 
-#include "shared/glsl_buffers.h"
-#include "shared/cull_math.h"
-#include "shared/lod_math.h"
-#include "shared/occlusion_test.h"
-#include "shared/task_queue.h"
-#include "shared/meshlet_payload.h"
-#include "shared/cluster_cull.h"
-#include "shared/raster_bin.h"
+#include "gpu_shared/glsl_buffers.h"
+#include "math/cull_math.h"
+#include "gpu_shared/lod_math.h"
+#include "gpu_shared/occlusion_test.h"
+#include "gpu_shared/task_queue.h"
+#include "gpu_shared/meshlet_payload.h"
+#include "gpu_shared/cluster_cull.h"
+#include "gpu_shared/raster_bin.h"
 
 layout(local_size_x = GDR_CULL_WORKGROUP_SIZE) in;
 layout(constant_id = 0) const bool EMIT_TASKS = false;

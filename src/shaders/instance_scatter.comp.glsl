@@ -1,6 +1,6 @@
 #version 460
 // Applies this frame's "tag + data" records from the instance ring to the persistent instance buffer.
-#include "shared/glsl_buffers.h"
+#include "gpu_shared/glsl_buffers.h"
 
 layout(local_size_x = GDR_SCATTER_WORKGROUP_SIZE) in;
 

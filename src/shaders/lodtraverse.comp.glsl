@@ -12,12 +12,12 @@
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 
-#include "shared/glsl_buffers.h"
-#include "shared/cull_math.h"
-#include "shared/lod_math.h"
-#include "shared/occlusion_test.h"
-#include "shared/task_queue.h"
-#include "shared/residency.h"
+#include "gpu_shared/glsl_buffers.h"
+#include "math/cull_math.h"
+#include "gpu_shared/lod_math.h"
+#include "gpu_shared/occlusion_test.h"
+#include "gpu_shared/task_queue.h"
+#include "gpu_shared/residency.h"
 
 layout(local_size_x = GDR_TRAVERSE_WORKGROUP_SIZE) in;
 layout(constant_id = 0) const uint PHASE = GDR_PHASE_NONE;

@@ -13,10 +13,10 @@
 #define GDR_COLOR_INPUT flat in
 #endif
 #extension GL_EXT_nonuniform_qualifier : require
-#include "shared/glsl_buffers.h"
-#include "shared/material.h"
-#include "shared/material_flags.h"
-#include "shared/shading.h"
+#include "gpu_shared/glsl_buffers.h"
+#include "gpu_shared/material.h"
+#include "gpu_shared/material_flags.h"
+#include "gpu_shared/shading.h"
 
 #ifndef GDR_ALPHA_TEST
 layout(early_fragment_tests) in;

@@ -1,9 +1,9 @@
 #version 460
 #extension GL_EXT_nonuniform_qualifier : require
 // Forward path vertex shader: the instance comes from gl_InstanceIndex (= the draw's first_instance).
-#include "shared/glsl_buffers.h"
-#include "shared/material.h"
-#include "shared/shading.h"
+#include "gpu_shared/glsl_buffers.h"
+#include "gpu_shared/material.h"
+#include "gpu_shared/shading.h"
 
 layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec3 in_normal;

@@ -11,12 +11,12 @@
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_EXT_nonuniform_qualifier : require
 
-#include "shared/glsl_buffers.h"
-#include "shared/material.h"
-#include "shared/material_flags.h"
-#include "shared/meshlet_payload.h"
-#include "shared/shading.h"
-#include "shared/visbuffer.h"
+#include "gpu_shared/glsl_buffers.h"
+#include "gpu_shared/material.h"
+#include "gpu_shared/material_flags.h"
+#include "gpu_shared/meshlet_payload.h"
+#include "gpu_shared/shading.h"
+#include "gpu_shared/visbuffer.h"
 
 layout(local_size_x = GDR_MESH_WORKGROUP_SIZE) in;
 layout(triangles, max_vertices = GDR_MESH_MAX_VERTICES, max_primitives = GDR_MESH_MAX_TRIANGLES) out;

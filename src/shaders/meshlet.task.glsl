@@ -8,12 +8,12 @@
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 
-#include "shared/glsl_buffers.h"
-#include "shared/cull_math.h"
-#include "shared/lod_math.h"
-#include "shared/occlusion_test.h"
-#include "shared/meshlet_payload.h"
-#include "shared/cluster_cull.h"
+#include "gpu_shared/glsl_buffers.h"
+#include "math/cull_math.h"
+#include "gpu_shared/lod_math.h"
+#include "gpu_shared/occlusion_test.h"
+#include "gpu_shared/meshlet_payload.h"
+#include "gpu_shared/cluster_cull.h"
 
 layout(local_size_x = GDR_TASK_WORKGROUP_SIZE) in;
 // Occlusion culling phase: GDR_PHASE_NONE, _EARLY or _LATE.

@@ -9,14 +9,14 @@
 #extension GL_EXT_mesh_shader : require
 #extension GL_EXT_shader_atomic_int64 : require
 #extension GL_EXT_nonuniform_qualifier : require
-#include "shared/glsl_buffers.h"
-#include "shared/visbuffer.h"
+#include "gpu_shared/glsl_buffers.h"
+#include "gpu_shared/visbuffer.h"
 
 layout(location = 3) perprimitiveEXT flat in uint in_visibility_id;
 
 #ifdef GDR_ALPHA_TEST
-#include "shared/material.h"
-#include "shared/material_flags.h"
+#include "gpu_shared/material.h"
+#include "gpu_shared/material_flags.h"
 
 layout(location = 4) in vec2 in_uv;
 layout(location = 5) perprimitiveEXT flat in uint in_material;

@@ -3,7 +3,7 @@
 // max, then workgroup shared memory, then one global atomicMax per workgroup into the slot after
 // the last pixel.
 #extension GL_KHR_shader_subgroup_arithmetic : require
-#include "shared/glsl_buffers.h"
+#include "gpu_shared/glsl_buffers.h"
 
 layout(local_size_x = GDR_REDUCE_WORKGROUP_SIZE) in;
 

@@ -1,7 +1,7 @@
 #version 460
 // Overdraw view, step 2: each pixel's fragment count as a heat map (black, blue, green, yellow, red,
 // white), normalised by the frame's maximum. Pixels no fragment reached keep the background.
-#include "shared/glsl_buffers.h"
+#include "gpu_shared/glsl_buffers.h"
 
 layout(location = 0) out vec4 out_color;
 

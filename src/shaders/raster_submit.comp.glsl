@@ -6,8 +6,8 @@
 // clusters beyond the device's launch limit are dropped and counted as overflow. And the resolve's
 // VkDispatchIndirectCommand: the whole screen in the frame's first phase and in a later phase with
 // clusters to draw, nothing otherwise (the visibility buffer has not changed since the last resolve).
-#include "shared/glsl_buffers.h"
-#include "shared/visbuffer.h"
+#include "gpu_shared/glsl_buffers.h"
+#include "gpu_shared/visbuffer.h"
 
 layout(local_size_x = 1) in;
 

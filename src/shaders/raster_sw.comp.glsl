@@ -15,9 +15,9 @@
 // nothing is clipped here.
 #extension GL_EXT_shader_atomic_int64 : require
 
-#include "shared/glsl_buffers.h"
-#include "shared/meshlet_payload.h"
-#include "shared/visbuffer.h"
+#include "gpu_shared/glsl_buffers.h"
+#include "gpu_shared/meshlet_payload.h"
+#include "gpu_shared/visbuffer.h"
 
 layout(local_size_x = GDR_SW_RASTER_WORKGROUP_SIZE) in;
 

@@ -4,7 +4,7 @@
 // VkDispatchIndirectCommand of the cluster cull (visibility-buffer modes: GDR_CLUSTER_CULL_TASKS per
 // workgroup). Launches wider than GDR_TASK_GROUPS_PER_ROW use rows (y); the shaders skip the tail of
 // the last row.
-#include "shared/glsl_buffers.h"
+#include "gpu_shared/glsl_buffers.h"
 
 layout(local_size_x = 1) in;
 // The late phase of occlusion culling launches its own task commands.

@@ -13,11 +13,11 @@
 // A compute pass rather than a full-screen fragment pass: on the Hopper GPUs a fragment pass that
 // writes depth costs about 1 ms at 1440p before any shading (docs/PERFORMANCE.md).
 #extension GL_EXT_nonuniform_qualifier : require
-#include "shared/glsl_buffers.h"
-#include "shared/material.h"
-#include "shared/meshlet_payload.h"
-#include "shared/shading.h"
-#include "shared/visbuffer.h"
+#include "gpu_shared/glsl_buffers.h"
+#include "gpu_shared/material.h"
+#include "gpu_shared/meshlet_payload.h"
+#include "gpu_shared/shading.h"
+#include "gpu_shared/visbuffer.h"
 
 layout(local_size_x = GDR_RESOLVE_TILE, local_size_y = GDR_RESOLVE_TILE) in;
 layout(set = 0, binding = 1, rgba8) uniform writeonly image2D color_target;

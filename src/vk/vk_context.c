@@ -4,7 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "gdr/geometry.h"
+#include "gdr/mesh_clusters.h"
 
 const char *gdr_vk_result_name(VkResult result)
 {

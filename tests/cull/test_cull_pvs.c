@@ -7,7 +7,7 @@
 
 #include <zstd.h>
 
-#include "core/thread_pool.h"
+#include "gdr/thread_pool.h"
 #include "gdr/cull.h"
 #include "test_util.h"
 

@@ -3,7 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/thread_pool.h"
+#include "gdr/thread_pool.h"
 #include "gdr/cull.h"
 #include "test_util.h"
 

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "gdr/cull.h"
+#include "gdr/procedural.h"
 #include "gdr/scene.h"
 #include "test_util.h"
 

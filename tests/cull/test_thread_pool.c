@@ -2,7 +2,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 
-#include "core/thread_pool.h"
+#include "gdr/thread_pool.h"
 #include "test_util.h"
 
 typedef struct job {

@@ -8,9 +8,11 @@
 
 #include "cluster_checks.h"
 #include "gdr/io.h"
+#include "gdr/procedural.h"
+#include "gdr/geometry.h"
 #include "gdr/scene.h"
 #include "io/io_internal.h"
-#include "scene/procedural_meshes.h"
+#include "procedural/procedural_meshes.h"
 #include "test_util.h"
 
 static uint8_t *read_whole(const char *path, size_t *size)

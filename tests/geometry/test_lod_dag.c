@@ -12,10 +12,11 @@
 #include "cluster_checks.h"
 #include "point_distance.h"
 #include "gdr/geometry.h"
+#include "gdr/procedural.h"
 #include "gdr/scene.h"
 #include "geometry/lod_cut.h"
 #include "geometry/lod_grid.h"
-#include "scene/procedural_meshes.h"
+#include "procedural/procedural_meshes.h"
 #include "test_util.h"
 
 /* --- meshes --------------------------------------------------------------------------------- */

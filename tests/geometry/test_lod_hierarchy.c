@@ -14,7 +14,7 @@
 #include "gdr/io.h"
 #include "gdr/scene.h"
 #include "geometry/lod_cut.h"
-#include "scene/procedural_meshes.h"
+#include "procedural/procedural_meshes.h"
 #include "test_util.h"
 
 #define ASSIMP_MODELS_DIR "/usr/share/assimp/models"

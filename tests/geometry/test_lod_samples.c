@@ -12,7 +12,7 @@
 #include "gdr/scene.h"
 #include "geometry/lod_internal.h"
 #include "point_distance.h"
-#include "scene/procedural_meshes.h"
+#include "procedural/procedural_meshes.h"
 #include "test_util.h"
 
 #define NONE UINT32_MAX

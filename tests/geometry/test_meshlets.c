@@ -11,8 +11,9 @@
 
 #include "cluster_checks.h"
 #include "gdr/io.h"
+#include "gdr/geometry.h"
 #include "gdr/scene.h"
-#include "scene/procedural_meshes.h"
+#include "procedural/procedural_meshes.h"
 #include "test_util.h"
 
 #define ASSIMP_MODELS_DIR "/usr/share/assimp/models"

@@ -1,11 +1,11 @@
 #version 460
-// test_hzb: the occlusion query of src/shaders/shared/occlusion_math.h in GLSL, and the one fetch
+// test_hzb: the occlusion query of src/gpu_shared/occlusion_math.h in GLSL, and the one fetch
 // through the pyramid's min-reduction sampler that a culling shader makes with it. One thread per
 // sphere; out: 8 uints per sphere (testable, level, x0, y0, x1, y1, fetched value, nearest depth).
 #extension GL_EXT_scalar_block_layout : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 
-#include "shared/occlusion_math.h"
+#include "gpu_shared/occlusion_math.h"
 
 layout(local_size_x = 64) in;
 

@@ -10,7 +10,7 @@
 #include <stdbool.h>
 
 #include "gdr/gdr.h"
-#include "shaders/shared/gpu_config.h"
+#include "gpu_shared/gpu_config.h"
 
 typedef struct ref_vec3 {
     double x, y, z;

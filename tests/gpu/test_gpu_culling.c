@@ -1,6 +1,7 @@
 /* GPU instance culling against the CPU reference, and culling never changing the picture. */
 #include <math.h>
 
+#include "gdr/io.h"
 #include "gpu_test_util.h"
 
 #define WIDTH 192

@@ -2,6 +2,7 @@
  * updates sent through the per-frame ring reach the GPU. */
 #include <math.h>
 
+#include "gdr/io.h"
 #include "gpu_test_util.h"
 
 #define WIDTH 160

@@ -8,9 +8,11 @@
  *    drawn fall with distance. */
 #include <math.h>
 
+#include "gdr/geometry.h"
+#include "gdr/io.h"
 #include "geometry/lod_cut.h"
 #include "gpu_test_util.h"
-#include "scene/procedural_meshes.h"
+#include "procedural/procedural_meshes.h"
 
 #define WIDTH 256
 #define HEIGHT 160

@@ -4,6 +4,7 @@
  * GdrGpuMesh (as uploaded) names its range and level count. Validation on: no message. */
 #include <string.h>
 
+#include "gdr/io.h"
 #include "gpu_test_util.h"
 #include "render/renderer_internal.h"
 

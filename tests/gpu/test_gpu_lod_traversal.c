@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gdr/geometry.h"
+#include "gdr/io.h"
 #include "gpu_test_util.h"
 
 #define WIDTH 192

@@ -11,9 +11,11 @@
  *    of a wall, occlusion culling on: the wall shows through the holes in every path. */
 #include <math.h>
 
+#include "gdr/geometry.h"
+#include "gdr/io.h"
 #include "gpu_test_util.h"
 #include "material_reference.h"
-#include "scene/procedural_meshes.h"
+#include "procedural/procedural_meshes.h"
 
 #define MODELS "/usr/share/assimp/models/glTF2/"
 /* Per channel, of 255: the GPU evaluates the same formulas in float, with 8-bit sRGB texture

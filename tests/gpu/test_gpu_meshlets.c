@@ -8,8 +8,10 @@
  *  - a device without mesh shaders falls back to the indirect pipeline and says why. */
 #include <math.h>
 
+#include "gdr/geometry.h"
+#include "gdr/io.h"
 #include "gpu_test_util.h"
-#include "shaders/shared/cull_math.h"
+#include "math/cull_math.h"
 
 #define WIDTH 192
 #define HEIGHT 108

@@ -9,6 +9,7 @@
  *  - the per-phase statistics add up. */
 #include <math.h>
 
+#include "gdr/procedural.h"
 #include "gpu_test_util.h"
 
 #define WIDTH 192

@@ -12,6 +12,8 @@
  *    visibility buffer is a clear error. */
 #include <math.h>
 
+#include "gdr/geometry.h"
+#include "gdr/io.h"
 #include "gpu_test_util.h"
 #include "render/visbuffer.h"
 

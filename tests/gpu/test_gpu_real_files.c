@@ -1,5 +1,6 @@
 /* Real third-party glTF files (Debian's assimp-testmodels) render to a plausible image: something
  * covers a sensible part of the frame, and culling does not change a pixel. */
+#include "gdr/io.h"
 #include "gpu_test_util.h"
 
 #define WIDTH 200

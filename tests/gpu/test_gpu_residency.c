@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gdr/io.h"
 #include "geometry/lod_cut.h"
 #include "gpu_test_util.h"
 

@@ -15,6 +15,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "gdr/geometry.h"
 #include "gdr/io.h"
 #include "gdr/paged_cache.h"
 #include "geometry/lod_cut.h"

@@ -11,6 +11,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "gdr/geometry.h"
 #include "gdr/io.h"
 #include "gdr/paged_cache.h"
 #include "gpu_test_util.h"

@@ -10,6 +10,8 @@
 
 #include <xxhash.h>
 
+#include "gdr/geometry.h"
+#include "gdr/procedural.h"
 #include "gdr/cull.h"
 #include "gdr/io.h"
 #include "geometry/cluster_checks.h"

@@ -12,6 +12,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "gdr/geometry.h"
 #include "gdr/io.h"
 #include "gdr/paged_cache.h"
 #include "test_util.h"

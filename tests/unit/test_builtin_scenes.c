@@ -3,6 +3,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gdr/procedural.h"
+#include "gdr/io.h"
 #include "gdr/scene.h"
 #include "test_util.h"
 

@@ -1,4 +1,4 @@
-/* The occlusion test math of src/shaders/shared/occlusion_math.h, against independent references
+/* The occlusion test math of src/gpu_shared/occlusion_math.h, against independent references
  * computed in double precision through the projection matrices and the viewport of include/gdr/math.h:
  *  - the screen rectangle contains the projection of points sampled on the sphere, and its bounds
  *    match the exact tangent angles;
@@ -11,7 +11,7 @@
 #include <stdlib.h>
 
 #include "gdr/math.h"
-#include "shaders/shared/occlusion_math.h"
+#include "gpu_shared/occlusion_math.h"
 #include "test_util.h"
 
 #define PI 3.14159265358979323846

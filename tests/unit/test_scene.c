@@ -1,6 +1,7 @@
 /* Scene model and the built-in procedural scene. */
 #include <string.h>
 
+#include "gdr/io.h"
 #include "gdr/scene.h"
 #include "test_util.h"
 

@@ -1,3 +1,4 @@
+#include "gdr/io.h"
 #include "cli_args.h"
 
 #include <errno.h>

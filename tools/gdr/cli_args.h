@@ -6,6 +6,7 @@
 #include <stdint.h>
 
 #include "gdr/renderer.h"
+#include "gdr/io.h"
 #include "gdr/scene.h"
 
 /* Each prints "gdr: OPTION VALUE: why" on failure and returns false. */

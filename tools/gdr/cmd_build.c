@@ -6,9 +6,10 @@
 #include <string.h>
 #include <time.h>
 
+#include "gdr/geometry.h"
 #include "cli_args.h"
 #include "commands.h"
-#include "core/thread_pool.h"
+#include "gdr/thread_pool.h"
 #include "gdr/cull.h"
 #include "gdr/io.h"
 #include "gdr/paged_cache.h"

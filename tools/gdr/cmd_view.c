@@ -7,6 +7,7 @@
 #define GLFW_INCLUDE_VULKAN
 #include <GLFW/glfw3.h>
 
+#include "gdr/io.h"
 #include "camera_path.h"
 #include "cli_args.h"
 #include "commands.h"

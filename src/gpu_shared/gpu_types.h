@@ -3,9 +3,9 @@
 #ifndef GDR_GPU_TYPES_H
 #define GDR_GPU_TYPES_H
 
-#include "glsl_c_bridge.h"
-#include "gpu_config.h"
-#include "occlusion_math.h"
+#include "math/glsl_c_bridge.h"
+#include "gpu_shared/gpu_config.h"
+#include "gpu_shared/occlusion_math.h"
 
 /* The reference types the structs below hold (GLSL defines them in glsl_buffers.h). */
 GDR_DECLARE_REF(FrameGlobalsRef)

@@ -4,7 +4,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "scene/demo_materials.h"
+#include "gdr/procedural.h"
+#include "procedural/demo_materials.h"
 
 #define SIDE 256
 #define PI_F 3.14159265f

@@ -2,7 +2,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "gdr/geometry.h"
+#include "gdr/mesh_clusters.h"
 
 void gdr_mesh_clusters_free(gdr_mesh_clusters *clusters)
 {

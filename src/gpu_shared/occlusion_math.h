@@ -22,7 +22,7 @@
 #ifndef GDR_OCCLUSION_MATH_H
 #define GDR_OCCLUSION_MATH_H
 
-#include "glsl_c_bridge.h"
+#include "math/glsl_c_bridge.h"
 
 #ifdef GDR_GLSL
 #define gdr_occ_floor floor

@@ -3,9 +3,11 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "gdr/geometry.h"
+#include "gdr/procedural.h"
 #include "gdr/scene.h"
-#include "scene/procedural_meshes.h"
-#include "scene/scene_random.h"
+#include "procedural/procedural_meshes.h"
+#include "procedural/scene_random.h"
 
 #define PI_F 3.14159265358979f
 #define FIELD_NEAR 4.0f                    /* depth of the first grid row, metres */

@@ -7,7 +7,7 @@
 #extension GL_EXT_scalar_block_layout : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 
-#include "gpu_types.h"
+#include "gpu_shared/gpu_types.h"
 
 layout(buffer_reference, scalar) readonly buffer FrameGlobalsRef { GdrGpuFrameGlobals value; };
 layout(buffer_reference, scalar) readonly buffer SceneRef { GdrGpuScene value; };

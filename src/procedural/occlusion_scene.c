@@ -4,9 +4,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "gdr/geometry.h"
+#include "gdr/procedural.h"
 #include "gdr/scene.h"
-#include "scene/procedural_meshes.h"
-#include "scene/scene_random.h"
+#include "procedural/procedural_meshes.h"
+#include "procedural/scene_random.h"
 
 #define PI_F 3.14159265358979f
 #define DEG(x) ((x) * PI_F / 180.0f)

@@ -1,4 +1,4 @@
-#include "scene/procedural_meshes.h"
+#include "procedural/procedural_meshes.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -5,6 +5,8 @@
 #include <string.h>
 
 #include "gdr/io.h"
+#include "gdr/geometry.h"
+#include "gdr/procedural.h"
 #include "gdr/scene.h"
 
 /* One option of a built-in scene: an integer in [min, max] or, with `number` set, a float whose

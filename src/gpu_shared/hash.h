@@ -3,7 +3,7 @@
 #ifndef GDR_HASH_H
 #define GDR_HASH_H
 
-#include "glsl_c_bridge.h"
+#include "math/glsl_c_bridge.h"
 
 GDR_SHARED_FN gdr_uint gdr_hash(gdr_uint x)
 {

@@ -3,8 +3,8 @@
 #ifndef GDR_LOD_MATH_H
 #define GDR_LOD_MATH_H
 
-#include "cull_math.h"
-#include "glsl_c_bridge.h"
+#include "math/cull_math.h"
+#include "math/glsl_c_bridge.h"
 
 /* Projected error in pixels of a group whose world-space sphere has centre `centre` and radius
  * `radius` and whose world-space error is `error`, seen from `camera`:

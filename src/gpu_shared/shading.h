@@ -2,7 +2,7 @@
 #ifndef GDR_SHADING_H
 #define GDR_SHADING_H
 
-#include "hash.h"
+#include "gpu_shared/hash.h"
 
 /* A directional light (the frame's light_direction), a sky/ground ambient term and a faint world
  * grid; returns sRGB-encoded colour. */

@@ -4,7 +4,7 @@
 #ifndef GDR_MATERIAL_FLAGS_H
 #define GDR_MATERIAL_FLAGS_H
 
-#include "glsl_buffers.h"
+#include "gpu_shared/glsl_buffers.h"
 
 /* MASK or BLEND: its fragments are alpha-tested, by the mesh shaders' raster only. */
 bool gdr_material_alpha_tested(uint frame_flags, uint material)

@@ -11,8 +11,8 @@
 #ifndef GDR_OCCLUSION_TEST_H
 #define GDR_OCCLUSION_TEST_H
 
-#include "occlusion_math.h"
-#include "task_queue.h" // the phases
+#include "gpu_shared/occlusion_math.h"
+#include "gpu_shared/task_queue.h" // the phases
 
 layout(set = 0, binding = 0) uniform sampler2D gdr_depth_pyramid;
 

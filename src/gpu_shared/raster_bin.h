@@ -4,8 +4,8 @@
 #ifndef GDR_RASTER_BIN_H
 #define GDR_RASTER_BIN_H
 
-#include "glsl_c_bridge.h"
-#include "gpu_types.h"
+#include "math/glsl_c_bridge.h"
+#include "gpu_shared/gpu_types.h"
 
 /* The compute rasteriser takes clusters whose projection stays within this many NDC units of the
  * centre (the viewport is [-1, 1]): fixed-point coordinates stay far from overflow. */
@@ -47,8 +47,8 @@ GDR_SHARED_FN bool gdr_raster_bin_sw(gdr_uint mode, float threshold_px, gdr_vec3
 }
 
 #ifdef GDR_GLSL
-#include "material_flags.h"
-#include "visbuffer.h"
+#include "gpu_shared/material_flags.h"
+#include "gpu_shared/visbuffer.h"
 
 /* The cluster cull (clustercull.comp), every invocation in uniform control flow, after the tests:
  * bins the invocation's cluster when visible and appends it to the frame's visible-cluster list,

@@ -7,7 +7,7 @@
 #include <stdint.h>
 
 #include "gdr/math.h"
-#include "shaders/shared/hash.h"
+#include "gpu_shared/hash.h"
 
 /* A number in [0, 1) for object `index`, property `channel` (below 8). */
 static inline float gdr_hash_unit(uint32_t seed, uint32_t index, uint32_t channel)

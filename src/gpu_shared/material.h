@@ -8,8 +8,8 @@
 #ifndef GDR_MATERIAL_H
 #define GDR_MATERIAL_H
 
-#include "glsl_buffers.h"
-#include "shading.h"
+#include "gpu_shared/glsl_buffers.h"
+#include "gpu_shared/shading.h"
 
 layout(set = GDR_TEXTURE_SET, binding = 0) uniform texture2D gdr_images[];
 layout(set = GDR_TEXTURE_SET, binding = 1) uniform sampler gdr_samplers[GDR_SAMPLER_SLOTS];

@@ -10,9 +10,9 @@
 #ifndef GDR_CLUSTER_CULL_H
 #define GDR_CLUSTER_CULL_H
 
-#include "task_queue.h" // the occlusion culling phases
-#include "material_flags.h"
-#include "residency.h"
+#include "gpu_shared/task_queue.h" // the occlusion culling phases
+#include "gpu_shared/material_flags.h"
+#include "gpu_shared/residency.h"
 
 
 // What the tests decided for one invocation's cluster.

@@ -3,7 +3,7 @@
 #ifndef GDR_CULL_MATH_H
 #define GDR_CULL_MATH_H
 
-#include "glsl_c_bridge.h"
+#include "math/glsl_c_bridge.h"
 
 /* Sphere (view-space centre c, radius r) against the symmetric frustum (i, j, k, l):
  *   left/right:  j*z >= |i*x| - r      bottom/top:  l*z >= |k*y| - r

@@ -4,10 +4,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gdr/geometry.h"
+#include "gdr/procedural.h"
 #include "gdr/scene.h"
-#include "scene/demo_materials.h"
-#include "scene/procedural_meshes.h"
-#include "scene/scene_random.h"
+#include "procedural/demo_materials.h"
+#include "procedural/procedural_meshes.h"
+#include "procedural/scene_random.h"
 
 #define PI_F 3.14159265358979f
 

@@ -6,8 +6,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "gdr/geometry.h"
+#include "gdr/procedural.h"
 #include "gdr/scene.h"
-#include "scene/scene_random.h"
+#include "procedural/scene_random.h"
 
 #define PI_F 3.14159265358979f
 #define UNIQUE_MAJOR 0.62f /* torus major radius before the waves, metres */
