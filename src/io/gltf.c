@@ -182,8 +182,9 @@ static void image_place(uint32_t image, const char *uri, const char *name, uint3
 
 /* Decodes an image within the import's budgets: its pixels, and as decoded bytes its mip chain
  * (kept by the scene) plus, for the time of the decoding, the RGBA8 copy and the decoder's own
- * memory (gdr_io_image_info.work_bytes), given back once the texture is made. A budget overrun is
- * returned in c->err (*refused); any other failure in *image_err (the texture is left out). */
+ * memory (gdr_io_image_info.work_bytes), given back once decoding is over (a failed image's chain
+ * stays counted, as its pixels do). A budget overrun is returned in c->err (*refused); any other
+ * failure in *image_err (the texture is left out). */
 static gdr_status decode_image(gltf_ctx *c, const uint8_t *bytes, size_t size, const char *place, uint8_t **rgba,
                                gdr_io_image_info *info, uint64_t *transient, bool *refused, gdr_error *image_err)
 {
