@@ -117,7 +117,8 @@ GDR_API gdr_status gdr_import_obj_memory(const void *data, size_t size, const ch
                                          const gdr_import_options *options, gdr_scene **out,
                                          gdr_import_result *result, gdr_error *err);
 
-/* Decodes a PNG or JPEG (anything stb_image reads) into RGBA8. *out_rgba is malloc'ed. */
+/* Decodes a PNG or JPEG (told by its signature; other formats are refused) into RGBA8, within
+ * GDR_DEFAULT_MAX_DECODED_BYTES of decoder memory besides the result. *out_rgba is malloc'ed. */
 GDR_API gdr_status gdr_image_decode(const void *data, size_t size, const char *name, uint8_t **out_rgba,
                                     uint32_t *out_width, uint32_t *out_height, gdr_error *err);
 

@@ -38,3 +38,8 @@ gdr_status gdr_io_budget_take(gdr_io_budget *b, gdr_io_budget_kind kind, uint64_
     b->used[kind] = used + amount;
     return GDR_OK;
 }
+
+void gdr_io_budget_give(gdr_io_budget *b, gdr_io_budget_kind kind, uint64_t amount)
+{
+    b->used[kind] -= amount < b->used[kind] ? amount : b->used[kind];
+}

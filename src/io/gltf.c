@@ -2,6 +2,7 @@
  * gltf_buffers.c; this file walks the document: extensions, materials, textures, meshes, the
  * node tree and cameras. */
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -160,6 +161,53 @@ static gdr_status check_asset_and_extensions(gltf_ctx *c)
 
 /* --- materials and textures ------------------------------------------------------------------ */
 
+/* "images[3] (textures/wood.png)": the index and what the image is, its URI (a data: URI is not
+ * quoted), else its name, else its buffer view; characters that are not printable ASCII become '?'. */
+static void image_place(uint32_t image, const char *uri, const char *name, uint32_t view, char *out, size_t size)
+{
+    char what[80];
+    if (uri && strncmp(uri, "data:", 5) == 0)
+        snprintf(what, sizeof what, "a data: URI");
+    else if (uri || name)
+        snprintf(what, sizeof what, "%.*s%s", 64, uri ? uri : name, strlen(uri ? uri : name) > 64 ? "..." : "");
+    else if (view != GDR_NO_INDEX)
+        snprintf(what, sizeof what, "bufferView %u", view);
+    else
+        snprintf(what, sizeof what, "no data");
+    for (char *p = what; *p; p++)
+        if ((unsigned char)*p < 32 || (unsigned char)*p > 126)
+            *p = '?';
+    snprintf(out, size, "images[%u] (%s)", image, what);
+}
+
+/* Decodes an image within the import's budgets: its pixels, and as decoded bytes its mip chain
+ * (kept by the scene) plus, for the time of the decoding, the RGBA8 copy and the decoder's own
+ * memory (gdr_io_image_info.work_bytes), given back once decoding is over (a failed image's chain
+ * stays counted, as its pixels do). A budget overrun is returned in c->err (*refused); any other
+ * failure in *image_err (the texture is left out). */
+static gdr_status decode_image(gltf_ctx *c, const uint8_t *bytes, size_t size, const char *place, uint8_t **rgba,
+                               gdr_io_image_info *info, uint64_t *transient, bool *refused, gdr_error *image_err)
+{
+    char label[GDR_ERROR_MESSAGE_MAX];
+    snprintf(label, sizeof label, "%s: %s", c->name, place);
+    *transient = 0;
+    *refused = false;
+    gdr_status status = gdr_io_image_probe(bytes, size, label, info, image_err);
+    if (status != GDR_OK)
+        return status;
+    uint64_t pixels = (uint64_t)info->width * info->height;
+    uint64_t kept = gdr_texture_level_offset(info->width, info->height,
+                                             gdr_texture_level_count(info->width, info->height));
+    if (gdr_io_budget_take(&c->budget, GDR_BUDGET_TEXTURE_PIXELS, pixels, c->name, place, c->err) != GDR_OK ||
+        gdr_io_budget_take(&c->budget, GDR_BUDGET_DECODED_BYTES, kept + pixels * 4 + info->work_bytes, c->name,
+                           place, c->err) != GDR_OK) {
+        *refused = true; /* over a budget: refused, not left out, so that the user learns why */
+        return c->err->status;
+    }
+    *transient = pixels * 4 + info->work_bytes;
+    return gdr_io_image_decode(bytes, size, label, info, rgba, image_err);
+}
+
 static gdr_status load_image(gltf_ctx *c, uint32_t image, int srgb, uint32_t *out)
 {
     *out = GDR_NO_INDEX;
@@ -170,7 +218,7 @@ static gdr_status load_image(gltf_ctx *c, uint32_t image, int srgb, uint32_t *ou
         *out = *slot;
         return GDR_OK;
     }
-    char here[48];
+    char here[32], described[128]; /* "images[3]"; "images[3] (textures/wood.png)" */
     snprintf(here, sizeof here, "images[%u]", image);
     const cJSON *json = c->image_at[image];
     const char *uri = NULL, *name = NULL;
@@ -182,6 +230,7 @@ static gdr_status load_image(gltf_ctx *c, uint32_t image, int srgb, uint32_t *ou
         status = gltf_get_uint(c, json, "bufferView", here, 0, UINT32_MAX - 1, &view_index);
     if (status != GDR_OK)
         return status;
+    image_place(image, uri, name, view_index, described, sizeof described);
     uint8_t *owned = NULL;
     const uint8_t *bytes = NULL;
     size_t size = 0;
@@ -203,30 +252,31 @@ static gdr_status load_image(gltf_ctx *c, uint32_t image, int srgb, uint32_t *ou
     }
     c->err = saved;
     uint8_t *rgba = NULL;
-    uint32_t width = 0, height = 0;
-    char label[96];
-    snprintf(label, sizeof label, "%s: %s", c->name, here);
-    if (status == GDR_OK)
-        status = gdr_io_image_size(bytes, size, label, &width, &height, &image_err);
-    if (status == GDR_OK &&
-        gdr_io_budget_take(&c->budget, GDR_BUDGET_TEXTURE_PIXELS, (uint64_t)width * height, c->name, here, c->err) !=
-            GDR_OK) {
-        free(owned);
-        return c->err->status; /* over the budget: refused, not left out, so that the user learns why */
+    gdr_io_image_info info = {0};
+    uint64_t transient = 0;
+    bool refused = false;
+    if (status == GDR_OK) {
+        status = decode_image(c, bytes, size, described, &rgba, &info, &transient, &refused, &image_err);
+        if (refused) {
+            free(owned);
+            return status;
+        }
     }
-    if (status == GDR_OK)
-        status = gdr_image_decode(bytes, size, label, &rgba, &width, &height, &image_err);
     free(owned);
     if (status == GDR_OK) {
         char texture_name[GDR_NAME_MAX];
-        snprintf(texture_name, sizeof texture_name, "%s", name ? name : uri && strncmp(uri, "data:", 5) ? uri : here);
-        status = gdr_scene_add_texture(c->scene, texture_name, width, height, rgba, (uint32_t)srgb, out, c->err);
+        snprintf(texture_name, sizeof texture_name, "%s",
+                 name ? name : uri && strncmp(uri, "data:", 5) ? uri : here);
+        status = gdr_scene_add_texture(c->scene, texture_name, info.width, info.height, rgba, (uint32_t)srgb, out,
+                                       c->err);
         free(rgba);
+        gdr_io_budget_give(&c->budget, GDR_BUDGET_DECODED_BYTES, transient);
         if (status != GDR_OK)
             return status;
         *slot = *out;
         return GDR_OK;
     }
+    gdr_io_budget_give(&c->budget, GDR_BUDGET_DECODED_BYTES, transient);
     if (status == GDR_ERROR_OUT_OF_MEMORY)
         return gdr_error_set(c->err, status, "%s", image_err.message);
     gdr_io_warn(&c->warnings, "%s (texture left out)", image_err.message);

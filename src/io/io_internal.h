@@ -60,6 +60,8 @@ void gdr_io_budget_init(gdr_io_budget *b, const gdr_budget *limits);
  * the place, the budget and how to raise it (GDR_ERROR_CAPACITY). */
 gdr_status gdr_io_budget_take(gdr_io_budget *b, gdr_io_budget_kind kind, uint64_t amount, const char *name,
                               const char *place, gdr_error *err);
+/* Gives back `amount` taken before for memory that has been freed since (an image's decoding). */
+void gdr_io_budget_give(gdr_io_budget *b, gdr_io_budget_kind kind, uint64_t amount);
 
 /* mesh_clean.c: positions all finite and within GDR_IO_MAX_COORDINATE, else an error naming the
  * file (`name`), the place and the vertex. */
@@ -81,10 +83,27 @@ gdr_status gdr_io_split_shared_vertices(gdr_vec3 **positions, gdr_vec3 **normals
  * without them): what gdr_scene_build_clusters then gets is clean. */
 gdr_status gdr_io_clean_unclustered_meshes(gdr_scene *scene, const char *name, gdr_error *err);
 
-/* An image's size from its header (PNG, JPEG, anything stb_image reads), without decoding it;
- * refused when a side exceeds the decoder's limit. */
-gdr_status gdr_io_image_size(const void *data, size_t size, const char *name, uint32_t *width, uint32_t *height,
-                             gdr_error *err);
+/* Images: PNG and JPEG only (what glTF allows), told apart by their signature (image.c). */
+typedef enum gdr_io_image_format { GDR_IO_IMAGE_PNG = 1, GDR_IO_IMAGE_JPEG = 2 } gdr_io_image_format;
+
+typedef struct gdr_io_image_info {
+    gdr_io_image_format format;
+    uint32_t width, height;
+    /* What the decoder may allocate besides the RGBA8 result (rows, a progressive JPEG's
+     * coefficients); decoding is refused when it would need more. */
+    uint64_t work_bytes;
+} gdr_io_image_info;
+
+/* An image's format, size and decoding memory from its headers, without decoding it: anything
+ * but a PNG or JPEG signature is refused, naming the format where it is a known one, and so is a
+ * side above GDR_IO_IMAGE_MAX_SIDE. `name` starts every message. */
+#define GDR_IO_IMAGE_MAX_SIDE 16384u
+gdr_status gdr_io_image_probe(const void *data, size_t size, const char *name, gdr_io_image_info *info,
+                              gdr_error *err);
+/* Decodes what gdr_io_image_probe described into *out_rgba (malloc'ed, width x height x 4),
+ * within info->work_bytes of working memory. */
+gdr_status gdr_io_image_decode(const void *data, size_t size, const char *name, const gdr_io_image_info *info,
+                               uint8_t **out_rgba, gdr_error *err);
 
 /* gdr_cache_read for the cache of `source` (NULL: a cache read on its own): the cache must
  * record that file as the first of its sources, with the same size and contents (its folder may
