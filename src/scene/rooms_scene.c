@@ -241,9 +241,9 @@ static gdr_status add_cameras(rooms_builder *b, gdr_error *err)
     uint32_t middle = (b->rows / 2) * b->columns + b->columns / 2;
     middle = middle < b->desc.rooms ? middle : 0;
     gdr_camera cameras[3] = {
-        room_camera(b, 0, "first-room", (gdr_vec3){0.0f, 0.0f, ROOM_HALF - 1.0f}, 0.0f),
+        room_camera(b, 0, "first-room", (gdr_vec3){0.0f, 0.0f, ROOM_HALF - 1.3f}, 0.0f),
         room_camera(b, middle, "middle", (gdr_vec3){-ROOM_HALF + 1.0f, 0.0f, 0.3f}, -0.5f * PI_F),
-        room_camera(b, 0, "corner", (gdr_vec3){-ROOM_HALF + 0.8f, 0.0f, ROOM_HALF - 0.8f}, -0.25f * PI_F),
+        room_camera(b, 0, "corner", (gdr_vec3){-ROOM_HALF + 1.6f, 0.0f, ROOM_HALF - 1.6f}, -0.25f * PI_F),
     };
     gdr_status status = GDR_OK;
     for (int i = 0; i < 3 && status == GDR_OK; i++)
