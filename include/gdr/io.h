@@ -209,8 +209,8 @@ GDR_API gdr_status gdr_scene_load_file(const char *path, const gdr_load_options 
 
 /* --- Loading: the one way from a name to a scene -------------------------------------------- */
 
-/* True when `spec` names a built-in scene ("demo", "lod-field", "occlusion", "unique-field", alone or followed by
- * ":options"), which gdr_scene_load builds instead of reading a file. */
+/* True when `spec` names a built-in scene ("demo", "lod-field", "occlusion", "unique-field", "rooms", alone or
+ * followed by ":options"), which gdr_scene_load builds instead of reading a file. */
 GDR_API bool gdr_scene_spec_is_builtin(const char *spec);
 
 /* Loads a scene from a specification, a built-in scene with its level-0 clusters and LOD DAG:
@@ -218,6 +218,7 @@ GDR_API bool gdr_scene_spec_is_builtin(const char *spec);
  *     "lod-field[:instances=N,seed=S,triangles=T,spacing=X]" gdr_scene_create_lod_field
  *     "occlusion[:seed=S,hidden=N,visible=N]"               gdr_scene_create_occlusion
  *     "unique-field[:meshes=M,seed=S,triangles=T,spacing=X]" gdr_scene_create_unique_field
+ *     "rooms[:rooms=N,seed=S,objects=K]"                    gdr_scene_create_rooms
  * (options in any order, each at most once; values as in the desc, 0 refused), or a file path of
  * a supported format. Source files (.gltf, .glb, .obj) go through the processed-scene cache unless
  * options->no_cache; a .gdrc file is read directly. options: NULL for the defaults. */

@@ -121,6 +121,33 @@ GDR_API gdr_status gdr_scene_create_occlusion(const gdr_occlusion_scene_desc *de
  * The camera never enters a building or an object; yfov 60 degrees, znear 0.1, infinite far. */
 GDR_API gdr_camera gdr_scene_occlusion_camera_path(uint32_t frame, bool *camera_cut);
 
+/* The rooms scene (docs/SCENES.md), made for precomputed visibility: `rooms` rooms of 8 m x 8 m on
+ * a square grid (columns = ceil(sqrt(rooms)), room k at column k % columns, row k / columns, rows
+ * going towards -Z, 12.6 m apart), walls 0.3 m thick and 3 m high, joined into a maze by corridors
+ * 4 m long and 1.4 m wide (a random spanning tree of the grid: one way between any two rooms,
+ * doorways at random places along the walls), so that walls hide most rooms from any point.
+ * Instances, in order:
+ *   [0]                       the ground under the whole grid (mesh "ground")
+ *   [1, ..)                   the rooms' walls, room after room (mesh "wall", a 2 m cube scaled): a
+ *                             side without a doorway is one box, a side with one two boxes
+ *   [.., ..)                  the corridors' side walls, two per corridor (mesh "wall")
+ *   [.., + rooms x objects)   the last instances: `objects` props per room (meshes "sphere", "torus",
+ *                             "box"), room after room, on a jittered grid over its floor, at most
+ *                             0.92 m high, 0.6 m or more from its walls
+ * Cameras at 1.6 m: 0 "first-room" (room 0, looking -Z across the grid), 1 "middle" (the middle
+ * room, looking +X), 2 "corner" (room 0, looking diagonally into the grid). Deterministic: the same
+ * desc gives the same bytes. gdr_scene_create_rooms builds level-0 clusters; gdr_scene_load("rooms...")
+ * also builds the LOD DAG. */
+#define GDR_ROOMS_MAX 4096u
+#define GDR_ROOMS_MAX_OBJECTS 1000u
+typedef struct gdr_rooms_scene_desc {
+    uint32_t rooms;   /* 0: 16; at most GDR_ROOMS_MAX */
+    uint32_t seed;    /* 0: 1 */
+    uint32_t objects; /* props per room; 0: 24; at most GDR_ROOMS_MAX_OBJECTS */
+} gdr_rooms_scene_desc;
+
+GDR_API gdr_status gdr_scene_create_rooms(const gdr_rooms_scene_desc *desc, gdr_scene **out, gdr_error *err);
+
 #ifdef __cplusplus
 }
 #endif

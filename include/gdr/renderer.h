@@ -18,6 +18,7 @@ extern "C" {
 #endif
 
 typedef struct gdr_renderer gdr_renderer;
+typedef struct gdr_pvs gdr_pvs; /* precomputed visibility (gdr/cull.h) */
 
 typedef struct gdr_renderer_desc {
     uint32_t width, height; /* render target size; 0: 1280 x 720 */
@@ -145,6 +146,11 @@ typedef struct gdr_frame_desc {
      * (the depth pyramid is the drawing camera's), and the hybrid rasteriser's per-cluster choice
      * is made for the culling camera. */
     const gdr_camera *cull_camera;
+    /* Precomputed visibility (gdr_renderer_set_pvs; docs/CULLING.md): instances that the baked cell
+     * holding the culling camera does not list are not drawn, in every pipeline, when cull is on.
+     * DEFAULT: on when the renderer holds a PVS; ON without one is an error; OFF: not used. A camera
+     * in no baked cell culls nothing by it. */
+    gdr_cull_mode pvs;
 } gdr_frame_desc;
 
 /* "shaded", "meshlets", "instances", "triangles", "overdraw" or "lod". */
@@ -265,6 +271,20 @@ typedef struct gdr_memory_stats {
     uint64_t frame_bytes;
 } gdr_memory_stats;
 
+/* Precomputed visibility, last frame: whether the frame used it (the renderer holds a PVS, the
+ * frame did not switch it or culling off), whether the culling camera was in a baked cell (only
+ * then does it cull), the instances it removed (valid and in the frustum, not listed by the cell;
+ * each culled instance is counted by the first test that culls it: invalid, frustum, PVS, screen
+ * size, clip plane), and the CPU time of the cell's lookup and upload (GPU-driven pipelines) or of
+ * nothing more than the CPU cull already counts (CPU pipeline: 0), mean per frame. */
+typedef struct gdr_pvs_stats {
+    bool enabled;
+    bool cell_found;
+    uint32_t instances_culled;
+    uint32_t cells;   /* baked cells of the PVS held */
+    double cpu_ms_per_frame;
+} gdr_pvs_stats;
+
 typedef struct gdr_frame_stats {
     uint32_t frames;
     uint32_t instances_total;
@@ -312,6 +332,7 @@ typedef struct gdr_frame_stats {
     gdr_traversal_stats traversal;
     gdr_streaming_stats streaming;
     gdr_memory_stats memory;
+    gdr_pvs_stats pvs;
 } gdr_frame_stats;
 
 GDR_API gdr_status gdr_renderer_create(const gdr_renderer_desc *desc, gdr_renderer **out, gdr_error *err);
@@ -320,6 +341,16 @@ GDR_API void gdr_renderer_destroy(gdr_renderer *renderer);
 /* Uploads the scene's geometry into the geometry pool and its instances into the instance buffer.
  * The renderer keeps no pointer into `scene`. */
 GDR_API gdr_status gdr_renderer_set_scene(gdr_renderer *renderer, const gdr_scene *scene, gdr_error *err);
+
+/* Precomputed visibility for the scene set (docs/CULLING.md, "Precomputed visibility in the
+ * frame"): a PVS baked for this scene (gdr_pvs_bake, or read from its cache: gdr_scene_load_file's
+ * out_pvs), whose object i is instance i. Frames then cull, by default, the instances that the
+ * baked cell holding the culling camera does not list; instances moved with
+ * gdr_renderer_update_instance since the scene was set are never culled by it. The renderer keeps
+ * the pointer: `pvs` must stay alive until the renderer is destroyed or another call replaces it;
+ * NULL removes it. Fails (and keeps the PVS it held) without a scene, or when the PVS's object
+ * count is not the scene's instance count. */
+GDR_API gdr_status gdr_renderer_set_pvs(gdr_renderer *renderer, const gdr_pvs *pvs, gdr_error *err);
 
 /* Streaming (docs/STREAMING.md): the clusters' vertices and triangles live in a page pool of fixed
  * size instead of being uploaded whole; the pages of a paged cache of the same scene are read by a

@@ -345,9 +345,10 @@ GDR_STRUCT_BEGIN(GdrGpuDrawStats)
     gdr_uint instances_invalid;
     gdr_uint instances_screen_size_culled;
     gdr_uint instances_clip_plane_culled;
+    gdr_uint instances_pvs_culled;  /* valid, in the frustum, not listed by the camera's PVS cell */
 GDR_STRUCT_END(GdrGpuDrawStats)
 GDR_ASSERT_SIZE(GdrGpuDrawStats, 64 + 8 * GDR_LOD_STATS_DEPTHS + 96 + 32 * GDR_LOD_TREE_LEVELS + 32 + 32 +
-                                     4 * GDR_LOD_TREE_LEVELS);
+                                     4 * GDR_LOD_TREE_LEVELS + 4);
 GDR_ASSERT_OFFSET(GdrGpuDrawStats, draw_count, 0);
 GDR_ASSERT_OFFSET(GdrGpuDrawStats, task_groups_x, 16);
 
@@ -389,8 +390,11 @@ GDR_STRUCT_BEGIN(GdrGpuFrameBuffers)
     GDR_REF(StreamRequestsRef) stream_requests; /* GdrGpuStreamRequest[GDR_STREAM_REQUEST_CAPACITY], read by the host */
     GDR_REF(WritableUintsRef) used_groups;    /* streaming frames: page-table index of each group the cut drew,
                                                  once (room for every group), read by the host */
+    /* GDR_FRAME_PVS: the instances the culling camera's precomputed-visibility cell lists (bit i of
+     * word i / 32: instance i may be seen), host-written per frame */
+    GDR_REF(UintsRef) pvs_visible;
 GDR_STRUCT_END(GdrGpuFrameBuffers)
-GDR_ASSERT_SIZE(GdrGpuFrameBuffers, 104);
+GDR_ASSERT_SIZE(GdrGpuFrameBuffers, 112);
 
 /* Per-frame constants, written by the CPU into its frame's slot. */
 GDR_STRUCT_BEGIN(GdrGpuFrameGlobals)
@@ -451,6 +455,7 @@ GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, viewport, 208);
 #define GDR_FRAME_DOUBLE_SIDED 8192u   /* some material is double-sided: back faces are culled per material */
 #define GDR_FRAME_VERTEX_COLORS 16384u /* some mesh has vertex colours (GdrGpuScene.vertex_colors) */
 #define GDR_FRAME_PARTIAL_RESIDENCY 2048u /* some LOD group is absent: read the page table (shared/residency.h) */
+#define GDR_FRAME_PVS 32768u          /* the instance cull drops instances GdrGpuFrameBuffers.pvs_visible does not list */
 #define GDR_FRAME_DIRECT_CLUSTERS 1024u /* visibility-buffer modes: the instance cull tests the clusters of an
                                            instance that needs at most GDR_DIRECT_CLUSTERS of them and bins
                                            them itself, instead of a task command for the cluster cull */

@@ -72,15 +72,15 @@ static gdr_status parse_options(const char *scene, const char *text, const scene
 }
 
 typedef enum builtin_scene {
-    BUILTIN_NONE, BUILTIN_DEMO, BUILTIN_LOD_FIELD, BUILTIN_OCCLUSION, BUILTIN_UNIQUE_FIELD
+    BUILTIN_NONE, BUILTIN_DEMO, BUILTIN_LOD_FIELD, BUILTIN_OCCLUSION, BUILTIN_UNIQUE_FIELD, BUILTIN_ROOMS
 } builtin_scene;
 
-static const char *const builtin_names[] = {NULL, "demo", "lod-field", "occlusion", "unique-field"};
+static const char *const builtin_names[] = {NULL, "demo", "lod-field", "occlusion", "unique-field", "rooms"};
 
 /* Which built-in scene `spec` names, and where its options start ("" when there are none). */
 static builtin_scene find_builtin(const char *spec, const char **options)
 {
-    for (int b = BUILTIN_DEMO; b <= BUILTIN_UNIQUE_FIELD; b++) {
+    for (int b = BUILTIN_DEMO; b <= BUILTIN_ROOMS; b++) {
         size_t n = strlen(builtin_names[b]);
         if (strncmp(spec, builtin_names[b], n) == 0 && (spec[n] == '\0' || spec[n] == ':')) {
             *options = spec[n] ? spec + n + 1 : "";
@@ -126,6 +126,14 @@ static gdr_status create_builtin(builtin_scene which, const char *text, gdr_scen
                             {"spacing", NULL, &d.spacing, 0, 0}};
         status = parse_options(name, text, o, 4, err);
         return status == GDR_OK ? gdr_scene_create_unique_field(&d, out, err) : status;
+    }
+    if (which == BUILTIN_ROOMS) {
+        gdr_rooms_scene_desc d = {0};
+        scene_option o[] = {{"rooms", &d.rooms, NULL, 1, GDR_ROOMS_MAX},
+                            {"seed", &d.seed, NULL, 1, 16000000},
+                            {"objects", &d.objects, NULL, 1, GDR_ROOMS_MAX_OBJECTS}};
+        status = parse_options(name, text, o, 3, err);
+        return status == GDR_OK ? gdr_scene_create_rooms(&d, out, err) : status;
     }
     gdr_occlusion_scene_desc d = {0};
     scene_option o[] = {{"seed", &d.seed, NULL, 1, 16000000},

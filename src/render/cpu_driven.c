@@ -1,5 +1,5 @@
 /* The CPU-driven baseline (seed 003's "before"): every frame the CPU culls the instances
- * with the gdr/cull.h library (octree, frustum planes) and records, per visible instance, seed 003's
+ * with the gdr/cull.h library (octree, frustum planes, the precomputed visibility) and records, per visible instance, seed 003's
  * six commands: its own binds (pipeline, vertex buffer, index buffer, descriptor set, push
  * constants) and one vkCmdDrawIndexed. It exists to be
  * measured against the GPU-driven pipelines on the same scene and camera, and to draw the same image. */
@@ -65,6 +65,8 @@ static gdr_status build_cull_scene(gdr_renderer *r, gdr_error *err)
         const GdrGpuInstance *instance = &r->scene.cpu_instances[i];
         const gdr_cull_mesh_bounds *b = instance->mesh < cpu->mesh_count ? &cpu->mesh_bounds[instance->mesh] : &none;
         objects[i] = gdr_cull_object_from_mesh_bounds(b, &instance->model);
+        if (gdr_render_pvs_is_moved(r, i)) /* the precomputed visibility does not know where it is */
+            objects[i].flags |= GDR_CULL_OBJECT_DYNAMIC;
         objects[i].min_screen_size = instance->min_screen_size;
         objects[i].max_screen_size = instance->max_screen_size;
     }
@@ -89,6 +91,8 @@ gdr_status gdr_cpu_path_update_instance(gdr_renderer *r, uint32_t index, gdr_err
         return GDR_OK; /* built from the current transforms when first used */
     const GdrGpuInstance *instance = &r->scene.cpu_instances[index];
     gdr_cull_object object = object_from_instance(instance, &r->scene.cpu_meshes[instance->mesh]);
+    if (gdr_render_pvs_is_moved(r, index))
+        object.flags |= GDR_CULL_OBJECT_DYNAMIC;
     return gdr_cull_scene_update(r->cpu.cull_scene, index, 1, &object, err);
 }
 
@@ -102,18 +106,22 @@ gdr_status gdr_cpu_path_cull(gdr_renderer *r, const gdr_frame_desc *frame, gdr_e
     }
     double start = gdr_now_ms();
     gdr_status status = GDR_OK;
+    gdr_cull_stats cull_stats = {0};
     if (frame->cull == GDR_CULL_OFF) { /* nothing culled: every instance with something to draw */
         memset(cpu->visible_bits, 0, sizeof(uint32_t) * gdr_cull_word_count(r->scene.instance_count));
         for (uint32_t i = 0; i < r->scene.instance_count; i++)
             if (r->scene.cpu_meshes[r->scene.cpu_instances[i].mesh].index_count > 0)
                 cpu->visible_bits[i / 32] |= 1u << (i % 32);
     } else {
-        gdr_cull_view view = {.min_screen_size = frame->min_screen_size, .clip_plane = frame->clip_plane};
+        gdr_cull_view view = {.min_screen_size = frame->min_screen_size, .clip_plane = frame->clip_plane,
+                              .visibility = gdr_render_pvs_wanted(r, frame) ? r->pvs.cache : NULL};
         gdr_frame_matrices(r, frame->cull_camera ? frame->cull_camera : &frame->camera, &view.projection,
                            &view.view);
         gdr_cull_result result = {.visible = cpu->visible_bits};
-        status = gdr_cull_execute(cpu->cull_scene, &view, NULL, &result, NULL, err);
+        status = gdr_cull_execute(cpu->cull_scene, &view, NULL, &result, &cull_stats, err);
     }
+    cpu->pvs_culled = cull_stats.precomputed;
+    cpu->pvs_cell_found = cull_stats.visibility_cell_found;
     if (status != GDR_OK)
         return status;
     uint32_t count = 0;

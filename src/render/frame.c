@@ -28,7 +28,7 @@ static GdrGpuFrameBuffers frame_buffers(const gdr_renderer *r, const gdr_frame_s
         .occluded_instances = r->occlusion.occluded_instances.address,
         .occluded_nodes = r->occlusion.occluded_nodes.address, .retest_masks = r->occlusion.retest_masks.address,
         .stream_requests = slot->stream_requests.address,
-        .used_groups = slot->used_groups.address};
+        .used_groups = slot->used_groups.address, .pvs_visible = slot->pvs_visible.address};
 }
 
 static uint32_t frame_flags(const gdr_frame_desc *frame, bool lod, bool occlusion, bool history, bool hierarchy)
@@ -81,6 +81,7 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
                  (r->materials.scene_flags & GDR_MATERIALS_MASKED ? GDR_FRAME_ALPHA_TEST : 0u) |
                  (r->materials.scene_flags & GDR_MATERIALS_DOUBLE_SIDED ? GDR_FRAME_DOUBLE_SIDED : 0u) |
                  (r->materials.scene_flags & GDR_MATERIALS_VERTEX_COLORS ? GDR_FRAME_VERTEX_COLORS : 0u) |
+                 (slot->pvs_cell_found && pipeline != GDR_PIPELINE_CPU ? GDR_FRAME_PVS : 0u) |
                  (pipeline == GDR_PIPELINE_MESH && r->vis.mode != GDR_GPU_RASTER_FORWARD ? GDR_FRAME_DIRECT_CLUSTERS
                                                                                         : 0u),
         .view_mode = (uint32_t)frame->view,

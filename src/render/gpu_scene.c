@@ -482,6 +482,10 @@ gdr_status gdr_frame_slots_create(gdr_renderer *r, gdr_error *err)
             status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuStreamRequest) * GDR_STREAM_REQUEST_CAPACITY,
                                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GDR_VK_BUFFER_READBACK,
                                           &slot->stream_requests, err);
+        if (status == GDR_OK) /* a bit per instance */
+            status = gdr_vk_buffer_create(&r->allocator, sizeof(uint32_t) * (instances / 32 + 1),
+                                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GDR_VK_BUFFER_UPLOAD, &slot->pvs_visible,
+                                          err);
         if (status == GDR_OK) /* each group once at most: cannot overflow */
             status = gdr_vk_buffer_create(&r->allocator, sizeof(uint32_t) * (r->scene.group_total ? r->scene.group_total : 1),
                                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GDR_VK_BUFFER_READBACK,
@@ -518,6 +522,7 @@ void gdr_frame_slots_destroy(gdr_renderer *r)
         gdr_vk_buffer_destroy(r->ctx, &slot->tasks);
         gdr_vk_buffer_destroy(r->ctx, &slot->stream_requests);
         gdr_vk_buffer_destroy(r->ctx, &slot->used_groups);
+        gdr_vk_buffer_destroy(r->ctx, &slot->pvs_visible);
         gdr_vk_buffer_destroy(r->ctx, &slot->stream_staging);
         if (slot->stream_cmd)
             vkFreeCommandBuffers(r->ctx->device, r->ctx->command_pool, 1, &slot->stream_cmd);

@@ -127,6 +127,7 @@ void gdr_renderer_destroy(gdr_renderer *r)
         gdr_gpu_scene_destroy(r);
         gdr_streaming_destroy(r);
         gdr_cpu_path_destroy(r);
+        gdr_render_pvs_destroy(r);
         gdr_visbuffer_destroy(r);
         VkDevice device = r->ctx->device;
         if (r->timestamps)
@@ -176,6 +177,8 @@ static gdr_status set_scene(gdr_renderer *r, const gdr_scene *scene, const gdr_s
     if (status == GDR_OK)
         status = gdr_cpu_path_create(r, scene, err);
     if (status == GDR_OK)
+        status = gdr_render_pvs_scene(r, err);
+    if (status == GDR_OK)
         status = gdr_visbuffer_set_scene(r, err);
     if (status == GDR_OK)
         status = gdr_occlusion_scene_create(r, err);
@@ -217,8 +220,10 @@ gdr_status gdr_renderer_update_instance(gdr_renderer *r, uint32_t index, const g
         g->pending_capacity = capacity;
     }
     GdrGpuInstance *instance = &g->cpu_instances[index];
-    if (transform)
+    if (transform) {
         instance->model = *transform;
+        gdr_render_pvs_moved(r, index); /* the PVS was baked where it stood */
+    }
     if (color)
         instance->color = *color;
     g->pending[g->pending_count++] = (GdrGpuInstanceUpdate){.tag = GDR_UPDATE_TAG_INSTANCE, .index = index,
@@ -313,6 +318,11 @@ static gdr_status check_frame(gdr_renderer *r, const gdr_frame_desc *frame, uint
     for (int i = 0; i < 4; i++)
         if (!isfinite(plane[i]))
             return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: clip_plane must be finite");
+    if ((unsigned)frame->pvs > GDR_CULL_OFF)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: unknown pvs mode %d", (int)frame->pvs);
+    if (frame->pvs == GDR_CULL_ON && !r->pvs.pvs)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: pvs on, but the renderer holds no precomputed "
+                             "visibility (gdr_renderer_set_pvs; gdr build --pvs writes it into a scene's cache)");
     gdr_status status = resolve_pipeline(r, frame, pipeline, reason, reason_size, err);
     /* Streamed geometry is drawn only through the LOD cut over resident groups. */
     if (status == GDR_OK && r->scene.streamed && (*pipeline != GDR_PIPELINE_MESH || frame->lod_fixed_depth ||
@@ -341,6 +351,7 @@ static gdr_status run_frame(gdr_renderer *r, const gdr_frame_desc *frame, gdr_pi
     if (status != GDR_OK)
         return status;
     double start = gdr_now_ms();
+    gdr_render_pvs_begin_frame(r, slot, frame, pipeline);
     if (pipeline == GDR_PIPELINE_CPU)
         status = gdr_cpu_path_cull(r, frame, err);
     if (status == GDR_OK)
@@ -348,6 +359,9 @@ static gdr_status run_frame(gdr_renderer *r, const gdr_frame_desc *frame, gdr_pi
     if (status == GDR_OK) {
         slot->cpu_visible_count = r->cpu.visible_count;
         slot->cpu_triangles = r->cpu.triangles;
+        slot->cpu_pvs_culled = r->cpu.pvs_culled;
+        if (pipeline == GDR_PIPELINE_CPU)
+            slot->pvs_cell_found = r->cpu.pvs_cell_found;
         status = gdr_frame_record_and_submit(r, slot, frame, pipeline, read_back, submit_ms, err);
     }
     *frame_cpu_ms = gdr_now_ms() - start;
@@ -372,6 +386,7 @@ gdr_status gdr_renderer_render(gdr_renderer *r, const gdr_frame_desc *frame, uin
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "render: out of memory");
     r->timings = (gdr_frame_timings){0};
     r->cpu.cull_ms = 0.0;
+    r->pvs.cpu_ms = 0.0;
     r->color_read_back = false;
     double submit_ms = 0.0;
     uint32_t recorded = 0;

@@ -32,8 +32,22 @@ typedef struct gdr_cpu_path {
     uint32_t *visible;        /* indices of the visible instances of the last culled frame */
     uint32_t visible_count;
     uint64_t triangles;
+    uint32_t pvs_culled;      /* the last frame's instances culled by the precomputed visibility */
+    bool pvs_cell_found;      /* the last frame's camera was in a baked cell */
     double cull_ms;           /* summed over the frames of one gdr_renderer_render */
 } gdr_cpu_path;
+
+/* Precomputed visibility (pvs_frame.c): the caller's PVS, the renderer's lookups in it, and the
+ * instances moved since the scene was set, which it never culls. */
+typedef struct gdr_render_pvs {
+    const struct gdr_pvs *pvs;       /* NULL: none */
+    struct gdr_pvs_cache *cache;     /* lookups for the GPU-driven frames and the CPU pipeline's cull */
+    uint32_t *moved;                 /* gdr_cull_word_count(instances) words: bit i, instance i moved */
+    uint32_t words;
+    uint64_t moved_version;          /* bumped when a bit of `moved` is set */
+    uint64_t version;                /* bumped when the PVS is replaced */
+    double cpu_ms;                   /* lookups and uploads, summed over the frames of one render call */
+} gdr_render_pvs;
 
 /* The geometry pool and the instances on the GPU (seed 000's PrimitiveBuffer and InstanceBuffer). */
 typedef struct gdr_gpu_scene {
@@ -106,6 +120,14 @@ typedef struct gdr_frame_slot {
     /* CPU pipeline: what the CPU decided for the frame last recorded into this slot. */
     uint32_t cpu_visible_count;
     uint64_t cpu_triangles;
+    uint32_t cpu_pvs_culled;
+    /* Precomputed visibility: the cell's bits of the slot's frame (host-written, read by the
+     * instance cull under GDR_FRAME_PVS), what they were made from (to skip an unchanged copy), and
+     * what the frame used. */
+    gdr_vk_buffer pvs_visible;
+    const uint32_t *pvs_source;
+    uint64_t pvs_source_decompressions, pvs_source_moved, pvs_source_version;
+    bool pvs_enabled, pvs_cell_found;
 } gdr_frame_slot;
 
 /* The renderer's side of streaming (streaming.c, docs/STREAMING.md): the page pool, the residency
@@ -154,6 +176,7 @@ struct gdr_renderer {
     gdr_vk_buffer visible_meshlets; /* uint32 pairs, one per cluster of every instance; made on first use */
     gdr_visbuffer vis;            /* the visibility buffer and the hybrid rasteriser */
     gdr_cpu_path cpu;
+    gdr_render_pvs pvs;
     VkQueryPool timestamps;       /* GDR_FRAME_MAX_TIMESTAMPS per frame slot */
     gdr_frame_timings timings;
     gdr_gpu_scene scene;
@@ -236,6 +259,18 @@ void gdr_frame_stats_fill(gdr_renderer *r, gdr_pipeline pipeline, const char *re
 void gdr_frame_set_viewport(gdr_renderer *r, VkCommandBuffer cmd, bool flip_y);
 /* What every frame pipeline expects bound: the push constants and the depth pyramid (set 0). */
 void gdr_frame_bind_state(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer cmd);
+
+/* Precomputed visibility (pvs_frame.c): the moved-instance bits for a scene being set, the frame's
+ * decision and the cell's bits in the slot's buffer (before its globals are written), an instance
+ * that moved, and the end. */
+gdr_status gdr_render_pvs_scene(gdr_renderer *r, gdr_error *err);
+/* Whether a frame culls by the PVS: one is held and neither culling nor the PVS is switched off. */
+bool gdr_render_pvs_wanted(const gdr_renderer *r, const gdr_frame_desc *frame);
+void gdr_render_pvs_begin_frame(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame,
+                                gdr_pipeline pipeline);
+void gdr_render_pvs_moved(gdr_renderer *r, uint32_t instance);
+bool gdr_render_pvs_is_moved(const gdr_renderer *r, uint32_t instance);
+void gdr_render_pvs_destroy(gdr_renderer *r);
 
 /* CPU pipeline (cpu_driven.c). */
 gdr_status gdr_cpu_path_create(gdr_renderer *r, const gdr_scene *scene, gdr_error *err);

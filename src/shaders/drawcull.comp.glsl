@@ -1,6 +1,6 @@
 #version 460
 // Instance culling (seeds 000/001/002/003): one thread per instance, which tests its bounds (invalid
-// or empty, frustum, screen size, the global clip plane, occlusion); visible instances are appended,
+// or empty, frustum, precomputed visibility, screen size, the global clip plane, occlusion); visible instances are appended,
 // compacted with subgroup ballots, as VkDrawIndexedIndirectCommands for one
 // vkCmdDrawIndexedIndirectCount (first_instance carries the instance index to the vertex shader),
 // or, for the meshlet pipeline (EMIT_TASKS), as task commands: one task workgroup per up to
@@ -56,6 +56,13 @@ bool screen_size_visible(GdrGpuFrameGlobals g, GdrGpuInstance instance, vec3 wor
     return !(instance.max_screen_size > 0.0 && size >= instance.max_screen_size);
 }
 
+// Precomputed visibility (seed 002): whether the culling camera's cell lists the instance.
+bool pvs_listed(uint instance)
+{
+    uint word = UintsRef(GDR_FRAME.pvs_visible).items[instance >> 5u];
+    return (word & (1u << (instance & 31u))) != 0u;
+}
+
 // The global clip plane (seed 002): true when the sphere lies entirely on its negative side.
 bool behind_clip_plane(GdrGpuFrameGlobals g, vec3 world_center, float radius)
 {
@@ -104,7 +111,7 @@ void main()
     mat4 model;
     vec3 world_center = vec3(0.0);
     float radius = 0.0;
-    bool invalid = false, small_or_large = false, clipped = false;
+    bool invalid = false, pvs_hidden = false, small_or_large = false, clipped = false;
     if (id < g.instance_count) {
         GdrGpuInstance instance = InstancesRef(GDR_SCENE.instances).items[id];
         model = instance.model;
@@ -118,11 +125,14 @@ void main()
         visible = !invalid;
         if (visible && g.cull_enabled != 0u) {
             visible = gdr_sphere_visible(g.frustum, center, radius, g.znear, g.zfar);
+            pvs_hidden = visible && (g.flags & GDR_FRAME_PVS) != 0u && !pvs_listed(id);
+            visible = visible && !pvs_hidden;
             small_or_large = visible && !screen_size_visible(g, instance, world_center, radius);
             clipped = visible && !small_or_large && behind_clip_plane(g, world_center, radius);
             visible = visible && !small_or_large && !clipped;
         }
     }
+    GDR_COUNT(stats, instances_pvs_culled, pvs_hidden);
     GDR_COUNT(stats, instances_invalid, invalid);
     GDR_COUNT(stats, instances_screen_size_culled, small_or_large);
     GDR_COUNT(stats, instances_clip_plane_culled, clipped);

@@ -16,11 +16,14 @@
 
 static void build_usage(void)
 {
-    fputs("usage: gdr build INPUT -o OUTPUT.gdrc [--pvs] [--pages[=KIB]] [--no-progress] [--budget KEY=N,...]\n"
-          "                 [--allow-outside-files]\n"
+    fputs("usage: gdr build INPUT -o OUTPUT.gdrc [--pvs] [--pvs-cell M] [--pvs-samples N] [--pages[=KIB]]\n"
+          "                 [--no-progress] [--budget KEY=N,...] [--allow-outside-files]\n"
           "  INPUT: a .gltf, .glb or .obj file, a .gdrc cache, or a built-in scene: 'demo', 'lod-field',\n"
-          "         'occlusion' or 'unique-field', each with optional ':key=value,...' (see gdr --help)\n"
-          "  --pvs: bake precomputed visibility (default options, every processor) into the cache\n"
+          "         'occlusion', 'unique-field' or 'rooms', each with optional ':key=value,...' (see gdr --help)\n"
+          "  --pvs: bake precomputed visibility (every processor) into the cache; gdr render culls with it\n"
+          "  --pvs-cell M: its cells' size in metres (default: the scene's largest side / 16; the rooms\n"
+          "         scene wants 1: a cell touched by geometry gets no data)\n"
+          "  --pvs-samples N: camera points per cell (default 8, at most 4096)\n"
           "  --pages[=KIB]: also store the geometry in compressed pages of KIB kibibytes (default 128),\n"
           "         read on demand for streaming (docs/CACHE_FORMAT.md, section 'PAGE'); the vertices are\n"
           "         first moved onto a 16-bit grid per mesh (gdr_scene_quantize_vertices), which the pages\n"
@@ -44,8 +47,8 @@ static gdr_status quantize(gdr_scene *scene, gdr_error *err)
     return status;
 }
 
-/* The bake with default options (docs/CULLING.md) on a pool of every processor. */
-static gdr_status bake_pvs(const gdr_scene *scene, gdr_pvs **out, gdr_error *err)
+/* The bake (docs/CULLING.md) on a pool of every processor; 0: the default cell size and samples. */
+static gdr_status bake_pvs(const gdr_scene *scene, float cell_size, uint32_t samples, gdr_pvs **out, gdr_error *err)
 {
     gdr_thread_pool *pool = NULL;
     gdr_status status = gdr_thread_pool_create(0, &pool, err);
@@ -53,7 +56,7 @@ static gdr_status bake_pvs(const gdr_scene *scene, gdr_pvs **out, gdr_error *err
         return status;
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
-    gdr_pvs_bake_desc desc = {.scene = scene, .pool = pool};
+    gdr_pvs_bake_desc desc = {.scene = scene, .pool = pool, .cell_size = cell_size, .samples_per_cell = samples};
     gdr_pvs_bake_report report;
     status = gdr_pvs_bake(&desc, out, &report, err);
     clock_gettime(CLOCK_MONOTONIC, &t1);
@@ -73,7 +76,8 @@ int gdr_cmd_build(int argc, char **argv)
 {
     const char *input = NULL, *output = NULL;
     int no_progress = 0, pvs_wanted = 0, allow_outside_files = 0;
-    uint32_t page_bytes = 0;
+    uint32_t page_bytes = 0, pvs_samples = 0;
+    float pvs_cell = 0.0f;
     gdr_budget budget = {0};
     for (int i = 1; i < argc; i++) {
         if ((strcmp(argv[i], "-o") == 0 || strcmp(argv[i], "--out") == 0) && i + 1 < argc) {
@@ -82,6 +86,16 @@ int gdr_cmd_build(int argc, char **argv)
             no_progress = 1;
         } else if (strcmp(argv[i], "--pvs") == 0) {
             pvs_wanted = 1;
+        } else if (strcmp(argv[i], "--pvs-cell") == 0 && i + 1 < argc) {
+            if (!cli_parse_float(argv[i], argv[i + 1], 0.01f, 1e6f, &pvs_cell))
+                return 2;
+            pvs_wanted = 1;
+            i++;
+        } else if (strcmp(argv[i], "--pvs-samples") == 0 && i + 1 < argc) {
+            if (!cli_parse_u32(argv[i], argv[i + 1], 1, 4096, &pvs_samples))
+                return 2;
+            pvs_wanted = 1;
+            i++;
         } else if (strcmp(argv[i], "--pages") == 0) {
             page_bytes = GDR_PAGE_BYTES_DEFAULT;
         } else if (strncmp(argv[i], "--pages=", 8) == 0) {
@@ -141,7 +155,7 @@ int gdr_cmd_build(int argc, char **argv)
     if (status == GDR_OK && pvs_wanted) {
         gdr_pvs_destroy(pvs);
         pvs = NULL;
-        status = bake_pvs(scene, &pvs, &err); /* before writing: a failed bake leaves no file */
+        status = bake_pvs(scene, pvs_cell, pvs_samples, &pvs, &err); /* before writing: a failed bake leaves no file */
     }
     if (status == GDR_OK) {
         gdr_cache_write_options write = {.source = {gdr_cache_build_options(), &sources}, .pvs = pvs,

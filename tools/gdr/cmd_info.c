@@ -12,7 +12,7 @@
 #include "gdr/renderer.h"
 
 #define INFO_USAGE                                                                                       \
-    "usage: gdr info FILE|demo|lod-field|occlusion|unique-field[:...] [--no-cache] [--cache-dir DIR]\n"  \
+    "usage: gdr info FILE|demo|lod-field|occlusion|unique-field|rooms[:...] [--no-cache] [--cache-dir DIR]\n"  \
     "       [--budget KEY=N,...] [--allow-outside-files]\n"                                             \
     "       gdr info --passes\n"
 

@@ -5,7 +5,9 @@
 
 #include "cli_args.h"
 #include "commands.h"
+#include "gdr/cull.h"
 #include "gdr/gdr.h"
+#include "gdr/io.h"
 #include "camera_path.h"
 #include "render_options.h"
 #include "stats_output.h"
@@ -74,6 +76,11 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
             ok = cli_parse_on_off(arg, value, &o->triangle_cull);
         else if (strcmp(arg, "--occlusion") == 0)
             ok = o->occlusion_given = cli_parse_on_off(arg, value, &o->occlusion);
+        else if (strcmp(arg, "--pvs") == 0) {
+            bool on = false;
+            ok = cli_parse_on_off(arg, value, &on);
+            o->pvs = on ? GDR_CULL_ON : GDR_CULL_OFF;
+        }
         else if (strcmp(arg, "--lod-hierarchy") == 0)
             ok = cli_parse_on_off(arg, value, &o->lod_hierarchy);
         else if (strcmp(arg, "--pipeline") == 0)
@@ -153,7 +160,7 @@ gdr_frame_desc render_options_frame(const render_options *o, gdr_camera camera)
                                          : o->occlusion       ? GDR_CULL_ON
                                                              : GDR_CULL_OFF,
                             .lod_hierarchy = o->lod_hierarchy ? GDR_CULL_ON : GDR_CULL_OFF,
-                            .min_screen_size = o->min_screen_size, .clip_plane = o->clip_plane};
+                            .min_screen_size = o->min_screen_size, .clip_plane = o->clip_plane, .pvs = o->pvs};
 }
 
 /* The frames asked for: o->frames of one view, or with --camera-path one frame per pose (the path
@@ -179,15 +186,19 @@ static gdr_status render_frames(gdr_renderer *renderer, gdr_frame_desc *frame, c
 
 static bool streamed(const render_options *o) { return o->geometry_budget_mib || o->upload_budget_mib; }
 
-/* A streamed scene is read from its cache without the geometry the pages hold. */
-static gdr_status load_scene(render_options *o, gdr_scene **scene, gdr_error *err)
+/* A streamed scene is read from its cache without the geometry the pages hold. A file's cache may
+ * hold the scene's precomputed visibility (*pvs, else NULL; not read for streaming). */
+static gdr_status load_scene(render_options *o, gdr_scene **scene, gdr_pvs **pvs, gdr_error *err)
 {
+    *pvs = NULL;
     size_t length = strlen(o->scene);
     if (streamed(o) && (length < 5 || strcmp(o->scene + length - 5, ".gdrc") != 0))
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "--geometry-budget/--upload-budget stream from a cache: "
                              "give a .gdrc written with 'gdr build --pages' (not '%s')", o->scene);
     o->load.geometry_in_pages = streamed(o);
-    return gdr_scene_load(o->scene, &o->load, scene, err);
+    if (gdr_scene_spec_is_builtin(o->scene) || streamed(o))
+        return gdr_scene_load(o->scene, &o->load, scene, err);
+    return gdr_scene_load_file(o->scene, &o->load, scene, pvs, err);
 }
 
 /* The scene, streamed from its cache file when a budget is given (the scene is that file). */
@@ -209,8 +220,15 @@ int gdr_cmd_render(int argc, char **argv)
         return usage;
     gdr_error err = {0};
     gdr_scene *scene = NULL;
-    if (load_scene(&o, &scene, &err) != GDR_OK)
+    gdr_pvs *pvs = NULL;
+    if (load_scene(&o, &scene, &pvs, &err) != GDR_OK)
         return cli_load_failed(o.scene, &err);
+    if (o.pvs == GDR_CULL_ON && !pvs) {
+        fprintf(stderr, "gdr: --pvs on: %s holds no precomputed visibility (write it with gdr build %s -o FILE.gdrc "
+                "--pvs)\n", o.scene, o.scene);
+        gdr_scene_destroy(scene);
+        return 2;
+    }
     if (o.has_camera_index && o.camera_index >= scene->camera_count) {
         fprintf(stderr, "gdr: --camera-index %u: the scene has %u camera(s)\n", o.camera_index, scene->camera_count);
         gdr_scene_destroy(scene);
@@ -223,7 +241,7 @@ int gdr_cmd_render(int argc, char **argv)
     int result = 0;
     gdr_frame_desc frame = render_options_frame(&o, render_options_camera(scene, &o));
     if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK || set_scene(renderer, scene, &o, &err) != GDR_OK ||
-        render_frames(renderer, &frame, &o, &stats, &err) != GDR_OK) {
+        gdr_renderer_set_pvs(renderer, pvs, &err) != GDR_OK || render_frames(renderer, &frame, &o, &stats, &err) != GDR_OK) {
         result = fail(&err);
         goto done;
     }
@@ -252,6 +270,7 @@ int gdr_cmd_render(int argc, char **argv)
 done:
     free(pixels);
     gdr_renderer_destroy(renderer);
+    gdr_pvs_destroy(pvs);
     gdr_scene_destroy(scene);
     return result;
 }

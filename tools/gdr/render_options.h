@@ -15,6 +15,7 @@ typedef struct render_options {
     bool has_camera, has_camera_index, cull, validate;
     bool meshlet_cull, cone_cull, triangle_cull, occlusion, occlusion_given, lod_hierarchy;
     gdr_pipeline pipeline;
+    gdr_cull_mode pvs;     /* --pvs on|off; DEFAULT when not given */
     gdr_raster raster;
     float sw_threshold;
     gdr_view view;

@@ -4,6 +4,25 @@
 
 #include <cjson/cJSON.h>
 
+/* "on", "off" (held, switched off) or "none" (the scene's cache holds no precomputed visibility). */
+static const char *pvs_state(const gdr_pvs_stats *pvs)
+{
+    return pvs->enabled ? "on" : pvs->cells > 0 ? "off" : "none";
+}
+
+static void stats_print_pvs(FILE *out, const gdr_pvs_stats *pvs)
+{
+    if (!pvs->enabled) {
+        fprintf(out, "pvs                 %s\n", pvs_state(pvs));
+        return;
+    }
+    if (pvs->cell_found)
+        fprintf(out, "pvs                 on: camera in a baked cell (of %u), %u instances culled (in the frustum, "
+                "not listed by the cell); lookup %.4f ms/frame\n", pvs->cells, pvs->instances_culled, pvs->cpu_ms_per_frame);
+    else
+        fprintf(out, "pvs                 on: camera in none of the %u baked cells, nothing culled by it\n", pvs->cells);
+}
+
 void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats *s)
 {
     fprintf(out, "scene               %s\n", context->scene);
@@ -18,6 +37,7 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
     if (s->instances_invalid || s->instances_screen_size_culled || s->instances_clip_plane_culled)
         fprintf(out, "instances_culled    %u invalid or empty bounds, %u by screen size, %u behind the clip plane\n",
                 s->instances_invalid, s->instances_screen_size_culled, s->instances_clip_plane_culled);
+    stats_print_pvs(out, &s->pvs);
     fprintf(out, "triangles           %llu\n", (unsigned long long)s->triangles);
     if (s->pipeline == GDR_PIPELINE_MESH) {
         fprintf(out, "meshlets_total      %llu\n", (unsigned long long)s->meshlets_total);
@@ -212,6 +232,11 @@ char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
     cJSON_AddNumberToObject(root, "instances_invalid", s->instances_invalid);
     cJSON_AddNumberToObject(root, "instances_screen_size_culled", s->instances_screen_size_culled);
     cJSON_AddNumberToObject(root, "instances_clip_plane_culled", s->instances_clip_plane_culled);
+    cJSON_AddStringToObject(root, "pvs", pvs_state(&s->pvs));
+    cJSON_AddBoolToObject(root, "pvs_cell_found", s->pvs.cell_found);
+    cJSON_AddNumberToObject(root, "pvs_cells", s->pvs.cells);
+    cJSON_AddNumberToObject(root, "instances_pvs_culled", s->pvs.instances_culled);
+    cJSON_AddNumberToObject(root, "pvs_cpu_ms_per_frame", s->pvs.cpu_ms_per_frame);
     cJSON_AddNumberToObject(root, "triangles", (double)s->triangles);
     cJSON_AddNumberToObject(root, "draws", s->draws);
     cJSON_AddNumberToObject(root, "draw_calls", s->draw_calls);
