@@ -5,7 +5,7 @@ RELEASE_DIR ?= build-release
 JOBS ?= $(shell nproc)
 PREFIX ?= /usr/local
 
-.PHONY: all deps build demo check test test-asan build-release test-release build-release-clang pipeline-doc install clean
+.PHONY: all deps build demo check test test-asan build-release test-release build-release-clang pipeline-doc architecture-doc install clean
 
 all: build
 
@@ -36,6 +36,11 @@ test-asan: deps
 # docs/PIPELINE.md's printout of every frame configuration, regenerated from `gdr info --passes`.
 pipeline-doc: build
 	./scripts/update-pipeline-doc.sh $(BUILD_DIR)/tools/gdr/gdr
+
+# docs/architecture.svg, the module graph of docs/ARCHITECTURE.md, drawn again from the includes
+# (needs Graphviz, Debian's graphviz; not needed to build or test).
+architecture-doc:
+	./scripts/check-layers.sh --dot | grep -v '"umbrella"' | tred | dot -Tsvg >docs/architecture.svg
 
 # The Release build type with warnings as errors: gcc warns at -O3 where it does not at -O2.
 # build-release-clang does the same with clang (CI runs both).

@@ -8,6 +8,7 @@
 #include <time.h>
 
 #include "gdr/io.h"
+#include "io/loaders.h"
 
 static double now(void)
 {

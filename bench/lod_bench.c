@@ -28,6 +28,7 @@
 #include "gdr/io.h"
 #include "gdr/scene.h"
 #include "procedural/procedural_meshes.h"
+#include "io/loaders.h"
 
 /* --- helpers -------------------------------------------------------------------------------------- */
 

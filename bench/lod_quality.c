@@ -40,6 +40,7 @@
 #include "gdr/io.h"
 #include "gdr/scene.h"
 #include "procedural/procedural_meshes.h"
+#include "io/loaders.h"
 
 #define SWEEP_STEPS 21         /* thresholds 10^(-4 + i / 8) of the radius */
 #define SAMPLE_BUDGET 200000.0 /* samples of the full surface: sets the sampling spacing */

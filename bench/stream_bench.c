@@ -14,6 +14,7 @@
 
 #include "gdr/gdr.h"
 #include "gdr/io.h"
+#include "io/loaders.h"
 
 #define MAX_FRAMES 600
 #define SETTLED_FRAMES 10
@@ -184,13 +185,16 @@ int main(int argc, char **argv)
     gdr_renderer *r = NULL;
     view_result whole_a = {0}, whole_b = {0}, near = {0}, far = {0};
     gdr_frame_stats stats = {0};
-    gdr_streaming_desc stream = {.cache_path = path, .geometry_budget_bytes = (uint64_t)budget_mib << 20,
+    gdr_paged_cache *paged = NULL;
+    gdr_streaming_desc stream = {.cache = NULL, .geometry_budget_bytes = (uint64_t)budget_mib << 20,
                                  .upload_budget_bytes = (uint64_t)upload_mib << 20};
     double t_setup = 0, t_first = 0, t_load = 0;
     int ok = gdr_renderer_create(&desc, &r, &err) == GDR_OK;
     if (ok) {
         double t0 = now_ms();
-        ok = gdr_renderer_set_scene_streamed(r, scene, &stream, &err) == GDR_OK;
+        ok = gdr_paged_cache_open(path, &paged, &err) == GDR_OK;
+        stream.cache = paged;
+        ok = ok && gdr_renderer_set_scene_streamed(r, scene, &stream, &err) == GDR_OK;
         t_setup = now_ms() - t0;
         ok = ok && gdr_renderer_render(r, &frame, 1, &stats, &err) == GDR_OK;
         t_first = t_open + now_ms() - t0; /* from the open's start */
@@ -199,6 +203,7 @@ int main(int argc, char **argv)
     if (!ok)
         fprintf(stderr, "stream_bench: streamed: %s\n", err.message);
     gdr_renderer_destroy(r);
+    gdr_paged_cache_close(paged);
     /* The whole upload after the streamed run, whose frames have brought the GPU's clocks up. */
     if (ok && whole)
         ok = run_whole(&o, &frame, &jump, &whole_a, &whole_b, &t_load);

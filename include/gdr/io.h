@@ -21,6 +21,29 @@
 extern "C" {
 #endif
 
+/* --- source files -------------------------------------------------------------------------- */
+
+/* A file an import read: its identity is what makes a cache stale. */
+typedef struct gdr_source_file {
+    char *path;        /* absolute (realpath) when it can be resolved, else as opened */
+    uint64_t size;     /* bytes */
+    int64_t mtime_ns;  /* modification time, nanoseconds since the epoch */
+    uint64_t hash;     /* XXH3-64 of the contents */
+} gdr_source_file;
+
+typedef struct gdr_source_list {
+    gdr_source_file *files;
+    uint32_t count, capacity;
+} gdr_source_list;
+
+GDR_API void gdr_source_list_free(gdr_source_list *list);
+
+/* Precomputed visibility (include/gdr/cull.h): baked offline for a scene's instances (object i =
+ * instance i), it is stored in the cache next to the scene, not in gdr_scene (which stays plain
+ * arrays with no culling dependency). Write it with gdr_cache_write (options->pvs), get it back with
+ * gdr_scene_load (gdr_load_options.pvs). */
+typedef struct gdr_pvs gdr_pvs;
+
 /* --- Options shared by every loader ------------------------------------------------------ */
 
 /* Warnings from importers (a file that loads, but not entirely as written): `message` names the
@@ -59,63 +82,17 @@ typedef struct gdr_load_options {
     int allow_outside_files; /* 1: a glTF may name buffers and images outside its own folder
                                 (absolute paths, '..', symlinks out); 0: refused */
     int geometry_in_pages;   /* 1: for streaming, a .gdrc with geometry pages is read without the
-                                geometry its pages hold (gdr_cache_read_for_streaming); any other
-                                scene is refused */
+                                geometry its pages hold (the pages are read by gdr_paged_cache_open);
+                                any other scene is refused */
+    gdr_pvs **pvs;           /* non-NULL: receives the precomputed visibility of the cache the scene
+                                was read from (gdr_pvs_destroy frees it), or NULL when there is none
+                                (a built-in scene, an import, a cache without one) */
+    gdr_source_list *sources; /* non-NULL: receives every file an import read (the source, its
+                                buffers and images), for gdr_cache_write; empty when the scene came
+                                from a cache or is built in. Free it with gdr_source_list_free */
 } gdr_load_options;
 
-/* --- source files -------------------------------------------------------------------------- */
-
-/* A file an import read: its identity is what makes a cache stale. */
-typedef struct gdr_source_file {
-    char *path;        /* absolute (realpath) when it can be resolved, else as opened */
-    uint64_t size;     /* bytes */
-    int64_t mtime_ns;  /* modification time, nanoseconds since the epoch */
-    uint64_t hash;     /* XXH3-64 of the contents */
-} gdr_source_file;
-
-typedef struct gdr_source_list {
-    gdr_source_file *files;
-    uint32_t count, capacity;
-} gdr_source_list;
-
-GDR_API void gdr_source_list_free(gdr_source_list *list);
-
-/* --- importers ------------------------------------------------------------------------------ */
-
-/* Zero-initialise; every field has a default. */
-typedef struct gdr_import_options {
-    gdr_warning_fn warning; /* NULL: "gdr: warning: <message>" on stderr */
-    void *warning_user;
-    int no_progress;          /* 1: no progress bar (default: shown on a terminal for long work) */
-    gdr_source_list *sources; /* optional: receives every file read (the source and its buffers,
-                                 images), for the cache's staleness check */
-    gdr_budget budget;        /* limits for untrusted files (gdr/scene.h); zero: the defaults */
-    int allow_outside_files;  /* 1: external URIs may leave the file's folder (absolute paths, '..',
-                                 symlinks pointing out); 0 (default): such a URI is refused */
-} gdr_import_options;
-
-typedef struct gdr_import_result {
-    uint32_t warning_count;
-} gdr_import_result;
-
-/* Imports a .gltf or .glb file (told apart by content: GLB starts with "glTF"). External
- * buffers and images are resolved relative to the file's folder. result may be NULL. */
-GDR_API gdr_status gdr_import_gltf(const char *path, const gdr_import_options *options, gdr_scene **out,
-                                   gdr_import_result *result, gdr_error *err);
-
-/* Imports glTF JSON or GLB from memory. `name` is used in messages; `base_dir` resolves external
- * URIs (NULL: external URIs are refused, only data: URIs and the GLB chunk are used). */
-GDR_API gdr_status gdr_import_gltf_memory(const void *data, size_t size, const char *name, const char *base_dir,
-                                          const gdr_import_options *options, gdr_scene **out,
-                                          gdr_import_result *result, gdr_error *err);
-
-/* Imports a Wavefront .obj file: v/vt/vn/f, polygons fan-triangulated, negative indices, one mesh
- * per group/object (g, o) and one instance of each with the identity transform. */
-GDR_API gdr_status gdr_import_obj(const char *path, const gdr_import_options *options, gdr_scene **out,
-                                  gdr_import_result *result, gdr_error *err);
-GDR_API gdr_status gdr_import_obj_memory(const void *data, size_t size, const char *name,
-                                         const gdr_import_options *options, gdr_scene **out,
-                                         gdr_import_result *result, gdr_error *err);
+/* --- images ------------------------------------------------------------------------------- */
 
 /* Decodes a PNG or JPEG (told by its signature; other formats are refused) into RGBA8, within
  * GDR_DEFAULT_MAX_DECODED_BYTES of decoder memory besides the result. *out_rgba is malloc'ed. */
@@ -132,12 +109,6 @@ typedef struct gdr_cache_source {
     const char *build_options;
     const gdr_source_list *files; /* NULL or empty for the built-in demo scene */
 } gdr_cache_source;
-
-/* Precomputed visibility (include/gdr/cull.h): baked offline for a scene's instances (object i =
- * instance i), it is stored in the cache next to the scene, not in gdr_scene (which stays plain
- * arrays with no culling dependency). Write it with gdr_cache_write (options->pvs), get it back with
- * gdr_cache_read or gdr_scene_load_file (out_pvs). */
-typedef struct gdr_pvs gdr_pvs;
 
 /* What gdr_cache_write stores next to the scene; zero-initialise (or pass NULL): every field has a
  * default. */
@@ -159,32 +130,6 @@ typedef struct gdr_cache_write_options {
 GDR_API gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_cache_write_options *options,
                                    gdr_error *err);
 
-/* Reads a cache. Checks magic, version, every size, offset and checksum. When build_options is
- * not NULL, a cache built with different options is refused (stale); each recorded source file
- * that exists with a different size or contents makes it stale too (a missing one does not:
- * a cache may travel without its sources). On GDR_OK, *out is the scene and, when out_pvs is not
- * NULL, *out_pvs the precomputed visibility (a gdr_pvs the caller destroys with gdr_pvs_destroy),
- * or NULL when the cache holds none. Either way a 'PVIS' section is checked (gdr_pvs_load, and its
- * object count against the scene's instances): a damaged one makes the whole cache refused,
- * naming the section. */
-GDR_API gdr_status gdr_cache_read(const char *path, const char *build_options, gdr_scene **out, gdr_pvs **out_pvs,
-                                  gdr_error *err);
-
-/* Reads a cache with geometry pages for streaming (gdr_renderer_set_scene_streamed): the header, the
- * table and, each with a positioned read and its checksum checked, every section but the geometry
- * the pages hold too (vertices, indices, vertex colours, cluster vertex lists and triangles, the
- * pages). The scene has every mesh's counts, bounds, cluster and group records and LOD hierarchy,
- * the materials, textures, instances and cameras, and scene->geometry_in_pages set: its meshes hold
- * no vertex or index arrays. Staleness as in gdr_cache_read. A cache without pages is refused
- * (GDR_ERROR_INVALID_ARGUMENT). out_bytes_read (may be NULL): the bytes read from the file. */
-GDR_API gdr_status gdr_cache_read_for_streaming(const char *path, const char *build_options, gdr_scene **out,
-                                                uint64_t *out_bytes_read, gdr_error *err);
-
-/* Parses a cache from memory without any staleness check (the fuzz target uses this); out_pvs as
- * in gdr_cache_read. */
-GDR_API gdr_status gdr_cache_read_memory(const void *data, size_t size, const char *name, gdr_scene **out,
-                                         gdr_pvs **out_pvs, gdr_error *err);
-
 /* The cache path used for a source: SOURCE.gdrc next to it, or in cache_dir (named after a hash
  * of the absolute source path) when cache_dir is given. Returns the length written, or 0 when
  * it does not fit. */
@@ -192,20 +137,6 @@ GDR_API size_t gdr_cache_path_for(const char *source_path, const char *cache_dir
 
 /* The build options string of this version of the importers. */
 GDR_API const char *gdr_cache_build_options(void);
-
-/* Imports any supported source file (.gltf, .glb, .obj by extension) without the cache, and
- * builds every mesh's clusters (gdr_scene_build_clusters, include/gdr/geometry.h). */
-GDR_API gdr_status gdr_import_file(const char *path, const gdr_import_options *options, gdr_scene **out,
-                                   gdr_import_result *result, gdr_error *err);
-
-/* A source file (.gltf, .glb, .obj) through the cache, or a .gdrc file directly: what
- * gdr_scene_load does for paths. See gdr_load_options in scene.h (NULL: defaults). Every mesh of
- * the scene has its clusters: read from the cache, or built (a cache written from a scene without
- * them). When out_pvs is not NULL, *out_pvs is the precomputed visibility of the cache the scene
- * was read from, a gdr_pvs to destroy with gdr_pvs_destroy, or NULL (an import, or a cache without
- * one). A stale cache is rebuilt from the source without it (the bake is not redone). */
-GDR_API gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options, gdr_scene **out,
-                                       gdr_pvs **out_pvs, gdr_error *err);
 
 /* --- Loading: the one way from a name to a scene -------------------------------------------- */
 

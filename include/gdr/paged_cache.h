@@ -100,6 +100,8 @@ typedef struct gdr_paged_cache gdr_paged_cache;
 GDR_API gdr_status gdr_paged_cache_open(const char *path, gdr_paged_cache **out, gdr_error *err);
 GDR_API void gdr_paged_cache_close(gdr_paged_cache *cache);
 
+/* The path it was opened with, for messages. */
+GDR_API const char *gdr_paged_cache_path(const gdr_paged_cache *cache);
 GDR_API uint32_t gdr_paged_cache_mesh_count(const gdr_paged_cache *cache);
 GDR_API const gdr_paged_mesh *gdr_paged_cache_mesh(const gdr_paged_cache *cache, uint32_t mesh);
 GDR_API const gdr_instance *gdr_paged_cache_instances(const gdr_paged_cache *cache, uint32_t *count);

@@ -11,6 +11,7 @@
 #include <stdint.h>
 
 #include "gdr/core.h"
+#include "gdr/paged_cache.h"
 #include "gdr/scene.h"
 
 #ifdef __cplusplus
@@ -35,15 +36,6 @@ typedef struct gdr_renderer_desc {
      * whether instance updates are pending). true: record every frame (to measure what recording
      * costs). The CPU pipeline always records. */
     bool record_every_frame;
-    /* Tests only: the task list's and the LOD traversal's capacities per frame phase, and the
-     * occluded-node list's (0: sized from the scene), to provoke their overflow, which the statistics
-     * report. */
-    uint32_t debug_task_capacity;
-    uint32_t debug_traversal_capacity;
-    uint32_t debug_occluded_node_capacity;
-    /* Tests only: a deliberately wrong LOD hierarchy (node spheres shrunk), to show that the image
-     * tests catch a node test that is not conservative. */
-    bool debug_shrink_lod_nodes;
     /* Presenting to a window (gdr/present.h): the instance extensions the window system needs
      * (e.g. from glfwGetRequiredInstanceExtensions; at most 8), and whether the device must be able
      * to present (VK_KHR_swapchain). Without them the renderer is headless. */
@@ -358,7 +350,10 @@ GDR_API gdr_status gdr_renderer_set_pvs(gdr_renderer *renderer, const gdr_pvs *p
  * budget; where a group is absent the cut draws the resident group above it (never a hole, never a
  * crack). Frames must use the mesh pipeline and a LOD cut by error (lod_error_px > 0). */
 typedef struct gdr_streaming_desc {
-    const char *cache_path;         /* the scene's cache, written with gdr_cache_write_options.page_bytes */
+    gdr_paged_cache *cache;         /* the scene's cache (written with gdr_cache_write_options.page_bytes),
+                                       opened by the caller with gdr_paged_cache_open; it stays the
+                                       caller's, open until the renderer is destroyed (a loader thread
+                                       reads its pages) */
     uint64_t geometry_budget_bytes; /* the page pool; 0: a quarter of the device-local heap; at most 4 GiB */
     uint64_t upload_budget_bytes;   /* copied into the pool per frame at most (at least one page); 0: 16 MiB */
     bool wait_for_loads;            /* each frame waits for the pages it planned (deterministic: tests) */
@@ -368,8 +363,8 @@ typedef struct gdr_streaming_desc {
 #define GDR_UPLOAD_BUDGET_DEFAULT (16ull << 20)
 
 /* gdr_renderer_set_scene with streaming: only the scene's cluster records, LOD hierarchy and page
- * table are uploaded; geometry arrives page by page. `scene` must be the one the cache at
- * desc->cache_path was written from (checked: meshes, groups and clusters per page) and must stay
+ * table are uploaded; geometry arrives page by page. `scene` must be the one the cache
+ * desc->cache was written from (checked: meshes, groups and clusters per page) and must stay
  * alive, unchanged, until the renderer is destroyed (the renderer reads its LOD hierarchy). */
 GDR_API gdr_status gdr_renderer_set_scene_streamed(gdr_renderer *renderer, const gdr_scene *scene,
                                                    const gdr_streaming_desc *desc, gdr_error *err);
@@ -411,15 +406,6 @@ typedef struct gdr_visible_meshlet {
  * with record_visible_meshlets. */
 GDR_API gdr_status gdr_renderer_read_visible_meshlets(gdr_renderer *renderer, gdr_visible_meshlet *meshlets,
                                                       uint32_t capacity, uint32_t *count, gdr_error *err);
-
-/* Tests: marks the groups of mesh `mesh` absent where group_resident[g] is 0 (its cluster data's
- * group_count entries), as a streaming residency would, with node_absent_refined its
- * lod_node_count counts of the clusters below each node whose refined group is absent. The
- * traversal and the cluster tests then draw the cut over resident groups (docs/STREAMING.md): an
- * absent group counts as passing. The geometry itself stays uploaded. Waits for the GPU. */
-GDR_API gdr_status gdr_renderer_debug_set_residency(gdr_renderer *renderer, uint32_t mesh,
-                                                    const uint8_t *group_resident,
-                                                    const uint32_t *node_absent_refined, gdr_error *err);
 
 /* A group the last frame found absent where its cut needs it (docs/STREAMING.md): a cluster was
  * drawn in its place while the group's projected error, `priority` (pixels), is above the

@@ -12,6 +12,7 @@
 #include "gdr/cull.h"
 #include "gdr/geometry.h"
 #include "io/io_internal.h"
+#include "io/loaders.h"
 
 /* Builds the clusters of every mesh that has none (all of them after an import; none, normally,
  * after a cache read) and, with `lod` (imports: what the cache then stores), the LOD DAG of every
@@ -117,8 +118,10 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
     gdr_import_options import = {.warning = options->warning, .warning_user = options->warning_user,
                                  .no_progress = options->no_progress, .budget = options->budget,
                                  .allow_outside_files = options->allow_outside_files};
-    if (options->no_cache)
+    if (options->no_cache) {
+        import.sources = options->sources;
         return gdr_import_file(path, &import, out, NULL, err);
+    }
 
     /* Candidates: the given cache_dir, or next to the source then the per-user folder. */
     char candidates[2][PATH_MAX], fallback[PATH_MAX];
@@ -154,6 +157,9 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
         if (!written && count)
             warn(options, "cache not written: %s", write_err.message);
     }
-    gdr_source_list_free(&sources);
+    if (status == GDR_OK && options->sources) /* the caller's, as gdr_load_options.sources asks */
+        *options->sources = sources;
+    else
+        gdr_source_list_free(&sources);
     return status;
 }

@@ -9,6 +9,7 @@
 #include "gdr/geometry.h"
 #include "core/progress.h"
 #include "gdr/io.h"
+#include "io/loaders.h"
 
 /* Largest file an importer reads whole (bytes). */
 #define GDR_IO_MAX_FILE_SIZE (4ull << 30)

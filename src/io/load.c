@@ -8,6 +8,7 @@
 #include "gdr/geometry.h"
 #include "gdr/procedural.h"
 #include "gdr/scene.h"
+#include "io/loaders.h"
 
 /* One option of a built-in scene: an integer in [min, max] or, with `number` set, a float whose
  * range the scene's create function checks. */
@@ -146,6 +147,10 @@ static gdr_status create_builtin(builtin_scene which, const char *text, gdr_scen
 gdr_status gdr_scene_load(const char *spec, const gdr_load_options *options, gdr_scene **out, gdr_error *err)
 {
     *out = NULL;
+    if (options && options->pvs)
+        *options->pvs = NULL;
+    if (options && options->sources)
+        *options->sources = (gdr_source_list){0};
     const char *text;
     builtin_scene which = find_builtin(spec, &text);
     if (which != BUILTIN_NONE && options && options->geometry_in_pages)
@@ -162,5 +167,5 @@ gdr_status gdr_scene_load(const char *spec, const gdr_load_options *options, gdr
         return status;
     }
     /* Files: .gltf / .glb / .obj through the processed-scene cache, .gdrc directly (src/io). */
-    return gdr_scene_load_file(spec, options, out, NULL, err);
+    return gdr_scene_load_file(spec, options, out, options ? options->pvs : NULL, err);
 }

@@ -242,6 +242,8 @@ void gdr_paged_cache_close(gdr_paged_cache *pc)
     free(pc);
 }
 
+const char *gdr_paged_cache_path(const gdr_paged_cache *cache) { return cache->name; }
+
 uint32_t gdr_paged_cache_mesh_count(const gdr_paged_cache *pc) { return pc->mesh_count; }
 const gdr_paged_mesh *gdr_paged_cache_mesh(const gdr_paged_cache *pc, uint32_t mesh)
 {

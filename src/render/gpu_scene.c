@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "gdr/geometry.h"
+#include "gdr/geometry.h" /* gdr_lod_enclosing_sphere */
 #include "render/renderer_internal.h"
 
 static GdrGpuInstance gpu_instance_from(const gdr_scene *scene, const gdr_instance *instance)
@@ -20,18 +20,18 @@ static GdrGpuInstance gpu_instance_from(const gdr_scene *scene, const gdr_instan
 
 /* The clusters of every mesh: the scene's own, or built here for meshes that have none (a scene
  * assembled through the API). built[m] holds what was built and is freed by the caller. */
-static gdr_status gather_clusters(const gdr_scene *scene, const gdr_mesh_clusters **clusters, gdr_mesh_clusters *built,
-                                  gdr_error *err)
+/* Every mesh's clusters, which the scene must bring: uploading never builds geometry (that is the
+ * geometry module's, run by gdr_scene_load or the caller). A mesh with triangles and no clusters is
+ * refused. */
+static gdr_status gather_clusters(const gdr_scene *scene, const gdr_mesh_clusters **clusters, gdr_error *err)
 {
     for (uint32_t m = 0; m < scene->mesh_count; m++) {
         const gdr_mesh *mesh = &scene->meshes[m];
+        if (mesh->clusters.cluster_count == 0 && mesh->index_count > 0)
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "scene upload: mesh %u '%s' has no clusters: build "
+                                 "them first (gdr_scene_build_clusters or gdr_scene_build_lod, gdr/geometry.h; "
+                                 "gdr_scene_load does)", m, mesh->name);
         clusters[m] = &mesh->clusters;
-        if (mesh->clusters.cluster_count > 0 || mesh->index_count == 0)
-            continue;
-        gdr_status status = gdr_meshlets_build(mesh, NULL, &built[m], err);
-        if (status != GDR_OK)
-            return status;
-        clusters[m] = &built[m];
     }
     return GDR_OK;
 }
@@ -196,7 +196,7 @@ static uint64_t tasks_per_instance(const gdr_mesh_clusters *c, const GdrGpuMesh 
 }
 
 /* The task list and the traversal's levels: what every instance could need, up to the limits of
- * gpu_config.h (a frame that needs more counts what it drops); `debug_*` override for tests. */
+ * gpu_config.h (a frame that needs more counts what it drops); render/renderer_debug.h overrides them for tests. */
 static void size_queues(gdr_renderer *r, const gdr_scene *scene, const gdr_mesh_clusters *const *clusters)
 {
     gdr_gpu_scene *g = &r->scene;
@@ -212,10 +212,10 @@ static void size_queues(gdr_renderer *r, const gdr_scene *scene, const gdr_mesh_
     free(per_mesh);
     g->task_capacity = (uint32_t)(tasks < GDR_MAX_TASK_COMMANDS ? tasks : GDR_MAX_TASK_COMMANDS);
     g->traversal_capacity = (uint32_t)(visits < GDR_TRAVERSE_MAX_VISITS ? visits : GDR_TRAVERSE_MAX_VISITS);
-    if (r->debug_task_capacity)
-        g->task_capacity = r->debug_task_capacity;
-    if (r->debug_traversal_capacity)
-        g->traversal_capacity = r->debug_traversal_capacity;
+    if (r->debug.task_capacity)
+        g->task_capacity = r->debug.task_capacity;
+    if (r->debug.traversal_capacity)
+        g->traversal_capacity = r->debug.traversal_capacity;
     g->task_capacity = g->task_capacity ? g->task_capacity : 1;
     g->traversal_capacity = g->traversal_capacity ? g->traversal_capacity : 1;
 }
@@ -348,11 +348,10 @@ gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
                                       GDR_VK_BUFFER_DEVICE, &g->indices, err);
     /* The cluster pool first: it fills the meshes' cluster fields. */
     const gdr_mesh_clusters **clusters = calloc(scene->mesh_count ? scene->mesh_count : 1, sizeof *clusters);
-    gdr_mesh_clusters *built = calloc(scene->mesh_count ? scene->mesh_count : 1, sizeof *built);
-    if (status == GDR_OK && (!clusters || !built))
+    if (status == GDR_OK && !clusters)
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory");
     if (status == GDR_OK)
-        status = gather_clusters(scene, clusters, built, err);
+        status = gather_clusters(scene, clusters, err);
     if (status == GDR_OK)
         status = upload_clusters(r, scene, clusters, err);
     if (status == GDR_OK)
@@ -364,9 +363,6 @@ gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
     if (status == GDR_OK) /* the traversal's visits: even levels, then odd levels */
         status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuNodeVisit) * 2 * (VkDeviceSize)g->traversal_capacity,
                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GDR_VK_BUFFER_DEVICE, &g->traversal, err);
-    for (uint32_t m = 0; built && m < scene->mesh_count; m++)
-        gdr_mesh_clusters_free(&built[m]);
-    free(built);
     free(clusters);
     if (status == GDR_OK)
         status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuMesh) * g->mesh_count,

@@ -3,12 +3,12 @@
 #include <stddef.h>
 #include <vulkan/vulkan.h>
 
-#include "gdr/geometry.h"
+#include "gdr/mesh_clusters.h"
 #include "gdr/renderer.h"
 #include "gpu_shared/gpu_types.h"
 
 _Static_assert(GDR_MESH_MAX_VERTICES == GDR_CLUSTER_MAX_VERTICES && GDR_MESH_MAX_TRIANGLES == GDR_CLUSTER_MAX_TRIANGLES,
-               "the mesh shader's limits are gdr/geometry.h's");
+               "the mesh shader's limits are gdr/mesh_clusters.h's");
 _Static_assert(sizeof(GdrGpuDrawCommand) == sizeof(VkDrawIndexedIndirectCommand), "GdrGpuDrawCommand");
 _Static_assert(offsetof(GdrGpuDrawCommand, vertex_offset) == offsetof(VkDrawIndexedIndirectCommand, vertexOffset) &&
                    offsetof(GdrGpuDrawCommand, first_instance) == offsetof(VkDrawIndexedIndirectCommand, firstInstance),

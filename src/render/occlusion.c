@@ -86,7 +86,7 @@ gdr_status gdr_occlusion_scene_create(gdr_renderer *r, gdr_error *err)
     gdr_occlusion *o = &r->occlusion;
     const gdr_gpu_scene *g = &r->scene;
     /* One level's worth of visits: a frame that defers more traverses the rest in its early phase. */
-    o->occluded_node_capacity = r->debug_occluded_node_capacity ? r->debug_occluded_node_capacity : g->traversal_capacity;
+    o->occluded_node_capacity = r->debug.occluded_node_capacity ? r->debug.occluded_node_capacity : g->traversal_capacity;
     const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     gdr_status status = gdr_vk_buffer_create(&r->allocator, 4 * (VkDeviceSize)(g->instance_count ? g->instance_count : 1),
                                              usage, GDR_VK_BUFFER_DEVICE, &o->occluded_instances, err);

@@ -84,10 +84,6 @@ gdr_status gdr_renderer_create(const gdr_renderer_desc *desc_in, gdr_renderer **
     r->last_slot = -1;
     r->busy_wait = desc.busy_wait;
     r->record_every_frame = desc.record_every_frame;
-    r->debug_task_capacity = desc.debug_task_capacity;
-    r->debug_traversal_capacity = desc.debug_traversal_capacity;
-    r->debug_occluded_node_capacity = desc.debug_occluded_node_capacity;
-    r->debug_shrink_lod_nodes = desc.debug_shrink_lod_nodes;
     gdr_vk_context_desc context_desc = {.device = desc.device, .validate = desc.validate,
                                         .synchronization_validation = desc.synchronization_validation,
                                         .disable_mesh_shaders = desc.disable_mesh_shaders,
@@ -494,3 +490,5 @@ void gdr_renderer_size(const gdr_renderer *r, uint32_t *width, uint32_t *height)
     *width = r->width;
     *height = r->height;
 }
+
+void gdr_renderer_set_debug(gdr_renderer *r, const gdr_renderer_debug *debug) { r->debug = *debug; }

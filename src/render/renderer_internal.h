@@ -4,6 +4,7 @@
 
 #include "gdr/renderer.h"
 #include "render/frame_plan.h"
+#include "render/renderer_debug.h"
 #include "render/materials.h"
 #include "render/occlusion.h"
 #include "render/pipelines.h"
@@ -185,9 +186,7 @@ struct gdr_renderer {
     gdr_frame_slot slots[GDR_FRAMES_IN_FLIGHT];
     uint32_t frame_index;
     bool record_every_frame;      /* gdr_renderer_desc.record_every_frame: never resubmit */
-    uint32_t debug_task_capacity, debug_traversal_capacity, debug_occluded_node_capacity; /* gdr_renderer_desc's
-                                                                                               test settings */
-    bool debug_shrink_lod_nodes;
+    gdr_renderer_debug debug;     /* tests' knobs (render/renderer_debug.h) */
     int last_slot; /* slot of the last submitted frame, -1 before the first */
 };
 

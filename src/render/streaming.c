@@ -156,8 +156,8 @@ static uint64_t staging_bytes(const gdr_streaming *s, const gdr_scene *scene)
 gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr_streaming_desc *desc, gdr_error *err)
 {
     gdr_streaming *s = &r->stream;
-    if (!desc || !desc->cache_path)
-        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "streaming: no cache path");
+    if (!desc || !desc->cache)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "streaming: no paged cache");
     if (desc->geometry_budget_bytes > GDR_GEOMETRY_BUDGET_MAX)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "streaming: a geometry budget of %llu MiB is over the "
                              "%llu MiB the pool's 32-bit offsets reach",
@@ -167,9 +167,8 @@ gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr
     s->scene = scene;
     s->wait_for_loads = desc->wait_for_loads;
     s->upload_budget = desc->upload_budget_bytes ? desc->upload_budget_bytes : GDR_UPLOAD_BUDGET_DEFAULT;
-    gdr_status status = gdr_paged_cache_open(desc->cache_path, &s->cache, err);
-    if (status == GDR_OK)
-        status = check_cache_matches(s, scene, desc->cache_path, err);
+    s->cache = desc->cache;
+    gdr_status status = check_cache_matches(s, scene, gdr_paged_cache_path(s->cache), err);
     gdr_residency_desc res = {.cache = s->cache,
                               .budget_bytes = desc->geometry_budget_bytes ? desc->geometry_budget_bytes
                                                                           : default_budget(r),
@@ -214,8 +213,7 @@ void gdr_streaming_destroy(gdr_renderer *r)
     gdr_page_loader_destroy(s->loader);
     for (uint32_t i = 0; i < s->pending_count; i++)
         gdr_page_free(&s->pending[i].page);
-    gdr_residency_destroy(s->residency);
-    gdr_paged_cache_close(s->cache);
+    gdr_residency_destroy(s->residency); /* the paged cache stays open: it is the caller's */
     if (r->ctx)
         gdr_vk_buffer_destroy(r->ctx, &s->pool);
     free(s->pending), free(s->slot_page), free(s->page_base), free(s->mesh_dirty), free(s->resident);

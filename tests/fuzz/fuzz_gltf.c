@@ -4,6 +4,7 @@
 
 #include "gdr/io.h"
 #include "fuzz_geometry.h"
+#include "io/loaders.h"
 
 static void ignore_warning(void *user, const char *message)
 {

@@ -9,6 +9,7 @@
 
 #include "gdr/io.h"
 #include "gdr/scene.h"
+#include "io/loaders.h"
 
 /* fuzz_geometry.h's budgets for pixels and decoded bytes: an image of up to about 600,000 pixels
  * (RGBA, mip chain and decoder memory within 8 MiB). */

@@ -16,6 +16,7 @@
 #include "geometry/lod_cut.h"
 #include "procedural/procedural_meshes.h"
 #include "test_util.h"
+#include "io/loaders.h"
 
 #define ASSIMP_MODELS_DIR "/usr/share/assimp/models"
 

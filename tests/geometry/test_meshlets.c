@@ -15,6 +15,7 @@
 #include "gdr/scene.h"
 #include "procedural/procedural_meshes.h"
 #include "test_util.h"
+#include "io/loaders.h"
 
 #define ASSIMP_MODELS_DIR "/usr/share/assimp/models"
 

@@ -3,6 +3,7 @@
 #ifndef GDR_GPU_TEST_UTIL_H
 #define GDR_GPU_TEST_UTIL_H
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -62,6 +63,37 @@ static inline int compare_u32(const void *a, const void *b)
 {
     uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
     return x < y ? -1 : x > y;
+}
+
+/* The paged caches opened for streamed renderers, closed when the test exits: a streamed renderer
+ * reads its cache until it is destroyed. */
+#define GPU_TEST_PAGED_CACHES 32
+static gdr_paged_cache *gpu_test_paged_caches[GPU_TEST_PAGED_CACHES];
+
+static inline void gpu_test_close_paged_caches(void)
+{
+    for (int i = 0; i < GPU_TEST_PAGED_CACHES; i++)
+        gdr_paged_cache_close(gpu_test_paged_caches[i]), gpu_test_paged_caches[i] = NULL;
+}
+
+/* `path` opened as a paged cache for gdr_streaming_desc.cache; NULL, with a message, on failure. */
+static inline gdr_paged_cache *gpu_test_paged_cache(const char *path)
+{
+    static int registered;
+    if (!registered)
+        registered = atexit(gpu_test_close_paged_caches) == 0;
+    for (int i = 0; i < GPU_TEST_PAGED_CACHES; i++) {
+        if (gpu_test_paged_caches[i])
+            continue;
+        gdr_error err = {0};
+        if (gdr_paged_cache_open(path, &gpu_test_paged_caches[i], &err) != GDR_OK) {
+            fprintf(stderr, "%s: %s\n", path, err.message);
+            return NULL;
+        }
+        return gpu_test_paged_caches[i];
+    }
+    fprintf(stderr, "%s: more than %d paged caches open\n", path, GPU_TEST_PAGED_CACHES);
+    return NULL;
 }
 
 #endif

@@ -10,6 +10,7 @@
 #include "gdr/geometry.h"
 #include "gdr/io.h"
 #include "gpu_test_util.h"
+#include "render/renderer_debug.h"
 
 #define WIDTH 192
 #define HEIGHT 128
@@ -53,14 +54,14 @@ static bool same_clusters(const frame_result *a, const frame_result *b)
            memcmp(a->clusters, b->clusters, sizeof *a->clusters * a->cluster_count) == 0;
 }
 
-static gdr_renderer *make_renderer(const gdr_scene *scene, gdr_renderer_desc desc)
+static gdr_renderer *make_renderer(const gdr_scene *scene, gdr_renderer_debug debug)
 {
     gdr_error err = {0};
     gdr_renderer *r = NULL;
-    desc.width = WIDTH;
-    desc.height = HEIGHT;
-    desc.validate = true;
-    if (gdr_renderer_create(&desc, &r, &err) != GDR_OK || gdr_renderer_set_scene(r, scene, &err) != GDR_OK) {
+    gdr_renderer_desc desc = {.width = WIDTH, .height = HEIGHT, .validate = true};
+    if (gdr_renderer_create(&desc, &r, &err) == GDR_OK)
+        gdr_renderer_set_debug(r, &debug);
+    if (!r || gdr_renderer_set_scene(r, scene, &err) != GDR_OK) {
         fprintf(stderr, "renderer: %s\n", err.message);
         gdr_renderer_destroy(r);
         return NULL;
@@ -116,7 +117,7 @@ static void check_same_as_flat(gdr_renderer *r, unsigned seed)
 /* A node test that is not conservative (shrunken spheres) loses clusters: the image tests see it. */
 static void check_wrong_node_test_is_caught(const gdr_scene *scene, gdr_renderer *good)
 {
-    gdr_renderer *bad = make_renderer(scene, (gdr_renderer_desc){.debug_shrink_lod_nodes = true});
+    gdr_renderer *bad = make_renderer(scene, (gdr_renderer_debug){.shrink_lod_nodes = true});
     CHECK(bad != NULL);
     unsigned rng = 5;
     uint32_t differing = 0;
@@ -136,7 +137,7 @@ static void check_wrong_node_test_is_caught(const gdr_scene *scene, gdr_renderer
 /* Queues too small for the frame: the statistics say how much did not fit. */
 static void check_overflow_reported(const gdr_scene *scene)
 {
-    gdr_renderer_desc descs[2] = {{.debug_traversal_capacity = 3}, {.debug_task_capacity = 5}};
+    gdr_renderer_debug descs[2] = {{.traversal_capacity = 3}, {.task_capacity = 5}};
     for (int i = 0; i < 2; i++) {
         gdr_renderer *r = make_renderer(scene, descs[i]);
         CHECK(r != NULL);
@@ -184,8 +185,8 @@ static bool add_wall(gdr_scene *scene)
  * (counted as overflow): every image equals the one without occlusion culling. */
 static void check_deferred_nodes(gdr_scene *scene)
 {
-    gdr_renderer *r = add_wall(scene) ? make_renderer(scene, (gdr_renderer_desc){0}) : NULL;
-    gdr_renderer *small = r ? make_renderer(scene, (gdr_renderer_desc){.debug_occluded_node_capacity = 2}) : NULL;
+    gdr_renderer *r = add_wall(scene) ? make_renderer(scene, (gdr_renderer_debug){0}) : NULL;
+    gdr_renderer *small = r ? make_renderer(scene, (gdr_renderer_debug){.occluded_node_capacity = 2}) : NULL;
     CHECK(r != NULL && small != NULL);
     uint64_t deferred = 0, retested = 0, occluded = 0, overflow = 0;
     uint32_t differing = 0;
@@ -226,7 +227,7 @@ int main(void)
     gdr_error err = {0};
     gdr_scene *scene = NULL;
     CHECK(gdr_scene_load("lod-field:instances=60,triangles=30000,seed=3", NULL, &scene, &err) == GDR_OK);
-    gdr_renderer *r = scene ? make_renderer(scene, (gdr_renderer_desc){0}) : NULL;
+    gdr_renderer *r = scene ? make_renderer(scene, (gdr_renderer_debug){0}) : NULL;
     if (r) {
         check_same_as_flat(r, 11);
         check_wrong_node_test_is_caught(scene, r);

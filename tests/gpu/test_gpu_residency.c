@@ -13,6 +13,7 @@
 #include "gdr/io.h"
 #include "geometry/lod_cut.h"
 #include "gpu_test_util.h"
+#include "render/renderer_debug.h"
 
 #define WIDTH 192
 #define HEIGHT 128

@@ -21,6 +21,7 @@
 #include "geometry/lod_cut.h"
 #include "gpu_test_util.h"
 #include "stream/residency.h"
+#include "io/loaders.h"
 
 #define WIDTH 160
 #define HEIGHT 120
@@ -212,7 +213,7 @@ static gdr_renderer *streamed_renderer(const gdr_scene *scene, const char *path,
     gdr_error err = {0};
     gdr_renderer *r = NULL;
     gdr_renderer_desc desc = {.width = WIDTH, .height = HEIGHT, .validate = true};
-    gdr_streaming_desc stream = {.cache_path = path, .geometry_budget_bytes = budget,
+    gdr_streaming_desc stream = {.cache = gpu_test_paged_cache(path), .geometry_budget_bytes = budget,
                                  .upload_budget_bytes = UPLOAD_BUDGET, .wait_for_loads = true};
     if (gdr_renderer_create(&desc, &r, &err) != GDR_OK ||
         gdr_renderer_set_scene_streamed(r, scene, &stream, &err) != GDR_OK) {
@@ -465,7 +466,7 @@ static void run(const gdr_scene *scene, const char *path)
     gdr_renderer *small = NULL;
     gdr_error err = {0};
     gdr_renderer_desc desc = {.width = WIDTH, .height = HEIGHT, .validate = true};
-    gdr_streaming_desc tiny = {.cache_path = path, .geometry_budget_bytes = 1024};
+    gdr_streaming_desc tiny = {.cache = gpu_test_paged_cache(path), .geometry_budget_bytes = 1024};
     CHECK(gdr_renderer_create(&desc, &small, &err) == GDR_OK &&
           gdr_renderer_set_scene_streamed(small, scene, &tiny, &err) == GDR_ERROR_CAPACITY);
     printf("a 1 KiB budget: %s\n", err.message);

@@ -15,6 +15,7 @@
 #include "gdr/io.h"
 #include "gdr/paged_cache.h"
 #include "gpu_test_util.h"
+#include "io/loaders.h"
 
 #define WIDTH 160
 #define HEIGHT 96
@@ -64,7 +65,7 @@ static gdr_renderer *streamed(const gdr_scene *paged, const char *path)
     gdr_error err = {0};
     gdr_renderer *r = NULL;
     gdr_renderer_desc desc = {.width = WIDTH, .height = HEIGHT, .validate = true};
-    gdr_streaming_desc stream = {.cache_path = path, .geometry_budget_bytes = 256u << 20, .wait_for_loads = true};
+    gdr_streaming_desc stream = {.cache = gpu_test_paged_cache(path), .geometry_budget_bytes = 256u << 20, .wait_for_loads = true};
     if (gdr_renderer_create(&desc, &r, &err) != GDR_OK || gdr_renderer_set_scene_streamed(r, paged, &stream, &err) != GDR_OK) {
         fprintf(stderr, "streamed renderer: %s\n", err.message);
         gdr_renderer_destroy(r);

@@ -17,6 +17,7 @@
 #include "geometry/cluster_checks.h"
 #include "io_test_helpers.h"
 #include "test_util.h"
+#include "io/loaders.h"
 
 static int same_scene(const gdr_scene *a, const gdr_scene *b)
 {

@@ -16,6 +16,7 @@
 #include "gdr/io.h"
 #include "gdr/paged_cache.h"
 #include "test_util.h"
+#include "io/loaders.h"
 
 /* A vertex of the page and one of the mesh: the same bytes. */
 static int same_vertex(const gdr_page_vertex *pv, const gdr_mesh *mesh, uint32_t v)

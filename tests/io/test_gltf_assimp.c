@@ -12,6 +12,7 @@
 
 #include "gdr/io.h"
 #include "test_util.h"
+#include "io/loaders.h"
 
 #ifndef ASSIMP_GLTF2_DIR
 #define ASSIMP_GLTF2_DIR "/usr/share/assimp/models/glTF2"

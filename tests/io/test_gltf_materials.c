@@ -14,6 +14,7 @@
 #include "gdr/io.h"
 #include "io_test_helpers.h"
 #include "test_util.h"
+#include "io/loaders.h"
 
 static char json[65536];
 static test_warnings warnings;

@@ -22,6 +22,7 @@
 #include "gdr/io.h"
 #include "io/io_test_helpers.h"
 #include "test_util.h"
+#include "io/loaders.h"
 
 static test_warnings warnings;
 static gdr_error err;

@@ -8,6 +8,7 @@
 #include "gdr/io.h"
 #include "io_test_helpers.h"
 #include "test_util.h"
+#include "io/loaders.h"
 
 static test_warnings warnings;
 static gdr_error err;

@@ -16,6 +16,7 @@
 #include "gdr/io.h"
 #include "io/io_test_helpers.h"
 #include "test_util.h"
+#include "io/loaders.h"
 
 typedef struct text {
     char *data;

@@ -134,22 +134,14 @@ int gdr_cmd_build(int argc, char **argv)
     gdr_source_list sources = {0};
     gdr_status status;
     gdr_pvs *pvs = NULL; /* a .gdrc input's precomputed visibility is carried over unless rebaked */
-    int is_builtin = gdr_scene_spec_is_builtin(input);
-    size_t length = strlen(input);
+    /* A .gdrc input's precomputed visibility is carried over unless rebaked; a source's files are
+     * recorded in the cache written. */
     gdr_load_options load = {.no_cache = 1, .no_progress = no_progress, .budget = budget,
-                             .allow_outside_files = allow_outside_files};
-    if (is_builtin) {
-        status = gdr_scene_load(input, &load, &scene, &err);
-    } else if (length > 5 && strcmp(input + length - 5, ".gdrc") == 0) {
-        status = gdr_scene_load_file(input, &load, &scene, &pvs, &err);
-        if (status == GDR_OK && pvs && !pvs_wanted)
-            printf("pvs: kept from %s (%u cells, %u objects)\n", input, gdr_pvs_cell_count(pvs),
-                   gdr_pvs_object_count(pvs));
-    } else {
-        gdr_import_options import = {.no_progress = no_progress, .sources = &sources, .budget = budget,
-                                     .allow_outside_files = allow_outside_files};
-        status = gdr_import_file(input, &import, &scene, NULL, &err);
-    }
+                             .allow_outside_files = allow_outside_files, .pvs = &pvs, .sources = &sources};
+    status = gdr_scene_load(input, &load, &scene, &err);
+    if (status == GDR_OK && pvs && !pvs_wanted)
+        printf("pvs: kept from %s (%u cells, %u objects)\n", input, gdr_pvs_cell_count(pvs),
+               gdr_pvs_object_count(pvs));
     if (status == GDR_OK && page_bytes)
         status = quantize(scene, &err);
     if (status == GDR_OK && pvs_wanted) {

@@ -101,9 +101,8 @@ int gdr_cmd_info(int argc, char **argv)
     gdr_error err = {0};
     gdr_scene *scene = NULL;
     gdr_pvs *pvs = NULL;
-    /* Files go the way gdr_scene_load sends them, asking for their cache's PVS too. */
-    gdr_status status = gdr_scene_spec_is_builtin(input) ? gdr_scene_load(input, &options, &scene, &err)
-                                                         : gdr_scene_load_file(input, &options, &scene, &pvs, &err);
+    options.pvs = &pvs; /* a cache's precomputed visibility is described too */
+    gdr_status status = gdr_scene_load(input, &options, &scene, &err);
     if (status != GDR_OK)
         return cli_load_failed(input, &err);
     uint64_t vertices = 0, unique_triangles = 0, clusters = 0, level0 = 0, cluster_triangles = 0;

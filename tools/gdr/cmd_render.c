@@ -196,17 +196,21 @@ static gdr_status load_scene(render_options *o, gdr_scene **scene, gdr_pvs **pvs
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "--geometry-budget/--upload-budget stream from a cache: "
                              "give a .gdrc written with 'gdr build --pages' (not '%s')", o->scene);
     o->load.geometry_in_pages = streamed(o);
-    if (gdr_scene_spec_is_builtin(o->scene) || streamed(o))
-        return gdr_scene_load(o->scene, &o->load, scene, err);
-    return gdr_scene_load_file(o->scene, &o->load, scene, pvs, err);
+    o->load.pvs = streamed(o) ? NULL : pvs;
+    return gdr_scene_load(o->scene, &o->load, scene, err);
 }
 
-/* The scene, streamed from its cache file when a budget is given (the scene is that file). */
-static gdr_status set_scene(gdr_renderer *renderer, const gdr_scene *scene, const render_options *o, gdr_error *err)
+/* The scene, streamed from its cache file when a budget is given (the scene is that file, opened
+ * here as a paged cache: *paged, closed by the caller after the renderer). */
+static gdr_status set_scene(gdr_renderer *renderer, const gdr_scene *scene, const render_options *o,
+                            gdr_paged_cache **paged, gdr_error *err)
 {
     if (!streamed(o))
         return gdr_renderer_set_scene(renderer, scene, err);
-    gdr_streaming_desc stream = {.cache_path = o->scene,
+    gdr_status status = gdr_paged_cache_open(o->scene, paged, err);
+    if (status != GDR_OK)
+        return status;
+    gdr_streaming_desc stream = {.cache = *paged,
                                  .geometry_budget_bytes = (uint64_t)o->geometry_budget_mib << 20,
                                  .upload_budget_bytes = (uint64_t)o->upload_budget_mib << 20};
     return gdr_renderer_set_scene_streamed(renderer, scene, &stream, err);
@@ -236,11 +240,12 @@ int gdr_cmd_render(int argc, char **argv)
     }
     gdr_renderer_desc desc = {.width = o.width, .height = o.height, .device = o.device, .validate = o.validate};
     gdr_renderer *renderer = NULL;
+    gdr_paged_cache *paged = NULL;
     gdr_frame_stats stats;
     uint8_t *pixels = NULL;
     int result = 0;
     gdr_frame_desc frame = render_options_frame(&o, render_options_camera(scene, &o));
-    if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK || set_scene(renderer, scene, &o, &err) != GDR_OK ||
+    if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK || set_scene(renderer, scene, &o, &paged, &err) != GDR_OK ||
         gdr_renderer_set_pvs(renderer, pvs, &err) != GDR_OK || render_frames(renderer, &frame, &o, &stats, &err) != GDR_OK) {
         result = fail(&err);
         goto done;
@@ -270,6 +275,7 @@ int gdr_cmd_render(int argc, char **argv)
 done:
     free(pixels);
     gdr_renderer_destroy(renderer);
+    gdr_paged_cache_close(paged);
     gdr_pvs_destroy(pvs);
     gdr_scene_destroy(scene);
     return result;

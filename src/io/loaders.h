@@ -1,0 +1,89 @@
+/* The loaders behind gdr_scene_load (gdr/io.h), for the library, its tests and benchmarks: the
+ * importers of each format, the cache's readers and the path loader. Applications call
+ * gdr_scene_load. */
+#ifndef GDR_IO_LOADERS_H
+#define GDR_IO_LOADERS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "gdr/io.h"
+
+/* --- importers ------------------------------------------------------------------------------ */
+
+/* Zero-initialise; every field has a default. */
+typedef struct gdr_import_options {
+    gdr_warning_fn warning; /* NULL: "gdr: warning: <message>" on stderr */
+    void *warning_user;
+    int no_progress;          /* 1: no progress bar (default: shown on a terminal for long work) */
+    gdr_source_list *sources; /* optional: receives every file read (the source and its buffers,
+                                 images), for the cache's staleness check */
+    gdr_budget budget;        /* limits for untrusted files (gdr/scene.h); zero: the defaults */
+    int allow_outside_files;  /* 1: external URIs may leave the file's folder (absolute paths, '..',
+                                 symlinks pointing out); 0 (default): such a URI is refused */
+} gdr_import_options;
+
+typedef struct gdr_import_result {
+    uint32_t warning_count;
+} gdr_import_result;
+
+/* Imports a .gltf or .glb file (told apart by content: GLB starts with "glTF"). External
+ * buffers and images are resolved relative to the file's folder. result may be NULL. */
+gdr_status gdr_import_gltf(const char *path, const gdr_import_options *options, gdr_scene **out,
+                                   gdr_import_result *result, gdr_error *err);
+
+/* Imports glTF JSON or GLB from memory. `name` is used in messages; `base_dir` resolves external
+ * URIs (NULL: external URIs are refused, only data: URIs and the GLB chunk are used). */
+gdr_status gdr_import_gltf_memory(const void *data, size_t size, const char *name, const char *base_dir,
+                                          const gdr_import_options *options, gdr_scene **out,
+                                          gdr_import_result *result, gdr_error *err);
+
+/* Imports a Wavefront .obj file: v/vt/vn/f, polygons fan-triangulated, negative indices, one mesh
+ * per group/object (g, o) and one instance of each with the identity transform. */
+gdr_status gdr_import_obj(const char *path, const gdr_import_options *options, gdr_scene **out,
+                                  gdr_import_result *result, gdr_error *err);
+gdr_status gdr_import_obj_memory(const void *data, size_t size, const char *name,
+                                         const gdr_import_options *options, gdr_scene **out,
+                                         gdr_import_result *result, gdr_error *err);
+
+/* Reads a cache. Checks magic, version, every size, offset and checksum. When build_options is
+ * not NULL, a cache built with different options is refused (stale); each recorded source file
+ * that exists with a different size or contents makes it stale too (a missing one does not:
+ * a cache may travel without its sources). On GDR_OK, *out is the scene and, when out_pvs is not
+ * NULL, *out_pvs the precomputed visibility (a gdr_pvs the caller destroys with gdr_pvs_destroy),
+ * or NULL when the cache holds none. Either way a 'PVIS' section is checked (gdr_pvs_load, and its
+ * object count against the scene's instances): a damaged one makes the whole cache refused,
+ * naming the section. */
+gdr_status gdr_cache_read(const char *path, const char *build_options, gdr_scene **out, gdr_pvs **out_pvs,
+                                  gdr_error *err);
+
+/* Reads a cache with geometry pages for streaming (gdr_renderer_set_scene_streamed): the header, the
+ * table and, each with a positioned read and its checksum checked, every section but the geometry
+ * the pages hold too (vertices, indices, vertex colours, cluster vertex lists and triangles, the
+ * pages). The scene has every mesh's counts, bounds, cluster and group records and LOD hierarchy,
+ * the materials, textures, instances and cameras, and scene->geometry_in_pages set: its meshes hold
+ * no vertex or index arrays. Staleness as in gdr_cache_read. A cache without pages is refused
+ * (GDR_ERROR_INVALID_ARGUMENT). out_bytes_read (may be NULL): the bytes read from the file. */
+gdr_status gdr_cache_read_for_streaming(const char *path, const char *build_options, gdr_scene **out,
+                                                uint64_t *out_bytes_read, gdr_error *err);
+
+/* Parses a cache from memory without any staleness check (the fuzz target uses this); out_pvs as
+ * in gdr_cache_read. */
+gdr_status gdr_cache_read_memory(const void *data, size_t size, const char *name, gdr_scene **out,
+                                         gdr_pvs **out_pvs, gdr_error *err);
+
+/* Imports any supported source file (.gltf, .glb, .obj by extension) without the cache, and
+ * builds every mesh's clusters (gdr_scene_build_clusters, include/gdr/geometry.h). */
+gdr_status gdr_import_file(const char *path, const gdr_import_options *options, gdr_scene **out,
+                                   gdr_import_result *result, gdr_error *err);
+
+/* A source file (.gltf, .glb, .obj) through the cache, or a .gdrc file directly: what
+ * gdr_scene_load does for paths. See gdr_load_options in gdr/io.h (NULL: defaults). Every mesh of
+ * the scene has its clusters: read from the cache, or built (a cache written from a scene without
+ * them). When out_pvs is not NULL, *out_pvs is the precomputed visibility of the cache the scene
+ * was read from, a gdr_pvs to destroy with gdr_pvs_destroy, or NULL (an import, or a cache without
+ * one). A stale cache is rebuilt from the source without it (the bake is not redone). */
+gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options, gdr_scene **out,
+                                       gdr_pvs **out_pvs, gdr_error *err);
+
+#endif

@@ -1,0 +1,35 @@
+/* Knobs for tests only, kept out of the public API: capacities forced small to provoke overflows,
+ * a deliberately wrong LOD hierarchy, residency set by hand. */
+#ifndef GDR_RENDERER_DEBUG_H
+#define GDR_RENDERER_DEBUG_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "gdr/renderer.h"
+
+typedef struct gdr_renderer_debug {
+    /* The task list's and the LOD traversal's capacities per frame phase, and the occluded-node
+     * list's (0: sized from the scene), to provoke their overflow, which the statistics report. */
+    uint32_t task_capacity;
+    uint32_t traversal_capacity;
+    uint32_t occluded_node_capacity;
+    /* A deliberately wrong LOD hierarchy (node spheres shrunk), to show that the image tests catch
+     * a node test that is not conservative. */
+    bool shrink_lod_nodes;
+} gdr_renderer_debug;
+
+/* Applies `debug` to the scenes set after this call (call it between gdr_renderer_create and
+ * gdr_renderer_set_scene). */
+void gdr_renderer_set_debug(gdr_renderer *renderer, const gdr_renderer_debug *debug);
+
+/* Tests: marks the groups of mesh `mesh` absent where group_resident[g] is 0 (its cluster data's
+ * group_count entries), as a streaming residency would, with node_absent_refined its
+ * lod_node_count counts of the clusters below each node whose refined group is absent. The
+ * traversal and the cluster tests then draw the cut over resident groups (docs/STREAMING.md): an
+ * absent group counts as passing. The geometry itself stays uploaded. Waits for the GPU. */
+gdr_status gdr_renderer_debug_set_residency(gdr_renderer *renderer, uint32_t mesh,
+                                                    const uint8_t *group_resident,
+                                                    const uint32_t *node_absent_refined, gdr_error *err);
+
+#endif
