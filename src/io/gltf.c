@@ -298,15 +298,13 @@ static gdr_status texture_transform(gltf_ctx *c, const cJSON *info, const char *
         return GDR_OK;
     char place[224];
     snprintf(place, sizeof place, "%s.extensions.KHR_texture_transform", here);
-    double rotation = 0.0;
     gdr_status status = gltf_get_floats(c, t, "offset", place, 2, &ref->offset.x);
     if (status == GDR_OK)
         status = gltf_get_floats(c, t, "scale", place, 2, &ref->scale.x);
     if (status == GDR_OK)
-        status = gltf_get_number(c, t, "rotation", place, &rotation);
+        status = gltf_get_float(c, t, "rotation", place, &ref->rotation);
     if (status == GDR_OK)
         status = gltf_get_uint(c, t, "texCoord", place, 0, UINT32_MAX, texcoord);
-    ref->rotation = (float)rotation;
     return status;
 }
 
@@ -323,13 +321,13 @@ static gdr_status texture_ref(gltf_ctx *c, const cJSON *parent, const char *key,
     char here[160];
     snprintf(here, sizeof here, "%s.%s", place, key);
     uint32_t texture = 0, texcoord = 0;
-    double value = factor ? *factor : 1.0;
+    float value = factor ? *factor : 1.0f;
     gdr_status status = gltf_get_object(c, parent, key, place, 0, &info);
     if (status != GDR_OK || !info)
         return status;
     status = gltf_get_uint(c, info, "texCoord", here, 0, UINT32_MAX, &texcoord);
     if (status == GDR_OK && factor_key)
-        status = gltf_get_number(c, info, factor_key, here, &value);
+        status = gltf_get_float(c, info, factor_key, here, &value);
     if (status == GDR_OK)
         status = gltf_get_uint(c, info, "index", here, 1, UINT32_MAX, &texture);
     if (status == GDR_OK)
@@ -337,7 +335,7 @@ static gdr_status texture_ref(gltf_ctx *c, const cJSON *parent, const char *key,
     if (status != GDR_OK)
         return status;
     if (factor)
-        *factor = (float)value;
+        *factor = value;
     if (texcoord != 0) {
         gdr_io_warn(&c->warnings, "%s: %s: texture coordinate set %u is not supported (meshes carry set 0); texture "
                     "left out", c->name, here, texcoord);
@@ -393,12 +391,11 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
     gdr_material m = gdr_material_default();
     const char *name = NULL, *alpha_mode = NULL;
     const cJSON *pbr = NULL, *double_sided = cJSON_GetObjectItemCaseSensitive(json, "doubleSided");
-    double metallic = 1.0, roughness = 1.0, cutoff = 0.5;
     gdr_status status = gltf_get_string(c, json, "name", here, &name);
     if (status == GDR_OK)
         status = gltf_get_string(c, json, "alphaMode", here, &alpha_mode);
     if (status == GDR_OK)
-        status = gltf_get_number(c, json, "alphaCutoff", here, &cutoff);
+        status = gltf_get_float(c, json, "alphaCutoff", here, &m.alpha_cutoff);
     if (status == GDR_OK)
         status = gltf_get_object(c, json, "pbrMetallicRoughness", here, 0, &pbr);
     if (status == GDR_OK)
@@ -408,7 +405,6 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
     if (double_sided && !cJSON_IsBool(double_sided))
         return gltf_fail(c, GDR_ERROR_PARSE, "%s.doubleSided: expected a boolean", here);
     m.double_sided = cJSON_IsTrue(double_sided) ? 1u : 0u;
-    m.alpha_cutoff = (float)cutoff;
     if (alpha_mode) {
         if (strcmp(alpha_mode, "MASK") == 0)
             m.alpha_mode = GDR_ALPHA_MASK;
@@ -424,9 +420,9 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
         snprintf(pplace, sizeof pplace, "%s.pbrMetallicRoughness", here);
         status = gltf_get_floats(c, pbr, "baseColorFactor", pplace, 4, &m.base_color.x);
         if (status == GDR_OK)
-            status = gltf_get_number(c, pbr, "metallicFactor", pplace, &metallic);
+            status = gltf_get_float(c, pbr, "metallicFactor", pplace, &m.metallic_factor);
         if (status == GDR_OK)
-            status = gltf_get_number(c, pbr, "roughnessFactor", pplace, &roughness);
+            status = gltf_get_float(c, pbr, "roughnessFactor", pplace, &m.roughness_factor);
         if (status == GDR_OK)
             status = texture_ref(c, pbr, "baseColorTexture", pplace, 1, NULL, NULL, &m.base_color_texture);
         if (status == GDR_OK)
@@ -434,8 +430,6 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
         if (status != GDR_OK)
             return status;
     }
-    m.metallic_factor = (float)metallic;
-    m.roughness_factor = (float)roughness;
     status = texture_ref(c, json, "normalTexture", here, 0, "scale", &m.normal_scale, &m.normal_texture);
     if (status == GDR_OK)
         status = texture_ref(c, json, "occlusionTexture", here, 0, "strength", &m.occlusion_strength,
@@ -446,6 +440,10 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
         status = emissive_strength(c, json, here, &m.emissive);
     if (status != GDR_OK)
         return status;
+    /* The rule the cache reader applies (an emissive factor times its strength may overflow). */
+    const char *problem = gdr_material_problem(&m);
+    if (problem)
+        return gltf_fail(c, GDR_ERROR_PARSE, "%s: %s", here, problem);
     return gdr_scene_add_material(c->scene, &m, NULL, c->err);
 }
 

@@ -51,6 +51,24 @@ gdr_status gltf_get_number(gltf_ctx *c, const cJSON *obj, const char *key, const
     return GDR_OK;
 }
 
+/* A number that becomes a float: finite, and finite once rounded to 32 bits (1e300 would be +inf). */
+static int fits_float(double v)
+{
+    return isfinite(v) && fabs(v) <= GLTF_MAX_FLOAT;
+}
+
+gdr_status gltf_get_float(gltf_ctx *c, const cJSON *obj, const char *key, const char *place, float *out)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!item)
+        return GDR_OK;
+    if (!cJSON_IsNumber(item) || !fits_float(item->valuedouble))
+        return gltf_fail(c, GDR_ERROR_PARSE, "%s.%s: expected a finite number of at most %g in magnitude (a 32-bit "
+                         "float)", place, key, GLTF_MAX_FLOAT);
+    *out = (float)item->valuedouble;
+    return GDR_OK;
+}
+
 gdr_status gltf_get_string(gltf_ctx *c, const cJSON *obj, const char *key, const char *place, const char **out)
 {
     const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
@@ -103,8 +121,9 @@ gdr_status gltf_get_floats(gltf_ctx *c, const cJSON *obj, const char *key, const
     uint32_t i = 0;
     float values[16];
     for (const cJSON *e = item->child; e && i < n; e = e->next, i++) {
-        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > 3.0e38)
-            return gltf_fail(c, GDR_ERROR_PARSE, "%s.%s[%u]: expected a finite number", place, key, i);
+        if (!cJSON_IsNumber(e) || !fits_float(e->valuedouble))
+            return gltf_fail(c, GDR_ERROR_PARSE, "%s.%s[%u]: expected a finite number of at most %g in magnitude (a "
+                             "32-bit float)", place, key, i, GLTF_MAX_FLOAT);
         values[i] = (float)e->valuedouble;
     }
     memcpy(out, values, sizeof(float) * n);

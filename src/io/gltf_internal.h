@@ -71,6 +71,11 @@ gdr_status gltf_fail(gltf_ctx *c, gdr_status status, const char *format, ...) __
 gdr_status gltf_get_uint(gltf_ctx *c, const cJSON *obj, const char *key, const char *place, int required,
                          uint32_t max, uint32_t *out);
 gdr_status gltf_get_number(gltf_ctx *c, const cJSON *obj, const char *key, const char *place, double *out);
+/* The largest magnitude a number read into a float may have (a little below FLT_MAX, so that rounding
+ * never makes it infinite). */
+#define GLTF_MAX_FLOAT 3.0e38
+/* A number read into a float: refused unless finite and at most GLTF_MAX_FLOAT in magnitude. */
+gdr_status gltf_get_float(gltf_ctx *c, const cJSON *obj, const char *key, const char *place, float *out);
 gdr_status gltf_get_string(gltf_ctx *c, const cJSON *obj, const char *key, const char *place, const char **out);
 gdr_status gltf_get_object(gltf_ctx *c, const cJSON *obj, const char *key, const char *place, int required,
                            const cJSON **out);

@@ -204,6 +204,10 @@ gdr_status gdr_scene_set_mesh_colors(gdr_scene *scene, uint32_t mesh, const gdr_
 gdr_status gdr_scene_add_material(gdr_scene *scene, const gdr_material *material, uint32_t *out_index,
                                   gdr_error *err)
 {
+    const char *problem = gdr_material_problem(material);
+    if (problem)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "material %u ('%.*s'): %s", scene->material_count, GDR_NAME_MAX - 1,
+                             material->name, problem);
     gdr_status status = reserve_one((void **)&scene->materials, &scene->material_capacity,
                                     scene->material_count, sizeof(gdr_material), err);
     if (status != GDR_OK)

@@ -504,6 +504,64 @@ static void test_messages(void)
     free(rgba);
 }
 
+/* A glTF of one triangle with the material `material` (JSON text). */
+static gdr_scene *material_gltf(const char *material)
+{
+    static const float corners[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    char *uri = test_data_uri(corners, sizeof corners);
+    char text[2048];
+    snprintf(text, sizeof text,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":36,\"uri\":\"%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],\"accessors\":[{\"bufferView\":0,"
+             "\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}],\"materials\":[%s],\"meshes\":[{"
+             "\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]}],\"nodes\":[{\"mesh\":0}],"
+             "\"scenes\":[{\"nodes\":[0]}]}",
+             uri, material);
+    free(uri);
+    return gltf_text(text, NULL);
+}
+
+/* Material values a cache cannot hold: refused at import, by the API and by the writer, with the
+ * reader's own rule (a factor of 1e300 was written as +inf, and the reader then refused the cache). */
+static void test_material_values(void)
+{
+    static const char *const bad[] = {
+        "{\"pbrMetallicRoughness\":{\"metallicFactor\":1e300}}",
+        "{\"pbrMetallicRoughness\":{\"roughnessFactor\":-1e39}}",
+        "{\"alphaCutoff\":1e300}",
+        "{\"normalTexture\":{\"index\":0,\"scale\":1e300}}",
+        "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,1e300]}}",
+        "{\"emissiveFactor\":[3e38,0,0],\"extensions\":{\"KHR_materials_emissive_strength\":"
+        "{\"emissiveStrength\":1e6}}}",
+    };
+    static const char *const where[] = {"materials[0].pbrMetallicRoughness.metallicFactor",
+                                        "materials[0].pbrMetallicRoughness.roughnessFactor", "materials[0].alphaCutoff",
+                                        "materials[0].normalTexture.scale",
+                                        "materials[0].pbrMetallicRoughness.baseColorFactor[3]",
+                                        "materials[0]: emissive factor"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        gdr_scene *s = material_gltf(bad[i]);
+        CHECK(!s && strstr(err.message, "t.gltf") && strstr(err.message, where[i]));
+        if (s || !strstr(err.message, where[i]))
+            printf("material %zu: %s\n", i, s ? "accepted" : err.message);
+        gdr_scene_destroy(s);
+    }
+    gdr_scene *s = material_gltf("{\"pbrMetallicRoughness\":{\"metallicFactor\":0.25}}");
+    CHECK(s && s->material_count == 1 && s->materials[0].metallic_factor == 0.25f);
+    /* Through the API, and a material poked into the scene's array: the writer refuses it. */
+    gdr_material m = gdr_material_default();
+    m.roughness_factor = 1.0f / 0.0f;
+    CHECK(s && gdr_scene_add_material(s, &m, NULL, &err) != GDR_OK && strstr(err.message, "roughness factor"));
+    char cache[1200];
+    snprintf(cache, sizeof cache, "%s/inf_material.gdrc", dir);
+    unlink(cache);
+    if (s)
+        s->materials[0].occlusion_strength = 1.0f / 0.0f;
+    CHECK(s && gdr_cache_write(cache, s, NULL, &err) != GDR_OK && strstr(err.message, "occlusion strength") &&
+          access(cache, F_OK) != 0);
+    gdr_scene_destroy(s);
+}
+
 /* Output files: links followed, devices written in place, FIFOs without a reader refused. */
 static void test_output_targets(void)
 {
@@ -566,6 +624,7 @@ int main(void)
     test_instance_budget();
     test_other_budgets();
     test_messages();
+    test_material_values();
     test_output_targets();
     return test_finish("test_hostile");
 }
