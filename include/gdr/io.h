@@ -116,6 +116,12 @@ typedef struct gdr_cache_write_options {
 GDR_API gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_cache_write_options *options,
                                    gdr_error *err);
 
+/* Reads a whole regular file of at most max_size bytes into *out (malloc'ed, one NUL byte after the
+ * data, which may hold NUL bytes of its own). A FIFO, device, socket or directory is refused at once
+ * ("not a regular file"), never waited on; a larger file is refused before it is read. For the
+ * program's small inputs (camera paths, results files). */
+GDR_API gdr_status gdr_read_file(const char *path, size_t max_size, char **out, size_t *out_size, gdr_error *err);
+
 /* Reads a cache as it stands. Checks magic, version, every size, offset and checksum. When
  * build_options is not NULL, a cache built with different options is refused (stale). The files its
  * source list names are never opened (they are compared only when gdr_scene_load_file reads the

@@ -119,5 +119,33 @@ for at in 0 4 8 12 20 36; do
     check "no image for the damaged cache (index byte $at)" test ! -e "$work/mutant.png"
 done
 
+# FIFOs as the program's own inputs: refused at once, never waited on (expect's timeout fails a hang).
+mkfifo "$work/path.fifo"
+# shellcheck disable=SC2086
+expect 1 "camera path is a FIFO (render)" "path.fifo: not a regular file" \
+    "$gdr" render demo:instances=4 $tiny --camera-path "$work/path.fifo"
+# shellcheck disable=SC2086
+expect 1 "camera path is a FIFO (bench)" "path.fifo: not a regular file" \
+    "$gdr" bench --scene demo:instances=4 $tiny --frames 1 --camera-path "$work/path.fifo"
+expect 1 "results file is a FIFO" "path.fifo: not a regular file" \
+    "$gdr" bench --plot-from "$work/path.fifo" --plot "$work/fifo.svg"
+# A bad camera path is reported before the scene is loaded (here a scene that does not exist).
+printf 'gdr-camera-path 1\n0 0 0 0 0 0\n' > "$work/short.path"
+# shellcheck disable=SC2086
+expect 1 "camera path checked before the scene" "short.path:2: expected 7 numbers .*found 6" \
+    "$gdr" render "$work/missing.obj" $tiny --camera-path "$work/short.path"
+# Camera path messages that say what is wrong; a value too small for a float is a number like any.
+printf 'gdr-camera-path 1\n0 0 5 0 0 0\0001\n' > "$work/nul.path"
+# shellcheck disable=SC2086
+expect 1 "a NUL byte in a camera path" "nul.path:2: a NUL byte at column 12" \
+    "$gdr" render demo:instances=4 $tiny --camera-path "$work/nul.path"
+printf 'gdr-camera-path 1\n0 0 5 0 0 1e39 1\n' > "$work/big.path"
+# shellcheck disable=SC2086
+expect 1 "a number beyond a float in a camera path" "big.path:2: number 6: '1e39' is not finite as a 32-bit float" \
+    "$gdr" render demo:instances=4 $tiny --camera-path "$work/big.path"
+printf 'gdr-camera-path 1\n0 0 5 0 0 1e-45 1\n' > "$work/tiny.path"
+# shellcheck disable=SC2086
+expect 0 "a denormal in a camera path" "" "$gdr" render demo:instances=4 $tiny --camera-path "$work/tiny.path"
+
 echo "test_hostile_cli: $failures failure(s)"
 [ "$failures" = 0 ]

@@ -156,24 +156,23 @@ gdr_frame_desc render_options_frame(const render_options *o, gdr_camera camera)
                             .min_screen_size = o->min_screen_size, .clip_plane = o->clip_plane};
 }
 
-/* The frames asked for: o->frames of one view, or with --camera-path one frame per pose (the path
- * repeated to make --frames N, N the path's length by default); the statistics are the last call's. */
+/* The frames asked for: o->frames of one view, or with a camera path (path->count > 0) one frame per
+ * pose (the path repeated to make --frames N, N the path's length by default); the statistics are
+ * the last call's. */
 static gdr_status render_frames(gdr_renderer *renderer, gdr_frame_desc *frame, const render_options *o,
-                                gdr_frame_stats *stats, gdr_error *err)
+                                const camera_path *path, gdr_frame_stats *stats, gdr_error *err)
 {
-    if (!o->camera_path)
+    if (path->count == 0)
         return gdr_renderer_render(renderer, frame, o->frames, stats, err);
-    camera_path path;
-    gdr_status status = camera_path_read(o->camera_path, &path, err);
-    uint32_t frames = o->frames_given ? o->frames : path.count;
+    gdr_status status = GDR_OK;
+    uint32_t frames = o->frames_given ? o->frames : path->count;
     bool read_back = frame->read_back;
     for (uint32_t f = 0; f < frames && status == GDR_OK; f++) {
-        frame->camera.position = path.poses[f % path.count].position;
-        frame->camera.rotation = path.poses[f % path.count].rotation;
+        frame->camera.position = path->poses[f % path->count].position;
+        frame->camera.rotation = path->poses[f % path->count].rotation;
         frame->read_back = read_back && f + 1 == frames;
         status = gdr_renderer_render(renderer, frame, 1, stats, err);
     }
-    camera_path_free(&path);
     return status;
 }
 
@@ -209,11 +208,20 @@ int gdr_cmd_render(int argc, char **argv)
         return usage;
     gdr_error err = {0};
     gdr_scene *scene = NULL;
-    if (load_scene(&o, &scene, &err) != GDR_OK)
+    /* The camera path first: a bad one is reported before the scene is imported and uploaded. */
+    camera_path path = {0};
+    if (o.camera_path && camera_path_read(o.camera_path, &path, &err) != GDR_OK) {
+        fprintf(stderr, "gdr: --camera-path: %s\n", err.message);
+        return 1;
+    }
+    if (load_scene(&o, &scene, &err) != GDR_OK) {
+        camera_path_free(&path);
         return cli_load_failed(o.scene, &err);
+    }
     if (o.has_camera_index && o.camera_index >= scene->camera_count) {
         fprintf(stderr, "gdr: --camera-index %u: the scene has %u camera(s)\n", o.camera_index, scene->camera_count);
         gdr_scene_destroy(scene);
+        camera_path_free(&path);
         return 2;
     }
     gdr_renderer_desc desc = {.width = o.width, .height = o.height, .device = o.device, .validate = o.validate};
@@ -223,7 +231,7 @@ int gdr_cmd_render(int argc, char **argv)
     int result = 0;
     gdr_frame_desc frame = render_options_frame(&o, render_options_camera(scene, &o));
     if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK || set_scene(renderer, scene, &o, &err) != GDR_OK ||
-        render_frames(renderer, &frame, &o, &stats, &err) != GDR_OK) {
+        render_frames(renderer, &frame, &o, &path, &stats, &err) != GDR_OK) {
         result = fail(&err);
         goto done;
     }
@@ -250,6 +258,7 @@ int gdr_cmd_render(int argc, char **argv)
         result = 3;
     }
 done:
+    camera_path_free(&path);
     free(pixels);
     gdr_renderer_destroy(renderer);
     gdr_scene_destroy(scene);
