@@ -701,7 +701,28 @@ static gdr_status read_indices(gltf_ctx *c, uint32_t accessor, uint32_t mode, ui
     return status;
 }
 
-/* One primitive -> one gdr mesh (or GDR_NO_INDEX when it has no triangles). */
+/* The accessors a primitive's geometry is read from (gltf_geometry_key), each a checked index. */
+static gdr_status geometry_key(gltf_ctx *c, const cJSON *attributes, const char *place, uint32_t mode,
+                               uint32_t indices, gltf_geometry_key *key)
+{
+    static const char *const semantics[4] = {"POSITION", "NORMAL", "TEXCOORD_0", "COLOR_0"};
+    char use[160];
+    snprintf(use, sizeof use, "%s.attributes", place);
+    key->values[0] = mode;
+    key->values[1] = indices;
+    gdr_status status = GDR_OK;
+    for (int k = 0; k < 4 && status == GDR_OK; k++) {
+        key->values[2 + k] = GDR_NO_INDEX;
+        status = gltf_get_uint(c, attributes, semantics[k], use, 0, UINT32_MAX - 1, &key->values[2 + k]);
+    }
+    return status;
+}
+
+static gdr_status convert_geometry(gltf_ctx *c, const cJSON *attributes, const char *place, const char *mesh_name,
+                                   uint32_t mode, uint32_t indices_accessor, uint32_t *out_mesh);
+
+/* One primitive -> a gdr mesh (or GDR_NO_INDEX when it has no triangles): the mesh of an earlier
+ * primitive that read the same accessors, else a new one. */
 static gdr_status convert_primitive(gltf_ctx *c, const cJSON *prim, const char *place, const char *mesh_name,
                                     uint32_t *out_mesh, uint32_t *out_material)
 {
@@ -733,7 +754,22 @@ static gdr_status convert_primitive(gltf_ctx *c, const cJSON *prim, const char *
     }
     if (gltf_extension(prim, "KHR_draco_mesh_compression"))
         return gltf_fail(c, GDR_ERROR_UNSUPPORTED, "%s: KHR_draco_mesh_compression is not supported", place);
+    gltf_geometry_key key;
+    status = geometry_key(c, attributes, place, mode, indices_accessor, &key);
+    if (status != GDR_OK || gltf_shared_mesh_find(&c->shared, &key, out_mesh))
+        return status;
+    status = convert_geometry(c, attributes, place, mesh_name, mode, indices_accessor, out_mesh);
+    if (status == GDR_OK && !gltf_shared_mesh_add(&c->shared, &key, *out_mesh))
+        status = gltf_fail(c, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", place);
+    return status;
+}
 
+/* The primitive's geometry, read, checked and cleaned, as a new gdr mesh (GDR_NO_INDEX when no
+ * triangle is left). */
+static gdr_status convert_geometry(gltf_ctx *c, const cJSON *attributes, const char *place, const char *mesh_name,
+                                   uint32_t mode, uint32_t indices_accessor, uint32_t *out_mesh)
+{
+    gdr_status status;
     prim_arrays a = {0};
     uint32_t vertex_count = 0, n = 0, normal_count, uv_count;
     float *positions = NULL, *normals = NULL, *uvs = NULL;
@@ -1288,6 +1324,7 @@ gdr_status gdr_import_gltf_memory(const void *data, size_t size, const char *nam
     free(c.mesh_first);
     free(c.prim_mesh);
     free(c.prim_material);
+    gltf_shared_meshes_free(&c.shared);
     free(c.image_texture);
     if (result)
         result->warning_count = c.warnings.count;

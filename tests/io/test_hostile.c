@@ -610,6 +610,41 @@ static void test_material_values(void)
     gdr_scene_destroy(s);
 }
 
+/* Primitives reading the same accessors share one mesh (each primitive its own instance, with its
+ * own material); other indices make another mesh. Each primitive was a mesh and a DAG of its own. */
+static void test_shared_accessors(void)
+{
+    static const float corners[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+    static const uint32_t quads[9] = {0, 1, 2, 1, 3, 2, 0, 1, 3};
+    uint8_t bytes[sizeof corners + sizeof quads];
+    memcpy(bytes, corners, sizeof corners);
+    memcpy(bytes + sizeof corners, quads, sizeof quads);
+    char *uri = test_data_uri(bytes, sizeof bytes);
+    char text[4096];
+    const char *same = "{\"attributes\":{\"POSITION\":0},\"indices\":1";
+    snprintf(text, sizeof text,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":84,\"uri\":\"%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":36}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+             "{\"bufferView\":1,\"componentType\":5125,\"count\":6,\"type\":\"SCALAR\"},"
+             "{\"bufferView\":1,\"byteOffset\":24,\"componentType\":5125,\"count\":3,\"type\":\"SCALAR\"}],"
+             "\"materials\":[{},{}],\"meshes\":[{\"primitives\":[%s},%s,\"material\":1},%s,\"mode\":4},"
+             "{\"attributes\":{\"POSITION\":0},\"indices\":2}]},{\"primitives\":[%s,\"material\":0}]}],"
+             "\"nodes\":[{\"mesh\":0},{\"mesh\":1,\"translation\":[5,0,0]}],\"scenes\":[{\"nodes\":[0,1]}]}",
+             uri, same, same, same, same);
+    free(uri);
+    gdr_scene *s = gltf_text(text, NULL);
+    CHECK(s && s->mesh_count == 2 && s->instance_count == 5);
+    uint32_t uses[2] = {0, 0};
+    for (uint32_t i = 0; s && i < s->instance_count; i++)
+        uses[s->instances[i].mesh < 2 ? s->instances[i].mesh : 0]++;
+    CHECK(s && uses[0] + uses[1] == 5 && (uses[0] == 4 || uses[1] == 4));
+    CHECK(s && s->instances[0].material != s->instances[1].material && s->instances[1].material == 1);
+    if (s)
+        printf("shared accessors: %u meshes, %u instances\n", s->mesh_count, s->instance_count);
+    gdr_scene_destroy(s);
+}
+
 /* Output files: links followed, devices written in place, FIFOs without a reader refused. */
 static void test_output_targets(void)
 {
@@ -673,6 +708,7 @@ int main(void)
     test_other_budgets();
     test_messages();
     test_material_values();
+    test_shared_accessors();
     test_output_targets();
     return test_finish("test_hostile");
 }
