@@ -153,6 +153,35 @@ static uint64_t staging_bytes(const gdr_streaming *s, const gdr_scene *scene)
     return s->upload_budget + s->slot_bytes + largest_records + 4 * nodes;
 }
 
+/* The staging of every frame in flight must fit the device: each one buffer of at most
+ * maxBufferSize, all of them in the largest host-visible heap. Checked before anything is created,
+ * so that an upload budget the device cannot hold is refused with its numbers rather than by a
+ * failed vkCreateBuffer (or an allocation the driver cannot back). */
+static gdr_status check_staging_fits(const gdr_renderer *r, uint64_t bytes, gdr_error *err)
+{
+    VkPhysicalDeviceMaintenance4Properties limits = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_4_PROPERTIES};
+    VkPhysicalDeviceProperties2 properties = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &limits};
+    vkGetPhysicalDeviceProperties2(r->ctx->physical_device, &properties);
+    VkPhysicalDeviceMemoryProperties memory;
+    vkGetPhysicalDeviceMemoryProperties(r->ctx->physical_device, &memory);
+    uint64_t host_heap = 0;
+    for (uint32_t t = 0; t < memory.memoryTypeCount; t++) {
+        VkMemoryPropertyFlags wanted = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+        uint64_t size = memory.memoryHeaps[memory.memoryTypes[t].heapIndex].size;
+        if ((memory.memoryTypes[t].propertyFlags & wanted) == wanted && size > host_heap)
+            host_heap = size;
+    }
+    uint64_t total = bytes * GDR_FRAMES_IN_FLIGHT, largest = limits.maxBufferSize;
+    if (bytes > largest || total > host_heap)
+        return gdr_error_set(err, GDR_ERROR_CAPACITY, "streaming: an upload budget of %llu MiB needs %u staging buffers "
+                             "of %llu MiB (one per frame in flight); this device allows buffers of at most %llu MiB "
+                             "and has %llu MiB of host-visible memory: give a smaller upload budget "
+                             "(gdr render --upload-budget MIB)", (unsigned long long)(r->stream.upload_budget >> 20),
+                             GDR_FRAMES_IN_FLIGHT, (unsigned long long)((bytes + (1u << 20) - 1) >> 20),
+                             (unsigned long long)(largest >> 20), (unsigned long long)(host_heap >> 20));
+    return GDR_OK;
+}
+
 gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr_streaming_desc *desc, gdr_error *err)
 {
     gdr_streaming *s = &r->stream;
@@ -181,6 +210,10 @@ gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr
         s->slot_bytes = gdr_residency_slot_bytes(s->residency);
         status = alloc_tables(s, scene, err);
     }
+    if (status == GDR_OK) {
+        s->staging_bytes = staging_bytes(s, scene);
+        status = check_staging_fits(r, s->staging_bytes, err);
+    }
     if (status == GDR_OK)
         status = gdr_page_loader_create(s->cache, 0, &s->loader, err);
     if (status == GDR_OK)
@@ -189,7 +222,6 @@ gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr
                                       GDR_VK_BUFFER_DEVICE, &s->pool, err);
     if (status != GDR_OK) /* a cache that failed to open or to match has no pages to size anything by */
         return status;
-    s->staging_bytes = staging_bytes(s, scene);
     s->stats.enabled = true;
     s->stats.slot_count = s->slot_count;
     s->stats.slot_bytes = s->slot_bytes;

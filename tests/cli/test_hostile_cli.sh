@@ -147,5 +147,22 @@ printf 'gdr-camera-path 1\n0 0 5 0 0 1e-45 1\n' > "$work/tiny.path"
 # shellcheck disable=SC2086
 expect 0 "a denormal in a camera path" "" "$gdr" render demo:instances=4 $tiny --camera-path "$work/tiny.path"
 
+# Command-line values: an unknown option is called so (not "needs a value"), a device the machine
+# lacks is a bad value (exit 2, before the scene is loaded), an upload budget or a target size the
+# device cannot back is refused with its numbers (not a raw vkCreateBuffer failure or a driver crash).
+expect 2 "unknown render option" "unknown option '--bogus-option'" "$gdr" render demo --bogus-option
+expect 2 "unknown bench option" "unknown option '--bogus-option'" "$gdr" bench --bogus-option
+# shellcheck disable=SC2086
+expect 2 "a device that does not exist" "device 99: there are" \
+    "$gdr" render "$work/missing.obj" $tiny --device 99
+# shellcheck disable=SC2086
+expect 1 "an upload budget over the device's buffers" "upload budget of 4096 MiB needs 2 staging buffers" \
+    "$gdr" render "$work/paged.gdrc" --geometry-budget 8 --upload-budget 4096 $tiny
+# A CPU device's memory is the process's: under a 4 GiB address-space limit, a 16384^2 target (about
+# 7.5 GiB) is refused before it is made.
+expect 2 "a target larger than the device can back" "render size 16384x16384 needs about [0-9]+ MiB" \
+    sh -c "ulimit -v 4194304 && exec '$gdr' render demo:instances=4 --width 16384 --height 16384 --out '$work/big.png'"
+check "no image for the refused target" test ! -e "$work/big.png"
+
 echo "test_hostile_cli: $failures failure(s)"
 [ "$failures" = 0 ]

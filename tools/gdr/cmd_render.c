@@ -45,7 +45,14 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
             return 2;
         if (consumed > 0)
             continue;
-        if (!(value = cli_value(argc, argv, &i)))
+        /* The options that take a value (an unknown one is reported as such). */
+        static const char *const known[] = {
+            "--out", "-o", "--stats", "--width", "--height", "--frames", "--camera-path", "--camera",
+            "--camera-index", "--cull", "--meshlet-cull", "--cone-cull", "--triangle-cull", "--occlusion",
+            "--lod-hierarchy", "--pipeline", "--raster", "--sw-threshold", "--view", "--lod-error",
+            "--min-screen-size", "--clip-plane", "--lod-depth", "--device", "--geometry-budget",
+            "--upload-budget", "--cache-dir", "--budget", NULL};
+        if (!(value = cli_known_value(command, known, argc, argv, &i)))
             return 2;
         bool ok = true;
         if (strcmp(arg, "--out") == 0 || strcmp(arg, "-o") == 0)
@@ -214,24 +221,28 @@ int gdr_cmd_render(int argc, char **argv)
         fprintf(stderr, "gdr: --camera-path: %s\n", err.message);
         return 1;
     }
-    if (load_scene(&o, &scene, &err) != GDR_OK) {
-        camera_path_free(&path);
-        return cli_load_failed(o.scene, &err);
-    }
-    if (o.has_camera_index && o.camera_index >= scene->camera_count) {
-        fprintf(stderr, "gdr: --camera-index %u: the scene has %u camera(s)\n", o.camera_index, scene->camera_count);
-        gdr_scene_destroy(scene);
-        camera_path_free(&path);
-        return 2;
-    }
+    /* The renderer next: a device or target size the machine cannot give is a command-line value,
+     * refused (exit 2) before the scene is loaded. */
     gdr_renderer_desc desc = {.width = o.width, .height = o.height, .device = o.device, .validate = o.validate};
     gdr_renderer *renderer = NULL;
     gdr_frame_stats stats;
     uint8_t *pixels = NULL;
     int result = 0;
+    if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK) {
+        result = cli_renderer_failed(&err);
+        goto done;
+    }
+    if (load_scene(&o, &scene, &err) != GDR_OK) {
+        result = cli_load_failed(o.scene, &err);
+        goto done;
+    }
+    if (o.has_camera_index && o.camera_index >= scene->camera_count) {
+        fprintf(stderr, "gdr: --camera-index %u: the scene has %u camera(s)\n", o.camera_index, scene->camera_count);
+        result = 2;
+        goto done;
+    }
     gdr_frame_desc frame = render_options_frame(&o, render_options_camera(scene, &o));
-    if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK || set_scene(renderer, scene, &o, &err) != GDR_OK ||
-        render_frames(renderer, &frame, &o, &path, &stats, &err) != GDR_OK) {
+    if (set_scene(renderer, scene, &o, &err) != GDR_OK || render_frames(renderer, &frame, &o, &path, &stats, &err) != GDR_OK) {
         result = fail(&err);
         goto done;
     }
