@@ -169,6 +169,8 @@ static gdr_status confine_to_folder(gltf_ctx *c, const char *place, const char *
     if (!realpath(*path, resolved))
         return GDR_OK; /* nothing there to read: opening it says so */
     size_t length = strlen(folder);
+    if (strcmp(resolved, folder) == 0)
+        return gltf_fail(c, GDR_ERROR_PARSE, "%s.uri: '%.64s' names the scene's folder, not a file", place, uri);
     int inside = strncmp(resolved, folder, length) == 0 && (resolved[length] == '/' || strcmp(folder, "/") == 0);
     if (!inside)
         return gltf_fail(c, GDR_ERROR_UNSUPPORTED, "%s.uri: '%.64s' resolves outside the scene's folder (a symbolic "
@@ -207,6 +209,8 @@ gdr_status gltf_load_uri(gltf_ctx *c, const char *uri, const char *place, uint8_
         *size = n;
         return GDR_OK;
     }
+    if (uri[0] == 0)
+        return gltf_fail(c, GDR_ERROR_PARSE, "%s.uri: empty: it names no file", place);
     const char *colon = strchr(uri, ':'), *slash = strchr(uri, '/');
     if (colon && (!slash || colon < slash))
         return gltf_fail(c, GDR_ERROR_UNSUPPORTED, "%s.uri: '%.64s' has a URI scheme; only relative paths and "

@@ -248,6 +248,33 @@ static void test_uri_confinement(void)
     }
 }
 
+/* URIs that name no file: called so (both were "resolves outside the scene's folder (a symbolic
+ * link)"). */
+static void test_uri_messages(void)
+{
+    struct { const char *uri; const char *message; } cases[] = {
+        {"", "buffers[0].uri: empty: it names no file"},
+        {".", "buffers[0].uri: '.' names the scene's folder, not a file"},
+        {"./", "buffers[0].uri: './' names the scene's folder, not a file"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char text[1024], file[1200];
+        snprintf(text, sizeof text,
+                 "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":36,\"uri\":\"%s\"}],"
+                 "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],\"accessors\":[{\"bufferView\":0,"
+                 "\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}],\"meshes\":[{\"primitives\":[{\"attributes\":"
+                 "{\"POSITION\":0}}]}],\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]}",
+                 cases[i].uri);
+        snprintf(file, sizeof file, "%s/scene/t.gltf", dir);
+        CHECK(test_write_file(file, text, strlen(text)));
+        gdr_scene *s = gltf_file(file, NULL, 0);
+        CHECK(!s && strstr(err.message, cases[i].message) && !strstr(err.message, "symbolic link"));
+        if (s || !strstr(err.message, cases[i].message))
+            fprintf(stderr, "  uri '%s': %s\n", cases[i].uri, s ? "accepted" : err.message);
+        gdr_scene_destroy(s);
+    }
+}
+
 static void on_alarm(int signal)
 {
     (void)signal;
@@ -700,6 +727,7 @@ int main(void)
     test_fan_split();
     test_soup_with_outlier();
     test_uri_confinement();
+    test_uri_messages();
     test_fifo();
     test_source_list_repeats();
     test_cache_knows_its_source();
