@@ -12,6 +12,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -718,6 +719,31 @@ static void test_output_targets(void)
     unlink(target), unlink(link), unlink(fifo);
 }
 
+/* Temporary files left by writers killed by a signal (PATH.tmp.PID): removed by the next write of
+ * PATH when their process no longer runs; a running writer's, and other names, are kept. */
+static void test_stale_temporaries(void)
+{
+    pid_t child = fork();
+    if (child == 0)
+        _exit(0);
+    CHECK(child > 0 && waitpid(child, NULL, 0) == child); /* its pid now runs nothing */
+    char target[1200], stale[1300], live[1300], other[1300], odd[1300];
+    snprintf(target, sizeof target, "%s/written.bin", dir);
+    snprintf(stale, sizeof stale, "%s.tmp.%ld", target, (long)child);
+    snprintf(live, sizeof live, "%s.tmp.%ld", target, (long)getppid());
+    snprintf(other, sizeof other, "%s/another.bin.tmp.%ld", dir, (long)child);
+    snprintf(odd, sizeof odd, "%s.tmp.%ldx", target, (long)child);
+    const char *files[4] = {stale, live, other, odd};
+    for (int i = 0; i < 4; i++)
+        CHECK(test_write_file(files[i], "left", 4));
+    CHECK(gdr_write_file_atomic(target, "new", 3, &err) == GDR_OK);
+    CHECK(access(stale, F_OK) != 0);
+    CHECK(access(live, F_OK) == 0 && access(other, F_OK) == 0 && access(odd, F_OK) == 0);
+    for (int i = 0; i < 4; i++)
+        unlink(files[i]);
+    unlink(target);
+}
+
 int main(void)
 {
     snprintf(dir, sizeof dir, "%s/hostile", GDR_IO_TEST_TMP);
@@ -738,5 +764,6 @@ int main(void)
     test_material_values();
     test_shared_accessors();
     test_output_targets();
+    test_stale_temporaries();
     return test_finish("test_hostile");
 }
