@@ -923,7 +923,7 @@ static gdr_status add_instances(gltf_ctx *c, uint32_t mesh, gdr_mat4 transform, 
             return status;
         status = gdr_scene_add_instance(c->scene, &instance, c->err);
         if (status != GDR_OK)
-            return gltf_fail(c, status, "meshes[%u]: %s", mesh, c->err ? c->err->message : "");
+            return gltf_fail(c, status, "%s: meshes[%u]: %s", place, mesh, c->err ? c->err->message : "");
     }
     return GDR_OK;
 }

@@ -164,5 +164,15 @@ expect 2 "a target larger than the device can back" "render size 16384x16384 nee
     sh -c "ulimit -v 4194304 && exec '$gdr' render demo:instances=4 --width 16384 --height 16384 --out '$work/big.png'"
 check "no image for the refused target" test ! -e "$work/big.png"
 
+# A node scale of 3e38: every pipeline refuses the scene the same way, naming the file (the CPU
+# pipeline said "cull view: a matrix has a NaN or infinity", the others drew nothing and exited 0).
+printf '{"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}],"bufferViews":[{"buffer":0,"byteLength":36}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0,"scale":[3e38,3e38,3e38]}],"scenes":[{"nodes":[0]}]}' > "$work/scaled.gltf"
+for pipeline in cpu mesh indirect; do
+    # shellcheck disable=SC2086
+    expect 1 "a scene beyond the limit on coordinates ($pipeline)" "scaled.gltf: nodes\[0\].*limit on coordinates" \
+        "$gdr" render "$work/scaled.gltf" --no-cache $tiny --pipeline $pipeline --out "$work/scaled.png"
+done
+check "no image for the scene beyond the limit" test ! -e "$work/scaled.png"
+
 echo "test_hostile_cli: $failures failure(s)"
 [ "$failures" = 0 ]

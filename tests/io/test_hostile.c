@@ -719,6 +719,37 @@ static void test_output_targets(void)
     unlink(target), unlink(link), unlink(fifo);
 }
 
+/* A transform that places a mesh beyond the limit on coordinates (a node scale of 3e38 on a unit
+ * triangle): refused at import naming the file and the node; the CPU pipeline refused it at render
+ * time without a file while the GPU pipelines drew nothing. The limit is mesh space's. */
+static void test_world_extent(void)
+{
+    static const float corners[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    gdr_scene *s = NULL;
+    const char *scales[2] = {"3e38", "1e13"};
+    for (int k = 0; k < 2; k++) {
+        char *text = triangle_gltf(corners, 3);
+        char *node = strstr(text, "{\"mesh\":0}");
+        char edited[4096];
+        CHECK(node != NULL);
+        if (!node)
+            break;
+        snprintf(edited, sizeof edited, "%.*s{\"mesh\":0,\"scale\":[%s,%s,%s]}%s", (int)(node - text), text, scales[k],
+                 scales[k], scales[k], node + strlen("{\"mesh\":0}"));
+        free(text);
+        s = gltf_text(edited, NULL);
+        CHECK(!s && strstr(err.message, "t.gltf: nodes[0]") && strstr(err.message, "limit on coordinates"));
+        gdr_scene_destroy(s);
+    }
+    s = obj_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", NULL);
+    gdr_instance far = {.transform = gdr_mat4_from_trs((gdr_vec3){1e13f, 0, 0}, gdr_quat_identity(), (gdr_vec3){1, 1, 1}), .mesh = 0,
+                        .material = GDR_NO_INDEX, .color = {1, 1, 1, 1}};
+    CHECK(s && gdr_scene_add_instance(s, &far, &err) != GDR_OK && strstr(err.message, "limit on coordinates"));
+    far.transform = gdr_mat4_from_trs((gdr_vec3){1e11f, 0, 0}, gdr_quat_identity(), (gdr_vec3){1, 1, 1});
+    CHECK(s && gdr_scene_add_instance(s, &far, &err) == GDR_OK);
+    gdr_scene_destroy(s);
+}
+
 /* Temporary files left by writers killed by a signal (PATH.tmp.PID): removed by the next write of
  * PATH when their process no longer runs; a running writer's, and other names, are kept. */
 static void test_stale_temporaries(void)
@@ -765,5 +796,6 @@ int main(void)
     test_shared_accessors();
     test_output_targets();
     test_stale_temporaries();
+    test_world_extent();
     return test_finish("test_hostile");
 }
