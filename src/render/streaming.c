@@ -63,33 +63,6 @@ static uint32_t word_mesh(const gdr_gpu_scene *g, uint32_t word)
     return lo;
 }
 
-/* The scene and the cache must describe the same clusters: each mesh's groups, and each page's
- * clusters as the sum of its groups'. */
-static gdr_status check_cache_matches(const gdr_streaming *s, const gdr_scene *scene, const char *path, gdr_error *err)
-{
-    if (gdr_paged_cache_mesh_count(s->cache) != scene->mesh_count)
-        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: %u meshes, the scene has %u: not its cache", path,
-                             gdr_paged_cache_mesh_count(s->cache), scene->mesh_count);
-    for (uint32_t m = 0; m < scene->mesh_count; m++) {
-        const gdr_mesh_clusters *c = &scene->meshes[m].clusters;
-        const gdr_paged_mesh *pm = paged_mesh(s, m);
-        if (pm->group_count != c->group_count || (c->cluster_count > 0 && c->group_count == 0))
-            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: mesh %u has %u LOD groups, the scene's %u "
-                                 "(streaming needs every mesh's LOD DAG)", path, m, pm->group_count, c->group_count);
-        for (uint32_t p = 0; p < pm->page_count; p++) {
-            const gdr_page_info *info = &pm->pages[p];
-            uint64_t clusters = 0;
-            for (uint32_t k = info->first; k < info->first + info->group_count; k++)
-                clusters += c->groups[pm->page_groups[k]].cluster_count;
-            if (clusters != info->cluster_count)
-                return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: mesh %u page %u holds %u clusters, the "
-                                     "scene's groups %llu: not its cache", path, m, p, info->cluster_count,
-                                     (unsigned long long)clusters);
-        }
-    }
-    return GDR_OK;
-}
-
 /* The default budget: a quarter of the largest device-local heap, at most GDR_GEOMETRY_BUDGET_MAX. */
 static uint64_t default_budget(const gdr_renderer *r)
 {
@@ -198,7 +171,7 @@ gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr
     s->upload_budget = desc->upload_budget_bytes ? desc->upload_budget_bytes : GDR_UPLOAD_BUDGET_DEFAULT;
     gdr_status status = gdr_paged_cache_open(desc->cache_path, &s->cache, err);
     if (status == GDR_OK)
-        status = check_cache_matches(s, scene, desc->cache_path, err);
+        status = gdr_paged_cache_check_scene(s->cache, scene, desc->cache_path, err);
     gdr_residency_desc res = {.cache = s->cache,
                               .budget_bytes = desc->geometry_budget_bytes ? desc->geometry_budget_bytes
                                                                           : default_budget(r),
