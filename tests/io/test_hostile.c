@@ -607,8 +607,8 @@ static void test_material_values(void)
         "{\"alphaCutoff\":1e300}",
         "{\"normalTexture\":{\"index\":0,\"scale\":1e300}}",
         "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,1e300]}}",
-        "{\"emissiveFactor\":[3e38,0,0],\"extensions\":{\"KHR_materials_emissive_strength\":"
-        "{\"emissiveStrength\":1e6}}}",
+        ("{\"emissiveFactor\":[3e38,0,0],\"extensions\":{\"KHR_materials_emissive_strength\":"
+         "{\"emissiveStrength\":1e6}}}"),
     };
     static const char *const where[] = {"materials[0].pbrMetallicRoughness.metallicFactor",
                                         "materials[0].pbrMetallicRoughness.roughnessFactor", "materials[0].alphaCutoff",
