@@ -130,6 +130,12 @@ typedef struct gdr_cache_write_options {
 GDR_API gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_cache_write_options *options,
                                    gdr_error *err);
 
+/* Reads a whole regular file of at most max_size bytes into *out (malloc'ed, one NUL byte after the
+ * data, which may hold NUL bytes of its own). A FIFO, device, socket or directory is refused at once
+ * ("not a regular file"), never waited on; a larger file is refused before it is read. For the
+ * program's small inputs (camera paths, results files). */
+GDR_API gdr_status gdr_read_file(const char *path, size_t max_size, char **out, size_t *out_size, gdr_error *err);
+
 /* The cache path used for a source: SOURCE.gdrc next to it, or in cache_dir (named after a hash
  * of the absolute source path) when cache_dir is given. Returns the length written, or 0 when
  * it does not fit. */

@@ -116,6 +116,12 @@ GDR_API uint64_t gdr_paged_cache_page_bytes(const gdr_paged_cache *cache);
 GDR_API gdr_status gdr_paged_cache_read_page(gdr_paged_cache *cache, uint32_t mesh, uint32_t page, gdr_page *out,
                                              gdr_error *err);
 GDR_API void gdr_page_free(gdr_page *page);
+/* Checks that the cache's pages describe `scene` (read from the same file with
+ * gdr_cache_read_for_streaming): the same mesh count, each mesh's LOD groups, and each page's
+ * clusters as the sum of its groups'. What streaming (gdr_renderer_set_scene_streamed) checks before
+ * sizing anything from the pages; `path` names the file in the error (GDR_ERROR_INVALID_ARGUMENT). */
+GDR_API gdr_status gdr_paged_cache_check_scene(const gdr_paged_cache *cache, const gdr_scene *scene, const char *path,
+                                               gdr_error *err);
 
 #ifdef __cplusplus
 }

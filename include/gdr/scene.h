@@ -83,6 +83,10 @@ typedef struct gdr_material {
 /* glTF's default material: white, metallic 1, roughness 1, no textures (every reference
  * GDR_NO_INDEX with the default sampler and no transform), opaque with cutoff 0.5, single-sided. */
 GDR_API gdr_material gdr_material_default(void);
+/* NULL when every value of the material is sound (every float finite, sampler states below
+ * GDR_SAMPLER_STATES, a known alpha mode, double_sided 0 or 1), else what is wrong, in words. The
+ * one rule that gdr_scene_add_material, the importers, the cache writer and the cache reader apply. */
+GDR_API const char *gdr_material_problem(const gdr_material *material);
 
 typedef enum gdr_alpha_mode { GDR_ALPHA_OPAQUE = 0, GDR_ALPHA_MASK = 1, GDR_ALPHA_BLEND = 2 } gdr_alpha_mode;
 

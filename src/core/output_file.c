@@ -3,13 +3,56 @@
 #define _XOPEN_SOURCE 700 /* realpath, fsync */
 #include "core/output_file.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <signal.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+/* The process id of a temporary file of `base` ("BASE.tmp.PID"), or 0 when `name` is not one. */
+static long temporary_pid(const char *name, const char *base)
+{
+    size_t length = strlen(base);
+    if (strncmp(name, base, length) != 0 || strncmp(name + length, ".tmp.", 5) != 0)
+        return 0;
+    const char *digits = name + length + 5;
+    char *end;
+    errno = 0;
+    long pid = strtol(digits, &end, 10);
+    return digits[0] >= '1' && digits[0] <= '9' && !*end && !errno && pid > 0 ? pid : 0;
+}
+
+/* Removes the temporary files of `target` ("TARGET.tmp.PID") that writers killed by a signal left
+ * behind: those whose process no longer runs (one still running, or of another user, is kept). */
+static void remove_stale_temporaries(const char *target)
+{
+    const char *slash = strrchr(target, '/');
+    char folder[PATH_MAX];
+    if (!slash)
+        snprintf(folder, sizeof folder, ".");
+    else
+        snprintf(folder, sizeof folder, "%.*s", slash == target ? 1 : (int)(slash - target), target);
+    const char *base = slash ? slash + 1 : target;
+    DIR *d = opendir(folder);
+    if (!d)
+        return;
+    for (struct dirent *e; (e = readdir(d));) {
+        long pid = temporary_pid(e->d_name, base);
+        struct stat st;
+        if (pid == 0 || (pid_t)pid == getpid())
+            continue;
+        if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) /* running (perhaps as another user) */
+            continue;
+        if (fstatat(dirfd(d), e->d_name, &st, AT_SYMLINK_NOFOLLOW) == 0 && S_ISREG(st.st_mode))
+            unlinkat(dirfd(d), e->d_name, 0);
+    }
+    closedir(d);
+}
 
 /* A device, FIFO or socket: opened for writing as it is (no O_CREAT, no O_TRUNC). */
 static gdr_status open_direct(const char *path, gdr_output_file *out, gdr_error *err)
@@ -137,6 +180,7 @@ gdr_status gdr_output_open(const char *path, gdr_output_file *out, gdr_error *er
         free(out->target), out->target = NULL;
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
     }
+    remove_stale_temporaries(target);
     snprintf(out->temporary, length, "%s.tmp.%ld", target, (long)getpid());
     int fd = open(out->temporary, O_WRONLY | O_CREAT | O_TRUNC | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
     if (fd < 0 && errno == EEXIST && unlink(out->temporary) == 0) /* left by a crashed run of this pid */

@@ -377,19 +377,21 @@ gdr_status gdr_cache_read_memory(const void *data, size_t size, const char *name
 }
 
 /* One entry of section 'SRCE': a file the scene was built from, as it was then. */
-typedef struct source_entry {
-    char *path;    /* where to look for it now (malloc'ed) */
-    uint64_t size, mtime, hash;
-    uint64_t key;  /* hash of the path, to check each path once */
-    int moved;     /* its folder moved with the source: the mtime says nothing, compare contents */
-} source_entry;
-
-/* A file as it is now: looked at once however many entries name it. */
+/* A file as it is now: its identity (device and inode) and, once looked at, its contents' hash. */
 typedef struct source_now {
     int exists, hashed, unreadable;
     uint64_t size, hash;
     int64_t mtime;
+    uint64_t device, inode;
 } source_now;
+
+typedef struct source_entry {
+    char *path;    /* where to look for it now (malloc'ed) */
+    uint64_t size, mtime, hash;
+    uint64_t key;  /* hash of the path, to stat each spelling once */
+    int moved;     /* its folder moved with the source: the mtime says nothing, compare contents */
+    source_now now;
+} source_entry;
 
 static int compare_entries(const void *a, const void *b)
 {
@@ -397,6 +399,33 @@ static int compare_entries(const void *a, const void *b)
     if (x->key != y->key)
         return x->key < y->key ? -1 : 1;
     return strcmp(x->path, y->path);
+}
+
+/* Orders entries by the file they name (missing ones first): spellings of one file are adjacent. */
+static int compare_files(const void *a, const void *b)
+{
+    const source_now *x = &((const source_entry *)a)->now, *y = &((const source_entry *)b)->now;
+    if (x->exists != y->exists)
+        return x->exists < y->exists ? -1 : 1;
+    if (x->device != y->device)
+        return x->device < y->device ? -1 : 1;
+    if (x->inode != y->inode)
+        return x->inode < y->inode ? -1 : 1;
+    return 0;
+}
+
+static source_now stat_now(const char *path)
+{
+    struct stat st;
+    source_now now = {0};
+    if (stat(path, &st) != 0)
+        return now;
+    now.exists = 1;
+    now.size = (uint64_t)st.st_size;
+    now.mtime = (int64_t)st.st_mtim.tv_sec * 1000000000ll + st.st_mtim.tv_nsec;
+    now.device = (uint64_t)st.st_dev;
+    now.inode = (uint64_t)st.st_ino;
+    return now;
 }
 
 static void free_entries(source_entry *entries, uint32_t count)
@@ -459,7 +488,7 @@ static gdr_status read_entries(const char *name, reader *r, const char *source, 
     return GDR_OK;
 }
 
-/* Compares one entry with the file now (stat once, contents hashed at most once per path). */
+/* Compares one entry with the file now (contents hashed at most once per file). */
 static gdr_status check_entry(const char *name, const source_entry *e, source_now *now, gdr_error *err)
 {
     if (!now->exists)
@@ -487,8 +516,10 @@ static gdr_status check_entry(const char *name, const source_entry *e, source_no
     return GDR_OK;
 }
 
-/* Compares the SRCE section with the build options and the files on disk. With `source` (the file
- * the cache stands for), the cache must record it as its first entry, with the same contents. */
+/* Compares the SRCE section with the build options and, when the cache is read for `source` (the
+ * file it stands for), with the files on disk: the cache must record the source as its first entry,
+ * with the same contents, and no other recorded file that exists may differ. Without `source` the
+ * cache is read as it stands: no recorded file is opened. */
 static gdr_status check_fresh(const char *name, cache_view *v, const char *build_options, const char *source,
                               gdr_error *err)
 {
@@ -507,8 +538,12 @@ static gdr_status check_fresh(const char *name, cache_view *v, const char *build
     source_entry *entries = NULL;
     uint32_t count = 0;
     gdr_status status = read_entries(name, &r, source, &entries, &count, err);
-    if (status != GDR_OK)
+    if (status != GDR_OK || !source) {
+        /* Read as it stands: the recorded sources are never opened (whether a file named there
+         * exists, or has given contents, must not change the outcome). */
+        free_entries(entries, count);
         return status;
+    }
     if (source && count == 0)
         status = gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: it does not record the source it was "
                                "built from", name);
@@ -522,15 +557,18 @@ static gdr_status check_fresh(const char *name, cache_view *v, const char *build
         else
             status = check_entry(name, &entries[0], &now, err);
     }
-    /* Every other path once, however often the list names it. */
+    /* Every file once, however often and however spelled (`//dir/./f`) the list names it: each
+     * spelling is looked up once, then entries naming one device and inode share one hash. */
     qsort(entries, count, sizeof *entries, compare_entries);
-    source_now now = {0};
+    for (uint32_t i = 0; i < count && status == GDR_OK; i++)
+        entries[i].now = i > 0 && compare_entries(&entries[i - 1], &entries[i]) == 0 ? entries[i - 1].now
+                                                                                      : stat_now(entries[i].path);
+    qsort(entries, count, sizeof *entries, compare_files);
+    source_now shared = {0};
     for (uint32_t i = 0; i < count && status == GDR_OK; i++) {
-        if (i == 0 || compare_entries(&entries[i - 1], &entries[i]) != 0) {
-            now = (source_now){0};
-            now.exists = gdr_io_stat(entries[i].path, &now.size, &now.mtime) == 0;
-        }
-        status = check_entry(name, &entries[i], &now, err);
+        if (i == 0 || compare_files(&entries[i - 1], &entries[i]) != 0)
+            shared = entries[i].now;
+        status = check_entry(name, &entries[i], &shared, err);
     }
     free_entries(entries, count);
     return status;

@@ -692,6 +692,18 @@ static void put_texture_ref(writer *w, const gdr_texture_ref *t)
     put_u32(w, 0); /* reserved */
 }
 
+/* The reader's rule for a material's values (gdr_material_problem), enforced by the writer. */
+static gdr_status check_materials(const cache_write_input *in, const char *path, gdr_error *err)
+{
+    for (uint32_t i = 0; i < in->scene->material_count; i++) {
+        const char *problem = gdr_material_problem(&in->scene->materials[i]);
+        if (problem)
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: material %u: %s; a cache cannot hold it", path,
+                                 i, problem);
+    }
+    return GDR_OK;
+}
+
 static void write_materials(writer *w, const cache_write_input *in)
 {
     const gdr_scene *s = in->scene;
@@ -711,7 +723,8 @@ static void write_materials(writer *w, const cache_write_input *in)
     }
 }
 
-/* One texture reference, checked: the texture exists, the sampler state is known, the transform finite. */
+/* One texture reference: the texture must exist; its sampler state and transform are checked with the
+ * material (gdr_material_problem). */
 static gdr_status get_texture_ref(cache_read_state *st, reader *ma, uint32_t material, gdr_texture_ref *t, gdr_error *err)
 {
     t->texture = get_u32(ma);
@@ -725,9 +738,6 @@ static gdr_status get_texture_ref(cache_read_state *st, reader *ma, uint32_t mat
     if (t->texture != GDR_NO_INDEX && t->texture >= st->texture_count)
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: material %u: texture %u does not exist (%u textures)",
                              st->name, material, t->texture, st->texture_count);
-    if (t->sampler >= GDR_SAMPLER_STATES || !all_finite(f, 5))
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: material %u: a texture's sampler or transform is out of range",
-                             st->name, material);
     return GDR_OK;
 }
 
@@ -753,9 +763,9 @@ static gdr_status read_one_material(cache_read_state *st, reader *ma, uint32_t i
     m.alpha_cutoff = factors[4];
     m.alpha_mode = get_u32(ma);
     m.double_sided = get_u32(ma);
-    if (!all_finite(&m.base_color.x, 4) || !all_finite(&m.emissive.x, 3) || !all_finite(factors, 5) ||
-        m.alpha_mode > GDR_ALPHA_BLEND || m.double_sided > 1)
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: material %u: values out of range", st->name, i);
+    const char *problem = gdr_material_problem(&m);
+    if (problem)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: material %u: %s", st->name, i, problem);
     return gdr_scene_add_material(st->scene, &m, NULL, err);
 }
 
@@ -932,7 +942,7 @@ const cache_section gdr_cache_sections[CACHE_SECTION_COUNT] = {
                                 read_cluster_geometry, 1},
     [CACHE_HIERARCHY] = {FOURCC('L', 'O', 'D', 'H'), REQUIRED, 0, NULL, check_hierarchy_present, write_hierarchy,
                          read_hierarchy, 0},
-    [CACHE_MATERIALS] = {FOURCC('M', 'A', 'T', 'L'), REQUIRED, 0, NULL, NULL, write_materials, read_materials, 0},
+    [CACHE_MATERIALS] = {FOURCC('M', 'A', 'T', 'L'), REQUIRED, 0, NULL, check_materials, write_materials, read_materials, 0},
     [CACHE_INSTANCES] = {FOURCC('I', 'N', 'S', 'T'), REQUIRED, 0, NULL, NULL, write_instances, read_instances, 0},
     [CACHE_CAMERAS] = {FOURCC('C', 'A', 'M', 'R'), REQUIRED, 0, NULL, NULL, write_cameras, read_cameras, 0},
     /* optional: readers that predate it skip it */

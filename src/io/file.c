@@ -214,3 +214,36 @@ int gdr_io_has_extension(const char *path, const char *ext)
     size_t n = strlen(path), e = strlen(ext);
     return n >= e && strcasecmp(path + n - e, ext) == 0;
 }
+
+gdr_status gdr_read_file(const char *path, size_t max_size, char **out, size_t *out_size, gdr_error *err)
+{
+    *out = NULL;
+    *out_size = 0;
+    int fd;
+    gdr_status status = gdr_io_open_regular(path, &fd, err);
+    if (status != GDR_OK)
+        return status;
+    struct stat st;
+    if (fstat(fd, &st) != 0 || (uint64_t)st.st_size > max_size) {
+        close(fd);
+        return gdr_error_set(err, GDR_ERROR_CAPACITY, "%s: larger than %zu bytes", path, max_size);
+    }
+    size_t size = (size_t)st.st_size;
+    char *data = malloc(size + 1);
+    if (!data) {
+        close(fd);
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory reading %zu bytes", path, size);
+    }
+    size_t got = gdr_io_pread_exact(fd, data, size, 0);
+    int read_errno = errno;
+    close(fd);
+    if (got != size) {
+        free(data);
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: read %zu of %zu bytes%s%s", path, got, size,
+                             read_errno ? ": " : "", read_errno ? strerror(read_errno) : "");
+    }
+    data[size] = 0;
+    *out = data;
+    *out_size = size;
+    return GDR_OK;
+}

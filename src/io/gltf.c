@@ -348,15 +348,13 @@ static gdr_status texture_transform(gltf_ctx *c, const cJSON *info, const char *
         return GDR_OK;
     char place[224];
     snprintf(place, sizeof place, "%s.extensions.KHR_texture_transform", here);
-    double rotation = 0.0;
     gdr_status status = gltf_get_floats(c, t, "offset", place, 2, &ref->offset.x);
     if (status == GDR_OK)
         status = gltf_get_floats(c, t, "scale", place, 2, &ref->scale.x);
     if (status == GDR_OK)
-        status = gltf_get_number(c, t, "rotation", place, &rotation);
+        status = gltf_get_float(c, t, "rotation", place, &ref->rotation);
     if (status == GDR_OK)
         status = gltf_get_uint(c, t, "texCoord", place, 0, UINT32_MAX, texcoord);
-    ref->rotation = (float)rotation;
     return status;
 }
 
@@ -373,13 +371,13 @@ static gdr_status texture_ref(gltf_ctx *c, const cJSON *parent, const char *key,
     char here[160];
     snprintf(here, sizeof here, "%s.%s", place, key);
     uint32_t texture = 0, texcoord = 0;
-    double value = factor ? *factor : 1.0;
+    float value = factor ? *factor : 1.0f;
     gdr_status status = gltf_get_object(c, parent, key, place, 0, &info);
     if (status != GDR_OK || !info)
         return status;
     status = gltf_get_uint(c, info, "texCoord", here, 0, UINT32_MAX, &texcoord);
     if (status == GDR_OK && factor_key)
-        status = gltf_get_number(c, info, factor_key, here, &value);
+        status = gltf_get_float(c, info, factor_key, here, &value);
     if (status == GDR_OK)
         status = gltf_get_uint(c, info, "index", here, 1, UINT32_MAX, &texture);
     if (status == GDR_OK)
@@ -387,7 +385,7 @@ static gdr_status texture_ref(gltf_ctx *c, const cJSON *parent, const char *key,
     if (status != GDR_OK)
         return status;
     if (factor)
-        *factor = (float)value;
+        *factor = value;
     if (texcoord != 0) {
         gdr_io_warn(&c->warnings, "%s: %s: texture coordinate set %u is not supported (meshes carry set 0); texture "
                     "left out", c->name, here, texcoord);
@@ -443,12 +441,11 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
     gdr_material m = gdr_material_default();
     const char *name = NULL, *alpha_mode = NULL;
     const cJSON *pbr = NULL, *double_sided = cJSON_GetObjectItemCaseSensitive(json, "doubleSided");
-    double metallic = 1.0, roughness = 1.0, cutoff = 0.5;
     gdr_status status = gltf_get_string(c, json, "name", here, &name);
     if (status == GDR_OK)
         status = gltf_get_string(c, json, "alphaMode", here, &alpha_mode);
     if (status == GDR_OK)
-        status = gltf_get_number(c, json, "alphaCutoff", here, &cutoff);
+        status = gltf_get_float(c, json, "alphaCutoff", here, &m.alpha_cutoff);
     if (status == GDR_OK)
         status = gltf_get_object(c, json, "pbrMetallicRoughness", here, 0, &pbr);
     if (status == GDR_OK)
@@ -458,7 +455,6 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
     if (double_sided && !cJSON_IsBool(double_sided))
         return gltf_fail(c, GDR_ERROR_PARSE, "%s.doubleSided: expected a boolean", here);
     m.double_sided = cJSON_IsTrue(double_sided) ? 1u : 0u;
-    m.alpha_cutoff = (float)cutoff;
     if (alpha_mode) {
         if (strcmp(alpha_mode, "MASK") == 0)
             m.alpha_mode = GDR_ALPHA_MASK;
@@ -474,9 +470,9 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
         snprintf(pplace, sizeof pplace, "%s.pbrMetallicRoughness", here);
         status = gltf_get_floats(c, pbr, "baseColorFactor", pplace, 4, &m.base_color.x);
         if (status == GDR_OK)
-            status = gltf_get_number(c, pbr, "metallicFactor", pplace, &metallic);
+            status = gltf_get_float(c, pbr, "metallicFactor", pplace, &m.metallic_factor);
         if (status == GDR_OK)
-            status = gltf_get_number(c, pbr, "roughnessFactor", pplace, &roughness);
+            status = gltf_get_float(c, pbr, "roughnessFactor", pplace, &m.roughness_factor);
         if (status == GDR_OK)
             status = texture_ref(c, pbr, "baseColorTexture", pplace, 1, NULL, NULL, &m.base_color_texture);
         if (status == GDR_OK)
@@ -484,8 +480,6 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
         if (status != GDR_OK)
             return status;
     }
-    m.metallic_factor = (float)metallic;
-    m.roughness_factor = (float)roughness;
     status = texture_ref(c, json, "normalTexture", here, 0, "scale", &m.normal_scale, &m.normal_texture);
     if (status == GDR_OK)
         status = texture_ref(c, json, "occlusionTexture", here, 0, "strength", &m.occlusion_strength,
@@ -496,6 +490,10 @@ static gdr_status load_material(gltf_ctx *c, uint32_t index)
         status = emissive_strength(c, json, here, &m.emissive);
     if (status != GDR_OK)
         return status;
+    /* The rule the cache reader applies (an emissive factor times its strength may overflow). */
+    const char *problem = gdr_material_problem(&m);
+    if (problem)
+        return gltf_fail(c, GDR_ERROR_PARSE, "%s: %s", here, problem);
     return gdr_scene_add_material(c->scene, &m, NULL, c->err);
 }
 
@@ -753,7 +751,28 @@ static gdr_status read_indices(gltf_ctx *c, uint32_t accessor, uint32_t mode, ui
     return status;
 }
 
-/* One primitive -> one gdr mesh (or GDR_NO_INDEX when it has no triangles). */
+/* The accessors a primitive's geometry is read from (gltf_geometry_key), each a checked index. */
+static gdr_status geometry_key(gltf_ctx *c, const cJSON *attributes, const char *place, uint32_t mode,
+                               uint32_t indices, gltf_geometry_key *key)
+{
+    static const char *const semantics[4] = {"POSITION", "NORMAL", "TEXCOORD_0", "COLOR_0"};
+    char use[160];
+    snprintf(use, sizeof use, "%s.attributes", place);
+    key->values[0] = mode;
+    key->values[1] = indices;
+    gdr_status status = GDR_OK;
+    for (int k = 0; k < 4 && status == GDR_OK; k++) {
+        key->values[2 + k] = GDR_NO_INDEX;
+        status = gltf_get_uint(c, attributes, semantics[k], use, 0, UINT32_MAX - 1, &key->values[2 + k]);
+    }
+    return status;
+}
+
+static gdr_status convert_geometry(gltf_ctx *c, const cJSON *attributes, const char *place, const char *mesh_name,
+                                   uint32_t mode, uint32_t indices_accessor, uint32_t *out_mesh);
+
+/* One primitive -> a gdr mesh (or GDR_NO_INDEX when it has no triangles): the mesh of an earlier
+ * primitive that read the same accessors, else a new one. */
 static gdr_status convert_primitive(gltf_ctx *c, const cJSON *prim, const char *place, const char *mesh_name,
                                     uint32_t *out_mesh, uint32_t *out_material)
 {
@@ -785,7 +804,22 @@ static gdr_status convert_primitive(gltf_ctx *c, const cJSON *prim, const char *
     }
     if (gltf_extension(prim, "KHR_draco_mesh_compression"))
         return gltf_fail(c, GDR_ERROR_UNSUPPORTED, "%s: KHR_draco_mesh_compression is not supported", place);
+    gltf_geometry_key key;
+    status = geometry_key(c, attributes, place, mode, indices_accessor, &key);
+    if (status != GDR_OK || gltf_shared_mesh_find(&c->shared, &key, out_mesh))
+        return status;
+    status = convert_geometry(c, attributes, place, mesh_name, mode, indices_accessor, out_mesh);
+    if (status == GDR_OK && !gltf_shared_mesh_add(&c->shared, &key, *out_mesh))
+        status = gltf_fail(c, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", place);
+    return status;
+}
 
+/* The primitive's geometry, read, checked and cleaned, as a new gdr mesh (GDR_NO_INDEX when no
+ * triangle is left). */
+static gdr_status convert_geometry(gltf_ctx *c, const cJSON *attributes, const char *place, const char *mesh_name,
+                                   uint32_t mode, uint32_t indices_accessor, uint32_t *out_mesh)
+{
+    gdr_status status;
     prim_arrays a = {0};
     uint32_t vertex_count = 0, n = 0, normal_count, uv_count;
     float *positions = NULL, *normals = NULL, *uvs = NULL;
@@ -939,7 +973,7 @@ static gdr_status add_instances(gltf_ctx *c, uint32_t mesh, gdr_mat4 transform, 
             return status;
         status = gdr_scene_add_instance(c->scene, &instance, c->err);
         if (status != GDR_OK)
-            return gltf_fail(c, status, "meshes[%u]: %s", mesh, c->err ? c->err->message : "");
+            return gltf_fail(c, status, "%s: meshes[%u]: %s", place, mesh, c->err ? c->err->message : "");
     }
     return GDR_OK;
 }
@@ -1340,6 +1374,7 @@ gdr_status gdr_import_gltf_memory(const void *data, size_t size, const char *nam
     free(c.mesh_first);
     free(c.prim_mesh);
     free(c.prim_material);
+    gltf_shared_meshes_free(&c.shared);
     free(c.image_texture);
     if (result)
         result->warning_count = c.warnings.count;

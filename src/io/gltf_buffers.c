@@ -51,6 +51,24 @@ gdr_status gltf_get_number(gltf_ctx *c, const cJSON *obj, const char *key, const
     return GDR_OK;
 }
 
+/* A number that becomes a float: finite, and finite once rounded to 32 bits (1e300 would be +inf). */
+static int fits_float(double v)
+{
+    return isfinite(v) && fabs(v) <= GLTF_MAX_FLOAT;
+}
+
+gdr_status gltf_get_float(gltf_ctx *c, const cJSON *obj, const char *key, const char *place, float *out)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!item)
+        return GDR_OK;
+    if (!cJSON_IsNumber(item) || !fits_float(item->valuedouble))
+        return gltf_fail(c, GDR_ERROR_PARSE, "%s.%s: expected a finite number of at most %g in magnitude (a 32-bit "
+                         "float)", place, key, GLTF_MAX_FLOAT);
+    *out = (float)item->valuedouble;
+    return GDR_OK;
+}
+
 gdr_status gltf_get_string(gltf_ctx *c, const cJSON *obj, const char *key, const char *place, const char **out)
 {
     const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
@@ -103,8 +121,9 @@ gdr_status gltf_get_floats(gltf_ctx *c, const cJSON *obj, const char *key, const
     uint32_t i = 0;
     float values[16];
     for (const cJSON *e = item->child; e && i < n; e = e->next, i++) {
-        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > 3.0e38)
-            return gltf_fail(c, GDR_ERROR_PARSE, "%s.%s[%u]: expected a finite number", place, key, i);
+        if (!cJSON_IsNumber(e) || !fits_float(e->valuedouble))
+            return gltf_fail(c, GDR_ERROR_PARSE, "%s.%s[%u]: expected a finite number of at most %g in magnitude (a "
+                             "32-bit float)", place, key, i, GLTF_MAX_FLOAT);
         values[i] = (float)e->valuedouble;
     }
     memcpy(out, values, sizeof(float) * n);
@@ -150,6 +169,8 @@ static gdr_status confine_to_folder(gltf_ctx *c, const char *place, const char *
     if (!realpath(*path, resolved))
         return GDR_OK; /* nothing there to read: opening it says so */
     size_t length = strlen(folder);
+    if (strcmp(resolved, folder) == 0)
+        return gltf_fail(c, GDR_ERROR_PARSE, "%s.uri: '%.64s' names the scene's folder, not a file", place, uri);
     int inside = strncmp(resolved, folder, length) == 0 && (resolved[length] == '/' || strcmp(folder, "/") == 0);
     if (!inside)
         return gltf_fail(c, GDR_ERROR_UNSUPPORTED, "%s.uri: '%.64s' resolves outside the scene's folder (a symbolic "
@@ -188,6 +209,8 @@ gdr_status gltf_load_uri(gltf_ctx *c, const char *uri, const char *place, uint8_
         *size = n;
         return GDR_OK;
     }
+    if (uri[0] == 0)
+        return gltf_fail(c, GDR_ERROR_PARSE, "%s.uri: empty: it names no file", place);
     const char *colon = strchr(uri, ':'), *slash = strchr(uri, '/');
     if (colon && (!slash || colon < slash))
         return gltf_fail(c, GDR_ERROR_UNSUPPORTED, "%s.uri: '%.64s' has a URI scheme; only relative paths and "

@@ -24,6 +24,29 @@ typedef struct gltf_view {
     uint32_t stride;      /* byteStride, 0 when absent */
 } gltf_view;
 
+/* What a primitive's geometry is made of: mode, indices, POSITION, NORMAL, TEXCOORD_0, COLOR_0
+ * (accessor indices, GDR_NO_INDEX when absent). */
+typedef struct gltf_geometry_key {
+    uint32_t values[6];
+} gltf_geometry_key;
+
+typedef struct gltf_shared_mesh {
+    gltf_geometry_key key;
+    uint32_t mesh; /* the gdr mesh, or GDR_NO_INDEX when the primitive made none */
+    int used;
+} gltf_shared_mesh;
+
+/* The meshes made so far, by geometry key (gltf_shared_mesh.c). */
+typedef struct gltf_shared_meshes {
+    gltf_shared_mesh *slots;
+    size_t capacity, count;
+} gltf_shared_meshes;
+
+int gltf_shared_mesh_find(const gltf_shared_meshes *t, const gltf_geometry_key *key, uint32_t *mesh);
+/* Returns 0 when out of memory. */
+int gltf_shared_mesh_add(gltf_shared_meshes *t, const gltf_geometry_key *key, uint32_t mesh);
+void gltf_shared_meshes_free(gltf_shared_meshes *t);
+
 typedef struct gltf_ctx {
     const char *name;     /* file name for messages */
     const char *base_dir; /* NULL: external URIs are refused */
@@ -58,6 +81,7 @@ typedef struct gltf_ctx {
     uint32_t *prim_mesh;      /* grows as meshes are converted */
     uint32_t *prim_material;
     uint32_t prim_count, prim_capacity;
+    gltf_shared_meshes shared; /* primitives of the same accessors share one mesh */
     uint32_t *image_texture;  /* per glTF image, linear then sRGB: gdr texture, GDR_NO_INDEX, or UINT32_MAX - 1 (failed) */
 } gltf_ctx;
 
@@ -71,6 +95,11 @@ gdr_status gltf_fail(gltf_ctx *c, gdr_status status, const char *format, ...) __
 gdr_status gltf_get_uint(gltf_ctx *c, const cJSON *obj, const char *key, const char *place, int required,
                          uint32_t max, uint32_t *out);
 gdr_status gltf_get_number(gltf_ctx *c, const cJSON *obj, const char *key, const char *place, double *out);
+/* The largest magnitude a number read into a float may have (a little below FLT_MAX, so that rounding
+ * never makes it infinite). */
+#define GLTF_MAX_FLOAT 3.0e38
+/* A number read into a float: refused unless finite and at most GLTF_MAX_FLOAT in magnitude. */
+gdr_status gltf_get_float(gltf_ctx *c, const cJSON *obj, const char *key, const char *place, float *out);
 gdr_status gltf_get_string(gltf_ctx *c, const cJSON *obj, const char *key, const char *place, const char **out);
 gdr_status gltf_get_object(gltf_ctx *c, const cJSON *obj, const char *key, const char *place, int required,
                            const cJSON **out);

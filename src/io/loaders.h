@@ -46,10 +46,10 @@ gdr_status gdr_import_obj_memory(const void *data, size_t size, const char *name
                                          const gdr_import_options *options, gdr_scene **out,
                                          gdr_import_result *result, gdr_error *err);
 
-/* Reads a cache. Checks magic, version, every size, offset and checksum. When build_options is
- * not NULL, a cache built with different options is refused (stale); each recorded source file
- * that exists with a different size or contents makes it stale too (a missing one does not:
- * a cache may travel without its sources). On GDR_OK, *out is the scene and, when out_pvs is not
+/* Reads a cache as it stands. Checks magic, version, every size, offset and checksum. When
+ * build_options is not NULL, a cache built with different options is refused (stale). The files its
+ * source list names are never opened (they are compared only when gdr_scene_load_file reads the
+ * cache for its source). On GDR_OK, *out is the scene and, when out_pvs is not
  * NULL, *out_pvs the precomputed visibility (a gdr_pvs the caller destroys with gdr_pvs_destroy),
  * or NULL when the cache holds none. Either way a 'PVIS' section is checked (gdr_pvs_load, and its
  * object count against the scene's instances): a damaged one makes the whole cache refused,

@@ -96,6 +96,8 @@ gdr_status gdr_renderer_create(const gdr_renderer_desc *desc_in, gdr_renderer **
         status = gdr_vk_staging_create(&r->allocator, &r->staging, err);
     }
     if (status == GDR_OK)
+        status = gdr_target_memory_check(r->ctx, r->width, r->height, err);
+    if (status == GDR_OK)
         status = create_targets(r, err);
     if (status == GDR_OK)
         status = gdr_occlusion_create(r, err);

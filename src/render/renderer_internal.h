@@ -192,6 +192,11 @@ struct gdr_renderer {
 
 #define GDR_COLOR_FORMAT VK_FORMAT_R8G8B8A8_UNORM
 #define GDR_DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
+
+/* Refuses (GDR_ERROR_INVALID_ARGUMENT) a render size whose targets the device cannot back: its
+ * largest device-local heap, and for a CPU device (lavapipe) the address space the process may still
+ * map (target_memory.c). */
+gdr_status gdr_target_memory_check(const gdr_vk_context *ctx, uint32_t width, uint32_t height, gdr_error *err);
 #define GDR_CLEAR_COLOR {{GDR_BACKGROUND_R, GDR_BACKGROUND_G, GDR_BACKGROUND_B, 1.0f}} /* the background */
 
 gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_error *err);

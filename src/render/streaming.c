@@ -63,33 +63,6 @@ static uint32_t word_mesh(const gdr_gpu_scene *g, uint32_t word)
     return lo;
 }
 
-/* The scene and the cache must describe the same clusters: each mesh's groups, and each page's
- * clusters as the sum of its groups'. */
-static gdr_status check_cache_matches(const gdr_streaming *s, const gdr_scene *scene, const char *path, gdr_error *err)
-{
-    if (gdr_paged_cache_mesh_count(s->cache) != scene->mesh_count)
-        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: %u meshes, the scene has %u: not its cache", path,
-                             gdr_paged_cache_mesh_count(s->cache), scene->mesh_count);
-    for (uint32_t m = 0; m < scene->mesh_count; m++) {
-        const gdr_mesh_clusters *c = &scene->meshes[m].clusters;
-        const gdr_paged_mesh *pm = paged_mesh(s, m);
-        if (pm->group_count != c->group_count || (c->cluster_count > 0 && c->group_count == 0))
-            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: mesh %u has %u LOD groups, the scene's %u "
-                                 "(streaming needs every mesh's LOD DAG)", path, m, pm->group_count, c->group_count);
-        for (uint32_t p = 0; p < pm->page_count; p++) {
-            const gdr_page_info *info = &pm->pages[p];
-            uint64_t clusters = 0;
-            for (uint32_t k = info->first; k < info->first + info->group_count; k++)
-                clusters += c->groups[pm->page_groups[k]].cluster_count;
-            if (clusters != info->cluster_count)
-                return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: mesh %u page %u holds %u clusters, the "
-                                     "scene's groups %llu: not its cache", path, m, p, info->cluster_count,
-                                     (unsigned long long)clusters);
-        }
-    }
-    return GDR_OK;
-}
-
 /* The default budget: a quarter of the largest device-local heap, at most GDR_GEOMETRY_BUDGET_MAX. */
 static uint64_t default_budget(const gdr_renderer *r)
 {
@@ -153,6 +126,35 @@ static uint64_t staging_bytes(const gdr_streaming *s, const gdr_scene *scene)
     return s->upload_budget + s->slot_bytes + largest_records + 4 * nodes;
 }
 
+/* The staging of every frame in flight must fit the device: each one buffer of at most
+ * maxBufferSize, all of them in the largest host-visible heap. Checked before anything is created,
+ * so that an upload budget the device cannot hold is refused with its numbers rather than by a
+ * failed vkCreateBuffer (or an allocation the driver cannot back). */
+static gdr_status check_staging_fits(const gdr_renderer *r, uint64_t bytes, gdr_error *err)
+{
+    VkPhysicalDeviceMaintenance4Properties limits = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_4_PROPERTIES};
+    VkPhysicalDeviceProperties2 properties = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &limits};
+    vkGetPhysicalDeviceProperties2(r->ctx->physical_device, &properties);
+    VkPhysicalDeviceMemoryProperties memory;
+    vkGetPhysicalDeviceMemoryProperties(r->ctx->physical_device, &memory);
+    uint64_t host_heap = 0;
+    for (uint32_t t = 0; t < memory.memoryTypeCount; t++) {
+        VkMemoryPropertyFlags wanted = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+        uint64_t size = memory.memoryHeaps[memory.memoryTypes[t].heapIndex].size;
+        if ((memory.memoryTypes[t].propertyFlags & wanted) == wanted && size > host_heap)
+            host_heap = size;
+    }
+    uint64_t total = bytes * GDR_FRAMES_IN_FLIGHT, largest = limits.maxBufferSize;
+    if (bytes > largest || total > host_heap)
+        return gdr_error_set(err, GDR_ERROR_CAPACITY, "streaming: an upload budget of %llu MiB needs %u staging buffers "
+                             "of %llu MiB (one per frame in flight); this device allows buffers of at most %llu MiB "
+                             "and has %llu MiB of host-visible memory: give a smaller upload budget "
+                             "(gdr render --upload-budget MIB)", (unsigned long long)(r->stream.upload_budget >> 20),
+                             GDR_FRAMES_IN_FLIGHT, (unsigned long long)((bytes + (1u << 20) - 1) >> 20),
+                             (unsigned long long)(largest >> 20), (unsigned long long)(host_heap >> 20));
+    return GDR_OK;
+}
+
 gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr_streaming_desc *desc, gdr_error *err)
 {
     gdr_streaming *s = &r->stream;
@@ -168,7 +170,7 @@ gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr
     s->wait_for_loads = desc->wait_for_loads;
     s->upload_budget = desc->upload_budget_bytes ? desc->upload_budget_bytes : GDR_UPLOAD_BUDGET_DEFAULT;
     s->cache = desc->cache;
-    gdr_status status = check_cache_matches(s, scene, gdr_paged_cache_path(s->cache), err);
+    gdr_status status = gdr_paged_cache_check_scene(s->cache, scene, gdr_paged_cache_path(s->cache), err);
     gdr_residency_desc res = {.cache = s->cache,
                               .budget_bytes = desc->geometry_budget_bytes ? desc->geometry_budget_bytes
                                                                           : default_budget(r),
@@ -180,6 +182,10 @@ gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr
         s->slot_bytes = gdr_residency_slot_bytes(s->residency);
         status = alloc_tables(s, scene, err);
     }
+    if (status == GDR_OK) {
+        s->staging_bytes = staging_bytes(s, scene);
+        status = check_staging_fits(r, s->staging_bytes, err);
+    }
     if (status == GDR_OK)
         status = gdr_page_loader_create(s->cache, 0, &s->loader, err);
     if (status == GDR_OK)
@@ -188,7 +194,6 @@ gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr
                                       GDR_VK_BUFFER_DEVICE, &s->pool, err);
     if (status != GDR_OK) /* a cache that failed to open or to match has no pages to size anything by */
         return status;
-    s->staging_bytes = staging_bytes(s, scene);
     s->stats.enabled = true;
     s->stats.slot_count = s->slot_count;
     s->stats.slot_bytes = s->slot_bytes;

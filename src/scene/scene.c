@@ -204,6 +204,10 @@ gdr_status gdr_scene_set_mesh_colors(gdr_scene *scene, uint32_t mesh, const gdr_
 gdr_status gdr_scene_add_material(gdr_scene *scene, const gdr_material *material, uint32_t *out_index,
                                   gdr_error *err)
 {
+    const char *problem = gdr_material_problem(material);
+    if (problem)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "material %u ('%.*s'): %s", scene->material_count, GDR_NAME_MAX - 1,
+                             material->name, problem);
     gdr_status status = reserve_one((void **)&scene->materials, &scene->material_capacity,
                                     scene->material_count, sizeof(gdr_material), err);
     if (status != GDR_OK)
@@ -212,6 +216,26 @@ gdr_status gdr_scene_add_material(gdr_scene *scene, const gdr_material *material
         *out_index = scene->material_count;
     scene->materials[scene->material_count++] = *material;
     return GDR_OK;
+}
+
+/* How far from the origin (largest coordinate, plus the radius) a transform places a mesh's bounding
+ * sphere, in doubles so that nothing overflows. World space has the limit of mesh space: beyond
+ * about 1e18 the view, the culling planes and the screen-size tests stop being finite, and the
+ * pipelines disagreed (one refused with no file named, the others drew nothing). */
+static double world_reach(const gdr_mesh *mesh, const gdr_mat4 *t)
+{
+    const float *m = t->m;
+    double centre[3], scale = 0.0;
+    for (int r = 0; r < 3; r++)
+        centre[r] = (double)m[r] * mesh->bounds.x + (double)m[4 + r] * mesh->bounds.y +
+                    (double)m[8 + r] * mesh->bounds.z + (double)m[12 + r];
+    for (int col = 0; col < 3; col++) {
+        double length = sqrt((double)m[4 * col] * m[4 * col] + (double)m[4 * col + 1] * m[4 * col + 1] +
+                             (double)m[4 * col + 2] * m[4 * col + 2]);
+        scale = length > scale ? length : scale;
+    }
+    double largest = fmax(fabs(centre[0]), fmax(fabs(centre[1]), fabs(centre[2])));
+    return largest + scale * fabs((double)mesh->bounds.w);
 }
 
 gdr_status gdr_scene_add_instance(gdr_scene *scene, const gdr_instance *instance, gdr_error *err)
@@ -227,6 +251,13 @@ gdr_status gdr_scene_add_instance(gdr_scene *scene, const gdr_instance *instance
         if (!isfinite(instance->transform.m[i]))
             return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "instance %u: transform is not finite",
                                  scene->instance_count);
+    /* A scene that holds mesh counts only (the paged reader's holder of instances) has no bounds:
+     * the scene read beside it checks them. */
+    double reach = scene->meshes ? world_reach(&scene->meshes[instance->mesh], &instance->transform) : 0.0;
+    if (!(reach <= (double)GDR_MAX_COORDINATE))
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "instance %u: its transform places mesh %u %g from the "
+                             "origin, beyond the %g limit on coordinates", scene->instance_count, instance->mesh, reach,
+                             (double)GDR_MAX_COORDINATE);
     if (!(instance->min_screen_size >= 0.0f && instance->min_screen_size <= FLT_MAX) ||
         !(instance->max_screen_size >= 0.0f && instance->max_screen_size <= FLT_MAX))
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,

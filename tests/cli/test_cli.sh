@@ -103,8 +103,8 @@ expect 2 "camera index out of range" "$gdr" render demo:instances=10 $small --ca
 expect 2 "zero instances" "$gdr" render demo:instances=0 $small
 expect 2 "unknown demo option" "$gdr" render demo:size=3 $small
 expect 1 "missing scene file" "$gdr" render "$work/does-not-exist.gltf" $small
-expect 1 "no such device" "$gdr" render demo:instances=10 $small --device 99
-expect 1 "no such device name" "$gdr" render demo:instances=10 $small --device "no such gpu"
+expect 2 "no such device" "$gdr" render demo:instances=10 $small --device 99
+expect 2 "no such device name" "$gdr" render demo:instances=10 $small --device "no such gpu"
 expect 1 "unwritable PNG" "$gdr" render demo:instances=10 $small --out "$work/missing-dir/a.png"
 expect 2 "bench bad sizes" "$gdr" bench --sizes 10,abc
 }

@@ -119,5 +119,60 @@ for at in 0 4 8 12 20 36; do
     check "no image for the damaged cache (index byte $at)" test ! -e "$work/mutant.png"
 done
 
+# FIFOs as the program's own inputs: refused at once, never waited on (expect's timeout fails a hang).
+mkfifo "$work/path.fifo"
+# shellcheck disable=SC2086
+expect 1 "camera path is a FIFO (render)" "path.fifo: not a regular file" \
+    "$gdr" render demo:instances=4 $tiny --camera-path "$work/path.fifo"
+# shellcheck disable=SC2086
+expect 1 "camera path is a FIFO (bench)" "path.fifo: not a regular file" \
+    "$gdr" bench --scene demo:instances=4 $tiny --frames 1 --camera-path "$work/path.fifo"
+expect 1 "results file is a FIFO" "path.fifo: not a regular file" \
+    "$gdr" bench --plot-from "$work/path.fifo" --plot "$work/fifo.svg"
+# A bad camera path is reported before the scene is loaded (here a scene that does not exist).
+printf 'gdr-camera-path 1\n0 0 0 0 0 0\n' > "$work/short.path"
+# shellcheck disable=SC2086
+expect 1 "camera path checked before the scene" "short.path:2: expected 7 numbers .*found 6" \
+    "$gdr" render "$work/missing.obj" $tiny --camera-path "$work/short.path"
+# Camera path messages that say what is wrong; a value too small for a float is a number like any.
+printf 'gdr-camera-path 1\n0 0 5 0 0 0\0001\n' > "$work/nul.path"
+# shellcheck disable=SC2086
+expect 1 "a NUL byte in a camera path" "nul.path:2: a NUL byte at column 12" \
+    "$gdr" render demo:instances=4 $tiny --camera-path "$work/nul.path"
+printf 'gdr-camera-path 1\n0 0 5 0 0 1e39 1\n' > "$work/big.path"
+# shellcheck disable=SC2086
+expect 1 "a number beyond a float in a camera path" "big.path:2: number 6: '1e39' is not finite as a 32-bit float" \
+    "$gdr" render demo:instances=4 $tiny --camera-path "$work/big.path"
+printf 'gdr-camera-path 1\n0 0 5 0 0 1e-45 1\n' > "$work/tiny.path"
+# shellcheck disable=SC2086
+expect 0 "a denormal in a camera path" "" "$gdr" render demo:instances=4 $tiny --camera-path "$work/tiny.path"
+
+# Command-line values: an unknown option is called so (not "needs a value"), a device the machine
+# lacks is a bad value (exit 2, before the scene is loaded), an upload budget or a target size the
+# device cannot back is refused with its numbers (not a raw vkCreateBuffer failure or a driver crash).
+expect 2 "unknown render option" "unknown option '--bogus-option'" "$gdr" render demo --bogus-option
+expect 2 "unknown bench option" "unknown option '--bogus-option'" "$gdr" bench --bogus-option
+# shellcheck disable=SC2086
+expect 2 "a device that does not exist" "device 99: there are" \
+    "$gdr" render "$work/missing.obj" $tiny --device 99
+# shellcheck disable=SC2086
+expect 1 "an upload budget over the device's buffers" "upload budget of 4096 MiB needs 2 staging buffers" \
+    "$gdr" render "$work/paged.gdrc" --geometry-budget 8 --upload-budget 4096 $tiny
+# A CPU device's memory is the process's: under a 4 GiB address-space limit, a 16384^2 target (about
+# 7.5 GiB) is refused before it is made.
+expect 2 "a target larger than the device can back" "render size 16384x16384 needs about [0-9]+ MiB" \
+    sh -c "ulimit -v 4194304 && exec '$gdr' render demo:instances=4 --width 16384 --height 16384 --out '$work/big.png'"
+check "no image for the refused target" test ! -e "$work/big.png"
+
+# A node scale of 3e38: every pipeline refuses the scene the same way, naming the file (the CPU
+# pipeline said "cull view: a matrix has a NaN or infinity", the others drew nothing and exited 0).
+printf '{"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}],"bufferViews":[{"buffer":0,"byteLength":36}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0,"scale":[3e38,3e38,3e38]}],"scenes":[{"nodes":[0]}]}' > "$work/scaled.gltf"
+for pipeline in cpu mesh indirect; do
+    # shellcheck disable=SC2086
+    expect 1 "a scene beyond the limit on coordinates ($pipeline)" "scaled.gltf: nodes\[0\].*limit on coordinates" \
+        "$gdr" render "$work/scaled.gltf" --no-cache $tiny --pipeline $pipeline --out "$work/scaled.png"
+done
+check "no image for the scene beyond the limit" test ! -e "$work/scaled.png"
+
 echo "test_hostile_cli: $failures failure(s)"
 [ "$failures" = 0 ]

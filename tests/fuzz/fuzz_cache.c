@@ -10,6 +10,7 @@
  * quad.gdrc and paged.gdrc come from corpus/gltf/nodes.gltf, corpus/obj/quad.obj and
  * `gdr build unique-field:meshes=2,triangles=1000 --pages=4` (tests/fuzz/make_cache_seeds.sh). */
 #define _GNU_SOURCE /* memfd_create */
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -22,6 +23,7 @@
 
 #include "gdr/cull.h"
 #include "gdr/io.h"
+#include "gdr/paged_cache.h"
 #include "fuzz_geometry.h"
 #include "io/io_internal.h"
 
@@ -54,8 +56,57 @@ static const uint8_t *pvs_section(const uint8_t *data, size_t *length)
     return NULL;
 }
 
+/* What streaming relies on in a page the reader accepted: the counts of its index entry, every
+ * cluster's group, vertices and triangles inside the page, every vertex finite. */
+static void check_page(const gdr_paged_mesh *pm, const gdr_page_info *info, const gdr_page *page)
+{
+    if (page->cluster_count != info->cluster_count || page->vertex_count != info->vertex_count)
+        __builtin_trap();
+    for (uint32_t c = 0; c < page->cluster_count; c++) {
+        const gdr_page_cluster *pc = &page->clusters[c];
+        if (pc->group >= pm->group_count || pc->vertex_offset > page->vertex_count ||
+            pc->vertex_count > page->vertex_count - pc->vertex_offset ||
+            pc->triangle_offset > page->triangle_byte_count ||
+            3 * pc->triangle_count > page->triangle_byte_count - pc->triangle_offset)
+            __builtin_trap();
+        for (uint32_t t = 0; t < 3 * pc->triangle_count; t++)
+            if (page->triangles[pc->triangle_offset + t] >= pc->vertex_count)
+                __builtin_trap();
+    }
+    for (uint32_t v = 0; v < page->vertex_count; v++)
+        if (!isfinite(page->vertices[v].position.x) || !isfinite(page->vertices[v].position.y) ||
+            !isfinite(page->vertices[v].position.z))
+            __builtin_trap();
+}
+
+/* The rest of the streaming open (gdr_streaming_open), without a GPU: the paged reader opens the same
+ * file, is checked against the scene read for streaming, and its pages are read (at most 32, so that
+ * an input runs in milliseconds). A refusal at any step stops there, as streaming does. */
+static void open_pages(const char *path, const gdr_scene *paged)
+{
+    gdr_paged_cache *cache = NULL;
+    gdr_error err;
+    if (gdr_paged_cache_open(path, &cache, &err) != GDR_OK)
+        return;
+    if (gdr_paged_cache_check_scene(cache, paged, path, &err) == GDR_OK) {
+        uint32_t budget = 32;
+        for (uint32_t m = 0; m < gdr_paged_cache_mesh_count(cache) && budget; m++) {
+            const gdr_paged_mesh *pm = gdr_paged_cache_mesh(cache, m);
+            for (uint32_t p = 0; p < pm->page_count && budget; p++, budget--) {
+                gdr_page page;
+                if (gdr_paged_cache_read_page(cache, m, p, &page, &err) != GDR_OK)
+                    continue;
+                check_page(pm, &pm->pages[p], &page);
+                gdr_page_free(&page);
+            }
+        }
+    }
+    gdr_paged_cache_close(cache);
+}
+
 /* The streaming read of the same bytes, from a file in memory; where the whole read accepted them
- * too (whole != NULL), every mesh's counts and cluster and group records must be the same. */
+ * too (whole != NULL), every mesh's counts and cluster and group records must be the same. Then the
+ * paged reader, as the streaming open uses it. */
 static void read_for_streaming(const uint8_t *data, size_t size, const gdr_scene *whole)
 {
     int fd = memfd_create("fuzz.gdrc", 0);
@@ -76,6 +127,7 @@ static void read_for_streaming(const uint8_t *data, size_t size, const gdr_scene
                 (a->group_count && memcmp(a->groups, b->groups, sizeof *a->groups * a->group_count)))
                 __builtin_trap();
         }
+        open_pages(path, paged);
         gdr_scene_destroy(paged);
     }
     close(fd);

@@ -70,7 +70,10 @@ static void collect(void *user, const char *message)
 
 typedef struct expected {
     uint32_t instances, meshes, cameras, materials;
-    uint8_t used[4096]; /* (mesh, primitive) pairs seen, mesh * 16 + primitive */
+    /* The geometries seen: primitives of one mode and the same indices, POSITION, NORMAL, TEXCOORD_0
+     * and COLOR_0 accessors share one mesh. */
+    int geometry[4096][6];
+    uint32_t geometry_count;
     int default_material; /* an instanced triangle primitive has no material: glTF's default one is added */
 } expected;
 
@@ -82,23 +85,38 @@ static int triangle_primitive(const cJSON *prim)
     return m >= 4 && cJSON_GetObjectItem(attributes, "POSITION") != NULL;
 }
 
+/* 1 when the primitive reads accessors no earlier one read (recorded then). */
+static int new_geometry(const cJSON *prim, expected *e)
+{
+    static const char *const semantics[4] = {"POSITION", "NORMAL", "TEXCOORD_0", "COLOR_0"};
+    const cJSON *attributes = cJSON_GetObjectItem(prim, "attributes");
+    const cJSON *mode = cJSON_GetObjectItem(prim, "mode"), *indices = cJSON_GetObjectItem(prim, "indices");
+    int key[6] = {mode ? mode->valueint : 4, indices ? indices->valueint : -1};
+    for (int k = 0; k < 4; k++) {
+        const cJSON *a = cJSON_GetObjectItem(attributes, semantics[k]);
+        key[2 + k] = a ? a->valueint : -1;
+    }
+    for (uint32_t i = 0; i < e->geometry_count; i++)
+        if (memcmp(e->geometry[i], key, sizeof key) == 0)
+            return 0;
+    if (e->geometry_count < 4096)
+        memcpy(e->geometry[e->geometry_count++], key, sizeof key);
+    return 1;
+}
+
 static void walk(const cJSON *root, int node, expected *e)
 {
     const cJSON *n = cJSON_GetArrayItem(cJSON_GetObjectItem(root, "nodes"), node);
     const cJSON *mesh = cJSON_GetObjectItem(n, "mesh"), *camera = cJSON_GetObjectItem(n, "camera");
     if (mesh) {
         const cJSON *m = cJSON_GetArrayItem(cJSON_GetObjectItem(root, "meshes"), mesh->valueint);
-        int p = 0;
-        for (const cJSON *prim = cJSON_GetObjectItem(m, "primitives")->child; prim; prim = prim->next, p++) {
+        for (const cJSON *prim = cJSON_GetObjectItem(m, "primitives")->child; prim; prim = prim->next) {
             if (!triangle_primitive(prim))
                 continue;
             e->instances++;
             e->default_material |= cJSON_GetObjectItem(prim, "material") == NULL;
-            int key = mesh->valueint * 16 + p;
-            if (key < 4096 && !e->used[key]) {
-                e->used[key] = 1;
+            if (new_geometry(prim, e))
                 e->meshes++;
-            }
         }
     }
     if (camera) {

@@ -4,6 +4,7 @@
 #define _GNU_SOURCE /* mkfifo, symlink, utimensat */
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -11,6 +12,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -249,6 +251,33 @@ static void test_uri_confinement(void)
     }
 }
 
+/* URIs that name no file: called so (both were "resolves outside the scene's folder (a symbolic
+ * link)"). */
+static void test_uri_messages(void)
+{
+    struct { const char *uri; const char *message; } cases[] = {
+        {"", "buffers[0].uri: empty: it names no file"},
+        {".", "buffers[0].uri: '.' names the scene's folder, not a file"},
+        {"./", "buffers[0].uri: './' names the scene's folder, not a file"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char text[1024], file[1200];
+        snprintf(text, sizeof text,
+                 "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":36,\"uri\":\"%s\"}],"
+                 "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],\"accessors\":[{\"bufferView\":0,"
+                 "\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}],\"meshes\":[{\"primitives\":[{\"attributes\":"
+                 "{\"POSITION\":0}}]}],\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]}",
+                 cases[i].uri);
+        snprintf(file, sizeof file, "%s/scene/t.gltf", dir);
+        CHECK(test_write_file(file, text, strlen(text)));
+        gdr_scene *s = gltf_file(file, NULL, 0);
+        CHECK(!s && strstr(err.message, cases[i].message) && !strstr(err.message, "symbolic link"));
+        if (s || !strstr(err.message, cases[i].message))
+            fprintf(stderr, "  uri '%s': %s\n", cases[i].uri, s ? "accepted" : err.message);
+        gdr_scene_destroy(s);
+    }
+}
+
 static void on_alarm(int signal)
 {
     (void)signal;
@@ -291,42 +320,89 @@ static void test_fifo(void)
     unlink(fifo);
 }
 
-/* A source list naming one file many times: the file is read and hashed once, not per entry. */
+/* Writes `s` as the cache of `source` (its first entry, fresh), listing `spellings` names of `big`
+ * (recorded with another mtime: their contents are compared). */
+static void write_listing_cache(const char *cache, const gdr_scene *s, const char *source, const char *big,
+                                uint32_t spellings)
+{
+    struct stat st_source, st_big;
+    CHECK(stat(source, &st_source) == 0 && stat(big, &st_big) == 0);
+    size_t size;
+    uint8_t *contents = test_read_file(big, &size);
+    uint64_t hash = contents ? XXH3_64bits(contents, size) : 0;
+    free(contents);
+    char absolute[PATH_MAX];
+    CHECK(realpath(source, absolute) != NULL);
+    gdr_source_file *files = calloc(spellings + 1, sizeof *files);
+    char (*names)[PATH_MAX] = calloc(spellings, PATH_MAX);
+    files[0] = (gdr_source_file){absolute, (uint64_t)st_source.st_size,
+                                 (int64_t)st_source.st_mtim.tv_sec * 1000000000ll + st_source.st_mtim.tv_nsec, 0};
+    /* `//dir/./big.bin`, `/dir/././big.bin`, ...: one file, many strings. */
+    for (uint32_t i = 0; i < spellings; i++) {
+        int n = snprintf(names[i], PATH_MAX, "%s%s", i % 2 ? "/" : "", big);
+        char *slash = strrchr(names[i], '/');
+        memmove(slash + 2 * (i / 2), slash, strlen(slash) + 1);
+        for (uint32_t k = 0; k < i / 2; k++)
+            memcpy(slash + 2 * k, "/.", 2);
+        CHECK(n > 0 && strlen(names[i]) < PATH_MAX - 2);
+        files[i + 1] = (gdr_source_file){names[i], (uint64_t)st_big.st_size, 1, hash};
+    }
+    gdr_source_list list = {files, spellings + 1, spellings + 1};
+    gdr_cache_write_options write = {.source = {gdr_cache_build_options(), &list}};
+    CHECK(gdr_cache_write(cache, s, &write, &err) == GDR_OK);
+    free(files);
+    free(names);
+}
+
+/* A source list naming one file many times, under many spellings: the file is read and hashed once,
+ * not per entry nor per string. */
 static void test_source_list_repeats(void)
 {
-    char big[1200], cache[1200];
+    char big[1200], source[1200], cache[1300];
     snprintf(big, sizeof big, "%s/big.bin", dir);
+    snprintf(source, sizeof source, "%s/repeats.obj", dir);
+    snprintf(cache, sizeof cache, "%s.gdrc", source);
     size_t size = 16u << 20;
     uint8_t *bytes = calloc(size, 1);
     CHECK(bytes && test_write_file(big, bytes, size));
     free(bytes);
-    gdr_scene *s = obj_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", NULL);
+    const char *one = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    CHECK(test_write_file(source, one, strlen(one)));
+    /* The cache holds two triangles, the source one: a scene of two came from the cache. */
+    gdr_scene *s = obj_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n", NULL);
     double seconds[2];
-    uint32_t counts[2] = {1, 256};
-    size_t read_size;
-    uint8_t *contents = test_read_file(big, &read_size);
-    uint64_t hash = contents ? XXH3_64bits(contents, read_size) : 0;
-    free(contents);
+    uint32_t counts[2] = {1, 243};
+    gdr_load_options o = {.no_progress = 1, .warning = test_collect_warning, .warning_user = &warnings};
     for (int k = 0; k < 2; k++) {
-        gdr_source_file *files = calloc(counts[k], sizeof *files);
-        for (uint32_t i = 0; i < counts[k]; i++)
-            files[i] = (gdr_source_file){big, size, 1 /* another mtime: contents compared */, hash};
-        gdr_source_list list = {files, counts[k], counts[k]};
-        gdr_cache_write_options write = {.source = {gdr_cache_build_options(), &list}};
-        snprintf(cache, sizeof cache, "%s/repeats%d.gdrc", dir, k);
-        CHECK(gdr_cache_write(cache, s, &write, &err) == GDR_OK);
-        free(files);
+        write_listing_cache(cache, s, source, big, counts[k]);
         struct timespec t0, t1;
         clock_gettime(CLOCK_MONOTONIC, &t0);
         gdr_scene *loaded = NULL;
-        CHECK(gdr_cache_read(cache, gdr_cache_build_options(), &loaded, NULL, &err) == GDR_OK); /* every entry fresh */
+        CHECK(gdr_scene_load_file(source, &o, &loaded, NULL, &err) == GDR_OK);
         clock_gettime(CLOCK_MONOTONIC, &t1);
+        CHECK(loaded && loaded->meshes[0].index_count == 6); /* every entry fresh: the cache was used */
         seconds[k] = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
         gdr_scene_destroy(loaded);
     }
-    /* Once per entry, 256 entries take about 256 times as long; once per path, about the same. */
-    printf("source list: 1 entry %.2f ms, 256 entries of one path %.2f ms\n", seconds[0] * 1e3, seconds[1] * 1e3);
+    /* Once per string, 243 spellings take about 243 times as long; once per file, about the same. */
+    printf("source list: 1 entry %.2f ms, 243 spellings of one file %.2f ms\n", seconds[0] * 1e3, seconds[1] * 1e3);
     CHECK(seconds[1] < 8 * seconds[0] + 0.05);
+    /* Read as it stands (a .gdrc given directly), the cache opens none of its recorded files: one
+     * whose contents differ from the record, or a FIFO, changes nothing. */
+    CHECK(test_write_file(big, "other contents", 14));
+    gdr_scene *loaded = NULL;
+    CHECK(gdr_cache_read(cache, gdr_cache_build_options(), &loaded, NULL, &err) == GDR_OK && loaded &&
+          loaded->meshes[0].index_count == 6);
+    gdr_scene_destroy(loaded);
+    loaded = NULL;
+    CHECK(gdr_scene_load_file(cache, &o, &loaded, NULL, &err) == GDR_OK && loaded &&
+          loaded->meshes[0].index_count == 6);
+    gdr_scene_destroy(loaded);
+    /* Read for its source, the changed file makes it stale: rebuilt from the source. */
+    loaded = NULL;
+    CHECK(gdr_scene_load_file(source, &o, &loaded, NULL, &err) == GDR_OK && loaded &&
+          loaded->meshes[0].index_count == 3);
+    gdr_scene_destroy(loaded);
     gdr_scene_destroy(s);
     unlink(big);
 }
@@ -510,6 +586,99 @@ static void test_messages(void)
     free(rgba);
 }
 
+/* A glTF of one triangle with the material `material` (JSON text). */
+static gdr_scene *material_gltf(const char *material)
+{
+    static const float corners[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    char *uri = test_data_uri(corners, sizeof corners);
+    char text[2048];
+    snprintf(text, sizeof text,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":36,\"uri\":\"%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],\"accessors\":[{\"bufferView\":0,"
+             "\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}],\"materials\":[%s],\"meshes\":[{"
+             "\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]}],\"nodes\":[{\"mesh\":0}],"
+             "\"scenes\":[{\"nodes\":[0]}]}",
+             uri, material);
+    free(uri);
+    return gltf_text(text, NULL);
+}
+
+/* Material values a cache cannot hold: refused at import, by the API and by the writer, with the
+ * reader's own rule (a factor of 1e300 was written as +inf, and the reader then refused the cache). */
+static void test_material_values(void)
+{
+    static const char *const bad[] = {
+        "{\"pbrMetallicRoughness\":{\"metallicFactor\":1e300}}",
+        "{\"pbrMetallicRoughness\":{\"roughnessFactor\":-1e39}}",
+        "{\"alphaCutoff\":1e300}",
+        "{\"normalTexture\":{\"index\":0,\"scale\":1e300}}",
+        "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,1e300]}}",
+        ("{\"emissiveFactor\":[3e38,0,0],\"extensions\":{\"KHR_materials_emissive_strength\":"
+         "{\"emissiveStrength\":1e6}}}"),
+    };
+    static const char *const where[] = {"materials[0].pbrMetallicRoughness.metallicFactor",
+                                        "materials[0].pbrMetallicRoughness.roughnessFactor", "materials[0].alphaCutoff",
+                                        "materials[0].normalTexture.scale",
+                                        "materials[0].pbrMetallicRoughness.baseColorFactor[3]",
+                                        "materials[0]: emissive factor"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        gdr_scene *s = material_gltf(bad[i]);
+        CHECK(!s && strstr(err.message, "t.gltf") && strstr(err.message, where[i]));
+        if (s || !strstr(err.message, where[i]))
+            printf("material %zu: %s\n", i, s ? "accepted" : err.message);
+        gdr_scene_destroy(s);
+    }
+    gdr_scene *s = material_gltf("{\"pbrMetallicRoughness\":{\"metallicFactor\":0.25}}");
+    CHECK(s && s->material_count == 1 && s->materials[0].metallic_factor == 0.25f);
+    /* Through the API, and a material poked into the scene's array: the writer refuses it. */
+    gdr_material m = gdr_material_default();
+    m.roughness_factor = 1.0f / 0.0f;
+    CHECK(s && gdr_scene_add_material(s, &m, NULL, &err) != GDR_OK && strstr(err.message, "roughness factor"));
+    char cache[1200];
+    snprintf(cache, sizeof cache, "%s/inf_material.gdrc", dir);
+    unlink(cache);
+    if (s)
+        s->materials[0].occlusion_strength = 1.0f / 0.0f;
+    CHECK(s && gdr_cache_write(cache, s, NULL, &err) != GDR_OK && strstr(err.message, "occlusion strength") &&
+          access(cache, F_OK) != 0);
+    gdr_scene_destroy(s);
+}
+
+/* Primitives reading the same accessors share one mesh (each primitive its own instance, with its
+ * own material); other indices make another mesh. Each primitive was a mesh and a DAG of its own. */
+static void test_shared_accessors(void)
+{
+    static const float corners[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+    static const uint32_t quads[9] = {0, 1, 2, 1, 3, 2, 0, 1, 3};
+    uint8_t bytes[sizeof corners + sizeof quads];
+    memcpy(bytes, corners, sizeof corners);
+    memcpy(bytes + sizeof corners, quads, sizeof quads);
+    char *uri = test_data_uri(bytes, sizeof bytes);
+    char text[4096];
+    const char *same = "{\"attributes\":{\"POSITION\":0},\"indices\":1";
+    snprintf(text, sizeof text,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":84,\"uri\":\"%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":36}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+             "{\"bufferView\":1,\"componentType\":5125,\"count\":6,\"type\":\"SCALAR\"},"
+             "{\"bufferView\":1,\"byteOffset\":24,\"componentType\":5125,\"count\":3,\"type\":\"SCALAR\"}],"
+             "\"materials\":[{},{}],\"meshes\":[{\"primitives\":[%s},%s,\"material\":1},%s,\"mode\":4},"
+             "{\"attributes\":{\"POSITION\":0},\"indices\":2}]},{\"primitives\":[%s,\"material\":0}]}],"
+             "\"nodes\":[{\"mesh\":0},{\"mesh\":1,\"translation\":[5,0,0]}],\"scenes\":[{\"nodes\":[0,1]}]}",
+             uri, same, same, same, same);
+    free(uri);
+    gdr_scene *s = gltf_text(text, NULL);
+    CHECK(s && s->mesh_count == 2 && s->instance_count == 5);
+    uint32_t uses[2] = {0, 0};
+    for (uint32_t i = 0; s && i < s->instance_count; i++)
+        uses[s->instances[i].mesh < 2 ? s->instances[i].mesh : 0]++;
+    CHECK(s && uses[0] + uses[1] == 5 && (uses[0] == 4 || uses[1] == 4));
+    CHECK(s && s->instances[0].material != s->instances[1].material && s->instances[1].material == 1);
+    if (s)
+        printf("shared accessors: %u meshes, %u instances\n", s->mesh_count, s->instance_count);
+    gdr_scene_destroy(s);
+}
+
 /* Output files: links followed, devices written in place, FIFOs without a reader refused. */
 static void test_output_targets(void)
 {
@@ -556,6 +725,62 @@ static void test_output_targets(void)
     unlink(target), unlink(link), unlink(fifo);
 }
 
+/* A transform that places a mesh beyond the limit on coordinates (a node scale of 3e38 on a unit
+ * triangle): refused at import naming the file and the node; the CPU pipeline refused it at render
+ * time without a file while the GPU pipelines drew nothing. The limit is mesh space's. */
+static void test_world_extent(void)
+{
+    static const float corners[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    gdr_scene *s = NULL;
+    const char *scales[2] = {"3e38", "1e13"};
+    for (int k = 0; k < 2; k++) {
+        char *text = triangle_gltf(corners, 3);
+        char *node = strstr(text, "{\"mesh\":0}");
+        char edited[4096];
+        CHECK(node != NULL);
+        if (!node)
+            break;
+        snprintf(edited, sizeof edited, "%.*s{\"mesh\":0,\"scale\":[%s,%s,%s]}%s", (int)(node - text), text, scales[k],
+                 scales[k], scales[k], node + strlen("{\"mesh\":0}"));
+        free(text);
+        s = gltf_text(edited, NULL);
+        CHECK(!s && strstr(err.message, "t.gltf: nodes[0]") && strstr(err.message, "limit on coordinates"));
+        gdr_scene_destroy(s);
+    }
+    s = obj_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", NULL);
+    gdr_instance far = {.transform = gdr_mat4_from_trs((gdr_vec3){1e13f, 0, 0}, gdr_quat_identity(), (gdr_vec3){1, 1, 1}), .mesh = 0,
+                        .material = GDR_NO_INDEX, .color = {1, 1, 1, 1}};
+    CHECK(s && gdr_scene_add_instance(s, &far, &err) != GDR_OK && strstr(err.message, "limit on coordinates"));
+    far.transform = gdr_mat4_from_trs((gdr_vec3){1e11f, 0, 0}, gdr_quat_identity(), (gdr_vec3){1, 1, 1});
+    CHECK(s && gdr_scene_add_instance(s, &far, &err) == GDR_OK);
+    gdr_scene_destroy(s);
+}
+
+/* Temporary files left by writers killed by a signal (PATH.tmp.PID): removed by the next write of
+ * PATH when their process no longer runs; a running writer's, and other names, are kept. */
+static void test_stale_temporaries(void)
+{
+    pid_t child = fork();
+    if (child == 0)
+        _exit(0);
+    CHECK(child > 0 && waitpid(child, NULL, 0) == child); /* its pid now runs nothing */
+    char target[1200], stale[1300], live[1300], other[1300], odd[1300];
+    snprintf(target, sizeof target, "%s/written.bin", dir);
+    snprintf(stale, sizeof stale, "%s.tmp.%ld", target, (long)child);
+    snprintf(live, sizeof live, "%s.tmp.%ld", target, (long)getppid());
+    snprintf(other, sizeof other, "%s/another.bin.tmp.%ld", dir, (long)child);
+    snprintf(odd, sizeof odd, "%s.tmp.%ldx", target, (long)child);
+    const char *files[4] = {stale, live, other, odd};
+    for (int i = 0; i < 4; i++)
+        CHECK(test_write_file(files[i], "left", 4));
+    CHECK(gdr_write_file_atomic(target, "new", 3, &err) == GDR_OK);
+    CHECK(access(stale, F_OK) != 0);
+    CHECK(access(live, F_OK) == 0 && access(other, F_OK) == 0 && access(odd, F_OK) == 0);
+    for (int i = 0; i < 4; i++)
+        unlink(files[i]);
+    unlink(target);
+}
+
 int main(void)
 {
     snprintf(dir, sizeof dir, "%s/hostile", GDR_IO_TEST_TMP);
@@ -565,6 +790,7 @@ int main(void)
     test_fan_split();
     test_soup_with_outlier();
     test_uri_confinement();
+    test_uri_messages();
     test_fifo();
     test_source_list_repeats();
     test_cache_knows_its_source();
@@ -572,6 +798,10 @@ int main(void)
     test_instance_budget();
     test_other_budgets();
     test_messages();
+    test_material_values();
+    test_shared_accessors();
     test_output_targets();
+    test_stale_temporaries();
+    test_world_extent();
     return test_finish("test_hostile");
 }

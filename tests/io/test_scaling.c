@@ -1,6 +1,6 @@
 /* Work proportional to input: for every dimension of a scene file that drives a loop or an
  * allocation (triangles, repeated and degenerate faces, shared vertices, groups, nodes, meshes,
- * materials, images, instances, a soup with an outlier), the file is generated at size N and 4N
+ * materials, images, instances, a soup with an outlier, one accessor named by many primitives), the file is generated at size N and 4N
  * and taken through import, meshlets and the LOD DAG; for a cache's meshes and triangles, the
  * cache of such a file is read. The CPU time must grow less than 8-fold (linear: 4, n log n: about
  * 4.5, quadratic: 16). Times are the best of three runs, measured side by side. */
@@ -180,6 +180,39 @@ static void gltf_gpu_instances(text *t, uint32_t n)
         "\"scenes\":[{\"nodes\":[0]}]}", gltf_head, gltf_triangle, n);
 }
 
+static void gltf_shared_accessor(text *t, uint32_t n)
+{
+    /* A grid of about n triangles (positions and indices in one data: URI), named by n / 10
+     * primitives: read, cleaned and given a DAG once, each primitive an instance of it. */
+    uint32_t side = 2;
+    while (2 * side * side < n)
+        side++;
+    uint32_t vertices = (side + 1) * (side + 1), indices = 6 * side * side;
+    size_t size = 12 * (size_t)vertices + 4 * (size_t)indices;
+    uint8_t *bytes = malloc(size);
+    float *p = (float *)bytes;
+    for (uint32_t y = 0; y <= side; y++)
+        for (uint32_t x = 0; x <= side; x++, p += 3)
+            p[0] = (float)x, p[1] = (float)y, p[2] = (float)((x * 7 + y * 13) % 5);
+    uint32_t *index = (uint32_t *)(bytes + 12 * (size_t)vertices);
+    for (uint32_t y = 0; y < side; y++)
+        for (uint32_t x = 0; x < side; x++, index += 6) {
+            uint32_t a = y * (side + 1) + x, b = a + 1, c = a + side + 1, d = c + 1;
+            memcpy(index, (uint32_t[6]){a, b, d, a, d, c}, sizeof(uint32_t[6]));
+        }
+    char *uri = test_data_uri(bytes, size);
+    free(bytes);
+    put(t, "%s\"buffers\":[{\"byteLength\":%zu,\"uri\":\"%s\"}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":%u},"
+        "{\"buffer\":0,\"byteOffset\":%u,\"byteLength\":%u}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,"
+        "\"count\":%u,\"type\":\"VEC3\"},{\"bufferView\":1,\"componentType\":5125,\"count\":%u,\"type\":\"SCALAR\"}],"
+        "\"meshes\":[{\"primitives\":[", gltf_head, size, uri, 12 * vertices, 12 * vertices, 4 * indices, vertices,
+        indices);
+    free(uri);
+    for (uint32_t i = 0; i < n / 10; i++)
+        put(t, "%s{\"attributes\":{\"POSITION\":0},\"indices\":1}", i ? "," : "");
+    put(t, "]}],\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]}");
+}
+
 /* --- measurement ------------------------------------------------------------------------------ */
 
 enum { OBJ, GLTF, CACHE, MESHLETS };
@@ -252,6 +285,8 @@ int main(void)
         {"gltf: meshes and materials", GLTF, 5000, gltf_unused_meshes_and_materials},
         {"gltf: images", GLTF, 2000, gltf_images},
         {"gltf: gpu instances", GLTF, 50000, gltf_gpu_instances},
+        /* Each primitive was a mesh and a DAG of its own: n / 10 DAGs of n triangles, quadratic. */
+        {"gltf: one accessor, many primitives", GLTF, 1000, gltf_shared_accessor},
         /* A cache read is a few passes over memory: sizes whose 4N still fits a processor's caches,
          * since at 100,000 triangles the 4N read ran from main memory and took 9-10x the time of
          * N on the dev VM (with any malloc settings), which is the memory hierarchy, not the code. */

@@ -2,6 +2,8 @@
  * gnuplot-nox) against scene size or, along a camera path, against the frame. */
 #include "bench_plot.h"
 
+#include "gdr/io.h"
+
 #include <spawn.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -126,52 +128,11 @@ static gdr_status run_gnuplot(const char *script, gdr_error *err)
     return GDR_OK;
 }
 
-/* The whole file, at most `limit` bytes, NUL-terminated. */
-static gdr_status read_all(const char *path, size_t limit, char **out, size_t *out_size, gdr_error *err)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return gdr_error_set(err, GDR_ERROR_IO, "%s: cannot open", path);
-    char *data = NULL;
-    size_t size = 0, capacity = 0, got;
-    char chunk[65536];
-    gdr_status status = GDR_OK;
-    while (status == GDR_OK && (got = fread(chunk, 1, sizeof chunk, f)) > 0) {
-        if (size + got > limit) {
-            status = gdr_error_set(err, GDR_ERROR_CAPACITY, "%s: larger than %zu bytes", path, limit);
-            break;
-        }
-        if (size + got + 1 > capacity) {
-            capacity = (size + got + 1) * 2;
-            char *grown = realloc(data, capacity);
-            if (!grown)
-                status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
-            else
-                data = grown;
-        }
-        if (status == GDR_OK)
-            memcpy(data + size, chunk, got), size += got;
-    }
-    if (status == GDR_OK && ferror(f))
-        status = gdr_error_set(err, GDR_ERROR_IO, "%s: read error", path);
-    fclose(f);
-    if (status == GDR_OK && !data)
-        data = calloc(1, 1);
-    if (status != GDR_OK || !data) {
-        free(data);
-        return status != GDR_OK ? status : gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
-    }
-    data[size] = '\0';
-    *out = data;
-    *out_size = size;
-    return GDR_OK;
-}
-
 static gdr_status copy_out(const char *from, const char *to, gdr_error *err)
 {
     char *data;
     size_t size;
-    gdr_status status = read_all(from, (size_t)1 << 30, &data, &size, err);
+    gdr_status status = gdr_read_file(from, (size_t)1 << 30, &data, &size, err);
     if (status != GDR_OK)
         return status;
     status = gdr_write_file_atomic(to, data, size, err);
@@ -183,7 +144,8 @@ gdr_status bench_plot_from_json(const char *json_path, const char *svg_path, gdr
 {
     char *text;
     size_t size;
-    gdr_status status = read_all(json_path, (size_t)256 << 20, &text, &size, err);
+    /* A regular file only: a FIFO is refused at once, never waited on. */
+    gdr_status status = gdr_read_file(json_path, (size_t)256 << 20, &text, &size, err);
     if (status != GDR_OK)
         return status;
     cJSON *rows = cJSON_ParseWithLength(text, size);

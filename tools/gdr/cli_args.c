@@ -102,6 +102,21 @@ const char *cli_value(int argc, char **argv, int *i)
     return argv[*i];
 }
 
+const char *cli_known_value(const char *command, const char *const *known, int argc, char **argv, int *i)
+{
+    for (const char *const *k = known; *k; k++)
+        if (strcmp(argv[*i], *k) == 0)
+            return cli_value(argc, argv, i);
+    fprintf(stderr, "gdr %s: unknown option '%s' (see gdr --help)\n", command, argv[*i]);
+    return NULL;
+}
+
+int cli_renderer_failed(const gdr_error *err)
+{
+    fprintf(stderr, "gdr: %s\n", err->message);
+    return err->status == GDR_ERROR_INVALID_ARGUMENT ? 2 : 1;
+}
+
 bool cli_parse_pipeline(const char *option, const char *text, gdr_pipeline *out)
 {
     static const char *const names[] = {"mesh", "indirect", "cpu"};

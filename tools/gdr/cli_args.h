@@ -32,5 +32,12 @@ bool cli_parse_budget(const char *option, const char *text, gdr_budget *out);
 int cli_load_failed(const char *spec, const gdr_error *err);
 /* Returns the option's value (argv[*i + 1]) and advances *i, or prints an error and returns NULL. */
 const char *cli_value(int argc, char **argv, int *i);
+/* cli_value for an option of `command` that must be one of `known` (NULL-terminated): an option
+ * not in the list is "unknown", never "needs a value". */
+const char *cli_known_value(const char *command, const char *const *known, int argc, char **argv, int *i);
+/* Prints "gdr: MESSAGE" for a renderer that could not be made and returns the exit status: 2 when a
+ * value given on the command line was refused (GDR_ERROR_INVALID_ARGUMENT: a device number or name,
+ * a size), 1 otherwise. */
+int cli_renderer_failed(const gdr_error *err);
 
 #endif

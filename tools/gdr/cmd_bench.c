@@ -81,7 +81,12 @@ int gdr_cmd_bench(int argc, char **argv)
             record_every_frame = true;
             continue;
         }
-        if (!(value = cli_value(argc, argv, &i)))
+        /* The options that take a value (an unknown one is reported as such). */
+        static const char *const known[] = {
+            "--sizes", "--frames", "--width", "--height", "--device", "--camera", "--json", "--scene",
+            "--camera-path", "--plot", "--plot-from", "--lod-hierarchy", "--lod-errors", "--occlusion",
+            "--pipelines", NULL};
+        if (!(value = cli_known_value("bench", known, argc, argv, &i)))
             return 2;
         bool ok = true;
         if (strcmp(arg, "--sizes") == 0)
@@ -181,8 +186,9 @@ int gdr_cmd_bench(int argc, char **argv)
         gdr_status loaded = scene_spec ? gdr_scene_load(scene_spec, NULL, &scene, &err) : gdr_scene_create_demo(&demo, &scene, &err);
         if (loaded != GDR_OK) {
             result = cli_load_failed(scene_spec ? scene_spec : "demo", &err);
-        } else if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK ||
-            gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK) {
+        } else if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK) {
+            result = cli_renderer_failed(&err); /* 2 for a --device the machine does not have */
+        } else if (gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK) {
             fprintf(stderr, "gdr: %s\n", err.message);
             result = 1;
         }

@@ -47,7 +47,14 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
             return 2;
         if (consumed > 0)
             continue;
-        if (!(value = cli_value(argc, argv, &i)))
+        /* The options that take a value (an unknown one is reported as such). */
+        static const char *const known[] = {
+            "--out", "-o", "--stats", "--width", "--height", "--frames", "--camera-path", "--camera",
+            "--camera-index", "--cull", "--meshlet-cull", "--cone-cull", "--triangle-cull", "--occlusion",
+            "--lod-hierarchy", "--pipeline", "--raster", "--sw-threshold", "--view", "--lod-error",
+            "--min-screen-size", "--clip-plane", "--lod-depth", "--device", "--geometry-budget",
+            "--upload-budget", "--cache-dir", "--budget", NULL};
+        if (!(value = cli_known_value(command, known, argc, argv, &i)))
             return 2;
         bool ok = true;
         if (strcmp(arg, "--out") == 0 || strcmp(arg, "-o") == 0)
@@ -163,24 +170,23 @@ gdr_frame_desc render_options_frame(const render_options *o, gdr_camera camera)
                             .min_screen_size = o->min_screen_size, .clip_plane = o->clip_plane, .pvs = o->pvs};
 }
 
-/* The frames asked for: o->frames of one view, or with --camera-path one frame per pose (the path
- * repeated to make --frames N, N the path's length by default); the statistics are the last call's. */
+/* The frames asked for: o->frames of one view, or with a camera path (path->count > 0) one frame per
+ * pose (the path repeated to make --frames N, N the path's length by default); the statistics are
+ * the last call's. */
 static gdr_status render_frames(gdr_renderer *renderer, gdr_frame_desc *frame, const render_options *o,
-                                gdr_frame_stats *stats, gdr_error *err)
+                                const camera_path *path, gdr_frame_stats *stats, gdr_error *err)
 {
-    if (!o->camera_path)
+    if (path->count == 0)
         return gdr_renderer_render(renderer, frame, o->frames, stats, err);
-    camera_path path;
-    gdr_status status = camera_path_read(o->camera_path, &path, err);
-    uint32_t frames = o->frames_given ? o->frames : path.count;
+    gdr_status status = GDR_OK;
+    uint32_t frames = o->frames_given ? o->frames : path->count;
     bool read_back = frame->read_back;
     for (uint32_t f = 0; f < frames && status == GDR_OK; f++) {
-        frame->camera.position = path.poses[f % path.count].position;
-        frame->camera.rotation = path.poses[f % path.count].rotation;
+        frame->camera.position = path->poses[f % path->count].position;
+        frame->camera.rotation = path->poses[f % path->count].rotation;
         frame->read_back = read_back && f + 1 == frames;
         status = gdr_renderer_render(renderer, frame, 1, stats, err);
     }
-    camera_path_free(&path);
     return status;
 }
 
@@ -225,28 +231,42 @@ int gdr_cmd_render(int argc, char **argv)
     gdr_error err = {0};
     gdr_scene *scene = NULL;
     gdr_pvs *pvs = NULL;
-    if (load_scene(&o, &scene, &pvs, &err) != GDR_OK)
-        return cli_load_failed(o.scene, &err);
-    if (o.pvs == GDR_CULL_ON && !pvs) {
-        fprintf(stderr, "gdr: --pvs on: %s holds no precomputed visibility (write it with gdr build %s -o FILE.gdrc "
-                "--pvs)\n", o.scene, o.scene);
-        gdr_scene_destroy(scene);
-        return 2;
+    /* The camera path first: a bad one is reported before the scene is imported and uploaded. */
+    camera_path path = {0};
+    if (o.camera_path && camera_path_read(o.camera_path, &path, &err) != GDR_OK) {
+        fprintf(stderr, "gdr: --camera-path: %s\n", err.message);
+        return 1;
     }
-    if (o.has_camera_index && o.camera_index >= scene->camera_count) {
-        fprintf(stderr, "gdr: --camera-index %u: the scene has %u camera(s)\n", o.camera_index, scene->camera_count);
-        gdr_scene_destroy(scene);
-        return 2;
-    }
+    /* The renderer next: a device or target size the machine cannot give is a command-line value,
+     * refused (exit 2) before the scene is loaded. */
     gdr_renderer_desc desc = {.width = o.width, .height = o.height, .device = o.device, .validate = o.validate};
     gdr_renderer *renderer = NULL;
     gdr_paged_cache *paged = NULL;
     gdr_frame_stats stats;
     uint8_t *pixels = NULL;
     int result = 0;
+    if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK) {
+        result = cli_renderer_failed(&err);
+        goto done;
+    }
+    if (load_scene(&o, &scene, &pvs, &err) != GDR_OK) {
+        result = cli_load_failed(o.scene, &err);
+        goto done;
+    }
+    if (o.pvs == GDR_CULL_ON && !pvs) {
+        fprintf(stderr, "gdr: --pvs on: %s holds no precomputed visibility (write it with gdr build %s -o FILE.gdrc "
+                "--pvs)\n", o.scene, o.scene);
+        result = 2;
+        goto done;
+    }
+    if (o.has_camera_index && o.camera_index >= scene->camera_count) {
+        fprintf(stderr, "gdr: --camera-index %u: the scene has %u camera(s)\n", o.camera_index, scene->camera_count);
+        result = 2;
+        goto done;
+    }
     gdr_frame_desc frame = render_options_frame(&o, render_options_camera(scene, &o));
-    if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK || set_scene(renderer, scene, &o, &paged, &err) != GDR_OK ||
-        gdr_renderer_set_pvs(renderer, pvs, &err) != GDR_OK || render_frames(renderer, &frame, &o, &stats, &err) != GDR_OK) {
+    if (set_scene(renderer, scene, &o, &paged, &err) != GDR_OK || gdr_renderer_set_pvs(renderer, pvs, &err) != GDR_OK ||
+        render_frames(renderer, &frame, &o, &path, &stats, &err) != GDR_OK) {
         result = fail(&err);
         goto done;
     }
@@ -273,6 +293,7 @@ int gdr_cmd_render(int argc, char **argv)
         result = 3;
     }
 done:
+    camera_path_free(&path);
     free(pixels);
     gdr_renderer_destroy(renderer);
     gdr_paged_cache_close(paged);

@@ -170,8 +170,9 @@ static int open_window(view_app *app, const gdr_scene *scene)
     gdr_renderer_desc desc = {.width = app->o->width, .height = app->o->height, .device = app->o->device,
                               .validate = app->o->validate, .instance_extensions = extensions,
                               .instance_extension_count = extension_count, .presentable = true};
-    if (gdr_renderer_create(&desc, &app->renderer, &err) != GDR_OK ||
-        gdr_renderer_set_scene(app->renderer, scene, &err) != GDR_OK)
+    if (gdr_renderer_create(&desc, &app->renderer, &err) != GDR_OK)
+        return cli_renderer_failed(&err); /* 2 for a --device the machine does not have */
+    if (gdr_renderer_set_scene(app->renderer, scene, &err) != GDR_OK)
         return fail("", &err);
     VkResult made = glfwCreateWindowSurface(gdr_renderer_vulkan(app->renderer).instance, app->window, NULL,
                                             &app->surface);
