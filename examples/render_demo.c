@@ -1,4 +1,5 @@
-/* A program using the installed gdr library: render the built-in scene and save a PNG.
+/* A program using the installed gdr library: load the built-in scene, render it, save a PNG and
+ * print the frame's statistics.
  *
  *   cc render_demo.c $(pkg-config --cflags --libs gdr) -o render_demo
  *   ./render_demo out.png
@@ -14,11 +15,10 @@ int main(int argc, char **argv)
     gdr_error err = {0};
     gdr_scene *scene = NULL;
     gdr_renderer *renderer = NULL;
-    gdr_demo_desc demo = {.instances = 1000};
     gdr_renderer_desc desc = {.width = 320, .height = 180};
     uint8_t *pixels = malloc(320 * 180 * 4);
     int status = 1;
-    if (pixels && gdr_scene_create_demo(&demo, &scene, &err) == GDR_OK &&
+    if (pixels && gdr_scene_load("demo:instances=1000", NULL, &scene, &err) == GDR_OK &&
         gdr_renderer_create(&desc, &renderer, &err) == GDR_OK && gdr_renderer_set_scene(renderer, scene, &err) == GDR_OK) {
         gdr_frame_desc frame = {.camera = scene->cameras[0], .read_back = true};
         gdr_frame_stats stats;

@@ -167,6 +167,7 @@ static void check_pipeline(gdr_renderer *r, const gdr_scene *scene, gdr_pipeline
 int main(void)
 {
     gdr_scene *scene = make_scene();
+    CHECK(scene && gdr_scene_build_clusters(scene, NULL, &(gdr_error){0}) == GDR_OK); /* the renderer never builds them */
     gdr_renderer *r = scene ? gpu_test_renderer(WIDTH, HEIGHT, scene) : NULL;
     CHECK(r != NULL);
     if (r) {

@@ -174,6 +174,7 @@ static void test_cases(void)
 {
     enum { W = 420, H = 108 };
     gdr_scene *s = cases_scene();
+    CHECK(s && gdr_scene_build_clusters(s, NULL, &(gdr_error){0}) == GDR_OK); /* the renderer never builds them */
     gdr_renderer *r = gpu_test_renderer(W, H, s);
     CHECK(r != NULL);
     gdr_camera camera = test_look((gdr_vec3){4.1f, 0.5f, 3.6f}, 0.0f, 0.0f, 0.6f, 0.1f);
@@ -208,6 +209,7 @@ static void test_box_textured(const char *relative)
         return;
     }
     CHECK(s->texture_count == 1 && s->material_count >= 1);
+    CHECK(s && gdr_scene_build_clusters(s, NULL, &(gdr_error){0}) == GDR_OK); /* the renderer never builds them */
     gdr_renderer *r = gpu_test_renderer(W, H, s);
     gdr_camera camera = gdr_scene_framing_camera(s);
     gdr_vec4 b = s->meshes[0].bounds;
@@ -283,6 +285,7 @@ static void test_checker_mips(void)
 {
     enum { W = 160, H = 120 };
     gdr_scene *s = checker_scene();
+    CHECK(s && gdr_scene_build_clusters(s, NULL, &(gdr_error){0}) == GDR_OK); /* the renderer never builds them */
     gdr_renderer *r = gpu_test_renderer(W, H, s);
     CHECK(r != NULL);
     const gdr_camera views[2] = {test_look((gdr_vec3){0.3f, 0.2f, 5.0f}, 0.0f, 0.0f, 0.9f, 0.1f),
@@ -369,6 +372,7 @@ static void test_alpha(void)
 {
     enum { W = 200, H = 100 };
     gdr_scene *s = alpha_scene();
+    CHECK(s && gdr_scene_build_clusters(s, NULL, &(gdr_error){0}) == GDR_OK); /* the renderer never builds them */
     gdr_renderer *r = gpu_test_renderer(W, H, s);
     CHECK(r != NULL);
     gdr_camera camera = test_look((gdr_vec3){0.0f, 0.5f, 2.2f}, 0.0f, 0.0f, 0.6f, 0.1f);
@@ -454,6 +458,7 @@ static void test_double_sided(void)
     gdr_instance wall = {.transform = gdr_mat4_from_trs((gdr_vec3){-3, -1, -1}, gdr_quat_identity(), (gdr_vec3){6, 3, 1}),
                          .mesh = mesh, .material = ids[3], .color = {1, 1, 1, 1}};
     CHECK(gdr_scene_add_instance(s, &wall, &err) == GDR_OK);
+    CHECK(s && gdr_scene_build_clusters(s, NULL, &(gdr_error){0}) == GDR_OK); /* the renderer never builds them */
     gdr_renderer *r = gpu_test_renderer(W, H, s);
     CHECK(r != NULL);
     gdr_camera camera = test_look((gdr_vec3){0.6f, 0.5f, 2.6f}, 0.0f, 0.0f, 0.6f, 0.1f);
@@ -533,6 +538,7 @@ static void test_textured_lod(void)
     CHECK(gdr_scene_add_instance(s, &inst, &err) == GDR_OK);
     gdr_lod_options options = {0};
     CHECK(gdr_scene_build_lod(s, &options, NULL, &err) == GDR_OK);
+    CHECK(s && gdr_scene_build_clusters(s, NULL, &(gdr_error){0}) == GDR_OK); /* the renderer never builds them */
     gdr_renderer *r = gpu_test_renderer(W, H, s);
     CHECK(r != NULL);
     gdr_camera camera = test_look((gdr_vec3){0.0f, 2.2f, 2.6f}, 0.0f, -0.7f, 0.8f, 0.1f);

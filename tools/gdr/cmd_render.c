@@ -53,7 +53,7 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
             "--camera-index", "--cull", "--meshlet-cull", "--cone-cull", "--triangle-cull", "--occlusion",
             "--lod-hierarchy", "--pipeline", "--raster", "--sw-threshold", "--view", "--lod-error",
             "--min-screen-size", "--clip-plane", "--lod-depth", "--device", "--geometry-budget",
-            "--upload-budget", "--cache-dir", "--budget", NULL};
+            "--upload-budget", "--cache-dir", "--budget", "--pvs", NULL};
         if (!(value = cli_known_value(command, known, argc, argv, &i)))
             return 2;
         bool ok = true;
