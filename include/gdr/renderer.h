@@ -106,7 +106,7 @@ typedef struct gdr_frame_desc {
     float sw_threshold_px;
     /* Mesh pipeline, meshes with a LOD DAG (gdr/geometry.h "The cut"): the clusters drawn
      * are the cut whose projected error is within lod_error_px pixels (0, the default: full detail,
-     * level 0), or with lod_fixed_depth the discrete cut at DAG depth lod_depth (0: level 0). The
+     * level 0; the gdr program's --lod-error defaults to 1, an image a user sees as the same), or with lod_fixed_depth the discrete cut at DAG depth lod_depth (0: level 0). The
      * indirect and CPU pipelines always draw full detail. */
     float lod_error_px;
     bool lod_fixed_depth;

@@ -6,16 +6,6 @@
 
 #include "present/presenter_internal.h"
 
-#define TRY(err, call)                                                                                  \
-    do {                                                                                                \
-        VkResult try_result_ = (call);                                                                  \
-        if (try_result_ != VK_SUCCESS)                                                                  \
-            return gdr_error_set((err), try_result_ == VK_ERROR_OUT_OF_DEVICE_MEMORY ||                  \
-                                            try_result_ == VK_ERROR_OUT_OF_HOST_MEMORY                   \
-                                        ? GDR_ERROR_OUT_OF_MEMORY                                       \
-                                        : GDR_ERROR_VULKAN,                                             \
-                                 "%s failed: VkResult %d (%s:%d)", #call, (int)try_result_, __FILE__, __LINE__); \
-    } while (0)
 
 #define OVERLAY_SCALE 2
 
@@ -24,14 +14,14 @@ static gdr_status create_sync(gdr_presenter *p, gdr_error *err)
     VkCommandPoolCreateInfo pool = {.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
                                     .flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT,
                                     .queueFamilyIndex = p->vk.queue_family};
-    TRY(err, vkCreateCommandPool(p->vk.device, &pool, NULL, &p->pool));
+    GDR_VK_TRY(err, vkCreateCommandPool(p->vk.device, &pool, NULL, &p->pool));
     VkCommandBufferAllocateInfo alloc = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, .commandPool = p->pool,
                                          .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY, .commandBufferCount = 1};
-    TRY(err, vkAllocateCommandBuffers(p->vk.device, &alloc, &p->cmd));
+    GDR_VK_TRY(err, vkAllocateCommandBuffers(p->vk.device, &alloc, &p->cmd));
     VkFenceCreateInfo fence = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    TRY(err, vkCreateFence(p->vk.device, &fence, NULL, &p->done));
+    GDR_VK_TRY(err, vkCreateFence(p->vk.device, &fence, NULL, &p->done));
     VkSemaphoreCreateInfo semaphore = {.sType = VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-    TRY(err, vkCreateSemaphore(p->vk.device, &semaphore, NULL, &p->acquired));
+    GDR_VK_TRY(err, vkCreateSemaphore(p->vk.device, &semaphore, NULL, &p->acquired));
     return GDR_OK;
 }
 
@@ -129,7 +119,7 @@ static gdr_status ensure_capture(gdr_presenter *p, VkDeviceSize bytes, gdr_error
     release_capture(p);
     VkBufferCreateInfo info = {.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO, .size = bytes,
                                .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT, .sharingMode = VK_SHARING_MODE_EXCLUSIVE};
-    TRY(err, vkCreateBuffer(p->vk.device, &info, NULL, &p->capture));
+    GDR_VK_TRY(err, vkCreateBuffer(p->vk.device, &info, NULL, &p->capture));
     VkMemoryRequirements needs;
     vkGetBufferMemoryRequirements(p->vk.device, p->capture, &needs);
     VkPhysicalDeviceMemoryProperties memory;
@@ -143,9 +133,9 @@ static gdr_status ensure_capture(gdr_presenter *p, VkDeviceSize bytes, gdr_error
         return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "capture: no host-visible coherent memory");
     VkMemoryAllocateInfo alloc = {.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, .allocationSize = needs.size,
                                   .memoryTypeIndex = type};
-    TRY(err, vkAllocateMemory(p->vk.device, &alloc, NULL, &p->capture_memory));
-    TRY(err, vkBindBufferMemory(p->vk.device, p->capture, p->capture_memory, 0));
-    TRY(err, vkMapMemory(p->vk.device, p->capture_memory, 0, VK_WHOLE_SIZE, 0, &p->capture_mapped));
+    GDR_VK_TRY(err, vkAllocateMemory(p->vk.device, &alloc, NULL, &p->capture_memory));
+    GDR_VK_TRY(err, vkBindBufferMemory(p->vk.device, p->capture, p->capture_memory, 0));
+    GDR_VK_TRY(err, vkMapMemory(p->vk.device, p->capture_memory, 0, VK_WHOLE_SIZE, 0, &p->capture_mapped));
     p->capture_bytes = bytes;
     return GDR_OK;
 }
@@ -227,10 +217,10 @@ static gdr_status record_frame(gdr_presenter *p, uint32_t index, const gdr_prese
     VkCommandBuffer cmd = p->cmd;
     VkImage target = p->swapchain.images[index];
     VkExtent2D e = p->swapchain.extent;
-    TRY(err, vkResetCommandBuffer(cmd, 0));
+    GDR_VK_TRY(err, vkResetCommandBuffer(cmd, 0));
     VkCommandBufferBeginInfo begin = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
                                       .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT};
-    TRY(err, vkBeginCommandBuffer(cmd, &begin));
+    GDR_VK_TRY(err, vkBeginCommandBuffer(cmd, &begin));
     image_barrier(cmd, p->vk.color_image, p->vk.color_layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                   VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_2_BLIT_BIT,
                   VK_ACCESS_2_TRANSFER_READ_BIT);
@@ -266,7 +256,7 @@ static gdr_status record_frame(gdr_presenter *p, uint32_t index, const gdr_prese
                                        .pMemoryBarriers = &host};
         vkCmdPipelineBarrier2(cmd, &dependency);
     }
-    TRY(err, vkEndCommandBuffer(cmd));
+    GDR_VK_TRY(err, vkEndCommandBuffer(cmd));
     return GDR_OK;
 }
 
@@ -281,7 +271,7 @@ static gdr_status submit_and_present(gdr_presenter *p, uint32_t index, gdr_error
     VkSubmitInfo2 submit = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2, .waitSemaphoreInfoCount = 1,
                             .pWaitSemaphoreInfos = &wait, .commandBufferInfoCount = 1, .pCommandBufferInfos = &cmd,
                             .signalSemaphoreInfoCount = 1, .pSignalSemaphoreInfos = &signal};
-    TRY(err, vkQueueSubmit2(p->vk.queue, 1, &submit, p->done));
+    GDR_VK_TRY(err, vkQueueSubmit2(p->vk.queue, 1, &submit, p->done));
     p->submitted = true;
     VkPresentInfoKHR present = {.sType = VK_STRUCTURE_TYPE_PRESENT_INFO_KHR, .waitSemaphoreCount = 1,
                                 .pWaitSemaphores = &p->swapchain.rendered[index], .swapchainCount = 1,
@@ -290,7 +280,7 @@ static gdr_status submit_and_present(gdr_presenter *p, uint32_t index, gdr_error
     if (result == VK_ERROR_OUT_OF_DATE_KHR || result == VK_SUBOPTIMAL_KHR)
         p->stale = true; /* made again before the next present */
     else
-        TRY(err, result);
+        GDR_VK_TRY(err, result);
     return GDR_OK;
 }
 
@@ -298,8 +288,8 @@ static gdr_status wait_previous(gdr_presenter *p, gdr_error *err)
 {
     if (!p->submitted)
         return GDR_OK;
-    TRY(err, vkWaitForFences(p->vk.device, 1, &p->done, VK_TRUE, UINT64_MAX));
-    TRY(err, vkResetFences(p->vk.device, 1, &p->done));
+    GDR_VK_TRY(err, vkWaitForFences(p->vk.device, 1, &p->done, VK_TRUE, UINT64_MAX));
+    GDR_VK_TRY(err, vkResetFences(p->vk.device, 1, &p->done));
     p->submitted = false;
     return GDR_OK;
 }
@@ -328,7 +318,7 @@ gdr_status gdr_presenter_present(gdr_presenter *p, const gdr_present_desc *desc_
     if (acquired == VK_SUBOPTIMAL_KHR)
         p->stale = true; /* the image is usable; present it, then make the swapchain again */
     else
-        TRY(err, acquired);
+        GDR_VK_TRY(err, acquired);
     status = record_frame(p, index, &desc, err);
     if (status == GDR_OK)
         status = submit_and_present(p, index, err);

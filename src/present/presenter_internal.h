@@ -4,6 +4,7 @@
 #define GDR_PRESENTER_INTERNAL_H
 
 #include "gdr/present.h"
+#include "vk/vk_context.h" /* GDR_VK_TRY */
 
 #define GDR_PRESENT_MAX_IMAGES 8
 #define GDR_OVERLAY_MAX_RECTS 16384

@@ -5,16 +5,6 @@
 
 #include "present/presenter_internal.h"
 
-#define TRY(err, call)                                                                                  \
-    do {                                                                                                \
-        VkResult try_result_ = (call);                                                                  \
-        if (try_result_ != VK_SUCCESS)                                                                  \
-            return gdr_error_set((err), try_result_ == VK_ERROR_OUT_OF_DEVICE_MEMORY ||                  \
-                                            try_result_ == VK_ERROR_OUT_OF_HOST_MEMORY                   \
-                                        ? GDR_ERROR_OUT_OF_MEMORY                                       \
-                                        : GDR_ERROR_VULKAN,                                             \
-                                 "%s failed: VkResult %d (%s:%d)", #call, (int)try_result_, __FILE__, __LINE__); \
-    } while (0)
 
 /* 8-bit UNORM formats first: the renderer's image holds display values already, which a blit into
  * an sRGB image would encode a second time. */
@@ -75,28 +65,28 @@ static gdr_status create_images(gdr_presenter *p, gdr_error *err)
 {
     gdr_swapchain *s = &p->swapchain;
     uint32_t count = 0;
-    TRY(err, vkGetSwapchainImagesKHR(p->vk.device, s->handle, &count, NULL));
+    GDR_VK_TRY(err, vkGetSwapchainImagesKHR(p->vk.device, s->handle, &count, NULL));
     if (count > GDR_PRESENT_MAX_IMAGES)
         return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "the swapchain has %u images, at most %d are handled", count,
                              GDR_PRESENT_MAX_IMAGES);
-    TRY(err, vkGetSwapchainImagesKHR(p->vk.device, s->handle, &count, s->images));
+    GDR_VK_TRY(err, vkGetSwapchainImagesKHR(p->vk.device, s->handle, &count, s->images));
     s->image_count = count;
     for (uint32_t i = 0; i < count; i++) {
         VkImageViewCreateInfo view = {.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, .image = s->images[i],
                                       .viewType = VK_IMAGE_VIEW_TYPE_2D, .format = s->format,
                                       .subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1}};
-        TRY(err, vkCreateImageView(p->vk.device, &view, NULL, &s->views[i]));
+        GDR_VK_TRY(err, vkCreateImageView(p->vk.device, &view, NULL, &s->views[i]));
         VkSemaphoreCreateInfo semaphore = {.sType = VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-        TRY(err, vkCreateSemaphore(p->vk.device, &semaphore, NULL, &s->rendered[i]));
+        GDR_VK_TRY(err, vkCreateSemaphore(p->vk.device, &semaphore, NULL, &s->rendered[i]));
     }
     return GDR_OK;
 }
 
 gdr_status gdr_swapchain_build(gdr_presenter *p, gdr_error *err)
 {
-    TRY(err, vkDeviceWaitIdle(p->vk.device)); /* nothing may still use the old images */
+    GDR_VK_TRY(err, vkDeviceWaitIdle(p->vk.device)); /* nothing may still use the old images */
     VkSurfaceCapabilitiesKHR caps;
-    TRY(err, vkGetPhysicalDeviceSurfaceCapabilitiesKHR(p->vk.physical_device, p->surface, &caps));
+    GDR_VK_TRY(err, vkGetPhysicalDeviceSurfaceCapabilitiesKHR(p->vk.physical_device, p->surface, &caps));
     gdr_swapchain old = p->swapchain;
     p->swapchain = (gdr_swapchain){0};
     VkExtent2D extent = choose_extent(p, &caps);
@@ -128,7 +118,7 @@ gdr_status gdr_swapchain_build(gdr_presenter *p, gdr_error *err)
         info.compositeAlpha = VK_COMPOSITE_ALPHA_INHERIT_BIT_KHR;
     VkResult created = vkCreateSwapchainKHR(p->vk.device, &info, NULL, &p->swapchain.handle);
     gdr_swapchain_release(p, &old);
-    TRY(err, created);
+    GDR_VK_TRY(err, created);
     p->swapchain.format = format.format;
     p->swapchain.extent = extent;
     p->swapchain.usage = usage;
