@@ -5,6 +5,7 @@
  * cache of such a file is read. The CPU time must grow less than 8-fold (linear: 4, n log n: about
  * 4.5, quadratic: 16). Times are the best of three runs, measured side by side. */
 #define _POSIX_C_SOURCE 200809L
+#include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -14,6 +15,7 @@
 
 #include "gdr/geometry.h"
 #include "gdr/io.h"
+#include "heap_count.h"
 #include "io/io_test_helpers.h"
 #include "test_util.h"
 
@@ -55,6 +57,20 @@ static void obj_fan(text *t, uint32_t n)
         put(t, "v %u 1 %u\n", i, i % 7);
     for (uint32_t i = 0; i < n; i++)
         put(t, "f 1 %u %u\n", i + 3, i + 2);
+}
+
+/* n thin triangles around one vertex, their rim on a circle, flat: every triangle reaches from the
+ * hub to the rim, so a grid cell sized by the triangles' spacing is crossed by O(sqrt n) of them,
+ * and the rim's samples lie on a curve, O(sqrt n) to a cell of a grid sized for a surface. */
+static void obj_fan_circle(text *t, uint32_t n)
+{
+    put(t, "v 0 0 0\n");
+    for (uint32_t i = 0; i < n; i++) {
+        double a = 6.283185307179586 * i / n;
+        put(t, "v %.9g %.9g 0\n", cos(a), sin(a));
+    }
+    for (uint32_t i = 0; i < n; i++)
+        put(t, "f 1 %u %u\n", i + 2, (i + 1) % n + 2);
 }
 
 static void obj_groups(text *t, uint32_t n)
@@ -236,11 +252,33 @@ static double run(const dimension *d, const text *t)
     return status == GDR_OK ? seconds : -1.0;
 }
 
+/* The peak heap of import, meshlets and DAG of the fan on a circle at n and 4n (heap_count.c counts
+ * every allocation): it grew 9-fold where the cells of the error measurement's grids did. */
+static void check_fan_heap(uint32_t n)
+{
+    const dimension d = {"obj: fan on a circle, peak heap", OBJ, n, obj_fan_circle};
+    double peak[2];
+    for (int k = 0; k < 2; k++) {
+        text t = {0};
+        d.generate(&t, k ? 4 * n : n);
+        long long base = heap_peak_reset();
+        CHECK(run(&d, &t) >= 0);
+        peak[k] = (double)(heap_peak() - base);
+        free(t.data);
+    }
+    double ratio = peak[1] / peak[0];
+    printf("%-32s %10u %9.1fM %9.1fM %7.2f\n", d.name, n, peak[0] / 1048576.0, peak[1] / 1048576.0, ratio);
+    if (!(ratio < 8.0))
+        fprintf(stderr, "%s: 4x the input took %.1fx the heap (super-linear)\n", d.name, ratio);
+    CHECK(ratio < 8.0);
+}
+
 int main(void)
 {
     const dimension dimensions[] = {
         {"obj: repeated face", OBJ, 20000, obj_duplicate_faces},
         {"obj: fan around one vertex", OBJ, 5000, obj_fan},
+        {"obj: fan on a circle", OBJ, 20000, obj_fan_circle},
         {"obj: grid (triangles)", OBJ, 10000, obj_grid},
         /* These two through meshlets only: their cost was in import and meshlet building. */
         {"obj: groups after a large one", MESHLETS, 20000, obj_groups},
@@ -280,5 +318,6 @@ int main(void)
         free(small.data);
         free(large.data);
     }
+    check_fan_heap(20000);
     return test_finish("test_scaling");
 }
