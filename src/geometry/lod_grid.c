@@ -84,10 +84,11 @@ static uint32_t point_cell(const lod_grid *g, gdr_vec3 p)
  * edge) fill the cells it crosses with about the square root of their count each, and no grid of
  * O(n) cells over their box does better: a query would cost O(sqrt n). Past this mean number of
  * points in a point's own cell (summed over the points: the sum of the squared cell counts), a k-d
- * tree answers instead. The constant keeps small grids, whose queries are cheap whatever their
- * cells, on the grid. Both give the exact nearest point, so only the cost depends on it. */
-#define GRID_CROWDED_MEAN 64.0
-#define GRID_CROWDED_FLOOR 65536.0
+ * tree answers instead; sound surfaces stay below 5, and the constant keeps small grids, whose
+ * queries are cheap whatever their cells, on the grid. Both give the exact nearest point, so only
+ * the cost depends on the choice. */
+#define GRID_CROWDED_MEAN 16.0
+#define GRID_CROWDED_FLOOR 4096.0
 
 static int crowded(const lod_grid *g, size_t cells, uint32_t n)
 {

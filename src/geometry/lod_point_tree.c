@@ -49,58 +49,77 @@ static void select_median(const lod_point_tree *t, uint32_t lo, uint32_t hi, uin
     }
 }
 
-/* The axis of order[lo .. hi)'s largest extent. */
-static int widest_axis(const lod_point_tree *t, uint32_t lo, uint32_t hi)
+/* Node i's box (its points' smallest and largest coordinates) and the axis of its largest extent. */
+static int node_box(lod_point_tree *t, uint32_t i, uint32_t lo, uint32_t hi)
 {
-    float a[3] = {INFINITY, INFINITY, INFINITY}, b[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (uint32_t i = lo; i < hi; i++)
+    float *b = t->box[i];
+    b[0] = b[1] = b[2] = INFINITY;
+    b[3] = b[4] = b[5] = -INFINITY;
+    for (uint32_t j = lo; j < hi; j++)
         for (int k = 0; k < 3; k++) {
-            float x = coordinate(t, t->order[i], k);
-            a[k] = x < a[k] ? x : a[k];
-            b[k] = x > b[k] ? x : b[k];
+            float x = coordinate(t, t->order[j], k);
+            b[k] = x < b[k] ? x : b[k];
+            b[3 + k] = x > b[3 + k] ? x : b[3 + k];
         }
     int axis = 0;
     for (int k = 1; k < 3; k++)
-        if (b[k] - a[k] > b[axis] - a[axis])
+        if (b[3 + k] - b[k] > b[3 + axis] - b[axis])
             axis = k;
     return axis;
 }
 
-static void build_node(lod_point_tree *t, uint32_t lo, uint32_t hi, uint32_t *state)
+static void build_node(lod_point_tree *t, uint32_t i, uint32_t lo, uint32_t hi, uint32_t *state)
 {
     while (hi - lo > TREE_LEAF) {
         uint32_t mid = lo + (hi - lo) / 2;
-        int k = widest_axis(t, lo, hi);
+        int k = node_box(t, i, lo, hi);
         select_median(t, lo, hi, mid, k, state);
-        t->axis[mid] = (uint8_t)k;
-        t->split[mid] = coordinate(t, t->order[mid], k);
-        build_node(t, lo, mid, state);
-        lo = mid; /* the upper half: a loop, so that the recursion is only as deep as the tree */
+        t->axis[i] = (uint8_t)k;
+        t->split[i] = coordinate(t, t->order[mid], k);
+        build_node(t, 2 * i, lo, mid, state);
+        i = 2 * i + 1; /* the upper half: a loop, so that the recursion is only as deep as the tree */
+        lo = mid;
     }
+}
+
+/* Grows t's node arrays to `nodes` entries; 0 when out of memory (what was grown is kept). */
+static int grow_nodes(lod_point_tree *t, size_t nodes)
+{
+    float *split = realloc(t->split, nodes * sizeof *split);
+    if (split)
+        t->split = split;
+    float(*box)[6] = realloc(t->box, nodes * sizeof *box);
+    if (box)
+        t->box = box;
+    uint8_t *axis = realloc(t->axis, nodes * sizeof *axis);
+    if (axis)
+        t->axis = axis;
+    if (!split || !box || !axis)
+        return 0;
+    t->node_cap = nodes;
+    return 1;
 }
 
 int lod_point_tree_build(lod_point_tree *t, const gdr_vec3 *points, uint32_t n)
 {
     t->points = points;
     t->count = n;
-    if (n > t->cap) {
+    /* A node of more than TREE_LEAF points at depth d holds at most ceil(n / 2^d) of them, so
+     * 2^d < n / TREE_LEAF and its index, below 2^(d + 1), is below n / 4. */
+    size_t nodes = (size_t)n / 4 + 2;
+    if (n > t->order_cap) {
         uint32_t *order = realloc(t->order, (size_t)n * sizeof *order);
-        if (order)
-            t->order = order;
-        float *split = realloc(t->split, (size_t)n * sizeof *split);
-        if (split)
-            t->split = split;
-        uint8_t *axis = realloc(t->axis, (size_t)n * sizeof *axis);
-        if (axis)
-            t->axis = axis;
-        if (!order || !split || !axis)
+        if (!order)
             return 0;
-        t->cap = n;
+        t->order = order;
+        t->order_cap = n;
     }
+    if (nodes > t->node_cap && !grow_nodes(t, nodes))
+        return 0;
     for (uint32_t i = 0; i < n; i++)
         t->order[i] = i;
     uint32_t state = 12345u;
-    build_node(t, 0, n, &state);
+    build_node(t, 1, 0, n, &state);
     return 1;
 }
 
@@ -124,33 +143,45 @@ static void visit_leaf(const lod_point_tree *t, uint32_t lo, uint32_t hi, tree_q
     }
 }
 
-/* The near half first, then the far one unless the splitting plane is farther than the best so far.
- * A point beyond the plane is at least as far along that axis as the plane (rounding is monotonic),
- * and its squared distance, a sum of non-negative squares, at least that axis's square: skipping
- * only where the plane's square is strictly larger keeps every tie, so the lowest index wins. */
-static void visit_node(const lod_point_tree *t, uint32_t lo, uint32_t hi, tree_query *s)
+/* Squared distance from q to node i's box, computed as a point's distance is (visit_leaf): for a point
+ * in the box, each axis's difference is at least the box's (rounding is monotonic) and the sum of
+ * non-negative squares in the same order no smaller, so a box strictly farther than the best so far
+ * holds no point as near, tie included. */
+static float box_d2(const lod_point_tree *t, uint32_t i, const float q[3])
+{
+    const float *b = t->box[i];
+    float g[3];
+    for (int k = 0; k < 3; k++) {
+        float below = b[k] - q[k], above = q[k] - b[3 + k];
+        g[k] = below > 0.0f ? below : above > 0.0f ? above : 0.0f;
+    }
+    return g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+}
+
+/* Node i over order[lo .. hi): skipped when its box is farther than the best so far; its near half
+ * first. */
+static void visit_node(const lod_point_tree *t, uint32_t i, uint32_t lo, uint32_t hi, tree_query *s)
 {
     if (hi - lo <= TREE_LEAF) {
         visit_leaf(t, lo, hi, s);
         return;
     }
+    if (box_d2(t, i, s->q) > s->best_d2)
+        return;
     uint32_t mid = lo + (hi - lo) / 2;
-    float gap = s->q[t->axis[mid]] - t->split[mid];
-    if (gap < 0.0f) {
-        visit_node(t, lo, mid, s);
-        if (!(gap * gap > s->best_d2))
-            visit_node(t, mid, hi, s);
+    if (s->q[t->axis[i]] < t->split[i]) {
+        visit_node(t, 2 * i, lo, mid, s);
+        visit_node(t, 2 * i + 1, mid, hi, s);
     } else {
-        visit_node(t, mid, hi, s);
-        if (!(gap * gap > s->best_d2))
-            visit_node(t, lo, mid, s);
+        visit_node(t, 2 * i + 1, mid, hi, s);
+        visit_node(t, 2 * i, lo, mid, s);
     }
 }
 
 uint32_t lod_point_tree_nearest(const lod_point_tree *t, gdr_vec3 point, float *distance_squared)
 {
     tree_query s = {{point.x, point.y, point.z}, UINT32_MAX, INFINITY};
-    visit_node(t, 0, t->count, &s);
+    visit_node(t, 1, 0, t->count, &s);
     *distance_squared = s.best_d2;
     return s.best;
 }
@@ -159,6 +190,7 @@ void lod_point_tree_free(lod_point_tree *t)
 {
     free(t->order);
     free(t->split);
+    free(t->box);
     free(t->axis);
     memset(t, 0, sizeof *t);
 }

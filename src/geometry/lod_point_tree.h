@@ -12,13 +12,16 @@
 typedef struct lod_point_tree {
     const gdr_vec3 *points; /* not owned */
     uint32_t count;
-    /* The points' indices, split in halves recursively: the node over order[lo .. hi) splits at
-     * mid = lo + (hi - lo) / 2 along axis[mid], at split[mid] (order[lo .. mid) at most split,
-     * order[mid .. hi) at least). */
+    /* The points' indices, split in halves recursively: node 1 (the root) holds order[0 .. count),
+     * node i of order[lo .. hi) splits at mid = lo + (hi - lo) / 2 along axis[i], at split[i]
+     * (its child 2i holds order[lo .. mid), at most split, 2i + 1 order[mid .. hi), at least);
+     * box[i]: the smallest and largest coordinate of its points along each axis. Only nodes of more
+     * than the leaf size are stored (indices below count / 4 + 2). */
     uint32_t *order;
     float *split;
+    float (*box)[6];
     uint8_t *axis;
-    size_t cap;
+    size_t order_cap, node_cap;
 } lod_point_tree;
 
 /* Indexes points[0 .. n), n > 0 (kept by pointer until the next build; the arrays are kept between
