@@ -105,8 +105,8 @@ int lod_point_tree_build(lod_point_tree *t, const gdr_vec3 *points, uint32_t n)
     t->points = points;
     t->count = n;
     /* A node of more than TREE_LEAF points at depth d holds at most ceil(n / 2^d) of them, so
-     * 2^d < n / TREE_LEAF and its index, below 2^(d + 1), is below n / 4. */
-    size_t nodes = (size_t)n / 4 + 2;
+     * 2^d < n / TREE_LEAF and its index, below 2^(d + 1), is below 2n / TREE_LEAF. */
+    size_t nodes = 2 * (size_t)n / TREE_LEAF + 2;
     if (n > t->order_cap) {
         uint32_t *order = realloc(t->order, (size_t)n * sizeof *order);
         if (!order)

@@ -16,7 +16,7 @@ typedef struct lod_point_tree {
      * node i of order[lo .. hi) splits at mid = lo + (hi - lo) / 2 along axis[i], at split[i]
      * (its child 2i holds order[lo .. mid), at most split, 2i + 1 order[mid .. hi), at least);
      * box[i]: the smallest and largest coordinate of its points along each axis. Only nodes of more
-     * than the leaf size are stored (indices below count / 4 + 2). */
+     * than the leaf size are stored (indices below 2 count / leaf size + 2). */
     uint32_t *order;
     float *split;
     float (*box)[6];
