@@ -553,16 +553,24 @@ static float cell_d2(const lod_triangle_grid *g, const int32_t c[3], const float
 
 /* The nearest of cell c's triangles (up to g->cell_limit) into best, unless the cell is farther
  * than best already: a triangle listed there whose nearest point is nearer lies in a nearer cell too,
- * where it is listed as well. Ties: the lowest triangle index. */
+ * where it is listed as well. Ties: the lowest triangle index. A cell of more than GRID_SPREAD_ABOVE
+ * times the limit (a fan's hub or a fan cut to linear listing, where thousands of thin triangles
+ * cross a cell) gives triangles spread evenly over its list instead of its first ones: the list is
+ * in triangle order, neighbours on the surface lie near each other in it, and the first ones cover
+ * a corner of the cell (on a fan of 80,000 triangles its groups' mean error was 0.092 of the radius
+ * with the first ones, 0.012 spread). A cell just over the limit (a CAD mesh's) keeps its first
+ * ones, as before: spread there, one group of regr01.obj stated more. */
+#define GRID_SPREAD_ABOVE 4u
 static void visit_triangle_cell(const lod_triangle_grid *g, const int32_t c[3], gdr_vec3 point, const float q[3],
                                 lod_point_triangle_fn *distance, uint32_t *best, float *best_d2)
 {
     if (cell_d2(g, c, q) > *best_d2)
         return;
     size_t k = ((size_t)c[2] * g->dim[1] + (uint32_t)c[1]) * g->dim[0] + (uint32_t)c[0];
-    uint32_t end = g->start[k + 1] - g->start[k] > g->cell_limit ? g->start[k] + g->cell_limit : g->start[k + 1];
-    for (uint32_t i = g->start[k]; i < end; i++) {
-        uint32_t t = g->items[i];
+    uint32_t first = g->start[k], count = g->start[k + 1] - first, looked = count < g->cell_limit ? count : g->cell_limit;
+    uint32_t spread = count > GRID_SPREAD_ABOVE * looked ? count : looked;
+    for (uint32_t j = 0; j < looked; j++) {
+        uint32_t t = g->items[first + (uint32_t)((uint64_t)j * spread / looked)];
         float d = distance(point, corner(g, t, 0), corner(g, t, 1), corner(g, t, 2));
         if (d < *best_d2 || (d == *best_d2 && t < *best)) {
             *best_d2 = d;
