@@ -558,7 +558,7 @@ static float cell_d2(const lod_triangle_grid *g, const int32_t c[3], const float
  * cross a cell) gives triangles spread evenly over its list instead of its first ones: the list is
  * in triangle order, neighbours on the surface lie near each other in it, and the first ones cover
  * a corner of the cell (on a fan of 80,000 triangles its groups' mean error was 0.092 of the radius
- * with the first ones, 0.012 spread). A cell just over the limit (a CAD mesh's) keeps its first
+ * with the first ones, 0.015 spread). A cell just over the limit (a CAD mesh's) keeps its first
  * ones, as before: spread there, one group of regr01.obj stated more. */
 #define GRID_SPREAD_ABOVE 4u
 static void visit_triangle_cell(const lod_triangle_grid *g, const int32_t c[3], gdr_vec3 point, const float q[3],
