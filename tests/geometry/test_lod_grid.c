@@ -266,14 +266,22 @@ static void test_fan_listing_linear(void)
     printf("fan of %u: %zu cells, %zu entries (%.1f a triangle)\n", n, cells, listed, (double)listed / n);
     CHECK(listed < 20u * n + 65536u);
     unsigned state = 5;
+    double excess = 0.0; /* how much farther than the nearest the answers are, summed */
     for (int i = 0; i < 200; i++) {
         gdr_vec3 p = {test_random_range(&state, -1.1f, 1.1f), test_random_range(&state, -1.1f, 1.1f),
                       test_random_range(&state, -0.1f, 0.1f)};
-        float d2;
+        float d2, exact_d2 = brute_force_d2(&s, p);
         uint32_t t = lod_triangle_grid_nearest(&g, p, test_point_triangle_d2, &d2);
         CHECK(t < n);
-        CHECK(d2 >= brute_force_d2(&s, p));
+        CHECK(d2 >= exact_d2);
+        excess += sqrt(d2) - sqrt(exact_d2);
     }
+    /* Its cells hold hundreds of triangles, of which a query looks at 64: spread over the cell's
+     * list, in triangle order (around the fan), the nearest of them is close to the nearest of all;
+     * the first 64 would cover a corner of the cell. */
+    printf("fan of %u: answers farther than the nearest by %.5f on average, cells of %.3f\n", n, excess / 200,
+           (double)g.cell);
+    CHECK(excess / 200 < 0.01 * g.cell);
     lod_triangle_grid_free(&g);
     free(s.positions);
     free(s.corners);
