@@ -69,6 +69,8 @@ static gdr_mesh_clusters copy_level0(const gdr_mesh_clusters *c)
     out.clusters = copy_array(c->clusters, sizeof *c->clusters * c->cluster_count);
     out.vertices = copy_array(c->vertices, sizeof *c->vertices * c->vertex_count);
     out.triangles = copy_array(c->triangles, c->triangle_byte_count);
+    /* level 0's hierarchy too: the DAG build frees and replaces it */
+    out.lod_nodes = c->lod_nodes ? copy_array(c->lod_nodes, sizeof *c->lod_nodes * c->lod_node_count) : NULL;
     return out;
 }
 

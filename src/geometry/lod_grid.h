@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #include "gdr/math.h"
+#include "geometry/lod_point_tree.h"
 
 typedef struct lod_grid {
     const gdr_vec3 *points; /* not owned */
@@ -16,11 +17,14 @@ typedef struct lod_grid {
     uint32_t dim[3];
     uint32_t *start, *items; /* cell c holds items[start[c] .. start[c + 1]) */
     size_t start_cap, items_cap;
+    lod_point_tree tree; /* what answers instead where the cells would be crowded (use_tree) */
+    int use_tree;
 } lod_grid;
 
 /* Indexes points[0 .. n), n > 0 (kept by pointer until the next build), in at most
- * cells_per_point * n + 64 cells (fewer cells: less memory, more points a query looks at). Returns
- * 0 when out of memory. */
+ * cells_per_point * n + 64 cells (fewer cells: less memory, more points a query looks at). Where
+ * those cells would be crowded (points on a curve: lod_grid.c), a k-d tree is built instead, with
+ * the same answers. Returns 0 when out of memory. */
 int lod_grid_build(lod_grid *g, const gdr_vec3 *points, uint32_t n, double cells_per_point);
 /* The index of the point nearest to `point` (the lowest index on ties) and its squared distance. */
 uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squared);

@@ -243,6 +243,50 @@ static void test_fan_bounded(void)
     free(s.corners);
 }
 
+/* A fan of n triangles on a circle, flat, each reaching from the hub to the rim: in cells sized by
+ * the triangles' spacing each would be listed in O(sqrt n) cells (about 80 each at 20,000
+ * triangles, 1.6 M entries and as many clippings), so the cells are made larger until about 16 a
+ * triangle; the answers stay distances to the fan's triangles, never below the nearest. */
+static void test_fan_listing_linear(void)
+{
+    const uint32_t n = 20000;
+    soup s = {0};
+    s.positions = malloc((size_t)n * 9 * sizeof *s.positions);
+    s.corners = malloc((size_t)n * 3 * sizeof *s.corners);
+    CHECK(s.positions && s.corners);
+    if (!s.positions || !s.corners)
+        return;
+    for (uint32_t i = 0; i < n; i++) {
+        float a0 = 6.2831853f * (float)i / (float)n, a1 = 6.2831853f * (float)(i + 1) / (float)n;
+        add_triangle(&s, (gdr_vec3){0, 0, 0}, (gdr_vec3){cosf(a0), sinf(a0), 0}, (gdr_vec3){cosf(a1), sinf(a1), 0});
+    }
+    lod_triangle_grid g = {0};
+    CHECK(lod_triangle_grid_build(&g, s.positions, s.corners, s.triangle_count));
+    size_t cells = (size_t)g.dim[0] * g.dim[1] * g.dim[2], listed = g.start[cells];
+    printf("fan of %u: %zu cells, %zu entries (%.1f a triangle)\n", n, cells, listed, (double)listed / n);
+    CHECK(listed < 20u * n + 65536u);
+    unsigned state = 5;
+    double excess = 0.0; /* how much farther than the nearest the answers are, summed */
+    for (int i = 0; i < 200; i++) {
+        gdr_vec3 p = {test_random_range(&state, -1.1f, 1.1f), test_random_range(&state, -1.1f, 1.1f),
+                      test_random_range(&state, -0.1f, 0.1f)};
+        float d2, exact_d2 = brute_force_d2(&s, p);
+        uint32_t t = lod_triangle_grid_nearest(&g, p, test_point_triangle_d2, &d2);
+        CHECK(t < n);
+        CHECK(d2 >= exact_d2);
+        excess += sqrt(d2) - sqrt(exact_d2);
+    }
+    /* Its cells hold hundreds of triangles, of which a query looks at 64: spread over the cell's
+     * list, in triangle order (around the fan), the nearest of them is close to the nearest of all;
+     * the first 64 would cover a corner of the cell. */
+    printf("fan of %u: answers farther than the nearest by %.5f on average, cells of %.3f\n", n, excess / 200,
+           (double)g.cell);
+    CHECK(excess / 200 < 0.01 * g.cell);
+    lod_triangle_grid_free(&g);
+    free(s.positions);
+    free(s.corners);
+}
+
 /* The point nearest to p by brute force, the lowest index on ties, computed as the grid does. */
 static uint32_t brute_force_point(const gdr_vec3 *points, uint32_t n, gdr_vec3 p, float *best_d2)
 {
@@ -280,6 +324,7 @@ static void test_points_exact(void)
     for (int pass = 0; pass < 2; pass++) {
         lod_grid g = {0};
         CHECK(lod_grid_build(&g, points, n, pass == 0 ? 4.0 : 1.0));
+        CHECK(!g.use_tree); /* a surface: the grid answers */
         for (int i = 0; i < 3000; i++) {
             float scale = i % 3 == 0 ? 1.02f : i % 3 == 1 ? 1.6f : 1.0f;
             gdr_vec3 p = i % 3 == 2 ? points[(uint32_t)i % n]
@@ -315,11 +360,54 @@ static void test_points_exact(void)
     free(points);
 }
 
+/* Points on a circle (a fan's rim; each written twice, for ties) and its centre: a grid of O(n) cells
+ * over their box holds O(sqrt n) of them in each cell they occupy, so the k-d tree answers
+ * (lod_point_tree.c); its answer is brute force's, index and distance, for queries inside the
+ * circle, outside, on the points and on the axes (where the splits lie), with the grid's cells
+ * counted either way. */
+static void test_points_on_a_curve_exact(void)
+{
+    const uint32_t n = 40000;
+    gdr_vec3 *points = malloc((size_t)n * sizeof *points);
+    CHECK(points != NULL);
+    if (!points)
+        return;
+    points[0] = (gdr_vec3){0, 0, 0};
+    for (uint32_t i = 1; i + 1 < n; i += 2) {
+        float a = 6.2831853f * (float)i / (float)n;
+        points[i] = points[i + 1] = (gdr_vec3){cosf(a), sinf(a), 0.0f};
+    }
+    points[n - 1] = points[1];
+    for (int pass = 0; pass < 2; pass++) {
+        lod_grid g = {0};
+        CHECK(lod_grid_build(&g, points, n, pass == 0 ? 4.0 : 1.0));
+        CHECK(g.use_tree);
+        unsigned state = 21;
+        for (int i = 0; i < 1500; i++) {
+            float scale = i % 4 == 0 ? 0.5f : i % 4 == 1 ? 1.3f : 1.0f;
+            gdr_vec3 p = i % 4 == 2 ? points[(uint32_t)(i * 13) % n]
+                                    : (gdr_vec3){scale * test_random_range(&state, -1.0f, 1.0f),
+                                                 scale * test_random_range(&state, -1.0f, 1.0f),
+                                                 test_random_range(&state, -0.1f, 0.1f)};
+            if (i % 4 == 3)
+                p.y = 0.0f;
+            float d2, want_d2;
+            uint32_t got = lod_grid_nearest(&g, p, &d2), want = brute_force_point(points, n, p, &want_d2);
+            CHECK(got == want);
+            CHECK(d2 == want_d2);
+        }
+        lod_grid_free(&g);
+    }
+    free(points);
+}
+
 int main(void)
 {
     test_points_exact();
     test_needles_exact();
     test_band_exact();
     test_fan_bounded();
+    test_fan_listing_linear();
+    test_points_on_a_curve_exact();
     return test_finish("test_lod_grid");
 }
