@@ -61,6 +61,8 @@ static gdr_scene *make_scene(void)
             CHECK(gdr_scene_add_instance(scene, &instance, &err) == GDR_OK);
         }
     }
+    /* The renderer never builds clusters: a scene comes with them. */
+    CHECK(gdr_scene_build_clusters(scene, NULL, &err) == GDR_OK);
     return scene;
 }
 
