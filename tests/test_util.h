@@ -29,18 +29,18 @@ static int test_failure_count;
     } while (0)
 
 /* The error `err` (a gdr_error) holds the status `code`; on a mismatch, says both and the message. */
-#define CHECK_STATUS(err, code) check_status_(&(err), (code), #code, __FILE__, __LINE__)
+#define CHECK_STATUS(err, code) check_status_(&(err), (code), __FILE__, __LINE__)
 
 /* `call` returns the status `code` and fills `err` (a gdr_error) with it. */
 #define CHECK_FAILS(call, err, code)                                                                   \
     do {                                                                                               \
         gdr_status check_returned_ = (call);                                                           \
         if (check_returned_ != (code)) {                                                               \
-            fprintf(stderr, "%s:%d: CHECK_FAILS: %s returned %s, expected %s\n", __FILE__, __LINE__,  \
-                    #call, gdr_status_name(check_returned_), #code);                                   \
+            fprintf(stderr, "%s:%d: CHECK_FAILS: %s returned %s, expected %s: %s\n", __FILE__, __LINE__, \
+                    #call, gdr_status_name(check_returned_), gdr_status_name(code), (err).message);       \
             test_failure_count++;                                                                      \
         } else {                                                                                       \
-            check_status_(&(err), (code), #code, __FILE__, __LINE__);                                  \
+            check_status_(&(err), (code), __FILE__, __LINE__);                                         \
         }                                                                                              \
     } while (0)
 
@@ -48,12 +48,11 @@ static int test_failure_count;
  * promise to say (docs/SECURITY.md). What went wrong is the status's to say, not the wording's. */
 #define CHECK_NAMES(err, place) check_names_(&(err), (place), __FILE__, __LINE__)
 
-static inline void check_status_(const gdr_error *err, gdr_status code, const char *expected, const char *file,
-                                 int line)
+static inline void check_status_(const gdr_error *err, gdr_status code, const char *file, int line)
 {
     if (err->status != code) {
         fprintf(stderr, "%s:%d: CHECK_STATUS failed: %s, expected %s: %s\n", file, line, gdr_status_name(err->status),
-                expected, err->message);
+                gdr_status_name(code), err->message);
         test_failure_count++;
     }
 }
