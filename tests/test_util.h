@@ -4,6 +4,9 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
+
+#include "gdr/core.h"
 
 static int test_failure_count;
 
@@ -24,6 +27,43 @@ static int test_failure_count;
             test_failure_count++;                                                                \
         }                                                                                        \
     } while (0)
+
+/* The error `err` (a gdr_error) holds the status `code`; on a mismatch, says both and the message. */
+#define CHECK_STATUS(err, code) check_status_(&(err), (code), __FILE__, __LINE__)
+
+/* `call` returns the status `code` and fills `err` (a gdr_error) with it. */
+#define CHECK_FAILS(call, err, code)                                                                   \
+    do {                                                                                               \
+        gdr_status check_returned_ = (call);                                                           \
+        if (check_returned_ != (code)) {                                                               \
+            fprintf(stderr, "%s:%d: CHECK_FAILS: %s returned %s, expected %s: %s\n", __FILE__, __LINE__, \
+                    #call, gdr_status_name(check_returned_), gdr_status_name(code), (err).message);       \
+            test_failure_count++;                                                                      \
+        } else {                                                                                       \
+            check_status_(&(err), (code), __FILE__, __LINE__);                                         \
+        }                                                                                              \
+    } while (0)
+
+/* The message of `err` names `place` (a file, a line, a JSON path, a section): what errors
+ * promise to say (docs/SECURITY.md). What went wrong is the status's to say, not the wording's. */
+#define CHECK_NAMES(err, place) check_names_(&(err), (place), __FILE__, __LINE__)
+
+static inline void check_status_(const gdr_error *err, gdr_status code, const char *file, int line)
+{
+    if (err->status != code) {
+        fprintf(stderr, "%s:%d: CHECK_STATUS failed: %s, expected %s: %s\n", file, line, gdr_status_name(err->status),
+                gdr_status_name(code), err->message);
+        test_failure_count++;
+    }
+}
+
+static inline void check_names_(const gdr_error *err, const char *place, const char *file, int line)
+{
+    if (!strstr(err->message, place)) {
+        fprintf(stderr, "%s:%d: CHECK_NAMES failed: '%s' not in: %s\n", file, line, place, err->message);
+        test_failure_count++;
+    }
+}
 
 static inline int test_finish(const char *name)
 {

@@ -16,16 +16,55 @@ extern "C" {
 
 #define GDR_API __attribute__((visibility("default")))
 
-/* --- status codes (one list, so tests can match them) --- */
+/* --- status codes (one list, so callers and tests can act on them) ---
+ *
+ * Each code says what a caller can do about the failure; the message says where (the file and
+ * the place in it) and why. The `gdr` program exits with 2 for a value given on its command line
+ * that was refused (GDR_ERROR_INVALID_ARGUMENT from a built-in scene's options, a --device, a
+ * target size) and with 1 for every other failure, whatever its code. New codes are added at the
+ * end, so a code's number never changes. */
 typedef enum gdr_status {
     GDR_OK = 0,
-    GDR_ERROR_INVALID_ARGUMENT, /* a caller-supplied value is out of range */
-    GDR_ERROR_IO,               /* a file could not be read or written */
-    GDR_ERROR_PARSE,            /* input data is malformed */
-    GDR_ERROR_OUT_OF_MEMORY,    /* host or device allocation failed */
-    GDR_ERROR_UNSUPPORTED,      /* the device or input needs something gdr does not have */
-    GDR_ERROR_VULKAN,           /* a Vulkan call failed */
-    GDR_ERROR_CAPACITY,         /* a fixed-size list would overflow */
+    /* A caller-supplied value is out of range (a desc field, a built-in scene's option, a mesh
+     * handed to the API). Fix the value. Exit status 2 where the value came from the command
+     * line, 1 otherwise. */
+    GDR_ERROR_INVALID_ARGUMENT,
+    /* A file could not be opened, read or written (the system's reason follows). Exit status 1. */
+    GDR_ERROR_IO,
+    /* Input data is malformed: it breaks its format's rules (a glTF index out of range, an OBJ
+     * number that is not one, a cache section that contradicts itself). Fix or re-export the
+     * file. Exit status 1. */
+    GDR_ERROR_PARSE,
+    /* Host or device memory ran out. Exit status 1. */
+    GDR_ERROR_OUT_OF_MEMORY,
+    /* Well-formed input, or a request, that needs something gdr or the device does not have (a
+     * required glTF extension, an image format glTF does not allow, a cache of another format
+     * version, the mesh pipeline on a device without mesh shaders). Exit status 1. */
+    GDR_ERROR_UNSUPPORTED,
+    /* A Vulkan call failed (the VkResult is named). Exit status 1. */
+    GDR_ERROR_VULKAN,
+    /* A fixed limit of gdr's would be exceeded (a list's 32-bit offsets, the renderer's texture
+     * slots, a cache's largest texture): no option raises it. Exit status 1. */
+    GDR_ERROR_CAPACITY,
+    /* A file needs more than a budget allows (triangles, instances, texture pixels or decoded
+     * bytes: gdr_budget). The message names the budget; raise it with `--budget KEY=N` (the
+     * program) or gdr_budget (the library). Exit status 1. */
+    GDR_ERROR_BUDGET,
+    /* A file a scene refers to (a glTF buffer's or image's URI) lies outside the scene's folder
+     * (an absolute path, '..', a symbolic link leading out) and was not read. Allow it with
+     * `--allow-outside-files` (allow_outside_files in the options). Exit status 1. */
+    GDR_ERROR_OUTSIDE_FOLDER,
+    /* A path names a directory, FIFO, socket or device where gdr reads a whole file, or a
+     * directory where it writes one. Give a regular file. Exit status 1. */
+    GDR_ERROR_NOT_A_FILE,
+    /* A .gdrc cache that is intact but no longer matches what it was built from: its source
+     * files changed or are gone, or it was built with other options. gdr_scene_load rebuilds
+     * it without a word; rebuild it with `gdr build`. Exit status 1. */
+    GDR_ERROR_STALE,
+    /* A file's bytes fail its own integrity checks: a checksum mismatch, a file shorter or
+     * longer than its header says, a reserved byte that is not zero (a .gdrc cache, its pages).
+     * Damaged in storage or transfer: read it again or rebuild it. Exit status 1. */
+    GDR_ERROR_CORRUPT,
 } gdr_status;
 
 /* Marks "none" in every index field (a mesh's material, a cluster's group, ...). */

@@ -13,6 +13,11 @@ const char *gdr_status_name(gdr_status status)
     case GDR_ERROR_UNSUPPORTED: return "GDR_ERROR_UNSUPPORTED";
     case GDR_ERROR_VULKAN: return "GDR_ERROR_VULKAN";
     case GDR_ERROR_CAPACITY: return "GDR_ERROR_CAPACITY";
+    case GDR_ERROR_BUDGET: return "GDR_ERROR_BUDGET";
+    case GDR_ERROR_OUTSIDE_FOLDER: return "GDR_ERROR_OUTSIDE_FOLDER";
+    case GDR_ERROR_NOT_A_FILE: return "GDR_ERROR_NOT_A_FILE";
+    case GDR_ERROR_STALE: return "GDR_ERROR_STALE";
+    case GDR_ERROR_CORRUPT: return "GDR_ERROR_CORRUPT";
     }
     return "GDR_ERROR_UNKNOWN";
 }

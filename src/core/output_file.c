@@ -153,7 +153,7 @@ gdr_status gdr_output_open(const char *path, gdr_output_file *out, gdr_error *er
     /* What the path names, links followed: a device, FIFO or socket is written where it is (through
      * the path itself, so that /dev/stdout reaches a pipe). */
     if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
-        return gdr_error_set(err, GDR_ERROR_IO, "%s: is a directory", path);
+        return gdr_error_set(err, GDR_ERROR_NOT_A_FILE, "%s: is a directory", path);
     if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
         if (!(out->target = strdup(path)))
             return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);

@@ -30,7 +30,7 @@ gdr_status gdr_io_budget_take(gdr_io_budget *b, gdr_io_budget_kind kind, uint64_
                                                             "decoded bytes"};
     uint64_t used = b->used[kind];
     if (amount > b->limit[kind] || used > b->limit[kind] - amount)
-        return gdr_error_set(err, GDR_ERROR_CAPACITY, "%s: %s: %llu %s (%llu before it) exceed the budget of %llu; "
+        return gdr_error_set(err, GDR_ERROR_BUDGET, "%s: %s: %llu %s (%llu before it) exceed the budget of %llu; "
                              "raise it with --budget %s=N (gdr_budget.%s)", name, place, (unsigned long long)amount,
                              what[kind], (unsigned long long)used, (unsigned long long)b->limit[kind], names[kind],
                              kind == GDR_BUDGET_TEXTURE_PIXELS ? "texture_pixels"

@@ -189,7 +189,7 @@ static gdr_status check_coverage(const char *name, const uint8_t *data, size_t s
                                  (unsigned long long)cursor, after);
         for (uint64_t at = cursor; at < next; at++)
             if (data[at] != 0)
-                return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: padding byte at offset %llu, after %s, is "
+                return gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: corrupted: padding byte at offset %llu, after %s, is "
                                      "not zero", name, (unsigned long long)at, after);
         if (i < count) {
             char text[5];
@@ -250,7 +250,7 @@ static gdr_status fetch_section(container_source *src, int known, uint64_t offse
         bytes = src->owned[known];
     }
     if (checksum != gdr_io_hash(bytes, (size_t)length))
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: section '%s' checksum mismatch", src->name, text);
+        return gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: corrupted: section '%s' checksum mismatch", src->name, text);
     if (known >= 0)
         v->sections[known] = (reader){bytes, (size_t)length, 0, 0};
     return GDR_OK;
@@ -269,18 +269,18 @@ gdr_status cache_parse_header(const char *name, const uint8_t *h, uint64_t size,
         return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: cache format version %u, this build reads %u; rebuild it",
                              name, version, GDR_CACHE_FORMAT_VERSION);
     if (header_hash != gdr_io_hash(h, 40))
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: header checksum mismatch", name);
+        return gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: corrupted: header checksum mismatch", name);
     if (header_size != CACHE_HEADER_SIZE)
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: header size %u, expected %u", name, header_size,
                              CACHE_HEADER_SIZE);
     if (file_size != size)
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: truncated or extended: %llu bytes, the header says %llu", name,
+        return gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: truncated or extended: %llu bytes, the header says %llu", name,
                              (unsigned long long)size, (unsigned long long)file_size);
     if (count > CACHE_MAX_SECTIONS || CACHE_HEADER_SIZE + (uint64_t)count * CACHE_ENTRY_SIZE > size)
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section table (%u entries) does not fit", name, count);
     for (unsigned i = 48; i < CACHE_HEADER_SIZE; i++)
         if (h[i] != 0)
-            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: reserved header byte %u is not zero", name, i);
+            return gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: corrupted: reserved header byte %u is not zero", name, i);
     *out_count = count;
     *out_table_hash = table_hash;
     return GDR_OK;
@@ -324,7 +324,7 @@ static gdr_status parse_container(container_source *src, cache_view *v, gdr_erro
     const char *name = src->name;
     uint8_t h[CACHE_HEADER_SIZE];
     if (src->size < CACHE_HEADER_SIZE)
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: truncated: %llu bytes, shorter than the header", name,
+        return gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: truncated: %llu bytes, shorter than the header", name,
                              (unsigned long long)src->size);
     uint32_t count = 0;
     uint64_t table_hash = 0;
@@ -337,7 +337,7 @@ static gdr_status parse_container(container_source *src, cache_view *v, gdr_erro
     if (status == GDR_OK)
         status = source_read(src, table, (uint64_t)count * CACHE_ENTRY_SIZE, CACHE_HEADER_SIZE, err);
     if (status == GDR_OK && table_hash != gdr_io_hash(table, (size_t)count * CACHE_ENTRY_SIZE))
-        status = gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: section table checksum mismatch", name);
+        status = gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: corrupted: section table checksum mismatch", name);
     uint64_t table_end = CACHE_HEADER_SIZE + (uint64_t)count * CACHE_ENTRY_SIZE;
     byte_range ranges[CACHE_MAX_SECTIONS];
     for (uint32_t i = 0; i < count && status == GDR_OK; i++)
@@ -494,7 +494,7 @@ static gdr_status check_entry(const char *name, const source_entry *e, source_no
     if (!now->exists)
         return GDR_OK; /* the file is not here: the cache stands alone */
     if (now->size != e->size)
-        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: %s changed size (%llu -> %llu bytes)", name,
+        return gdr_error_set(err, GDR_ERROR_STALE, "%s: stale: %s changed size (%llu -> %llu bytes)", name,
                              e->path, (unsigned long long)e->size, (unsigned long long)now->size);
     if ((uint64_t)now->mtime == e->mtime && !e->moved)
         return GDR_OK;
@@ -511,7 +511,7 @@ static gdr_status check_entry(const char *name, const source_entry *e, source_no
         }
     }
     if (now->hashed && now->hash != e->hash)
-        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: %s changed since the cache was built", name,
+        return gdr_error_set(err, GDR_ERROR_STALE, "%s: stale: %s changed since the cache was built", name,
                              e->path);
     return GDR_OK;
 }
@@ -524,7 +524,7 @@ static gdr_status check_fresh(const char *name, cache_view *v, const char *build
                               gdr_error *err)
 {
     if (!v->present[CACHE_SOURCE])
-        return source ? gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: it does not record the source it "
+        return source ? gdr_error_set(err, GDR_ERROR_STALE, "%s: stale: it does not record the source it "
                                       "was built from", name)
                       : GDR_OK;
     reader r = v->sections[CACHE_SOURCE];
@@ -533,7 +533,7 @@ static gdr_status check_fresh(const char *name, cache_view *v, const char *build
     if (r.failed)
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'SRCE' is truncated", name);
     if (build_options && (strlen(build_options) != length || memcmp(options, build_options, length) != 0))
-        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: built with options '%.*s', now '%s'", name,
+        return gdr_error_set(err, GDR_ERROR_STALE, "%s: stale: built with options '%.*s', now '%s'", name,
                              (int)(length > 64 ? 64 : length), options, build_options);
     source_entry *entries = NULL;
     uint32_t count = 0;
@@ -545,14 +545,14 @@ static gdr_status check_fresh(const char *name, cache_view *v, const char *build
         return status;
     }
     if (source && count == 0)
-        status = gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: it does not record the source it was "
+        status = gdr_error_set(err, GDR_ERROR_STALE, "%s: stale: it does not record the source it was "
                                "built from", name);
     if (source && status == GDR_OK) {
         /* The source itself must be there, with the contents the cache was built from. */
         source_now now = {0};
         now.exists = gdr_io_stat(entries[0].path, &now.size, &now.mtime) == 0;
         if (!now.exists)
-            status = gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: stale: its source %s is not there", name,
+            status = gdr_error_set(err, GDR_ERROR_STALE, "%s: stale: its source %s is not there", name,
                                    entries[0].path);
         else
             status = check_entry(name, &entries[0], &now, err);

@@ -825,8 +825,8 @@ gdr_status cache_page_decode(const char *name, uint32_t mesh, uint32_t page, con
     const gdr_page_info *pi = &pm->pages[page];
     uint64_t hash = gdr_io_hash(bytes, size);
     if (size != pi->stored_size || hash != pi->checksum)
-        return PAGE_ERR("%s: checksum mismatch (%zu bytes read at offset %llu): the page is damaged", where, size,
-                        (unsigned long long)pi->offset);
+        return gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: checksum mismatch (%zu bytes read at offset %llu): the page "
+                             "is damaged", where, size, (unsigned long long)pi->offset);
     uint32_t h[8];
     memcpy(h, bytes, sizeof h);
     /* h[4]: the page's own vertices, each shared by the clusters that use it (at most theirs in all). */

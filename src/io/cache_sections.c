@@ -915,7 +915,7 @@ static gdr_status read_pages(cache_read_state *st, reader *r, gdr_error *err)
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'PAGE': %u meshes, the scene has %u", st->name,
                              mesh_count, st->mesh_count);
     if (gdr_io_hash(r->data + CACHE_PAGES_HEADER, (size_t)index_size) != index_hash)
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'PAGE': index checksum mismatch", st->name);
+        return gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: section 'PAGE': index checksum mismatch", st->name);
     gdr_paged_mesh *meshes;
     status = cache_pages_parse_index(st->name, r->data + CACHE_PAGES_HEADER, index_size, mesh_count, 0, r->size,
                                      &meshes, err);

@@ -70,9 +70,19 @@ gdr_status gdr_io_open_regular(const char *path, int *out_fd, gdr_error *err)
         return gdr_error_set(err, GDR_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
     struct stat st;
     int flags = fcntl(fd, F_GETFL);
-    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || flags < 0 || fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0) {
+    if (fstat(fd, &st) != 0 || flags < 0) {
+        int error = errno;
         close(fd);
-        return gdr_error_set(err, GDR_ERROR_IO, "%s: not a regular file", path);
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: cannot stat: %s", path, strerror(error));
+    }
+    if (!S_ISREG(st.st_mode)) {
+        close(fd);
+        return gdr_error_set(err, GDR_ERROR_NOT_A_FILE, "%s: not a regular file", path);
+    }
+    if (fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0) {
+        int error = errno;
+        close(fd);
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: cannot open: %s", path, strerror(error));
     }
     *out_fd = fd;
     return GDR_OK;
@@ -112,7 +122,7 @@ gdr_status gdr_io_read_file(const char *path, uint8_t **out_data, size_t *out_si
     struct stat st;
     if (fstat(fileno(file), &st) != 0 || !S_ISREG(st.st_mode)) {
         fclose(file);
-        return gdr_error_set(err, GDR_ERROR_IO, "%s: not a regular file", path);
+        return gdr_error_set(err, GDR_ERROR_NOT_A_FILE, "%s: not a regular file", path);
     }
     if ((uint64_t)st.st_size > GDR_IO_MAX_FILE_SIZE) {
         fclose(file);

@@ -972,8 +972,10 @@ static gdr_status add_instances(gltf_ctx *c, uint32_t mesh, gdr_mat4 transform, 
         if (status != GDR_OK)
             return status;
         status = gdr_scene_add_instance(c->scene, &instance, c->err);
+        /* A transform the scene refuses (beyond the limit on coordinates) is the file's fault. */
         if (status != GDR_OK)
-            return gltf_fail(c, status, "%s: meshes[%u]: %s", place, mesh, c->err ? c->err->message : "");
+            return gltf_fail(c, status == GDR_ERROR_INVALID_ARGUMENT ? GDR_ERROR_PARSE : status, "%s: meshes[%u]: %s",
+                             place, mesh, c->err ? c->err->message : "");
     }
     return GDR_OK;
 }

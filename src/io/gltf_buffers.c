@@ -161,7 +161,7 @@ static gdr_status confine_to_folder(gltf_ctx *c, const char *place, const char *
     for (const char *part = relative; *part && !escapes; part = strchr(part, '/') ? strchr(part, '/') + 1 : "")
         escapes = strncmp(part, "..", 2) == 0 && (part[2] == '/' || part[2] == 0);
     if (escapes)
-        return gltf_fail(c, GDR_ERROR_UNSUPPORTED, "%s.uri: '%.64s' leaves the scene's folder (absolute or '..'); "
+        return gltf_fail(c, GDR_ERROR_OUTSIDE_FOLDER, "%s.uri: '%.64s' leaves the scene's folder (absolute or '..'); "
                          "allow it with --allow-outside-files", place, uri);
     char folder[PATH_MAX], resolved[PATH_MAX];
     if (!realpath(c->base_dir[0] ? c->base_dir : ".", folder))
@@ -170,10 +170,10 @@ static gdr_status confine_to_folder(gltf_ctx *c, const char *place, const char *
         return GDR_OK; /* nothing there to read: opening it says so */
     size_t length = strlen(folder);
     if (strcmp(resolved, folder) == 0)
-        return gltf_fail(c, GDR_ERROR_PARSE, "%s.uri: '%.64s' names the scene's folder, not a file", place, uri);
+        return gltf_fail(c, GDR_ERROR_NOT_A_FILE, "%s.uri: '%.64s' names the scene's folder, not a file", place, uri);
     int inside = strncmp(resolved, folder, length) == 0 && (resolved[length] == '/' || strcmp(folder, "/") == 0);
     if (!inside)
-        return gltf_fail(c, GDR_ERROR_UNSUPPORTED, "%s.uri: '%.64s' resolves outside the scene's folder (a symbolic "
+        return gltf_fail(c, GDR_ERROR_OUTSIDE_FOLDER, "%s.uri: '%.64s' resolves outside the scene's folder (a symbolic "
                          "link); allow it with --allow-outside-files", place, uri);
     char *copy = strdup(resolved);
     if (!copy)

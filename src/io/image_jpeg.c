@@ -11,21 +11,24 @@
 
 #include "io/image_decoders.h"
 
-/* libjpeg's error manager, extended with where to jump and the message to report. */
+/* libjpeg's error manager, extended with where to jump and the status and message to report. */
 typedef struct jpeg_reader {
     struct jpeg_error_mgr pub;
     struct jpeg_progress_mgr progress;
     jmp_buf jump;
+    gdr_status status; /* GDR_ERROR_PARSE but for gdr's own limits */
     char message[JMSG_LENGTH_MAX + 64];
 } jpeg_reader;
 
 static void on_error_exit(j_common_ptr cinfo)
 {
     jpeg_reader *r = (jpeg_reader *)cinfo->err;
-    if (cinfo->err->msg_code == JERR_NO_BACKING_STORE)
+    if (cinfo->err->msg_code == JERR_NO_BACKING_STORE) {
+        r->status = GDR_ERROR_CAPACITY; /* the memory gdr allows the decoder, not the machine's */
         snprintf(r->message, sizeof r->message, "decoding needs more memory than counted for the image");
-    else
+    } else {
         cinfo->err->format_message(cinfo, r->message);
+    }
     longjmp(r->jump, 1);
 }
 
@@ -46,6 +49,7 @@ static void on_progress(j_common_ptr cinfo)
     j_decompress_ptr d = (j_decompress_ptr)cinfo;
     if (d->input_scan_number > GDR_IO_JPEG_MAX_SCANS) {
         jpeg_reader *r = (jpeg_reader *)cinfo->err;
+        r->status = GDR_ERROR_UNSUPPORTED; /* a limit of gdr's, as the image size is */
         snprintf(r->message, sizeof r->message, "more than %d scans", GDR_IO_JPEG_MAX_SCANS);
         longjmp(r->jump, 1);
     }
@@ -56,6 +60,7 @@ static void reader_init(j_decompress_ptr cinfo, jpeg_reader *r, const uint8_t *d
     cinfo->err = jpeg_std_error(&r->pub);
     r->pub.error_exit = on_error_exit;
     r->pub.emit_message = on_message;
+    r->status = GDR_ERROR_PARSE;
     r->message[0] = 0;
     jpeg_create_decompress(cinfo);
     r->progress.progress_monitor = on_progress;
@@ -156,6 +161,6 @@ gdr_status gdr_io_jpeg_decode(const uint8_t *data, size_t size, const char *name
     bool decoded = decode_rows(&cinfo, &r, info, rgba);
     jpeg_destroy_decompress(&cinfo); /* also after an error: it frees whatever was allocated */
     if (!decoded)
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: JPEG: %s", name, r.message);
+        return gdr_error_set(err, r.status, "%s: JPEG: %s", name, r.message);
     return GDR_OK;
 }

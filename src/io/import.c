@@ -138,10 +138,11 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
         if (access(candidates[i], F_OK) != 0)
             continue;
         gdr_error cache_err;
-        if (gdr_io_cache_read_for(candidates[i], path, build_options, out, out_pvs ? &pvs : NULL, &cache_err) ==
-            GDR_OK)
+        gdr_status read = gdr_io_cache_read_for(candidates[i], path, build_options, out, out_pvs ? &pvs : NULL,
+                                                &cache_err);
+        if (read == GDR_OK)
             return finish_cache_read(candidates[i], out, pvs, out_pvs, err);
-        if (!strstr(cache_err.message, ": stale: "))
+        if (read != GDR_ERROR_STALE) /* a stale cache is rebuilt without a word; anything else is said */
             warn(options, "%s; rebuilding it", cache_err.message);
     }
 

@@ -58,7 +58,7 @@ typedef struct gdr_io_budget {
 
 void gdr_io_budget_init(gdr_io_budget *b, const gdr_budget *limits);
 /* Takes `amount` of a budget, before allocating for it; over the limit, an error naming the file,
- * the place, the budget and how to raise it (GDR_ERROR_CAPACITY). */
+ * the place, the budget and how to raise it (GDR_ERROR_BUDGET). */
 gdr_status gdr_io_budget_take(gdr_io_budget *b, gdr_io_budget_kind kind, uint64_t amount, const char *name,
                               const char *place, gdr_error *err);
 /* Gives back `amount` taken before for memory that has been freed since (an image's decoding). */

@@ -55,7 +55,7 @@ static gdr_status read_table(gdr_paged_cache *pc, section_ref *scne, section_ref
 {
     uint8_t h[CACHE_HEADER_SIZE];
     if (pc->file_size < CACHE_HEADER_SIZE)
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: truncated: %llu bytes, shorter than the header", pc->name,
+        return gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: truncated: %llu bytes, shorter than the header", pc->name,
                              (unsigned long long)pc->file_size);
     uint32_t count = 0;
     uint64_t table_hash = 0;
@@ -69,7 +69,7 @@ static gdr_status read_table(gdr_paged_cache *pc, section_ref *scne, section_ref
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: section table", pc->name);
     status = read_at(pc, table, (size_t)count * CACHE_ENTRY_SIZE, CACHE_HEADER_SIZE, "section table", err);
     if (status == GDR_OK && table_hash != gdr_io_hash(table, (size_t)count * CACHE_ENTRY_SIZE))
-        status = gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: section table checksum mismatch", pc->name);
+        status = gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: corrupted: section table checksum mismatch", pc->name);
     for (uint32_t i = 0; i < count && status == GDR_OK; i++) {
         const uint8_t *e = table + (size_t)i * CACHE_ENTRY_SIZE;
         uint32_t id = load_u32(e);
@@ -102,7 +102,7 @@ static gdr_status read_section(gdr_paged_cache *pc, const section_ref *ref, cons
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: section '%s'", pc->name, id);
     gdr_status status = read_at(pc, *out, (size_t)ref->size, ref->offset, id, err);
     if (status == GDR_OK && gdr_io_hash(*out, (size_t)ref->size) != ref->checksum)
-        status = gdr_error_set(err, GDR_ERROR_PARSE, "%s: corrupted: section '%s' checksum mismatch", pc->name, id);
+        status = gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: corrupted: section '%s' checksum mismatch", pc->name, id);
     if (status != GDR_OK) {
         free(*out);
         *out = NULL;
@@ -170,7 +170,7 @@ static gdr_status read_page_index(gdr_paged_cache *pc, const section_ref *page, 
                              (unsigned long long)index_size);
     status = read_at(pc, index, (size_t)index_size, page->offset + CACHE_PAGES_HEADER, "page index", err);
     if (status == GDR_OK && gdr_io_hash(index, (size_t)index_size) != index_hash)
-        status = gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'PAGE': index checksum mismatch", pc->name);
+        status = gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: section 'PAGE': index checksum mismatch", pc->name);
     if (status == GDR_OK)
         status = cache_pages_parse_index(pc->name, index, index_size, mesh_count, page->offset, page->size,
                                          &pc->meshes, err);
@@ -214,9 +214,10 @@ gdr_status gdr_paged_cache_open(const char *path, gdr_paged_cache **out, gdr_err
     }
     struct stat st;
     pc->fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC); /* a FIFO must not block the open */
-    if (pc->fd < 0 || fstat(pc->fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        gdr_status status = gdr_error_set(err, GDR_ERROR_IO, "%s: %s", path,
-                                          pc->fd < 0 ? strerror(errno) : "not a regular file");
+    int opened = pc->fd >= 0 && fstat(pc->fd, &st) == 0;
+    if (!opened || !S_ISREG(st.st_mode)) {
+        gdr_status status = opened ? gdr_error_set(err, GDR_ERROR_NOT_A_FILE, "%s: not a regular file", path)
+                                   : gdr_error_set(err, GDR_ERROR_IO, "%s: %s", path, strerror(errno));
         gdr_paged_cache_close(pc);
         return status;
     }

@@ -275,15 +275,13 @@ static void test_cone_convention(void)
 
 /* --- bad input -------------------------------------------------------------------------------- */
 
-static void expect_error(const gdr_mesh *mesh, gdr_meshlet_options o, const char *text)
+/* Refused as a bad argument, naming the option or the mesh and its bad value. */
+static void expect_error(const gdr_mesh *mesh, gdr_meshlet_options o, const char *place)
 {
     gdr_mesh_clusters mc = {0};
     gdr_error err = {0};
-    gdr_status status = gdr_meshlets_build(mesh, &o, &mc, &err);
-    CHECK(status == GDR_ERROR_INVALID_ARGUMENT);
-    CHECK(strstr(err.message, text) != NULL);
-    if (!strstr(err.message, text))
-        fprintf(stderr, "expected '%s' in: %s\n", text, err.message);
+    CHECK_FAILS(gdr_meshlets_build(mesh, &o, &mc, &err), err, GDR_ERROR_INVALID_ARGUMENT);
+    CHECK_NAMES(err, place);
     CHECK(mc.clusters == NULL && mc.vertices == NULL && mc.triangles == NULL && mc.cluster_count == 0);
 }
 
@@ -292,34 +290,34 @@ static void test_bad_input(void)
     gdr_vec3 p[4] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
     uint32_t idx[6] = {0, 1, 2, 2, 1, 3};
     gdr_mesh mesh = {.name = "quad", .vertex_count = 4, .positions = p, .index_count = 6, .indices = idx};
-    expect_error(&mesh, (gdr_meshlet_options){.max_vertices = 65}, "max_vertices 65 is outside [3, 64]");
+    expect_error(&mesh, (gdr_meshlet_options){.max_vertices = 65}, "max_vertices 65");
     expect_error(&mesh, (gdr_meshlet_options){.max_vertices = 2}, "max_vertices 2");
-    expect_error(&mesh, (gdr_meshlet_options){.max_triangles = 128}, "max_triangles 128 is not a multiple of 4 in [4, 124]");
+    expect_error(&mesh, (gdr_meshlet_options){.max_triangles = 128}, "max_triangles 128");
     expect_error(&mesh, (gdr_meshlet_options){.max_triangles = 126}, "max_triangles 126");
     expect_error(&mesh, (gdr_meshlet_options){.max_triangles = 3}, "max_triangles 3");
-    expect_error(&mesh, (gdr_meshlet_options){.cone_weight = 1.5f}, "cone_weight 1.5 is outside (0, 1]");
+    expect_error(&mesh, (gdr_meshlet_options){.cone_weight = 1.5f}, "cone_weight 1.5");
     expect_error(&mesh, (gdr_meshlet_options){.cone_weight = -0.5f}, "cone_weight -0.5");
     expect_error(&mesh, (gdr_meshlet_options){.cone_weight = NAN}, "cone_weight nan");
-    expect_error(&mesh, (gdr_meshlet_options){.thread_count = 1000}, "thread_count 1000 exceeds 256");
+    expect_error(&mesh, (gdr_meshlet_options){.thread_count = 1000}, "thread_count 1000");
     gdr_mesh bad = mesh;
     bad.index_count = 0;
-    expect_error(&bad, (gdr_meshlet_options){0}, "mesh 'quad': 0 indices: meshlets need a non-empty triangle list");
+    expect_error(&bad, (gdr_meshlet_options){0}, "mesh 'quad': 0 indices");
     bad.index_count = 5;
     expect_error(&bad, (gdr_meshlet_options){0}, "5 indices");
     bad = mesh;
     bad.vertex_count = 3;
-    expect_error(&bad, (gdr_meshlet_options){0}, "mesh 'quad': index 3 (at 5) is out of range (vertex count 3)");
+    expect_error(&bad, (gdr_meshlet_options){0}, "mesh 'quad': index 3 (at 5)");
     gdr_vec3 q[4] = {{0, 0, 0}, {1, 0, 0}, {0, INFINITY, 0}, {1, 1, 0}};
     bad = mesh;
     bad.positions = q;
-    expect_error(&bad, (gdr_meshlet_options){0}, "mesh 'quad': position 2 is not finite");
+    expect_error(&bad, (gdr_meshlet_options){0}, "mesh 'quad': position 2");
     /* An output that holds data is refused, not leaked or overwritten. */
     gdr_mesh_clusters mc = {0};
     gdr_error err = {0};
     CHECK(gdr_meshlets_build(&mesh, NULL, &mc, &err) == GDR_OK);
     gdr_cluster *kept = mc.clusters;
-    CHECK(gdr_meshlets_build(&mesh, NULL, &mc, &err) == GDR_ERROR_INVALID_ARGUMENT);
-    CHECK(strstr(err.message, "must be zeroed") != NULL && mc.clusters == kept);
+    CHECK_FAILS(gdr_meshlets_build(&mesh, NULL, &mc, &err), err, GDR_ERROR_INVALID_ARGUMENT);
+    CHECK(mc.clusters == kept);
     gdr_mesh_clusters_free(&mc);
 }
 
@@ -433,18 +431,16 @@ static void test_scene_failure(void)
         gdr_error err = {0};
         CHECK(gdr_scene_build_clusters(s, &(gdr_meshlet_options){.thread_count = threads[t]}, &err) ==
               GDR_ERROR_INVALID_ARGUMENT);
-        CHECK(strstr(err.message, "meshes[3]: mesh 'blob': position 2 is not finite") != NULL);
-        if (!strstr(err.message, "meshes[3]"))
-            fprintf(stderr, "%s\n", err.message);
+        CHECK_STATUS(err, GDR_ERROR_INVALID_ARGUMENT);
+        CHECK_NAMES(err, "meshes[3]: mesh 'blob': position 2"); /* the first mesh that fails, whatever the threads */
         for (uint32_t i = 0; i < s->mesh_count; i++)
             CHECK(s->meshes[i].clusters.cluster_count == 0 && s->meshes[i].clusters.clusters == NULL);
         gdr_scene_destroy(s);
     }
     gdr_scene *s = make_scene(2);
     gdr_error err = {0};
-    CHECK(gdr_scene_build_clusters(s, &(gdr_meshlet_options){.max_triangles = 130}, &err) ==
-          GDR_ERROR_INVALID_ARGUMENT);
-    CHECK(strstr(err.message, "max_triangles 130") != NULL);
+    CHECK_FAILS(gdr_scene_build_clusters(s, &(gdr_meshlet_options){.max_triangles = 130}, &err), err,
+                GDR_ERROR_INVALID_ARGUMENT);
     gdr_scene_destroy(s);
 }
 

@@ -232,8 +232,7 @@ static void check_demo(void)
         CHECK(stats.pipeline == GDR_PIPELINE_INDIRECT && strstr(stats.pipeline_reason, "no mesh pipeline"));
         CHECK(stats.instances_visible > 0 && stats.validation_messages == 0);
         frame.pipeline = GDR_PIPELINE_MESH;
-        gdr_status status = gdr_renderer_render(renderer, &frame, 1, &stats, &err);
-        CHECK(status == GDR_ERROR_UNSUPPORTED && strstr(err.message, "pipeline mesh"));
+        CHECK_FAILS(gdr_renderer_render(renderer, &frame, 1, &stats, &err), err, GDR_ERROR_UNSUPPORTED);
         gdr_renderer_destroy(renderer);
         renderer = NULL;
     }

@@ -407,9 +407,9 @@ static gdr_scene *read_for_streaming(const char *path)
     CHECK(bytes_read > 0 && bytes_read < file_size / 8);
     gdr_renderer *whole = NULL;
     gdr_renderer_desc desc = {.width = WIDTH, .height = HEIGHT, .validate = true};
-    CHECK(paged && gdr_renderer_create(&desc, &whole, &err) == GDR_OK &&
-          gdr_renderer_set_scene(whole, paged, &err) == GDR_ERROR_INVALID_ARGUMENT &&
-          strstr(err.message, "set_scene_streamed"));
+    CHECK(paged && gdr_renderer_create(&desc, &whole, &err) == GDR_OK);
+    if (paged && whole)
+        CHECK_FAILS(gdr_renderer_set_scene(whole, paged, &err), err, GDR_ERROR_INVALID_ARGUMENT);
     gdr_renderer_destroy(whole);
     char copy[300];
     snprintf(copy, sizeof copy, "%s.copy", path);

@@ -157,8 +157,10 @@ static void test_damaged_pixels(const char *path)
         return;
     data[offset + length - 2] ^= 0x10; /* the 1 x 1 level of the second texture */
     gdr_scene *s = NULL;
-    CHECK(gdr_cache_read_memory(data, size, "materials.gdrc", &s, NULL, &err) != GDR_OK && s == NULL);
-    CHECK(strstr(err.message, "materials.gdrc") && strstr(err.message, "'TXPX'"));
+    CHECK_FAILS(gdr_cache_read_memory(data, size, "materials.gdrc", &s, NULL, &err), err, GDR_ERROR_CORRUPT);
+    CHECK(s == NULL);
+    CHECK_NAMES(err, "materials.gdrc");
+    CHECK_NAMES(err, "'TXPX'");
 }
 
 static void test_import_and_cache(void)

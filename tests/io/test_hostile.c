@@ -84,28 +84,33 @@ static char *triangle_gltf(const float *positions, uint32_t vertices)
 static void test_huge_coordinates(void)
 {
     gdr_scene *s = obj_text("v 0x1p127 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\n", NULL);
-    CHECK(!s && strstr(err.message, "hostile.obj:1: v: '0x1p127' is beyond the 1e+12 limit"));
+    CHECK(!s);
+    CHECK_STATUS(err, GDR_ERROR_PARSE);
+    CHECK_NAMES(err, "hostile.obj:1: v: '0x1p127'");
     s = obj_text("v 1e19 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\n", NULL);
-    CHECK(!s && strstr(err.message, "hostile.obj:1:"));
+    CHECK(!s);
+    CHECK_STATUS(err, GDR_ERROR_PARSE);
+    CHECK_NAMES(err, "hostile.obj:1:");
     const float values[] = {1e19f, 1e20f, -3e38f};
     for (int k = 0; k < 3; k++) {
         float p[9] = {values[k], 0, 0, 0, 1, 0, 0, 0, 1};
         char *text = triangle_gltf(p, 3);
         s = gltf_text(text, NULL);
         free(text);
-        CHECK(!s && strstr(err.message, "meshes[0].primitives[0].attributes.POSITION: vertex 0"));
+        CHECK(!s);
+        CHECK_STATUS(err, GDR_ERROR_PARSE);
+        CHECK_NAMES(err, "meshes[0].primitives[0].attributes.POSITION: vertex 0");
     }
     /* The same numbers handed to the library directly (a cache, an application). */
     gdr_vec3 p[3] = {{1e19f, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     uint32_t idx[3] = {0, 1, 2};
     gdr_scene *scene = NULL;
     CHECK(gdr_scene_create(&scene, &err) == GDR_OK);
-    CHECK(gdr_scene_add_mesh(scene, "huge", p, NULL, NULL, 3, idx, 3, NULL, &err) != GDR_OK &&
-          strstr(err.message, "limit on coordinates"));
+    CHECK_FAILS(gdr_scene_add_mesh(scene, "huge", p, NULL, NULL, 3, idx, 3, NULL, &err), err,
+                GDR_ERROR_INVALID_ARGUMENT);
     gdr_mesh mesh = {.vertex_count = 3, .positions = p, .index_count = 3, .indices = idx};
     gdr_mesh_clusters clusters = {0};
-    CHECK(gdr_meshlets_build(&mesh, NULL, &clusters, &err) == GDR_ERROR_INVALID_ARGUMENT &&
-          strstr(err.message, "limit on coordinates"));
+    CHECK_FAILS(gdr_meshlets_build(&mesh, NULL, &clusters, &err), err, GDR_ERROR_INVALID_ARGUMENT);
     gdr_scene_destroy(scene);
     /* 1e11 is allowed and builds meshlets. */
     s = obj_text("v 1e11 0 0\nv 0 1e11 0\nv 0 0 1e11\nf 1 2 3\n", NULL);
@@ -213,15 +218,10 @@ static void test_uri_confinement(void)
     snprintf(path, sizeof path, "%s/link.bin", scene_dir);
     unlink(path);
     CHECK(symlink(secret, path) == 0);
-    struct { const char *uri; const char *message; } cases[] = {
-        {"../outside/secret.bin", "leaves the scene's folder"},
-        {"%2e%2e/outside/secret.bin", "leaves the scene's folder"},
-        {"sub/../../outside/secret.bin", "leaves the scene's folder"},
-        {"link.bin", "resolves outside the scene's folder"},
-        {"/etc/passwd", "leaves the scene's folder"},
-        {"%2fetc%2fpasswd", "leaves the scene's folder"},
-        {"sub/inside.bin", NULL},
-        {"sub/./inside.bin", NULL},
+    struct { const char *uri; bool refused; } cases[] = {
+        {"../outside/secret.bin", true}, {"%2e%2e/outside/secret.bin", true}, {"sub/../../outside/secret.bin", true},
+        {"link.bin", true},              {"/etc/passwd", true},               {"%2fetc%2fpasswd", true},
+        {"sub/inside.bin", false},       {"sub/./inside.bin", false},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         char text[1024], file[1200];
@@ -234,10 +234,10 @@ static void test_uri_confinement(void)
         snprintf(file, sizeof file, "%s/t.gltf", scene_dir);
         CHECK(test_write_file(file, text, strlen(text)));
         gdr_scene *s = gltf_file(file, NULL, 0);
-        if (cases[i].message) {
-            CHECK(!s && strstr(err.message, cases[i].message) && strstr(err.message, "buffers[0].uri"));
-            if (s || !strstr(err.message, cases[i].message))
-                fprintf(stderr, "  uri %s: %s\n", cases[i].uri, err.message);
+        if (cases[i].refused) {
+            CHECK(!s);
+            CHECK_STATUS(err, GDR_ERROR_OUTSIDE_FOLDER);
+            CHECK_NAMES(err, "buffers[0].uri");
             CHECK(!strstr(err.message, "root:")); /* no byte of /etc/passwd in the message */
             if (strcmp(cases[i].uri, "/etc/passwd") != 0 && strcmp(cases[i].uri, "%2fetc%2fpasswd") != 0) {
                 gdr_scene_destroy(s);
@@ -252,13 +252,13 @@ static void test_uri_confinement(void)
 }
 
 /* URIs that name no file: called so (both were "resolves outside the scene's folder (a symbolic
- * link)"). */
+ * link)"): no file at all is malformed, the scene's folder is not a file. */
 static void test_uri_messages(void)
 {
-    struct { const char *uri; const char *message; } cases[] = {
-        {"", "buffers[0].uri: empty: it names no file"},
-        {".", "buffers[0].uri: '.' names the scene's folder, not a file"},
-        {"./", "buffers[0].uri: './' names the scene's folder, not a file"},
+    struct { const char *uri; gdr_status status; } cases[] = {
+        {"", GDR_ERROR_PARSE},
+        {".", GDR_ERROR_NOT_A_FILE},
+        {"./", GDR_ERROR_NOT_A_FILE},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         char text[1024], file[1200];
@@ -271,9 +271,9 @@ static void test_uri_messages(void)
         snprintf(file, sizeof file, "%s/scene/t.gltf", dir);
         CHECK(test_write_file(file, text, strlen(text)));
         gdr_scene *s = gltf_file(file, NULL, 0);
-        CHECK(!s && strstr(err.message, cases[i].message) && !strstr(err.message, "symbolic link"));
-        if (s || !strstr(err.message, cases[i].message))
-            fprintf(stderr, "  uri '%s': %s\n", cases[i].uri, s ? "accepted" : err.message);
+        CHECK(!s);
+        CHECK_STATUS(err, cases[i].status);
+        CHECK_NAMES(err, "buffers[0].uri");
         gdr_scene_destroy(s);
     }
 }
@@ -302,8 +302,10 @@ static void test_fifo(void)
     snprintf(file, sizeof file, "%s/scene/t.gltf", dir);
     CHECK(test_write_file(file, text, strlen(text)));
     gdr_scene *s = gltf_file(file, NULL, 0);
-    CHECK(!s && strstr(err.message, "not a regular file"));
-    CHECK(gdr_cache_read(fifo, NULL, &s, NULL, &err) != GDR_OK && strstr(err.message, "not a regular file"));
+    CHECK(!s);
+    CHECK_STATUS(err, GDR_ERROR_NOT_A_FILE);
+    CHECK_NAMES(err, "fifo.bin");
+    CHECK_FAILS(gdr_cache_read(fifo, NULL, &s, NULL, &err), err, GDR_ERROR_NOT_A_FILE);
     /* A cache whose source list names the FIFO (with another mtime: its contents would be read). */
     char cache[1200];
     snprintf(cache, sizeof cache, "%s/fifo_list.gdrc", dir);
@@ -498,12 +500,16 @@ static void test_texture_pixels(void)
     char *text = textured_gltf(1, 16384);
     gdr_scene *s = gltf_text(text, NULL);
     free(text);
-    CHECK(!s && err.status == GDR_ERROR_CAPACITY && strstr(err.message, "images[0]") &&
-          strstr(err.message, "268435456 texture pixels") && strstr(err.message, "--budget pixels=N"));
+    CHECK(!s);
+    CHECK_STATUS(err, GDR_ERROR_BUDGET);
+    CHECK_NAMES(err, "images[0]");
+    CHECK_NAMES(err, "--budget pixels=N"); /* how to raise it, as docs/SECURITY.md promises */
     /* Two 8192^2 images fill the default budget; the third is refused. */
     text = textured_gltf(3, 8192);
     s = gltf_text(text, NULL);
-    CHECK(!s && strstr(err.message, "images[2]") && strstr(err.message, "134217728 before it"));
+    CHECK(!s);
+    CHECK_STATUS(err, GDR_ERROR_BUDGET);
+    CHECK_NAMES(err, "images[2]");
     /* Raised, they pass the budget (and, being headers only, are left out with a warning). */
     gdr_budget raised = {.texture_pixels = 3ull << 26};
     s = gltf_text(text, &raised);
@@ -519,8 +525,9 @@ static void test_texture_pixels(void)
     char cache[1200];
     snprintf(cache, sizeof cache, "%s/wide.gdrc", dir);
     unlink(cache);
-    CHECK(gdr_cache_write(cache, s, NULL, &err) == GDR_ERROR_CAPACITY && strstr(err.message, "32769x1") &&
-          access(cache, F_OK) != 0);
+    CHECK_FAILS(gdr_cache_write(cache, s, NULL, &err), err, GDR_ERROR_CAPACITY);
+    CHECK_NAMES(err, "texture 0");
+    CHECK(access(cache, F_OK) != 0);
     s->textures[0].width = 32768;
     free(row);
     gdr_scene_destroy(s);
@@ -539,8 +546,10 @@ static void test_instance_budget(void)
         "\"EXT_mesh_gpu_instancing\":{\"attributes\":{\"TRANSLATION\":1}}}}],\"scenes\":[{\"nodes\":[0]}]}";
     snprintf(text, sizeof text, format, 16777216u);
     gdr_scene *s = gltf_text(text, NULL);
-    CHECK(!s && err.status == GDR_ERROR_CAPACITY && strstr(err.message, "16777216 instances") &&
-          strstr(err.message, "EXT_mesh_gpu_instancing") && strstr(err.message, "--budget instances=N"));
+    CHECK(!s);
+    CHECK_STATUS(err, GDR_ERROR_BUDGET);
+    CHECK_NAMES(err, "EXT_mesh_gpu_instancing");
+    CHECK_NAMES(err, "--budget instances=N");
     gdr_budget small = {.instances = 100};
     snprintf(text, sizeof text, format, 100u);
     s = gltf_text(text, &small);
@@ -548,7 +557,8 @@ static void test_instance_budget(void)
     gdr_scene_destroy(s);
     snprintf(text, sizeof text, format, 101u);
     s = gltf_text(text, &small);
-    CHECK(!s && strstr(err.message, "101 instances"));
+    CHECK(!s);
+    CHECK_STATUS(err, GDR_ERROR_BUDGET);
 }
 
 /* Triangles and decoded bytes: refused before the memory is allocated. */
@@ -556,7 +566,10 @@ static void test_other_budgets(void)
 {
     gdr_budget small = {.triangles = 2};
     gdr_scene *s = obj_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\nf 1 2 4 3\n", &small);
-    CHECK(!s && strstr(err.message, "hostile.obj:7:") && strstr(err.message, "--budget triangles=N"));
+    CHECK(!s);
+    CHECK_STATUS(err, GDR_ERROR_BUDGET);
+    CHECK_NAMES(err, "hostile.obj:7:");
+    CHECK_NAMES(err, "--budget triangles=N");
     float p[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
     char *text = triangle_gltf(p, 3);
     gdr_budget one = {.triangles = 1}, bytes = {.decoded_bytes = 16};
@@ -565,8 +578,10 @@ static void test_other_budgets(void)
     gdr_scene_destroy(s);
     s = gltf_text(text, &bytes);
     free(text);
-    CHECK(!s && strstr(err.message, "buffers[0]") && strstr(err.message, "decoded bytes") &&
-          strstr(err.message, "--budget bytes=N"));
+    CHECK(!s);
+    CHECK_STATUS(err, GDR_ERROR_BUDGET);
+    CHECK_NAMES(err, "buffers[0]");
+    CHECK_NAMES(err, "--budget bytes=N");
 }
 
 /* Messages that say what is wrong. */
@@ -576,13 +591,15 @@ static void test_messages(void)
     for (int i = 0; i < 1100; i++)
         strcat(text, "[");
     gdr_scene *s = gltf_text(text, NULL);
-    CHECK(!s && strstr(err.message, "JSON nested deeper than 1000 arrays and objects"));
+    CHECK(!s);
+    CHECK_STATUS(err, GDR_ERROR_PARSE);
+    CHECK_NAMES(err, "JSON nested deeper than 1000 arrays and objects"); /* the wording is what is tested */
     uint8_t png[64];
     size_t n = png_header(png, 4, 4);
     uint8_t *rgba = NULL;
     uint32_t w, h;
-    CHECK(gdr_image_decode(png, n, "cut.png", &rgba, &w, &h, &err) != GDR_OK &&
-          strstr(err.message, "cut.png: PNG: the file ends before its IEND chunk (truncated)"));
+    CHECK_FAILS(gdr_image_decode(png, n, "cut.png", &rgba, &w, &h, &err), err, GDR_ERROR_PARSE);
+    CHECK_NAMES(err, "cut.png: PNG: the file ends before its IEND chunk (truncated)");
     free(rgba);
 }
 
@@ -623,9 +640,10 @@ static void test_material_values(void)
                                         "materials[0]: emissive factor"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         gdr_scene *s = material_gltf(bad[i]);
-        CHECK(!s && strstr(err.message, "t.gltf") && strstr(err.message, where[i]));
-        if (s || !strstr(err.message, where[i]))
-            printf("material %zu: %s\n", i, s ? "accepted" : err.message);
+        CHECK(!s);
+        CHECK_STATUS(err, GDR_ERROR_PARSE);
+        CHECK_NAMES(err, "t.gltf");
+        CHECK_NAMES(err, where[i]);
         gdr_scene_destroy(s);
     }
     gdr_scene *s = material_gltf("{\"pbrMetallicRoughness\":{\"metallicFactor\":0.25}}");
@@ -633,14 +651,19 @@ static void test_material_values(void)
     /* Through the API, and a material poked into the scene's array: the writer refuses it. */
     gdr_material m = gdr_material_default();
     m.roughness_factor = 1.0f / 0.0f;
-    CHECK(s && gdr_scene_add_material(s, &m, NULL, &err) != GDR_OK && strstr(err.message, "roughness factor"));
+    CHECK(s);
+    if (s)
+        CHECK_FAILS(gdr_scene_add_material(s, &m, NULL, &err), err, GDR_ERROR_INVALID_ARGUMENT);
     char cache[1200];
     snprintf(cache, sizeof cache, "%s/inf_material.gdrc", dir);
     unlink(cache);
     if (s)
         s->materials[0].occlusion_strength = 1.0f / 0.0f;
-    CHECK(s && gdr_cache_write(cache, s, NULL, &err) != GDR_OK && strstr(err.message, "occlusion strength") &&
-          access(cache, F_OK) != 0);
+    if (s) {
+        CHECK_FAILS(gdr_cache_write(cache, s, NULL, &err), err, GDR_ERROR_INVALID_ARGUMENT);
+        CHECK_NAMES(err, "material 0");
+    }
+    CHECK(access(cache, F_OK) != 0);
     gdr_scene_destroy(s);
 }
 
@@ -700,7 +723,7 @@ static void test_output_targets(void)
     if (mknod(null_device, S_IFCHR | 0666, makedev(1, 3)) == 0 && mknod(full_device, S_IFCHR | 0666, makedev(1, 7)) == 0) {
         CHECK(gdr_write_file_atomic(null_device, "x", 1, &err) == GDR_OK);
         CHECK(stat(null_device, &st) == 0 && S_ISCHR(st.st_mode));
-        CHECK(gdr_write_file_atomic(full_device, "x", 1, &err) == GDR_ERROR_IO && strstr(err.message, "space"));
+        CHECK_FAILS(gdr_write_file_atomic(full_device, "x", 1, &err), err, GDR_ERROR_IO);
         CHECK(stat(full_device, &st) == 0 && S_ISCHR(st.st_mode));
     } else {
         printf("devices: not root, written to /dev/stdout only\n");
@@ -715,13 +738,13 @@ static void test_output_targets(void)
     unlink(null_device), unlink(full_device), unlink(stdout_link);
     CHECK(mkfifo(fifo, 0600) == 0);
     alarm(20);
-    CHECK(gdr_write_file_atomic(fifo, "x", 1, &err) == GDR_ERROR_IO && strstr(err.message, "no reader"));
+    CHECK_FAILS(gdr_write_file_atomic(fifo, "x", 1, &err), err, GDR_ERROR_IO);
     alarm(0);
     CHECK(stat(fifo, &st) == 0 && S_ISFIFO(st.st_mode));
-    CHECK(gdr_write_file_atomic(dir, "x", 1, &err) == GDR_ERROR_IO && strstr(err.message, "is a directory"));
+    CHECK_FAILS(gdr_write_file_atomic(dir, "x", 1, &err), err, GDR_ERROR_NOT_A_FILE);
     unlink(link);
     CHECK(symlink("/nonexistent/dir/file", link) == 0);
-    CHECK(gdr_write_file_atomic(link, "x", 1, &err) == GDR_ERROR_IO && strstr(err.message, "symbolic link"));
+    CHECK_FAILS(gdr_write_file_atomic(link, "x", 1, &err), err, GDR_ERROR_IO);
     unlink(target), unlink(link), unlink(fifo);
 }
 
@@ -744,13 +767,17 @@ static void test_world_extent(void)
                  scales[k], scales[k], node + strlen("{\"mesh\":0}"));
         free(text);
         s = gltf_text(edited, NULL);
-        CHECK(!s && strstr(err.message, "t.gltf: nodes[0]") && strstr(err.message, "limit on coordinates"));
+        CHECK(!s);
+        CHECK_STATUS(err, GDR_ERROR_PARSE);
+        CHECK_NAMES(err, "t.gltf: nodes[0]");
         gdr_scene_destroy(s);
     }
     s = obj_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", NULL);
     gdr_instance far = {.transform = gdr_mat4_from_trs((gdr_vec3){1e13f, 0, 0}, gdr_quat_identity(), (gdr_vec3){1, 1, 1}), .mesh = 0,
                         .material = GDR_NO_INDEX, .color = {1, 1, 1, 1}};
-    CHECK(s && gdr_scene_add_instance(s, &far, &err) != GDR_OK && strstr(err.message, "limit on coordinates"));
+    CHECK(s);
+    if (s)
+        CHECK_FAILS(gdr_scene_add_instance(s, &far, &err), err, GDR_ERROR_INVALID_ARGUMENT);
     far.transform = gdr_mat4_from_trs((gdr_vec3){1e11f, 0, 0}, gdr_quat_identity(), (gdr_vec3){1, 1, 1});
     CHECK(s && gdr_scene_add_instance(s, &far, &err) == GDR_OK);
     gdr_scene_destroy(s);

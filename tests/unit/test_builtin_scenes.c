@@ -221,11 +221,10 @@ static void test_lod_field_bad(void)
         CHECK(gdr_scene_create_lod_field(&bad_descs[i], &scene, &err) == GDR_ERROR_INVALID_ARGUMENT);
         CHECK(strncmp(err.message, "lod-field: ", 11) == 0);
     }
-    CHECK(strstr(err.message, "instances") != NULL);
     CHECK(scene == NULL);
     /* Unknown-option messages list the known ones. */
-    CHECK(gdr_scene_load("lod-field:size=3", NULL, &scene, &err) != GDR_OK);
-    CHECK(strstr(err.message, "instances, seed, triangles, spacing") != NULL);
+    CHECK_FAILS(gdr_scene_load("lod-field:size=3", NULL, &scene, &err), err, GDR_ERROR_INVALID_ARGUMENT);
+    CHECK_NAMES(err, "instances, seed, triangles, spacing");
 }
 
 /* --- occlusion -------------------------------------------------------------------------------- */
@@ -498,9 +497,9 @@ static void test_occlusion_defaults_and_bad(void)
     scene = NULL;
     CHECK(gdr_scene_create_occlusion(&(gdr_occlusion_scene_desc){.hidden = 2000000}, &scene, &err) ==
           GDR_ERROR_INVALID_ARGUMENT);
-    CHECK(scene == NULL && strstr(err.message, "hidden") != NULL);
-    CHECK(gdr_scene_load("occlusion:size=3", NULL, &scene, &err) != GDR_OK);
-    CHECK(strstr(err.message, "seed, hidden, visible") != NULL);
+    CHECK(scene == NULL);
+    CHECK_FAILS(gdr_scene_load("occlusion:size=3", NULL, &scene, &err), err, GDR_ERROR_INVALID_ARGUMENT);
+    CHECK_NAMES(err, "seed, hidden, visible");
 }
 
 /* --- unique-field ------------------------------------------------------------------------------ */
