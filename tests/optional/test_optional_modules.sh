@@ -6,8 +6,10 @@
 #   - CMake refuses a module that is not optional, and tests with modules left out, naming why;
 #   - libgdr.so leaves no gdr_ symbol undefined and defines every GDR_API function of the headers
 #     it installs; gdr/cull.h and gdr/present.h are not installed, gdr/config.h says 0 for both, and
-#     examples/render_demo.c compiles against the installed tree (gdr/gdr.h without them);
-#   - gdr renders demo:instances=10 with the mesh pipeline to a PNG, render_demo runs;
+#     examples/render_demo.c and lean_api.c compile against the installed tree (gdr/gdr.h without
+#     them);
+#   - gdr renders demo:instances=10 with the mesh pipeline to a PNG, render_demo runs, and lean_api
+#     checks the library's answers without the culling module (lean_api.c says which);
 #   - --pipeline cpu, --pvs on, build --pvs, bench --pipelines cpu and gdr view exit 2 with the
 #     message, and no view_demo target exists;
 #   - with FULL_GDR (a gdr program with every module): the lean build renders the demo as the full
@@ -72,9 +74,13 @@ nm -D --defined-only "$lib" | awk '{print $3}' | sort -u >"$work/defined"
 missing=$(comm -23 "$work/declared" "$work/defined")
 [ -z "$missing" ] || fail "declared in the installed headers, not in libgdr.so: $missing"
 pc=$(dirname "$(find "$prefix" -name gdr.pc | head -n 1)")
-# shellcheck disable=SC2046
-cc -std=c17 -Wall -Wextra -Werror "$source/examples/render_demo.c" $(PKG_CONFIG_PATH=$pc pkg-config --cflags --libs gdr) \
-    -o "$work/render_demo_installed" 2>"$work/stderr" || fail "render_demo.c against the installed headers: $(cat "$work/stderr")"
+flags=$(PKG_CONFIG_PATH=$pc pkg-config --cflags --libs gdr)
+libdir=$(PKG_CONFIG_PATH=$pc pkg-config --variable=libdir gdr)
+for program in "$source/examples/render_demo.c" "$source/tests/optional/lean_api.c"; do
+    # shellcheck disable=SC2086
+    cc -std=c17 -Wall -Wextra -Werror "$program" $flags -Wl,-rpath,"$libdir" -o "$work/$(basename "$program" .c)" \
+        2>"$work/stderr" || fail "$(basename "$program") against the installed headers: $(cat "$work/stderr")"
+done
 
 # --- the program and the example ---------------------------------------------------------------
 gdr=$build/tools/gdr/gdr
@@ -86,7 +92,7 @@ expect 0 "render mesh" "$gdr" render demo:instances=10 --pipeline mesh $small --
 visible=$(sed -n 's/^[[:space:]]*"instances_visible":[[:space:]]*\([0-9]*\),$/\1/p' "$work/lean.json")
 [ "${visible:-0}" -gt 0 ] || fail "nothing drawn: instances_visible '$visible'"
 grep -q '"pvs":[[:space:]]*"none"' "$work/lean.json" || fail "the statistics do not say pvs none"
-expect 0 "render_demo" "$build/examples/render_demo" "$work/render_demo.png"
+expect 0 "render_demo" "$work/render_demo" "$work/render_demo.png"
 [ -s "$work/render_demo.png" ] || fail "render_demo wrote no image"
 
 # shellcheck disable=SC2086
@@ -122,6 +128,13 @@ if [ -n "$full" ]; then
     expect 0 "full info of the rebuilt cache" "$full" info "$work/rebuilt.gdrc"
     grep -q '^pvs: *none$' "$work/stdout" || fail "the lean build wrote a PVS: $(grep pvs "$work/stdout")"
 fi
+
+# The library's own answers, through the API (a cache with a PVS when the full build made one).
+pvs_cache=
+[ -s "$work/pvs.gdrc" ] && pvs_cache=$work/pvs.gdrc
+# shellcheck disable=SC2086
+expect 0 "lean_api" "$work/lean_api" "$work" $pvs_cache
+cat "$work/stderr"
 
 if [ "$failures" != 0 ]; then
     echo "test_optional_modules: $failures failure(s)"
