@@ -2,10 +2,11 @@
 BUILD_DIR ?= build
 ASAN_DIR ?= build-asan
 RELEASE_DIR ?= build-release
+OPTIONAL_DIR ?= build-optional
 JOBS ?= $(shell nproc)
 PREFIX ?= /usr/local
 
-.PHONY: all deps build demo check test test-asan build-release test-release build-release-clang pipeline-doc architecture-doc install clean
+.PHONY: all deps build demo check test test-asan build-release test-release build-release-clang test-optional pipeline-doc architecture-doc install clean
 
 all: build
 
@@ -22,8 +23,9 @@ demo: build
 
 # The whole suite: every test on lavapipe with validation on, then the unit tests and the GPU paths
 # (test_gpu_sanitized) under ASan+UBSan, then the Release configuration users build, compiled, and
-# its unit tests (-O3 vectorises what -O0 does not: a cluster sphere short by an ulp hid there).
-check: build test test-asan build-release test-release
+# its unit tests (-O3 vectorises what -O0 does not: a cluster sphere short by an ulp hid there),
+# then a build without the optional modules.
+check: build test test-asan build-release test-release test-optional
 
 test:
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
@@ -55,8 +57,14 @@ build-release-clang: deps
 	CC=clang cmake -S . -B $(RELEASE_DIR)-clang -DCMAKE_BUILD_TYPE=Release -DGDR_WERROR=ON -DGDR_BUILD_FUZZ=OFF
 	cmake --build $(RELEASE_DIR)-clang -j $(JOBS)
 
+# The library and the program built without the optional modules (cull, present) in a tree of their
+# own, linked, installed and run beside the full build's program (docs/ARCHITECTURE.md, "Optional
+# modules"): only the library, gdr and render_demo are built, so it adds well under a minute.
+test-optional: build
+	JOBS=$(JOBS) ./tests/optional/test_optional_modules.sh . $(OPTIONAL_DIR) $(BUILD_DIR)/tools/gdr/gdr
+
 install: build
 	cmake --install $(BUILD_DIR)
 
 clean:
-	rm -rf $(BUILD_DIR) $(ASAN_DIR) $(RELEASE_DIR) $(RELEASE_DIR)-clang
+	rm -rf $(BUILD_DIR) $(ASAN_DIR) $(RELEASE_DIR) $(RELEASE_DIR)-clang $(OPTIONAL_DIR)

@@ -41,7 +41,7 @@ allowed() {
 module_of_include() {
     case $1 in
     gdr/gdr.h) echo umbrella ;;
-    gdr/core.h | gdr/thread_pool.h) echo core ;;
+    gdr/core.h | gdr/thread_pool.h | gdr/config.h) echo core ;;
     gdr/math.h) echo math ;;
     gdr/scene.h | gdr/mesh_clusters.h) echo scene ;;
     gdr/geometry.h) echo geometry ;;

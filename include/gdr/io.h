@@ -41,7 +41,8 @@ GDR_API void gdr_source_list_free(gdr_source_list *list);
 /* Precomputed visibility (include/gdr/cull.h): baked offline for a scene's instances (object i =
  * instance i), it is stored in the cache next to the scene, not in gdr_scene (which stays plain
  * arrays with no culling dependency). Write it with gdr_cache_write (options->pvs), get it back with
- * gdr_scene_load (gdr_load_options.pvs). */
+ * gdr_scene_load (gdr_load_options.pvs). A library without the culling module (gdr/config.h:
+ * GDR_HAVE_CULL 0) neither reads nor writes one: a cache's section is skipped and no PVS returned. */
 typedef struct gdr_pvs gdr_pvs;
 
 /* --- Options shared by every loader ------------------------------------------------------ */
@@ -86,7 +87,8 @@ typedef struct gdr_load_options {
                                 any other scene is refused */
     gdr_pvs **pvs;           /* non-NULL: receives the precomputed visibility of the cache the scene
                                 was read from (gdr_pvs_destroy frees it), or NULL when there is none
-                                (a built-in scene, an import, a cache without one) */
+                                (a built-in scene, an import, a cache without one, a library
+                                without the culling module) */
     gdr_source_list *sources; /* non-NULL: receives every file an import read (the source, its
                                 buffers and images), for gdr_cache_write; empty when the scene came
                                 from a cache or is built in. Free it with gdr_source_list_free */
@@ -117,7 +119,8 @@ typedef struct gdr_cache_write_options {
     const gdr_pvs *pvs;      /* NULL: no precomputed visibility. Otherwise its serialised form in the
                                 optional section 'PVIS'; it must have been baked for this scene
                                 (gdr_pvs_object_count(pvs) == scene->instance_count), else
-                                GDR_ERROR_INVALID_ARGUMENT and nothing is written */
+                                GDR_ERROR_INVALID_ARGUMENT and nothing is written (a library
+                                without the culling module: GDR_ERROR_UNSUPPORTED) */
     uint32_t page_bytes;     /* 0: no geometry pages. Otherwise the optional section 'PAGE' holds every
                                 mesh's LOD DAG groups in pages filled to this many raw bytes, in
                                 [GDR_PAGE_BYTES_MIN, GDR_PAGE_BYTES_MAX] (gdr/paged_cache.h;

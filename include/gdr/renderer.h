@@ -56,7 +56,9 @@ typedef enum gdr_pipeline {
     GDR_PIPELINE_MESH,        /* compute instance cull -> task shader meshlet cull -> mesh shader */
     GDR_PIPELINE_INDIRECT,    /* compute instance cull -> one vkCmdDrawIndexedIndirectCount (seed 003) */
     GDR_PIPELINE_CPU,         /* CPU-driven baseline: gdr/cull.h on the CPU, then one vkCmdDrawIndexed
-                                 with its own binds per visible instance (seed 003's "before") */
+                                 with its own binds per visible instance (seed 003's "before"); a
+                                 library without the culling module (GDR_HAVE_CULL 0) refuses it
+                                 with GDR_ERROR_UNSUPPORTED */
 } gdr_pipeline;
 
 /* What the image shows. */
@@ -140,8 +142,9 @@ typedef struct gdr_frame_desc {
     const gdr_camera *cull_camera;
     /* Precomputed visibility (gdr_renderer_set_pvs; docs/CULLING.md): instances that the baked cell
      * holding the culling camera does not list are not drawn, in every pipeline, when cull is on.
-     * DEFAULT: on when the renderer holds a PVS; ON without one is an error; OFF: not used. A camera
-     * in no baked cell culls nothing by it. */
+     * DEFAULT: on when the renderer holds a PVS; ON without one is an error (GDR_ERROR_UNSUPPORTED
+     * in a library without the culling module); OFF: not used. A camera in no baked cell culls
+     * nothing by it. */
     gdr_cull_mode pvs;
 } gdr_frame_desc;
 
@@ -341,7 +344,9 @@ GDR_API gdr_status gdr_renderer_set_scene(gdr_renderer *renderer, const gdr_scen
  * gdr_renderer_update_instance since the scene was set are never culled by it. The renderer keeps
  * the pointer: `pvs` must stay alive until the renderer is destroyed or another call replaces it;
  * NULL removes it. Fails (and keeps the PVS it held) without a scene, or when the PVS's object
- * count is not the scene's instance count. */
+ * count is not the scene's instance count. A library without the culling module (gdr/config.h:
+ * GDR_HAVE_CULL 0) can make no PVS and holds none: NULL succeeds, anything else fails with
+ * GDR_ERROR_UNSUPPORTED. */
 GDR_API gdr_status gdr_renderer_set_pvs(gdr_renderer *renderer, const gdr_pvs *pvs, gdr_error *err);
 
 /* Streaming (docs/STREAMING.md): the clusters' vertices and triangles live in a page pool of fixed

@@ -12,7 +12,6 @@
 #include <unistd.h>
 
 #include "core/output_file.h"
-#include "gdr/cull.h"
 #include "io/cache_internal.h"
 #include "io/io_internal.h"
 

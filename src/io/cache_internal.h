@@ -9,7 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "gdr/cull.h"
 #include "gdr/io.h"
 
 #define CACHE_MAGIC "GDRCACHE"

@@ -9,6 +9,7 @@
 #include "gdr/geometry.h"
 #include "io/cache_internal.h"
 #include "io/cache_pages.h"
+#include "io/cache_pvs.h"
 #include "io/io_internal.h"
 
 #if !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
@@ -841,48 +842,12 @@ static gdr_status read_cameras(cache_read_state *st, reader *ca, gdr_error *err)
     return status;
 }
 
-/* --- PVIS (optional): the precomputed-visibility blob --------------------------------------------- */
+/* --- PVIS (optional): the precomputed-visibility blob (cache_pvs.h) ------------------------------ */
 
-static int has_pvs(const cache_write_input *in) { return in->pvs != NULL; }
-
-static gdr_status check_pvs_objects(const cache_write_input *in, const char *path, gdr_error *err)
-{
-    if (gdr_pvs_object_count(in->pvs) == in->scene->instance_count)
-        return GDR_OK;
-    return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
-                         "%s: the precomputed visibility was baked for %u objects, the scene has %u instances", path,
-                         gdr_pvs_object_count(in->pvs), in->scene->instance_count);
-}
-
-static void write_pvs(writer *w, const cache_write_input *in)
-{
-    size_t size = gdr_pvs_serialized_size(in->pvs);
-    uint8_t *blob = put_space(w, size);
-    if (blob && gdr_pvs_serialize(in->pvs, blob, size, NULL) != GDR_OK)
-        w->failed = 1;
-}
-
-/* gdr_pvs_load checks all of the blob, baked for this scene's instances. Checked whether or not the
- * caller wants it (out_pvs may be NULL), like every section. */
+/* Checked whether or not the caller wants it (out_pvs may be NULL), like every section. */
 static gdr_status read_pvs(cache_read_state *st, reader *r, gdr_error *err)
 {
-    gdr_pvs *pvs = NULL;
-    gdr_error pvs_err = {0};
-    gdr_status status = gdr_pvs_load(r->data, r->size, &pvs, &pvs_err);
-    if (status != GDR_OK)
-        return gdr_error_set(err, status, "%s: section 'PVIS' (%zu bytes at offset %zu): %s", st->name, r->size,
-                             (size_t)(r->data - st->file), pvs_err.message);
-    if (gdr_pvs_object_count(pvs) != st->scene->instance_count) {
-        status = gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'PVIS': baked for %u objects, the scene has %u "
-                               "instances", st->name, gdr_pvs_object_count(pvs), st->scene->instance_count);
-        gdr_pvs_destroy(pvs);
-        return status;
-    }
-    if (st->out_pvs)
-        *st->out_pvs = pvs;
-    else
-        gdr_pvs_destroy(pvs);
-    return GDR_OK;
+    return cache_pvs_read(st->name, r, (size_t)(r->data - st->file), st->scene->instance_count, st->out_pvs, err);
 }
 
 /* --- PAGE: the geometry in pages, for reading on demand (cache_pages.c, paged_cache.c) --------- */
@@ -946,7 +911,8 @@ const cache_section gdr_cache_sections[CACHE_SECTION_COUNT] = {
     [CACHE_INSTANCES] = {FOURCC('I', 'N', 'S', 'T'), REQUIRED, 0, NULL, NULL, write_instances, read_instances, 0},
     [CACHE_CAMERAS] = {FOURCC('C', 'A', 'M', 'R'), REQUIRED, 0, NULL, NULL, write_cameras, read_cameras, 0},
     /* optional: readers that predate it skip it */
-    [CACHE_PVS] = {FOURCC('P', 'V', 'I', 'S'), 0, 1, has_pvs, check_pvs_objects, write_pvs, read_pvs, 0},
+    [CACHE_PVS] = {FOURCC('P', 'V', 'I', 'S'), 0, 1, cache_pvs_present, cache_pvs_check, cache_pvs_write, read_pvs,
+                   0},
     [CACHE_PAGES] = {FOURCC('P', 'A', 'G', 'E'), 0, 1, has_pages, check_page_bytes, write_pages, read_pages, 1},
 };
 #undef REQUIRED
@@ -961,7 +927,7 @@ gdr_status gdr_cache_read_sections(const char *name, cache_view *v, int paged, g
             status = gdr_cache_sections[k].read(&st, &v->sections[k], err);
     if (status != GDR_OK) {
         if (out_pvs && *out_pvs) {
-            gdr_pvs_destroy(*out_pvs);
+            cache_pvs_destroy(*out_pvs);
             *out_pvs = NULL;
         }
         gdr_scene_destroy(st.scene);

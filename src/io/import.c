@@ -9,8 +9,8 @@
 #include <unistd.h>
 
 #include "gdr/io.h"
-#include "gdr/cull.h"
 #include "gdr/geometry.h"
+#include "io/cache_pvs.h"
 #include "io/io_internal.h"
 #include "io/loaders.h"
 
@@ -90,7 +90,7 @@ static gdr_status finish_cache_read(const char *path, gdr_scene **out, gdr_pvs *
     if (status == GDR_OK && out_pvs)
         *out_pvs = pvs;
     else
-        gdr_pvs_destroy(pvs);
+        cache_pvs_destroy(pvs);
     return status;
 }
 

@@ -4,7 +4,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "gdr/cull.h"
 #include "render/renderer_internal.h"
 
 static int compare_double(const void *a, const void *b)
@@ -149,7 +148,7 @@ void gdr_frame_stats_fill(gdr_renderer *r, gdr_pipeline pipeline, const char *re
     stats->pvs = (gdr_pvs_stats){
         .enabled = last_slot->pvs_enabled, .cell_found = last_slot->pvs_cell_found,
         .instances_culled = pipeline == GDR_PIPELINE_CPU ? last_slot->cpu_pvs_culled : gpu.instances_pvs_culled,
-        .cells = r->pvs.pvs ? gdr_pvs_cell_count(r->pvs.pvs) : 0, .cpu_ms_per_frame = r->pvs.cpu_ms / frames};
+        .cells = gdr_render_pvs_cells(r), .cpu_ms_per_frame = r->pvs.cpu_ms / frames};
     fill_timings(r, frame_cpu_ms, frames, submit_ms, recorded, stats);
     fill_memory(r, &stats->memory);
     snprintf(stats->device, sizeof stats->device, "%s", r->ctx->properties.deviceName);

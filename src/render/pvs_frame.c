@@ -92,6 +92,8 @@ bool gdr_render_pvs_is_moved(const gdr_renderer *r, uint32_t instance)
     return r->pvs.moved && (r->pvs.moved[instance / 32] >> (instance % 32) & 1u);
 }
 
+uint32_t gdr_render_pvs_cells(const gdr_renderer *r) { return r->pvs.pvs ? gdr_pvs_cell_count(r->pvs.pvs) : 0; }
+
 void gdr_render_pvs_destroy(gdr_renderer *r)
 {
     gdr_pvs_cache_destroy(r->pvs.cache);

@@ -318,6 +318,10 @@ static gdr_status check_frame(gdr_renderer *r, const gdr_frame_desc *frame, uint
             return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: clip_plane must be finite");
     if ((unsigned)frame->pvs > GDR_CULL_OFF)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: unknown pvs mode %d", (int)frame->pvs);
+    /* A build without the culling module (gdr/config.h) has neither the CPU pipeline nor a PVS. */
+    if (!GDR_HAVE_CULL && (frame->pipeline == GDR_PIPELINE_CPU || frame->pvs == GDR_CULL_ON))
+        return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "render: %s: built without the culling module "
+                             "(GDR_EXCLUDE_MODULES)", frame->pipeline == GDR_PIPELINE_CPU ? "pipeline cpu" : "pvs on");
     if (frame->pvs == GDR_CULL_ON && !r->pvs.pvs)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: pvs on, but the renderer holds no precomputed "
                              "visibility (gdr_renderer_set_pvs; gdr build --pvs writes it into a scene's cache)");

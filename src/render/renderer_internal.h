@@ -264,9 +264,9 @@ void gdr_frame_set_viewport(gdr_renderer *r, VkCommandBuffer cmd, bool flip_y);
 /* What every frame pipeline expects bound: the push constants and the depth pyramid (set 0). */
 void gdr_frame_bind_state(gdr_renderer *r, gdr_frame_slot *slot, VkCommandBuffer cmd);
 
-/* Precomputed visibility (pvs_frame.c): the moved-instance bits for a scene being set, the frame's
- * decision and the cell's bits in the slot's buffer (before its globals are written), an instance
- * that moved, and the end. */
+/* Precomputed visibility (pvs_frame.c; cull_absent.c in a build without the culling module): the
+ * moved-instance bits for a scene being set, the frame's decision and the cell's bits in the slot's
+ * buffer (before its globals are written), an instance that moved, and the end. */
 gdr_status gdr_render_pvs_scene(gdr_renderer *r, gdr_error *err);
 /* Whether a frame culls by the PVS: one is held and neither culling nor the PVS is switched off. */
 bool gdr_render_pvs_wanted(const gdr_renderer *r, const gdr_frame_desc *frame);
@@ -275,8 +275,10 @@ void gdr_render_pvs_begin_frame(gdr_renderer *r, gdr_frame_slot *slot, const gdr
 void gdr_render_pvs_moved(gdr_renderer *r, uint32_t instance);
 bool gdr_render_pvs_is_moved(const gdr_renderer *r, uint32_t instance);
 void gdr_render_pvs_destroy(gdr_renderer *r);
+/* The baked cells of the PVS held (0: none). */
+uint32_t gdr_render_pvs_cells(const gdr_renderer *r);
 
-/* CPU pipeline (cpu_driven.c). */
+/* CPU pipeline (cpu_driven.c; cull_absent.c in a build without the culling module). */
 gdr_status gdr_cpu_path_create(gdr_renderer *r, const gdr_scene *scene, gdr_error *err);
 void gdr_cpu_path_destroy(gdr_renderer *r);
 /* Instance `index` has moved: refresh its culling bounds. */

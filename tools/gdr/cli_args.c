@@ -124,8 +124,20 @@ bool cli_parse_pipeline(const char *option, const char *text, gdr_pipeline *out)
     int index;
     if (!cli_parse_choice(option, text, names, 3, &index))
         return false;
+    char what[96];
+    snprintf(what, sizeof what, "%s cpu", option);
+    if (values[index] == GDR_PIPELINE_CPU && !cli_needs_cull(what))
+        return false;
     *out = values[index];
     return true;
+}
+
+bool cli_needs_cull(const char *what)
+{
+    if (GDR_HAVE_CULL)
+        return true;
+    fprintf(stderr, "gdr: %s: built without the culling module (GDR_EXCLUDE_MODULES)\n", what);
+    return false;
 }
 
 bool cli_parse_raster(const char *option, const char *text, gdr_raster *out)

@@ -16,7 +16,7 @@ bool cli_parse_float(const char *option, const char *text, float min, float max,
 bool cli_parse_on_off(const char *option, const char *text, bool *out);
 /* One of names[0 .. count): *out is its index. */
 bool cli_parse_choice(const char *option, const char *text, const char *const *names, int count, int *out);
-/* --pipeline mesh|indirect|cpu */
+/* --pipeline mesh|indirect|cpu (cpu: only with the culling module) */
 bool cli_parse_pipeline(const char *option, const char *text, gdr_pipeline *out);
 /* --raster hybrid|hw|sw|forward */
 bool cli_parse_raster(const char *option, const char *text, gdr_raster *out);
@@ -27,6 +27,9 @@ bool cli_parse_floats(const char *text, int count, float *out);
 /* --budget "triangles=N,instances=N,pixels=N,bytes=N" (any of them, each a positive integer): the
  * limits on what one untrusted file may make gdr allocate (docs/SECURITY.md). */
 bool cli_parse_budget(const char *option, const char *text, gdr_budget *out);
+/* Whether the library holds the culling module (gdr/config.h), which `what` (an option) needs; if
+ * not, prints "gdr: WHAT: built without the culling module (GDR_EXCLUDE_MODULES)" and returns false. */
+bool cli_needs_cull(const char *what);
 /* Prints "gdr: MESSAGE" for a scene that did not load and returns the exit status: 2 (bad usage)
  * for a built-in scene's options out of range, 1 otherwise. */
 int cli_load_failed(const char *spec, const gdr_error *err);

@@ -4,13 +4,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "gdr/geometry.h"
 #include "cli_args.h"
+#include "cli_pvs.h"
 #include "commands.h"
-#include "gdr/thread_pool.h"
-#include "gdr/cull.h"
 #include "gdr/io.h"
 #include "gdr/paged_cache.h"
 
@@ -47,31 +45,6 @@ static gdr_status quantize(gdr_scene *scene, gdr_error *err)
     return status;
 }
 
-/* The bake (docs/CULLING.md) on a pool of every processor; 0: the default cell size and samples. */
-static gdr_status bake_pvs(const gdr_scene *scene, float cell_size, uint32_t samples, gdr_pvs **out, gdr_error *err)
-{
-    gdr_thread_pool *pool = NULL;
-    gdr_status status = gdr_thread_pool_create(0, &pool, err);
-    if (status != GDR_OK)
-        return status;
-    struct timespec t0, t1;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
-    gdr_pvs_bake_desc desc = {.scene = scene, .pool = pool, .cell_size = cell_size, .samples_per_cell = samples};
-    gdr_pvs_bake_report report;
-    status = gdr_pvs_bake(&desc, out, &report, err);
-    clock_gettime(CLOCK_MONOTONIC, &t1);
-    if (status == GDR_OK)
-        printf("pvs: %ux%ux%u cells, %u baked (%u touched by geometry), %u objects, %llu samples, %zu bytes "
-               "compressed from %zu, %.0f ms on %u threads\n",
-               report.grid[0], report.grid[1], report.grid[2], report.cells_baked, report.cells_occupied,
-               gdr_pvs_object_count(*out), (unsigned long long)report.samples_used, report.compressed_bytes,
-               report.uncompressed_bytes,
-               (double)(t1.tv_sec - t0.tv_sec) * 1e3 + (double)(t1.tv_nsec - t0.tv_nsec) * 1e-6,
-               gdr_thread_pool_thread_count(pool));
-    gdr_thread_pool_destroy(pool);
-    return status;
-}
-
 int gdr_cmd_build(int argc, char **argv)
 {
     const char *input = NULL, *output = NULL;
@@ -85,14 +58,16 @@ int gdr_cmd_build(int argc, char **argv)
         } else if (strcmp(argv[i], "--no-progress") == 0) {
             no_progress = 1;
         } else if (strcmp(argv[i], "--pvs") == 0) {
+            if (!cli_needs_cull(argv[i]))
+                return 2;
             pvs_wanted = 1;
         } else if (strcmp(argv[i], "--pvs-cell") == 0 && i + 1 < argc) {
-            if (!cli_parse_float(argv[i], argv[i + 1], 0.01f, 1e6f, &pvs_cell))
+            if (!cli_needs_cull(argv[i]) || !cli_parse_float(argv[i], argv[i + 1], 0.01f, 1e6f, &pvs_cell))
                 return 2;
             pvs_wanted = 1;
             i++;
         } else if (strcmp(argv[i], "--pvs-samples") == 0 && i + 1 < argc) {
-            if (!cli_parse_u32(argv[i], argv[i + 1], 1, 4096, &pvs_samples))
+            if (!cli_needs_cull(argv[i]) || !cli_parse_u32(argv[i], argv[i + 1], 1, 4096, &pvs_samples))
                 return 2;
             pvs_wanted = 1;
             i++;
@@ -140,14 +115,13 @@ int gdr_cmd_build(int argc, char **argv)
                              .allow_outside_files = allow_outside_files, .pvs = &pvs, .sources = &sources};
     status = gdr_scene_load(input, &load, &scene, &err);
     if (status == GDR_OK && pvs && !pvs_wanted)
-        printf("pvs: kept from %s (%u cells, %u objects)\n", input, gdr_pvs_cell_count(pvs),
-               gdr_pvs_object_count(pvs));
+        cli_pvs_print_kept(input, pvs);
     if (status == GDR_OK && page_bytes)
         status = quantize(scene, &err);
     if (status == GDR_OK && pvs_wanted) {
-        gdr_pvs_destroy(pvs);
+        cli_pvs_destroy(pvs);
         pvs = NULL;
-        status = bake_pvs(scene, pvs_cell, pvs_samples, &pvs, &err); /* before writing: a failed bake leaves no file */
+        status = cli_pvs_bake(scene, pvs_cell, pvs_samples, &pvs, &err); /* before writing: a failed bake leaves no file */
     }
     if (status == GDR_OK) {
         gdr_cache_write_options write = {.source = {gdr_cache_build_options(), &sources}, .pvs = pvs,
@@ -159,7 +133,7 @@ int gdr_cmd_build(int argc, char **argv)
                scene->mesh_count, scene->instance_count, (unsigned long long)gdr_scene_triangle_count(scene),
                scene->material_count, scene->texture_count, scene->camera_count);
     int result = status == GDR_OK ? 0 : cli_load_failed(input, &err);
-    gdr_pvs_destroy(pvs);
+    cli_pvs_destroy(pvs);
     gdr_source_list_free(&sources);
     gdr_scene_destroy(scene);
     return result;

@@ -6,7 +6,7 @@
 
 #include "cli_args.h"
 #include "commands.h"
-#include "gdr/cull.h"
+#include "cli_pvs.h"
 #include "gdr/io.h"
 #include "gdr/paged_cache.h"
 #include "gdr/renderer.h"
@@ -138,17 +138,13 @@ int gdr_cmd_info(int argc, char **argv)
     printf("cameras:     %u\n", scene->camera_count);
     printf("extensions:  %s\n", scene->extensions ? scene->extensions : "(none)");
     print_quantization(scene);
-    if (pvs)
-        printf("pvs:         %u cells, %u objects (%zu bytes)\n", gdr_pvs_cell_count(pvs), gdr_pvs_object_count(pvs),
-               gdr_pvs_serialized_size(pvs));
-    else
-        printf("pvs:         none\n");
+    cli_pvs_print_info(pvs);
     size_t length = strlen(input);
     if (length > 5 && strcmp(input + length - 5, ".gdrc") == 0)
         print_cache_bytes(input, unique_triangles);
     if (warnings)
         printf("warnings:    %u\n", warnings);
-    gdr_pvs_destroy(pvs);
+    cli_pvs_destroy(pvs);
     gdr_scene_destroy(scene);
     return 0;
 }

@@ -5,7 +5,7 @@
 
 #include "cli_args.h"
 #include "commands.h"
-#include "gdr/cull.h"
+#include "cli_pvs.h"
 #include "gdr/gdr.h"
 #include "gdr/io.h"
 #include "camera_path.h"
@@ -85,7 +85,7 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
             ok = o->occlusion_given = cli_parse_on_off(arg, value, &o->occlusion);
         else if (strcmp(arg, "--pvs") == 0) {
             bool on = false;
-            ok = cli_parse_on_off(arg, value, &on);
+            ok = cli_parse_on_off(arg, value, &on) && (!on || cli_needs_cull("--pvs on"));
             o->pvs = on ? GDR_CULL_ON : GDR_CULL_OFF;
         }
         else if (strcmp(arg, "--lod-hierarchy") == 0)
@@ -297,7 +297,7 @@ done:
     free(pixels);
     gdr_renderer_destroy(renderer);
     gdr_paged_cache_close(paged);
-    gdr_pvs_destroy(pvs);
+    cli_pvs_destroy(pvs);
     gdr_scene_destroy(scene);
     return result;
 }

@@ -20,14 +20,15 @@ static void next_view(view_settings *s)
     snprintf(s->message, sizeof s->message, "view %s", gdr_view_name(s->frame.view));
 }
 
-/* mesh (where the device has it) -> indirect -> cpu -> ...; raster modes are the mesh pipeline's. */
+/* mesh (where the device has it) -> indirect -> cpu (where the library has the culling module) -> ...;
+ * raster modes are the mesh pipeline's. */
 static void next_pipeline(view_settings *s)
 {
     gdr_pipeline p = s->frame.pipeline;
     if (p == GDR_PIPELINE_DEFAULT)
         p = s->has_mesh_pipeline ? GDR_PIPELINE_MESH : GDR_PIPELINE_INDIRECT;
     p = p == GDR_PIPELINE_MESH ? GDR_PIPELINE_INDIRECT
-        : p == GDR_PIPELINE_INDIRECT ? GDR_PIPELINE_CPU
+        : p == GDR_PIPELINE_INDIRECT && GDR_HAVE_CULL ? GDR_PIPELINE_CPU
         : s->has_mesh_pipeline ? GDR_PIPELINE_MESH : GDR_PIPELINE_INDIRECT;
     s->frame.pipeline = p;
     if (p != GDR_PIPELINE_MESH)
