@@ -54,6 +54,13 @@ for pipeline in mesh indirect cpu; do
         fail "$pipeline: the printout lacks the pvs line"
     echo "$pipeline: $off instances drawn without the pvs, $on with it ($culled removed), the same image"
 done
+# gdr bench culls with the cache's PVS too (on, as gdr render by default): its row draws what
+# gdr render --pvs on draws from the same camera, fewer than with the PVS off.
+expect 0 "bench of the cache" "$gdr" bench --scene "$work/rooms.gdrc" --pipelines mesh --frames 2 \
+    --width 96 --height 64 --validate --json "$work/bench.json"
+bench_drawn=$(sed -n 's/^[[:space:]]*"instances_visible":[[:space:]]*\([0-9]*\),\{0,1\}$/\1/p' "$work/bench.json" | head -n 1)
+[ "$bench_drawn" = "$(value instances_visible "$work/mesh-on.json")" ] ||
+    fail "bench drew ${bench_drawn:-?} instances, gdr render with the pvs $(value instances_visible "$work/mesh-on.json")"
 # By default the pvs is on when the cache has one, none otherwise.
 # shellcheck disable=SC2086
 expect 0 "render, pvs by default" "$gdr" render "$work/rooms.gdrc" $small --pipeline indirect --stats "$work/default.json"

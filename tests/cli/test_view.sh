@@ -163,6 +163,22 @@ for args in "" "demo --out x.png" "demo --max-fps 0" "demo --overlay maybe" "dem
     [ "$status" = 2 ] && [ -s "$work/err" ] || fail "gdr view $args: exit $status, expected 2 with a message"
 done
 
+# A cache's precomputed visibility: the viewer culls with it as gdr render does (the same first
+# frame), and --pvs on for a scene without one is refused before a window opens.
+"$gdr" build "rooms:rooms=4,objects=6" -o "$work/rooms.gdrc" --pvs-cell 1 --pvs-samples 1 --no-progress >/dev/null ||
+    fail "build of the rooms scene with a pvs"
+# shellcheck disable=SC2086
+"$gdr" view "$work/rooms.gdrc" $size --pvs on --frames 2 --overlay off --screenshot "$work/rooms-view.png" \
+    --validate >/dev/null 2>"$work/err" || { fail "view with the cache's pvs"; cat "$work/err"; }
+# shellcheck disable=SC2086
+"$gdr" render "$work/rooms.gdrc" $size --pvs on --out "$work/rooms-render.png" >/dev/null 2>&1 ||
+    fail "render with the cache's pvs"
+cmp -s "$work/rooms-view.png" "$work/rooms-render.png" || fail "view with the pvs drew another image than render"
+"$gdr" view demo:instances=4 --pvs on --frames 1 >/dev/null 2>"$work/err"
+status=$?
+[ "$status" = 2 ] && grep -q 'holds no precomputed visibility' "$work/err" ||
+    fail "view --pvs on without a pvs: exit $status, expected 2 with a message"
+
 # 4. No display, no presenting driver: a message and a non-zero exit; gdr render is unaffected.
 env -u DISPLAY -u WAYLAND_DISPLAY "$gdr" view $scene --frames 1 >/dev/null 2>"$work/err" && fail "view without a display"
 [ -s "$work/err" ] || fail "view without a display said nothing"

@@ -8,6 +8,7 @@
 
 #include "bench_plot.h"
 #include "cli_args.h"
+#include "cli_pvs.h"
 #include "commands.h"
 #include "stats_output.h"
 #include "gdr/gdr.h"
@@ -183,12 +184,15 @@ int gdr_cmd_bench(int argc, char **argv)
         gdr_demo_desc demo = {.instances = sizes[s]};
         gdr_renderer_desc desc = {.width = width, .height = height, .device = device, .validate = validate,
                                   .busy_wait = true, .record_every_frame = record_every_frame};
-        gdr_status loaded = scene_spec ? gdr_scene_load(scene_spec, NULL, &scene, &err) : gdr_scene_create_demo(&demo, &scene, &err);
+        gdr_pvs *pvs = NULL; /* a cache's precomputed visibility culls as in gdr render (on by default) */
+        gdr_load_options load = {.pvs = &pvs};
+        gdr_status loaded = scene_spec ? gdr_scene_load(scene_spec, &load, &scene, &err) : gdr_scene_create_demo(&demo, &scene, &err);
         if (loaded != GDR_OK) {
             result = cli_load_failed(scene_spec ? scene_spec : "demo", &err);
         } else if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK) {
             result = cli_renderer_failed(&err); /* 2 for a --device the machine does not have */
-        } else if (gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK) {
+        } else if (gdr_renderer_set_scene(renderer, scene, &err) != GDR_OK ||
+                   gdr_renderer_set_pvs(renderer, pvs, &err) != GDR_OK) {
             fprintf(stderr, "gdr: %s\n", err.message);
             result = 1;
         }
@@ -262,6 +266,7 @@ int gdr_cmd_bench(int argc, char **argv)
                 result = 3;
         }
         gdr_renderer_destroy(renderer);
+        cli_pvs_destroy(pvs);
         gdr_scene_destroy(scene);
     }
     char *json = cJSON_Print(rows);

@@ -10,6 +10,7 @@
 #include "gdr/io.h"
 #include "camera_path.h"
 #include "cli_args.h"
+#include "cli_pvs.h"
 #include "commands.h"
 #include "gdr/present.h"
 #include "render_options.h"
@@ -139,7 +140,7 @@ static int fail(const char *what, const gdr_error *err)
 
 /* The window, the renderer with the window system's instance extensions, the surface and the
  * presenter. Returns 0 or the exit status. */
-static int open_window(view_app *app, const gdr_scene *scene)
+static int open_window(view_app *app, const gdr_scene *scene, const gdr_pvs *pvs)
 {
     glfwSetErrorCallback(on_glfw_error);
     if (!glfwInit()) {
@@ -172,7 +173,8 @@ static int open_window(view_app *app, const gdr_scene *scene)
                               .instance_extension_count = extension_count, .presentable = true};
     if (gdr_renderer_create(&desc, &app->renderer, &err) != GDR_OK)
         return cli_renderer_failed(&err); /* 2 for a --device the machine does not have */
-    if (gdr_renderer_set_scene(app->renderer, scene, &err) != GDR_OK)
+    if (gdr_renderer_set_scene(app->renderer, scene, &err) != GDR_OK ||
+        gdr_renderer_set_pvs(app->renderer, pvs, &err) != GDR_OK) /* the cache's PVS culls as in gdr render */
         return fail("", &err);
     VkResult made = glfwCreateWindowSurface(gdr_renderer_vulkan(app->renderer).instance, app->window, NULL,
                                             &app->surface);
@@ -383,11 +385,18 @@ int gdr_cmd_view(int argc, char **argv)
     view_app app = {.o = &o, .v = &v};
     gdr_error err = {0};
     gdr_scene *scene = NULL;
+    gdr_pvs *pvs = NULL;
     if (o.camera_path && camera_path_read(o.camera_path, &app.replay, &err) != GDR_OK)
         return fail("--camera-path: ", &err);
+    o.load.pvs = &pvs;
     if (gdr_scene_load(o.scene, &o.load, &scene, &err) != GDR_OK) {
         camera_path_free(&app.replay);
         return cli_load_failed(o.scene, &err);
+    }
+    if (o.pvs == GDR_CULL_ON && !pvs) {
+        fprintf(stderr, "gdr view: --pvs on: %s holds no precomputed visibility (write it with gdr build %s -o "
+                "FILE.gdrc --pvs)\n", o.scene, o.scene);
+        result = 2;
     }
     if (o.has_camera_index && o.camera_index >= scene->camera_count) {
         fprintf(stderr, "gdr view: --camera-index %u: the scene has %u camera(s)\n", o.camera_index,
@@ -395,12 +404,13 @@ int gdr_cmd_view(int argc, char **argv)
         result = 2;
     }
     if (result == 0)
-        result = open_window(&app, scene);
+        result = open_window(&app, scene, pvs);
     if (result == 0) {
         start_settings(&app, scene);
         result = finish(&app, run_loop(&app));
     }
     close_window(&app);
+    cli_pvs_destroy(pvs); /* after the renderer that held it */
     gdr_scene_destroy(scene);
     camera_path_free(&app.replay);
     camera_path_free(&app.recorded);
