@@ -164,7 +164,7 @@ int main(int argc, char **argv)
     /* The open: the cache without the geometry its pages hold. */
     uint64_t open_bytes = 0;
     double t_open = now_ms();
-    if (gdr_cache_read_for_streaming(path, NULL, &scene, &open_bytes, &err) != GDR_OK) {
+    if (gdr_cache_read_for_streaming(path, NULL, &scene, NULL, &open_bytes, &err) != GDR_OK) {
         fprintf(stderr, "stream_bench: %s\n", err.message);
         return 1;
     }

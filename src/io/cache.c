@@ -602,9 +602,11 @@ gdr_status gdr_io_cache_read_for(const char *path, const char *source, const cha
 }
 
 gdr_status gdr_cache_read_for_streaming(const char *path, const char *build_options, gdr_scene **out,
-                                        uint64_t *out_bytes_read, gdr_error *err)
+                                        gdr_pvs **out_pvs, uint64_t *out_bytes_read, gdr_error *err)
 {
     *out = NULL;
+    if (out_pvs)
+        *out_pvs = NULL;
     if (out_bytes_read)
         *out_bytes_read = 0;
     container_source src = {.name = path, .paged = 1};
@@ -625,7 +627,7 @@ gdr_status gdr_cache_read_for_streaming(const char *path, const char *build_opti
     if (status == GDR_OK)
         status = check_fresh(path, &v, build_options, NULL, err);
     if (status == GDR_OK)
-        status = gdr_cache_read_sections(path, &v, 1, out, NULL, err);
+        status = gdr_cache_read_sections(path, &v, 1, out, out_pvs, err);
     close(src.fd);
     source_free(&src);
     if (out_bytes_read)

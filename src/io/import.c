@@ -109,7 +109,7 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
         if (!gdr_io_has_extension(path, ".gdrc"))
             return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: streaming reads a .gdrc cache with geometry "
                                  "pages (gdr build SCENE -o FILE.gdrc --pages), not a source file", path);
-        return gdr_cache_read_for_streaming(path, build_options, out, NULL, err);
+        return gdr_cache_read_for_streaming(path, build_options, out, out_pvs, NULL, err);
     }
     if (gdr_io_has_extension(path, ".gdrc")) {
         gdr_status status = gdr_cache_read(path, build_options, out, out_pvs ? &pvs : NULL, err);

@@ -63,9 +63,10 @@ gdr_status gdr_cache_read(const char *path, const char *build_options, gdr_scene
  * pages). The scene has every mesh's counts, bounds, cluster and group records and LOD hierarchy,
  * the materials, textures, instances and cameras, and scene->geometry_in_pages set: its meshes hold
  * no vertex or index arrays. Staleness as in gdr_cache_read. A cache without pages is refused
- * (GDR_ERROR_INVALID_ARGUMENT). out_bytes_read (may be NULL): the bytes read from the file. */
+ * (GDR_ERROR_INVALID_ARGUMENT). out_pvs as in gdr_cache_read (the 'PVIS' section is read too).
+ * out_bytes_read (may be NULL): the bytes read from the file. */
 gdr_status gdr_cache_read_for_streaming(const char *path, const char *build_options, gdr_scene **out,
-                                                uint64_t *out_bytes_read, gdr_error *err);
+                                        gdr_pvs **out_pvs, uint64_t *out_bytes_read, gdr_error *err);
 
 /* Parses a cache from memory without any staleness check (the fuzz target uses this); out_pvs as
  * in gdr_cache_read. */

@@ -61,6 +61,16 @@ expect 0 "bench of the cache" "$gdr" bench --scene "$work/rooms.gdrc" --pipeline
 bench_drawn=$(sed -n 's/^[[:space:]]*"instances_visible":[[:space:]]*\([0-9]*\),\{0,1\}$/\1/p' "$work/bench.json" | head -n 1)
 [ "$bench_drawn" = "$(value instances_visible "$work/mesh-on.json")" ] ||
     fail "bench drew ${bench_drawn:-?} instances, gdr render with the pvs $(value instances_visible "$work/mesh-on.json")"
+# A streamed render reads the cache's PVS too (gdr build keeps it when it adds pages): the same
+# image with it on and off once the pages are in, instances removed only with it on.
+expect 0 "pages added to the cache" "$gdr" build "$work/rooms.gdrc" -o "$work/paged.gdrc" --pages --no-progress
+for pvs in on off; do
+    # shellcheck disable=SC2086
+    expect 0 "streamed render, pvs $pvs" "$gdr" render "$work/paged.gdrc" $small --geometry-budget 64 --frames 30 \
+        --pvs "$pvs" --out "$work/streamed-$pvs.png" --stats "$work/streamed-$pvs.json"
+done
+cmp -s "$work/streamed-on.png" "$work/streamed-off.png" || fail "streamed: the image differs with the pvs on"
+[ "$(value instances_pvs_culled "$work/streamed-on.json")" -gt 0 ] 2>/dev/null || fail "streamed: the pvs removed nothing"
 # By default the pvs is on when the cache has one, none otherwise.
 # shellcheck disable=SC2086
 expect 0 "render, pvs by default" "$gdr" render "$work/rooms.gdrc" $small --pipeline indirect --stats "$work/default.json"

@@ -116,7 +116,7 @@ static void read_for_streaming(const uint8_t *data, size_t size, const gdr_scene
     snprintf(path, sizeof path, "/proc/self/fd/%d", fd);
     gdr_scene *paged = NULL;
     gdr_error err;
-    if (write(fd, data, size) == (ssize_t)size && gdr_cache_read_for_streaming(path, NULL, &paged, NULL, &err) == GDR_OK) {
+    if (write(fd, data, size) == (ssize_t)size && gdr_cache_read_for_streaming(path, NULL, &paged, NULL, NULL, &err) == GDR_OK) {
         if (!paged->geometry_in_pages)
             __builtin_trap();
         for (uint32_t m = 0; whole && m < whole->mesh_count; m++) {

@@ -400,7 +400,7 @@ static gdr_scene *read_for_streaming(const char *path)
         file_size = (uint64_t)ftell(f);
     if (f)
         fclose(f);
-    CHECK(gdr_cache_read_for_streaming(path, NULL, &paged, &bytes_read, &err) == GDR_OK && paged &&
+    CHECK(gdr_cache_read_for_streaming(path, NULL, &paged, NULL, &bytes_read, &err) == GDR_OK && paged &&
           paged->geometry_in_pages && paged->meshes[0].positions == NULL && paged->meshes[0].clusters.triangles == NULL);
     printf("read for streaming: %llu of the file's %llu bytes\n", (unsigned long long)bytes_read,
            (unsigned long long)file_size);

@@ -105,7 +105,7 @@ static void run_scene(const char *spec)
     gdr_cache_write_options write = {.page_bytes = GDR_PAGE_BYTES_MIN};
     CHECK(gdr_scene_load(spec, &load, &scene, &err) == GDR_OK && gdr_scene_quantize_vertices(scene, &err) == GDR_OK &&
           gdr_cache_write(path, scene, &write, &err) == GDR_OK &&
-          gdr_cache_read_for_streaming(path, NULL, &paged, NULL, &err) == GDR_OK);
+          gdr_cache_read_for_streaming(path, NULL, &paged, NULL, NULL, &err) == GDR_OK);
     gdr_renderer *whole = scene ? gpu_test_renderer(WIDTH, HEIGHT, scene) : NULL;
     gdr_renderer *r = paged ? streamed(paged, path) : NULL;
     uint8_t *a = malloc(WIDTH * HEIGHT * 4), *b = malloc(WIDTH * HEIGHT * 4);

@@ -193,7 +193,7 @@ static gdr_status render_frames(gdr_renderer *renderer, gdr_frame_desc *frame, c
 static bool streamed(const render_options *o) { return o->geometry_budget_mib || o->upload_budget_mib; }
 
 /* A streamed scene is read from its cache without the geometry the pages hold. A file's cache may
- * hold the scene's precomputed visibility (*pvs, else NULL; not read for streaming). */
+ * hold the scene's precomputed visibility (*pvs, else NULL), streamed or not. */
 static gdr_status load_scene(render_options *o, gdr_scene **scene, gdr_pvs **pvs, gdr_error *err)
 {
     *pvs = NULL;
@@ -202,7 +202,7 @@ static gdr_status load_scene(render_options *o, gdr_scene **scene, gdr_pvs **pvs
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "--geometry-budget/--upload-budget stream from a cache: "
                              "give a .gdrc written with 'gdr build --pages' (not '%s')", o->scene);
     o->load.geometry_in_pages = streamed(o);
-    o->load.pvs = streamed(o) ? NULL : pvs;
+    o->load.pvs = pvs;
     return gdr_scene_load(o->scene, &o->load, scene, err);
 }
 
