@@ -9,6 +9,9 @@
 
 #include "gdr/cull.h"
 #include "render/renderer_internal.h"
+#include "render/cpu_driven.h"
+#include "render/frame.h"
+#include "render/pvs_frame.h"
 
 /* The bounds of a moved instance: the mesh sphere under its transform, as the GPU culls it. */
 static gdr_cull_object object_from_instance(const GdrGpuInstance *instance, const GdrGpuMesh *mesh)

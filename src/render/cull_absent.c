@@ -5,6 +5,8 @@
  * gdr_renderer_set_pvs accepts only NULL (nothing to hold), since nothing in this build can make a
  * gdr_pvs. */
 #include "render/renderer_internal.h"
+#include "render/cpu_driven.h"
+#include "render/pvs_frame.h"
 
 #define WITHOUT_CULL "built without the culling module (GDR_EXCLUDE_MODULES)"
 

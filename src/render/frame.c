@@ -4,6 +4,8 @@
 #include <string.h>
 
 #include "render/renderer_internal.h"
+#include "render/frame.h"
+#include "render/frame_record.h"
 
 void gdr_frame_matrices(const gdr_renderer *r, const gdr_camera *camera, gdr_mat4 *projection, gdr_mat4 *view)
 {

@@ -1,6 +1,7 @@
 /* The frame plans as Markdown: gdr info --passes, and docs/PIPELINE.md (a test keeps them equal). */
 #include <inttypes.h>
 
+#include "render/frame_record.h"
 #include "render/renderer_internal.h"
 
 const char *gdr_frame_section_name(gdr_frame_section section)

@@ -3,6 +3,7 @@
  * visibility buffer's passes record in visbuffer.c. */
 #include <assert.h>
 
+#include "render/frame_record.h"
 #include "render/renderer_internal.h"
 
 #define COMPUTE VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT

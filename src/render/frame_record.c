@@ -1,6 +1,9 @@
 /* The recording functions of the frame's passes (frame_passes.c lists them with their resources;
  * the barriers between them are derived and recorded by frame.c, not here). */
 #include "render/renderer_internal.h"
+#include "render/cpu_driven.h"
+#include "render/frame.h"
+#include "render/frame_record.h"
 
 static void bind_compute(gdr_renderer *r, VkCommandBuffer cmd, gdr_pipeline_id id)
 {

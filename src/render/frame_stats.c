@@ -5,6 +5,8 @@
 #include <string.h>
 
 #include "render/renderer_internal.h"
+#include "render/frame_stats.h"
+#include "render/pvs_frame.h"
 
 static int compare_double(const void *a, const void *b)
 {

@@ -6,6 +6,10 @@
 
 #include "gdr/geometry.h" /* gdr_lod_enclosing_sphere */
 #include "render/renderer_internal.h"
+#include "render/frame.h"
+#include "render/gpu_scene.h"
+#include "render/page_table.h"
+#include "render/streaming.h"
 
 static GdrGpuInstance gpu_instance_from(const gdr_scene *scene, const gdr_instance *instance)
 {

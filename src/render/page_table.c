@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "renderer_internal.h"
+#include "render/page_table.h"
 
 gdr_status gdr_page_table_create(gdr_renderer *r, const gdr_mesh_clusters *const *clusters, uint32_t mesh_count,
                                  gdr_error *err)

@@ -8,6 +8,7 @@
 
 #include "gdr/cull.h"
 #include "render/renderer_internal.h"
+#include "render/pvs_frame.h"
 
 gdr_status gdr_render_pvs_scene(gdr_renderer *r, gdr_error *err)
 {

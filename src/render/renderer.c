@@ -8,6 +8,13 @@
 #include "render/renderer_internal.h"
 #include "vk/vk_descriptors.h"
 #include "vk/vk_pipeline.h"
+#include "render/cpu_driven.h"
+#include "render/frame.h"
+#include "render/frame_stats.h"
+#include "render/gpu_scene.h"
+#include "render/pvs_frame.h"
+#include "render/streaming.h"
+#include "render/target_memory.h"
 
 double gdr_now_ms(void)
 {

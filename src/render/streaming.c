@@ -18,6 +18,8 @@
 #include "render/renderer_internal.h"
 #include "stream/page_loader.h"
 #include "stream/residency.h"
+#include "render/page_table.h"
+#include "render/streaming.h"
 
 /* What one frame copies: regions into the pool, the records and the node counts, words to fill in the
  * page table, all staged in the slot's staging buffer. */

@@ -7,6 +7,7 @@
 #include <sys/resource.h>
 
 #include "render/renderer_internal.h"
+#include "render/target_memory.h"
 
 /* Bytes per pixel of the targets a renderer makes: colour (RGBA8) 4, depth (D32) 4, the colour
  * read-back 4, the overdraw counts 4, the visibility buffer 8, and the depth pyramid (R32F at most

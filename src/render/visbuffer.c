@@ -7,6 +7,8 @@
 
 #include "render/renderer_internal.h"
 #include "vk/vk_pipeline.h"
+#include "render/frame.h"
+#include "render/frame_record.h"
 
 gdr_status gdr_visbuffer_create(gdr_renderer *r, bool disabled, gdr_error *err)
 {
