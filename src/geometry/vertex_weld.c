@@ -85,6 +85,26 @@ static size_t attribute_streams(const gdr_mesh *m, struct meshopt_Stream *stream
     return k;
 }
 
+/* remap[v]: the class of vertex v, the vertices bit-equal to it, classes numbered in the order of
+ * their first vertex. Returns the number of classes, 0 when out of memory. meshoptimizer numbers
+ * them in the order of an index buffer whose length is a multiple of 3: every vertex in order
+ * (used or not), the last repeated up to twice. */
+static uint32_t vertex_classes(const gdr_mesh *mesh, uint32_t *remap)
+{
+    uint32_t n = mesh->vertex_count;
+    size_t count = ((size_t)n + 2) / 3 * 3;
+    uint32_t *order = malloc(sizeof *order * count);
+    if (!order)
+        return 0;
+    for (size_t i = 0; i < count; i++)
+        order[i] = i < n ? (uint32_t)i : n - 1;
+    struct meshopt_Stream streams[4];
+    size_t stream_count = attribute_streams(mesh, streams);
+    size_t classes = meshopt_generateVertexRemapMulti(remap, order, count, n, streams, stream_count);
+    free(order);
+    return (uint32_t)classes;
+}
+
 gdr_status gdr_mesh_weld_vertices(gdr_mesh *mesh, uint32_t *welded, gdr_error *err)
 {
     if (welded)
@@ -100,11 +120,9 @@ gdr_status gdr_mesh_weld_vertices(gdr_mesh *mesh, uint32_t *welded, gdr_error *e
     status = GDR_OK;
     if (!count_uses(mesh, uses))
         goto done; /* a bad index: gdr_meshlets_build names it */
-    struct meshopt_Stream streams[4];
-    size_t stream_count = attribute_streams(mesh, streams);
-    /* No index buffer: every vertex, used or not, in vertex order. */
-    uint32_t classes = (uint32_t)meshopt_generateVertexRemapMulti(remap, NULL, n, n, streams, stream_count);
-    if (classes == n)
+    uint32_t classes = vertex_classes(mesh, remap);
+    status = classes ? GDR_OK : GDR_ERROR_OUT_OF_MEMORY;
+    if (classes == 0 || classes == n)
         goto done; /* already welded: untouched, bit for bit */
     copy_of_class = malloc(sizeof *copy_of_class * classes);
     copy_uses = malloc(sizeof *copy_uses * n);

@@ -190,6 +190,30 @@ static void test_fan_keeps_valence(void)
     gdr_scene_destroy(s);
 }
 
+/* Vertex counts that are not a multiple of 3 (meshoptimizer's remap wants a triangle list), and an
+ * unused vertex equal to a used one: a quad of two triangles, exploded, and a copy of its first
+ * vertex that no triangle uses (7 vertices) welds into the quad's 4. */
+static void test_odd_vertex_count(void)
+{
+    const gdr_vec3 p[7] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 0}, {0, 0, 0}};
+    const uint32_t idx[6] = {0, 1, 2, 3, 4, 5};
+    gdr_vec3 nn[7];
+    gdr_vec2 t[7];
+    for (int v = 0; v < 7; v++)
+        nn[v] = (gdr_vec3){0, 0, 1}, t[v] = (gdr_vec2){p[v].x, p[v].y};
+    gdr_scene *s = NULL;
+    gdr_error err = {0};
+    uint32_t mesh = 0;
+    check_ok(gdr_scene_create(&s, &err), &err, "scene");
+    check_ok(gdr_scene_add_mesh(s, "quad", p, nn, t, 7, idx, 6, &mesh, &err), &err, "quad");
+    corner *before = corners_of(&s->meshes[mesh]);
+    check_ok(gdr_scene_build_clusters(s, NULL, &err), &err, "clusters");
+    CHECK(s->meshes[mesh].vertex_count == 4);
+    CHECK(keeps_corners(&s->meshes[mesh], before));
+    free(before);
+    gdr_scene_destroy(s);
+}
+
 /* A mesh with no two equal vertices is left as it is: the same arrays, bit for bit. */
 static void test_welded_mesh_untouched(void)
 {
@@ -220,5 +244,6 @@ int main(void)
     test_hard_edged_cube();
     test_fan_keeps_valence();
     test_welded_mesh_untouched();
+    test_odd_vertex_count();
     return test_finish("test_vertex_weld");
 }
