@@ -45,9 +45,12 @@ GDR_API gdr_status gdr_meshlets_build(const gdr_mesh *mesh, const gdr_meshlet_op
 
 /* Builds the clusters of every mesh of `scene` whose clusters are empty and that has triangles
  * (options may be NULL), one mesh per task on a thread pool; the result does not depend on the
- * thread count. Each mesh built also has its vertices renumbered in the order its clusters first
- * use them (positions, normals, uvs, indices and cluster vertices together; the triangles and
- * their order are unchanged), for fetch locality. On failure the error names the first failing
+ * thread count. Each mesh built first has its vertices that are equal in every attribute, bit for
+ * bit (position, normal, uv, colour), made one vertex, at most 128 triangle corners each (a mesh
+ * with no two such vertices is left as it is; docs/GEOMETRY.md, "Welding equal vertices"), and
+ * afterwards its vertices renumbered in the order its clusters first use them (positions,
+ * normals, uvs, colours, indices and cluster vertices together; the triangles and their order are
+ * unchanged, every corner keeps its attributes), for fetch locality. On failure the error names the first failing
  * mesh ("meshes[3]: mesh 'rock': ...") and no mesh keeps clusters from this call. */
 GDR_API gdr_status gdr_scene_build_clusters(gdr_scene *scene, const gdr_meshlet_options *options, gdr_error *err);
 

@@ -10,6 +10,7 @@
 #include "gdr/thread_pool.h"
 #include "geometry/cluster_bounds.h"
 #include "geometry/meshlet_chunks.h"
+#include "geometry/vertex_weld.h"
 #include "gdr/geometry.h"
 #include "gdr/scene.h"
 
@@ -467,7 +468,8 @@ gdr_status gdr_meshlets_build(const gdr_mesh *mesh, const gdr_meshlet_options *o
  * in their old order), so that a cluster's vertices lie together in memory and a mesh shader
  * fetching them touches few cache lines. Triangles, their order and winding are unchanged.
  * Inside a cluster, meshoptimizer already lists the vertices in the order its triangles first use
- * them; reordering the triangles within a meshlet (meshopt_optimizeMeshlet) came after 0.18. */
+ * them; reordering the triangles within a meshlet (meshopt_optimizeMeshlet) came after 0.18.
+ * Vertex colours, where the mesh has them, move with their vertices. */
 static gdr_status reorder_vertices(gdr_mesh *mesh, gdr_error *err)
 {
     gdr_mesh_clusters *c = &mesh->clusters;
@@ -477,12 +479,14 @@ static gdr_status reorder_vertices(gdr_mesh *mesh, gdr_error *err)
     uint32_t *corners = malloc(corner_count * sizeof *corners), *remap = malloc(n * sizeof *remap);
     gdr_vec3 *positions = malloc(n * sizeof *positions), *normals = malloc(n * sizeof *normals);
     gdr_vec2 *uvs = malloc(n * sizeof *uvs);
-    if (!corners || !remap || !positions || !normals || !uvs) {
+    gdr_vec4 *colors = mesh->colors ? malloc(n * sizeof *colors) : NULL;
+    if (!corners || !remap || !positions || !normals || !uvs || (mesh->colors && !colors)) {
         free(corners);
         free(remap);
         free(positions);
         free(normals);
         free(uvs);
+        free(colors);
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "mesh '%s': out of memory reordering vertices",
                              mesh->name);
     }
@@ -500,6 +504,8 @@ static gdr_status reorder_vertices(gdr_mesh *mesh, gdr_error *err)
     meshopt_remapVertexBuffer(positions, mesh->positions, n, sizeof *positions, remap);
     meshopt_remapVertexBuffer(normals, mesh->normals, n, sizeof *normals, remap);
     meshopt_remapVertexBuffer(uvs, mesh->uvs, n, sizeof *uvs, remap);
+    if (colors)
+        meshopt_remapVertexBuffer(colors, mesh->colors, n, sizeof *colors, remap);
     meshopt_remapIndexBuffer(mesh->indices, mesh->indices, mesh->index_count, remap);
     for (uint32_t i = 0; i < c->vertex_count; i++)
         c->vertices[i] = remap[c->vertices[i]];
@@ -509,6 +515,10 @@ static gdr_status reorder_vertices(gdr_mesh *mesh, gdr_error *err)
     mesh->positions = positions;
     mesh->normals = normals;
     mesh->uvs = uvs;
+    if (colors) {
+        free(mesh->colors);
+        mesh->colors = colors;
+    }
     free(corners);
     free(remap);
     return GDR_OK;
@@ -534,7 +544,10 @@ static void build_task(void *user, uint32_t task_index, uint32_t worker_index)
     /* Meshes side by side, one thread each; a single mesh gets every thread. */
     gdr_meshlet_options o = *b->options;
     o.thread_count = b->mesh_threads;
-    gdr_status status = gdr_meshlets_build(mesh, &o, &mesh->clusters, &err);
+    /* Bit-equal vertices first, so that clusters fill and the DAG sees the shared edges. */
+    gdr_status status = gdr_mesh_weld_vertices(mesh, NULL, &err);
+    if (status == GDR_OK)
+        status = gdr_meshlets_build(mesh, &o, &mesh->clusters, &err);
     if (status == GDR_OK)
         status = reorder_vertices(mesh, &err);
     /* Keeping the lowest failing index per worker makes the reported error independent of the

@@ -8,6 +8,7 @@
 
 #include "gdr/geometry.h"
 #include "core/progress.h"
+#include "geometry/vertex_weld.h"
 #include "gdr/io.h"
 #include "io/loaders.h"
 
@@ -18,8 +19,10 @@
 
 /* Largest magnitude of a vertex coordinate an importer accepts (gdr/scene.h). */
 #define GDR_IO_MAX_COORDINATE GDR_MAX_COORDINATE
-/* A vertex used by more triangles than this is split into copies (gdr_io_split_shared_vertices). */
-#define GDR_IO_MAX_VERTEX_VALENCE 128u
+/* A vertex used by more triangles than this is split into copies (gdr_io_split_shared_vertices).
+ * The geometry builder's weld of equal vertices joins no more than this many uses, so that it
+ * never joins those copies again. */
+#define GDR_IO_MAX_VERTEX_VALENCE GDR_WELD_MAX_VERTEX_USES
 
 /* Opens a file for reading without blocking on a FIFO or a device: refuses anything that is not a
  * regular file ("not a regular file") before reading a byte. *out_fd is the descriptor (blocking
