@@ -105,6 +105,28 @@ size_t gdr_io_pread_exact(int fd, void *dst, size_t size, uint64_t offset)
     return done;
 }
 
+/* The `size` bytes of the open regular file `fd` (closed here) into a malloc'ed buffer with one NUL
+ * byte after them. */
+static gdr_status read_open_file(const char *path, int fd, size_t size, char **out, gdr_error *err)
+{
+    char *data = malloc(size + 1);
+    if (!data) {
+        close(fd);
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory reading %zu bytes", path, size);
+    }
+    size_t got = gdr_io_pread_exact(fd, data, size, 0);
+    int read_errno = errno;
+    close(fd);
+    if (got != size) {
+        free(data);
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: read %zu of %zu bytes%s%s", path, got, size,
+                             read_errno ? ": " : "", read_errno ? strerror(read_errno) : "");
+    }
+    data[size] = 0;
+    *out = data;
+    return GDR_OK;
+}
+
 gdr_status gdr_io_read_file(const char *path, uint8_t **out_data, size_t *out_size, gdr_source_list *sources,
                             gdr_error *err)
 {
@@ -114,41 +136,28 @@ gdr_status gdr_io_read_file(const char *path, uint8_t **out_data, size_t *out_si
     gdr_status opened = gdr_io_open_regular(path, &fd, err);
     if (opened != GDR_OK)
         return opened;
-    FILE *file = fdopen(fd, "rb");
-    if (!file) {
-        close(fd);
-        return gdr_error_set(err, GDR_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
-    }
     struct stat st;
-    if (fstat(fileno(file), &st) != 0 || !S_ISREG(st.st_mode)) {
-        fclose(file);
-        return gdr_error_set(err, GDR_ERROR_NOT_A_FILE, "%s: not a regular file", path);
+    if (fstat(fd, &st) != 0) {
+        close(fd);
+        return gdr_error_set(err, GDR_ERROR_IO, "%s: cannot stat: %s", path, strerror(errno));
     }
     if ((uint64_t)st.st_size > GDR_IO_MAX_FILE_SIZE) {
-        fclose(file);
+        close(fd);
         return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: %llu bytes is larger than the %llu byte limit",
                              path, (unsigned long long)st.st_size, (unsigned long long)GDR_IO_MAX_FILE_SIZE);
     }
     size_t size = (size_t)st.st_size;
-    uint8_t *data = malloc(size + 1);
-    if (!data) {
-        fclose(file);
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory reading %zu bytes", path, size);
-    }
-    size_t got = size ? fread(data, 1, size, file) : 0;
-    int failed = ferror(file);
-    fclose(file);
-    if (got != size || failed) {
-        free(data);
-        return gdr_error_set(err, GDR_ERROR_IO, "%s: read %zu of %zu bytes", path, got, size);
-    }
-    data[size] = 0;
+    char *text;
+    gdr_status status = read_open_file(path, fd, size, &text, err);
+    if (status != GDR_OK)
+        return status;
+    uint8_t *data = (uint8_t *)text;
     if (sources) {
         /* Absolute, so the cache can be checked from any working directory. */
         char absolute[PATH_MAX];
-        gdr_status status = gdr_io_source_add(sources, realpath(path, absolute) ? absolute : path, size,
-                                              (int64_t)st.st_mtim.tv_sec * 1000000000ll + st.st_mtim.tv_nsec,
-                                              gdr_io_hash(data, size), err);
+        status = gdr_io_source_add(sources, realpath(path, absolute) ? absolute : path, size,
+                                   (int64_t)st.st_mtim.tv_sec * 1000000000ll + st.st_mtim.tv_nsec,
+                                   gdr_io_hash(data, size), err);
         if (status != GDR_OK) {
             free(data);
             return status;
@@ -238,22 +247,8 @@ gdr_status gdr_read_file(const char *path, size_t max_size, char **out, size_t *
         close(fd);
         return gdr_error_set(err, GDR_ERROR_CAPACITY, "%s: larger than %zu bytes", path, max_size);
     }
-    size_t size = (size_t)st.st_size;
-    char *data = malloc(size + 1);
-    if (!data) {
-        close(fd);
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory reading %zu bytes", path, size);
-    }
-    size_t got = gdr_io_pread_exact(fd, data, size, 0);
-    int read_errno = errno;
-    close(fd);
-    if (got != size) {
-        free(data);
-        return gdr_error_set(err, GDR_ERROR_IO, "%s: read %zu of %zu bytes%s%s", path, got, size,
-                             read_errno ? ": " : "", read_errno ? strerror(read_errno) : "");
-    }
-    data[size] = 0;
-    *out = data;
-    *out_size = size;
-    return GDR_OK;
+    status = read_open_file(path, fd, (size_t)st.st_size, out, err);
+    if (status == GDR_OK)
+        *out_size = (size_t)st.st_size;
+    return status;
 }
