@@ -13,7 +13,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "gdr/geometry.h"
 #include "geometry/lod_internal.h"
 
 /* Smallest group error, relative to the mesh's bounding radius: errors are > 0, so threshold 0

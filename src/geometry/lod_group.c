@@ -7,7 +7,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "gdr/geometry.h"
 #include "geometry/cluster_bounds.h"
 #include "geometry/lod_internal.h"
 

@@ -15,7 +15,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "gdr/geometry.h"
 #include "geometry/lod_internal.h"
 
 /* A sphere grows by at most half for redirections (measured against 2x: docs/PERFORMANCE.md). */

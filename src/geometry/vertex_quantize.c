@@ -10,7 +10,6 @@
 #include "gdr/thread_pool.h"
 #include "geometry/cluster_bounds.h"
 #include "geometry/vertex_quantize.h"
-#include "gdr/geometry.h"
 #include "gdr/scene.h"
 
 #define POSITION_MAX ((1u << GDR_QUANTIZED_POSITION_BITS) - 1u)

@@ -6,7 +6,6 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "gdr/geometry.h"
 #include "core/progress.h"
 #include "geometry/vertex_weld.h"
 #include "gdr/io.h"
