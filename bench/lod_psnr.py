@@ -110,15 +110,16 @@ def point(args, full_png, scene, lod_error, stem, threshold):
 def triangles_at(points, full_triangles, target):
     """The fewest triangles at which the curve reaches `target` dB, as (value, how)."""
     curve = sorted(((p["triangles"], p["psnr"]) for p in points), key=lambda c: (c[0], -c[1]))
-    curve.append((full_triangles, math.inf))
+    curve.append((full_triangles, math.inf))  # full detail
     for i, (t, q) in enumerate(curve):
         if q < target:
             continue
         if i == 0:
             return t, "at or below the coarsest cut"
         t0, q0 = curve[i - 1]
-        if math.isinf(q):
-            return t, "between %d (%.2f dB) and full detail" % (t0, q0)
+        if math.isinf(q):  # full detail, or a cut whose image equals it: no slope to interpolate on
+            return t, "between %d (%.2f dB) and %d (%s)" % (t0, q0, t, "full detail" if i == len(curve) - 1
+                                                             else "an image equal to full detail")
         f = (target - q0) / (q - q0)
         return math.exp(math.log(t0) + f * (math.log(t) - math.log(t0))), "interpolated"
     return None, "not reached"
