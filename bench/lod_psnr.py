@@ -118,7 +118,7 @@ def triangles_at(points, full_triangles, target):
             return t, "at or below the coarsest cut"
         t0, q0 = curve[i - 1]
         if math.isinf(q):  # full detail, or a cut whose image equals it: no slope to interpolate on
-            return t, "between %d (%.2f dB) and %d (%s)" % (t0, q0, t, "full detail" if i == len(curve) - 1
+            return t, "between %d (%.2f dB) and %d (%s)" % (t0, q0, t, "full detail" if t == full_triangles
                                                              else "an image equal to full detail")
         f = (target - q0) / (q - q0)
         return math.exp(math.log(t0) + f * (math.log(t) - math.log(t0))), "interpolated"
