@@ -72,12 +72,17 @@ def parse_args():
     return p.parse_args()
 
 
+def path_arg(path):
+    """A file name as a program's argument: one starting with '-' would read as an option."""
+    return "./" + path if path.startswith("-") else path
+
+
 def render(args, scene, lod_error, stem):
     png = os.path.join(args.out, stem + ".png")
     stats = os.path.join(args.out, stem + ".json")
-    command = [args.gdr, "render", scene, "--width", str(args.width), "--height", str(args.height),
+    command = [args.gdr, "render", path_arg(scene), "--width", str(args.width), "--height", str(args.height),
                "--camera", args.camera, "--lod-error", "%g" % lod_error, "--cone-cull", "off",
-               "--triangle-cull", "off", "--no-cache", "--out", png, "--stats", stats]
+               "--triangle-cull", "off", "--no-cache", "--out", path_arg(png), "--stats", path_arg(stats)]
     if args.allow_outside_files:
         command.append("--allow-outside-files")
     done = subprocess.run(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
@@ -91,7 +96,8 @@ def render(args, scene, lod_error, stem):
 
 
 def psnr(args, full_png, png):
-    done = subprocess.run([args.psnr, full_png, png], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    done = subprocess.run([args.psnr, path_arg(full_png), path_arg(png)], stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, text=True)
     if done.returncode != 0:
         fail("image_psnr %s %s: %s" % (full_png, png, done.stderr.strip()))
     r = json.loads(done.stdout)
