@@ -1215,14 +1215,24 @@ done:
     return status;
 }
 
-static gdr_status load_scene(gltf_ctx *c)
+/* The root's "scene": the index of the scene to show, GDR_NO_INDEX when absent. */
+static gdr_status scene_index(gltf_ctx *c, uint32_t *scene)
 {
-    uint32_t scene = GDR_NO_INDEX;
-    gdr_status status = gltf_get_uint(c, c->root, "scene", "(root)", 0, UINT32_MAX - 1, &scene);
+    *scene = GDR_NO_INDEX;
+    gdr_status status = gltf_get_uint(c, c->root, "scene", "(root)", 0, UINT32_MAX - 1, scene);
     if (status != GDR_OK)
         return gltf_fail(c, GDR_ERROR_PARSE, "scene: expected a scene index");
-    if (scene != GDR_NO_INDEX && scene >= c->scene_count)
-        return gltf_fail(c, GDR_ERROR_PARSE, "scene: scene %u does not exist (%u scenes)", scene, c->scene_count);
+    if (*scene != GDR_NO_INDEX && *scene >= c->scene_count)
+        return gltf_fail(c, GDR_ERROR_PARSE, "scene: scene %u does not exist (%u scenes)", *scene, c->scene_count);
+    return GDR_OK;
+}
+
+static gdr_status load_scene(gltf_ctx *c)
+{
+    uint32_t scene;
+    gdr_status status = scene_index(c, &scene);
+    if (status != GDR_OK)
+        return status;
     uint32_t *roots = NULL, root_count = 0;
     char place[48];
     if (scene == GDR_NO_INDEX && c->scene_count == 0) {
@@ -1353,8 +1363,12 @@ static gdr_status import_document(gltf_ctx *c, const uint8_t *data, size_t size)
     memset(c->mesh_first, 0xff, sizeof(uint32_t) * (c->mesh_count + 1));
     memset(c->image_texture, 0xff, sizeof(uint32_t) * 2 * (c->image_count + 1));
     gltf_report_unsupported(c);
-    /* The geometry's buffers before the materials: a missing .bin is said before any image is decoded. */
-    status = gltf_load_mesh_buffers(c);
+    /* The document's structure, then the geometry's buffers, before the materials: a missing .bin
+     * is said before any image is decoded. */
+    uint32_t scene;
+    status = scene_index(c, &scene);
+    if (status == GDR_OK)
+        status = gltf_load_mesh_buffers(c);
     for (uint32_t m = 0; m < c->material_count && status == GDR_OK; m++)
         status = load_material(c, m);
     if (status == GDR_OK)

@@ -20,8 +20,8 @@ static void report_skins(gltf_ctx *c)
         if (cJSON_GetObjectItemCaseSensitive(c->node_at[n], "skin") && count++ == 0)
             first = n;
     if (count)
-        gdr_io_warn(&c->warnings, "%s: nodes[%u].skin: skins are not supported (%u node%s use one); skinned meshes "
-                    "are drawn in their bind pose", c->name, first, count, count == 1 ? "" : "s");
+        gdr_io_warn(&c->warnings, "%s: nodes[%u].skin: skins are not supported (%u node%s one); skinned meshes "
+                    "are drawn in their bind pose", c->name, first, count, count == 1 ? " uses" : "s use");
 }
 
 /* Primitives with morph targets: drawn as their base shape. */
@@ -37,8 +37,8 @@ static void report_morph_targets(gltf_ctx *c)
                 snprintf(first, sizeof first, "meshes[%u].primitives[%u].targets", m, p);
     }
     if (count)
-        gdr_io_warn(&c->warnings, "%s: %s: morph targets are not supported (%u primitive%s have them); drawn as "
-                    "the base shape", c->name, first, count, count == 1 ? "" : "s");
+        gdr_io_warn(&c->warnings, "%s: %s: morph targets are not supported (%u primitive%s them); drawn as "
+                    "the base shape", c->name, first, count, count == 1 ? " has" : "s have");
 }
 
 static void report_animations(gltf_ctx *c)
@@ -85,8 +85,8 @@ static void report_material_extensions(gltf_ctx *c)
         }
     }
     for (uint32_t k = 0; k < distinct; k++)
-        gdr_io_warn(&c->warnings, "%s: materials[%u].extensions.%.64s: %.64s is not supported (%u material%s use "
-                    "it); left out", c->name, first[k], names[k], names[k], uses[k], uses[k] == 1 ? "" : "s");
+        gdr_io_warn(&c->warnings, "%s: materials[%u].extensions.%.64s: %.64s is not supported (%u material%s it); "
+                    "left out", c->name, first[k], names[k], names[k], uses[k], uses[k] == 1 ? " uses" : "s use");
     if (more)
         gdr_io_warn(&c->warnings, "%s: %u more uses of unsupported material extensions beyond the %d named above",
                     c->name, more, DISTINCT_EXTENSIONS_MAX);
