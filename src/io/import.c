@@ -132,6 +132,8 @@ static int read_cached(const char *path, const char *cache, const gdr_load_optio
         return 0;
     }
     gdr_io_cache_touch(cache); /* used now: the last to be evicted */
+    gdr_error ignored;
+    gdr_io_report_untemplate(&cached, path, &ignored); /* out of memory: said with its markers */
     gdr_io_report_replay(&cached, options->warning, options->warning_user);
     *report = cached;
     report->cache_path = strdup(cache);
@@ -149,17 +151,22 @@ static gdr_status load_cache_file(const char *path, gdr_scene **out, gdr_pvs **o
                                               report, err);
     if (status != GDR_OK)
         return status;
+    gdr_error ignored;
+    gdr_io_report_untemplate(report, NULL, &ignored);
     gdr_io_report_replay(report, options->warning, options->warning_user);
     return finish_cache_read(path, out, pvs, out_pvs, err);
 }
 
 /* Writes the cache of a fresh import, then keeps its folder within the size limit. */
-static void write_cache(const char *cache, const char *dir, const gdr_scene *scene, const gdr_source_list *sources,
-                        const gdr_load_options *options, gdr_import_report *report)
+static void write_cache(const char *path, const char *cache, const char *dir, const gdr_scene *scene,
+                        const gdr_source_list *sources, const gdr_load_options *options, gdr_import_report *report)
 {
-    gdr_cache_write_options write = {.source = {gdr_cache_build_options(), sources}, .report = report};
+    gdr_import_report kept;
     gdr_error write_err = {0};
-    int written = gdr_cache_write(cache, scene, &write, &write_err) == GDR_OK;
+    int written = gdr_io_report_template(report, path, &kept, &write_err) == GDR_OK;
+    gdr_cache_write_options write = {.source = {gdr_cache_build_options(), sources}, .report = &kept};
+    written = written && gdr_cache_write(cache, scene, &write, &write_err) == GDR_OK;
+    gdr_import_report_free(&kept);
     report->cache_path = strdup(cache);
     report->cache_state = written ? GDR_CACHE_WRITTEN : GDR_CACHE_NOT_WRITTEN;
     if (!written)
@@ -207,7 +214,7 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
     status = gdr_import_file(path, &import, out, &result, err);
     report->file_cameras = result.file_cameras;
     if (status == GDR_OK && cached)
-        write_cache(cache, dir, *out, &sources, options, report);
+        write_cache(path, cache, dir, *out, &sources, options, report);
     if (status == GDR_OK && options->sources) /* the caller's, as gdr_load_options.sources asks */
         *options->sources = sources;
     else
