@@ -686,6 +686,13 @@ gdr_status gdr_io_cache_read_for(const char *path, const char *source, const cha
 gdr_status gdr_cache_read_for_streaming(const char *path, const char *build_options, gdr_scene **out,
                                         gdr_pvs **out_pvs, uint64_t *out_bytes_read, gdr_error *err)
 {
+    return gdr_io_cache_read_for_streaming(path, build_options, out, out_pvs, NULL, out_bytes_read, err);
+}
+
+gdr_status gdr_io_cache_read_for_streaming(const char *path, const char *build_options, gdr_scene **out,
+                                           gdr_pvs **out_pvs, gdr_import_report *out_report, uint64_t *out_bytes_read,
+                                           gdr_error *err)
+{
     *out = NULL;
     if (out_pvs)
         *out_pvs = NULL;
@@ -708,8 +715,15 @@ gdr_status gdr_cache_read_for_streaming(const char *path, const char *build_opti
                                "pages (gdr build --pages)", path);
     if (status == GDR_OK)
         status = check_fresh(path, &v, build_options, NULL, err);
+    gdr_import_report report = {0};
+    if (status == GDR_OK)
+        status = read_report(path, &v, &report, err);
     if (status == GDR_OK)
         status = gdr_cache_read_sections(path, &v, 1, out, out_pvs, err);
+    if (status == GDR_OK && out_report)
+        *out_report = report;
+    else
+        gdr_import_report_free(&report);
     close(src.fd);
     source_free(&src);
     if (out_bytes_read)

@@ -191,7 +191,14 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
         if (!gdr_io_has_extension(path, ".gdrc"))
             return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: streaming reads a .gdrc cache with geometry "
                                  "pages (gdr build SCENE -o FILE.gdrc --pages), not a source file", path);
-        return gdr_cache_read_for_streaming(path, gdr_cache_build_options(), out, out_pvs, NULL, err);
+        status = gdr_io_cache_read_for_streaming(path, gdr_cache_build_options(), out, out_pvs, report, NULL, err);
+        gdr_error ignored;
+        if (status == GDR_OK) {
+            gdr_io_report_untemplate(report, NULL, &ignored); /* out of memory: said with its markers */
+            gdr_io_report_replay(report, options->warning, options->warning_user);
+        }
+        gdr_import_report_free(&local);
+        return status;
     }
     if (gdr_io_has_extension(path, ".gdrc")) {
         status = load_cache_file(path, out, out_pvs, options, report, err);

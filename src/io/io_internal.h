@@ -128,6 +128,11 @@ gdr_status gdr_io_image_decode(const void *data, size_t size, const char *name, 
 gdr_status gdr_io_cache_read_for(const char *path, const char *source, const char *build_options, gdr_scene **out,
                                  gdr_pvs **out_pvs, gdr_import_report *out_report, gdr_error *err);
 
+/* gdr_cache_read_for_streaming that also returns the import's report the cache keeps (may be NULL). */
+gdr_status gdr_io_cache_read_for_streaming(const char *path, const char *build_options, gdr_scene **out,
+                                           gdr_pvs **out_pvs, gdr_import_report *out_report, uint64_t *out_bytes_read,
+                                           gdr_error *err);
+
 /* The source a cache file records first (the file it was built from), control characters escaped;
  * reads only the header, the table and section 'SRCE', each checksum checked. */
 gdr_status gdr_io_cache_recorded_source(const char *path, char *out, size_t out_size, gdr_error *err);

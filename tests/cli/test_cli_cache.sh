@@ -110,6 +110,9 @@ expect 0 "info --strict, clean" "$gdr" info "$work/copy/BoxTextured.gltf" --stri
 expect 0 "build with a warning" "$gdr" build "$work/box/BoxTextured.gltf" -o "$work/built.gdrc"
 expect 4 "render the built cache --strict" "$gdr" render "$work/built.gdrc" $small --strict
 grep -q 'texture left out' "$work/stderr" || fail "the built cache did not keep the warning"
+expect 0 "build with pages" "$gdr" build "$work/box/BoxTextured.gltf" -o "$work/paged.gdrc" --pages
+expect 4 "render streamed --strict" "$gdr" render "$work/paged.gdrc" $small --geometry-budget 16 --strict
+grep -q 'texture left out' "$work/stderr" || fail "the streamed read did not say the kept warning"
 
 # --camera-index counts every camera the file places (here one perspective, one orthographic).
 expect 2 "camera index beyond" "$gdr" render "$corpus/cameras/Cameras.gltf" $small --camera-index 2

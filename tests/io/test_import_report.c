@@ -199,6 +199,7 @@ static void test_report_section(void)
     CHECK(gdr_scene_load(obj, &options, &s, &err) == GDR_OK);
     CHECK(report.cache_state == GDR_CACHE_READ && again.count == 1 && strcmp(first.text, again.text) == 0);
     gdr_scene_destroy(s);
+    gdr_import_report_free(&report);
     /* A report with a raw escape sequence (as a hostile cache could hold) is escaped when read. */
     gdr_scene *plain = NULL;
     CHECK(gdr_scene_load(obj, &(gdr_load_options){.no_cache = 1, .no_progress = 1,
