@@ -102,6 +102,8 @@ grep -q 'gdr: error: .*texture left out' "$work/stderr" || fail "render --strict
 [ -e "$work/strict.png" ] && fail "render --strict wrote an image"
 expect 4 "render --strict, uncached" "$gdr" render "$work/box/BoxTextured.gltf" $small --strict --no-cache
 expect 4 "info --strict" "$gdr" info "$work/box/BoxTextured.gltf" --strict
+# (the viewer refuses before it opens a window, so no display is needed)
+expect 4 "view --strict" env -u DISPLAY -u WAYLAND_DISPLAY "$gdr" view "$work/box/BoxTextured.gltf" --strict --frames 1
 expect 4 "build --strict" "$gdr" build "$work/box/BoxTextured.gltf" -o "$work/strict.gdrc" --strict
 [ -e "$work/strict.gdrc" ] && fail "build --strict wrote a cache"
 expect 0 "render --strict, clean" "$gdr" render "$work/copy/BoxTextured.gltf" $small --strict
