@@ -23,12 +23,22 @@ extern "C" {
 
 /* --- source files -------------------------------------------------------------------------- */
 
-/* A file an import read: its identity is what makes a cache stale. */
+/* What an import found at a path it looked at. */
+typedef enum gdr_source_state {
+    GDR_SOURCE_READ = 0,   /* a regular file, read: size, time and hash are its own */
+    GDR_SOURCE_ABSENT = 1, /* nothing there (size, time and hash 0) */
+    GDR_SOURCE_UNREAD = 2, /* something there that was not read (not a regular file, no permission,
+                              a link out of the folder): size and time as stat gave them, hash 0 */
+} gdr_source_state;
+
+/* A file an import looked for, found or not: its identity is what makes a cache stale (adding,
+ * removing or changing any of them rebuilds the cache). */
 typedef struct gdr_source_file {
     char *path;        /* absolute (realpath) when it can be resolved, else as opened */
     uint64_t size;     /* bytes */
     int64_t mtime_ns;  /* modification time, nanoseconds since the epoch */
     uint64_t hash;     /* XXH3-64 of the contents */
+    gdr_source_state state;
 } gdr_source_file;
 
 typedef struct gdr_source_list {
@@ -71,11 +81,40 @@ typedef struct gdr_budget {
 /* The budget with every 0 replaced by its default. */
 GDR_API gdr_budget gdr_budget_resolve(const gdr_budget *budget);
 
+/* What an import said about a file, kept in its cache so that every later run says it again.
+ * Zero-initialise; free with gdr_import_report_free. */
+typedef struct gdr_import_report {
+    char **warnings;         /* the warnings, in order (at most GDR_REPORT_MAX_WARNINGS kept) */
+    uint32_t warning_count;  /* entries of warnings[] */
+    uint32_t warning_total;  /* warnings given, >= warning_count */
+    uint32_t warning_capacity;
+    uint32_t file_cameras;   /* camera placements of the file (nodes with a camera), used or not */
+    /* Filled by gdr_scene_load for a source file: */
+    char *cache_path;        /* the cache read or written (malloc'ed), NULL when none */
+    int cache_state;         /* GDR_CACHE_NONE, _READ, _WRITTEN or _NOT_WRITTEN */
+} gdr_import_report;
+
+enum { GDR_CACHE_NONE = 0, GDR_CACHE_READ = 1, GDR_CACHE_WRITTEN = 2, GDR_CACHE_NOT_WRITTEN = 3 };
+
+#define GDR_REPORT_MAX_WARNINGS 1024u
+#define GDR_REPORT_MAX_WARNING_BYTES 511u /* a stored warning's longest text */
+
+GDR_API void gdr_import_report_free(gdr_import_report *report);
+
+/* The per-user cache folder's size limit when none is given: GDR_CACHE_MAX_MIB from the
+ * environment, else this. */
+#define GDR_CACHE_DEFAULT_MAX_BYTES (4ull << 30)
+
 /* Options of gdr_scene_load; zero-initialise, every field has a default. */
 typedef struct gdr_load_options {
     int no_cache;          /* 1: import the source, never read or write a .gdrc cache */
-    const char *cache_dir; /* NULL: next to the source (FILE.gdrc), falling back to
-                              $XDG_CACHE_HOME/gdr or ~/.cache/gdr when that is not writable */
+    const char *cache_dir; /* NULL: the per-user folder ($XDG_CACHE_HOME/gdr, else ~/.cache/gdr,
+                              gdr_cache_default_dir), names keyed by the source's absolute path;
+                              ".": next to the source (FILE.gdrc); else that folder, keyed alike */
+    uint64_t cache_max_bytes; /* a cache folder's size limit: after a write, the least recently used
+                              caches gdr wrote there are removed until the folder's caches fit
+                              (never the one just written; not for "."); 0: GDR_CACHE_MAX_MIB
+                              from the environment, else GDR_CACHE_DEFAULT_MAX_BYTES */
     int no_progress;       /* 1: never draw a progress bar (default: on a terminal only) */
     gdr_warning_fn warning; /* NULL: warnings go to stderr as "gdr: warning: ..." */
     void *warning_user;
@@ -92,6 +131,10 @@ typedef struct gdr_load_options {
     gdr_source_list *sources; /* non-NULL: receives every file an import read (the source, its
                                 buffers and images), for gdr_cache_write; empty when the scene came
                                 from a cache or is built in. Free it with gdr_source_list_free */
+    gdr_import_report *report; /* non-NULL: receives the import's warnings and camera count (from the
+                                cache on a cached run) and where the cache is; the caller frees it
+                                with gdr_import_report_free. The warnings are also given to
+                                `warning` as they are said, on every run, cached or not */
 } gdr_load_options;
 
 /* --- images ------------------------------------------------------------------------------- */
@@ -103,7 +146,7 @@ GDR_API gdr_status gdr_image_decode(const void *data, size_t size, const char *n
 
 /* --- processed-scene cache ------------------------------------------------------------------ */
 
-#define GDR_CACHE_FORMAT_VERSION 8u
+#define GDR_CACHE_FORMAT_VERSION 9u
 
 /* What a cache was built from: the build options (a string that changes whenever the processing
  * would produce different data, e.g. "import=1") and the source files. */
@@ -116,6 +159,7 @@ typedef struct gdr_cache_source {
  * default. */
 typedef struct gdr_cache_write_options {
     gdr_cache_source source; /* build options and source files; empty: none recorded, never stale */
+    const gdr_import_report *report; /* the import's warnings and cameras (section 'REPT'); NULL: none */
     const gdr_pvs *pvs;      /* NULL: no precomputed visibility. Otherwise its serialised form in the
                                 optional section 'PVIS'; it must have been baked for this scene
                                 (gdr_pvs_object_count(pvs) == scene->instance_count), else
@@ -139,10 +183,33 @@ GDR_API gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, con
  * program's small inputs (camera paths, results files). */
 GDR_API gdr_status gdr_read_file(const char *path, size_t max_size, char **out, size_t *out_size, gdr_error *err);
 
-/* The cache path used for a source: SOURCE.gdrc next to it, or in cache_dir (named after a hash
- * of the absolute source path) when cache_dir is given. Returns the length written, or 0 when
- * it does not fit. */
+/* The cache path of a source in a folder: SOURCE.gdrc next to it when cache_dir is NULL or ".", else
+ * in cache_dir, named after the source's file name and a hash of its absolute path. Returns the
+ * length written, or 0 when it does not fit. */
 GDR_API size_t gdr_cache_path_for(const char *source_path, const char *cache_dir, char *out, size_t out_size);
+
+/* The per-user cache folder: $XDG_CACHE_HOME/gdr when XDG_CACHE_HOME is an absolute path, else
+ * $HOME/.cache/gdr. Returns the length written, 0 when there is none (no usable variable) or it does
+ * not fit. Nothing is created. */
+GDR_API size_t gdr_cache_default_dir(char *out, size_t out_size);
+
+/* One cache file gdr wrote in a cache folder (gdr_cache_list). */
+typedef struct gdr_cache_entry {
+    const char *path;    /* the cache file */
+    const char *source;  /* its source's path as recorded, control characters escaped; "" if unknown */
+    uint64_t size;       /* bytes */
+    int64_t used_ns;     /* last use (its modification time: a read touches it), ns since the epoch */
+} gdr_cache_entry;
+
+typedef void (*gdr_cache_entry_fn)(void *user, const gdr_cache_entry *entry);
+
+/* Every cache gdr wrote in `dir` (NULL: the per-user folder), least recently used first: regular
+ * files named NAME-<16 hex digits>.gdrc that start with the cache's magic; nothing else in the
+ * folder is looked at further. */
+GDR_API gdr_status gdr_cache_list(const char *dir, gdr_cache_entry_fn fn, void *user, gdr_error *err);
+
+/* Removes the caches gdr_cache_list lists (and nothing else); *removed (may be NULL) counts them. */
+GDR_API gdr_status gdr_cache_clear(const char *dir, uint32_t *removed, uint64_t *bytes, gdr_error *err);
 
 /* The build options string of this version of the importers. */
 GDR_API const char *gdr_cache_build_options(void);

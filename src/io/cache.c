@@ -13,6 +13,7 @@
 
 #include "core/output_file.h"
 #include "io/cache_internal.h"
+#include "io/import_report.h"
 #include "io/io_internal.h"
 
 #if !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
@@ -87,7 +88,7 @@ gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_c
     if (limits != GDR_OK)
         return limits;
     /* The table has exactly one entry per section: no byte of the file lies outside a checksum. */
-    cache_write_input in = {scene, &options->source, options->pvs, options->page_bytes};
+    cache_write_input in = {scene, &options->source, options->report, options->pvs, options->page_bytes};
     uint32_t expected = 0;
     for (uint32_t k = 0; k < CACHE_SECTION_COUNT; k++) {
         const cache_section *sec = &gdr_cache_sections[k];
@@ -361,6 +362,8 @@ static void source_free(container_source *src)
         free(src->owned[k]);
 }
 
+static gdr_status read_report(const char *name, cache_view *v, gdr_import_report *out, gdr_error *err);
+
 gdr_status gdr_cache_read_memory(const void *data, size_t size, const char *name, gdr_scene **out, gdr_pvs **out_pvs,
                                  gdr_error *err)
 {
@@ -370,9 +373,50 @@ gdr_status gdr_cache_read_memory(const void *data, size_t size, const char *name
     cache_view v;
     container_source src = {.name = name ? name : "(memory)", .data = data, .size = size};
     gdr_status status = parse_container(&src, &v, err);
+    gdr_import_report report = {0};
+    if (status == GDR_OK)
+        status = read_report(src.name, &v, &report, err); /* checked, then dropped */
+    gdr_import_report_free(&report);
     if (status != GDR_OK)
         return status;
     return gdr_cache_read_sections(src.name, &v, 0, out, out_pvs, err);
+}
+
+/* Section 'REPT': the import's warnings, each checked against the limits before it is kept and kept
+ * with its control characters escaped (the text is the file's, and is printed on every run). */
+static gdr_status read_report(const char *name, cache_view *v, gdr_import_report *out, gdr_error *err)
+{
+    reader r = v->sections[CACHE_REPORT];
+    uint32_t cameras = get_u32(&r), total = get_u32(&r), kept = get_u32(&r);
+    if (r.failed)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'REPT' is truncated (%zu bytes)", name, r.size);
+    if (kept > GDR_REPORT_MAX_WARNINGS || kept > total || (kept < total && kept < GDR_REPORT_MAX_WARNINGS) ||
+        kept > (r.size - r.at) / 4)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'REPT': %u warnings kept of %u (at most %u, all of "
+                             "them below that, 4 bytes each at least)", name, kept, total, GDR_REPORT_MAX_WARNINGS);
+    for (uint32_t i = 0; i < kept; i++) {
+        uint32_t length;
+        const char *text = get_string(&r, &length);
+        if (r.failed || length > GDR_REPORT_MAX_WARNING_BYTES) {
+            gdr_import_report_free(out);
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'REPT': warning %u: %s", name, i,
+                                 r.failed ? "runs past the section's end" : "longer than the 511 bytes a warning may be");
+        }
+        char safe[4 * GDR_REPORT_MAX_WARNING_BYTES + 1];
+        size_t n = gdr_io_escape_text(text, length, safe, sizeof safe);
+        gdr_status status = gdr_io_report_add(out, safe, n, err);
+        if (status != GDR_OK) {
+            gdr_import_report_free(out);
+            return status;
+        }
+    }
+    if (r.at != r.size) {
+        gdr_import_report_free(out);
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'REPT' has %zu bytes left over", name, r.size - r.at);
+    }
+    out->warning_total = total;
+    out->file_cameras = cameras;
+    return GDR_OK;
 }
 
 /* One entry of section 'SRCE': a file the scene was built from, as it was then. */
@@ -386,6 +430,7 @@ typedef struct source_now {
 
 typedef struct source_entry {
     char *path;    /* where to look for it now (malloc'ed) */
+    uint32_t state; /* gdr_source_state: what the import found there */
     uint64_t size, mtime, hash;
     uint64_t key;  /* hash of the path, to stat each spelling once */
     int moved;     /* its folder moved with the source: the mtime says nothing, compare contents */
@@ -442,7 +487,7 @@ static gdr_status read_entries(const char *name, reader *r, const char *source, 
                                uint32_t *out_count, gdr_error *err)
 {
     uint32_t files = get_u32(r);
-    if (r->failed || files > (r->size - r->at) / 28) /* each entry is at least 28 bytes */
+    if (r->failed || files > (r->size - r->at) / 33) /* each entry is at least 33 bytes */
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'SRCE' is malformed", name);
     source_entry *entries = calloc((size_t)files + 1, sizeof *entries);
     if (!entries)
@@ -452,8 +497,10 @@ static gdr_status read_entries(const char *name, reader *r, const char *source, 
         uint32_t length;
         const char *path = get_string(r, &length);
         source_entry *e = &entries[i];
+        e->state = get_u32(r);
         e->size = get_u64(r), e->mtime = get_u64(r), e->hash = get_u64(r);
-        if (r->failed || length == 0 || length >= PATH_MAX || memchr(path, 0, length)) {
+        if (r->failed || length == 0 || length >= PATH_MAX || memchr(path, 0, length) || e->state > GDR_SOURCE_UNREAD ||
+            (i == 0 && e->state != GDR_SOURCE_READ)) {
             free_entries(entries, files);
             return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'SRCE' is malformed", name);
         }
@@ -487,31 +534,58 @@ static gdr_status read_entries(const char *name, reader *r, const char *source, 
     return GDR_OK;
 }
 
-/* Compares one entry with the file now (contents hashed at most once per file). */
+/* A recorded path for a message: it comes from the file, so control characters are escaped. */
+static const char *shown(const char *path, char out[PATH_MAX])
+{
+    gdr_io_escape_text(path, strlen(path), out, PATH_MAX);
+    return out;
+}
+
+/* Hashes the file now, once (now->hashed or now->unreadable afterwards). */
+static void hash_now(const char *path, source_now *now)
+{
+    if (now->hashed || now->unreadable)
+        return;
+    uint8_t *contents;
+    size_t contents_size;
+    gdr_error read_err;
+    if (gdr_io_read_file(path, &contents, &contents_size, NULL, &read_err) == GDR_OK) {
+        now->hash = gdr_io_hash(contents, contents_size);
+        now->hashed = 1;
+        free(contents);
+    } else {
+        now->unreadable = 1;
+    }
+}
+
+/* Compares one entry with the file now (contents hashed at most once per file): the import would
+ * find the same thing there, or the cache is stale. A file that was read must be there with the same
+ * contents (a touched file with the same contents stays valid); a path where nothing was found must
+ * still be empty; something that was there but not read must be unchanged (size and time). */
 static gdr_status check_entry(const char *name, const source_entry *e, source_now *now, gdr_error *err)
 {
+    char text[PATH_MAX];
+    if (e->state == GDR_SOURCE_ABSENT)
+        return now->exists ? gdr_error_set(err, GDR_ERROR_STALE, "%s: stale: %s was not there when the cache was "
+                                           "built", name, shown(e->path, text))
+                           : GDR_OK;
     if (!now->exists)
-        return GDR_OK; /* the file is not here: the cache stands alone */
+        return gdr_error_set(err, GDR_ERROR_STALE, "%s: stale: %s is gone", name, shown(e->path, text));
     if (now->size != e->size)
         return gdr_error_set(err, GDR_ERROR_STALE, "%s: stale: %s changed size (%llu -> %llu bytes)", name,
-                             e->path, (unsigned long long)e->size, (unsigned long long)now->size);
+                             shown(e->path, text), (unsigned long long)e->size, (unsigned long long)now->size);
+    if (e->state == GDR_SOURCE_UNREAD)
+        return (uint64_t)now->mtime == e->mtime && !e->moved
+                   ? GDR_OK
+                   : gdr_error_set(err, GDR_ERROR_STALE, "%s: stale: %s changed", name, shown(e->path, text));
     if ((uint64_t)now->mtime == e->mtime && !e->moved)
         return GDR_OK;
-    if (!now->hashed && !now->unreadable) {
-        uint8_t *contents;
-        size_t contents_size;
-        gdr_error read_err;
-        if (gdr_io_read_file(e->path, &contents, &contents_size, NULL, &read_err) == GDR_OK) {
-            now->hash = gdr_io_hash(contents, contents_size);
-            now->hashed = 1;
-            free(contents);
-        } else {
-            now->unreadable = 1;
-        }
-    }
-    if (now->hashed && now->hash != e->hash)
+    hash_now(e->path, now);
+    if (!now->hashed)
+        return gdr_error_set(err, GDR_ERROR_STALE, "%s: stale: %s can no longer be read", name, shown(e->path, text));
+    if (now->hash != e->hash)
         return gdr_error_set(err, GDR_ERROR_STALE, "%s: stale: %s changed since the cache was built", name,
-                             e->path);
+                             shown(e->path, text));
     return GDR_OK;
 }
 
@@ -550,9 +624,10 @@ static gdr_status check_fresh(const char *name, cache_view *v, const char *build
         /* The source itself must be there, with the contents the cache was built from. */
         source_now now = {0};
         now.exists = gdr_io_stat(entries[0].path, &now.size, &now.mtime) == 0;
+        char text[PATH_MAX];
         if (!now.exists)
             status = gdr_error_set(err, GDR_ERROR_STALE, "%s: stale: its source %s is not there", name,
-                                   entries[0].path);
+                                   shown(entries[0].path, text));
         else
             status = check_entry(name, &entries[0], &now, err);
     }
@@ -576,11 +651,11 @@ static gdr_status check_fresh(const char *name, cache_view *v, const char *build
 gdr_status gdr_cache_read(const char *path, const char *build_options, gdr_scene **out, gdr_pvs **out_pvs,
                           gdr_error *err)
 {
-    return gdr_io_cache_read_for(path, NULL, build_options, out, out_pvs, err);
+    return gdr_io_cache_read_for(path, NULL, build_options, out, out_pvs, NULL, err);
 }
 
 gdr_status gdr_io_cache_read_for(const char *path, const char *source, const char *build_options, gdr_scene **out,
-                                 gdr_pvs **out_pvs, gdr_error *err)
+                                 gdr_pvs **out_pvs, gdr_import_report *out_report, gdr_error *err)
 {
     *out = NULL;
     if (out_pvs)
@@ -595,14 +670,28 @@ gdr_status gdr_io_cache_read_for(const char *path, const char *source, const cha
     status = parse_container(&src, &v, err);
     if (status == GDR_OK)
         status = check_fresh(path, &v, build_options, source, err);
+    gdr_import_report report = {0};
+    if (status == GDR_OK)
+        status = read_report(path, &v, &report, err);
     if (status == GDR_OK)
         status = gdr_cache_read_sections(path, &v, 0, out, out_pvs, err);
+    if (status == GDR_OK && out_report)
+        *out_report = report;
+    else
+        gdr_import_report_free(&report);
     free(data);
     return status;
 }
 
 gdr_status gdr_cache_read_for_streaming(const char *path, const char *build_options, gdr_scene **out,
                                         gdr_pvs **out_pvs, uint64_t *out_bytes_read, gdr_error *err)
+{
+    return gdr_io_cache_read_for_streaming(path, build_options, out, out_pvs, NULL, out_bytes_read, err);
+}
+
+gdr_status gdr_io_cache_read_for_streaming(const char *path, const char *build_options, gdr_scene **out,
+                                           gdr_pvs **out_pvs, gdr_import_report *out_report, uint64_t *out_bytes_read,
+                                           gdr_error *err)
 {
     *out = NULL;
     if (out_pvs)
@@ -626,8 +715,15 @@ gdr_status gdr_cache_read_for_streaming(const char *path, const char *build_opti
                                "pages (gdr build --pages)", path);
     if (status == GDR_OK)
         status = check_fresh(path, &v, build_options, NULL, err);
+    gdr_import_report report = {0};
+    if (status == GDR_OK)
+        status = read_report(path, &v, &report, err);
     if (status == GDR_OK)
         status = gdr_cache_read_sections(path, &v, 1, out, out_pvs, err);
+    if (status == GDR_OK && out_report)
+        *out_report = report;
+    else
+        gdr_import_report_free(&report);
     close(src.fd);
     source_free(&src);
     if (out_bytes_read)
@@ -638,7 +734,7 @@ gdr_status gdr_cache_read_for_streaming(const char *path, const char *build_opti
 size_t gdr_cache_path_for(const char *source_path, const char *cache_dir, char *out, size_t out_size)
 {
     int n;
-    if (!cache_dir) {
+    if (!cache_dir || strcmp(cache_dir, ".") == 0) {
         n = snprintf(out, out_size, "%s.gdrc", source_path);
     } else {
         char absolute[PATH_MAX];
@@ -649,4 +745,77 @@ size_t gdr_cache_path_for(const char *source_path, const char *cache_dir, char *
                      (unsigned long long)gdr_io_hash(key, strlen(key)));
     }
     return n > 0 && (size_t)n < out_size ? (size_t)n : 0;
+}
+
+/* The 'SRCE' section of an open cache (header, table and that section only, each checksum checked),
+ * at most 16 MiB; *out is malloc'ed. */
+static gdr_status read_source_section(const char *path, int fd, uint64_t size, uint8_t **out, size_t *out_size,
+                                      gdr_error *err)
+{
+    uint8_t h[CACHE_HEADER_SIZE];
+    uint32_t count;
+    uint64_t table_hash;
+    if (size < CACHE_HEADER_SIZE || gdr_io_pread_exact(fd, h, CACHE_HEADER_SIZE, 0) != CACHE_HEADER_SIZE)
+        return gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: truncated", path);
+    gdr_status status = cache_parse_header(path, h, size, &count, &table_hash, err);
+    if (status != GDR_OK)
+        return status;
+    uint8_t *table = malloc((size_t)count * CACHE_ENTRY_SIZE + 1);
+    if (!table)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+    size_t table_size = (size_t)count * CACHE_ENTRY_SIZE;
+    if (gdr_io_pread_exact(fd, table, table_size, CACHE_HEADER_SIZE) != table_size ||
+        gdr_io_hash(table, table_size) != table_hash) {
+        free(table);
+        return gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: corrupted: section table", path);
+    }
+    status = gdr_error_set(err, GDR_ERROR_PARSE, "%s: records no source", path);
+    for (uint32_t i = 0; i < count; i++) {
+        reader t = {table + (size_t)i * CACHE_ENTRY_SIZE, CACHE_ENTRY_SIZE, 0, 0};
+        uint32_t id = get_u32(&t);
+        (void)get_u32(&t);
+        uint64_t offset = get_u64(&t), length = get_u64(&t), checksum = get_u64(&t);
+        if (id != gdr_cache_sections[CACHE_SOURCE].id)
+            continue;
+        uint8_t *bytes = offset <= size && length <= size - offset && length <= (16u << 20) ? malloc(length + 1) : NULL;
+        if (!bytes || gdr_io_pread_exact(fd, bytes, length, offset) != length || gdr_io_hash(bytes, length) != checksum) {
+            free(bytes);
+            status = gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: section 'SRCE' is damaged", path);
+            break;
+        }
+        *out = bytes;
+        *out_size = length;
+        status = GDR_OK;
+        break;
+    }
+    free(table);
+    return status;
+}
+
+gdr_status gdr_io_cache_recorded_source(const char *path, char *out, size_t out_size, gdr_error *err)
+{
+    out[0] = 0;
+    int fd;
+    gdr_status status = gdr_io_open_regular(path, &fd, err);
+    if (status != GDR_OK)
+        return status;
+    struct stat st;
+    uint8_t *bytes = NULL;
+    size_t size = 0;
+    status = fstat(fd, &st) == 0 ? read_source_section(path, fd, (uint64_t)st.st_size, &bytes, &size, err)
+                                 : gdr_error_set(err, GDR_ERROR_IO, "%s: cannot stat", path);
+    close(fd);
+    if (status != GDR_OK)
+        return status;
+    reader r = {bytes, size, 0, 0};
+    uint32_t length;
+    (void)get_string(&r, &length); /* the build options */
+    uint32_t files = get_u32(&r);
+    const char *first = files ? get_string(&r, &length) : NULL;
+    if (r.failed || !first)
+        status = gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'SRCE' is malformed", path);
+    else
+        gdr_io_escape_text(first, length, out, out_size);
+    free(bytes);
+    return status;
 }

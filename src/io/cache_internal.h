@@ -161,7 +161,7 @@ static inline void fourcc_text(uint32_t id, char out[5])
 /* Every section this build knows, in the order they are written and read (a section may use what
  * the ones before it read). */
 enum {
-    CACHE_SOURCE, CACHE_SCENE, CACHE_TEXTURES, CACHE_PIXELS, CACHE_MESHES, CACHE_GEOMETRY, CACHE_COLORS, CACHE_CLUSTERS,
+    CACHE_SOURCE, CACHE_REPORT, CACHE_SCENE, CACHE_TEXTURES, CACHE_PIXELS, CACHE_MESHES, CACHE_GEOMETRY, CACHE_COLORS, CACHE_CLUSTERS,
     CACHE_CLUSTER_DATA, CACHE_CLUSTER_GEOMETRY, CACHE_HIERARCHY, CACHE_MATERIALS, CACHE_INSTANCES, CACHE_CAMERAS, CACHE_PVS,
     CACHE_PAGES, CACHE_SECTION_COUNT
 };
@@ -170,6 +170,7 @@ enum {
 typedef struct cache_write_input {
     const gdr_scene *scene;
     const gdr_cache_source *source;
+    const gdr_import_report *report; /* NULL: a report with no warnings */
     const gdr_pvs *pvs; /* NULL: no PVIS section */
     uint32_t page_bytes; /* 0: no PAGE section */
 } cache_write_input;
@@ -186,7 +187,7 @@ typedef struct cache_section {
     gdr_status (*check)(const cache_write_input *in, const char *path, gdr_error *err);
     void (*write)(writer *w, const cache_write_input *in);
     /* Reads and checks the whole section into the scene being built; NULL: the container reads it
-     * (SRCE, for staleness). */
+     * (SRCE, for staleness; REPT, the import's report). */
     gdr_status (*read)(cache_read_state *st, reader *r, gdr_error *err);
     int in_pages; /* geometry the pages hold too: a read for streaming leaves it in the file */
 } cache_section;

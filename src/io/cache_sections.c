@@ -78,9 +78,28 @@ static void write_source(writer *w, const cache_write_input *in)
     for (uint32_t i = 0; i < files; i++) {
         const gdr_source_file *f = &source->files->files[i];
         put_string(w, f->path);
+        put_u32(w, (uint32_t)f->state);
         put_u64(w, f->size);
         put_u64(w, (uint64_t)f->mtime_ns);
         put_u64(w, f->hash);
+    }
+}
+
+/* --- REPT: what the import said (read by the container) ----------------------------------------- */
+
+static void write_report(writer *w, const cache_write_input *in)
+{
+    const gdr_import_report *report = in->report;
+    uint32_t kept = report ? report->warning_count : 0;
+    if (kept > GDR_REPORT_MAX_WARNINGS)
+        kept = GDR_REPORT_MAX_WARNINGS;
+    put_u32(w, report ? report->file_cameras : 0);
+    put_u32(w, report && report->warning_total > kept ? report->warning_total : kept);
+    put_u32(w, kept);
+    for (uint32_t i = 0; i < kept; i++) {
+        size_t length = strlen(report->warnings[i]);
+        put_u32(w, (uint32_t)(length > GDR_REPORT_MAX_WARNING_BYTES ? GDR_REPORT_MAX_WARNING_BYTES : length));
+        put(w, report->warnings[i], length > GDR_REPORT_MAX_WARNING_BYTES ? GDR_REPORT_MAX_WARNING_BYTES : length);
     }
 }
 
@@ -893,6 +912,7 @@ static gdr_status read_pages(cache_read_state *st, reader *r, gdr_error *err)
 #define REQUIRED CACHE_SECTION_REQUIRED
 const cache_section gdr_cache_sections[CACHE_SECTION_COUNT] = {
     [CACHE_SOURCE] = {FOURCC('S', 'R', 'C', 'E'), 0, 1, NULL, NULL, write_source, NULL, 0},
+    [CACHE_REPORT] = {FOURCC('R', 'E', 'P', 'T'), REQUIRED, 0, NULL, NULL, write_report, NULL, 0},
     [CACHE_SCENE] = {FOURCC('S', 'C', 'N', 'E'), REQUIRED, 0, NULL, NULL, write_scene, read_scene, 0},
     [CACHE_TEXTURES] = {FOURCC('T', 'E', 'X', 'R'), REQUIRED, 0, NULL, check_texture_sides, write_textures,
                         read_textures, 0},

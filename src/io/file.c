@@ -46,8 +46,84 @@ gdr_status gdr_io_source_add(gdr_source_list *list, const char *path, uint64_t s
     if (!copy)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
     memcpy(copy, path, length + 1);
-    list->files[list->count++] = (gdr_source_file){copy, size, mtime_ns, hash};
+    list->files[list->count++] = (gdr_source_file){copy, size, mtime_ns, hash, GDR_SOURCE_READ};
     return GDR_OK;
+}
+
+void gdr_io_absolute_path(const char *path, char *out, size_t out_size)
+{
+    char resolved[PATH_MAX], dir[PATH_MAX];
+    if (realpath(path, resolved)) {
+        snprintf(out, out_size, "%s", resolved);
+        return;
+    }
+    /* Nothing there: its folder resolved, with the last part as written. */
+    gdr_io_dirname(path, dir, sizeof dir);
+    const char *base = path + strlen(dir);
+    if (realpath(dir[0] ? dir : ".", resolved)) {
+        snprintf(out, out_size, "%s%s%s", resolved, strcmp(resolved, "/") ? "/" : "", base);
+        return;
+    }
+    char cwd[PATH_MAX];
+    if (path[0] != '/' && getcwd(cwd, sizeof cwd))
+        snprintf(out, out_size, "%s/%s", cwd, path);
+    else
+        snprintf(out, out_size, "%s", path);
+}
+
+gdr_status gdr_io_source_add_looked_for(gdr_source_list *list, const char *path, gdr_error *err)
+{
+    if (!list)
+        return GDR_OK;
+    char absolute[PATH_MAX];
+    gdr_io_absolute_path(path, absolute, sizeof absolute);
+    uint64_t size = 0;
+    int64_t mtime = 0;
+    int exists = gdr_io_stat(absolute, &size, &mtime) == 0;
+    gdr_status status = gdr_io_source_add(list, absolute, exists ? size : 0, exists ? mtime : 0, 0, err);
+    if (status == GDR_OK)
+        list->files[list->count - 1].state = exists ? GDR_SOURCE_UNREAD : GDR_SOURCE_ABSENT;
+    return status;
+}
+
+/* The length of a UTF-8 sequence at s (n bytes left) that encodes a printable code point (U+00A0
+ * and up, not a surrogate), or 0. */
+static size_t printable_utf8(const unsigned char *s, size_t n)
+{
+    size_t length = s[0] >= 0xf0 && s[0] <= 0xf4 ? 4 : s[0] >= 0xe0 ? 3 : s[0] >= 0xc2 && s[0] < 0xe0 ? 2 : 0;
+    if (length == 0 || length > n || (s[0] >= 0xe0 && s[0] < 0xf0 && length != 3))
+        return 0;
+    uint32_t cp = s[0] & (0x7f >> length);
+    for (size_t i = 1; i < length; i++) {
+        if ((s[i] & 0xc0) != 0x80)
+            return 0;
+        cp = cp << 6 | (s[i] & 0x3f);
+    }
+    int shortest = (length == 2 && cp >= 0x80) || (length == 3 && cp >= 0x800) || (length == 4 && cp >= 0x10000);
+    return shortest && cp >= 0xa0 && cp <= 0x10ffff && !(cp >= 0xd800 && cp <= 0xdfff) ? length : 0;
+}
+
+size_t gdr_io_escape_text(const char *text, size_t length, char *out, size_t out_size)
+{
+    const unsigned char *s = (const unsigned char *)text;
+    size_t n = 0;
+    for (size_t i = 0; i < length && out_size;) {
+        size_t utf8 = s[i] >= 0x80 ? printable_utf8(s + i, length - i) : 0;
+        size_t need = utf8 ? utf8 : s[i] >= 0x20 && s[i] < 0x7f ? 1 : 4;
+        if (n + need >= out_size)
+            break;
+        if (utf8)
+            memcpy(out + n, s + i, utf8);
+        else if (need == 1)
+            out[n] = (char)s[i];
+        else
+            snprintf(out + n, 5, "\\x%02x", s[i]);
+        n += need;
+        i += utf8 ? utf8 : 1;
+    }
+    if (out_size)
+        out[n] = 0;
+    return n;
 }
 
 void gdr_source_list_free(gdr_source_list *list)
@@ -176,6 +252,10 @@ void gdr_io_warn(gdr_io_warnings *w, const char *format, ...)
     vsnprintf(message, sizeof message, format, args);
     va_end(args);
     w->count++;
+    /* Text from the file (names, URIs) may hold control characters: escaped, never sent to a terminal. */
+    char safe[GDR_ERROR_MESSAGE_MAX];
+    gdr_io_escape_text(message, strlen(message), safe, sizeof safe);
+    memcpy(message, safe, sizeof safe);
     if (w->fn)
         w->fn(w->user, message);
     else

@@ -161,23 +161,29 @@ static gdr_status check_asset_and_extensions(gltf_ctx *c)
 
 /* --- materials and textures ------------------------------------------------------------------ */
 
-/* "images[3] (textures/wood.png)": the index and what the image is, its URI (a data: URI is not
- * quoted), else its name, else its buffer view; characters that are not printable ASCII become '?'. */
+/* "images[3] (textures/wood.png)", "images[3] 'albedo' (bufferView 5)": the index, the image's
+ * name if it has one, and where its bytes are: its file (a URI), a data: URI or its buffer view;
+ * characters that are not printable ASCII become '?'. */
 static void image_place(uint32_t image, const char *uri, const char *name, uint32_t view, char *out, size_t size)
 {
-    char what[80];
+    char what[80], named[80] = "";
     if (uri && strncmp(uri, "data:", 5) == 0)
         snprintf(what, sizeof what, "a data: URI");
-    else if (uri || name)
-        snprintf(what, sizeof what, "%.*s%s", 64, uri ? uri : name, strlen(uri ? uri : name) > 64 ? "..." : "");
+    else if (uri)
+        snprintf(what, sizeof what, "%.*s%s", 64, uri, strlen(uri) > 64 ? "..." : "");
     else if (view != GDR_NO_INDEX)
         snprintf(what, sizeof what, "bufferView %u", view);
     else
         snprintf(what, sizeof what, "no data");
+    if (name)
+        snprintf(named, sizeof named, " '%.*s%s'", 48, name, strlen(name) > 48 ? "..." : "");
     for (char *p = what; *p; p++)
         if ((unsigned char)*p < 32 || (unsigned char)*p > 126)
             *p = '?';
-    snprintf(out, size, "images[%u] (%s)", image, what);
+    for (char *p = named; *p; p++)
+        if ((unsigned char)*p < 32 || (unsigned char)*p > 126)
+            *p = '?';
+    snprintf(out, size, "images[%u]%s (%s)", image, named, what);
 }
 
 /* Decodes an image within the import's budgets: its pixels, and as decoded bytes its mip chain
@@ -218,7 +224,7 @@ static gdr_status load_image(gltf_ctx *c, uint32_t image, int srgb, uint32_t *ou
         *out = *slot;
         return GDR_OK;
     }
-    char here[32], described[128]; /* "images[3]"; "images[3] (textures/wood.png)" */
+    char here[32], described[192]; /* "images[3]"; "images[3] 'albedo' (textures/wood.png)" */
     snprintf(here, sizeof here, "images[%u]", image);
     const cJSON *json = c->image_at[image];
     const char *uri = NULL, *name = NULL;
@@ -1178,8 +1184,10 @@ static gdr_status walk_nodes(gltf_ctx *c, const uint32_t *roots, uint32_t root_c
                     status = inst ? gpu_instancing(c, inst, place, mesh, global)
                                   : add_instances(c, mesh, global, place, 0);
             }
-            if (status == GDR_OK && camera != GDR_NO_INDEX)
+            if (status == GDR_OK && camera != GDR_NO_INDEX) {
+                c->file_cameras++; /* counted whether or not gdr can use it: --camera-index says so */
                 status = add_camera(c, camera, place, global);
+            }
             uint32_t k = 0;
             for (const cJSON *child = children ? children->child : NULL; child && status == GDR_OK;
                  child = child->next, k++) {
@@ -1207,14 +1215,24 @@ done:
     return status;
 }
 
-static gdr_status load_scene(gltf_ctx *c)
+/* The root's "scene": the index of the scene to show, GDR_NO_INDEX when absent. */
+static gdr_status scene_index(gltf_ctx *c, uint32_t *scene)
 {
-    uint32_t scene = GDR_NO_INDEX;
-    gdr_status status = gltf_get_uint(c, c->root, "scene", "(root)", 0, UINT32_MAX - 1, &scene);
+    *scene = GDR_NO_INDEX;
+    gdr_status status = gltf_get_uint(c, c->root, "scene", "(root)", 0, UINT32_MAX - 1, scene);
     if (status != GDR_OK)
         return gltf_fail(c, GDR_ERROR_PARSE, "scene: expected a scene index");
-    if (scene != GDR_NO_INDEX && scene >= c->scene_count)
-        return gltf_fail(c, GDR_ERROR_PARSE, "scene: scene %u does not exist (%u scenes)", scene, c->scene_count);
+    if (*scene != GDR_NO_INDEX && *scene >= c->scene_count)
+        return gltf_fail(c, GDR_ERROR_PARSE, "scene: scene %u does not exist (%u scenes)", *scene, c->scene_count);
+    return GDR_OK;
+}
+
+static gdr_status load_scene(gltf_ctx *c)
+{
+    uint32_t scene;
+    gdr_status status = scene_index(c, &scene);
+    if (status != GDR_OK)
+        return status;
     uint32_t *roots = NULL, root_count = 0;
     char place[48];
     if (scene == GDR_NO_INDEX && c->scene_count == 0) {
@@ -1344,6 +1362,13 @@ static gdr_status import_document(gltf_ctx *c, const uint8_t *data, size_t size)
         return gltf_fail(c, GDR_ERROR_OUT_OF_MEMORY, "out of memory");
     memset(c->mesh_first, 0xff, sizeof(uint32_t) * (c->mesh_count + 1));
     memset(c->image_texture, 0xff, sizeof(uint32_t) * 2 * (c->image_count + 1));
+    gltf_report_unsupported(c);
+    /* The document's structure, then the geometry's buffers, before the materials: a missing .bin
+     * is said before any image is decoded. */
+    uint32_t scene;
+    status = scene_index(c, &scene);
+    if (status == GDR_OK)
+        status = gltf_load_mesh_buffers(c);
     for (uint32_t m = 0; m < c->material_count && status == GDR_OK; m++)
         status = load_material(c, m);
     if (status == GDR_OK)
@@ -1378,8 +1403,10 @@ gdr_status gdr_import_gltf_memory(const void *data, size_t size, const char *nam
     free(c.prim_material);
     gltf_shared_meshes_free(&c.shared);
     free(c.image_texture);
-    if (result)
+    if (result) {
         result->warning_count = c.warnings.count;
+        result->file_cameras = c.file_cameras;
+    }
     if (status != GDR_OK) {
         gdr_scene_destroy(c.scene);
         return status;

@@ -237,14 +237,20 @@ gdr_status gltf_load_uri(gltf_ctx *c, const char *uri, const char *place, uint8_
     path[n] = 0;
     gdr_error file_err;
     gdr_status status = c->allow_outside_files ? GDR_OK : confine_to_folder(c, place, uri, &path);
+    int confined = status == GDR_OK; /* else confine_to_folder said why in c->err */
+    if (confined)
+        status = gdr_io_read_file(path, out, size, c->sources, &file_err);
     if (status != GDR_OK) {
+        /* Looked for and not read: recorded too, so that a cache built without it is rebuilt once the
+         * file appears or changes. */
+        gdr_error record_err;
+        gdr_status recorded = gdr_io_source_add_looked_for(c->sources, path, &record_err);
         free(path);
-        return status;
+        if (recorded != GDR_OK)
+            return gltf_fail(c, recorded, "%s.uri: %s", place, record_err.message);
+        return confined ? gltf_fail(c, status, "%s.uri: %s", place, file_err.message) : status;
     }
-    status = gdr_io_read_file(path, out, size, c->sources, &file_err);
     free(path);
-    if (status != GDR_OK)
-        return gltf_fail(c, status, "%s.uri: %s", place, file_err.message);
     return GDR_OK;
 }
 
@@ -685,4 +691,76 @@ gdr_status gltf_accessor_read_uints(gltf_ctx *c, uint32_t index, const char *use
         }
     }
     return s.sparse ? apply_sparse(c, index, &s, 1, NULL, out) : GDR_OK;
+}
+
+/* An index member of a JSON object, or GDR_NO_INDEX when it is absent or not an index below `count`
+ * (the conversion that reads it later says what is wrong). */
+static uint32_t index_member(const cJSON *obj, const char *key, uint32_t count)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!cJSON_IsNumber(v) || !(v->valuedouble >= 0.0) || v->valuedouble >= (double)count ||
+        v->valuedouble != (double)(uint32_t)v->valuedouble)
+        return GDR_NO_INDEX;
+    return (uint32_t)v->valuedouble;
+}
+
+/* Marks the buffer behind bufferView `view`. */
+static void mark_view(gltf_ctx *c, uint32_t view, uint8_t *marked)
+{
+    if (view == GDR_NO_INDEX)
+        return;
+    /* A compressed view reads the extension's buffer; its own may be a fallback without data. */
+    const cJSON *meshopt = gltf_extension(c->view_at[view], "EXT_meshopt_compression");
+    uint32_t buffer = index_member(meshopt ? meshopt : c->view_at[view], "buffer", c->buffer_count);
+    if (buffer != GDR_NO_INDEX)
+        marked[buffer] = 1;
+}
+
+static void mark_accessor(gltf_ctx *c, uint32_t accessor, uint8_t *marked)
+{
+    if (accessor == GDR_NO_INDEX)
+        return;
+    const cJSON *a = c->accessor_at[accessor];
+    mark_view(c, index_member(a, "bufferView", c->view_count), marked);
+    const cJSON *sparse = cJSON_GetObjectItemCaseSensitive(a, "sparse");
+    if (!cJSON_IsObject(sparse))
+        return;
+    mark_view(c, index_member(cJSON_GetObjectItemCaseSensitive(sparse, "indices"), "bufferView", c->view_count),
+              marked);
+    mark_view(c, index_member(cJSON_GetObjectItemCaseSensitive(sparse, "values"), "bufferView", c->view_count),
+              marked);
+}
+
+static void mark_mesh(gltf_ctx *c, uint32_t mesh, uint8_t *marked)
+{
+    const cJSON *prims = cJSON_GetObjectItemCaseSensitive(c->mesh_at[mesh], "primitives");
+    for (const cJSON *prim = cJSON_IsArray(prims) ? prims->child : NULL; prim; prim = prim->next) {
+        mark_accessor(c, index_member(prim, "indices", c->accessor_count), marked);
+        const cJSON *attributes = cJSON_GetObjectItemCaseSensitive(prim, "attributes");
+        for (const cJSON *a = cJSON_IsObject(attributes) ? attributes->child : NULL; a; a = a->next)
+            if (a->string)
+                mark_accessor(c, index_member(attributes, a->string, c->accessor_count), marked);
+    }
+}
+
+gdr_status gltf_load_mesh_buffers(gltf_ctx *c)
+{
+    uint8_t *meshes = calloc(c->mesh_count + 1, 1), *buffers = calloc(c->buffer_count + 1, 1);
+    gdr_status status = meshes && buffers ? GDR_OK : gltf_fail(c, GDR_ERROR_OUT_OF_MEMORY, "out of memory");
+    for (uint32_t n = 0; n < c->node_count && status == GDR_OK; n++) {
+        uint32_t mesh = index_member(c->node_at[n], "mesh", c->mesh_count);
+        if (mesh != GDR_NO_INDEX && !meshes[mesh]) {
+            meshes[mesh] = 1;
+            mark_mesh(c, mesh, buffers);
+        }
+    }
+    for (uint32_t b = 0; b < c->buffer_count && status == GDR_OK; b++) {
+        const uint8_t *data;
+        size_t size;
+        if (buffers[b])
+            status = gltf_buffer_get(c, b, "buffers", &data, &size);
+    }
+    free(meshes);
+    free(buffers);
+    return status;
 }

@@ -82,6 +82,7 @@ typedef struct gltf_ctx {
     uint32_t *prim_material;
     uint32_t prim_count, prim_capacity;
     gltf_shared_meshes shared; /* primitives of the same accessors share one mesh */
+    uint32_t file_cameras;    /* nodes with a camera met in the scene's walk, used or not */
     uint32_t *image_texture;  /* per glTF image, linear then sRGB: gdr texture, GDR_NO_INDEX, or UINT32_MAX - 1 (failed) */
 } gltf_ctx;
 
@@ -110,7 +111,14 @@ gdr_status gltf_get_floats(gltf_ctx *c, const cJSON *obj, const char *key, const
 /* The extension object obj.extensions.NAME, or NULL. */
 const cJSON *gltf_extension(const cJSON *obj, const char *name);
 
+/* One warning per feature the file uses that gdr does not draw (skins, morph targets, animation,
+ * each unsupported material extension), naming the first place it occurs (gltf_unsupported.c). */
+void gltf_report_unsupported(gltf_ctx *c);
+
 /* Buffers and views. */
+/* Loads every buffer that the meshes of the file's nodes read through their accessors, so that a
+ * missing or short buffer is reported before any image is decoded. */
+gdr_status gltf_load_mesh_buffers(gltf_ctx *c);
 gdr_status gltf_buffer_get(gltf_ctx *c, uint32_t index, const char *place, const uint8_t **data, size_t *size);
 gdr_status gltf_view_get(gltf_ctx *c, uint32_t index, const char *place, const gltf_view **out);
 void gltf_buffers_free(gltf_ctx *c);

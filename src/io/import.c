@@ -11,6 +11,7 @@
 #include "gdr/io.h"
 #include "gdr/geometry.h"
 #include "io/cache_pvs.h"
+#include "io/import_report.h"
 #include "io/io_internal.h"
 #include "io/loaders.h"
 
@@ -42,24 +43,6 @@ gdr_status gdr_import_file(const char *path, const gdr_import_options *options, 
         return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: unknown file type (.gltf, .glb, .obj or .gdrc)", path);
     }
     return status == GDR_OK ? build_clusters(path, out, 1, options && options->no_progress, err) : status;
-}
-
-/* $XDG_CACHE_HOME/gdr or ~/.cache/gdr, created when missing; 0 when there is none. */
-static int fallback_cache_dir(char *out, size_t size)
-{
-    const char *xdg = getenv("XDG_CACHE_HOME"), *home = getenv("HOME");
-    char parent[PATH_MAX];
-    if (xdg && xdg[0] == '/')
-        snprintf(parent, sizeof parent, "%s", xdg);
-    else if (home && home[0] == '/')
-        snprintf(parent, sizeof parent, "%s/.cache", home);
-    else
-        return 0;
-    mkdir(parent, 0755);
-    int n = snprintf(out, size, "%s/gdr", parent);
-    if (n <= 0 || (size_t)n >= size)
-        return 0;
-    return mkdir(out, 0755) == 0 || errno == EEXIST;
 }
 
 static void warn(const gdr_load_options *o, const char *format, ...) __attribute__((format(printf, 2, 3)));
@@ -94,6 +77,104 @@ static gdr_status finish_cache_read(const char *path, gdr_scene **out, gdr_pvs *
     return status;
 }
 
+/* Every warning of an import goes to the caller's sink and into the report the cache keeps. */
+typedef struct warning_collector {
+    const gdr_load_options *options;
+    gdr_import_report *report;
+} warning_collector;
+
+static void collect_warning(void *user, const char *message)
+{
+    warning_collector *c = user;
+    gdr_error ignored;
+    gdr_io_report_add(c->report, message, strlen(message), &ignored); /* out of memory: said, not kept */
+    if (c->options->warning)
+        c->options->warning(c->options->warning_user, message);
+    else
+        fprintf(stderr, "gdr: warning: %s\n", message);
+}
+
+/* Where the cache of `path` goes: next to it for ".", else in cache_dir or the per-user folder
+ * (*dir, created and checked). 0: no cache (no folder to be had; said when there is a reason). */
+static int cache_location(const char *path, const gdr_load_options *options, char *dir, char *cache)
+{
+    dir[0] = 0;
+    if (options->cache_dir && strcmp(options->cache_dir, ".") == 0)
+        return gdr_cache_path_for(path, NULL, cache, PATH_MAX) != 0;
+    if (options->cache_dir)
+        snprintf(dir, PATH_MAX, "%s", options->cache_dir);
+    else if (!gdr_cache_default_dir(dir, PATH_MAX))
+        return 0; /* no HOME or XDG_CACHE_HOME: nowhere to keep one */
+    gdr_error dir_err;
+    if (gdr_io_cache_dir_prepare(dir, &dir_err) != GDR_OK) {
+        warn(options, "%s", dir_err.message);
+        return 0;
+    }
+    return gdr_cache_path_for(path, dir, cache, PATH_MAX) != 0;
+}
+
+/* The cache of `path` at `cache`, when it is there and fresh: the scene, its PVS and report, the
+ * warnings said again; 0 when it must be (re)built. */
+static int read_cached(const char *path, const char *cache, const gdr_load_options *options, gdr_scene **out,
+                       gdr_pvs **out_pvs, gdr_import_report *report, gdr_status *status, gdr_error *err)
+{
+    if (access(cache, F_OK) != 0)
+        return 0;
+    gdr_error cache_err;
+    gdr_pvs *pvs = NULL;
+    gdr_import_report cached = {0};
+    gdr_status read = gdr_io_cache_read_for(cache, path, gdr_cache_build_options(), out, out_pvs ? &pvs : NULL,
+                                            &cached, &cache_err);
+    if (read != GDR_OK) {
+        /* Stale: rebuilt without a word; gone meanwhile (another gdr evicted it): the same; else said. */
+        if (read != GDR_ERROR_STALE && access(cache, F_OK) == 0)
+            warn(options, "%s; rebuilding it", cache_err.message);
+        return 0;
+    }
+    gdr_io_cache_touch(cache); /* used now: the last to be evicted */
+    gdr_error ignored;
+    gdr_io_report_untemplate(&cached, path, &ignored); /* out of memory: said with its markers */
+    gdr_io_report_replay(&cached, options->warning, options->warning_user);
+    *report = cached;
+    report->cache_path = strdup(cache);
+    report->cache_state = GDR_CACHE_READ;
+    *status = finish_cache_read(cache, out, pvs, out_pvs, err);
+    return 1;
+}
+
+/* A .gdrc given directly: read as it stands, its import's warnings said again. */
+static gdr_status load_cache_file(const char *path, gdr_scene **out, gdr_pvs **out_pvs,
+                                  const gdr_load_options *options, gdr_import_report *report, gdr_error *err)
+{
+    gdr_pvs *pvs = NULL;
+    gdr_status status = gdr_io_cache_read_for(path, NULL, gdr_cache_build_options(), out, out_pvs ? &pvs : NULL,
+                                              report, err);
+    if (status != GDR_OK)
+        return status;
+    gdr_error ignored;
+    gdr_io_report_untemplate(report, NULL, &ignored);
+    gdr_io_report_replay(report, options->warning, options->warning_user);
+    return finish_cache_read(path, out, pvs, out_pvs, err);
+}
+
+/* Writes the cache of a fresh import, then keeps its folder within the size limit. */
+static void write_cache(const char *path, const char *cache, const char *dir, const gdr_scene *scene,
+                        const gdr_source_list *sources, const gdr_load_options *options, gdr_import_report *report)
+{
+    gdr_import_report kept;
+    gdr_error write_err = {0};
+    int written = gdr_io_report_template(report, path, &kept, &write_err) == GDR_OK;
+    gdr_cache_write_options write = {.source = {gdr_cache_build_options(), sources}, .report = &kept};
+    written = written && gdr_cache_write(cache, scene, &write, &write_err) == GDR_OK;
+    gdr_import_report_free(&kept);
+    report->cache_path = strdup(cache);
+    report->cache_state = written ? GDR_CACHE_WRITTEN : GDR_CACHE_NOT_WRITTEN;
+    if (!written)
+        warn(options, "cache not written: %s", write_err.message);
+    else if (dir[0])
+        gdr_io_cache_evict(dir, gdr_io_cache_limit(options->cache_max_bytes), cache);
+}
+
 gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options, gdr_scene **out, gdr_pvs **out_pvs,
                                gdr_error *err)
 {
@@ -103,64 +184,48 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
     *out = NULL;
     if (out_pvs)
         *out_pvs = NULL;
-    const char *build_options = gdr_cache_build_options();
-    gdr_pvs *pvs = NULL;
+    gdr_import_report local = {0}, *report = options->report ? options->report : &local;
+    *report = (gdr_import_report){0};
+    gdr_status status;
     if (options->geometry_in_pages) {
         if (!gdr_io_has_extension(path, ".gdrc"))
             return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: streaming reads a .gdrc cache with geometry "
                                  "pages (gdr build SCENE -o FILE.gdrc --pages), not a source file", path);
-        return gdr_cache_read_for_streaming(path, build_options, out, out_pvs, NULL, err);
+        status = gdr_io_cache_read_for_streaming(path, gdr_cache_build_options(), out, out_pvs, report, NULL, err);
+        gdr_error ignored;
+        if (status == GDR_OK) {
+            gdr_io_report_untemplate(report, NULL, &ignored); /* out of memory: said with its markers */
+            gdr_io_report_replay(report, options->warning, options->warning_user);
+        }
+        gdr_import_report_free(&local);
+        return status;
     }
     if (gdr_io_has_extension(path, ".gdrc")) {
-        gdr_status status = gdr_cache_read(path, build_options, out, out_pvs ? &pvs : NULL, err);
-        return status == GDR_OK ? finish_cache_read(path, out, pvs, out_pvs, err) : status;
+        status = load_cache_file(path, out, out_pvs, options, report, err);
+        gdr_import_report_free(&local);
+        return status;
     }
-    gdr_import_options import = {.warning = options->warning, .warning_user = options->warning_user,
+    warning_collector collector = {options, report};
+    gdr_import_options import = {.warning = collect_warning, .warning_user = &collector,
                                  .no_progress = options->no_progress, .budget = options->budget,
                                  .allow_outside_files = options->allow_outside_files};
-    if (options->no_cache) {
-        import.sources = options->sources;
-        return gdr_import_file(path, &import, out, NULL, err);
+    gdr_import_result result = {0};
+    char dir[PATH_MAX], cache[PATH_MAX];
+    int cached = !options->no_cache && cache_location(path, options, dir, cache);
+    if (cached && read_cached(path, cache, options, out, out_pvs, report, &status, err)) {
+        gdr_import_report_free(&local);
+        return status;
     }
-
-    /* Candidates: the given cache_dir, or next to the source then the per-user folder. */
-    char candidates[2][PATH_MAX], fallback[PATH_MAX];
-    int count = 0;
-    if (options->cache_dir) {
-        mkdir(options->cache_dir, 0755);
-        count += gdr_cache_path_for(path, options->cache_dir, candidates[count], PATH_MAX) != 0;
-    } else {
-        count += gdr_cache_path_for(path, NULL, candidates[count], PATH_MAX) != 0;
-        if (fallback_cache_dir(fallback, sizeof fallback))
-            count += gdr_cache_path_for(path, fallback, candidates[count], PATH_MAX) != 0;
-    }
-    for (int i = 0; i < count; i++) {
-        if (access(candidates[i], F_OK) != 0)
-            continue;
-        gdr_error cache_err;
-        gdr_status read = gdr_io_cache_read_for(candidates[i], path, build_options, out, out_pvs ? &pvs : NULL,
-                                                &cache_err);
-        if (read == GDR_OK)
-            return finish_cache_read(candidates[i], out, pvs, out_pvs, err);
-        if (read != GDR_ERROR_STALE) /* a stale cache is rebuilt without a word; anything else is said */
-            warn(options, "%s; rebuilding it", cache_err.message);
-    }
-
     gdr_source_list sources = {0};
     import.sources = &sources;
-    gdr_status status = gdr_import_file(path, &import, out, NULL, err);
-    if (status == GDR_OK) {
-        gdr_cache_write_options write = {.source = {build_options, &sources}};
-        int written = 0;
-        gdr_error write_err = {0};
-        for (int i = 0; i < count && !written; i++)
-            written = gdr_cache_write(candidates[i], *out, &write, &write_err) == GDR_OK;
-        if (!written && count)
-            warn(options, "cache not written: %s", write_err.message);
-    }
+    status = gdr_import_file(path, &import, out, &result, err);
+    report->file_cameras = result.file_cameras;
+    if (status == GDR_OK && cached)
+        write_cache(path, cache, dir, *out, &sources, options, report);
     if (status == GDR_OK && options->sources) /* the caller's, as gdr_load_options.sources asks */
         *options->sources = sources;
     else
         gdr_source_list_free(&sources);
+    gdr_import_report_free(&local);
     return status;
 }

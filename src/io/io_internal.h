@@ -42,6 +42,19 @@ gdr_status gdr_io_read_file(const char *path, uint8_t **out_data, size_t *out_si
 gdr_status gdr_io_source_add(gdr_source_list *list, const char *path, uint64_t size, int64_t mtime_ns,
                              uint64_t hash, gdr_error *err);
 
+/* Appends a path an import looked for but did not read (made absolute): GDR_SOURCE_ABSENT when
+ * nothing is there, else GDR_SOURCE_UNREAD with what stat says. list may be NULL. */
+gdr_status gdr_io_source_add_looked_for(gdr_source_list *list, const char *path, gdr_error *err);
+
+/* path made absolute: realpath when it exists, else its folder's realpath and its last part, else
+ * joined to the working directory. */
+void gdr_io_absolute_path(const char *path, char *out, size_t out_size);
+
+/* Copies `length` bytes of untrusted text into out (NUL-terminated, cut to fit) with every byte that
+ * a terminal could take for a command escaped as \xNN: control characters (C0, DEL, C1) and bytes
+ * that are not valid UTF-8. Returns the length written. */
+size_t gdr_io_escape_text(const char *text, size_t length, char *out, size_t out_size);
+
 /* size and modification time of a file; returns 0 on success. */
 int gdr_io_stat(const char *path, uint64_t *size, int64_t *mtime_ns);
 
@@ -110,9 +123,31 @@ gdr_status gdr_io_image_decode(const void *data, size_t size, const char *name, 
 
 /* gdr_cache_read for the cache of `source` (NULL: a cache read on its own): the cache must
  * record that file as the first of its sources, with the same size and contents (its folder may
- * have moved: the other sources are then looked for under the new folder), else it is stale. */
+ * have moved: the other sources are then looked for under the new folder), else it is stale.
+ * out_report (may be NULL): the import's report the cache keeps (section 'REPT'). */
 gdr_status gdr_io_cache_read_for(const char *path, const char *source, const char *build_options, gdr_scene **out,
-                                 gdr_pvs **out_pvs, gdr_error *err);
+                                 gdr_pvs **out_pvs, gdr_import_report *out_report, gdr_error *err);
+
+/* gdr_cache_read_for_streaming that also returns the import's report the cache keeps (may be NULL). */
+gdr_status gdr_io_cache_read_for_streaming(const char *path, const char *build_options, gdr_scene **out,
+                                           gdr_pvs **out_pvs, gdr_import_report *out_report, uint64_t *out_bytes_read,
+                                           gdr_error *err);
+
+/* The source a cache file records first (the file it was built from), control characters escaped;
+ * reads only the header, the table and section 'SRCE', each checksum checked. */
+gdr_status gdr_io_cache_recorded_source(const char *path, char *out, size_t out_size, gdr_error *err);
+
+/* cache_dir.c: a cache folder gdr keeps (the per-user one, or --cache-dir). */
+/* Creates it (mode 0700, its parent too when missing) and checks it is a folder of this user that
+ * no one else may write to; else an error naming it (a cache there could be planted by others). */
+gdr_status gdr_io_cache_dir_prepare(const char *dir, gdr_error *err);
+/* Marks a cache as used now (its modification time), for least-recently-used eviction. */
+void gdr_io_cache_touch(const char *path);
+/* Removes the least recently used caches gdr wrote in dir (gdr_cache_list's) until those left
+ * hold at most max_bytes; never `keep`. Returns how many were removed. */
+uint32_t gdr_io_cache_evict(const char *dir, uint64_t max_bytes, const char *keep);
+/* The size limit: max_bytes, else GDR_CACHE_MAX_MIB from the environment, else the default. */
+uint64_t gdr_io_cache_limit(uint64_t max_bytes);
 
 /* Warning sink of one import. */
 typedef struct gdr_io_warnings {

@@ -151,6 +151,8 @@ gdr_status gdr_scene_load(const char *spec, const gdr_load_options *options, gdr
         *options->pvs = NULL;
     if (options && options->sources)
         *options->sources = (gdr_source_list){0};
+    if (options && options->report)
+        *options->report = (gdr_import_report){0};
     const char *text;
     builtin_scene which = find_builtin(spec, &text);
     if (which != BUILTIN_NONE && options && options->geometry_in_pages)

@@ -17,7 +17,8 @@ typedef struct gdr_import_options {
     void *warning_user;
     int no_progress;          /* 1: no progress bar (default: shown on a terminal for long work) */
     gdr_source_list *sources; /* optional: receives every file read (the source and its buffers,
-                                 images), for the cache's staleness check */
+                                 images) and every path looked at where none could be read, for the
+                                 cache's staleness check */
     gdr_budget budget;        /* limits for untrusted files (gdr/scene.h); zero: the defaults */
     int allow_outside_files;  /* 1: external URIs may leave the file's folder (absolute paths, '..',
                                  symlinks pointing out); 0 (default): such a URI is refused */
@@ -25,6 +26,7 @@ typedef struct gdr_import_options {
 
 typedef struct gdr_import_result {
     uint32_t warning_count;
+    uint32_t file_cameras; /* camera placements in the file (nodes with a camera), used or not */
 } gdr_import_result;
 
 /* Imports a .gltf or .glb file (told apart by content: GLB starts with "glTF"). External

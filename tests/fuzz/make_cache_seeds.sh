@@ -11,12 +11,18 @@ seed() { # NAME: the flag byte, then WORK/NAME.gdrc
     { printf '\001'; cat "$work/$1.gdrc"; } >"$here/corpus/cache/$1.gdrc"
 }
 # A second build from the first cache drops the source paths (the seeds must not name this machine).
-"$gdr" build "$here/corpus/gltf/nodes.gltf" -o "$work/a.gdrc" --no-progress >/dev/null
-"$gdr" build "$work/a.gdrc" -o "$work/nodes.gdrc" --no-progress >/dev/null
-"$gdr" build "$here/corpus/obj/quad.obj" -o "$work/b.gdrc" --no-progress >/dev/null
-"$gdr" build "$work/b.gdrc" -o "$work/quad.gdrc" --no-progress >/dev/null
-"$gdr" build "$here/corpus/obj/tri.obj" -o "$work/c.gdrc" --pvs --no-progress >/dev/null
+# Built from inside their folders: the warnings the caches keep name the files, not this machine's paths.
+gdr=$(cd "$(dirname "$gdr")" && pwd)/$(basename "$gdr")
+cd "$here/corpus/gltf" && "$gdr" build nodes.gltf -o "$work/a.gdrc" --no-progress >/dev/null 2>&1
+"$gdr" build "$work/a.gdrc" -o "$work/nodes.gdrc" --no-progress >/dev/null 2>&1
+cd "$here/corpus/obj" && "$gdr" build quad.obj -o "$work/b.gdrc" --no-progress >/dev/null 2>&1
+"$gdr" build "$work/b.gdrc" -o "$work/quad.gdrc" --no-progress >/dev/null 2>&1
+"$gdr" build tri.obj -o "$work/c.gdrc" --pvs --no-progress >/dev/null
 "$gdr" build "$work/c.gdrc" -o "$work/pvs.gdrc" --no-progress >/dev/null
 "$gdr" build unique-field:meshes=2,triangles=1000 -o "$work/paged.gdrc" --pages=4 --no-progress >/dev/null
-for name in nodes quad pvs paged; do seed $name; done
+# A cache that keeps its import's warnings (section 'REPT'): an OBJ statement gdr ignores.
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nbevel on\n' >"$work/warned.obj"
+cd "$work" && "$gdr" build warned.obj -o "$work/d.gdrc" --no-progress >/dev/null 2>&1
+"$gdr" build "$work/d.gdrc" -o "$work/warned.gdrc" --no-progress >/dev/null 2>&1
+for name in nodes quad pvs paged warned; do seed $name; done
 ls -l "$here/corpus/cache"

@@ -159,7 +159,8 @@ static void test_unknown_sections(gdr_scene *scene)
     free(data);
 }
 
-/* gdr_scene_load: first load imports and writes SOURCE.gdrc; the second reads it; touching
+/* gdr_scene_load with the cache next to the source (cache_dir "."): first load imports and writes
+ * SOURCE.gdrc; the second reads it; touching
  * the source without changing it keeps it; changing the source rebuilds it. */
 static void test_automatic_cache(void)
 {
@@ -169,7 +170,7 @@ static void test_automatic_cache(void)
     const char *text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
     CHECK(test_write_file(obj, text, strlen(text)));
     unlink(cache);
-    gdr_load_options options = {.no_progress = 1};
+    gdr_load_options options = {.no_progress = 1, .cache_dir = "."}; /* ".": next to the source */
     gdr_error err = {0};
     gdr_scene *s = NULL;
     CHECK(gdr_scene_load(obj, &options, &s, &err) == GDR_OK);

@@ -342,7 +342,10 @@ static void test_glb_and_files(void)
         CHECK(s->texture_count == 1 && s->materials[0].base_color_texture.texture == 0);
         CHECK(s->materials[0].normal_texture.texture == GDR_NO_INDEX);
         CHECK(warnings.count == 1 && strstr(warnings.text, "images[1].uri") && strstr(warnings.text, "missing.png"));
-        CHECK(sources.count == 3); /* the .gltf, the .bin and the .png */
+        /* the .gltf, the .bin and the .png read, and missing.png looked for: a cache is rebuilt when it appears */
+        CHECK(sources.count == 4);
+        CHECK(sources.count == 4 && sources.files[3].state == GDR_SOURCE_ABSENT && strstr(sources.files[3].path, "/missing.png") &&
+              sources.files[3].path[0] == '/');
         gdr_scene_destroy(s);
     } else {
         fprintf(stderr, "gltf files: %s\n", err.message);

@@ -374,7 +374,9 @@ static void test_source_list_repeats(void)
     gdr_scene *s = obj_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n", NULL);
     double seconds[2];
     uint32_t counts[2] = {1, 243};
-    gdr_load_options o = {.no_progress = 1, .warning = test_collect_warning, .warning_user = &warnings};
+    /* next to the source ("."), where a copied folder carries its cache */
+    gdr_load_options o = {.no_progress = 1, .warning = test_collect_warning, .warning_user = &warnings,
+                          .cache_dir = "."};
     for (int k = 0; k < 2; k++) {
         write_listing_cache(cache, s, source, big, counts[k]);
         struct timespec t0, t1;
@@ -434,7 +436,9 @@ static void test_cache_knows_its_source(void)
     const char *three = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
     unlink(a_cache);
     CHECK(test_write_file(a_obj, one, strlen(one)));
-    gdr_load_options o = {.no_progress = 1, .warning = test_collect_warning, .warning_user = &warnings};
+    /* next to the source ("."), where a copied folder carries its cache */
+    gdr_load_options o = {.no_progress = 1, .warning = test_collect_warning, .warning_user = &warnings,
+                          .cache_dir = "."};
     gdr_scene *s = NULL;
     CHECK(gdr_scene_load_file(a_obj, &o, &s, NULL, &err) == GDR_OK && access(a_cache, F_OK) == 0);
     gdr_scene_destroy(s);

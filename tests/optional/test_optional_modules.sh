@@ -25,6 +25,7 @@ full=${3:-}
 jobs=${JOBS:-$(nproc)}
 rm -rf "$work" && mkdir -p "$work"
 work=$(cd "$work" && pwd)
+XDG_CACHE_HOME=$work/cache-home; export XDG_CACHE_HOME # caches of the sources here, not in the home
 failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 message="built without the culling module (GDR_EXCLUDE_MODULES)"

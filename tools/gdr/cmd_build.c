@@ -8,6 +8,7 @@
 #include "gdr/geometry.h"
 #include "cli_args.h"
 #include "cli_pvs.h"
+#include "cli_warnings.h"
 #include "commands.h"
 #include "gdr/io.h"
 #include "gdr/paged_cache.h"
@@ -15,9 +16,10 @@
 static void build_usage(void)
 {
     fputs("usage: gdr build INPUT -o OUTPUT.gdrc [--pvs] [--pvs-cell M] [--pvs-samples N] [--pages[=KIB]]\n"
-          "                 [--no-progress] [--budget KEY=N,...] [--allow-outside-files]\n"
+          "                 [--no-progress] [--strict] [--budget KEY=N,...] [--allow-outside-files]\n"
           "  INPUT: a .gltf, .glb or .obj file, a .gdrc cache, or a built-in scene: 'demo', 'lod-field',\n"
           "         'occlusion', 'unique-field' or 'rooms', each with optional ':key=value,...' (see gdr --help)\n"
+          "  --strict: every warning of the import is an error: nothing is written, exit status 4\n"
           "  --pvs: bake precomputed visibility (every processor) into the cache; gdr render culls with it\n"
           "  --pvs-cell M: its cells' size in metres (default: the scene's largest side / 16; the rooms\n"
           "         scene wants 1: a cell touched by geometry gets no data)\n"
@@ -52,11 +54,14 @@ int gdr_cmd_build(int argc, char **argv)
     uint32_t page_bytes = 0, pvs_samples = 0;
     float pvs_cell = 0.0f;
     gdr_budget budget = {0};
+    cli_warnings warnings = {0};
     for (int i = 1; i < argc; i++) {
         if ((strcmp(argv[i], "-o") == 0 || strcmp(argv[i], "--out") == 0) && i + 1 < argc) {
             output = argv[++i];
         } else if (strcmp(argv[i], "--no-progress") == 0) {
             no_progress = 1;
+        } else if (strcmp(argv[i], "--strict") == 0) {
+            warnings.strict = true;
         } else if (strcmp(argv[i], "--pvs") == 0) {
             if (!cli_needs_cull(argv[i]))
                 return 2;
@@ -111,9 +116,19 @@ int gdr_cmd_build(int argc, char **argv)
     gdr_pvs *pvs = NULL; /* a .gdrc input's precomputed visibility is carried over unless rebaked */
     /* A .gdrc input's precomputed visibility is carried over unless rebaked; a source's files are
      * recorded in the cache written. */
+    gdr_import_report report = {0}; /* the import's warnings, kept in the cache */
     gdr_load_options load = {.no_cache = 1, .no_progress = no_progress, .budget = budget,
-                             .allow_outside_files = allow_outside_files, .pvs = &pvs, .sources = &sources};
+                             .allow_outside_files = allow_outside_files, .pvs = &pvs, .sources = &sources,
+                             .warning = cli_warning, .warning_user = &warnings, .report = &report};
     status = gdr_scene_load(input, &load, &scene, &err);
+    int strict = status == GDR_OK ? cli_strict_check(&warnings, input) : 0;
+    if (strict) {
+        gdr_import_report_free(&report);
+        cli_pvs_destroy(pvs);
+        gdr_source_list_free(&sources);
+        gdr_scene_destroy(scene);
+        return strict;
+    }
     if (status == GDR_OK && pvs && !pvs_wanted)
         cli_pvs_print_kept(input, pvs);
     if (status == GDR_OK && page_bytes)
@@ -125,7 +140,7 @@ int gdr_cmd_build(int argc, char **argv)
     }
     if (status == GDR_OK) {
         gdr_cache_write_options write = {.source = {gdr_cache_build_options(), &sources}, .pvs = pvs,
-                                         .page_bytes = page_bytes};
+                                         .page_bytes = page_bytes, .report = &report};
         status = gdr_cache_write(output, scene, &write, &err);
     }
     if (status == GDR_OK)
@@ -134,6 +149,7 @@ int gdr_cmd_build(int argc, char **argv)
                scene->material_count, scene->texture_count, scene->camera_count);
     int result = status == GDR_OK ? 0 : cli_load_failed(input, &err);
     cli_pvs_destroy(pvs);
+    gdr_import_report_free(&report);
     gdr_source_list_free(&sources);
     gdr_scene_destroy(scene);
     return result;

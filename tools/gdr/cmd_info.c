@@ -7,20 +7,15 @@
 #include "cli_args.h"
 #include "commands.h"
 #include "cli_pvs.h"
+#include "cli_warnings.h"
 #include "gdr/io.h"
 #include "gdr/paged_cache.h"
 #include "gdr/renderer.h"
 
 #define INFO_USAGE                                                                                       \
     "usage: gdr info FILE|demo|lod-field|occlusion|unique-field|rooms[:...] [--no-cache] [--cache-dir DIR]\n"  \
-    "       [--budget KEY=N,...] [--allow-outside-files]\n"                                             \
+    "       [--cache-max MIB] [--strict] [--budget KEY=N,...] [--allow-outside-files]\n"                \
     "       gdr info --passes\n"
-
-static void count_warning(void *user, const char *message)
-{
-    (*(unsigned *)user)++;
-    fprintf(stderr, "gdr: warning: %s\n", message);
-}
 
 /* How many meshes have their vertices on a grid (gdr build --pages), and the largest move. */
 static void print_quantization(const gdr_scene *scene)
@@ -65,6 +60,20 @@ static void print_cache_bytes(const char *path, uint64_t source_triangles)
     gdr_paged_cache_close(paged);
 }
 
+/* Where the scene's cache is: read, written, not written, or none. */
+static void print_cache_location(const gdr_import_report *report, int no_cache, const char *input)
+{
+    static const char *const states[] = {"", "read", "written", "could not be written"};
+    if (report->cache_path)
+        printf("cached in:   %s (%s)\n", report->cache_path, states[report->cache_state & 3]);
+    else if (gdr_scene_spec_is_builtin(input))
+        printf("cached in:   none (a built-in scene)\n");
+    else if (strlen(input) > 5 && strcmp(input + strlen(input) - 5, ".gdrc") == 0)
+        printf("cached in:   %s itself\n", input);
+    else
+        printf("cached in:   none%s\n", no_cache ? " (--no-cache)" : " (no cache folder)");
+}
+
 int gdr_cmd_info(int argc, char **argv)
 {
     if (argc == 2 && strcmp(argv[1], "--passes") == 0) {
@@ -73,14 +82,22 @@ int gdr_cmd_info(int argc, char **argv)
     }
     const char *input = NULL;
     gdr_load_options options = {0};
-    unsigned warnings = 0;
-    options.warning = count_warning;
+    cli_warnings warnings = {0};
+    gdr_import_report report = {0};
+    options.warning = cli_warning;
     options.warning_user = &warnings;
+    options.report = &report;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--no-cache") == 0) {
             options.no_cache = 1;
         } else if (strcmp(argv[i], "--cache-dir") == 0 && i + 1 < argc) {
             options.cache_dir = argv[++i];
+        } else if (strcmp(argv[i], "--cache-max") == 0 && i + 1 < argc) {
+            if (!cli_parse_cache_max(argv[i], argv[i + 1], &options.cache_max_bytes))
+                return 2;
+            i++;
+        } else if (strcmp(argv[i], "--strict") == 0) {
+            warnings.strict = true;
         } else if (strcmp(argv[i], "--allow-outside-files") == 0) {
             options.allow_outside_files = 1;
         } else if (strcmp(argv[i], "--budget") == 0 && i + 1 < argc) {
@@ -103,8 +120,13 @@ int gdr_cmd_info(int argc, char **argv)
     gdr_pvs *pvs = NULL;
     options.pvs = &pvs; /* a cache's precomputed visibility is described too */
     gdr_status status = gdr_scene_load(input, &options, &scene, &err);
-    if (status != GDR_OK)
-        return cli_load_failed(input, &err);
+    int strict = status == GDR_OK ? cli_strict_check(&warnings, input) : 0;
+    if (status != GDR_OK || strict) {
+        gdr_import_report_free(&report);
+        cli_pvs_destroy(pvs);
+        gdr_scene_destroy(scene);
+        return status != GDR_OK ? cli_load_failed(input, &err) : strict;
+    }
     uint64_t vertices = 0, unique_triangles = 0, clusters = 0, level0 = 0, cluster_triangles = 0;
     uint64_t cluster_vertices = 0, nodes = 0;
     uint32_t node_levels = 0;
@@ -142,8 +164,10 @@ int gdr_cmd_info(int argc, char **argv)
     size_t length = strlen(input);
     if (length > 5 && strcmp(input + length - 5, ".gdrc") == 0)
         print_cache_bytes(input, unique_triangles);
-    if (warnings)
-        printf("warnings:    %u\n", warnings);
+    print_cache_location(&report, options.no_cache, input);
+    if (warnings.count)
+        printf("warnings:    %u\n", warnings.count);
+    gdr_import_report_free(&report);
     cli_pvs_destroy(pvs);
     gdr_scene_destroy(scene);
     return 0;

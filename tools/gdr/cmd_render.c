@@ -19,6 +19,9 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
     *o = (render_options){.width = 1280, .height = 720, .frames = 1, .cull = true, .meshlet_cull = true,
                           .cone_cull = true, .triangle_cull = true, .lod_error = 1.0f, .occlusion = true,
                           .lod_hierarchy = true};
+    o->load.warning = cli_warning;
+    o->load.warning_user = &o->warnings;
+    o->load.report = &o->report;
     static const char *const view_names[] = {"shaded", "meshlets", "instances", "triangles", "overdraw", "lod"};
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i], *value;
@@ -38,6 +41,10 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
             o->load.no_cache = 1;
             continue;
         }
+        if (strcmp(arg, "--strict") == 0) {
+            o->warnings.strict = true;
+            continue;
+        }
         if (strcmp(arg, "--allow-outside-files") == 0) {
             o->load.allow_outside_files = 1;
             continue;
@@ -53,7 +60,7 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
             "--camera-index", "--cull", "--meshlet-cull", "--cone-cull", "--triangle-cull", "--occlusion",
             "--lod-hierarchy", "--pipeline", "--raster", "--sw-threshold", "--view", "--lod-error",
             "--min-screen-size", "--clip-plane", "--lod-depth", "--device", "--geometry-budget",
-            "--upload-budget", "--cache-dir", "--budget", "--pvs", NULL};
+            "--upload-budget", "--cache-dir", "--cache-max", "--budget", "--pvs", NULL};
         if (!(value = cli_known_value(command, known, argc, argv, &i)))
             return 2;
         bool ok = true;
@@ -121,6 +128,8 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
             ok = cli_parse_u32(arg, value, 1, 4096, &o->upload_budget_mib);
         else if (strcmp(arg, "--cache-dir") == 0)
             o->load.cache_dir = value;
+        else if (strcmp(arg, "--cache-max") == 0)
+            ok = cli_parse_cache_max(arg, value, &o->load.cache_max_bytes);
         else if (strcmp(arg, "--budget") == 0)
             ok = cli_parse_budget(arg, value, &o->load.budget);
         else {
@@ -253,6 +262,8 @@ int gdr_cmd_render(int argc, char **argv)
         result = cli_load_failed(o.scene, &err);
         goto done;
     }
+    if ((result = cli_strict_check(&o.warnings, o.scene)) != 0)
+        goto done;
     if (o.pvs == GDR_CULL_ON && !pvs) {
         fprintf(stderr, "gdr: --pvs on: %s holds no precomputed visibility (write it with gdr build %s -o FILE.gdrc "
                 "--pvs)\n", o.scene, o.scene);
@@ -260,8 +271,7 @@ int gdr_cmd_render(int argc, char **argv)
         goto done;
     }
     if (o.has_camera_index && o.camera_index >= scene->camera_count) {
-        fprintf(stderr, "gdr: --camera-index %u: the scene has %u camera(s)\n", o.camera_index, scene->camera_count);
-        result = 2;
+        result = cli_camera_index_refused("render", o.camera_index, scene, &o.report);
         goto done;
     }
     gdr_frame_desc frame = render_options_frame(&o, render_options_camera(scene, &o));
@@ -293,6 +303,7 @@ int gdr_cmd_render(int argc, char **argv)
         result = 3;
     }
 done:
+    gdr_import_report_free(&o.report);
     camera_path_free(&path);
     free(pixels);
     gdr_renderer_destroy(renderer);

@@ -391,18 +391,17 @@ int gdr_cmd_view(int argc, char **argv)
     o.load.pvs = &pvs;
     if (gdr_scene_load(o.scene, &o.load, &scene, &err) != GDR_OK) {
         camera_path_free(&app.replay);
+        gdr_import_report_free(&o.report);
         return cli_load_failed(o.scene, &err);
     }
-    if (o.pvs == GDR_CULL_ON && !pvs) {
+    result = cli_strict_check(&o.warnings, o.scene);
+    if (result == 0 && o.pvs == GDR_CULL_ON && !pvs) {
         fprintf(stderr, "gdr view: --pvs on: %s holds no precomputed visibility (write it with gdr build %s -o "
                 "FILE.gdrc --pvs)\n", o.scene, o.scene);
         result = 2;
     }
-    if (o.has_camera_index && o.camera_index >= scene->camera_count) {
-        fprintf(stderr, "gdr view: --camera-index %u: the scene has %u camera(s)\n", o.camera_index,
-                scene->camera_count);
-        result = 2;
-    }
+    if (result == 0 && o.has_camera_index && o.camera_index >= scene->camera_count)
+        result = cli_camera_index_refused("view", o.camera_index, scene, &o.report);
     if (result == 0)
         result = open_window(&app, scene, pvs);
     if (result == 0) {
@@ -411,6 +410,7 @@ int gdr_cmd_view(int argc, char **argv)
     }
     close_window(&app);
     cli_pvs_destroy(pvs); /* after the renderer that held it */
+    gdr_import_report_free(&o.report);
     gdr_scene_destroy(scene);
     camera_path_free(&app.replay);
     camera_path_free(&app.recorded);

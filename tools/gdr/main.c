@@ -19,6 +19,7 @@ static void print_help(FILE *out)
           "                               M metres)\n"
           "  gdr info FILE                summarise a scene: meshes, instances, triangles, materials, ...\n"
           "  gdr info --passes            the passes, resources and barriers of every frame configuration\n"
+          "  gdr cache list|clear [--cache-dir DIR]   the caches gdr keeps in its cache folder\n"
           "  gdr --help | --version\n"
           "\n"
           "SCENE is a .gltf, .glb, .obj or .gdrc file, or a built-in procedural scene:\n"
@@ -32,7 +33,8 @@ static void print_help(FILE *out)
           "                          100) of about T triangles (default 100000), one copy each\n"
           "  rooms[:rooms=N,seed=S,objects=K]   N rooms (default 16) joined into a maze by corridors,\n"
           "                          K props in each (default 24): walls hide most rooms (for --pvs)\n"
-          "Source files go through a .gdrc cache next to them.\n"
+          "Source files go through a .gdrc cache in $XDG_CACHE_HOME/gdr (else ~/.cache/gdr), keyed by the\n"
+          "source's absolute path and checked against every file its import looked for.\n"
           "\n"
           "render options:\n"
           "  --out FILE.png          write the last frame's image\n"
@@ -78,7 +80,12 @@ static void print_help(FILE *out)
           "  --validate              enable the Khronos validation layer; messages are counted and\n"
           "                          make the exit status 3\n"
           "  --no-cache              import the source file, never read or write its .gdrc cache\n"
-          "  --cache-dir DIR         keep caches in DIR instead of next to the source\n"
+          "  --cache-dir DIR         keep caches in DIR instead of the per-user cache folder; '.': next\n"
+          "                          to the source (SOURCE.gdrc)\n"
+          "  --cache-max MIB         the cache folder's size limit: least recently used caches gdr wrote\n"
+          "                          there are removed past it (default GDR_CACHE_MAX_MIB, else 4096)\n"
+          "  --strict                every warning of the import (said again on cached runs) is an\n"
+          "                          error: exit status 4 (render, view, info, build)\n"
           "  --budget KEY=N,...      limits for untrusted files (render, info, build): triangles,\n"
           "                          instances, pixels (texture pixels), bytes (decoded bytes);\n"
           "                          see docs/SECURITY.md for the defaults\n"
@@ -116,7 +123,7 @@ static void print_help(FILE *out)
           "  --plot-from FILE.json   with --plot: plot an earlier run's --json instead of running\n"
           "  --device N|NAME, --validate, --json FILE\n"
           "\n"
-          "exit status: 0 success, 1 failure, 2 bad usage, 3 validation messages\n",
+          "exit status: 0 success, 1 failure, 2 bad usage, 3 validation messages, 4 warnings under --strict\n",
           view_key_help);
 }
 
@@ -145,6 +152,8 @@ int main(int argc, char **argv)
         return gdr_cmd_view(argc - 1, argv + 1);
     if (strcmp(command, "info") == 0)
         return gdr_cmd_info(argc - 1, argv + 1);
+    if (strcmp(command, "cache") == 0)
+        return gdr_cmd_cache(argc - 1, argv + 1);
     fprintf(stderr, "gdr: unknown command '%s' (see gdr --help)\n", command);
     return 2;
 }

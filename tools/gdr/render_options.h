@@ -6,6 +6,7 @@
 #include <stdint.h>
 
 #include "gdr/gdr.h"
+#include "cli_warnings.h"
 
 typedef struct render_options {
     const char *scene;
@@ -30,7 +31,9 @@ typedef struct render_options {
     const char *camera_path; /* --camera-path FILE: one pose per frame (docs/VIEWER.md) */
     bool frames_given;
     uint32_t geometry_budget_mib, upload_budget_mib; /* streaming (docs/STREAMING.md): 0 unless given */
-    gdr_load_options load;
+    gdr_load_options load;   /* its warning sink is `warnings`, its report `report` */
+    cli_warnings warnings;   /* counted; --strict makes them errors (exit GDR_EXIT_STRICT) */
+    gdr_import_report report; /* the import's, for --camera-index; freed with gdr_import_report_free */
 } render_options;
 
 /* Another command's own option at argv[*i]: returns 1 when it took it (advancing *i past a value),
