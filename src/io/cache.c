@@ -604,6 +604,13 @@ gdr_status gdr_io_cache_read_for(const char *path, const char *source, const cha
 gdr_status gdr_cache_read_for_streaming(const char *path, const char *build_options, gdr_scene **out,
                                         gdr_pvs **out_pvs, uint64_t *out_bytes_read, gdr_error *err)
 {
+    return gdr_io_cache_read_for_streaming_of(path, NULL, build_options, out, out_pvs, out_bytes_read, err);
+}
+
+gdr_status gdr_io_cache_read_for_streaming_of(const char *path, const char *source, const char *build_options,
+                                              gdr_scene **out, gdr_pvs **out_pvs, uint64_t *out_bytes_read,
+                                              gdr_error *err)
+{
     *out = NULL;
     if (out_pvs)
         *out_pvs = NULL;
@@ -625,7 +632,7 @@ gdr_status gdr_cache_read_for_streaming(const char *path, const char *build_opti
         status = gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: has no geometry pages to stream; build it with "
                                "pages (gdr build --pages)", path);
     if (status == GDR_OK)
-        status = check_fresh(path, &v, build_options, NULL, err);
+        status = check_fresh(path, &v, build_options, source, err);
     if (status == GDR_OK)
         status = gdr_cache_read_sections(path, &v, 1, out, out_pvs, err);
     close(src.fd);

@@ -62,6 +62,11 @@ static int fallback_cache_dir(char *out, size_t size)
     return mkdir(out, 0755) == 0 || errno == EEXIST;
 }
 
+int gdr_io_user_cache_dir(char *out, size_t size)
+{
+    return fallback_cache_dir(out, size);
+}
+
 static void warn(const gdr_load_options *o, const char *format, ...) __attribute__((format(printf, 2, 3)));
 static void warn(const gdr_load_options *o, const char *format, ...)
 {
@@ -105,12 +110,14 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
         *out_pvs = NULL;
     const char *build_options = gdr_cache_build_options();
     gdr_pvs *pvs = NULL;
-    if (options->geometry_in_pages) {
-        if (!gdr_io_has_extension(path, ".gdrc"))
-            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: streaming reads a .gdrc cache with geometry "
-                                 "pages (gdr build SCENE -o FILE.gdrc --pages), not a source file", path);
+    if (options->geometry_in_pages && gdr_io_has_extension(path, ".gdrc")) {
+        if (options->cache_path && snprintf(options->cache_path, options->cache_path_size, "%s", path) < 0)
+            options->cache_path[0] = '\0';
         return gdr_cache_read_for_streaming(path, build_options, out, out_pvs, NULL, err);
     }
+    if (options->geometry_in_pages && options->no_cache)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: streaming reads a cache with geometry pages, "
+                             "which no_cache (--no-cache) forbids", path);
     if (gdr_io_has_extension(path, ".gdrc")) {
         gdr_status status = gdr_cache_read(path, build_options, out, out_pvs ? &pvs : NULL, err);
         return status == GDR_OK ? finish_cache_read(path, out, pvs, out_pvs, err) : status;
@@ -134,6 +141,8 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
         if (fallback_cache_dir(fallback, sizeof fallback))
             count += gdr_cache_path_for(path, fallback, candidates[count], PATH_MAX) != 0;
     }
+    if (options->geometry_in_pages)
+        return gdr_io_load_paged(path, options, candidates, count, out, out_pvs, err);
     for (int i = 0; i < count; i++) {
         if (access(candidates[i], F_OK) != 0)
             continue;

@@ -190,36 +190,14 @@ static gdr_status render_frames(gdr_renderer *renderer, gdr_frame_desc *frame, c
     return status;
 }
 
-static bool streamed(const render_options *o) { return o->geometry_budget_mib || o->upload_budget_mib; }
-
-/* A streamed scene is read from its cache without the geometry the pages hold. A file's cache may
- * hold the scene's precomputed visibility (*pvs, else NULL), streamed or not. */
+/* A streamed scene is read from its paged cache without the geometry the pages hold (a source file
+ * or built-in scene gets one built first, in the cache folder). A file's cache may hold the scene's
+ * precomputed visibility (*pvs, else NULL), streamed or not. */
 static gdr_status load_scene(render_options *o, gdr_scene **scene, gdr_pvs **pvs, gdr_error *err)
 {
     *pvs = NULL;
-    size_t length = strlen(o->scene);
-    if (streamed(o) && (length < 5 || strcmp(o->scene + length - 5, ".gdrc") != 0))
-        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "--geometry-budget/--upload-budget stream from a cache: "
-                             "give a .gdrc written with 'gdr build --pages' (not '%s')", o->scene);
-    o->load.geometry_in_pages = streamed(o);
     o->load.pvs = pvs;
-    return gdr_scene_load(o->scene, &o->load, scene, err);
-}
-
-/* The scene, streamed from its cache file when a budget is given (the scene is that file, opened
- * here as a paged cache: *paged, closed by the caller after the renderer). */
-static gdr_status set_scene(gdr_renderer *renderer, const gdr_scene *scene, const render_options *o,
-                            gdr_paged_cache **paged, gdr_error *err)
-{
-    if (!streamed(o))
-        return gdr_renderer_set_scene(renderer, scene, err);
-    gdr_status status = gdr_paged_cache_open(o->scene, paged, err);
-    if (status != GDR_OK)
-        return status;
-    gdr_streaming_desc stream = {.cache = *paged,
-                                 .geometry_budget_bytes = (uint64_t)o->geometry_budget_mib << 20,
-                                 .upload_budget_bytes = (uint64_t)o->upload_budget_mib << 20};
-    return gdr_renderer_set_scene_streamed(renderer, scene, &stream, err);
+    return render_options_load(o, scene, err);
 }
 
 int gdr_cmd_render(int argc, char **argv)
@@ -265,7 +243,7 @@ int gdr_cmd_render(int argc, char **argv)
         goto done;
     }
     gdr_frame_desc frame = render_options_frame(&o, render_options_camera(scene, &o));
-    if (set_scene(renderer, scene, &o, &paged, &err) != GDR_OK || gdr_renderer_set_pvs(renderer, pvs, &err) != GDR_OK ||
+    if (render_options_set_scene(renderer, scene, &o, &paged, &err) != GDR_OK || gdr_renderer_set_pvs(renderer, pvs, &err) != GDR_OK ||
         render_frames(renderer, &frame, &o, &path, &stats, &err) != GDR_OK) {
         result = fail(&err);
         goto done;

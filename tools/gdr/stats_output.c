@@ -179,6 +179,9 @@ void stats_print_streaming(FILE *out, const gdr_streaming_stats *st)
             "%u deferred, %u pending; %u frames since a change\n", st->requests, st->distinct_requests, st->loads,
             st->uploads, (unsigned long long)st->upload_bytes, st->evictions, st->deferred, st->pending,
             st->frames_since_change);
+    fprintf(out, "streaming cut       threshold %g px (x %g to fit the pool, %u changes), %u pages wanted of %u slots, "
+            "settled %u frames\n", (double)st->lod_error_px, (double)st->lod_error_scale, st->lod_error_changes,
+            st->wanted_pages, st->slot_count, st->settled_frames);
     fprintf(out, "streaming totals    %llu uploads (%llu bytes), %llu evictions, %u pages refused%s%s\n",
             (unsigned long long)st->uploads_total, (unsigned long long)st->upload_bytes_total,
             (unsigned long long)st->evictions_total, st->pages_refused, st->pages_refused ? ": " : "",
@@ -199,7 +202,9 @@ static void add_streaming_json(cJSON *object, const gdr_streaming_stats *st)
         {"pending", st->pending}, {"frames_since_change", st->frames_since_change},
         {"uploads_total", (double)st->uploads_total}, {"upload_bytes_total", (double)st->upload_bytes_total},
         {"evictions_total", (double)st->evictions_total}, {"evicted_in_use", (double)st->evicted_in_use},
-        {"pages_refused", st->pages_refused}};
+        {"pages_refused", st->pages_refused}, {"lod_error_px", st->lod_error_px},
+        {"lod_error_scale", st->lod_error_scale}, {"lod_error_changes", st->lod_error_changes},
+        {"wanted_pages", st->wanted_pages}, {"settled_frames", st->settled_frames}};
     for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++)
         cJSON_AddNumberToObject(o, fields[i].name, fields[i].value);
 }
