@@ -29,14 +29,6 @@ static void warn(const gdr_load_options *o, const char *format, ...)
         fprintf(stderr, "gdr: warning: %s\n", message);
 }
 
-/* What a paged cache is built with: the importers' options, the page size and, for a built-in scene
- * (no source file to compare with), its specification. */
-static void paged_build_options(const char *spec, bool builtin, char *out, size_t size)
-{
-    snprintf(out, size, "%s;pages=%u%s%.400s", gdr_cache_build_options(), GDR_PAGE_BYTES_DEFAULT,
-             builtin ? ";scene=" : "", builtin ? spec : "");
-}
-
 /* FILE.gdrc -> FILE.pages.gdrc; 0 when it does not fit. */
 static int paged_name(const char *candidate, char *out, size_t size)
 {
@@ -117,7 +109,10 @@ gdr_status gdr_io_load_paged(const char *spec, const gdr_load_options *o, char (
 {
     *out = NULL;
     bool builtin = candidates == NULL;
-    char own[1][PATH_MAX], paths[2][PATH_MAX], build_options[1024];
+    char own[1][PATH_MAX], paths[2][PATH_MAX];
+    /* The options gdr build writes, so that the paged cache also reads as a plain .gdrc; a built-in
+     * scene has no source file to compare with: its specification names its cache file. */
+    const char *build_options = gdr_cache_build_options();
     if (builtin) {
         count = builtin_candidate(spec, o, own[0]);
         candidates = own;
@@ -125,7 +120,6 @@ gdr_status gdr_io_load_paged(const char *spec, const gdr_load_options *o, char (
     int n = 0;
     for (int i = 0; i < count && n < 2; i++)
         n += paged_name(candidates[i], paths[n], PATH_MAX);
-    paged_build_options(spec, builtin, build_options, sizeof build_options);
     const char *source = builtin ? NULL : spec;
     for (int i = 0; i < n; i++) {
         if (access(paths[i], F_OK) != 0)
