@@ -14,6 +14,7 @@
 #include "commands.h"
 #include "gdr/present.h"
 #include "render_options.h"
+#include "stats_output.h"
 #include "view.h"
 
 typedef struct view_options {
@@ -353,6 +354,7 @@ static int finish(view_app *app, int result)
             printf("camera path         %s (%u frames)\n", app->v->record_path, app->recorded.count);
     }
     printf("frames              %u\n", app->frames);
+    stats_print_streaming(stdout, &app->stats.streaming); /* the last frame's, as the overlay showed them */
     if (result == 0 && app->stats.validation_messages > 0) {
         fprintf(stderr, "gdr view: the validation layer reported %u message(s)\n", app->stats.validation_messages);
         result = 3;
