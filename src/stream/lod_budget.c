@@ -39,6 +39,19 @@ static void raise(gdr_lod_budget *b, const gdr_lod_budget_observation *o)
     set_scale(b, b->scale * step);
 }
 
+/* A lowering to `scale` (not below 1), on trial until a cut drawn with it is read back; none when it
+ * would change the factor by less than STEP_MIN and not reach 1. */
+static void start_trial(gdr_lod_budget *b, const gdr_lod_budget_observation *o, float scale)
+{
+    scale = scale < 1.0f ? 1.0f : scale;
+    if (scale > 1.0f && b->scale / scale < STEP_MIN)
+        return;
+    b->trial_from = b->scale;
+    b->trial_to = scale;
+    b->trial_wanted = o->wanted;
+    set_scale(b, scale);
+}
+
 /* The cut at this factor is resident and fits: lower it where the model says it still fits. */
 static void lower(gdr_lod_budget *b, const gdr_lod_budget_observation *o)
 {
@@ -49,19 +62,20 @@ static void lower(gdr_lod_budget *b, const gdr_lod_budget_observation *o)
     }
     if (b->scale <= 1.0f || b->step_limit < STEP_MIN)
         return;
-    float target = FILL_TARGET * (float)o->capacity - (float)o->pinned;
     float used = (float)o->wanted - (float)o->pinned;
+    if (used <= 0.0f) { /* the cut is all in the pinned pages: no model, the largest step */
+        start_trial(b, o, b->scale / b->step_limit);
+        return;
+    }
+    /* The requested threshold where the model says its cut fits the whole pool, else a lower factor
+     * whose cut fills FILL_TARGET of it. */
+    float target = used * b->scale * b->scale <= (float)(o->capacity - o->pinned)
+                       ? used * b->scale * b->scale
+                       : FILL_TARGET * (float)o->capacity - (float)o->pinned;
     if (target <= used)
         return;
-    float step = used > 0.0f ? sqrtf(target / used) : b->step_limit;
-    step = step > b->step_limit ? b->step_limit : step;
-    float scale = b->scale / step < 1.0f ? 1.0f : b->scale / step;
-    if (scale > 1.0f && b->scale / scale < STEP_MIN)
-        return;
-    b->trial_from = b->scale;
-    b->trial_to = scale;
-    b->trial_wanted = o->wanted;
-    set_scale(b, scale);
+    float step = sqrtf(target / used);
+    start_trial(b, o, b->scale / (step > b->step_limit ? b->step_limit : step));
 }
 
 bool gdr_lod_budget_update(gdr_lod_budget *b, const gdr_lod_budget_observation *o)
