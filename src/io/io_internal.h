@@ -13,6 +13,9 @@
 
 /* Largest file an importer reads whole (bytes). */
 #define GDR_IO_MAX_FILE_SIZE (4ull << 30)
+/* The whole-file reader's limit in force: GDR_IO_MAX_FILE_SIZE; tests lower it to reach the limit
+ * (and what the cache writer does past it) with small files. */
+extern uint64_t gdr_io_max_file_size;
 /* Largest element count of an accessor that no buffer data backs (it would be all zeros). */
 #define GDR_IO_MAX_UNBACKED_ELEMENTS (1u << 24)
 
