@@ -22,7 +22,7 @@ static void set_scale(gdr_lod_budget *b, float scale)
 }
 
 /* The cut needs more than the pool: back from a failed lowering, else up by the model. */
-static void raise(gdr_lod_budget *b, const gdr_lod_budget_observation *o)
+static void raise_scale(gdr_lod_budget *b, const gdr_lod_budget_observation *o)
 {
     if (b->trial_from > 0.0f) {
         b->step_limit = sqrtf(b->trial_from / b->trial_to);
@@ -53,7 +53,7 @@ static void start_trial(gdr_lod_budget *b, const gdr_lod_budget_observation *o, 
 }
 
 /* The cut at this factor is resident and fits: lower it where the model says it still fits. */
-static void lower(gdr_lod_budget *b, const gdr_lod_budget_observation *o)
+static void lower_scale(gdr_lod_budget *b, const gdr_lod_budget_observation *o)
 {
     b->trial_from = 0.0f; /* a lowering on trial has held */
     if (b->failed_wanted && (float)o->wanted < LIGHTER * (float)b->failed_wanted) {
@@ -86,9 +86,9 @@ bool gdr_lod_budget_update(gdr_lod_budget *b, const gdr_lod_budget_observation *
         set_scale(b, 1.0f);
     } else if (o->known && o->scale == b->scale) {
         if (o->wanted > o->capacity)
-            raise(b, o);
+            raise_scale(b, o);
         else if (o->requests == 0)
-            lower(b, o);
+            lower_scale(b, o);
     }
     return b->changes != changes;
 }

@@ -48,8 +48,10 @@ stream="--geometry-budget 16 --cache-dir $work/cache"
 ls "$work/cache"/unique-field*.pages.gdrc >/dev/null 2>&1 || fail "no paged cache built for the viewer"
 grep -q '^streaming cut' "$work/view.out" || fail "the viewer printed no streaming figures: $(cat "$work/view.out")"
 # shellcheck disable=SC2086
-"$gdr" render $scene $size $stream --camera-path "$work/jump.txt" --out "$work/render.png" >/dev/null 2>&1 ||
-    fail "render along the path exited $?"
+"$gdr" render $scene $size $stream --camera-path "$work/jump.txt" --out "$work/render.png" --stats "$work/path.json" \
+    >/dev/null 2>&1 || fail "render along the path exited $?"
+# The statistics hold a row per frame of the path (GPU time, threshold, pages, uploads, evictions).
+[ "$(grep -c '"lod_error_px":' "$work/path.json")" = 76 ] || fail "render --camera-path --stats: not a row per frame"
 cmp -s "$work/view.png" "$work/render.png" || fail "the viewer's last streamed image differs from gdr render's"
 # The overlay, with its streaming lines, is drawn.
 # shellcheck disable=SC2086

@@ -217,6 +217,33 @@ void stats_add_memory_json(cJSON *object, const gdr_frame_stats *s)
     cJSON_AddNumberToObject(object, "gpu_memory_frame_bytes", (double)s->memory.frame_bytes);
 }
 
+stats_path_frame stats_path_row(const gdr_frame_stats *s)
+{
+    const gdr_streaming_stats *st = &s->streaming;
+    return (stats_path_frame){s->gpu_ms_per_frame, s->triangles, st->lod_error_px, st->wanted_pages,
+                              st->resident_pages, st->uploads, st->evictions, st->requests};
+}
+
+static void add_path_json(cJSON *root, const stats_context *context)
+{
+    cJSON *rows = context->path_count ? cJSON_AddArrayToObject(root, "path") : NULL;
+    for (uint32_t i = 0; rows && i < context->path_count; i++) {
+        const stats_path_frame *f = &context->path[i];
+        cJSON *row = cJSON_CreateObject();
+        if (!row || !cJSON_AddItemToArray(rows, row))
+            break;
+        cJSON_AddNumberToObject(row, "frame", i);
+        cJSON_AddNumberToObject(row, "gpu_ms", f->gpu_ms);
+        cJSON_AddNumberToObject(row, "triangles", (double)f->triangles);
+        cJSON_AddNumberToObject(row, "lod_error_px", f->lod_error_px);
+        cJSON_AddNumberToObject(row, "wanted_pages", f->wanted_pages);
+        cJSON_AddNumberToObject(row, "resident_pages", f->resident_pages);
+        cJSON_AddNumberToObject(row, "uploads", f->uploads);
+        cJSON_AddNumberToObject(row, "evictions", f->evictions);
+        cJSON_AddNumberToObject(row, "requests", f->requests);
+    }
+}
+
 char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
 {
     cJSON *root = cJSON_CreateObject();
@@ -264,6 +291,7 @@ char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
         cJSON_AddNumberToObject(passes, s->passes[p].name, s->passes[p].gpu_ms);
     stats_add_memory_json(root, s);
     cJSON_AddNumberToObject(root, "validation_messages", s->validation_messages);
+    add_path_json(root, context);
     char *text = cJSON_Print(root);
     cJSON_Delete(root);
     return text;
