@@ -510,8 +510,9 @@ static stream_copies frame_copies(gdr_renderer *r)
 }
 
 /* The slot's read-back cut against the pool (stream/lod_budget.h): the factor on the LOD threshold
- * that this frame draws with. */
-static void fit_cut_to_pool(gdr_renderer *r, gdr_frame_slot *slot, uint32_t request_count)
+ * that this frame draws with. Returns the requests still wanted: none when the read-back frame drew
+ * with a lower threshold than this frame will (its requests were for detail no longer asked for). */
+static uint32_t fit_cut_to_pool(gdr_renderer *r, gdr_frame_slot *slot, uint32_t request_count)
 {
     gdr_streaming *s = &r->stream;
     bool known = slot->stream_results && slot->stream_frame != 0;
@@ -524,9 +525,11 @@ static void fit_cut_to_pool(gdr_renderer *r, gdr_frame_slot *slot, uint32_t requ
     s->stats.wanted_pages = o.wanted;
     if (!s->fixed_lod_error && gdr_lod_budget_update(&s->lod_budget, &o))
         s->unsettled_frame = s->frame;
+    bool coarser_now = known && o.scale < s->lod_budget.scale;
     slot->stream_lod_scale = s->lod_budget.scale;
     s->stats.lod_error_scale = s->lod_budget.scale;
     s->stats.lod_error_changes = s->lod_budget.changes;
+    return coarser_now ? 0 : request_count;
 }
 
 /* The residency's figures into the statistics. */
@@ -557,7 +560,7 @@ gdr_status gdr_streaming_begin_frame(gdr_renderer *r, gdr_frame_slot *slot, gdr_
     s->stats.uploads = 0;
     s->stats.upload_bytes = 0;
     uint32_t request_count = slot->stream_results ? read_slot_results(r, slot) : 0;
-    fit_cut_to_pool(r, slot, request_count);
+    request_count = fit_cut_to_pool(r, slot, request_count);
     uint32_t load_count = 0;
     gdr_residency_plan(s->residency, frame, s->requests, request_count, s->loads, s->slot_count, &load_count);
     gdr_status status = gdr_page_loader_submit(s->loader, s->loads, load_count, err);

@@ -4,9 +4,9 @@
  * frame the drawn clusters are the CPU's cut over the groups the renderer reports resident, at the
  * threshold the frame reports it drew with (exactly one cluster on every DAG path: no hole, no
  * crack), and no group the latest read-back cut drew leaves. Within SETTLE_FRAMES frames the
- * resident set is stable: no load, upload or eviction for STABLE_FRAMES frames in a row, the
- * threshold unchanged; the settled image is within MIN_PSNR dB of the full-detail image. The camera
- * then moves back to a view the pool holds: the threshold returns to the one asked for and the
+ * resident set is stable: no load, upload, eviction or request and the threshold unchanged for
+ * STABLE_FRAMES frames in a row; the settled image is within MIN_PSNR dB of the full-detail image.
+ * The camera then moves back to a view the pool holds: the threshold returns to the one asked for and the
  * image becomes the full-detail image of that view, byte for byte. With the threshold held fixed
  * (the behaviour before the cut fitted the pool) the same pool never settles. */
 #include <math.h>
@@ -199,10 +199,13 @@ static uint32_t settle(const gdr_scene *scene, gdr_renderer *r, uint8_t *image, 
 {
     gdr_frame_desc frame = near_frame();
     uint32_t quiet = 0, settled = UINT32_MAX;
+    float threshold = -1.0f;
     bool full;
     for (uint32_t f = 0; f < SETTLE_FRAMES + STABLE_FRAMES && draw(scene, r, &frame, image, stats, h, &full); f++) {
         const gdr_streaming_stats *s = &stats->streaming;
-        bool still = s->loads == 0 && s->uploads == 0 && s->evictions == 0 && s->requests == 0 && s->pending == 0;
+        bool still = s->loads == 0 && s->uploads == 0 && s->evictions == 0 && s->requests == 0 && s->pending == 0 &&
+                     s->lod_error_px == threshold;
+        threshold = s->lod_error_px;
         quiet = still ? quiet + 1 : 0;
         *partial += !full;
         if (getenv("GDR_TEST_VERBOSE"))
