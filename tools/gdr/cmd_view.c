@@ -139,11 +139,12 @@ static void overlay_text(const view_app *app, char *text, size_t size)
     const gdr_streaming_stats *st = &s->streaming;
     if (st->enabled && n < size)
         snprintf(text + n, size - n,
-                 "\nstreaming  LOD %g px (x %.2f to fit the pool)  pages wanted %u / %u slots, %u resident\n"
-                 "uploads %u  evictions %u  requests %u  settled %u frames  pool %llu MiB",
+                 "\nstreaming  LOD %.3g px (x %.3g to fit the pool)\n"
+                 "pages wanted %u / %u slots  resident %u  pool %.1f MiB\n"
+                 "uploads %u  evictions %u  requests %u  settled %u frames",
                  (double)st->lod_error_px, (double)st->lod_error_scale, st->wanted_pages, st->slot_count,
-                 st->resident_pages, st->uploads, st->evictions, st->requests, st->settled_frames,
-                 (unsigned long long)(st->pool_bytes >> 20));
+                 st->resident_pages, (double)st->pool_bytes / (1 << 20), st->uploads, st->evictions, st->requests,
+                 st->settled_frames);
 }
 
 static int fail(const char *what, const gdr_error *err)
