@@ -122,8 +122,15 @@ typedef struct gdr_load_options {
     int allow_outside_files; /* 1: a glTF may name buffers and images outside its own folder
                                 (absolute paths, '..', symlinks out); 0: refused */
     int geometry_in_pages;   /* 1: for streaming, a .gdrc with geometry pages is read without the
-                                geometry its pages hold (the pages are read by gdr_paged_cache_open);
-                                any other scene is refused */
+                                geometry its pages hold (the pages are read by gdr_paged_cache_open); a
+                                source file or built-in scene is read so from its paged cache, built
+                                first where none is fresh (quantized, with pages: as gdr build --pages;
+                                beside the loader's cache for the source, named FILE.pages.gdrc; a
+                                built-in scene's in cache_dir or the per-user folder); no_cache refuses
+                                a source file */
+    char *cache_path;        /* non-NULL, with geometry_in_pages: receives the path of the .gdrc read
+                                (cache_path_size bytes at most), to open with gdr_paged_cache_open */
+    size_t cache_path_size;
     gdr_pvs **pvs;           /* non-NULL: receives the precomputed visibility of the cache the scene
                                 was read from (gdr_pvs_destroy frees it), or NULL when there is none
                                 (a built-in scene, an import, a cache without one, a library

@@ -254,6 +254,16 @@ typedef struct gdr_streaming_stats {
     uint64_t uploads_total, upload_bytes_total, evictions_total; /* since the scene was set */
     uint64_t evicted_in_use;      /* debug counter: evictions of a page the latest cut used; always 0 */
     uint32_t pages_refused;       /* damaged pages so far (their groups stay absent) */
+    /* A cut that fits the pool (docs/STREAMING.md): the LOD threshold the last frame drew with
+     * (lod_error_px times lod_error_scale, which rises while the cut needs more pages than the pool
+     * holds and falls back to 1 when it fits), the pages the latest cut read back needs resident
+     * (its pages, those it asked for and their ancestors'; 0 when no cut was read back) against the
+     * pool's slots, and the frames since the threshold or the resident set last changed. */
+    float lod_error_px;
+    float lod_error_scale;
+    uint32_t wanted_pages;
+    uint32_t settled_frames;
+    uint32_t lod_error_changes;   /* times the threshold's factor changed since the scene was set */
     char refused[GDR_ERROR_MESSAGE_MAX];          /* the last refused page's message (file, mesh, page, why) */
 } gdr_streaming_stats;
 
@@ -362,6 +372,8 @@ typedef struct gdr_streaming_desc {
     uint64_t geometry_budget_bytes; /* the page pool; 0: a quarter of the device-local heap; at most 4 GiB */
     uint64_t upload_budget_bytes;   /* copied into the pool per frame at most (at least one page); 0: 16 MiB */
     bool wait_for_loads;            /* each frame waits for the pages it planned (deterministic: tests) */
+    bool fixed_lod_error;           /* true: the LOD threshold never rises to fit the pool (a pool smaller
+                                       than a view's cut then evicts and reloads pages frame after frame) */
 } gdr_streaming_desc;
 
 #define GDR_GEOMETRY_BUDGET_MAX (4ull << 30)

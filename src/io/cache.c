@@ -34,19 +34,50 @@ typedef struct section_entry {
     uint64_t offset, size, checksum;
 } section_entry;
 
-/* Every section whose description says it is present, in table order: one table entry each. */
-static void write_sections(writer *w, const cache_write_input *in, section_entry *entries, uint32_t *count)
+/* Where the serialised file goes: whole in memory, written at the end (a device or FIFO, written in
+ * place, cannot seek back to its header), or section by section into the temporary file, its header
+ * and table written last, so that memory holds one section at a time and a cache of pages may grow
+ * past what memory holds. */
+typedef struct cache_sink {
+    FILE *file;
+    bool seekable;    /* written section by section; else all in memory until the end */
+    uint64_t flushed; /* bytes written before w->data[0]: a multiple of 8 */
+    int failed;
+    gdr_progress progress; /* sections written */
+} cache_sink;
+
+/* The buffer's whole 8-byte words into the file; the rest stays (alignment is counted from it). */
+static void flush_sections(writer *w, cache_sink *sink)
+{
+    if (!sink->seekable || w->failed)
+        return;
+    size_t n = w->size & ~(size_t)7;
+    if (n && fwrite(w->data, 1, n, sink->file) != n)
+        sink->failed = 1;
+    memmove(w->data, w->data + n, w->size - n);
+    w->size -= n;
+    sink->flushed += n;
+}
+
+/* Every section whose description says it is present, in table order: one table entry each, its
+ * checksum taken while its bytes are in memory. */
+static void write_sections(writer *w, cache_sink *sink, const cache_write_input *in, section_entry *entries,
+                           uint32_t *count)
 {
     uint32_t n = 0;
-    for (uint32_t k = 0; k < CACHE_SECTION_COUNT; k++) {
+    for (uint32_t k = 0; k < CACHE_SECTION_COUNT && !sink->failed; k++) {
         const cache_section *sec = &gdr_cache_sections[k];
         if (sec->present && !sec->present(in))
             continue;
         put_align(w, 8);
-        entries[n] = (section_entry){sec->id, sec->flags, w->size, 0, 0};
+        size_t start = w->size;
+        entries[n] = (section_entry){sec->id, sec->flags, sink->flushed + start, 0, 0};
         sec->write(w, in);
-        entries[n].size = w->size - entries[n].offset;
+        entries[n].size = w->size - start;
+        entries[n].checksum = w->failed ? 0 : gdr_io_hash(w->data + start, (size_t)entries[n].size);
         n++;
+        flush_sections(w, sink);
+        gdr_progress_update(&sink->progress, n);
     }
     *count = n;
 }
@@ -58,7 +89,7 @@ static void store_u64(uint8_t *p, uint64_t v) { memcpy(p, &v, 8); }
  * (its meshes have no arrays to write), a file over the reader's size limit (counted here from the raw arrays alone, a lower bound of the file), and textures
  * larger than it reads (the TEXR section's check). A cache that cannot be read back is never
  * written. */
-static gdr_status check_reader_limits(const char *path, const gdr_scene *s, gdr_error *err)
+static gdr_status check_reader_limits(const char *path, const gdr_scene *s, bool paged, gdr_error *err)
 {
     if (s->geometry_in_pages)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: the scene was read for streaming and holds no "
@@ -71,11 +102,80 @@ static gdr_status check_reader_limits(const char *path, const gdr_scene *s, gdr_
         bytes += (uint64_t)m->vertex_count * 32 + (uint64_t)m->index_count * 4 + (uint64_t)m->clusters.vertex_count * 4 +
                  m->clusters.triangle_byte_count;
     }
-    if (bytes > GDR_IO_MAX_FILE_SIZE)
+    if (bytes > gdr_io_max_file_size && !paged)
         return gdr_error_set(err, GDR_ERROR_CAPACITY, "%s: the scene needs at least %llu bytes, more than the %llu a "
                              "cache may hold (the reader's limit)", path, (unsigned long long)bytes,
-                             (unsigned long long)GDR_IO_MAX_FILE_SIZE);
+                             (unsigned long long)gdr_io_max_file_size);
     return GDR_OK;
+}
+
+/* The header and section table (`count` entries) of a file of `size` bytes. */
+static void put_header(uint8_t *head, const section_entry *entries, uint32_t count, uint64_t size)
+{
+    memset(head, 0, CACHE_HEADER_SIZE);
+    uint8_t *table = head + CACHE_HEADER_SIZE;
+    for (uint32_t i = 0; i < count; i++) {
+        uint8_t *e = table + i * CACHE_ENTRY_SIZE;
+        store_u32(e, entries[i].id);
+        store_u32(e + 4, entries[i].flags);
+        store_u64(e + 8, entries[i].offset);
+        store_u64(e + 16, entries[i].size);
+        store_u64(e + 24, entries[i].checksum);
+    }
+    memcpy(head, CACHE_MAGIC, 8);
+    store_u32(head + 8, GDR_CACHE_FORMAT_VERSION);
+    store_u32(head + 12, CACHE_HEADER_SIZE);
+    store_u32(head + 16, count);
+    store_u32(head + 20, 0);
+    store_u64(head + 24, size);
+    store_u64(head + 32, gdr_io_hash(table, (size_t)count * CACHE_ENTRY_SIZE));
+    store_u64(head + 40, gdr_io_hash(head, 40));
+}
+
+/* Writes what is left in the buffer (in memory: the whole file, its header in place), then, section
+ * by section, the header and table at the start of the file. */
+static int finish_file(writer *w, cache_sink *sink, const uint8_t *head, size_t head_size)
+{
+    if (!sink->seekable) {
+        memcpy(w->data, head, head_size);
+        return fwrite(w->data, 1, w->size, sink->file) == w->size;
+    }
+    return fwrite(w->data, 1, w->size, sink->file) == w->size && fseek(sink->file, 0, SEEK_SET) == 0 &&
+           fwrite(head, 1, head_size, sink->file) == head_size && fseek(sink->file, 0, SEEK_END) == 0;
+}
+
+/* The file: its sections (into the sink as they are made), then its header. A file over the whole
+ * reader's limit is refused unless it has pages (`paged`), which the streaming reader reads with
+ * positioned reads at 64-bit offsets. */
+static gdr_status serialise(const char *path, const cache_write_input *in, uint32_t expected, cache_sink *sink,
+                            bool paged, uint64_t *size, gdr_error *err)
+{
+    section_entry entries[CACHE_SECTION_COUNT];
+    uint32_t count = 0;
+    size_t head_size = CACHE_HEADER_SIZE + (size_t)expected * CACHE_ENTRY_SIZE;
+    writer w = {0};
+    uint8_t *head = calloc(1, head_size);
+    put_space(&w, head_size); /* the header and table, written last */
+    if (w.data)
+        memset(w.data, 0, w.size);
+    write_sections(&w, sink, in, entries, &count);
+    assert(w.failed || sink->failed || count == expected);
+    *size = sink->flushed + w.size;
+    gdr_status status = GDR_OK;
+    if (w.failed || !head)
+        status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory serialising the scene", path);
+    else if (*size > gdr_io_max_file_size && !paged)
+        status = gdr_error_set(err, GDR_ERROR_CAPACITY, "%s: %llu bytes, more than the %llu a cache without pages may "
+                               "hold (the whole reader's limit)", path, (unsigned long long)*size,
+                               (unsigned long long)gdr_io_max_file_size);
+    if (status == GDR_OK) {
+        put_header(head, entries, count, *size);
+        if (sink->failed || !finish_file(&w, sink, head, head_size))
+            status = gdr_error_set(err, GDR_ERROR_IO, "%s: write failed: %s", path, strerror(errno));
+    }
+    free(head);
+    free(w.data);
+    return status;
 }
 
 gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_cache_write_options *options,
@@ -84,7 +184,7 @@ gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_c
     static const gdr_cache_write_options defaults = {0};
     if (!options)
         options = &defaults;
-    gdr_status limits = check_reader_limits(path, scene, err);
+    gdr_status limits = check_reader_limits(path, scene, options->page_bytes != 0, err);
     if (limits != GDR_OK)
         return limits;
     /* The table has exactly one entry per section: no byte of the file lies outside a checksum. */
@@ -99,62 +199,18 @@ gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_c
             return status;
         expected++;
     }
-    section_entry entries[CACHE_SECTION_COUNT];
-    uint32_t count = 0;
-    writer w = {0};
-    put_space(&w, CACHE_HEADER_SIZE + (size_t)expected * CACHE_ENTRY_SIZE); /* header and table, below */
-    if (w.data)
-        memset(w.data, 0, w.size);
-    write_sections(&w, &in, entries, &count);
-    assert(w.failed || count == expected);
-    if (w.failed) {
-        free(w.data);
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory serialising the scene", path);
-    }
-    if (w.size > GDR_IO_MAX_FILE_SIZE) {
-        free(w.data);
-        return gdr_error_set(err, GDR_ERROR_CAPACITY, "%s: %zu bytes, more than the %llu a cache may hold (the "
-                             "reader's limit)", path, w.size, (unsigned long long)GDR_IO_MAX_FILE_SIZE);
-    }
-    uint8_t *table = w.data + CACHE_HEADER_SIZE;
-    for (uint32_t i = 0; i < count; i++) {
-        entries[i].checksum = gdr_io_hash(w.data + entries[i].offset, entries[i].size);
-        uint8_t *e = table + i * CACHE_ENTRY_SIZE;
-        store_u32(e, entries[i].id);
-        store_u32(e + 4, entries[i].flags);
-        store_u64(e + 8, entries[i].offset);
-        store_u64(e + 16, entries[i].size);
-        store_u64(e + 24, entries[i].checksum);
-    }
-    memcpy(w.data, CACHE_MAGIC, 8);
-    store_u32(w.data + 8, GDR_CACHE_FORMAT_VERSION);
-    store_u32(w.data + 12, CACHE_HEADER_SIZE);
-    store_u32(w.data + 16, count);
-    store_u32(w.data + 20, 0);
-    store_u64(w.data + 24, w.size);
-    store_u64(w.data + 32, gdr_io_hash(table, (size_t)count * CACHE_ENTRY_SIZE));
-    store_u64(w.data + 40, gdr_io_hash(w.data, 40));
-
     /* A temporary file in the same folder, then rename: readers see the old file or the new one
      * (core/output_file.h: links followed, devices and FIFOs written directly). */
     gdr_output_file out;
     gdr_status status = gdr_output_open(path, &out, err);
-    if (status == GDR_OK) {
-        gdr_progress progress;
-        gdr_progress_begin(&progress, "write cache", w.size, 0);
-        size_t done = 0;
-        while (done < w.size) {
-            size_t chunk = w.size - done < (16u << 20) ? w.size - done : (16u << 20);
-            if (fwrite(w.data + done, 1, chunk, out.file) != chunk)
-                break;
-            done += chunk;
-            gdr_progress_update(&progress, done);
-        }
-        gdr_progress_end(&progress);
-        status = gdr_output_close(&out, done == w.size, path, err);
-    }
-    free(w.data);
-    return status;
+    if (status != GDR_OK)
+        return status;
+    cache_sink sink = {.file = out.file, .seekable = out.temporary != NULL};
+    uint64_t size = 0;
+    gdr_progress_begin(&sink.progress, "write cache", expected, 0);
+    status = serialise(path, &in, expected, &sink, options->page_bytes != 0, &size, err);
+    gdr_progress_end(&sink.progress);
+    return gdr_output_close(&out, status == GDR_OK, path, err) == GDR_OK ? status : err->status;
 }
 
 /* --- reading --------------------------------------------------------------------------------- */
@@ -686,12 +742,12 @@ gdr_status gdr_io_cache_read_for(const char *path, const char *source, const cha
 gdr_status gdr_cache_read_for_streaming(const char *path, const char *build_options, gdr_scene **out,
                                         gdr_pvs **out_pvs, uint64_t *out_bytes_read, gdr_error *err)
 {
-    return gdr_io_cache_read_for_streaming(path, build_options, out, out_pvs, NULL, out_bytes_read, err);
+    return gdr_io_cache_read_for_streaming(path, NULL, build_options, out, out_pvs, NULL, out_bytes_read, err);
 }
 
-gdr_status gdr_io_cache_read_for_streaming(const char *path, const char *build_options, gdr_scene **out,
-                                           gdr_pvs **out_pvs, gdr_import_report *out_report, uint64_t *out_bytes_read,
-                                           gdr_error *err)
+gdr_status gdr_io_cache_read_for_streaming(const char *path, const char *source, const char *build_options,
+                                           gdr_scene **out, gdr_pvs **out_pvs, gdr_import_report *out_report,
+                                           uint64_t *out_bytes_read, gdr_error *err)
 {
     *out = NULL;
     if (out_pvs)
@@ -714,7 +770,7 @@ gdr_status gdr_io_cache_read_for_streaming(const char *path, const char *build_o
         status = gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: has no geometry pages to stream; build it with "
                                "pages (gdr build --pages)", path);
     if (status == GDR_OK)
-        status = check_fresh(path, &v, build_options, NULL, err);
+        status = check_fresh(path, &v, build_options, source, err);
     gdr_import_report report = {0};
     if (status == GDR_OK)
         status = read_report(path, &v, &report, err);

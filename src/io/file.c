@@ -15,6 +15,8 @@
 
 #include "io/io_internal.h"
 
+uint64_t gdr_io_max_file_size = GDR_IO_MAX_FILE_SIZE;
+
 uint64_t gdr_io_hash(const void *data, size_t size)
 {
     return (uint64_t)XXH3_64bits(data, size);
@@ -217,10 +219,10 @@ gdr_status gdr_io_read_file(const char *path, uint8_t **out_data, size_t *out_si
         close(fd);
         return gdr_error_set(err, GDR_ERROR_IO, "%s: cannot stat: %s", path, strerror(errno));
     }
-    if ((uint64_t)st.st_size > GDR_IO_MAX_FILE_SIZE) {
+    if ((uint64_t)st.st_size > gdr_io_max_file_size) {
         close(fd);
         return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: %llu bytes is larger than the %llu byte limit",
-                             path, (unsigned long long)st.st_size, (unsigned long long)GDR_IO_MAX_FILE_SIZE);
+                             path, (unsigned long long)st.st_size, (unsigned long long)gdr_io_max_file_size);
     }
     size_t size = (size_t)st.st_size;
     char *text;

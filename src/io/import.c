@@ -187,11 +187,12 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
     gdr_import_report local = {0}, *report = options->report ? options->report : &local;
     *report = (gdr_import_report){0};
     gdr_status status;
-    if (options->geometry_in_pages) {
-        if (!gdr_io_has_extension(path, ".gdrc"))
-            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: streaming reads a .gdrc cache with geometry "
-                                 "pages (gdr build SCENE -o FILE.gdrc --pages), not a source file", path);
-        status = gdr_io_cache_read_for_streaming(path, gdr_cache_build_options(), out, out_pvs, report, NULL, err);
+    if (options->geometry_in_pages && gdr_io_has_extension(path, ".gdrc")) {
+        if (options->cache_path && options->cache_path_size &&
+            snprintf(options->cache_path, options->cache_path_size, "%s", path) >= (int)options->cache_path_size)
+            options->cache_path[0] = '\0';
+        status = gdr_io_cache_read_for_streaming(path, NULL, gdr_cache_build_options(), out, out_pvs, report, NULL,
+                                                 err);
         gdr_error ignored;
         if (status == GDR_OK) {
             gdr_io_report_untemplate(report, NULL, &ignored); /* out of memory: said with its markers */
@@ -200,6 +201,9 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
         gdr_import_report_free(&local);
         return status;
     }
+    if (options->geometry_in_pages && options->no_cache)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: streaming reads a cache with geometry pages, "
+                             "which no_cache (--no-cache) forbids", path);
     if (gdr_io_has_extension(path, ".gdrc")) {
         status = load_cache_file(path, out, out_pvs, options, report, err);
         gdr_import_report_free(&local);
@@ -210,9 +214,14 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
                                  .no_progress = options->no_progress, .budget = options->budget,
                                  .allow_outside_files = options->allow_outside_files};
     gdr_import_result result = {0};
-    char dir[PATH_MAX], cache[PATH_MAX];
-    int cached = !options->no_cache && cache_location(path, options, dir, cache);
-    if (cached && read_cached(path, cache, options, out, out_pvs, report, &status, err)) {
+    char dir[PATH_MAX], cache[1][PATH_MAX];
+    int cached = !options->no_cache && cache_location(path, options, dir, cache[0]);
+    if (options->geometry_in_pages) {
+        status = gdr_io_load_paged(path, options, cache, cached, out, out_pvs, report, err);
+        gdr_import_report_free(&local);
+        return status;
+    }
+    if (cached && read_cached(path, cache[0], options, out, out_pvs, report, &status, err)) {
         gdr_import_report_free(&local);
         return status;
     }
@@ -221,7 +230,7 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
     status = gdr_import_file(path, &import, out, &result, err);
     report->file_cameras = result.file_cameras;
     if (status == GDR_OK && cached)
-        write_cache(path, cache, dir, *out, &sources, options, report);
+        write_cache(path, cache[0], dir, *out, &sources, options, report);
     if (status == GDR_OK && options->sources) /* the caller's, as gdr_load_options.sources asks */
         *options->sources = sources;
     else

@@ -13,6 +13,9 @@
 
 /* Largest file an importer reads whole (bytes). */
 #define GDR_IO_MAX_FILE_SIZE (4ull << 30)
+/* The whole-file reader's limit in force: GDR_IO_MAX_FILE_SIZE; tests lower it to reach the limit
+ * (and what the cache writer does past it) with small files. */
+extern uint64_t gdr_io_max_file_size;
 /* Largest element count of an accessor that no buffer data backs (it would be all zeros). */
 #define GDR_IO_MAX_UNBACKED_ELEMENTS (1u << 24)
 
@@ -128,10 +131,11 @@ gdr_status gdr_io_image_decode(const void *data, size_t size, const char *name, 
 gdr_status gdr_io_cache_read_for(const char *path, const char *source, const char *build_options, gdr_scene **out,
                                  gdr_pvs **out_pvs, gdr_import_report *out_report, gdr_error *err);
 
-/* gdr_cache_read_for_streaming that also returns the import's report the cache keeps (may be NULL). */
-gdr_status gdr_io_cache_read_for_streaming(const char *path, const char *build_options, gdr_scene **out,
-                                           gdr_pvs **out_pvs, gdr_import_report *out_report, uint64_t *out_bytes_read,
-                                           gdr_error *err);
+/* gdr_cache_read_for_streaming for the cache of `source` (NULL: a cache read on its own; stale as
+ * gdr_io_cache_read_for says), also returning the import's report the cache keeps (may be NULL). */
+gdr_status gdr_io_cache_read_for_streaming(const char *path, const char *source, const char *build_options,
+                                           gdr_scene **out, gdr_pvs **out_pvs, gdr_import_report *out_report,
+                                           uint64_t *out_bytes_read, gdr_error *err);
 
 /* The source a cache file records first (the file it was built from), control characters escaped;
  * reads only the header, the table and section 'SRCE', each checksum checked. */

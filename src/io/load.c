@@ -156,8 +156,7 @@ gdr_status gdr_scene_load(const char *spec, const gdr_load_options *options, gdr
     const char *text;
     builtin_scene which = find_builtin(spec, &text);
     if (which != BUILTIN_NONE && options && options->geometry_in_pages)
-        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: streaming reads a .gdrc cache with geometry pages "
-                             "(gdr build %s -o FILE.gdrc --pages), not a built-in scene", spec, spec);
+        return gdr_io_load_paged(spec, options, NULL, 0, out, options->pvs, options->report, err);
     if (which != BUILTIN_NONE) {
         gdr_status status = create_builtin(which, text, out, err);
         /* The LOD DAG over the meshlets the built-in scenes come with (src/geometry). */

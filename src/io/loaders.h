@@ -4,6 +4,7 @@
 #ifndef GDR_IO_LOADERS_H
 #define GDR_IO_LOADERS_H
 
+#include <limits.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -69,6 +70,15 @@ gdr_status gdr_cache_read(const char *path, const char *build_options, gdr_scene
  * out_bytes_read (may be NULL): the bytes read from the file. */
 gdr_status gdr_cache_read_for_streaming(const char *path, const char *build_options, gdr_scene **out,
                                         gdr_pvs **out_pvs, uint64_t *out_bytes_read, gdr_error *err);
+
+/* Streaming from a source file or a built-in scene (load_paged.c): the scene read for streaming from
+ * its paged cache, built (quantized, with pages) where no fresh one is found. `candidates` are the
+ * loader's cache files for the source, in order (a built-in scene: NULL, the candidate is made
+ * from options->cache_dir or the per-user cache folder); the paged cache sits beside each, named
+ * FILE.pages.gdrc. Its path goes to options->cache_path; the import's warnings, said when it is
+ * built, are kept in it and said again when it is read (into `report`, which may be NULL). */
+gdr_status gdr_io_load_paged(const char *spec, const gdr_load_options *options, char (*candidates)[PATH_MAX], int count,
+                             gdr_scene **out, gdr_pvs **out_pvs, gdr_import_report *report, gdr_error *err);
 
 /* Parses a cache from memory without any staleness check (the fuzz target uses this); out_pvs as
  * in gdr_cache_read. */

@@ -52,6 +52,17 @@ static uint32_t traversal_levels(const gdr_renderer *r, const gdr_frame_desc *fr
                                                                                              : 0;
 }
 
+/* The frame's LOD threshold: a streamed scene raises it while its cut needs more pages than the
+ * pool holds (stream/lod_budget.h); the statistics report what was drawn with. */
+static float lod_threshold(gdr_renderer *r, const gdr_frame_slot *slot, const gdr_frame_desc *frame)
+{
+    if (!r->scene.streamed)
+        return frame->lod_error_px;
+    float threshold = frame->lod_error_px * slot->stream_lod_scale;
+    r->stream.stats.lod_error_px = threshold;
+    return threshold;
+}
+
 static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_desc *frame, gdr_pipeline pipeline,
                           uint32_t update_count, bool occlusion, bool history)
 {
@@ -89,7 +100,7 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .view_mode = (uint32_t)frame->view,
         .task_capacity = r->scene.task_capacity,
         .viewport = {(float)r->width, (float)r->height},
-        .lod_threshold = frame->lod_error_px,
+        .lod_threshold = lod_threshold(r, slot, frame),
         .lod_projection_scale = fabsf(projection.m[5]) * 0.5f * (float)r->height,
         .lod_depth = frame->lod_depth > INT32_MAX ? INT32_MAX : (int32_t)frame->lod_depth,
         .traversal_capacity = r->scene.traversal_capacity,

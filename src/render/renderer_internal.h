@@ -14,6 +14,7 @@
 #include "vk/vk_image.h"
 #include "vk/vk_memory.h"
 #include "render/visbuffer.h"
+#include "stream/lod_budget.h"
 
 /* GPU timings summed over the frames of one gdr_renderer_render call. */
 typedef struct gdr_frame_timings {
@@ -115,6 +116,7 @@ typedef struct gdr_frame_slot {
     bool stream_copies;          /* stream_cmd holds this frame's copies */
     bool stream_results;         /* the slot's last frame streamed: its lists are to be read */
     uint32_t stream_frame;       /* the number stamped on the groups the frame drew (0: no list) */
+    float stream_lod_scale;      /* the factor on the LOD threshold the frame drew with */
     gdr_pipeline pipeline;       /* of the frame last recorded into this slot */
     bool lod_applied;            /* that frame selected a LOD cut (GDR_FRAME_LOD) */
     bool occlusion_applied;      /* that frame culled in two phases against the depth pyramid */
@@ -157,6 +159,9 @@ typedef struct gdr_streaming {
     struct gdr_stream_request *requests; /* scratch: GDR_STREAM_REQUEST_CAPACITY */
     struct gdr_stream_load *loads;      /* scratch: slot_count */
     uint32_t frame;                     /* streaming frames begun */
+    gdr_lod_budget lod_budget;          /* the factor on the LOD threshold that fits the cut to the pool */
+    bool fixed_lod_error;               /* the factor stays 1 */
+    uint32_t unsettled_frame;           /* the last frame whose factor or resident set changed */
     gdr_streaming_stats stats;          /* the last frame's, and the totals */
 } gdr_streaming;
 

@@ -170,6 +170,8 @@ gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr
     s->enabled = true;
     s->scene = scene;
     s->wait_for_loads = desc->wait_for_loads;
+    s->fixed_lod_error = desc->fixed_lod_error;
+    gdr_lod_budget_init(&s->lod_budget);
     s->upload_budget = desc->upload_budget_bytes ? desc->upload_budget_bytes : GDR_UPLOAD_BUDGET_DEFAULT;
     s->cache = desc->cache;
     gdr_status status = gdr_paged_cache_check_scene(s->cache, scene, gdr_paged_cache_path(s->cache), err);
@@ -507,6 +509,29 @@ static stream_copies frame_copies(gdr_renderer *r)
                            .resident_words = s->words + groups, .resident_slots = s->words + 2 * (size_t)groups};
 }
 
+/* The slot's read-back cut against the pool (stream/lod_budget.h): the factor on the LOD threshold
+ * that this frame draws with. Returns the requests still wanted: none when the read-back frame drew
+ * with a lower threshold than this frame will (its requests were for detail no longer asked for). */
+static uint32_t fit_cut_to_pool(gdr_renderer *r, gdr_frame_slot *slot, uint32_t request_count)
+{
+    gdr_streaming *s = &r->stream;
+    bool known = slot->stream_results && slot->stream_frame != 0;
+    gdr_lod_budget_observation o = {.scale = slot->stream_lod_scale, .known = known,
+                                    .all_resident = r->scene.absent_groups == 0, .requests = request_count,
+                                    .capacity = s->slot_count,
+                                    .pinned = gdr_residency_get_stats(s->residency).pinned_pages};
+    if (known)
+        o.wanted = gdr_residency_count_wanted(s->residency, slot->stream_frame, s->requests, request_count);
+    s->stats.wanted_pages = o.wanted;
+    if (!s->fixed_lod_error && gdr_lod_budget_update(&s->lod_budget, &o))
+        s->unsettled_frame = s->frame;
+    bool coarser_now = known && o.scale < s->lod_budget.scale;
+    slot->stream_lod_scale = s->lod_budget.scale;
+    s->stats.lod_error_scale = s->lod_budget.scale;
+    s->stats.lod_error_changes = s->lod_budget.changes;
+    return coarser_now ? 0 : request_count;
+}
+
 /* The residency's figures into the statistics. */
 static void update_stats(gdr_streaming *s)
 {
@@ -535,6 +560,7 @@ gdr_status gdr_streaming_begin_frame(gdr_renderer *r, gdr_frame_slot *slot, gdr_
     s->stats.uploads = 0;
     s->stats.upload_bytes = 0;
     uint32_t request_count = slot->stream_results ? read_slot_results(r, slot) : 0;
+    request_count = fit_cut_to_pool(r, slot, request_count);
     uint32_t load_count = 0;
     gdr_residency_plan(s->residency, frame, s->requests, request_count, s->loads, s->slot_count, &load_count);
     gdr_status status = gdr_page_loader_submit(s->loader, s->loads, load_count, err);
@@ -554,6 +580,9 @@ gdr_status gdr_streaming_begin_frame(gdr_renderer *r, gdr_frame_slot *slot, gdr_
     slot->stream_frame = r->scene.absent_groups > 0 ? frame : 0;
     slot->stream_results = true;
     update_stats(s);
+    if (s->stats.uploads || s->stats.evictions)
+        s->unsettled_frame = frame;
+    s->stats.settled_frames = frame - s->unsettled_frame;
     return status;
 }
 

@@ -14,6 +14,7 @@ typedef struct page_state {
     uint32_t slot;
     uint32_t last_used;  /* frame whose cut last used it (UINT32_MAX: never) */
     uint32_t dependents; /* planned or resident pages holding a child of its groups */
+    uint32_t wanted_mark; /* the count of gdr_residency_count_wanted that last reached it */
     uint8_t state, pinned, requested;
 } page_state;
 
@@ -38,6 +39,7 @@ struct gdr_residency {
      * (UINT32_MAX: none), so that finding a page to evict walks the pool, never the scene. */
     uint32_t *lru_prev, *lru_next;
     uint32_t lru_head, lru_tail;
+    uint32_t wanted_mark;    /* counts of gdr_residency_count_wanted */
     gdr_residency_stats stats;
 };
 
@@ -394,6 +396,52 @@ void gdr_residency_plan(gdr_residency *res, uint32_t frame, const gdr_stream_req
                        gdr_paged_cache_mesh(res->cache, sorted[i].mesh)->groups[sorted[i].group].page].requested =
                 MARK_NONE;
     free(sorted);
+}
+
+/* --- what a cut needs ---------------------------------------------------------------------------- */
+
+/* Marks page `page` and the pages holding its groups' ancestors (not yet marked), pushing the new
+ * ones on `stack`; counts the marked pages that are not pinned. */
+static uint32_t mark_wanted(gdr_residency *res, uint32_t page, uint32_t *stack)
+{
+    uint32_t n = 0, top = 0;
+    if (res->pages[page].wanted_mark == res->wanted_mark)
+        return 0;
+    res->pages[page].wanted_mark = res->wanted_mark;
+    stack[top++] = page;
+    while (top > 0) {
+        uint32_t q = stack[--top];
+        n += !res->pages[q].pinned;
+        for (uint32_t e = res->parent_first[q]; e < res->parent_first[q + 1]; e++)
+            if (res->pages[res->parents[e]].wanted_mark != res->wanted_mark) {
+                res->pages[res->parents[e]].wanted_mark = res->wanted_mark;
+                stack[top++] = res->parents[e];
+            }
+    }
+    return n;
+}
+
+uint32_t gdr_residency_count_wanted(gdr_residency *res, uint32_t frame, const gdr_stream_request *requests,
+                                    uint32_t request_count)
+{
+    if (++res->wanted_mark == 0) { /* wrapped: forget every old mark */
+        for (uint32_t i = 0; i < res->page_total; i++)
+            res->pages[i].wanted_mark = 0;
+        res->wanted_mark = 1;
+    }
+    uint32_t *stack = res->scratch, wanted = 0;
+    /* Pages a cut used move to the end of the LRU list: frame's pages are its tail. */
+    for (uint32_t i = res->lru_tail; i != UINT32_MAX && res->pages[i].last_used == frame; i = res->lru_prev[i])
+        wanted += mark_wanted(res, i, stack);
+    for (uint32_t i = 0; i < request_count; i++) {
+        uint32_t m = requests[i].mesh;
+        const gdr_paged_mesh *pm = m < res->mesh_count ? gdr_paged_cache_mesh(res->cache, m) : NULL;
+        if (pm && requests[i].group < pm->group_count)
+            wanted += mark_wanted(res, res->page_base[m] + pm->groups[requests[i].group].page, stack);
+    }
+    for (uint32_t m = 0; m < res->mesh_count; m++)
+        wanted += gdr_paged_cache_mesh(res->cache, m)->page_count ? 1 : 0;
+    return wanted;
 }
 
 /* --- the rest ------------------------------------------------------------------------------------ */

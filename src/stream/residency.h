@@ -75,6 +75,12 @@ void gdr_residency_plan(gdr_residency *res, uint32_t frame, const gdr_stream_req
 void gdr_residency_loaded(gdr_residency *res, uint32_t mesh, uint32_t page);
 void gdr_residency_failed(gdr_residency *res, uint32_t mesh, uint32_t page);
 
+/* The pages the cut of frame `frame` needs resident: those holding the groups it drew (marked with
+ * gdr_residency_mark_used for that frame) or asked for, those holding their groups' ancestors in
+ * the DAG (the closure), and the pinned pages. Walks those pages only. */
+uint32_t gdr_residency_count_wanted(gdr_residency *res, uint32_t frame, const gdr_stream_request *requests,
+                                    uint32_t request_count);
+
 /* Whether group `group` of mesh `mesh` is resident (its page arrived). */
 int gdr_residency_group_resident(const gdr_residency *res, uint32_t mesh, uint32_t group);
 /* The slot of a resident page, or UINT32_MAX. */

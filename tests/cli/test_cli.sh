@@ -153,10 +153,31 @@ expect 2 "page size too small" "$gdr" build unique-field:meshes=1,triangles=1000
 # Streaming: a paged cache renders within a budget and reports its pool; anything else is refused.
 expect 0 "render streamed" "$gdr" render "$work/unique.gdrc" $tiny --geometry-budget 1 --upload-budget 1 --frames 4 --validate
 grep -q '^streaming pool' "$work/stdout" || { echo "FAIL: streamed render printed no pool: $(cat "$work/stdout")"; failures=$((failures + 1)); }
-expect 2 "stream a built-in scene" "$gdr" render unique-field:meshes=2,triangles=2000 $tiny --geometry-budget 1
-grep -q 'stream from a cache' "$work/stderr" || { echo "FAIL: stream built-in: $(cat "$work/stderr")"; failures=$((failures + 1)); }
-expect 2 "stream in the viewer" "$gdr" view "$work/unique.gdrc" --geometry-budget 1
-grep -q "gdr render's" "$work/stderr" || { echo "FAIL: view --geometry-budget: $(cat "$work/stderr")"; failures=$((failures + 1)); }
+# Streaming any scene: a built-in scene, a glTF and an OBJ without a prior gdr build get their paged
+# cache built in the cache folder (once: a second run reads it), and a glTF streamed with room for
+# everything converges to the image of that cache uploaded whole; --no-cache cannot stream a file.
+expect 0 "stream a built-in scene" "$gdr" render unique-field:meshes=2,triangles=2000 $tiny --geometry-budget 1 \
+    --cache-dir "$work/cache" --frames 8 --validate
+ls "$work/cache"/unique-field*.pages.gdrc >/dev/null 2>&1 || { echo "FAIL: no paged cache of the built-in scene"; failures=$((failures + 1)); }
+engine=/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb
+expect 0 "stream a glTF" "$gdr" render "$engine" $tiny --geometry-budget 64 --cache-dir "$work/cache" --frames 30 \
+    --out "$work/engine-streamed.png" --stats "$work/engine.json" --validate
+paged=$(ls "$work/cache"/2CylinderEngine.glb-*.pages.gdrc 2>/dev/null)
+[ -n "$paged" ] || { echo "FAIL: no paged cache of the glTF"; failures=$((failures + 1)); }
+for key in lod_error_px lod_error_scale wanted_pages settled_frames; do
+    grep -q "\"$key\"" "$work/engine.json" || { echo "FAIL: streaming stats JSON lacks $key"; failures=$((failures + 1)); }
+done
+cp "$paged" "$work/paged-before.gdrc" 2>/dev/null
+expect 0 "stream the glTF again" "$gdr" render "$engine" $tiny --geometry-budget 64 --cache-dir "$work/cache" --frames 30 \
+    --out "$work/engine-again.png"
+cmp -s "$paged" "$work/paged-before.gdrc" || { echo "FAIL: the paged cache was rebuilt"; failures=$((failures + 1)); }
+expect 0 "the paged cache whole" "$gdr" render "$paged" $tiny --out "$work/engine-whole.png"
+cmp -s "$work/engine-streamed.png" "$work/engine-whole.png" ||
+    { echo "FAIL: the streamed glTF's image is not its cache's"; failures=$((failures + 1)); }
+expect 0 "stream an OBJ" "$gdr" render /usr/share/assimp/models/OBJ/WusonOBJ.obj $tiny --geometry-budget 8 \
+    --cache-dir "$work/cache" --frames 10 --validate
+expect 1 "stream without a cache" "$gdr" render "$engine" $tiny --geometry-budget 8 --no-cache
+grep -q 'no_cache' "$work/stderr" || { echo "FAIL: stream --no-cache: $(cat "$work/stderr")"; failures=$((failures + 1)); }
 expect 1 "stream a cache without pages" "$gdr" render "$work/field.gdrc" $tiny --geometry-budget 1
 grep -q 'has no geometry pages' "$work/stderr" || { echo "FAIL: stream without pages: $(cat "$work/stderr")"; failures=$((failures + 1)); }
 expect 2 "unique-field no meshes" "$gdr" info unique-field:meshes=0

@@ -130,6 +130,11 @@ static bool draw(const gdr_scene *scene, gdr_renderer *r, const gdr_frame_desc *
     gdr_mat4 projection = gdr_perspective_reverse_z_infinite(frame->camera.yfov, (float)WIDTH / HEIGHT,
                                                              frame->camera.znear);
     uint32_t cursor = 0, wrong = 0;
+    /* The threshold the frame drew with: the pool may have raised it (a cut that fits the pool). */
+    float threshold = stats->streaming.enabled ? stats->streaming.lod_error_px : frame->lod_error_px;
+    if (threshold != frame->lod_error_px)
+        printf("frame drawn at threshold %g (x %g), %u pages wanted, %u slots\n", (double)threshold,
+               (double)stats->streaming.lod_error_scale, stats->streaming.wanted_pages, stats->streaming.slot_count);
     out->full = true, out->drawn = count, out->absent = 0;
     size_t *base = malloc(sizeof *base * (scene->mesh_count + 1));
     for (uint32_t m = 0; base && m <= scene->mesh_count; m++)
@@ -149,7 +154,7 @@ static bool draw(const gdr_scene *scene, gdr_renderer *r, const gdr_frame_desc *
         const gdr_mesh_clusters *c = &scene->meshes[m].clusters;
         gdr_lod_view view = {.transform = scene->instances[i].transform, .camera_position = frame->camera.position,
                              .projection_y = fabsf(projection.m[5]), .viewport_height = HEIGHT,
-                             .znear = frame->camera.znear, .threshold = frame->lod_error_px};
+                             .znear = frame->camera.znear, .threshold = threshold};
         uint8_t *resident = out->resident + base[m], *cut = malloc(c->cluster_count), *all = malloc(c->cluster_count);
         if (cut && all) {
             for (uint32_t g = 0; g < c->group_count; g++)

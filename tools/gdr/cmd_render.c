@@ -180,55 +180,39 @@ gdr_frame_desc render_options_frame(const render_options *o, gdr_camera camera)
 }
 
 /* The frames asked for: o->frames of one view, or with a camera path (path->count > 0) one frame per
- * pose (the path repeated to make --frames N, N the path's length by default); the statistics are
- * the last call's. */
+ * pose (the path repeated to make --frames N, N the path's length by default), each frame's figures
+ * a row of *rows (malloc'ed; the JSON's "path"); the statistics are the last call's. */
 static gdr_status render_frames(gdr_renderer *renderer, gdr_frame_desc *frame, const render_options *o,
-                                const camera_path *path, gdr_frame_stats *stats, gdr_error *err)
+                                const camera_path *path, gdr_frame_stats *stats, stats_path_frame **rows,
+                                gdr_error *err)
 {
     if (path->count == 0)
         return gdr_renderer_render(renderer, frame, o->frames, stats, err);
     gdr_status status = GDR_OK;
     uint32_t frames = o->frames_given ? o->frames : path->count;
+    *rows = calloc(frames, sizeof **rows);
+    if (!*rows)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "render: out of memory for %u frames' figures", frames);
     bool read_back = frame->read_back;
     for (uint32_t f = 0; f < frames && status == GDR_OK; f++) {
         frame->camera.position = path->poses[f % path->count].position;
         frame->camera.rotation = path->poses[f % path->count].rotation;
         frame->read_back = read_back && f + 1 == frames;
         status = gdr_renderer_render(renderer, frame, 1, stats, err);
+        if (status == GDR_OK)
+            (*rows)[f] = stats_path_row(stats);
     }
     return status;
 }
 
-static bool streamed(const render_options *o) { return o->geometry_budget_mib || o->upload_budget_mib; }
-
-/* A streamed scene is read from its cache without the geometry the pages hold. A file's cache may
- * hold the scene's precomputed visibility (*pvs, else NULL), streamed or not. */
+/* A streamed scene is read from its paged cache without the geometry the pages hold (a source file
+ * or built-in scene gets one built first, in the cache folder). A file's cache may hold the scene's
+ * precomputed visibility (*pvs, else NULL), streamed or not. */
 static gdr_status load_scene(render_options *o, gdr_scene **scene, gdr_pvs **pvs, gdr_error *err)
 {
     *pvs = NULL;
-    size_t length = strlen(o->scene);
-    if (streamed(o) && (length < 5 || strcmp(o->scene + length - 5, ".gdrc") != 0))
-        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "--geometry-budget/--upload-budget stream from a cache: "
-                             "give a .gdrc written with 'gdr build --pages' (not '%s')", o->scene);
-    o->load.geometry_in_pages = streamed(o);
     o->load.pvs = pvs;
-    return gdr_scene_load(o->scene, &o->load, scene, err);
-}
-
-/* The scene, streamed from its cache file when a budget is given (the scene is that file, opened
- * here as a paged cache: *paged, closed by the caller after the renderer). */
-static gdr_status set_scene(gdr_renderer *renderer, const gdr_scene *scene, const render_options *o,
-                            gdr_paged_cache **paged, gdr_error *err)
-{
-    if (!streamed(o))
-        return gdr_renderer_set_scene(renderer, scene, err);
-    gdr_status status = gdr_paged_cache_open(o->scene, paged, err);
-    if (status != GDR_OK)
-        return status;
-    gdr_streaming_desc stream = {.cache = *paged,
-                                 .geometry_budget_bytes = (uint64_t)o->geometry_budget_mib << 20,
-                                 .upload_budget_bytes = (uint64_t)o->upload_budget_mib << 20};
-    return gdr_renderer_set_scene_streamed(renderer, scene, &stream, err);
+    return render_options_load(o, scene, err);
 }
 
 int gdr_cmd_render(int argc, char **argv)
@@ -253,6 +237,7 @@ int gdr_cmd_render(int argc, char **argv)
     gdr_paged_cache *paged = NULL;
     gdr_frame_stats stats;
     uint8_t *pixels = NULL;
+    stats_path_frame *rows = NULL;
     int result = 0;
     if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK) {
         result = cli_renderer_failed(&err);
@@ -275,8 +260,8 @@ int gdr_cmd_render(int argc, char **argv)
         goto done;
     }
     gdr_frame_desc frame = render_options_frame(&o, render_options_camera(scene, &o));
-    if (set_scene(renderer, scene, &o, &paged, &err) != GDR_OK || gdr_renderer_set_pvs(renderer, pvs, &err) != GDR_OK ||
-        render_frames(renderer, &frame, &o, &path, &stats, &err) != GDR_OK) {
+    if (render_options_set_scene(renderer, scene, &o, &paged, &err) != GDR_OK || gdr_renderer_set_pvs(renderer, pvs, &err) != GDR_OK ||
+        render_frames(renderer, &frame, &o, &path, &stats, &rows, &err) != GDR_OK) {
         result = fail(&err);
         goto done;
     }
@@ -288,7 +273,8 @@ int gdr_cmd_render(int argc, char **argv)
             goto done;
         }
     }
-    stats_context context = {o.scene, o.width, o.height, o.cull ? "on" : "off", gdr_view_name(o.view)};
+    stats_context context = {o.scene, o.width, o.height, o.cull ? "on" : "off", gdr_view_name(o.view), rows,
+                             rows ? (o.frames_given ? o.frames : path.count) : 0};
     stats_print(stdout, &context, &stats);
     if (o.out_png)
         printf("image               %s\n", o.out_png);
@@ -306,6 +292,7 @@ done:
     gdr_import_report_free(&o.report);
     camera_path_free(&path);
     free(pixels);
+    free(rows);
     gdr_renderer_destroy(renderer);
     gdr_paged_cache_close(paged);
     cli_pvs_destroy(pvs);

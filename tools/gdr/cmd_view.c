@@ -14,6 +14,7 @@
 #include "commands.h"
 #include "gdr/present.h"
 #include "render_options.h"
+#include "stats_output.h"
 #include "view.h"
 
 typedef struct view_options {
@@ -27,6 +28,7 @@ typedef struct view_app {
     const view_options *v;
     GLFWwindow *window;
     gdr_renderer *renderer;
+    gdr_paged_cache *paged; /* streaming: the scene's paged cache, closed after the renderer */
     gdr_presenter *presenter;
     VkSurfaceKHR surface;
     view_settings settings;
@@ -81,6 +83,10 @@ static void on_key(GLFWwindow *window, int key, int scancode, int action, int mo
         now.position = app->camera.position;
         now.rotation = app->camera.rotation;
         view_key(&app->settings, &now, key, mods);
+        if (app->settings.jump) {
+            app->settings.jump = false;
+            view_jump(&app->settings, &app->camera.position, &app->camera.rotation);
+        }
     }
 }
 
@@ -130,6 +136,15 @@ static void overlay_text(const view_app *app, char *text, size_t size)
                               v->frame.cull == GDR_CULL_OFF ? "off" : "on", v->freeze_culling ? " (frozen)" : "",
                               occlusion[v->frame.occlusion], s->occlusion.applied ? "applied" : "not applied",
                               (double)v->frame.lod_error_px, v->message, v->help ? view_key_help : "H: keys");
+    const gdr_streaming_stats *st = &s->streaming;
+    if (st->enabled && n < size)
+        snprintf(text + n, size - n,
+                 "\nstreaming  LOD %.3g px (x %.3g to fit the pool)\n"
+                 "pages wanted %u / %u slots  resident %u  pool %.1f MiB\n"
+                 "uploads %u  evictions %u  requests %u  settled %u frames",
+                 (double)st->lod_error_px, (double)st->lod_error_scale, st->wanted_pages, st->slot_count,
+                 st->resident_pages, (double)st->pool_bytes / (1 << 20), st->uploads, st->evictions, st->requests,
+                 st->settled_frames);
 }
 
 static int fail(const char *what, const gdr_error *err)
@@ -173,7 +188,7 @@ static int open_window(view_app *app, const gdr_scene *scene, const gdr_pvs *pvs
                               .instance_extension_count = extension_count, .presentable = true};
     if (gdr_renderer_create(&desc, &app->renderer, &err) != GDR_OK)
         return cli_renderer_failed(&err); /* 2 for a --device the machine does not have */
-    if (gdr_renderer_set_scene(app->renderer, scene, &err) != GDR_OK ||
+    if (render_options_set_scene(app->renderer, scene, app->o, &app->paged, &err) != GDR_OK ||
         gdr_renderer_set_pvs(app->renderer, pvs, &err) != GDR_OK) /* the cache's PVS culls as in gdr render */
         return fail("", &err);
     VkResult made = glfwCreateWindowSurface(gdr_renderer_vulkan(app->renderer).instance, app->window, NULL,
@@ -197,6 +212,7 @@ static void close_window(view_app *app)
     if (app->surface)
         vkDestroySurfaceKHR(gdr_renderer_vulkan(app->renderer).instance, app->surface, NULL);
     gdr_renderer_destroy(app->renderer);
+    gdr_paged_cache_close(app->paged);
     if (app->window)
         glfwDestroyWindow(app->window);
     glfwTerminate();
@@ -339,6 +355,7 @@ static int finish(view_app *app, int result)
             printf("camera path         %s (%u frames)\n", app->v->record_path, app->recorded.count);
     }
     printf("frames              %u\n", app->frames);
+    stats_print_streaming(stdout, &app->stats.streaming); /* the last frame's, as the overlay showed them */
     if (result == 0 && app->stats.validation_messages > 0) {
         fprintf(stderr, "gdr view: the validation layer reported %u message(s)\n", app->stats.validation_messages);
         result = 3;
@@ -357,6 +374,9 @@ static void start_settings(view_app *app, const gdr_scene *scene)
     s->overlay = app->v->overlay;
     s->vsync = !app->v->no_vsync;
     s->has_mesh_pipeline = gdr_renderer_has_mesh_pipeline(app->renderer, NULL);
+    s->streamed = render_options_streamed(o);
+    s->home_position = app->camera.position;
+    s->home_rotation = app->camera.rotation;
     snprintf(s->message, sizeof s->message, "H: keys");
 }
 
@@ -377,11 +397,6 @@ int gdr_cmd_view(int argc, char **argv)
         fprintf(stderr, "gdr view: --out and --stats are gdr render's; use --screenshot FILE\n");
         return 2;
     }
-    if (o.geometry_budget_mib || o.upload_budget_mib) {
-        fprintf(stderr, "gdr view: --geometry-budget and --upload-budget are gdr render's: the viewer uploads the "
-                "scene whole (docs/STREAMING.md)\n");
-        return 2;
-    }
     view_app app = {.o = &o, .v = &v};
     gdr_error err = {0};
     gdr_scene *scene = NULL;
@@ -389,7 +404,7 @@ int gdr_cmd_view(int argc, char **argv)
     if (o.camera_path && camera_path_read(o.camera_path, &app.replay, &err) != GDR_OK)
         return fail("--camera-path: ", &err);
     o.load.pvs = &pvs;
-    if (gdr_scene_load(o.scene, &o.load, &scene, &err) != GDR_OK) {
+    if (render_options_load(&o, &scene, &err) != GDR_OK) {
         camera_path_free(&app.replay);
         gdr_import_report_free(&o.report);
         return cli_load_failed(o.scene, &err);

@@ -34,6 +34,7 @@ typedef struct render_options {
     gdr_load_options load;   /* its warning sink is `warnings`, its report `report` */
     cli_warnings warnings;   /* counted; --strict makes them errors (exit GDR_EXIT_STRICT) */
     gdr_import_report report; /* the import's, for --camera-index; freed with gdr_import_report_free */
+    char paged_cache[4096]; /* streaming: the paged cache the scene was read from */
 } render_options;
 
 /* Another command's own option at argv[*i]: returns 1 when it took it (advancing *i past a value),
@@ -45,6 +46,15 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
                          void *context);
 /* The scene's camera (--camera-index, or one framing the scene), with --camera's pose. */
 gdr_camera render_options_camera(const gdr_scene *scene, const render_options *o);
+/* Streaming (docs/STREAMING.md): whether a budget was given. */
+bool render_options_streamed(const render_options *o);
+/* The scene the options name; streamed, read from its paged cache (built in the cache folder where
+ * a source file or built-in scene has no fresh one), its path kept in o->paged_cache. */
+gdr_status render_options_load(render_options *o, gdr_scene **scene, gdr_error *err);
+/* The scene into the renderer: uploaded whole, or streamed from o->paged_cache (opened into *paged,
+ * closed by the caller after the renderer). */
+gdr_status render_options_set_scene(gdr_renderer *renderer, const gdr_scene *scene, const render_options *o,
+                                    gdr_paged_cache **paged, gdr_error *err);
 /* The frame description the options ask for, seen from `camera`. */
 gdr_frame_desc render_options_frame(const render_options *o, gdr_camera camera);
 

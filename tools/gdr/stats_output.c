@@ -179,6 +179,9 @@ void stats_print_streaming(FILE *out, const gdr_streaming_stats *st)
             "%u deferred, %u pending; %u frames since a change\n", st->requests, st->distinct_requests, st->loads,
             st->uploads, (unsigned long long)st->upload_bytes, st->evictions, st->deferred, st->pending,
             st->frames_since_change);
+    fprintf(out, "streaming cut       threshold %g px (x %g to fit the pool, %u changes), %u pages wanted of %u slots, "
+            "settled %u frames\n", (double)st->lod_error_px, (double)st->lod_error_scale, st->lod_error_changes,
+            st->wanted_pages, st->slot_count, st->settled_frames);
     fprintf(out, "streaming totals    %llu uploads (%llu bytes), %llu evictions, %u pages refused%s%s\n",
             (unsigned long long)st->uploads_total, (unsigned long long)st->upload_bytes_total,
             (unsigned long long)st->evictions_total, st->pages_refused, st->pages_refused ? ": " : "",
@@ -199,7 +202,9 @@ static void add_streaming_json(cJSON *object, const gdr_streaming_stats *st)
         {"pending", st->pending}, {"frames_since_change", st->frames_since_change},
         {"uploads_total", (double)st->uploads_total}, {"upload_bytes_total", (double)st->upload_bytes_total},
         {"evictions_total", (double)st->evictions_total}, {"evicted_in_use", (double)st->evicted_in_use},
-        {"pages_refused", st->pages_refused}};
+        {"pages_refused", st->pages_refused}, {"lod_error_px", st->lod_error_px},
+        {"lod_error_scale", st->lod_error_scale}, {"lod_error_changes", st->lod_error_changes},
+        {"wanted_pages", st->wanted_pages}, {"settled_frames", st->settled_frames}};
     for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++)
         cJSON_AddNumberToObject(o, fields[i].name, fields[i].value);
 }
@@ -210,6 +215,33 @@ void stats_add_memory_json(cJSON *object, const gdr_frame_stats *s)
     cJSON_AddNumberToObject(object, "gpu_memory_bytes", (double)s->memory.device_bytes);
     cJSON_AddNumberToObject(object, "gpu_memory_scene_bytes", (double)s->memory.scene_bytes);
     cJSON_AddNumberToObject(object, "gpu_memory_frame_bytes", (double)s->memory.frame_bytes);
+}
+
+stats_path_frame stats_path_row(const gdr_frame_stats *s)
+{
+    const gdr_streaming_stats *st = &s->streaming;
+    return (stats_path_frame){s->gpu_ms_per_frame, s->triangles, st->lod_error_px, st->wanted_pages,
+                              st->resident_pages, st->uploads, st->evictions, st->requests};
+}
+
+static void add_path_json(cJSON *root, const stats_context *context)
+{
+    cJSON *rows = context->path_count ? cJSON_AddArrayToObject(root, "path") : NULL;
+    for (uint32_t i = 0; rows && i < context->path_count; i++) {
+        const stats_path_frame *f = &context->path[i];
+        cJSON *row = cJSON_CreateObject();
+        if (!row || !cJSON_AddItemToArray(rows, row))
+            break;
+        cJSON_AddNumberToObject(row, "frame", i);
+        cJSON_AddNumberToObject(row, "gpu_ms", f->gpu_ms);
+        cJSON_AddNumberToObject(row, "triangles", (double)f->triangles);
+        cJSON_AddNumberToObject(row, "lod_error_px", f->lod_error_px);
+        cJSON_AddNumberToObject(row, "wanted_pages", f->wanted_pages);
+        cJSON_AddNumberToObject(row, "resident_pages", f->resident_pages);
+        cJSON_AddNumberToObject(row, "uploads", f->uploads);
+        cJSON_AddNumberToObject(row, "evictions", f->evictions);
+        cJSON_AddNumberToObject(row, "requests", f->requests);
+    }
 }
 
 char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
@@ -259,6 +291,7 @@ char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
         cJSON_AddNumberToObject(passes, s->passes[p].name, s->passes[p].gpu_ms);
     stats_add_memory_json(root, s);
     cJSON_AddNumberToObject(root, "validation_messages", s->validation_messages);
+    add_path_json(root, context);
     char *text = cJSON_Print(root);
     cJSON_Delete(root);
     return text;

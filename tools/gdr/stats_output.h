@@ -6,12 +6,25 @@
 
 #include "gdr/renderer.h"
 
+/* One frame along a camera path (gdr render --camera-path): what a plot along the path needs. */
+typedef struct stats_path_frame {
+    double gpu_ms;
+    uint64_t triangles;
+    float lod_error_px;                /* streamed: the threshold drawn with */
+    uint32_t wanted_pages, resident_pages, uploads, evictions, requests;
+} stats_path_frame;
+
 typedef struct stats_context {
     const char *scene;
     uint32_t width, height;
     const char *cull;
     const char *view;
+    const stats_path_frame *path;      /* the JSON's "path": a row per frame (NULL: none) */
+    uint32_t path_count;
 } stats_context;
+
+/* The figures of the frame just rendered, as a row of the path. */
+stats_path_frame stats_path_row(const gdr_frame_stats *stats);
 
 void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats *stats);
 typedef struct cJSON cJSON;

@@ -36,11 +36,18 @@ typedef struct view_settings {
     bool screenshot;          /* one wanted this frame */
     bool quit;
     bool has_mesh_pipeline;
+    bool streamed;            /* the scene streams: the mesh pipeline and a LOD threshold above 0 only */
+    bool jump;                /* J pressed: the camera jumps (view_jump) */
+    gdr_vec3 home_position, away_position; /* J jumps between the start and where it was pressed */
+    gdr_quat home_rotation, away_rotation;
+    bool away;                /* the camera is at home after a jump; J goes back */
     char message[160];        /* the last key's effect, shown in the overlay */
 } view_settings;
 
 /* A key pressed (GLFW key code and modifier bits): changes the settings, never the camera. */
 void view_key(view_settings *settings, const gdr_camera *camera, int key, int mods);
+/* J: the camera jumps to where the view started, or back to where it was when J was pressed. */
+void view_jump(view_settings *settings, gdr_vec3 *position, gdr_quat *rotation);
 /* The on-screen key list, also printed by gdr view --help. */
 extern const char view_key_help[];
 

@@ -12,6 +12,7 @@ const char view_key_help[] =
     "    V  view mode   P  pipeline     R  raster mode\n"
     "    O  occlusion   C  culling      F  freeze culling\n"
     "    ]  LOD threshold x2            [  LOD threshold /2\n"
+    "    J  jump to the start and back\n"
     "    F12  screenshot  Y  vsync  TAB  overlay  H  keys  ESC  quit\n";
 
 static void next_view(view_settings *s)
@@ -25,6 +26,10 @@ static void next_view(view_settings *s)
 static void next_pipeline(view_settings *s)
 {
     gdr_pipeline p = s->frame.pipeline;
+    if (s->streamed) {
+        snprintf(s->message, sizeof s->message, "a streamed scene draws with the mesh pipeline only");
+        return;
+    }
     if (p == GDR_PIPELINE_DEFAULT)
         p = s->has_mesh_pipeline ? GDR_PIPELINE_MESH : GDR_PIPELINE_INDIRECT;
     p = p == GDR_PIPELINE_MESH ? GDR_PIPELINE_INDIRECT
@@ -60,7 +65,7 @@ static void next_occlusion(view_settings *s)
 static void scale_lod(view_settings *s, bool up)
 {
     float e = s->frame.lod_error_px;
-    e = up ? (e < 0.25f ? 0.25f : e * 2.0f) : (e <= 0.25f ? 0.0f : e * 0.5f);
+    e = up ? (e < 0.25f ? 0.25f : e * 2.0f) : (e <= 0.25f ? (s->streamed ? 0.25f : 0.0f) : e * 0.5f);
     s->frame.lod_error_px = e > 4096.0f ? 4096.0f : e;
     s->frame.lod_fixed_depth = false;
     snprintf(s->message, sizeof s->message, "LOD threshold %g px", (double)s->frame.lod_error_px);
@@ -87,6 +92,7 @@ void view_key(view_settings *s, const gdr_camera *camera, int key, int mods)
     case GLFW_KEY_RIGHT_BRACKET: case GLFW_KEY_EQUAL: case GLFW_KEY_KP_ADD: scale_lod(s, true); break;
     case GLFW_KEY_LEFT_BRACKET: case GLFW_KEY_MINUS: case GLFW_KEY_KP_SUBTRACT: scale_lod(s, false); break;
     case GLFW_KEY_F12: s->screenshot = true; break;
+    case GLFW_KEY_J: s->jump = true; break;
     case GLFW_KEY_Y:
         s->vsync = !s->vsync;
         snprintf(s->message, sizeof s->message, "vsync %s", s->vsync ? "on" : "off");
@@ -95,4 +101,17 @@ void view_key(view_settings *s, const gdr_camera *camera, int key, int mods)
     case GLFW_KEY_H: case GLFW_KEY_F1: s->help = !s->help; break;
     default: break;
     }
+}
+
+void view_jump(view_settings *s, gdr_vec3 *position, gdr_quat *rotation)
+{
+    if (s->away) {
+        *position = s->away_position, *rotation = s->away_rotation;
+        snprintf(s->message, sizeof s->message, "jumped back");
+    } else {
+        s->away_position = *position, s->away_rotation = *rotation;
+        *position = s->home_position, *rotation = s->home_rotation;
+        snprintf(s->message, sizeof s->message, "jumped to the start (J: back)");
+    }
+    s->away = !s->away;
 }
