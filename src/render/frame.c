@@ -9,7 +9,9 @@
 
 void gdr_frame_matrices(const gdr_renderer *r, const gdr_camera *camera, gdr_mat4 *projection, gdr_mat4 *view)
 {
-    float aspect = camera->aspect > 0.0f ? camera->aspect : (float)r->width / (float)r->height;
+    /* The vertical field of view is kept and the aspect is the image's, whatever the camera's own
+     * (glTF's rule for an aspectRatio that differs from the viewport's: no stretching, no cropping). */
+    float aspect = (float)r->width / (float)r->height;
     *projection = camera->zfar > 0.0f ? gdr_perspective_reverse_z(camera->yfov, aspect, camera->znear, camera->zfar)
                                       : gdr_perspective_reverse_z_infinite(camera->yfov, aspect, camera->znear);
     *view = gdr_view_from_pose(camera->position, camera->rotation);

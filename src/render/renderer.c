@@ -94,6 +94,7 @@ gdr_status gdr_renderer_create(const gdr_renderer_desc *desc_in, gdr_renderer **
     gdr_vk_context_desc context_desc = {.device = desc.device, .validate = desc.validate,
                                         .synchronization_validation = desc.synchronization_validation,
                                         .disable_mesh_shaders = desc.disable_mesh_shaders,
+                                        .disable_texture_compression_bc = desc.disable_texture_compression_bc,
                                         .instance_extensions = desc.instance_extensions,
                                         .instance_extension_count = desc.instance_extension_count,
                                         .swapchain = desc.presentable};
