@@ -18,5 +18,10 @@ seed() { # NAME: the flag byte, then WORK/NAME.gdrc
 "$gdr" build "$here/corpus/obj/tri.obj" -o "$work/c.gdrc" --pvs --no-progress >/dev/null
 "$gdr" build "$work/c.gdrc" -o "$work/pvs.gdrc" --no-progress >/dev/null
 "$gdr" build unique-field:meshes=2,triangles=1000 -o "$work/paged.gdrc" --pages=4 --no-progress >/dev/null
-for name in nodes quad pvs paged; do seed $name; done
+# Block-compressed textures (BC1 with partial blocks and levels below 4 x 4: 211 x 211).
+models=/usr/share/assimp/models/glTF2/BoxTextured-glTF
+cp "$models/BoxTextured.gltf" "$models/BoxTextured0.bin" "$models/CesiumLogoFlat.png" "$work/"
+"$gdr" build "$work/BoxTextured.gltf" -o "$work/d.gdrc" --no-progress >/dev/null
+"$gdr" build "$work/d.gdrc" -o "$work/textured.gdrc" --no-progress >/dev/null
+for name in nodes quad pvs paged textured; do seed $name; done
 ls -l "$here/corpus/cache"
