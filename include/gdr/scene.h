@@ -155,6 +155,9 @@ typedef struct gdr_camera {
     float aspect;      /* the file's aspect ratio (0: none given), kept for information: the renderer
                           keeps yfov and takes the render target's aspect (glTF's rule when the
                           two differ: the image is neither stretched nor cropped) */
+    float ymag;        /* > 0: an orthographic camera seeing ymag metres above and below its axis (glTF's
+                          ymag; yfov unused; its width follows the image's aspect), zfar > znear >= 0
+                          (zfar finite); 0: perspective */
 } gdr_camera;
 
 typedef struct gdr_scene {

@@ -21,7 +21,7 @@ enum { TEXTURE_REF_RECORD = 4 * 4 + 4 * 4, QUANTIZATION_RECORD = 4 + 4 + 12 + 4 
 #define FOURCC(a, b, c, d) ((uint32_t)(a) | (uint32_t)(b) << 8 | (uint32_t)(c) << 16 | (uint32_t)(d) << 24)
 
 enum { MESH_RECORD = 64 + 8 + 16 + QUANTIZATION_RECORD, MATERIAL_RECORD = 64 + 16 + 5 * TEXTURE_REF_RECORD + 12 + 5 * 4 + 8, INSTANCE_RECORD = CACHE_INSTANCE_RECORD,
-       CAMERA_RECORD = 64 + 12 + 16 + 16, TEXTURE_RECORD = 64 + 16, CLUSTERS_RECORD = 6 * 4,
+       CAMERA_RECORD = 64 + 12 + 16 + 20, TEXTURE_RECORD = 64 + 16, CLUSTERS_RECORD = 6 * 4,
        CLUSTER_RECORD = 4 * 4 + 16 + 12 + 12 + 4 + 3 * 4, GROUP_RECORD = 16 + 4 + 3 * 4,
        NODE_RECORD = 16 + 4 + 4 + 4 * 4 + 2 * 4 };
 
@@ -822,7 +822,7 @@ static void write_cameras(writer *w, const cache_write_input *in)
         put_name(w, cam->name);
         put_f32s(w, &cam->position.x, 3);
         put_f32s(w, &cam->rotation.x, 4);
-        put_f32s(w, (const float[4]){cam->yfov, cam->znear, cam->zfar, cam->aspect}, 4);
+        put_f32s(w, (const float[5]){cam->yfov, cam->znear, cam->zfar, cam->aspect, cam->ymag}, 5);
     }
 }
 
@@ -831,16 +831,17 @@ static gdr_status read_cameras(cache_read_state *st, reader *ca, gdr_error *err)
     gdr_status status = expect_records(st, ca, FOURCC('C', 'A', 'M', 'R'), st->camera_count, CAMERA_RECORD, err);
     for (uint32_t i = 0; i < st->camera_count && status == GDR_OK; i++) {
         gdr_camera cam;
-        float lens[4];
+        float lens[5];
         get_name(ca, cam.name);
         get_f32s(ca, &cam.position.x, 3);
         get_f32s(ca, &cam.rotation.x, 4);
-        get_f32s(ca, lens, 4);
+        get_f32s(ca, lens, 5);
         cam.yfov = lens[0];
         cam.znear = lens[1];
         cam.zfar = lens[2];
         cam.aspect = lens[3];
-        if (!all_finite(&cam.position.x, 3) || !all_finite(&cam.rotation.x, 4) || !all_finite(lens, 4))
+        cam.ymag = lens[4];
+        if (!all_finite(&cam.position.x, 3) || !all_finite(&cam.rotation.x, 4) || !all_finite(lens, 5))
             return gdr_error_set(err, GDR_ERROR_PARSE, "%s: camera %u: values are not finite", st->name, i);
         status = gdr_scene_add_camera(st->scene, &cam, err);
     }
