@@ -3,7 +3,7 @@
  * the encoding time of the whole mip chain on one thread and on the pool, and the PSNR of the
  * decoded level 0 against the uncompressed level 0 over the channels its uses read.
  *
- *   texture_bench FILE.gltf [--threads N] [--fits range,cluster,iterative]
+ *   texture_bench FILE.gltf [--threads N]     (every fit for BC1/BC3, the one encoder of BC4/BC5)
  *
  * Prints a table and, at the end, one JSON line per row. */
 #include <math.h>
@@ -117,7 +117,7 @@ int main(int argc, char **argv)
                     continue; /* BC4 and BC5 have one encoder */
                 double one = encode(t, formats[f], fit, 1, decoded);
                 double pool = encode(t, formats[f], fit, threads, decoded);
-                double db = psnr(t->rgba, decoded, texels, channels & ~8u) ;
+                double db = psnr(t->rgba, decoded, texels, channels & ~8u);
                 printf("%-28s %-7s %-9s %10.3f %10.3f %8.2f\n", t->name, gdr_texture_format_name(formats[f]),
                        colour_fit ? fit_names[fit] : "-", one, pool, db);
                 printf("JSON {\"texture\":\"%s\",\"format\":\"%s\",\"fit\":\"%s\",\"one_thread_s\":%.4f,"
