@@ -23,7 +23,7 @@ validator_missing() {
 PACKAGES="build-essential cmake pkg-config clang \
 libvulkan-dev glslc vulkan-validationlayers \
 libmeshoptimizer-dev libmetis-dev libcjson-dev libstb-dev libzstd-dev libpng-dev libjpeg62-turbo-dev \
-libxxhash-dev libclang-rt-14-dev assimp-testmodels valgrind nodejs \
+libxxhash-dev libsquish-dev libclang-rt-14-dev assimp-testmodels valgrind nodejs \
 libglfw3-dev libx11-dev xvfb xauth xdotool gnuplot-nox"
 BACKPORTS_PACKAGES="mesa-vulkan-drivers"
 

@@ -151,9 +151,39 @@ typedef struct gdr_load_options {
 GDR_API gdr_status gdr_image_decode(const void *data, size_t size, const char *name, uint8_t **out_rgba,
                                     uint32_t *out_width, uint32_t *out_height, gdr_error *err);
 
+/* --- texture compression ------------------------------------------------------------------ */
+
+/* libsquish's colour fits for BC1 and BC3's colour, fastest first (docs/MATERIALS.md has what each
+ * costs and gives on real textures); BC4 and BC5 have one encoder. */
+#define GDR_TEXTURE_FIT_RANGE 1u
+#define GDR_TEXTURE_FIT_CLUSTER 2u
+#define GDR_TEXTURE_FIT_ITERATIVE 3u
+#define GDR_TEXTURE_FIT_DEFAULT GDR_TEXTURE_FIT_CLUSTER
+
+/* Options of gdr_scene_compress_textures; zero-initialise, every field has a default. */
+typedef struct gdr_texture_compress_options {
+    uint32_t fit;          /* a GDR_TEXTURE_FIT_*; 0: GDR_TEXTURE_FIT_DEFAULT */
+    uint32_t thread_count; /* encoding threads; 0: one per online processor */
+    uint32_t metallic_roughness_format; /* GDR_TEXTURE_BC5_GB (0: the default) or GDR_TEXTURE_BC1 */
+} gdr_texture_compress_options;
+
+/* Stores every RGBA8 texture that a material uses in a BC format chosen by its uses (gdr/scene.h,
+ * gdr_texture_format): colour (base colour, emissive) BC1, or BC3 where a MASK or BLEND material
+ * reads the base colour's alpha and the image has some; a normal map BC5 (x, y; the shaders
+ * rebuild z); occlusion alone BC4; metallic-roughness alone BC5_GB; several uses of one image
+ * the smallest format holding the channels they read (an occlusion-roughness-metallic image: BC1).
+ * Every level of the existing mip chain is encoded. Textures no material uses stay RGBA8.
+ * gdr_scene_load does this for every import; procedural scenes are not compressed. */
+GDR_API gdr_status gdr_scene_compress_textures(gdr_scene *scene, const gdr_texture_compress_options *options,
+                                               gdr_error *err);
+
+/* Decodes level `level` of t into rgba (its w x h RGBA8 texels) as a device samples the texture's
+ * format (gdr/scene.h); an RGBA8 texture's level is copied. */
+GDR_API gdr_status gdr_texture_decode_level(const gdr_texture *t, uint32_t level, uint8_t *rgba, gdr_error *err);
+
 /* --- processed-scene cache ------------------------------------------------------------------ */
 
-#define GDR_CACHE_FORMAT_VERSION 9u
+#define GDR_CACHE_FORMAT_VERSION 10u
 
 /* What a cache was built from: the build options (a string that changes whenever the processing
  * would produce different data, e.g. "import=1") and the source files. */

@@ -64,6 +64,9 @@ GDR_API gdr_mat4 gdr_view_from_pose(gdr_vec3 position, gdr_quat rotation);
 GDR_API gdr_mat4 gdr_perspective_reverse_z_infinite(float fovy_radians, float aspect, float znear);
 /* Reverse-Z finite perspective: P[2][2] = zn/(zf-zn), P[2][3] = zf*zn/(zf-zn) (row, column). */
 GDR_API gdr_mat4 gdr_perspective_reverse_z(float fovy_radians, float aspect, float znear, float zfar);
+/* Reverse-Z orthographic of half extents xmag, ymag: P = [1/xmag 0 0 0; 0 1/ymag 0 0;
+ * 0 0 1/(zf-zn) zf/(zf-zn); 0 0 0 1] (depth 1 at the near plane, 0 at the far one; w = 1). */
+GDR_API gdr_mat4 gdr_orthographic_reverse_z(float xmag, float ymag, float znear, float zfar);
 
 /* A viewport in framebuffer pixels, as VkViewport takes it. */
 typedef struct gdr_viewport { float x, y, width, height; } gdr_viewport;

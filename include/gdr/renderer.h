@@ -31,6 +31,9 @@ typedef struct gdr_renderer_desc {
     bool busy_wait;
     bool disable_mesh_shaders; /* behave as a device without VK_EXT_mesh_shader (tests the fallback) */
     bool disable_visibility_buffer; /* behave as a device without 64-bit buffer atomics */
+    /* behave as a device without BC texture sampling: block-compressed textures are decoded to
+     * RGBA8 at upload (tests the fallback; the program sets it from GDR_DISABLE_BC_TEXTURES=1) */
+    bool disable_texture_compression_bc;
     /* The GPU-driven pipelines record a frame slot's commands once and submit them again while
      * nothing they depend on changes (pipeline, raster mode, occlusion culling, overdraw view,
      * whether instance updates are pending). true: record every frame (to measure what recording
@@ -274,6 +277,12 @@ typedef struct gdr_memory_stats {
     uint64_t device_bytes;
     uint64_t scene_bytes;
     uint64_t frame_bytes;
+    /* The scene's textures, part of scene_bytes: the device memory their images were given, how
+     * many the device samples in their block format and how many were decoded to RGBA8 at upload
+     * (a device without BC sampling for the format, or disable_texture_compression_bc). */
+    uint64_t texture_bytes;
+    uint32_t textures_compressed;
+    uint32_t textures_decoded;
 } gdr_memory_stats;
 
 /* Precomputed visibility, last frame: whether the frame used it (the renderer holds a PVS, the

@@ -90,21 +90,48 @@ GDR_API const char *gdr_material_problem(const gdr_material *material);
 
 typedef enum gdr_alpha_mode { GDR_ALPHA_OPAQUE = 0, GDR_ALPHA_MASK = 1, GDR_ALPHA_BLEND = 2 } gdr_alpha_mode;
 
-/* A decoded image with its full mip chain: level l is max(width >> l, 1) x max(height >> l, 1)
- * tightly packed RGBA8 texels, top row first; the levels follow each other in `rgba`, level 0
- * first, down to 1 x 1 (gdr_texture_level_count, gdr_texture_level_offset). */
+/* How a texture's levels are stored. RGBA8: tightly packed texels. The BC formats: 4 x 4 blocks
+ * in rows, top row first, ceil(w / 4) x ceil(h / 4) blocks a level (levels below 4 x 4 take one
+ * partly used block), as Vulkan's BCn_*_BLOCK formats lay them out. What each samples as:
+ *   BC1    8 bytes a block: RGB (alpha 1); colour without alpha, or linear RGB
+ *   BC3   16 bytes: RGBA; colour whose alpha a MASK or BLEND material uses
+ *   BC4    8 bytes: (R, 0, 0, 1); one channel (occlusion)
+ *   BC5   16 bytes: (R, G, 0, 1); two channels (a normal map's x and y; z = sqrt(1 - x^2 - y^2))
+ *   BC5_GB 16 bytes: (0, G, B, 1), the block's two channels being G and B (metallic-roughness):
+ *          sampled through the image view's swizzle. */
+typedef enum gdr_texture_format {
+    GDR_TEXTURE_RGBA8 = 0,
+    GDR_TEXTURE_BC1 = 1,
+    GDR_TEXTURE_BC3 = 2,
+    GDR_TEXTURE_BC4 = 3,
+    GDR_TEXTURE_BC5 = 4,
+    GDR_TEXTURE_BC5_GB = 5,
+    GDR_TEXTURE_FORMAT_COUNT
+} gdr_texture_format;
+
+/* An image with its full mip chain: level l is max(width >> l, 1) x max(height >> l, 1) texels,
+ * top row first, stored as `format` says; the levels follow each other in `rgba`, level 0 first,
+ * down to 1 x 1 (gdr_texture_level_count, gdr_texture_format_level_offset). */
 typedef struct gdr_texture {
     char name[GDR_NAME_MAX];
     uint32_t width, height; /* level 0 */
     uint32_t levels;        /* gdr_texture_level_count(width, height) */
-    uint8_t *rgba;          /* every level: gdr_texture_level_offset(width, height, levels) bytes */
+    uint8_t *rgba;          /* every level: gdr_texture_format_level_offset(format, width, height, levels)
+                               bytes (RGBA8 texels, or blocks for a BC format) */
     uint32_t srgb; /* 1: colour data (base colour, emissive); 0: linear data (normals, metallic-roughness, occlusion) */
+    uint32_t format; /* gdr_texture_format; RGBA8 unless compressed (gdr_scene_compress_textures) */
 } gdr_texture;
 
 /* Levels of a full mip chain of a width x height image, down to 1 x 1. */
 GDR_API uint32_t gdr_texture_level_count(uint32_t width, uint32_t height);
 /* Byte offset of level `level` in a chain of a width x height image (level = the count: the chain's size). */
 GDR_API size_t gdr_texture_level_offset(uint32_t width, uint32_t height, uint32_t level);
+/* Bytes of one 4 x 4 block of a BC format (8 or 16); 0 for RGBA8. */
+GDR_API uint32_t gdr_texture_block_bytes(uint32_t format);
+/* Byte offset of level `level` in a chain stored in `format` (level = the count: the chain's size). */
+GDR_API size_t gdr_texture_format_level_offset(uint32_t format, uint32_t width, uint32_t height, uint32_t level);
+/* The format's name ("rgba8", "bc1", ...), or "?" for an unknown value. */
+GDR_API const char *gdr_texture_format_name(uint32_t format);
 
 typedef struct gdr_instance {
     gdr_mat4 transform; /* mesh space -> world space */
@@ -125,7 +152,12 @@ typedef struct gdr_camera {
     float yfov;        /* radians */
     float znear;
     float zfar;        /* 0 for the infinite projection */
-    float aspect;      /* 0: take it from the render target */
+    float aspect;      /* the file's aspect ratio (0: none given), kept for information: the renderer
+                          keeps yfov and takes the render target's aspect (glTF's rule when the
+                          two differ: the image is neither stretched nor cropped) */
+    float ymag;        /* > 0: an orthographic camera seeing ymag metres above and below its axis (glTF's
+                          ymag; yfov unused; its width follows the image's aspect), zfar > znear >= 0
+                          (zfar finite); 0: perspective */
 } gdr_camera;
 
 typedef struct gdr_scene {
@@ -179,6 +211,11 @@ GDR_API gdr_status gdr_scene_add_texture(gdr_scene *scene, const char *name, uin
 GDR_API gdr_status gdr_scene_add_texture_levels(gdr_scene *scene, const char *name, uint32_t width, uint32_t height,
                                                 const uint8_t *chain, uint32_t srgb, uint32_t *out_index,
                                                 gdr_error *err);
+/* Adds a texture whose whole mip chain is stored in `format` (a gdr_texture_format;
+ * gdr_texture_format_level_offset(format, width, height, levels) bytes, copied as it is). */
+GDR_API gdr_status gdr_scene_add_texture_format(gdr_scene *scene, const char *name, uint32_t width, uint32_t height,
+                                                uint32_t format, const uint8_t *chain, uint32_t srgb,
+                                                uint32_t *out_index, gdr_error *err);
 /* Replaces the scene's extension list (copied; NULL clears it). */
 GDR_API gdr_status gdr_scene_set_extensions(gdr_scene *scene, const char *extensions, gdr_error *err);
 

@@ -37,7 +37,7 @@ bool gdr_lod_passes(GdrGpuFrameGlobals g, vec4 sphere, float error, int depth, m
     if ((g.flags & GDR_FRAME_LOD_DEPTH) != 0u)
         return depth < g.lod_depth && !isinf(error);
     return gdr_lod_group_projected_error(sphere, error, model[0].xyz, model[1].xyz, model[2].xyz, model[3].xyz,
-                                         g.camera_position.xyz, g.znear, g.lod_projection_scale) <= g.lod_threshold;
+                                         g.camera_position.xyz, g.lod_znear, g.lod_projection_scale) <= g.lod_threshold;
 }
 
 // The task commands of `phase`'s region of the task list: the late phase's follow the early
@@ -121,7 +121,7 @@ GdrClusterResult gdr_cluster_test_command(GdrGpuFrameGlobals g, uint phase, GdrG
     }
     bool cull = g.cull_enabled != 0u;
     if (!retest && visible && cull && (g.flags & GDR_FRAME_MESHLET_FRUSTUM) != 0u) {
-        visible = gdr_sphere_visible(g.frustum, center, radius, g.znear, g.zfar);
+        visible = gdr_sphere_visible_offset(g.frustum, g.frustum_offset, center, radius, g.znear, g.zfar);
         result.frustum_culled = !visible;
     }
     mat3 linear = mat3(model);

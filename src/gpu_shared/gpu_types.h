@@ -430,11 +430,25 @@ GDR_STRUCT_BEGIN(GdrGpuFrameGlobals)
     float screen_scale;
     gdr_uint stream_frame;    /* streaming with groups absent: this frame's number (never 0), stamped on
                                  the groups its cut draws; 0: no group-use list */
-    gdr_uint reserved4;
-    gdr_uint reserved5;
+    gdr_vec2 frustum_offset;  /* the side planes' offsets (gdr_sphere_visible_offset): (xmag, ymag) for an
+                                 orthographic camera, (0, 0) for a perspective one */
     gdr_vec4 eye_position;    /* world space: the rendering camera's (camera_position is the culling camera's) */
+    /* The LOD tests' distance floor: znear for a perspective camera. An orthographic camera's
+     * projected error is not divided by distance: camera_position and eye_position are then placed
+     * GDR_ORTHO_VIEWER_DISTANCE behind the camera along its axis (the direction to the viewer, for
+     * the cone test and shading, is the same everywhere), this floor is beyond every distance from
+     * there and lod_projection_scale is multiplied by it, so error / floor * scale is the error
+     * times P[1][1] * 0.5 * viewport height. */
+    float lod_znear;
+    gdr_uint orthographic;    /* 1: an orthographic camera */
+    gdr_uint reserved6;
+    gdr_uint reserved7;
 GDR_STRUCT_END(GdrGpuFrameGlobals)
-GDR_ASSERT_SIZE(GdrGpuFrameGlobals, 416);
+GDR_ASSERT_SIZE(GdrGpuFrameGlobals, 432);
+/* An orthographic camera's viewer distance and LOD distance floor (lod_znear above): beyond a scene
+ * within GDR_MAX_COORDINATE (1e12) of the origin, and squared within a float's range. */
+#define GDR_ORTHO_VIEWER_DISTANCE 1.0e15f
+#define GDR_ORTHO_LOD_DISTANCE 4.0e15f
 GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, frustum, 128);
 GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, znear, 176);
 GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, update_count, 192);

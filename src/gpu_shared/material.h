@@ -105,8 +105,10 @@ vec3 gdr_apply_normal_map(uint material, GdrSurfacePoint p, vec3 n)
     vec3 bitangent = cross(n, tangent);
     if (dot(bitangent, dp_dv) * sign(det) > 0.0)
         bitangent = -bitangent;
-    vec3 texel = gdr_material_texture(material, GDR_MATERIAL_NORMAL, p, vec4(0.5, 0.5, 1.0, 1.0)).xyz * 2.0 - 1.0;
-    texel.xy *= GDR_MATERIAL(material).normal_scale;
+    /* x and y only: z follows from a unit normal, so that a two-channel (BC5) normal map needs
+     * nothing more; the scale applies to x and y after (glTF's normalTextureInfo.scale). */
+    vec2 xy = gdr_material_texture(material, GDR_MATERIAL_NORMAL, p, vec4(0.5, 0.5, 1.0, 1.0)).xy * 2.0 - 1.0;
+    vec3 texel = vec3(xy * GDR_MATERIAL(material).normal_scale, sqrt(max(1.0 - dot(xy, xy), 0.0)));
     return normalize(mat3(tangent, bitangent, n) * texel);
 }
 

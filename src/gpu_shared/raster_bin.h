@@ -66,7 +66,9 @@ void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint m
         vec3 center = (g.view * (model * vec4(meshlet.sphere.xyz, 1.0))).xyz;
         float radius = meshlet.sphere.w * gdr_max_axis_scale(model[0].xyz, model[1].xyz, model[2].xyz);
         triangles = meshlet.triangle_count;
-        sw = gdr_raster_bin_sw(params.value.mode, params.value.sw_threshold_px, center, radius, float(triangles), g.znear,
+        // The binning's projection of a cluster is perspective's: an orthographic camera's clusters all
+        // go to the mesh shaders.
+        sw = g.orthographic == 0u && gdr_raster_bin_sw(params.value.mode, params.value.sw_threshold_px, center, radius, float(triangles), g.znear,
                                g.zfar, params.value.ndc_scale, g.viewport.y);
         // Alpha-tested and double-sided materials are rasterised by the mesh shaders, whose
         // fragments sample the mask and whose pipelines then cull back faces per material.

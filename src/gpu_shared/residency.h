@@ -37,7 +37,7 @@ void gdr_request_group(GdrGpuFrameGlobals g, uint instance, uint mesh, uint grou
                        mat4 model)
 {
     float projected = gdr_lod_group_projected_error(sphere, error, model[0].xyz, model[1].xyz, model[2].xyz,
-                                                    model[3].xyz, g.camera_position.xyz, g.znear,
+                                                    model[3].xyz, g.camera_position.xyz, g.lod_znear,
                                                     g.lod_projection_scale);
     uint at = atomicAdd(DrawStatsRef(GDR_FRAME.draw_stats).value.stream_requests, 1u);
     if (at < GDR_STREAM_REQUEST_CAPACITY)

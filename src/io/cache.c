@@ -96,7 +96,7 @@ static gdr_status check_reader_limits(const char *path, const gdr_scene *s, bool
                              "geometry: nothing written", path);
     uint64_t bytes = CACHE_HEADER_SIZE;
     for (uint32_t i = 0; i < s->texture_count; i++)
-        bytes += (uint64_t)s->textures[i].width * s->textures[i].height * 4;
+        bytes += gdr_texture_format_level_offset(s->textures[i].format, s->textures[i].width, s->textures[i].height, 1);
     for (uint32_t i = 0; i < s->mesh_count; i++) {
         const gdr_mesh *m = &s->meshes[i];
         bytes += (uint64_t)m->vertex_count * 32 + (uint64_t)m->index_count * 4 + (uint64_t)m->clusters.vertex_count * 4 +

@@ -21,7 +21,7 @@ enum { TEXTURE_REF_RECORD = 4 * 4 + 4 * 4, QUANTIZATION_RECORD = 4 + 4 + 12 + 4 
 #define FOURCC(a, b, c, d) ((uint32_t)(a) | (uint32_t)(b) << 8 | (uint32_t)(c) << 16 | (uint32_t)(d) << 24)
 
 enum { MESH_RECORD = 64 + 8 + 16 + QUANTIZATION_RECORD, MATERIAL_RECORD = 64 + 16 + 5 * TEXTURE_REF_RECORD + 12 + 5 * 4 + 8, INSTANCE_RECORD = CACHE_INSTANCE_RECORD,
-       CAMERA_RECORD = 64 + 12 + 16 + 16, TEXTURE_RECORD = 64 + 12, CLUSTERS_RECORD = 6 * 4,
+       CAMERA_RECORD = 64 + 12 + 16 + 20, TEXTURE_RECORD = 64 + 16, CLUSTERS_RECORD = 6 * 4,
        CLUSTER_RECORD = 4 * 4 + 16 + 12 + 12 + 4 + 3 * 4, GROUP_RECORD = 16 + 4 + 3 * 4,
        NODE_RECORD = 16 + 4 + 4 + 4 * 4 + 2 * 4 };
 
@@ -139,7 +139,7 @@ static gdr_status read_scene(cache_read_state *st, reader *r, gdr_error *err)
     return status;
 }
 
-/* --- TEXR (per texture: name, size, sRGB) and TXPX (their pixels) ------------------------------ */
+/* --- TEXR (per texture: name, size, sRGB, format) and TXPX (their levels) --------------------- */
 
 /* The reader's limit on a texture's sides, enforced by the writer: no cache it cannot read back. */
 static gdr_status check_texture_sides(const cache_write_input *in, const char *path, gdr_error *err)
@@ -161,6 +161,7 @@ static void write_textures(writer *w, const cache_write_input *in)
         put_u32(w, s->textures[i].width);
         put_u32(w, s->textures[i].height);
         put_u32(w, s->textures[i].srgb);
+        put_u32(w, s->textures[i].format);
     }
 }
 
@@ -174,8 +175,8 @@ static void write_pixels(writer *w, const cache_write_input *in)
 {
     const gdr_scene *s = in->scene;
     for (uint32_t i = 0; i < s->texture_count; i++)
-        put(w, s->textures[i].rgba, gdr_texture_level_offset(s->textures[i].width, s->textures[i].height,
-                                                             s->textures[i].levels));
+        put(w, s->textures[i].rgba, gdr_texture_format_level_offset(s->textures[i].format, s->textures[i].width,
+                                                                    s->textures[i].height, s->textures[i].levels));
 }
 
 static gdr_status read_pixels(cache_read_state *st, reader *px, gdr_error *err)
@@ -184,18 +185,22 @@ static gdr_status read_pixels(cache_read_state *st, reader *px, gdr_error *err)
     for (uint32_t i = 0; i < st->texture_count; i++) {
         char tname[GDR_NAME_MAX];
         get_name(tr, tname);
-        uint32_t width = get_u32(tr), height = get_u32(tr), srgb = get_u32(tr);
+        uint32_t width = get_u32(tr), height = get_u32(tr), srgb = get_u32(tr), format = get_u32(tr);
         if (width == 0 || height == 0 || width > CACHE_MAX_TEXTURE_SIDE || height > CACHE_MAX_TEXTURE_SIDE ||
             srgb > 1)
             return gdr_error_set(err, GDR_ERROR_PARSE, "%s: texture %u: size %ux%u or flags are out of range",
                                  st->name, i, width, height);
-        /* The whole mip chain, stored so that loading builds nothing. */
-        size_t chain = gdr_texture_level_offset(width, height, gdr_texture_level_count(width, height));
+        if (format >= GDR_TEXTURE_FORMAT_COUNT)
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: texture %u: format %u is not one this build reads "
+                                 "(0 to %u)", st->name, i, format, GDR_TEXTURE_FORMAT_COUNT - 1);
+        /* The whole mip chain, texels or blocks, stored so that loading builds and encodes nothing. */
+        size_t chain = gdr_texture_format_level_offset(format, width, height, gdr_texture_level_count(width, height));
         const uint8_t *pixels = take(px, chain);
         if (!pixels)
-            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: texture %u: pixel data runs past section 'TXPX'",
-                                 st->name, i);
-        gdr_status status = gdr_scene_add_texture_levels(st->scene, tname, width, height, pixels, srgb, NULL, err);
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: texture %u (%s, %ux%u): its %zu bytes of levels run past "
+                                 "section 'TXPX'", st->name, i, gdr_texture_format_name(format), width, height, chain);
+        gdr_status status = gdr_scene_add_texture_format(st->scene, tname, width, height, format, pixels, srgb, NULL,
+                                                         err);
         if (status != GDR_OK)
             return status;
     }
@@ -836,7 +841,7 @@ static void write_cameras(writer *w, const cache_write_input *in)
         put_name(w, cam->name);
         put_f32s(w, &cam->position.x, 3);
         put_f32s(w, &cam->rotation.x, 4);
-        put_f32s(w, (const float[4]){cam->yfov, cam->znear, cam->zfar, cam->aspect}, 4);
+        put_f32s(w, (const float[5]){cam->yfov, cam->znear, cam->zfar, cam->aspect, cam->ymag}, 5);
     }
 }
 
@@ -845,16 +850,17 @@ static gdr_status read_cameras(cache_read_state *st, reader *ca, gdr_error *err)
     gdr_status status = expect_records(st, ca, FOURCC('C', 'A', 'M', 'R'), st->camera_count, CAMERA_RECORD, err);
     for (uint32_t i = 0; i < st->camera_count && status == GDR_OK; i++) {
         gdr_camera cam;
-        float lens[4];
+        float lens[5];
         get_name(ca, cam.name);
         get_f32s(ca, &cam.position.x, 3);
         get_f32s(ca, &cam.rotation.x, 4);
-        get_f32s(ca, lens, 4);
+        get_f32s(ca, lens, 5);
         cam.yfov = lens[0];
         cam.znear = lens[1];
         cam.zfar = lens[2];
         cam.aspect = lens[3];
-        if (!all_finite(&cam.position.x, 3) || !all_finite(&cam.rotation.x, 4) || !all_finite(lens, 4))
+        cam.ymag = lens[4];
+        if (!all_finite(&cam.position.x, 3) || !all_finite(&cam.rotation.x, 4) || !all_finite(lens, 5))
             return gdr_error_set(err, GDR_ERROR_PARSE, "%s: camera %u: values are not finite", st->name, i);
         status = gdr_scene_add_camera(st->scene, &cam, err);
     }

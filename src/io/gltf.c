@@ -1046,30 +1046,14 @@ static gdr_status gpu_instancing(gltf_ctx *c, const cJSON *ext, const char *plac
     return status;
 }
 
-static gdr_status add_camera(gltf_ctx *c, uint32_t index, const char *place, gdr_mat4 global)
+/* A perspective camera's lens (cameras[i].perspective): yfov, znear, zfar (0: infinite), aspect. */
+static gdr_status perspective_lens(gltf_ctx *c, const cJSON *json, const char *here, gdr_camera *cam)
 {
-    if (index >= c->camera_count)
-        return gltf_fail(c, GDR_ERROR_PARSE, "%s.camera: camera %u does not exist (%u cameras)", place, index,
-                         c->camera_count);
-    char here[48];
-    snprintf(here, sizeof here, "cameras[%u]", index);
-    const cJSON *json = c->camera_at[index];
-    const char *type = NULL, *name = NULL;
-    const cJSON *perspective = NULL;
-    gdr_status status = gltf_get_string(c, json, "type", here, &type);
-    if (status == GDR_OK)
-        status = gltf_get_string(c, json, "name", here, &name);
-    if (status != GDR_OK)
-        return status;
-    if (!type || strcmp(type, "perspective") != 0) {
-        gdr_io_warn(&c->warnings, "%s: %s: type '%.16s' skipped: only perspective cameras are supported", c->name,
-                    here, type ? type : "(missing)");
-        return GDR_OK;
-    }
     char pplace[64];
     snprintf(pplace, sizeof pplace, "%s.perspective", here);
+    const cJSON *perspective = NULL;
     double yfov = 0.0, znear = 0.0, zfar = 0.0, aspect = 0.0;
-    status = gltf_get_object(c, json, "perspective", here, 1, &perspective);
+    gdr_status status = gltf_get_object(c, json, "perspective", here, 1, &perspective);
     if (status == GDR_OK)
         status = gltf_get_number(c, perspective, "yfov", pplace, &yfov);
     if (status == GDR_OK)
@@ -1084,9 +1068,65 @@ static gdr_status add_camera(gltf_ctx *c, uint32_t index, const char *place, gdr
         aspect < 0.0)
         return gltf_fail(c, GDR_ERROR_PARSE, "%s: yfov %g, znear %g, zfar %g, aspectRatio %g are out of range",
                          pplace, yfov, znear, zfar, aspect);
-    /* Position from the last column; rotation from the basis with the scale divided out. */
-    gdr_camera cam = {.position = {global.m[12], global.m[13], global.m[14]}, .yfov = (float)yfov,
-                      .znear = (float)znear, .zfar = (float)zfar, .aspect = (float)aspect};
+    *cam = (gdr_camera){.yfov = (float)yfov, .znear = (float)znear, .zfar = (float)zfar, .aspect = (float)aspect};
+    return GDR_OK;
+}
+
+/* An orthographic camera's lens (cameras[i].orthographic): xmag, ymag (half extents, not zero),
+ * znear >= 0 and a finite zfar > znear, all required. The image keeps ymag and takes its own aspect;
+ * xmag / ymag is kept as the camera's aspect. */
+static gdr_status orthographic_lens(gltf_ctx *c, const cJSON *json, const char *here, gdr_camera *cam)
+{
+    char oplace[64];
+    snprintf(oplace, sizeof oplace, "%s.orthographic", here);
+    const cJSON *ortho = NULL;
+    double xmag = NAN, ymag = NAN, znear = NAN, zfar = NAN;
+    gdr_status status = gltf_get_object(c, json, "orthographic", here, 1, &ortho);
+    if (status == GDR_OK)
+        status = gltf_get_number(c, ortho, "xmag", oplace, &xmag);
+    if (status == GDR_OK)
+        status = gltf_get_number(c, ortho, "ymag", oplace, &ymag);
+    if (status == GDR_OK)
+        status = gltf_get_number(c, ortho, "znear", oplace, &znear);
+    if (status == GDR_OK)
+        status = gltf_get_number(c, ortho, "zfar", oplace, &zfar);
+    if (status != GDR_OK)
+        return status;
+    if (!(fabs(xmag) > 0.0 && fabs(xmag) <= 1e12) || !(fabs(ymag) > 0.0 && fabs(ymag) <= 1e12) || !(znear >= 0.0) ||
+        !(zfar > znear && zfar <= 1e30))
+        return gltf_fail(c, GDR_ERROR_PARSE, "%s: xmag %g, ymag %g, znear %g, zfar %g are missing or out of range",
+                         oplace, xmag, ymag, znear, zfar);
+    *cam = (gdr_camera){.ymag = (float)fabs(ymag), .znear = (float)znear, .zfar = (float)zfar,
+                        .aspect = (float)(fabs(xmag) / fabs(ymag))};
+    return GDR_OK;
+}
+
+static gdr_status add_camera(gltf_ctx *c, uint32_t index, const char *place, gdr_mat4 global)
+{
+    if (index >= c->camera_count)
+        return gltf_fail(c, GDR_ERROR_PARSE, "%s.camera: camera %u does not exist (%u cameras)", place, index,
+                         c->camera_count);
+    char here[48];
+    snprintf(here, sizeof here, "cameras[%u]", index);
+    const cJSON *json = c->camera_at[index];
+    const char *type = NULL, *name = NULL;
+    gdr_status status = gltf_get_string(c, json, "type", here, &type);
+    if (status == GDR_OK)
+        status = gltf_get_string(c, json, "name", here, &name);
+    if (status != GDR_OK)
+        return status;
+    bool perspective = type && strcmp(type, "perspective") == 0, ortho = type && strcmp(type, "orthographic") == 0;
+    if (!perspective && !ortho) {
+        gdr_io_warn(&c->warnings, "%s: %s: type '%.16s' skipped: cameras are perspective or orthographic", c->name,
+                    here, type ? type : "(missing)");
+        return GDR_OK;
+    }
+    gdr_camera cam;
+    status = perspective ? perspective_lens(c, json, here, &cam) : orthographic_lens(c, json, here, &cam);
+    if (status != GDR_OK)
+        return status;
+    cam.position = (gdr_vec3){global.m[12], global.m[13], global.m[14]};
+    /* Rotation from the basis with the scale divided out. */
     snprintf(cam.name, sizeof cam.name, "%s", name ? name : here);
     gdr_vec3 x = gdr_vec3_normalize((gdr_vec3){global.m[0], global.m[1], global.m[2]});
     gdr_vec3 y = gdr_vec3_normalize((gdr_vec3){global.m[4], global.m[5], global.m[6]});

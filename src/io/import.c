@@ -30,6 +30,18 @@ static gdr_status build_clusters(const char *path, gdr_scene **scene, int lod, i
     return gdr_error_set(err, build_err.status, "%s: %s", path, build_err.message);
 }
 
+/* Stores the textures in block formats (the same for a render through the cache or without it);
+ * on failure destroys the scene. */
+static gdr_status compress_textures(const char *path, gdr_scene **scene, gdr_error *err)
+{
+    gdr_error compress_err;
+    if (gdr_scene_compress_textures(*scene, NULL, &compress_err) == GDR_OK)
+        return GDR_OK;
+    gdr_scene_destroy(*scene);
+    *scene = NULL;
+    return gdr_error_set(err, compress_err.status, "%s: %s", path, compress_err.message);
+}
+
 gdr_status gdr_import_file(const char *path, const gdr_import_options *options, gdr_scene **out,
                            gdr_import_result *result, gdr_error *err)
 {
@@ -42,7 +54,9 @@ gdr_status gdr_import_file(const char *path, const gdr_import_options *options, 
         *out = NULL;
         return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: unknown file type (.gltf, .glb, .obj or .gdrc)", path);
     }
-    return status == GDR_OK ? build_clusters(path, out, 1, options && options->no_progress, err) : status;
+    if (status == GDR_OK)
+        status = build_clusters(path, out, 1, options && options->no_progress, err);
+    return status == GDR_OK ? compress_textures(path, out, err) : status;
 }
 
 static void warn(const gdr_load_options *o, const char *format, ...) __attribute__((format(printf, 2, 3)));

@@ -85,8 +85,9 @@ gdr_status gdr_io_load_paged(const char *spec, const gdr_load_options *options, 
 gdr_status gdr_cache_read_memory(const void *data, size_t size, const char *name, gdr_scene **out,
                                          gdr_pvs **out_pvs, gdr_error *err);
 
-/* Imports any supported source file (.gltf, .glb, .obj by extension) without the cache, and
- * builds every mesh's clusters (gdr_scene_build_clusters, include/gdr/geometry.h). */
+/* Imports any supported source file (.gltf, .glb, .obj by extension) without the cache, builds
+ * every mesh's clusters (gdr_scene_build_clusters, include/gdr/geometry.h) and compresses its
+ * textures (gdr_scene_compress_textures). */
 gdr_status gdr_import_file(const char *path, const gdr_import_options *options, gdr_scene **out,
                                    gdr_import_result *result, gdr_error *err);
 

@@ -17,6 +17,18 @@ GDR_SHARED_FN bool gdr_sphere_visible(gdr_vec4 ijkl, gdr_vec3 c, float r, float 
     return visible;
 }
 
+/* The same with the side planes moved out by offset (x, y): j*z + offset.x >= |i*x| - r and
+ * l*z + offset.y >= |k*y| - r. An orthographic view's box is (i, j, k, l) = (1, 0, 1, 0) with
+ * offset (xmag, ymag); a perspective frustum's offset is (0, 0), gdr_sphere_visible. */
+GDR_SHARED_FN bool gdr_sphere_visible_offset(gdr_vec4 ijkl, gdr_vec2 offset, gdr_vec3 c, float r, float znear,
+                                             float zfar)
+{
+    bool visible = (c.z - r <= -znear) && (c.z + r >= -zfar);
+    visible = visible && (ijkl.y * c.z + offset.x >= gdr_abs(ijkl.x * c.x) - r);
+    visible = visible && (ijkl.w * c.z + offset.y >= gdr_abs(ijkl.z * c.y) - r);
+    return visible;
+}
+
 /* Largest length of a transform's three basis columns: how much a bounding sphere's radius must
  * grow under that transform (seed 001: the radius is scaled by the largest axis scale). */
 GDR_SHARED_FN float gdr_max_axis_scale(gdr_vec3 c0, gdr_vec3 c1, gdr_vec3 c2)

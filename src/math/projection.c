@@ -40,6 +40,17 @@ gdr_mat4 gdr_perspective_reverse_z(float fovy_radians, float aspect, float znear
     return p;
 }
 
+gdr_mat4 gdr_orthographic_reverse_z(float xmag, float ymag, float znear, float zfar)
+{
+    gdr_mat4 p = {{0}};
+    AT(p, 0, 0) = 1.0f / xmag;
+    AT(p, 1, 1) = 1.0f / ymag;
+    AT(p, 2, 2) = 1.0f / (zfar - znear);
+    AT(p, 2, 3) = zfar / (zfar - znear);
+    AT(p, 3, 3) = 1.0f;
+    return p;
+}
+
 gdr_viewport gdr_viewport_flip_y(float width, float height)
 {
     return (gdr_viewport){0.0f, height, width, -height};

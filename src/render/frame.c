@@ -9,10 +9,26 @@
 
 void gdr_frame_matrices(const gdr_renderer *r, const gdr_camera *camera, gdr_mat4 *projection, gdr_mat4 *view)
 {
-    float aspect = camera->aspect > 0.0f ? camera->aspect : (float)r->width / (float)r->height;
-    *projection = camera->zfar > 0.0f ? gdr_perspective_reverse_z(camera->yfov, aspect, camera->znear, camera->zfar)
-                                      : gdr_perspective_reverse_z_infinite(camera->yfov, aspect, camera->znear);
+    /* The vertical field of view is kept and the aspect is the image's, whatever the camera's own
+     * (glTF's rule for an aspectRatio that differs from the viewport's: no stretching, no cropping). */
+    float aspect = (float)r->width / (float)r->height;
+    if (camera->ymag > 0.0f) /* orthographic: ymag kept, the width from the image's aspect, by the same rule */
+        *projection = gdr_orthographic_reverse_z(camera->ymag * aspect, camera->ymag, camera->znear, camera->zfar);
+    else
+        *projection = camera->zfar > 0.0f ? gdr_perspective_reverse_z(camera->yfov, aspect, camera->znear, camera->zfar)
+                                          : gdr_perspective_reverse_z_infinite(camera->yfov, aspect, camera->znear);
     *view = gdr_view_from_pose(camera->position, camera->rotation);
+}
+
+/* Where the culling and shading see a camera from (gdr_gpu_types.h, GdrGpuFrameGlobals.lod_znear):
+ * its position, or for an orthographic camera a point far behind it along its axis, from which
+ * every direction to the scene is the camera's own. */
+static gdr_vec3 viewer_position(const gdr_camera *camera)
+{
+    if (!(camera->ymag > 0.0f))
+        return camera->position;
+    gdr_vec3 forward = gdr_quat_rotate(gdr_quat_normalize(camera->rotation), (gdr_vec3){0.0f, 0.0f, -1.0f});
+    return gdr_vec3_sub(camera->position, gdr_vec3_scale(forward, GDR_ORTHO_VIEWER_DISTANCE));
 }
 
 GdrGpuPushConstants gdr_frame_push_constants(const gdr_renderer *r, const gdr_frame_slot *slot)
@@ -77,11 +93,18 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
      * other than level 0 (threshold 0 and depth 0 both select exactly level 0). */
     bool lod = pipeline == GDR_PIPELINE_MESH &&
                (frame->lod_fixed_depth ? frame->lod_depth > 0 : frame->lod_error_px > 0.0f);
+    bool ortho = camera->ymag > 0.0f; /* the culling camera's projection is the camera's (check_frame) */
+    gdr_vec3 cull_eye = viewer_position(cull_camera), eye = viewer_position(camera);
+    float lod_znear = ortho ? GDR_ORTHO_LOD_DISTANCE : camera->znear;
     GdrGpuFrameGlobals globals = {
         .view = cull_view,
         .view_projection = gdr_mat4_mul(projection, view),
-        .frustum = gdr_frustum_symmetric(cull_projection),
-        .camera_position = {cull_camera->position.x, cull_camera->position.y, cull_camera->position.z, 1.0f},
+        .frustum = ortho ? (gdr_vec4){1.0f, 0.0f, 1.0f, 0.0f} : gdr_frustum_symmetric(cull_projection),
+        .frustum_offset = ortho ? (gdr_vec2){1.0f / cull_projection.m[0], 1.0f / cull_projection.m[5]}
+                                : (gdr_vec2){0.0f, 0.0f},
+        .camera_position = {cull_eye.x, cull_eye.y, cull_eye.z, 1.0f},
+        .lod_znear = lod_znear,
+        .orthographic = ortho ? 1u : 0u,
         .light_direction = {light.x, light.y, light.z, 0.0f},
         .znear = camera->znear,
         .zfar = camera->zfar > 0.0f ? camera->zfar : INFINITY,
@@ -101,15 +124,15 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .task_capacity = r->scene.task_capacity,
         .viewport = {(float)r->width, (float)r->height},
         .lod_threshold = lod_threshold(r, slot, frame),
-        .lod_projection_scale = fabsf(projection.m[5]) * 0.5f * (float)r->height,
+        .lod_projection_scale = fabsf(projection.m[5]) * 0.5f * (float)r->height * (ortho ? lod_znear : 1.0f),
         .lod_depth = frame->lod_depth > INT32_MAX ? INT32_MAX : (int32_t)frame->lod_depth,
         .traversal_capacity = r->scene.traversal_capacity,
         .occluded_node_capacity = r->occlusion.occluded_node_capacity,
         .min_screen_size = frame->min_screen_size,
         .clip_plane = frame->clip_plane,
-        .screen_scale = fmaxf(fabsf(projection.m[0]), fabsf(projection.m[5])),
+        .screen_scale = fmaxf(fabsf(projection.m[0]), fabsf(projection.m[5])) * (ortho ? GDR_ORTHO_VIEWER_DISTANCE : 1.0f),
         .stream_frame = slot->stream_frame,
-        .eye_position = {camera->position.x, camera->position.y, camera->position.z, 1.0f},
+        .eye_position = {eye.x, eye.y, eye.z, 1.0f},
     };
     gdr_occlusion_params(r, &projection, camera->znear, &globals.occlusion);
     /* The early phase tests against last frame's pyramid as last frame's camera saw it. */
@@ -129,8 +152,10 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
  * H100 (docs/OCCLUSION.md, "Which pipelines cull by default"). */
 static bool occlusion_wanted(const gdr_frame_desc *frame, gdr_pipeline pipeline)
 {
+    /* The depth pyramid's sphere test is perspective's (docs/OCCLUSION.md): none for an
+     * orthographic camera. */
     if (pipeline == GDR_PIPELINE_CPU || frame->cull == GDR_CULL_OFF || frame->occlusion == GDR_CULL_OFF ||
-        frame->cull_camera)
+        frame->cull_camera || frame->camera.ymag > 0.0f)
         return false;
     return frame->occlusion == GDR_CULL_ON || pipeline == GDR_PIPELINE_INDIRECT;
 }

@@ -120,6 +120,9 @@ static void fill_memory(const gdr_renderer *r, gdr_memory_stats *memory)
         used += r->allocator.blocks[b].used;
     memory->device_bytes = r->allocator.bytes_allocated;
     memory->scene_bytes = r->scene.bytes;
+    memory->texture_bytes = r->materials.texture_bytes;
+    memory->textures_compressed = r->materials.textures_compressed;
+    memory->textures_decoded = r->materials.textures_decoded;
     memory->frame_bytes = used > r->scene.bytes ? used - r->scene.bytes : 0;
 }
 

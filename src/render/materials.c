@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "render/renderer_internal.h"
+#include "render/texture_upload.h"
 #include "vk/vk_descriptors.h"
 
 _Static_assert(GDR_SAMPLER_STATES == GDR_SAMPLER_SLOTS, "one sampler slot per packed sampler state");
@@ -172,71 +173,14 @@ static gdr_status upload_vertex_colors(gdr_renderer *r, const gdr_scene *scene, 
     return status;
 }
 
-/* One layout transition of every level of a texture, in a one-time command buffer of its own. */
-static gdr_status transition(gdr_vk_context *ctx, VkImage image, VkImageLayout from, VkImageLayout to, gdr_error *err)
+/* Texture `index` of the bindless array. */
+static void write_texture_descriptor(gdr_renderer *r, const gdr_vk_image *image, uint32_t index)
 {
-    VkCommandBuffer cmd;
-    gdr_status status = gdr_vk_begin_one_time(ctx, &cmd, err);
-    if (status != GDR_OK)
-        return status;
-    bool to_copy = to == VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-    gdr_vk_image_barrier(cmd, image, VK_IMAGE_ASPECT_COLOR_BIT, from, to,
-                         to_copy ? VK_PIPELINE_STAGE_2_NONE : VK_PIPELINE_STAGE_2_COPY_BIT,
-                         to_copy ? VK_ACCESS_2_NONE : VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                         to_copy ? VK_PIPELINE_STAGE_2_COPY_BIT : VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                         to_copy ? VK_ACCESS_2_TRANSFER_WRITE_BIT : VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-    return gdr_vk_end_one_time(ctx, cmd, err);
-}
-
-/* Copies one mip level into an image in TRANSFER_DST layout through the staging buffer, in bands
- * of whole rows that fit it. */
-static gdr_status upload_level(gdr_renderer *r, VkImage image, uint32_t level, const uint8_t *texels, uint32_t w,
-                               uint32_t h, gdr_error *err)
-{
-    uint32_t rows_per_copy = (uint32_t)(r->staging.size / ((VkDeviceSize)w * 4));
-    gdr_status status = GDR_OK;
-    for (uint32_t row = 0; status == GDR_OK && row < h; row += rows_per_copy) {
-        uint32_t rows = h - row < rows_per_copy ? h - row : rows_per_copy;
-        memcpy(r->staging.mapped, texels + (size_t)row * w * 4, (size_t)rows * w * 4);
-        VkCommandBuffer cmd;
-        status = gdr_vk_begin_one_time(r->ctx, &cmd, err);
-        if (status != GDR_OK)
-            break;
-        VkBufferImageCopy region = {.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, level, 0, 1},
-                                    .imageOffset = {0, (int32_t)row, 0}, .imageExtent = {w, rows, 1}};
-        vkCmdCopyBufferToImage(cmd, r->staging.buffer, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-        status = gdr_vk_end_one_time(r->ctx, cmd, err);
-    }
-    return status;
-}
-
-static gdr_status upload_texture(gdr_renderer *r, const gdr_texture *t, uint32_t index, gdr_error *err)
-{
-    gdr_materials *m = &r->materials;
-    gdr_vk_image_desc desc = {.width = t->width, .height = t->height,
-                              .format = t->srgb ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM,
-                              .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                              .mip_levels = t->levels};
-    gdr_vk_image *image = &m->textures[index];
-    gdr_status status = gdr_vk_image_create(&r->allocator, &desc, image, err);
-    if (status == GDR_OK)
-        status = transition(r->ctx, image->image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, err);
-    for (uint32_t l = 0; status == GDR_OK && l < t->levels; l++) {
-        uint32_t w = t->width >> l ? t->width >> l : 1, h = t->height >> l ? t->height >> l : 1;
-        status = upload_level(r, image->image, l, t->rgba + gdr_texture_level_offset(t->width, t->height, l), w, h, err);
-    }
-    if (status == GDR_OK)
-        status = transition(r->ctx, image->image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                            VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, err);
-    if (status != GDR_OK)
-        return status;
-    m->bytes += gdr_texture_level_offset(t->width, t->height, t->levels);
     VkDescriptorImageInfo info = {.imageView = image->view, .imageLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-    VkWriteDescriptorSet write = {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = m->set, .dstBinding = 0,
-                                  .dstArrayElement = index, .descriptorCount = 1,
+    VkWriteDescriptorSet write = {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = r->materials.set,
+                                  .dstBinding = 0, .dstArrayElement = index, .descriptorCount = 1,
                                   .descriptorType = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, .pImageInfo = &info};
     vkUpdateDescriptorSets(r->ctx->device, 1, &write, 0, NULL);
-    return GDR_OK;
 }
 
 gdr_status gdr_materials_upload(gdr_renderer *r, const gdr_scene *scene, gdr_error *err)
@@ -253,7 +197,9 @@ gdr_status gdr_materials_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "materials: out of memory for %u textures",
                                scene->texture_count);
     for (uint32_t i = 0; status == GDR_OK && i < scene->texture_count; i++) {
-        status = upload_texture(r, &scene->textures[i], i, err);
+        status = gdr_texture_upload(r, &scene->textures[i], &m->textures[i], err);
+        if (status == GDR_OK)
+            write_texture_descriptor(r, &m->textures[i], i);
         m->texture_count = i + 1; /* destroyed with the rest, whether or not it completed */
     }
     return status;

@@ -19,11 +19,15 @@ typedef struct gdr_materials {
     gdr_vk_buffer buffer;             /* GdrGpuMaterial[material_count + 1] */
     gdr_vk_buffer vertex_colors;      /* uint32[2] per vertex of the meshes that have colours: RGBA16 unorm */
     gdr_vk_buffer mesh_color_offsets; /* uint32 per mesh: its first entry in vertex_colors, or GDR_GPU_NO_COLORS */
-    gdr_vk_image *textures;           /* texture_count images, R8G8B8A8 sRGB or UNORM, every mip level */
+    gdr_vk_image *textures;           /* texture_count images in the texture's BC format, or R8G8B8A8 (sRGB or
+                                         UNORM) for RGBA8 textures and decoded ones; every mip level */
     uint32_t texture_count;
     uint32_t material_count;          /* the scene's; the default material is at this index */
     uint32_t scene_flags;             /* GDR_MATERIALS_* of the scene's materials */
     uint64_t bytes;                   /* device memory of the buffers and the textures */
+    uint64_t texture_bytes;           /* device memory of the textures alone */
+    uint32_t textures_compressed;     /* sampled in their BC format */
+    uint32_t textures_decoded;        /* BC textures decoded to RGBA8 at upload */
 } gdr_materials;
 
 #define GDR_MATERIALS_MASKED 1u       /* some material is MASK or BLEND: the raster paths test alpha */

@@ -94,6 +94,7 @@ gdr_status gdr_renderer_create(const gdr_renderer_desc *desc_in, gdr_renderer **
     gdr_vk_context_desc context_desc = {.device = desc.device, .validate = desc.validate,
                                         .synchronization_validation = desc.synchronization_validation,
                                         .disable_mesh_shaders = desc.disable_mesh_shaders,
+                                        .disable_texture_compression_bc = desc.disable_texture_compression_bc,
                                         .instance_extensions = desc.instance_extensions,
                                         .instance_extension_count = desc.instance_extension_count,
                                         .swapchain = desc.presentable};
@@ -300,17 +301,26 @@ static gdr_status check_frame(gdr_renderer *r, const gdr_frame_desc *frame, uint
     if (frames == 0)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: frames must be at least 1");
     const gdr_camera *camera = &frame->camera;
-    if (!(camera->yfov > 0.0f && camera->yfov < 3.14159f) || !(camera->znear > 0.0f) ||
-        !(camera->zfar == 0.0f || camera->zfar > camera->znear))
+    if (camera->ymag != 0.0f) {
+        if (!(camera->ymag > 0.0f && camera->ymag <= 1e30f) || !(camera->znear >= 0.0f) ||
+            !(camera->zfar > camera->znear && camera->zfar <= 1e30f))
+            return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
+                                 "render: an orthographic camera needs ymag > 0, znear >= 0 and a finite zfar > znear "
+                                 "(ymag %g, znear %g, zfar %g)", (double)camera->ymag, (double)camera->znear,
+                                 (double)camera->zfar);
+    } else if (!(camera->yfov > 0.0f && camera->yfov < 3.14159f) || !(camera->znear > 0.0f) ||
+               !(camera->zfar == 0.0f || camera->zfar > camera->znear)) {
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
                              "render: camera needs 0 < yfov < pi, znear > 0 and zfar = 0 or > znear "
                              "(yfov %g, znear %g, zfar %g)", (double)camera->yfov, (double)camera->znear,
                              (double)camera->zfar);
+    }
     const gdr_camera *cull = frame->cull_camera;
     if (cull && (cull->yfov != camera->yfov || cull->aspect != camera->aspect || cull->znear != camera->znear ||
-                 cull->zfar != camera->zfar))
+                 cull->zfar != camera->zfar || cull->ymag != camera->ymag))
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT,
-                             "render: the culling camera's projection (yfov, aspect, znear, zfar) must be the camera's");
+                             "render: the culling camera's projection (yfov, ymag, aspect, znear, zfar) must be the "
+                             "camera's");
     if ((unsigned)frame->view > GDR_VIEW_MODE_LOD)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: unknown view %d", (int)frame->view);
     if (!(frame->lod_error_px >= 0.0f && frame->lod_error_px <= 1e30f))

@@ -291,20 +291,23 @@ uint64_t gdr_scene_triangle_count(const gdr_scene *scene)
 
 /* A texture of `levels` levels (width x height at level 0) whose chain is copied from `chain`, all
  * of it when `whole_chain`, else level 0 only and the rest built here. */
-static gdr_status add_texture(gdr_scene *scene, const char *name, uint32_t width, uint32_t height, const uint8_t *chain,
-                              bool whole_chain, uint32_t srgb, uint32_t *out_index, gdr_error *err)
+static gdr_status add_texture(gdr_scene *scene, const char *name, uint32_t width, uint32_t height, uint32_t format,
+                              const uint8_t *chain, bool whole_chain, uint32_t srgb, uint32_t *out_index, gdr_error *err)
 {
     if (width == 0 || height == 0 || width > 32768 || height > 32768)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "texture '%s': size %ux%u is out of range",
                              name ? name : "", width, height);
+    if (format >= GDR_TEXTURE_FORMAT_COUNT || (format != GDR_TEXTURE_RGBA8 && !whole_chain))
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "texture '%s': format %u is not one gdr knows",
+                             name ? name : "", format);
     gdr_status status = reserve_one((void **)&scene->textures, &scene->texture_capacity, scene->texture_count,
                                     sizeof(gdr_texture), err);
     if (status != GDR_OK)
         return status;
     gdr_texture texture = {.width = width, .height = height, .levels = gdr_texture_level_count(width, height),
-                           .srgb = srgb ? 1u : 0u};
+                           .srgb = srgb ? 1u : 0u, .format = format};
     snprintf(texture.name, sizeof texture.name, "%s", name ? name : "");
-    size_t chain_bytes = gdr_texture_level_offset(width, height, texture.levels);
+    size_t chain_bytes = gdr_texture_format_level_offset(format, width, height, texture.levels);
     texture.rgba = malloc(chain_bytes);
     if (!texture.rgba)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "texture '%s': out of memory", texture.name);
@@ -323,13 +326,20 @@ static gdr_status add_texture(gdr_scene *scene, const char *name, uint32_t width
 gdr_status gdr_scene_add_texture(gdr_scene *scene, const char *name, uint32_t width, uint32_t height,
                                  const uint8_t *rgba, uint32_t srgb, uint32_t *out_index, gdr_error *err)
 {
-    return add_texture(scene, name, width, height, rgba, false, srgb, out_index, err);
+    return add_texture(scene, name, width, height, GDR_TEXTURE_RGBA8, rgba, false, srgb, out_index, err);
 }
 
 gdr_status gdr_scene_add_texture_levels(gdr_scene *scene, const char *name, uint32_t width, uint32_t height,
                                         const uint8_t *chain, uint32_t srgb, uint32_t *out_index, gdr_error *err)
 {
-    return add_texture(scene, name, width, height, chain, true, srgb, out_index, err);
+    return add_texture(scene, name, width, height, GDR_TEXTURE_RGBA8, chain, true, srgb, out_index, err);
+}
+
+gdr_status gdr_scene_add_texture_format(gdr_scene *scene, const char *name, uint32_t width, uint32_t height,
+                                        uint32_t format, const uint8_t *chain, uint32_t srgb, uint32_t *out_index,
+                                        gdr_error *err)
+{
+    return add_texture(scene, name, width, height, format, chain, true, srgb, out_index, err);
 }
 
 gdr_status gdr_scene_set_extensions(gdr_scene *scene, const char *extensions, gdr_error *err)

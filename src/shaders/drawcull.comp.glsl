@@ -35,7 +35,7 @@ GdrTaskRange task_range(GdrGpuFrameGlobals g, GdrGpuMesh mesh, mat4 model, out b
         return gdr_task_range(mesh.meshlet_offset, mesh.lod_cluster_count, 0u);
     if (mesh.root_cluster_count > 0u &&
         gdr_lod_group_projected_error(mesh.root_refined_sphere, mesh.root_refined_error, model[0].xyz, model[1].xyz,
-                                      model[2].xyz, model[3].xyz, g.camera_position.xyz, g.znear,
+                                      model[2].xyz, model[3].xyz, g.camera_position.xyz, g.lod_znear,
                                       g.lod_projection_scale) <= g.lod_threshold)
         return gdr_task_range(mesh.meshlet_offset + mesh.root_first, mesh.root_cluster_count, GDR_TASK_LOD_ACCEPTED);
     traverse = (g.flags & GDR_FRAME_LOD_HIERARCHY) != 0u && mesh.lod_node_count > 0u &&
@@ -124,7 +124,7 @@ void main()
                   any(isinf(world_center));
         visible = !invalid;
         if (visible && g.cull_enabled != 0u) {
-            visible = gdr_sphere_visible(g.frustum, center, radius, g.znear, g.zfar);
+            visible = gdr_sphere_visible_offset(g.frustum, g.frustum_offset, center, radius, g.znear, g.zfar);
             pvs_hidden = visible && (g.flags & GDR_FRAME_PVS) != 0u && !pvs_listed(id);
             visible = visible && !pvs_hidden;
             small_or_large = visible && !screen_size_visible(g, instance, world_center, radius);

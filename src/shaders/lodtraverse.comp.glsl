@@ -69,13 +69,13 @@ void main()
         mat4 model = instance.model;
         float min_refined_error = gdr_node_min_refined_error(g, mesh.lod_node_offset + visit.node, node.min_refined_error);
         lod_culled = !gdr_lod_node_may_draw(node.sphere, node.max_error, min_refined_error, model[0].xyz,
-                                            model[1].xyz, model[2].xyz, model[3].xyz, g.camera_position.xyz, g.znear,
+                                            model[1].xyz, model[2].xyz, model[3].xyz, g.camera_position.xyz, g.lod_znear,
                                             g.lod_projection_scale, g.lod_threshold);
         world_center = (model * vec4(node.bounds.xyz, 1.0)).xyz;
         radius = node.bounds.w * gdr_max_axis_scale(model[0].xyz, model[1].xyz, model[2].xyz);
         vec3 center = (g.view * vec4(world_center, 1.0)).xyz;
         bool cull = g.cull_enabled != 0u && (g.flags & GDR_FRAME_MESHLET_FRUSTUM) != 0u;
-        frustum_culled = !lod_culled && cull && !gdr_sphere_visible(g.frustum, center, radius, g.znear, g.zfar);
+        frustum_culled = !lod_culled && cull && !gdr_sphere_visible_offset(g.frustum, g.frustum_offset, center, radius, g.znear, g.zfar);
         occluded = PHASE != GDR_PHASE_NONE && !lod_culled && !frustum_culled && g.cull_enabled != 0u &&
                    gdr_phase_occluded(g, PHASE, world_center, radius);
     }

@@ -239,7 +239,8 @@ static void note_missing(char *list, size_t size, bool present, const char *name
     snprintf(list + used, size - used, "%s%s", used ? ", " : "", name);
 }
 
-static gdr_status create_device(gdr_vk_context *ctx, bool disable_mesh_shaders, bool swapchain, gdr_error *err)
+static gdr_status create_device(gdr_vk_context *ctx, bool disable_mesh_shaders, bool disable_bc, bool swapchain,
+                                gdr_error *err)
 {
     VkPhysicalDevice pd = ctx->physical_device;
     if (ctx->properties.apiVersion < VK_API_VERSION_1_3)
@@ -325,6 +326,9 @@ static gdr_status create_device(gdr_vk_context *ctx, bool disable_mesh_shaders, 
     e2.features.drawIndirectFirstInstance = VK_TRUE;
     e2.features.shaderInt64 = VK_TRUE;
     e2.features.fragmentStoresAndAtomics = VK_TRUE; /* the overdraw view counts fragments */
+    /* block-compressed textures where the device samples them, else they are decoded at upload */
+    ctx->has_texture_compression_bc = f2.features.textureCompressionBC == VK_TRUE && !disable_bc;
+    e2.features.textureCompressionBC = ctx->has_texture_compression_bc ? VK_TRUE : VK_FALSE;
     VkPhysicalDeviceMeshShaderFeaturesEXT mesh = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT,
                                                   .taskShader = VK_TRUE, .meshShader = VK_TRUE};
     check_mesh_shader_support(ctx, subgroup.supportedStages, disable_mesh_shaders);
@@ -382,7 +386,8 @@ gdr_status gdr_vk_context_create(const gdr_vk_context_desc *desc_in, gdr_vk_cont
     if (status == GDR_OK)
         status = choose_physical_device(ctx, desc->device, err);
     if (status == GDR_OK)
-        status = create_device(ctx, desc->disable_mesh_shaders, desc->swapchain, err);
+        status = create_device(ctx, desc->disable_mesh_shaders, desc->disable_texture_compression_bc, desc->swapchain,
+                               err);
     if (status != GDR_OK) {
         gdr_vk_context_destroy(ctx);
         return status;

@@ -14,6 +14,7 @@ typedef struct gdr_vk_context_desc {
     bool validate;        /* enable VK_LAYER_KHRONOS_validation and count its messages */
     bool synchronization_validation; /* also enable synchronization validation (implies validate) */
     bool disable_mesh_shaders; /* behave as a device without VK_EXT_mesh_shader (tests of the fallback) */
+    bool disable_texture_compression_bc; /* behave as a device without BC sampling (tests of the fallback) */
     /* Presentation: instance extensions a window system needs (VK_KHR_surface, ...), and whether the
      * device must have VK_KHR_swapchain (enabled; its absence is an error naming the device). */
     const char *const *instance_extensions;
@@ -40,6 +41,7 @@ typedef struct gdr_vk_context {
     /* 64-bit atomics on storage buffers (shaderBufferInt64Atomics), enabled when present: the
      * visibility buffer of the hybrid rasteriser needs them. */
     bool has_buffer_int64_atomics;
+    bool has_texture_compression_bc; /* textureCompressionBC enabled (each format's features still checked) */
     uint32_t subgroup_size;
     char driver_info[VK_MAX_DRIVER_NAME_SIZE + VK_MAX_DRIVER_INFO_SIZE + 2]; /* driver name and version, for stats and PERFORMANCE.md */
     /* Validation messages seen so far (warnings and errors); every one is also printed. */

@@ -36,12 +36,13 @@ gdr_status gdr_vk_image_create(gdr_vk_allocator *allocator, const gdr_vk_image_d
     GDR_VK_TRY(err, vkBindImageMemory(device, out->image, allocation.memory, allocation.offset));
     VkImageViewCreateInfo view = {.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, .image = out->image,
                                   .viewType = VK_IMAGE_VIEW_TYPE_2D, .format = desc.format,
-                                  .subresourceRange = {desc.aspect, 0, desc.mip_levels, 0, 1}};
+                                  .components = desc.components, .subresourceRange = {desc.aspect, 0, desc.mip_levels, 0, 1}};
     GDR_VK_TRY(err, vkCreateImageView(device, &view, NULL, &out->view));
     out->format = desc.format;
     out->width = desc.width;
     out->height = desc.height;
     out->mip_levels = desc.mip_levels;
+    out->bytes = requirements.size;
     return GDR_OK;
 }
 

@@ -11,6 +11,7 @@ typedef struct gdr_vk_image {
     VkFormat format;
     uint32_t width, height;
     uint32_t mip_levels;
+    VkDeviceSize bytes; /* the device memory it was given (its memory requirements' size) */
 } gdr_vk_image;
 
 /* Zero fields take the defaults of gdr_vk_image_desc_defaults. */
@@ -20,6 +21,7 @@ typedef struct gdr_vk_image_desc {
     VkImageUsageFlags usage;  /* required */
     VkImageAspectFlags aspect; /* 0: COLOR */
     uint32_t mip_levels;      /* 0: 1 */
+    VkComponentMapping components; /* the view's swizzle; zero: identity */
 } gdr_vk_image_desc;
 
 /* `desc` with every default applied. */

@@ -24,5 +24,10 @@ cd "$here/corpus/obj" && "$gdr" build quad.obj -o "$work/b.gdrc" --no-progress >
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nbevel on\n' >"$work/warned.obj"
 cd "$work" && "$gdr" build warned.obj -o "$work/d.gdrc" --no-progress >/dev/null 2>&1
 "$gdr" build "$work/d.gdrc" -o "$work/warned.gdrc" --no-progress >/dev/null 2>&1
-for name in nodes quad pvs paged warned; do seed $name; done
+# Block-compressed textures (BC1 with partial blocks and levels below 4 x 4: 211 x 211).
+models=/usr/share/assimp/models/glTF2/BoxTextured-glTF
+cp "$models/BoxTextured.gltf" "$models/BoxTextured0.bin" "$models/CesiumLogoFlat.png" "$work/"
+"$gdr" build "$work/BoxTextured.gltf" -o "$work/d.gdrc" --no-progress >/dev/null
+"$gdr" build "$work/d.gdrc" -o "$work/textured.gdrc" --no-progress >/dev/null
+for name in nodes quad pvs paged warned textured; do seed $name; done
 ls -l "$here/corpus/cache"

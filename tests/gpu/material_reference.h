@@ -107,9 +107,21 @@ static inline int64_t ref_wrap(int64_t i, int64_t size, uint32_t mode)
     return ((i % size) + size) % size;
 }
 
+/* Texel (x, y) of level 0: a block-compressed texture's decoded from its block, as the device
+ * samples it (gdr_texture_decode_level on that one block). */
 static inline void ref_texel(const gdr_texture *t, int64_t x, int64_t y, double out[4])
 {
     const uint8_t *c = t->rgba + ((size_t)y * t->width + (size_t)x) * 4;
+    uint8_t texels[64];
+    if (t->format != GDR_TEXTURE_RGBA8) {
+        size_t blocks_x = (t->width + 3) / 4;
+        gdr_texture one = {.width = 4, .height = 4, .levels = 1, .format = t->format,
+                           .rgba = t->rgba + ((size_t)(y / 4) * blocks_x + (size_t)(x / 4)) * gdr_texture_block_bytes(t->format)};
+        gdr_error err;
+        if (gdr_texture_decode_level(&one, 0, texels, &err) != GDR_OK)
+            memset(texels, 0, sizeof texels);
+        c = texels + ((y % 4) * 4 + (x % 4)) * 4;
+    }
     for (int k = 0; k < 4; k++)
         out[k] = k < 3 && t->srgb ? ref_srgb_decode(c[k] / 255.0) : c[k] / 255.0;
 }
@@ -322,8 +334,8 @@ static inline bool ref_shade_pixel(const gdr_scene *scene, const gdr_camera *cam
         ref_vec3 b = rv_cross(n, t);
         if (rv_dot(b, dp_dv) > 0)
             b = rv_scale(b, -1);
-        double x = (texel[2][0] * 2 - 1) * m.normal_scale, y = (texel[2][1] * 2 - 1) * m.normal_scale,
-               z = texel[2][2] * 2 - 1;
+        double tx = texel[2][0] * 2 - 1, ty = texel[2][1] * 2 - 1; /* z rebuilt from x and y, as the shaders do */
+        double x = tx * m.normal_scale, y = ty * m.normal_scale, z = sqrt(fmax(1 - tx * tx - ty * ty, 0));
         n = rv_normalize(rv_add(rv_add(rv_scale(t, x), rv_scale(b, y)), rv_scale(n, z)));
     }
     double metallic = fmin(fmax(m.metallic_factor * texel[1][2], 0), 1);

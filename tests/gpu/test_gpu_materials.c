@@ -193,6 +193,72 @@ static void test_cases(void)
     gdr_scene_destroy(s);
 }
 
+static int image_difference(const uint8_t *a, const uint8_t *b, uint32_t pixels, int tolerance, double *share_over);
+
+/* The block bytes of every texture's chain: what a device sampling the formats holds, less its
+ * images' alignment. */
+static uint64_t chain_bytes(const gdr_scene *s, bool as_rgba8)
+{
+    uint64_t bytes = 0;
+    for (uint32_t i = 0; i < s->texture_count; i++) {
+        const gdr_texture *t = &s->textures[i];
+        bytes += gdr_texture_format_level_offset(as_rgba8 ? GDR_TEXTURE_RGBA8 : t->format, t->width, t->height, t->levels);
+    }
+    return bytes;
+}
+
+/* The cases with every texture block-compressed: the format each use gets, every path against the
+ * reference (which reads the decoded blocks), the renderer's texture memory against the blocks'
+ * size, and a device without BC sampling (the decoding fallback) giving the same image. */
+static void test_cases_compressed(void)
+{
+    enum { W = 420, H = 108 };
+    gdr_scene *s = cases_scene();
+    gdr_error err = {0};
+    CHECK(s && gdr_scene_build_clusters(s, NULL, &err) == GDR_OK);
+    CHECK(gdr_scene_compress_textures(s, NULL, &err) == GDR_OK);
+    /* base colour and emissive (opaque): BC1; normal: BC5; metallic-roughness: BC5_GB; occlusion: BC4 */
+    const uint32_t expected[5] = {GDR_TEXTURE_BC1, GDR_TEXTURE_BC1, GDR_TEXTURE_BC5, GDR_TEXTURE_BC5_GB, GDR_TEXTURE_BC4};
+    for (uint32_t i = 0; i < 5 && i < s->texture_count; i++)
+        CHECK(s->textures[i].format == expected[i]);
+    gdr_renderer *bc = gpu_test_renderer(W, H, s), *decoding = NULL;
+    gdr_renderer_desc desc = {.width = W, .height = H, .validate = true, .disable_texture_compression_bc = true};
+    CHECK(gdr_renderer_create(&desc, &decoding, &err) == GDR_OK && gdr_renderer_set_scene(decoding, s, &err) == GDR_OK);
+    CHECK(bc != NULL);
+    gdr_camera camera = test_look((gdr_vec3){4.1f, 0.5f, 3.6f}, 0.0f, 0.0f, 0.6f, 0.1f);
+    uint8_t *rgba = malloc((size_t)W * H * 4), *fallback = malloc((size_t)W * H * 4);
+    for (size_t p = 0; bc && p < PATH_COUNT; p++) {
+        if (!render_path(bc, &camera, &paths[p], GDR_CULL_DEFAULT, rgba)) {
+            CHECK(false);
+            continue;
+        }
+        uint32_t compared = compare_with_reference(s, &camera, W, H, rgba, paths[p].name);
+        printf("cases compressed, %s: at least %u pixels of each quad match the reference\n", paths[p].name, compared);
+        CHECK(compared >= 40);
+        CHECK(render_path(decoding, &camera, &paths[p], GDR_CULL_DEFAULT, fallback));
+        double share = 0;
+        int largest = image_difference(rgba, fallback, W * H, 1, &share);
+        printf("cases compressed, %s: decoded at upload vs sampled as BC: largest difference %d\n", paths[p].name, largest);
+        CHECK(largest <= 1);
+    }
+    gdr_frame_stats stats[2];
+    gdr_frame_desc frame = {.camera = camera};
+    CHECK(gdr_renderer_render(bc, &frame, 1, &stats[0], &err) == GDR_OK);
+    CHECK(gdr_renderer_render(decoding, &frame, 1, &stats[1], &err) == GDR_OK);
+    uint64_t blocks = chain_bytes(s, false), texels = chain_bytes(s, true);
+    printf("cases compressed: texture memory %llu bytes as BC (blocks %llu), %llu decoded (RGBA8 %llu)\n",
+           (unsigned long long)stats[0].memory.texture_bytes, (unsigned long long)blocks,
+           (unsigned long long)stats[1].memory.texture_bytes, (unsigned long long)texels);
+    CHECK(stats[0].memory.textures_compressed == 5 && stats[0].memory.textures_decoded == 0);
+    CHECK(stats[1].memory.textures_compressed == 0 && stats[1].memory.textures_decoded == 5);
+    CHECK(stats[0].memory.texture_bytes >= blocks && stats[1].memory.texture_bytes >= texels);
+    free(rgba);
+    free(fallback);
+    gdr_renderer_destroy(bc);
+    gdr_renderer_destroy(decoding);
+    gdr_scene_destroy(s);
+}
+
 /* BoxTextured up close: the front face's texture magnified, so that the reference's level-0
  * bilinear sample is what every path reads. */
 static void test_box_textured(const char *relative)
@@ -223,6 +289,24 @@ static void test_box_textured(const char *relative)
         printf("%s, %s: %u pixels match the reference\n", relative, paths[p].name, compared);
         CHECK(compared >= 200);
     }
+    /* its one texture, base colour without alpha, sampled as BC1: 8 bytes per 4 x 4 block, a level
+     * below 4 texels a side taking one whole block */
+    const gdr_texture *t = &s->textures[0];
+    CHECK(t->format == GDR_TEXTURE_BC1);
+    uint64_t blocks = 0;
+    for (uint32_t w = t->width, h = t->height;; w = w > 1 ? w / 2 : 1, h = h > 1 ? h / 2 : 1) {
+        blocks += 8ull * ((w + 3) / 4) * ((h + 3) / 4);
+        if (w == 1 && h == 1)
+            break;
+    }
+    CHECK(blocks == chain_bytes(s, false));
+    gdr_frame_stats stats;
+    gdr_frame_desc frame = {.camera = camera};
+    CHECK(r && gdr_renderer_render(r, &frame, 1, &stats, &err) == GDR_OK);
+    printf("%s: %ux%u, texture memory %llu bytes, its BC1 blocks %llu\n", relative, t->width, t->height,
+           (unsigned long long)stats.memory.texture_bytes, (unsigned long long)blocks);
+    CHECK(stats.memory.textures_compressed == 1 && stats.memory.texture_bytes >= blocks &&
+          stats.memory.texture_bytes < blocks + 4096);
     free(rgba);
     gdr_renderer_destroy(r);
     gdr_scene_destroy(s);
@@ -564,6 +648,7 @@ static void test_textured_lod(void)
 int main(void)
 {
     test_cases();
+    test_cases_compressed();
     test_box_textured("BoxTextured-glTF/BoxTextured.gltf");
     test_box_textured("BoxTextured-glTF-Binary/BoxTextured.glb");
     test_box_textured("BoxTextured-glTF-Embedded/BoxTextured.gltf");

@@ -51,7 +51,8 @@ static int same_scene(const gdr_scene *a, const gdr_scene *b)
     for (uint32_t i = 0; i < a->texture_count; i++) {
         const gdr_texture *x = &a->textures[i], *y = &b->textures[i];
         if (strcmp(x->name, y->name) || x->width != y->width || x->height != y->height || x->srgb != y->srgb ||
-            x->levels != y->levels || memcmp(x->rgba, y->rgba, gdr_texture_level_offset(x->width, x->height, x->levels)))
+            x->levels != y->levels || x->format != y->format ||
+            memcmp(x->rgba, y->rgba, gdr_texture_format_level_offset(x->format, x->width, x->height, x->levels)))
             return 0;
     }
     return 1;
@@ -361,6 +362,20 @@ static void expect_refused(const uint8_t *data, size_t size, const char *where, 
     }
 }
 
+/* Reads a damaged cache without PVS: refused with `expected`, no scene, naming the file and `where`. */
+static void expect_read_refused(const uint8_t *data, size_t size, const char *where, gdr_status expected)
+{
+    gdr_scene *s = (gdr_scene *)(uintptr_t)1;
+    gdr_error err = {0};
+    gdr_status status = gdr_cache_read_memory(data, size, "blocks.gdrc", &s, NULL, &err);
+    CHECK(status == expected && s == NULL);
+    CHECK_STATUS(err, expected);
+    CHECK_NAMES(err, "blocks.gdrc");
+    CHECK_NAMES(err, where);
+    if (status == GDR_OK)
+        gdr_scene_destroy(s);
+}
+
 static void test_pvs_section(void)
 {
     gdr_scene *scene = pvs_scene();
@@ -525,6 +540,87 @@ static void test_pvs_section(void)
     gdr_scene_destroy(scene);
 }
 
+/* A scene with a texture of every block format, sides not multiples of 4 (9 x 5: partial blocks,
+ * levels below 4 x 4). */
+static gdr_scene *block_texture_scene(void)
+{
+    gdr_scene *s = NULL;
+    gdr_error err = {0};
+    CHECK(gdr_scene_create_demo(&(gdr_demo_desc){.instances = 4}, &s, &err) == GDR_OK);
+    uint8_t texels[9 * 5 * 4];
+    for (uint32_t i = 0; i < sizeof texels; i++)
+        texels[i] = (uint8_t)(i * 37u + (i >> 2) * 11u);
+    gdr_material m = gdr_material_default();
+    m.alpha_mode = GDR_ALPHA_MASK;
+    gdr_texture_ref *uses[5] = {&m.base_color_texture, &m.emissive_texture, &m.normal_texture,
+                                &m.metallic_roughness_texture, &m.occlusion_texture};
+    for (uint32_t k = 0; k < 5; k++)
+        CHECK(gdr_scene_add_texture(s, "t", 9, 5, texels, k < 2, &uses[k]->texture, &err) == GDR_OK);
+    CHECK(gdr_scene_add_material(s, &m, NULL, &err) == GDR_OK);
+    CHECK(gdr_scene_compress_textures(s, NULL, &err) == GDR_OK);
+    const uint32_t formats[5] = {GDR_TEXTURE_BC3, GDR_TEXTURE_BC1, GDR_TEXTURE_BC5, GDR_TEXTURE_BC5_GB, GDR_TEXTURE_BC4};
+    for (uint32_t k = 0; k < 5; k++)
+        CHECK(s->textures[k].format == formats[k]);
+    /* 9 x 5 -> 4 x 2 -> 2 x 1 -> 1 x 1: 3 x 2, 1, 1 and 1 blocks */
+    CHECK(gdr_texture_format_level_offset(GDR_TEXTURE_BC1, 9, 5, 4) == 8 * (6 + 1 + 1 + 1));
+    return s;
+}
+
+/* A cache's texture records and blocks damaged behind recomputed checksums: each refused with
+ * GDR_ERROR_PARSE naming the file, the section or texture and what is wrong. */
+static void test_block_textures(void)
+{
+    gdr_scene *scene = block_texture_scene();
+    test_round_trip_and_corruption("blocks", scene);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/blocks.gdrc", GDR_IO_TEST_TMP);
+    size_t size;
+    uint8_t *data = test_read_file(path, &size), *bad = malloc(size);
+    CHECK(data && bad);
+    if (!data || !bad)
+        return;
+    uint64_t texr, txpx, txpx_length;
+    memcpy(&texr, cache_entry(data, "TEXR") + 8, 8);
+    memcpy(&txpx, cache_entry(data, "TXPX") + 8, 8);
+    memcpy(&txpx_length, cache_entry(data, "TXPX") + 16, 8);
+    CHECK(txpx_length == 16 * 9 + 8 * 9 + 16 * 9 + 16 * 9 + 8 * 9); /* BC3, BC1, BC5, BC5_GB, BC4 */
+    /* texture 2's format (its record: name, width, height, sRGB, format) out of range */
+    memcpy(bad, data, size);
+    uint32_t format = GDR_TEXTURE_FORMAT_COUNT;
+    memcpy(bad + texr + 2 * (64 + 16) + 64 + 12, &format, 4);
+    cache_fix_checksums(bad, size);
+    expect_read_refused(bad, size, "texture 2: format 6", GDR_ERROR_PARSE);
+    /* texture 1 claiming BC5 (16-byte blocks) where its 8-byte BC1 blocks are: the levels after it
+     * no longer fit the section */
+    memcpy(bad, data, size);
+    format = GDR_TEXTURE_BC5;
+    memcpy(bad + texr + 1 * (64 + 16) + 64 + 12, &format, 4);
+    cache_fix_checksums(bad, size);
+    expect_read_refused(bad, size, "run past section 'TXPX'", GDR_ERROR_PARSE);
+    /* texture 0 claiming BC1 (8-byte blocks) where its 16-byte BC3 blocks are: bytes left over */
+    memcpy(bad, data, size);
+    format = GDR_TEXTURE_BC1;
+    memcpy(bad + texr + 64 + 12, &format, 4);
+    cache_fix_checksums(bad, size);
+    expect_read_refused(bad, size, "section 'TXPX' has 72 bytes left over", GDR_ERROR_PARSE);
+    /* the blocks cut short by one byte */
+    memcpy(bad, data, size);
+    uint64_t length = txpx_length - 1;
+    memcpy(cache_entry(bad, "TXPX") + 16, &length, 8);
+    cache_fix_checksums(bad, size);
+    expect_read_refused(bad, size, "texture 4 (bc4, 9x5): its 72 bytes of levels run past section 'TXPX'",
+                        GDR_ERROR_PARSE);
+    /* a flipped bit in the blocks, checksums as written: the section's checksum names it */
+    memcpy(bad, data, size);
+    bad[txpx + 20] ^= 4;
+    expect_read_refused(bad, size, "TXPX", GDR_ERROR_CORRUPT);
+    printf("block textures: %llu bytes of blocks; damaged formats, sizes and blocks refused\n",
+           (unsigned long long)txpx_length);
+    free(bad);
+    free(data);
+    gdr_scene_destroy(scene);
+}
+
 int main(void)
 {
     gdr_error err = {0};
@@ -548,6 +644,7 @@ int main(void)
     if (demo) {
         test_round_trip_and_corruption("demo", demo);
         test_unknown_sections(demo);
+        test_block_textures();
         gdr_scene_destroy(demo);
     }
     char path[1024];

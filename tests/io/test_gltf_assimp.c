@@ -50,7 +50,6 @@ static const struct { const char *file, *warning; } warned[] = {
     {"glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_08.gltf", "(lines) skipped"},
     {"glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_09.gltf", "(line loop) skipped"},
     {"glTF-Asset-Generator/Mesh_PrimitiveMode/Mesh_PrimitiveMode_10.gltf", "(line strip) skipped"},
-    {"cameras/Cameras.gltf", "only perspective cameras"},
     /* material extensions gdr does not apply: said once, at the first material using one */
     {"BoxTextured-glTF-pbrSpecularGlossiness/BoxTextured.gltf",
      "materials[0].extensions.KHR_materials_pbrSpecularGlossiness: KHR_materials_pbrSpecularGlossiness is not supported"},
@@ -130,7 +129,8 @@ static void walk(const cJSON *root, int node, expected *e)
     if (camera) {
         const cJSON *cam = cJSON_GetArrayItem(cJSON_GetObjectItem(root, "cameras"), camera->valueint);
         const cJSON *type = cJSON_GetObjectItem(cam, "type");
-        e->cameras += type && strcmp(type->valuestring, "perspective") == 0;
+        e->cameras += type && (strcmp(type->valuestring, "perspective") == 0 ||
+                               strcmp(type->valuestring, "orthographic") == 0);
     }
     for (const cJSON *child = cJSON_GetObjectItem(n, "children") ? cJSON_GetObjectItem(n, "children")->child : NULL;
          child; child = child->next)

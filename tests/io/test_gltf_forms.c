@@ -465,6 +465,12 @@ static void test_errors(void)
         {"{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"camera\":0}],\"cameras\":[{\"type\":\"perspective\","
          "\"perspective\":{\"yfov\":-1,\"znear\":0.1}}],\"scenes\":[{\"nodes\":[0]}]}",
          GDR_ERROR_PARSE, "cameras[0].perspective"},
+        {"{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"camera\":0}],\"cameras\":[{\"type\":\"orthographic\","
+         "\"orthographic\":{\"xmag\":1,\"ymag\":0,\"znear\":0,\"zfar\":10}}],\"scenes\":[{\"nodes\":[0]}]}",
+         GDR_ERROR_PARSE, "cameras[0].orthographic: xmag 1, ymag 0"},
+        {"{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"camera\":0}],\"cameras\":[{\"type\":\"orthographic\","
+         "\"orthographic\":{\"xmag\":1,\"ymag\":1,\"znear\":0}}],\"scenes\":[{\"nodes\":[0]}]}",
+         GDR_ERROR_PARSE, "cameras[0].orthographic: xmag 1, ymag 1, znear 0, zfar nan"},
         {"{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"uri\":\"http://example.com/a.bin\",\"byteLength\":4}],"
          "\"bufferViews\":[{\"buffer\":0,\"byteLength\":4}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,"
          "\"count\":1,\"type\":\"VEC3\"}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"

@@ -192,3 +192,9 @@ int cli_load_failed(const char *spec, const gdr_error *err)
     fprintf(stderr, "gdr: %s\n", err->message);
     return gdr_scene_spec_is_builtin(spec) && err->status == GDR_ERROR_INVALID_ARGUMENT ? 2 : 1;
 }
+
+bool cli_bc_textures_disabled(void)
+{
+    const char *value = getenv("GDR_DISABLE_BC_TEXTURES");
+    return value && strcmp(value, "1") == 0;
+}

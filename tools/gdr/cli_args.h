@@ -10,6 +10,9 @@
 #include "gdr/scene.h"
 
 /* Each prints "gdr: OPTION VALUE: why" on failure and returns false. */
+/* GDR_DISABLE_BC_TEXTURES=1 in the environment: behave as a device without BC texture sampling
+ * (gdr_renderer_desc.disable_texture_compression_bc), so that tests reach the decoding fallback. */
+bool cli_bc_textures_disabled(void);
 bool cli_parse_u32(const char *option, const char *text, uint32_t min, uint32_t max, uint32_t *out);
 /* A finite decimal number in [min, max]. */
 bool cli_parse_float(const char *option, const char *text, float min, float max, float *out);

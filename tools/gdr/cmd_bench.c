@@ -246,7 +246,8 @@ static int open_scene(const bench_options *o, uint32_t s, gdr_scene **scene, gdr
     gdr_error err = {0};
     gdr_demo_desc demo = {.instances = o->sizes[s]};
     gdr_renderer_desc desc = {.width = o->width, .height = o->height, .device = o->device, .validate = o->validate,
-                              .busy_wait = true, .record_every_frame = o->record_every_frame};
+                              .busy_wait = true, .record_every_frame = o->record_every_frame,
+                              .disable_texture_compression_bc = cli_bc_textures_disabled()};
     gdr_load_options load = {.pvs = pvs}; /* a cache's precomputed visibility culls as in gdr render */
     gdr_status loaded = o->scene_spec ? gdr_scene_load(o->scene_spec, &load, scene, &err)
                                       : gdr_scene_create_demo(&demo, scene, &err);

@@ -74,6 +74,28 @@ static void print_cache_location(const gdr_import_report *report, int no_cache, 
         printf("cached in:   none%s\n", no_cache ? " (--no-cache)" : " (no cache folder)");
 }
 
+/* The textures' count, then per format how many and the bytes their mip chains take (what the
+ * cache stores and a device that samples the format holds). */
+static void print_textures(const gdr_scene *scene)
+{
+    printf("textures:    %u\n", scene->texture_count);
+    for (uint32_t f = 0; f < GDR_TEXTURE_FORMAT_COUNT; f++) {
+        uint32_t count = 0;
+        unsigned long long bytes = 0, texels = 0;
+        for (uint32_t i = 0; i < scene->texture_count; i++) {
+            const gdr_texture *t = &scene->textures[i];
+            if (t->format != f)
+                continue;
+            count++;
+            bytes += gdr_texture_format_level_offset(t->format, t->width, t->height, t->levels);
+            texels += (unsigned long long)t->width * t->height;
+        }
+        if (count)
+            printf("  %-7s    %u (%llu texels at level 0, %llu bytes with their mips)\n", gdr_texture_format_name(f),
+                   count, texels, bytes);
+    }
+}
+
 int gdr_cmd_info(int argc, char **argv)
 {
     if (argc == 2 && strcmp(argv[1], "--passes") == 0) {
@@ -156,7 +178,7 @@ int gdr_cmd_info(int argc, char **argv)
     printf("instances:   %u\n", scene->instance_count);
     printf("triangles:   %llu (over all instances)\n", (unsigned long long)gdr_scene_triangle_count(scene));
     printf("materials:   %u\n", scene->material_count);
-    printf("textures:    %u\n", scene->texture_count);
+    print_textures(scene);
     printf("cameras:     %u\n", scene->camera_count);
     printf("extensions:  %s\n", scene->extensions ? scene->extensions : "(none)");
     print_quantization(scene);

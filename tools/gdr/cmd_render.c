@@ -232,7 +232,8 @@ int gdr_cmd_render(int argc, char **argv)
     }
     /* The renderer next: a device or target size the machine cannot give is a command-line value,
      * refused (exit 2) before the scene is loaded. */
-    gdr_renderer_desc desc = {.width = o.width, .height = o.height, .device = o.device, .validate = o.validate};
+    gdr_renderer_desc desc = {.width = o.width, .height = o.height, .device = o.device, .validate = o.validate,
+                              .disable_texture_compression_bc = cli_bc_textures_disabled()};
     gdr_renderer *renderer = NULL;
     gdr_paged_cache *paged = NULL;
     gdr_frame_stats stats;

@@ -185,7 +185,8 @@ static int open_window(view_app *app, const gdr_scene *scene, const gdr_pvs *pvs
     gdr_error err = {0};
     gdr_renderer_desc desc = {.width = app->o->width, .height = app->o->height, .device = app->o->device,
                               .validate = app->o->validate, .instance_extensions = extensions,
-                              .instance_extension_count = extension_count, .presentable = true};
+                              .instance_extension_count = extension_count, .presentable = true,
+                              .disable_texture_compression_bc = cli_bc_textures_disabled()};
     if (gdr_renderer_create(&desc, &app->renderer, &err) != GDR_OK)
         return cli_renderer_failed(&err); /* 2 for a --device the machine does not have */
     if (render_options_set_scene(app->renderer, scene, app->o, &app->paged, &err) != GDR_OK ||

@@ -98,6 +98,8 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
         fprintf(out, "  gpu_ms.%-16s %.4f\n", s->passes[p].name, s->passes[p].gpu_ms);
     fprintf(out, "gpu_memory_bytes    %llu (scene %llu, frame %llu)\n", (unsigned long long)s->memory.device_bytes,
             (unsigned long long)s->memory.scene_bytes, (unsigned long long)s->memory.frame_bytes);
+    fprintf(out, "gpu_texture_bytes   %llu (%u textures sampled compressed, %u decoded to RGBA8)\n",
+            (unsigned long long)s->memory.texture_bytes, s->memory.textures_compressed, s->memory.textures_decoded);
     stats_print_streaming(out, &s->streaming);
     fprintf(out, "validation_messages %u\n", s->validation_messages);
 }
@@ -215,6 +217,9 @@ void stats_add_memory_json(cJSON *object, const gdr_frame_stats *s)
     cJSON_AddNumberToObject(object, "gpu_memory_bytes", (double)s->memory.device_bytes);
     cJSON_AddNumberToObject(object, "gpu_memory_scene_bytes", (double)s->memory.scene_bytes);
     cJSON_AddNumberToObject(object, "gpu_memory_frame_bytes", (double)s->memory.frame_bytes);
+    cJSON_AddNumberToObject(object, "gpu_texture_bytes", (double)s->memory.texture_bytes);
+    cJSON_AddNumberToObject(object, "textures_compressed", s->memory.textures_compressed);
+    cJSON_AddNumberToObject(object, "textures_decoded", s->memory.textures_decoded);
 }
 
 stats_path_frame stats_path_row(const gdr_frame_stats *s)
