@@ -980,10 +980,10 @@ static void clusters_to_torus(const gdr_mesh *m, double *own)
     }
 }
 
-/* Per group that is the only one of its depth (it holds the whole mesh: the steps below one
- * cluster), the largest distance from a vertex of the mesh to its new clusters' triangles, into
- * own[] where larger. Such a group's few triangles lie close to the torus but leave most of it far
- * away: the distance from its clusters to the torus alone misses what it leaves out. */
+/* Per group that is the only one of its depth and made one cluster (it holds the whole mesh: the
+ * steps below one cluster), the largest distance from a vertex of the mesh to its new cluster's
+ * triangles, into own[] where larger. Such a cluster's few triangles lie close to the torus but
+ * leave most of it far away: the distance from its clusters to the torus alone misses that. */
 static void mesh_to_lone_groups(const gdr_mesh *m, double *own)
 {
     const gdr_mesh_clusters *mc = &m->clusters;
@@ -993,9 +993,13 @@ static void mesh_to_lone_groups(const gdr_mesh *m, double *own)
             at_depth += mc->groups[h].depth == mc->groups[g].depth;
         if (at_depth != 1)
             continue;
-        size_t n = 0;
-        for (uint32_t i = 0; i < mc->cluster_count; i++)
+        size_t n = 0, made = 0;
+        for (uint32_t i = 0; i < mc->cluster_count; i++) {
             n += mc->clusters[i].refined_group == g ? mc->clusters[i].triangle_count : 0;
+            made += mc->clusters[i].refined_group == g;
+        }
+        if (made != 1)
+            continue;
         uint32_t *corners = malloc(3 * n * sizeof *corners);
         n = 0;
         for (uint32_t i = 0; corners && i < mc->cluster_count; i++) {
