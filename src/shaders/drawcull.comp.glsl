@@ -23,6 +23,14 @@ layout(constant_id = 0) const bool EMIT_TASKS = false;
 // Occlusion culling phase: none, or the early / late phase of the two-phase scheme.
 layout(constant_id = 1) const uint PHASE = GDR_PHASE_NONE;
 
+// Whether the group cluster m was made from passes the cut.
+bool chain_refined_passes(GdrGpuFrameGlobals g, GdrGpuMeshlet m, mat4 model)
+{
+    return gdr_lod_group_projected_error(m.refined_sphere, m.refined_error, model[0].xyz, model[1].xyz,
+                                         model[2].xyz, model[3].xyz, g.camera_position.xyz, g.znear,
+                                         g.lod_projection_scale) <= g.lod_threshold;
+}
+
 // The root chain (GdrGpuMesh.root_chain), below a root whose refined group does not pass: the
 // first lone cluster whose refined group passes is the whole cut (the group it was made from held
 // the whole mesh, so every other group is below it and passes). With groups absent (streaming),
@@ -30,14 +38,20 @@ layout(constant_id = 1) const uint PHASE = GDR_PHASE_NONE;
 // Returns the mesh-local cluster, or GDR_GPU_NO_GROUP when the chain does not decide the cut.
 uint root_chain_cluster(GdrGpuFrameGlobals g, uint mesh_index, GdrGpuMesh mesh, mat4 model)
 {
-    for (uint i = 1u; i < min(mesh.root_chain, uint(GDR_LOD_ROOT_CHAIN)); i++) {
+    uint chain = min(mesh.root_chain, uint(GDR_LOD_ROOT_CHAIN));
+    // The finest first: where its refined group does not pass, no coarser one does (errors and
+    // spheres grow towards the root), and a nearer instance leaves after one read.
+    if (chain < 2u)
+        return GDR_GPU_NO_GROUP;
+    uint finest = mesh.meshlet_offset + mesh.root_first - (chain - 1u);
+    if (!chain_refined_passes(g, MeshletsRef(GDR_SCENE.meshlets).items[finest], model))
+        return GDR_GPU_NO_GROUP;
+    for (uint i = 1u; i < chain; i++) {
         uint cluster = mesh.root_first - i;
         GdrGpuMeshlet m = MeshletsRef(GDR_SCENE.meshlets).items[mesh.meshlet_offset + cluster];
         if (gdr_group_absent(g, mesh_index, m.group) || gdr_group_absent(g, mesh_index, m.refined_group))
             break;
-        if (gdr_lod_group_projected_error(m.refined_sphere, m.refined_error, model[0].xyz, model[1].xyz,
-                                          model[2].xyz, model[3].xyz, g.camera_position.xyz, g.znear,
-                                          g.lod_projection_scale) <= g.lod_threshold) {
+        if (chain_refined_passes(g, m, model)) {
             gdr_mark_group_used(g, mesh_index, m.group);
             return cluster;
         }
