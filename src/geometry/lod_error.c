@@ -1042,9 +1042,7 @@ static float group_floor(const lod_build *b, lod_scratch *s, const group_result 
 {
     float kept = kept_bound(&s->top), rest = kept > 0.0f ? sqrtf(kept) : 0.0f;
     float floor = r->error > rest ? r->error : rest;
-    if (!b->lone_group && to_simplified > floor && *to_full >= 0.0f && floor <= LOD_REDIRECT_GAIN * *to_full) {
-        /* (Not for the step's only group: no neighbour to pass samples to, so the floor decides
-         * nothing; the D2 measured first is a bound all the same.) */
+    if (to_simplified > floor && *to_full >= 0.0f && floor <= LOD_REDIRECT_GAIN * *to_full) {
         float again = simplified_to_full(b, s, floor, LOD_REDIRECT_GAIN * *to_full);
         *to_full = again < *to_full ? again : *to_full;
     }
@@ -1091,10 +1089,8 @@ int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *member
     s->top.limit = LOD_KEPT_FIRST;
     float to_simplified = s->gathered ? samples_to_simplified(b, s, local_count) : 0.0f;
     float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified, INFINITY);
-    /* Measured again (the same largest distance), over the vertex grid the probes may have taken;
-     * not for the step's only group (the steps below one cluster measure the whole mesh each): it
-     * has no neighbour to pass samples to, and 65 kept bounds keep their promise as well. */
-    if (!b->lone_group && to_simplified >= 0.0f && to_full >= 0.0f && keep_more(s, r, to_simplified, to_full) &&
+    /* Measured again (the same largest distance), over the vertex grid the probes may have taken. */
+    if (to_simplified >= 0.0f && to_full >= 0.0f && keep_more(s, r, to_simplified, to_full) &&
         (!build_vertex_grid(s, local_count) || measure_all_samples(b, s, LOD_EXCESS_LIMIT + 1) < 0.0f))
         return 0;
     float floor = to_simplified < 0.0f ? 0.0f : group_floor(b, s, r, to_simplified, &to_full);
