@@ -61,7 +61,9 @@ GDR_API gdr_status gdr_scene_build_clusters(gdr_scene *scene, const gdr_meshlet_
  * (METIS over the graph of clusters that share edges, weighted by the number of shared edges);
  * each group's triangles are merged, simplified to about half (meshoptimizer) with every vertex
  * that the group shares with other groups locked, and split into new clusters; repeat until one
- * cluster is left or nothing simplifies any more. The clusters that remain form the root group.
+ * cluster is left, then simplify that one further, step by step, until it holds at most
+ * gdr_lod_options.root_triangles triangles, or until nothing simplifies any more. The clusters that
+ * remain form the root group.
  *
  * After the build:
  *  - every cluster has a `group` (the group it is part of); level-0 clusters have refined_group
@@ -98,10 +100,14 @@ GDR_API gdr_status gdr_scene_build_clusters(gdr_scene *scene, const gdr_meshlet_
  * stops and what is left becomes the root group: gdr_lod_stats says why the build stopped. */
 
 #define GDR_LOD_MAX_LEVELS 64u
+/* The root a closed mesh simplifies down to, in triangles (docs/GEOMETRY.md, "A coarse end"). */
+#define GDR_LOD_DEFAULT_ROOT_TRIANGLES 4u
 
 typedef enum gdr_lod_stop {
     GDR_LOD_STOP_NONE = 0,       /* nothing built */
-    GDR_LOD_STOP_SINGLE_CLUSTER, /* simplified down to one cluster: the root group holds it */
+    GDR_LOD_STOP_SINGLE_CLUSTER, /* simplified down to one cluster of at most root_triangles
+                                    triangles, or to one that simplifies no further: the root
+                                    group holds it */
     GDR_LOD_STOP_NO_PROGRESS,    /* no group of the last step simplified enough: the root group
                                     holds the clusters that were left */
     GDR_LOD_STOP_LEVEL_LIMIT,    /* GDR_LOD_MAX_LEVELS steps; the root group holds what was left */
@@ -117,6 +123,10 @@ typedef struct gdr_lod_options {
     uint32_t thread_count; /* workers including the caller, at most 256; 0: one per processor. The
                               result does not depend on it (same bytes). */
     int no_progress;       /* 1: never draw a progress bar (default: on a terminal, after 0.3 s) */
+    uint32_t root_triangles; /* the build goes on below one cluster until the lone cluster holds at
+                                most this many triangles (or stops simplifying); 0:
+                                GDR_LOD_DEFAULT_ROOT_TRIANGLES; in [1, GDR_CLUSTER_MAX_TRIANGLES]
+                                (the largest: stop at one cluster, as before) */
 } gdr_lod_options;
 
 /* What a build did; for a scene, sums over the meshes built. */

@@ -499,6 +499,11 @@ static gdr_status resolve_options(const gdr_lod_options *in, gdr_lod_options *ou
         o.group_size = LOD_DEFAULT_GROUP_SIZE;
     if (o.target_ratio == 0.0f)
         o.target_ratio = 0.5f;
+    if (o.root_triangles == 0)
+        o.root_triangles = GDR_LOD_DEFAULT_ROOT_TRIANGLES;
+    if (o.root_triangles > GDR_CLUSTER_MAX_TRIANGLES)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "LOD options: root_triangles %u is outside [1, %u]",
+                             o.root_triangles, GDR_CLUSTER_MAX_TRIANGLES);
     if (o.group_size < 2 || o.group_size > LOD_MAX_GROUP_SIZE)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "LOD options: group_size %u is outside [2, %u]",
                              o.group_size, LOD_MAX_GROUP_SIZE);
@@ -622,7 +627,16 @@ static gdr_status step(lod_build *b, lod_stage *prev, lod_stage *cur, uint32_t d
     return GDR_OK;
 }
 
-/* Steps from level 0 until one cluster is left, a step makes no progress or the level limit;
+/* Whether the frontier `current` is one cluster of at most opt.root_triangles triangles: the root.
+ * One full cluster is not the end: an instance a pixel or two across would still draw its 60-124
+ * triangles, so the lone cluster is simplified further, step by step (one group, nothing locked),
+ * each step an ordinary group with its measured error. */
+static int small_root(const lod_build *b, const uint32_t *current)
+{
+    return b->frontier_count == 1 && b->clusters[current[0]].triangle_count <= b->opt.root_triangles;
+}
+
+/* Steps from level 0 until one small cluster is left, a step makes no progress or the level limit;
  * leaves the last frontier in *frontier (b->frontier) and the step count in *depth.
  *
  * A step's simplification and its errors are taken apart: which groups form, and so the next
@@ -644,8 +658,8 @@ static gdr_status run_steps(lod_build *b, uint32_t **frontier, uint32_t *depth, 
     observe(b, NULL, current, level0);
     for (*depth = 0;; ++*depth) {
         b->frontier = current;
-        if (b->frontier_count == 1 || *depth >= GDR_LOD_MAX_LEVELS) {
-            *stop = b->frontier_count == 1 ? GDR_LOD_STOP_SINGLE_CLUSTER : GDR_LOD_STOP_LEVEL_LIMIT;
+        if (small_root(b, current) || *depth >= GDR_LOD_MAX_LEVELS) {
+            *stop = small_root(b, current) ? GDR_LOD_STOP_SINGLE_CLUSTER : GDR_LOD_STOP_LEVEL_LIMIT;
             break;
         }
         /* The next frontier: members carried or passed through, plus new clusters, of which a
@@ -661,7 +675,7 @@ static gdr_status run_steps(lod_build *b, uint32_t **frontier, uint32_t *depth, 
         if ((status = step(b, &prev, &cur, *depth, &progressed, err)) != GDR_OK)
             goto done;
         if (!progressed) {
-            *stop = GDR_LOD_STOP_NO_PROGRESS;
+            *stop = b->frontier_count == 1 ? GDR_LOD_STOP_SINGLE_CLUSTER : GDR_LOD_STOP_NO_PROGRESS;
             break;
         }
         uint32_t next_count = 0;

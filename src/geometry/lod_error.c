@@ -1089,8 +1089,11 @@ int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *member
     s->top.limit = LOD_KEPT_FIRST;
     float to_simplified = s->gathered ? samples_to_simplified(b, s, local_count) : 0.0f;
     float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified, INFINITY);
-    /* Measured again (the same largest distance), over the vertex grid the probes may have taken. */
-    if (to_simplified >= 0.0f && to_full >= 0.0f && keep_more(s, r, to_simplified, to_full) &&
+    /* Measured again (the same largest distance), over the vertex grid the probes may have taken.
+     * Not for the step's only group (the steps below one cluster measure the whole mesh each): no
+     * neighbour can take its samples, and its error does not change: a lower floor only lets
+     * group_floor refine D2 further below the floor, and the floor is at most D1. */
+    if (!b->lone_group && to_simplified >= 0.0f && to_full >= 0.0f && keep_more(s, r, to_simplified, to_full) &&
         (!build_vertex_grid(s, local_count) || measure_all_samples(b, s, LOD_EXCESS_LIMIT + 1) < 0.0f))
         return 0;
     float floor = to_simplified < 0.0f ? 0.0f : group_floor(b, s, r, to_simplified, &to_full);

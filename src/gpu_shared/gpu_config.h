@@ -26,6 +26,9 @@
  * command of one or two clusters costs the cluster cull a whole GDR_CLUSTER_CULL_LANES slot and a
  * second pass over the instance. */
 #define GDR_DIRECT_CLUSTERS 4
+/* The instance cull walks at most this many clusters of a mesh's root chain (GdrGpuMesh.root_chain):
+ * a chain halves its triangles at every step, so a cluster's 124 reach a handful in 5 or 6. */
+#define GDR_LOD_ROOT_CHAIN 8
 /* LOD statistics: clusters and triangles drawn per DAG depth, the last bucket for deeper ones. */
 #define GDR_LOD_STATS_DEPTHS 32
 /* The LOD hierarchy traversal (lodtraverse.comp): one invocation per node visit, one dispatch per

@@ -57,7 +57,11 @@ GDR_STRUCT_BEGIN(GdrGpuMesh)
     gdr_uint lod_task_count;    /* ceil(lod_cluster_count / GDR_TASK_WORKGROUP_SIZE) */
     gdr_uint root_first;        /* first cluster of the root group, relative to meshlet_offset */
     gdr_uint root_cluster_count; /* 0 without a DAG: no root shortcut */
-    gdr_uint root_task_count;
+    /* The root chain: where the root group is one cluster, the lone clusters the build simplified
+     * step by step down to it (docs/GEOMETRY.md, "A coarse end"), coarsest first, at root_first,
+     * root_first - 1, ...: root_chain of them (the root's included; at most GDR_LOD_ROOT_CHAIN);
+     * each but the root in a group of that one cluster, made from the group of the next. 0: none. */
+    gdr_uint root_chain;
     gdr_uint lod_node_offset;   /* the mesh's LOD hierarchy: GdrGpuLodNode[lod_node_offset .. + lod_node_count) */
     /* The root shortcut: a sphere containing, and the largest error of, the groups the root
      * group's clusters were made from. When it passes, each of them passes (errors and spheres

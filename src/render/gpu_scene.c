@@ -65,13 +65,33 @@ static GdrGpuMeshlet gpu_meshlet_from(const gdr_mesh_clusters *c, uint32_t i, ui
     return m;
 }
 
+/* The root chain (GdrGpuMesh.root_chain): from a root group of one cluster, the lone clusters it was
+ * made from, step by step, while each is its group's only cluster and lies just before the one
+ * made from it. Such a group was the whole frontier of its step (its step made one cluster, the
+ * next frontier whole), so every other group of the DAG is below the group it was made from: where
+ * that group passes, the cut is this one cluster. */
+static uint32_t root_chain(const gdr_mesh_clusters *c)
+{
+    const gdr_cluster_group *root = &c->groups[c->group_count - 1];
+    if (root->cluster_count != 1)
+        return 0;
+    uint32_t chain = 1, at = root->first_cluster;
+    while (chain < GDR_LOD_ROOT_CHAIN && at > 0) {
+        uint32_t from = c->clusters[at].refined_group;
+        if (from == GDR_NO_INDEX || c->groups[from].cluster_count != 1 || c->groups[from].first_cluster != at - 1)
+            break;
+        at--;
+        chain++;
+    }
+    return chain;
+}
+
 /* The root shortcut of a mesh with a DAG (GdrGpuMesh.root_*): the root group is the last one. */
 static void set_root_shortcut(const gdr_mesh_clusters *c, GdrGpuMesh *mesh)
 {
     const gdr_cluster_group *root = &c->groups[c->group_count - 1];
     mesh->root_first = root->first_cluster;
     mesh->root_cluster_count = root->cluster_count;
-    mesh->root_task_count = (root->cluster_count + GDR_TASK_WORKGROUP_SIZE - 1) / GDR_TASK_WORKGROUP_SIZE;
     /* Each distinct refined group once: the root's clusters come from a handful of groups. */
     gdr_vec4 spheres[64];
     uint32_t seen[64], n = 0;
@@ -95,11 +115,13 @@ static void set_root_shortcut(const gdr_mesh_clusters *c, GdrGpuMesh *mesh)
         error = fmaxf(error, c->groups[refined].error);
     }
     if (!fits) { /* no shortcut: the per-cluster test decides */
-        mesh->root_cluster_count = mesh->root_task_count = 0;
+        mesh->root_cluster_count = 0;
         return;
     }
-    mesh->root_refined_sphere = n > 0 ? gdr_lod_enclosing_sphere(spheres, n) : (gdr_vec4){0, 0, 0, 0};
+    /* One refined group: its own sphere, so that the shortcut tests what the cluster test would. */
+    mesh->root_refined_sphere = n > 1 ? gdr_lod_enclosing_sphere(spheres, n) : n ? spheres[0] : (gdr_vec4){0, 0, 0, 0};
     mesh->root_refined_error = error;
+    mesh->root_chain = root_chain(c);
 }
 
 /* The cluster pool: GdrGpuMeshlet[] with pool-global offsets, global vertex indices, and the
@@ -196,7 +218,7 @@ static uint64_t tasks_per_instance(const gdr_mesh_clusters *c, const GdrGpuMesh 
     for (uint32_t n = 0; n < c->lod_node_count; n++)
         if (c->lod_nodes[n].flags & GDR_GPU_LOD_NODE_LEAF)
             leaves += (c->lod_nodes[n].count + GDR_TASK_WORKGROUP_SIZE - 1) / GDR_TASK_WORKGROUP_SIZE;
-    return leaves > mesh->lod_task_count ? leaves : mesh->lod_task_count; /* >= task_count, root_task_count */
+    return leaves > mesh->lod_task_count ? leaves : mesh->lod_task_count; /* >= task_count, the root's */
 }
 
 /* The task list and the traversal's levels: what every instance could need, up to the limits of

@@ -23,10 +23,47 @@ layout(constant_id = 0) const bool EMIT_TASKS = false;
 // Occlusion culling phase: none, or the early / late phase of the two-phase scheme.
 layout(constant_id = 1) const uint PHASE = GDR_PHASE_NONE;
 
+// Whether the group cluster m was made from passes the cut.
+bool chain_refined_passes(GdrGpuFrameGlobals g, GdrGpuMeshlet m, mat4 model)
+{
+    return gdr_lod_group_projected_error(m.refined_sphere, m.refined_error, model[0].xyz, model[1].xyz,
+                                         model[2].xyz, model[3].xyz, g.camera_position.xyz, g.znear,
+                                         g.lod_projection_scale) <= g.lod_threshold;
+}
+
+// The root chain (GdrGpuMesh.root_chain), below a root whose refined group does not pass: the
+// first lone cluster whose refined group passes is the whole cut (the group it was made from held
+// the whole mesh, so every other group is below it and passes). With groups absent (streaming),
+// the cluster test's rule decides instead, which draws in an absent group's place and asks for it.
+// Returns the mesh-local cluster, or GDR_GPU_NO_GROUP when the chain does not decide the cut.
+uint root_chain_cluster(GdrGpuFrameGlobals g, uint mesh_index, GdrGpuMesh mesh, mat4 model)
+{
+    uint chain = min(mesh.root_chain, uint(GDR_LOD_ROOT_CHAIN));
+    // The finest first: where its refined group does not pass, no coarser one does (errors and
+    // spheres grow towards the root), and a nearer instance leaves after one read.
+    if (chain < 2u)
+        return GDR_GPU_NO_GROUP;
+    uint finest = mesh.meshlet_offset + mesh.root_first - (chain - 1u);
+    if (!chain_refined_passes(g, MeshletsRef(GDR_SCENE.meshlets).items[finest], model))
+        return GDR_GPU_NO_GROUP;
+    for (uint i = 1u; i < chain; i++) {
+        uint cluster = mesh.root_first - i;
+        GdrGpuMeshlet m = MeshletsRef(GDR_SCENE.meshlets).items[mesh.meshlet_offset + cluster];
+        if (gdr_group_absent(g, mesh_index, m.group) || gdr_group_absent(g, mesh_index, m.refined_group))
+            break;
+        if (chain_refined_passes(g, m, model)) {
+            gdr_mark_group_used(g, mesh_index, m.group);
+            return cluster;
+        }
+    }
+    return GDR_GPU_NO_GROUP;
+}
+
 // The clusters an instance's task workgroups test: level 0; with the LOD cut, only the root
-// group's when the root shortcut passes, else those the traversal of its LOD hierarchy finds
-// (`traverse`: none here), or every cluster of the DAG (flat, or the discrete debug cut).
-GdrTaskRange task_range(GdrGpuFrameGlobals g, GdrGpuMesh mesh, mat4 model, out bool traverse)
+// group's when the root shortcut passes, one cluster of the root chain when one decides the cut,
+// else those the traversal of its LOD hierarchy finds (`traverse`: none here), or every cluster of
+// the DAG (flat, or the discrete debug cut).
+GdrTaskRange task_range(GdrGpuFrameGlobals g, uint mesh_index, GdrGpuMesh mesh, mat4 model, out bool traverse)
 {
     traverse = false;
     if ((g.flags & GDR_FRAME_LOD) == 0u)
@@ -38,6 +75,9 @@ GdrTaskRange task_range(GdrGpuFrameGlobals g, GdrGpuMesh mesh, mat4 model, out b
                                       model[2].xyz, model[3].xyz, g.camera_position.xyz, g.lod_znear,
                                       g.lod_projection_scale) <= g.lod_threshold)
         return gdr_task_range(mesh.meshlet_offset + mesh.root_first, mesh.root_cluster_count, GDR_TASK_LOD_ACCEPTED);
+    uint chained = root_chain_cluster(g, mesh_index, mesh, model);
+    if (chained != GDR_GPU_NO_GROUP)
+        return gdr_task_range(mesh.meshlet_offset + chained, 1u, GDR_TASK_LOD_ACCEPTED);
     traverse = (g.flags & GDR_FRAME_LOD_HIERARCHY) != 0u && mesh.lod_node_count > 0u &&
                mesh.lod_task_count > GDR_TRAVERSE_MIN_TASKS;
     return traverse ? GdrTaskRange(0u, 0u, 0u, 0u) : gdr_task_range(mesh.meshlet_offset, mesh.lod_cluster_count, 0u);
@@ -108,6 +148,7 @@ void main()
     uint id = instance_of_invocation(g, stats);
     bool visible = false;
     GdrGpuMesh mesh;
+    uint mesh_index = 0u;
     mat4 model;
     vec3 world_center = vec3(0.0);
     float radius = 0.0;
@@ -115,7 +156,8 @@ void main()
     if (id < g.instance_count) {
         GdrGpuInstance instance = InstancesRef(GDR_SCENE.instances).items[id];
         model = instance.model;
-        mesh = MeshesRef(GDR_SCENE.meshes).items[instance.mesh];
+        mesh_index = instance.mesh;
+        mesh = MeshesRef(GDR_SCENE.meshes).items[mesh_index];
         world_center = (model * vec4(mesh.bounds.xyz, 1.0)).xyz;
         radius = mesh.bounds.w * gdr_max_axis_scale(model[0].xyz, model[1].xyz, model[2].xyz);
         vec3 center = (g.view * vec4(world_center, 1.0)).xyz;
@@ -170,7 +212,7 @@ void main()
     base = subgroupBroadcastFirst(base);
     if (EMIT_TASKS) {
         bool traverse = false;
-        GdrTaskRange range = visible ? task_range(g, mesh, model, traverse) : GdrTaskRange(0u, 0u, 0u, 0u);
+        GdrTaskRange range = visible ? task_range(g, mesh_index, mesh, model, traverse) : GdrTaskRange(0u, 0u, 0u, 0u);
         bool direct_frame = (g.flags & GDR_FRAME_DIRECT_CLUSTERS) != 0u;
         bool direct = direct_frame && visible && !traverse && range.count <= GDR_DIRECT_CLUSTERS;
         gdr_append_tasks(g, PHASE, visible && !direct, id, range);

@@ -814,8 +814,39 @@ static void check_error_bounds_cuts(const gdr_mesh *m)
         if (stated > 0)
             worst_ratio = fmax(worst_ratio, deviation / stated);
     }
-    printf("%-8s cuts at 1e-4 .. 0.4 of the radius: true deviation / stated error at most %.3f\n", m->name,
-           worst_ratio);
+    /* The coarse end: a cut at the error of every group that is the only one of its depth (it
+     * holds the whole mesh: the steps below one cluster, a few triangles each). */
+    uint32_t coarse = 0;
+    double worst_coarse = 0, worst_centroid = 0;
+    for (uint32_t g = 0; g + 1 < mc->group_count; g++) {
+        float t = mc->groups[g].error;
+        uint32_t at_depth = 0;
+        for (uint32_t h = 0; h < mc->group_count; h++)
+            at_depth += mc->groups[h].depth == mc->groups[g].depth;
+        if (at_depth != 1)
+            continue;
+        double stated = 0;
+        size_t n = gather_cut(mc, t, cut, &stated);
+        /* What the error promises: from the cut's probes (corners, centroids) to full detail, and
+         * from every level-0 vertex (the samples) to the cut. Between the samples (a level-0
+         * centroid) the distance may exceed it by up to half a level-0 edge: reported. */
+        double a = one_sided(m, cut, n / 3, m->indices, m->index_count / 3);
+        double b = 0, centroids = one_sided(m, m->indices, m->index_count / 3, cut, n / 3);
+        for (uint32_t v = 0; v < m->index_count; v++)
+            b = fmax(b, point_surface(m, d3(m->positions[m->indices[v]]), cut, n / 3));
+        double deviation = fmax(a, b);
+        if (deviation > stated + 1e-5 * m->bounds.w)
+            fprintf(stderr, "mesh '%s': cut of %zu triangles at %g deviates %g (to full %g, from full %g), states %g\n",
+                    m->name, n / 3, (double)t, deviation, a, b, stated);
+        CHECK(deviation <= stated + 1e-5 * m->bounds.w);
+        worst_coarse = fmax(worst_coarse, deviation / stated);
+        worst_centroid = fmax(worst_centroid, centroids / stated);
+        coarse++;
+    }
+    CHECK(coarse >= 2);
+    printf("%-8s cuts at 1e-4 .. 0.4 of the radius: true deviation / stated error at most %.3f; at the errors of %u "
+           "whole-mesh groups %.3f (%.3f with level-0 centroids)\n", m->name, worst_ratio, coarse, worst_coarse,
+           worst_centroid);
     free(cut);
     free(sel);
 }
@@ -836,6 +867,54 @@ static void test_error_bounds_deviation(void)
         CHECK(m->clusters.dag_depth >= 2);
         check_error_bounds_cuts(m);
     }
+    gdr_scene_destroy(s);
+}
+
+/* The coarse end: below one cluster the build goes on, one lone cluster simplified step by step,
+ * until the root holds at most root_triangles triangles (GDR_LOD_DEFAULT_ROOT_TRIANGLES by default)
+ * or stops simplifying; root_triangles = GDR_CLUSTER_MAX_TRIANGLES stops at one cluster. */
+static void test_coarse_end(void)
+{
+    gdr_scene *s = new_scene();
+    gdr_error err = {0};
+    uint32_t blob, knot, early;
+    check_ok(gdr_procedural_blob(s, 5, &blob, &err), &err, "blob");            /* closed, genus 0 */
+    check_ok(gdr_procedural_torus_knot(s, 240, 24, &knot, &err), &err, "knot"); /* closed, genus 1 */
+    check_ok(gdr_procedural_blob(s, 5, &early, &err), &err, "blob");
+    const struct {
+        uint32_t mesh, root_triangles, most; /* most: the root's largest triangle count */
+    } cases[] = {{blob, 0, GDR_LOD_DEFAULT_ROOT_TRIANGLES}, {knot, 0, 16}, {early, GDR_CLUSTER_MAX_TRIANGLES, 124}};
+    for (int i = 0; i < 3; i++) {
+        gdr_mesh *m = &s->meshes[cases[i].mesh];
+        build_level0(m);
+        gdr_lod_options o = {.thread_count = 2, .no_progress = 1, .root_triangles = cases[i].root_triangles};
+        gdr_lod_stats st;
+        check_ok(gdr_mesh_build_lod_dag(m, &o, &st, &err), &err, m->name);
+        report(m, &st);
+        CHECK(check_dag(m, &st));
+        const gdr_mesh_clusters *mc = &m->clusters;
+        const gdr_cluster_group *root = &mc->groups[mc->group_count - 1];
+        CHECK(st.stop_counts[GDR_LOD_STOP_SINGLE_CLUSTER] == 1 && root->cluster_count == 1);
+        CHECK(st.root_triangles <= cases[i].most);
+        /* Below one cluster, every step is one group of one cluster that made one smaller cluster. */
+        uint32_t lone = 0;
+        for (uint32_t at = root->first_cluster; mc->clusters[at].refined_group != GDR_NO_INDEX; lone++) {
+            const gdr_cluster_group *from = &mc->groups[mc->clusters[at].refined_group];
+            if (from->cluster_count != 1)
+                break;
+            CHECK(mc->clusters[at].triangle_count < mc->clusters[from->first_cluster].triangle_count);
+            at = from->first_cluster;
+        }
+        printf("%-8s root of %llu triangles after %u steps below one cluster\n", m->name,
+               (unsigned long long)st.root_triangles, lone);
+        CHECK(cases[i].root_triangles == GDR_CLUSTER_MAX_TRIANGLES ? lone == 0 : lone >= 3);
+        if (cases[i].root_triangles == GDR_CLUSTER_MAX_TRIANGLES)
+            CHECK(st.root_triangles > 4 * GDR_LOD_DEFAULT_ROOT_TRIANGLES);
+    }
+    /* root_triangles outside [1, GDR_CLUSTER_MAX_TRIANGLES] is refused, naming the option. */
+    gdr_lod_options bad = {.no_progress = 1, .root_triangles = GDR_CLUSTER_MAX_TRIANGLES + 1};
+    CHECK(gdr_mesh_build_lod_dag(&s->meshes[blob], &bad, NULL, &err) == GDR_ERROR_INVALID_ARGUMENT &&
+          strstr(err.message, "root_triangles") != NULL);
     gdr_scene_destroy(s);
 }
 
@@ -901,6 +980,40 @@ static void clusters_to_torus(const gdr_mesh *m, double *own)
     }
 }
 
+/* Per group that is the only one of its depth and made one cluster (it holds the whole mesh: the
+ * steps below one cluster), the largest distance from a vertex of the mesh to its new cluster's
+ * triangles, into own[] where larger. Such a cluster's few triangles lie close to the torus but
+ * leave most of it far away: the distance from its clusters to the torus alone misses that. */
+static void mesh_to_lone_groups(const gdr_mesh *m, double *own)
+{
+    const gdr_mesh_clusters *mc = &m->clusters;
+    for (uint32_t g = 0; g + 1 < mc->group_count; g++) {
+        uint32_t at_depth = 0;
+        for (uint32_t h = 0; h < mc->group_count; h++)
+            at_depth += mc->groups[h].depth == mc->groups[g].depth;
+        if (at_depth != 1)
+            continue;
+        size_t n = 0, made = 0;
+        for (uint32_t i = 0; i < mc->cluster_count; i++) {
+            n += mc->clusters[i].refined_group == g ? mc->clusters[i].triangle_count : 0;
+            made += mc->clusters[i].refined_group == g;
+        }
+        if (made != 1)
+            continue;
+        uint32_t *corners = malloc(3 * n * sizeof *corners);
+        n = 0;
+        for (uint32_t i = 0; corners && i < mc->cluster_count; i++) {
+            const gdr_cluster *k = &mc->clusters[i];
+            for (uint32_t j = 0; k->refined_group == g && j < k->triangle_count * 3; j++)
+                corners[n++] = mc->vertices[k->vertex_offset + mc->triangles[k->triangle_offset + j]];
+        }
+        CHECK(corners != NULL);
+        for (uint32_t v = 0; corners && v < m->vertex_count; v++)
+            own[g] = fmax(own[g], point_surface(m, d3(m->positions[v]), corners, n / 3));
+        free(corners);
+    }
+}
+
 /* A torus of 360 x 180 quads has open seams (positions not bit-equal) and groups that drop a
  * border sliver their neighbour keeps: samples there lie far from their own group's new clusters
  * but on a neighbour's. Without passing them to the neighbour a group stated 5.2x the larger of
@@ -921,6 +1034,7 @@ static void test_samples_pass_to_neighbours(void)
     const gdr_mesh_clusters *mc = &m->clusters;
     double *own = calloc(mc->group_count, sizeof *own), *child = calloc(mc->group_count, sizeof *child);
     clusters_to_torus(m, own);
+    mesh_to_lone_groups(m, own);
     for (uint32_t i = 0; i < mc->cluster_count; i++) {
         const gdr_cluster *k = &mc->clusters[i];
         if (k->group != GDR_NO_INDEX && k->refined_group != GDR_NO_INDEX)
@@ -1057,6 +1171,7 @@ int main(void)
     test_meshes();
     test_determinism();
     test_error_bounds_deviation();
+    test_coarse_end();
     test_coarse_error_tight();
     test_samples_pass_to_neighbours();
     test_seams_welded();

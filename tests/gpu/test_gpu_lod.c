@@ -5,7 +5,9 @@
  *    silhouette of its full-detail render (a rim of 2 px plus the threshold is ignored: the
  *    silhouette itself may move by up to the threshold);
  *  - the image approaches full detail as the threshold falls (PSNR reported), and the triangles
- *    drawn fall with distance. */
+ *    drawn fall with distance;
+ *  - a field of far instances, one to a few pixels across, draws a few triangles each, from the
+ *    root chain (no hierarchy traversal), with the same pixels whether culling is on or off. */
 #include <math.h>
 
 #include "gdr/geometry.h"
@@ -296,10 +298,121 @@ static void check_cracks_and_quality(void)
     gdr_scene_destroy(scene);
 }
 
+/* A field of `count` instances of one blob (icosphere subdivided `levels` times) in front of the
+ * camera at the origin looking down -Z, at distances where each projects to `from` .. `to` pixels
+ * across (log-uniform), at 1 px scale p_scale (pixels per unit at distance 1). */
+static gdr_scene *far_field_scene(uint32_t levels, uint32_t count, float from, float to, float p_scale)
+{
+    gdr_scene *scene = blob_scene(levels, 0);
+    if (!scene)
+        return NULL;
+    gdr_error err = {0};
+    float radius = scene->meshes[0].bounds.w;
+    unsigned rng = 5;
+    for (uint32_t i = 0; i < count; i++) {
+        float pixels = from * powf(to / from, test_random(&rng));
+        float distance = 2.0f * radius * p_scale / pixels;
+        gdr_vec3 dir = gdr_vec3_normalize((gdr_vec3){test_random_range(&rng, -0.5f, 0.5f),
+                                                      test_random_range(&rng, -0.3f, 0.3f), -1.0f});
+        gdr_quat q = gdr_quat_from_axis_angle((gdr_vec3){0, 1, 0}, test_random_range(&rng, -PI_F, PI_F));
+        gdr_instance instance = {.transform = gdr_mat4_from_trs(gdr_vec3_scale(dir, distance), q, (gdr_vec3){1, 1, 1}),
+                                 .mesh = 0, .material = GDR_NO_INDEX, .color = {0.8f, 0.7f, 0.5f, 1.0f}};
+        if (gdr_scene_add_instance(scene, &instance, &err) != GDR_OK) {
+            fprintf(stderr, "far field: %s\n", err.message);
+            gdr_scene_destroy(scene);
+            return NULL;
+        }
+    }
+    return scene;
+}
+
+/* The bounding sphere of instance i, projected: its diameter in pixels. */
+static float projected_diameter(const gdr_scene *scene, uint32_t i, const gdr_camera *camera, float p_scale)
+{
+    const gdr_instance *instance = &scene->instances[i];
+    gdr_vec4 b = scene->meshes[instance->mesh].bounds;
+    gdr_vec3 centre = gdr_mat4_transform_point(instance->transform, (gdr_vec3){b.x, b.y, b.z});
+    return 2.0f * b.w * p_scale / gdr_vec3_length(gdr_vec3_sub(centre, camera->position));
+}
+
+/* Far instances cost a few triangles: the DAG goes on below one cluster, and the instance cull
+ * takes the cut from the root chain without traversing the hierarchy; the GPU cut equals the CPU
+ * reference at every level of the chain, and culling and occlusion culling change no pixel. */
+static void check_far_field(void)
+{
+    gdr_camera camera = test_look((gdr_vec3){0, 0, 0}, 0.0f, 0.0f, 0.9f, 0.1f);
+    gdr_mat4 projection = gdr_perspective_reverse_z_infinite(camera.yfov, (float)WIDTH / HEIGHT, camera.znear);
+    float p_scale = fabsf(projection.m[5]) * 0.5f * HEIGHT;
+    gdr_scene *scene = far_field_scene(6, 300, 0.5f, 6.0f, p_scale);
+    renderer = scene ? gpu_test_renderer(WIDTH, HEIGHT, scene) : NULL;
+    if (!renderer) {
+        CHECK(false);
+        gdr_scene_destroy(scene);
+        return;
+    }
+    const gdr_mesh_clusters *c = &scene->meshes[0].clusters;
+    uint32_t root_triangles = c->clusters[c->groups[c->group_count - 1].first_cluster].triangle_count;
+    printf("far field: blob of %u triangles, DAG depth %u, root of %u triangles\n", scene->meshes[0].index_count / 3,
+           c->dag_depth, root_triangles);
+    CHECK(c->groups[c->group_count - 1].cluster_count == 1 && root_triangles <= GDR_LOD_DEFAULT_ROOT_TRIANGLES);
+    const float thresholds[3] = {0.5f, 1.0f, 2.0f};
+    char what[64];
+    for (int t = 0; t < 3; t++) {
+        gdr_frame_desc frame = {.camera = camera, .cull = GDR_CULL_OFF, .pipeline = GDR_PIPELINE_MESH,
+                                .record_visible_meshlets = true, .lod_error_px = thresholds[t]};
+        snprintf(what, sizeof what, "far field threshold %g", (double)thresholds[t]);
+        check_cut(scene, &frame, what);
+    }
+    /* At 1 px: triangles per instance, from the clusters drawn. */
+    gdr_frame_desc frame = {.camera = camera, .pipeline = GDR_PIPELINE_MESH, .record_visible_meshlets = true,
+                            .lod_error_px = 1.0f, .read_back = true};
+    gdr_frame_stats stats;
+    gdr_error err = {0};
+    uint32_t capacity = scene->instance_count * c->cluster_count, count = 0;
+    gdr_visible_meshlet *drawn = malloc(sizeof *drawn * capacity);
+    uint32_t *triangles = calloc(scene->instance_count, sizeof *triangles);
+    CHECK(drawn && triangles && render(&frame, image_lod, &stats) &&
+          gdr_renderer_read_visible_meshlets(renderer, drawn, capacity, &count, &err) == GDR_OK);
+    for (uint32_t k = 0; drawn && triangles && k < count; k++)
+        triangles[drawn[k].instance] += c->clusters[drawn[k].meshlet].triangle_count;
+    uint32_t small = 0, worst_small = 0;
+    uint64_t total = 0;
+    for (uint32_t i = 0; triangles && i < scene->instance_count; i++) {
+        total += triangles[i];
+        if (projected_diameter(scene, i, &camera, p_scale) <= 2.0f) {
+            small++;
+            worst_small = triangles[i] > worst_small ? triangles[i] : worst_small;
+        }
+    }
+    printf("far field at 1 px: %u instances, %.1f triangles each on average; %u of them at most 2 px across draw "
+           "at most %u triangles; %llu hierarchy nodes tested\n",
+           scene->instance_count, (double)total / scene->instance_count, small, worst_small,
+           (unsigned long long)stats.traversal.nodes_tested);
+    CHECK(small > 50 && worst_small <= 8);
+    CHECK(total <= 16ull * scene->instance_count);
+    /* Every instance's cut lies on the root chain: none is left to the traversal. */
+    CHECK(stats.traversal.nodes_tested == 0);
+    /* Culling (frustum, cone, occlusion) is conservative for the small clusters: the same pixels. */
+    frame.cull = GDR_CULL_OFF;
+    frame.record_visible_meshlets = false;
+    CHECK(render(&frame, image_full, NULL));
+    CHECK(memcmp(image_full, image_lod, (size_t)WIDTH * HEIGHT * 4) == 0);
+    frame.cull = GDR_CULL_ON;
+    frame.occlusion = GDR_CULL_ON;
+    CHECK(render(&frame, NULL, NULL) && render(&frame, image_lod, NULL));
+    CHECK(memcmp(image_full, image_lod, (size_t)WIDTH * HEIGHT * 4) == 0);
+    free(drawn);
+    free(triangles);
+    gdr_renderer_destroy(renderer);
+    renderer = NULL;
+    gdr_scene_destroy(scene);
+}
+
 int main(void)
 {
     image_full = malloc(WIDTH * HEIGHT * 4);
     image_lod = malloc(WIDTH * HEIGHT * 4);
+    check_far_field();
     check_cuts();
     check_cracks_and_quality();
     free(image_full);
