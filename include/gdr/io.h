@@ -158,7 +158,7 @@ GDR_API gdr_status gdr_image_decode(const void *data, size_t size, const char *n
 #define GDR_TEXTURE_FIT_RANGE 1u
 #define GDR_TEXTURE_FIT_CLUSTER 2u
 #define GDR_TEXTURE_FIT_ITERATIVE 3u
-#define GDR_TEXTURE_FIT_DEFAULT GDR_TEXTURE_FIT_CLUSTER
+#define GDR_TEXTURE_FIT_DEFAULT GDR_TEXTURE_FIT_RANGE
 
 /* Options of gdr_scene_compress_textures; zero-initialise, every field has a default. */
 typedef struct gdr_texture_compress_options {

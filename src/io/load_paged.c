@@ -92,7 +92,7 @@ static int write_paged(const char *spec, const gdr_load_options *o, bool builtin
     int written = -1;
     gdr_error write_err = {0};
     if (build_scene(spec, o, builtin, &scene, &sources, &report, err) == GDR_OK &&
-        gdr_io_report_template(&report, builtin ? NULL : spec, &kept, err) == GDR_OK) {
+        gdr_io_report_template(&report, spec, &kept, err) == GDR_OK) {
         gdr_cache_write_options write = {.source = {build_options, &sources}, .page_bytes = GDR_PAGE_BYTES_DEFAULT,
                                          .report = &kept};
         for (int i = 0; i < count && written < 0; i++)
@@ -127,7 +127,7 @@ static int builtin_candidate(const char *spec, const gdr_load_options *o, char *
 
 /* Reads the paged cache for streaming; its kept warnings handed to `report` and, with `replay`,
  * said again (not when they were just said while it was built). */
-static gdr_status read_paged(const char *path, const char *source, const char *build_options,
+static gdr_status read_paged(const char *path, const char *spec, const char *source, const char *build_options,
                              const gdr_load_options *o, int replay, gdr_scene **out, gdr_pvs **out_pvs,
                              gdr_import_report *report, gdr_error *err)
 {
@@ -136,7 +136,7 @@ static gdr_status read_paged(const char *path, const char *source, const char *b
     if (status != GDR_OK)
         return status;
     gdr_error ignored;
-    gdr_io_report_untemplate(&cached, source, &ignored); /* out of memory: said with its markers */
+    gdr_io_report_untemplate(&cached, spec, &ignored); /* out of memory: said with its markers */
     if (replay)
         gdr_io_report_replay(&cached, o->warning, o->warning_user);
     if (report) {
@@ -174,7 +174,7 @@ gdr_status gdr_io_load_paged(const char *spec, const gdr_load_options *o, char (
         if (access(paths[i], F_OK) != 0)
             continue;
         gdr_error read_err;
-        gdr_status read = read_paged(paths[i], source, build_options, o, 1, out, out_pvs, report, &read_err);
+        gdr_status read = read_paged(paths[i], spec, source, build_options, o, 1, out, out_pvs, report, &read_err);
         if (read == GDR_OK) {
             gdr_io_cache_touch(paths[i]);
             return GDR_OK;
@@ -185,5 +185,5 @@ gdr_status gdr_io_load_paged(const char *spec, const gdr_load_options *o, char (
     int written = write_paged(spec, o, builtin, build_options, paths, n, err);
     if (written < 0)
         return err->status;
-    return read_paged(paths[written], source, build_options, o, 0, out, out_pvs, report, err);
+    return read_paged(paths[written], spec, source, build_options, o, 0, out, out_pvs, report, err);
 }

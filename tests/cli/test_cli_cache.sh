@@ -121,10 +121,15 @@ expect 2 "camera index beyond" "$gdr" render "$corpus/cameras/Cameras.gltf" $sma
 grep -q 'has 2 camera(s)' "$work/stderr" || fail "camera count: $(cat "$work/stderr")"
 
 # The size limit: least recently used caches go first, the newest stays, others' files stay.
+# Each cache must be a good part of the 1 MiB limit: the box's texture is replaced by a 1024 x 1024
+# image (gdr's own render), about 0.7 MB of BC1 blocks with its mips.
 mkdir -p "$work/limit"
+expect 0 "a large texture" "$gdr" render "$work/copy/BoxTextured.gltf" --width 1024 --height 1024 \
+    --no-cache --out "$work/large.png"
 for i in 1 2 3 4 5 6; do
     cp -r "$work/copy" "$work/limit/box$i"
     rm -f "$work/limit/box$i/BoxTextured.gltf.gdrc"
+    cp "$work/large.png" "$work/limit/box$i/CesiumLogoFlat.png"
 done
 mkdir -p "$work/lru" && echo "my notes" >"$work/lru/notes.gdrc"
 for i in 1 2 3 4 5 6; do
@@ -145,9 +150,9 @@ GDR_CACHE_MAX_MIB=1 "$gdr" info "$work/limit/box2/BoxTextured.gltf" --cache-dir 
 size=$(cat "$work/lru/"*-*.gdrc | wc -c)
 [ "$size" -le 1048576 ] || fail "GDR_CACHE_MAX_MIB: $size bytes"
 
-# gdr cache list and clear: only the caches gdr wrote.
+# gdr cache list and clear: only the caches gdr wrote (the one left: box2's, the last written).
 expect 0 "cache list" "$gdr" cache list --cache-dir "$work/lru"
-grep -q "box1/BoxTextured.gltf)$" "$work/stdout" || fail "cache list: $(cat "$work/stdout")"
+grep -q "box2/BoxTextured.gltf)$" "$work/stdout" || fail "cache list: $(cat "$work/stdout")"
 grep -q notes "$work/stdout" && fail "cache list shows a file gdr did not write"
 expect 0 "cache clear" "$gdr" cache clear --cache-dir "$work/lru"
 ls "$work/lru/"*-*.gdrc >/dev/null 2>&1 && fail "cache clear left caches"
