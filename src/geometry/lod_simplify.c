@@ -144,6 +144,8 @@ static uint32_t gather_neighbours(run *r, const uint32_t *fan, uint32_t n, uint3
 {
     lod_simplify_scratch *s = r->s;
     uint32_t k = 0, t = ++s->token;
+    if (n)
+        s->mark[corner_position(r, fan[0])] = t; /* not its own neighbour (a degenerate triangle) */
     for (uint32_t i = 0; i < n; i++) {
         uint32_t c = fan[i], base = c - c % 3;
         for (uint32_t j = 1; j < 3; j++) {
@@ -427,7 +429,7 @@ static void collapse(run *r, uint32_t a, uint32_t b)
     r->slide2 = (float)slide2 > r->slide2 ? (float)slide2 : r->slide2;
     for (uint32_t i = 0; i < n; i++) {
         uint32_t c = s->fan[i];
-        if (triangle_holds(r, c / 3, b)) {
+        if (s->alive[c / 3] && triangle_holds(r, c / 3, b)) {
             s->alive[c / 3] = 0;
             r->triangles--;
         }
@@ -514,7 +516,8 @@ static float pass_limit(lod_simplify_scratch *s, size_t needed)
     return select_kth(s->costs, s->heap_count, needed) * PASS_ERROR_BOUND;
 }
 
-/* Corner lists, triangles with two corners at one position dropped. */
+/* Corner lists. A triangle with two corners at one position (degenerate by position) stays: it
+ * closes the edges of its neighbours, and dropping it would open them. */
 static void build_lists(run *r)
 {
     lod_simplify_scratch *s = r->s;
@@ -524,14 +527,9 @@ static void build_lists(run *r)
     for (uint32_t p = 0; p < in->position_count; p++)
         s->head[p] = NONE, s->flags[p] = 0, s->mark[p] = 0, s->pass[p] = 0;
     s->token = 0;
-    r->triangles = 0;
+    r->triangles = nt;
     for (size_t t = nt; t-- > 0;) {
-        uint32_t p0 = corner_position(r, (uint32_t)t * 3), p1 = corner_position(r, (uint32_t)t * 3 + 1),
-                 p2 = corner_position(r, (uint32_t)t * 3 + 2);
-        s->alive[t] = p0 != p1 && p1 != p2 && p0 != p2;
-        if (!s->alive[t])
-            continue;
-        r->triangles++;
+        s->alive[t] = 1;
         for (uint32_t j = 0; j < 3; j++) {
             uint32_t c = (uint32_t)t * 3 + j, p = corner_position(r, c);
             s->next[c] = s->head[p];
