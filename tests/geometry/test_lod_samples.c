@@ -341,10 +341,10 @@ static sample_counts check_samples(gdr_mesh *m, uint32_t group_size, uint32_t th
     return n;
 }
 
-/* A blob, a torus (its seams welded), a flat grid with an open border and a UV sphere (degenerate triangles at its poles). At the sphere's poles a
- * fan of simplified triangles fills one cell of the triangle grid past the 64 triangles a query
- * looks at (docs/GEOMETRY.md, "Limits for hostile meshes"), so D1 there may be above the largest
- * distance (with that limit lifted it is exact): only checked to bound every sample. Groups of 4
+/* A blob, a torus (its seams welded), a flat grid with an open border and a UV sphere (degenerate
+ * triangles at its poles). At the sphere's poles a fan of simplified triangles fills one cell of
+ * the triangle grid past the 64 triangles a query looks at (docs/GEOMETRY.md, "Limits for hostile
+ * meshes"), so D1 there may be above the largest distance (with that limit lifted it is exact): only checked to bound every sample. Groups of 4
  * and 8 level-0 clusters give these small meshes several levels; the grid of 5,041 positions is
  * measured in ranges at its root, on two threads. */
 static void test_sample_promises(void)
