@@ -241,6 +241,7 @@ void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker)
         return;
     }
     size_t out_count = out.index_count;
+    r->slide = out.slide;
     int enough = out_count > 0 && (double)out_count <= (double)index_count * LOD_MAX_KEPT_SHARE;
     if (enough && !border_kept(b, s, index_count, out_count)) {
         r->border_reject = 1;

@@ -130,6 +130,8 @@ typedef struct group_result {
     int out_of_memory;
     float error;       /* the larger of its deviation and the largest error its members came with */
     float deviation;   /* measured against the full-detail surface (lod_error.c) */
+    float slide;       /* the largest texture slide one of its collapses charged (lod_simplify.c): part of
+                          the error, as D2 is */
     gdr_vec4 sphere;
     uint32_t input_triangles;
     uint32_t group;         /* its id among the DAG's groups, once formed (or passed through) */
