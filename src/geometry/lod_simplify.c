@@ -5,11 +5,14 @@
  * the wedge wb that shares a triangle along the edge a-b with wa where there is one (the attribute
  * field continues across the collapsed edge), else the wedge of b that best continues wa's field:
  * wa's surviving triangles' affine uv and normal, extrapolated to b's position, compared with each
- * wedge of b. The cost of a collapse is the Garland-Heckbert quadric error of the two positions at
- * b plus that attribute error, area-weighted (both are areas times squared lengths). A heap keeps
- * each position's cheapest collapse as last evaluated; a popped position is evaluated again and
- * moves only if it is still no dearer than the next one (lazy re-evaluation). Single-threaded per
- * group, ties broken by position index: the result does not depend on the thread count. */
+ * wedge of b. The cost of a collapse is the mean squared distance of a's Garland-Heckbert quadric
+ * at b plus that attribute error averaged over a's fan (both squared lengths). A heap keeps each
+ * position's cheapest collapse as last evaluated; a popped position is evaluated again and moves
+ * only if it is still no dearer than the next one (lazy re-evaluation). Collapses run in passes: a
+ * position moved onto waits for the next pass, and a pass ends past 1.5 x the cost that would
+ * reach the target, so collapses spread over the group instead of piling onto a few positions.
+ * Single-threaded per group, ties broken by position index: the result does not depend on the
+ * thread count. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
