@@ -178,92 +178,112 @@ static uint32_t gather_wedges(run *r, const uint32_t *fan, uint32_t n, uint32_t 
 
 /* --- the attribute error ---------------------------------------------------------------------------- */
 
-/* The error of giving corner c (of position a, wedge wa) the attributes of wedge wb at position q:
- * the triangle's affine uv and normal, extrapolated over its plane to q, against wb's. Returns the
- * area-weighted squared length; *slide2 gets the texture slide (squared mesh length). */
-static double corner_attribute_error(const run *r, uint32_t c, uint32_t wb, const double q[3], double *slide2)
+/* Fills s->info for the fan of a position (its corners' triangles: their affine frames and
+ * attribute gradients, computed once for every collapse evaluated from it); returns its area. */
+static double prepare_fan(run *r, const uint32_t *fan, uint32_t n)
 {
     const lod_simplify_input *in = r->in;
-    uint32_t base = c - c % 3, w[3];
-    double p[3][3];
-    for (uint32_t j = 0; j < 3; j++) {
-        w[j] = r->s->tri[base + (c % 3 + j) % 3];
-        load(r, wedge_position(r, w[j]), p[j]);
-    }
-    double e1[3], e2[3], d[3];
-    sub(p[1], p[0], e1), sub(p[2], p[0], e2), sub(q, p[0], d);
-    double g11 = dot(e1, e1), g12 = dot(e1, e2), g22 = dot(e2, e2), det = g11 * g22 - g12 * g12;
-    *slide2 = 0.0;
-    if (!(det > 1e-12 * g11 * g22))
-        return 0.0; /* degenerate: no field to continue */
-    double r1 = dot(d, e1), r2 = dot(d, e2);
-    double u = (g22 * r1 - g12 * r2) / det, v = (g11 * r2 - g12 * r1) / det;
-    double area = 0.5 * sqrt(det), error = 0.0;
-    const uint32_t m0 = in->vertex_source[w[0]], m1 = in->vertex_source[w[1]], m2 = in->vertex_source[w[2]],
-                   mb = in->vertex_source[wb];
-    if (in->uvs) {
-        const gdr_vec2 t0 = in->uvs[m0], t1 = in->uvs[m1], t2 = in->uvs[m2], tb = in->uvs[mb];
-        double a1 = (double)t1.x - t0.x, b1 = (double)t1.y - t0.y, a2 = (double)t2.x - t0.x, b2 = (double)t2.y - t0.y;
-        double uv_area = 0.5 * fabs(a1 * b2 - a2 * b1);
-        if (uv_area > 1e-20) {
-            double du = t0.x + u * a1 + v * a2 - tb.x, dv = t0.y + u * b1 + v * b2 - tb.y;
-            *slide2 = (du * du + dv * dv) * area / uv_area;
-            error += *slide2 * UV_WEIGHT;
+    double total = 0.0;
+    for (uint32_t i = 0; i < n; i++) {
+        lod_simplify_corner *f = &r->s->info[i];
+        uint32_t c = fan[i], base = c - c % 3, w[3];
+        double p[3][3];
+        for (uint32_t j = 0; j < 3; j++) {
+            w[j] = r->s->tri[base + (c % 3 + j) % 3];
+            load(r, wedge_position(r, w[j]), p[j]);
+        }
+        f->wedge = w[0];
+        f->other[0] = wedge_position(r, w[1]), f->other[1] = wedge_position(r, w[2]);
+        memcpy(f->p0, p[0], sizeof f->p0);
+        sub(p[1], p[0], f->e1), sub(p[2], p[0], f->e2);
+        f->g11 = dot(f->e1, f->e1), f->g12 = dot(f->e1, f->e2), f->g22 = dot(f->e2, f->e2);
+        double det = f->g11 * f->g22 - f->g12 * f->g12;
+        f->area = det > 0.0 ? 0.5 * sqrt(det) : 0.0;
+        total += f->area;
+        f->inv_det = det > 1e-12 * f->g11 * f->g22 ? 1.0 / det : 0.0; /* 0: degenerate, no field */
+        const uint32_t m0 = in->vertex_source[w[0]], m1 = in->vertex_source[w[1]], m2 = in->vertex_source[w[2]];
+        f->uv_scale = 0.0;
+        if (in->uvs) {
+            const gdr_vec2 t0 = in->uvs[m0], t1 = in->uvs[m1], t2 = in->uvs[m2];
+            f->t0[0] = t0.x, f->t0[1] = t0.y;
+            f->t1[0] = (double)t1.x - t0.x, f->t1[1] = (double)t1.y - t0.y;
+            f->t2[0] = (double)t2.x - t0.x, f->t2[1] = (double)t2.y - t0.y;
+            double uv_area = 0.5 * fabs(f->t1[0] * f->t2[1] - f->t2[0] * f->t1[1]);
+            f->uv_scale = uv_area > 1e-20 ? f->area / uv_area : 0.0;
+        }
+        if (in->normals) {
+            const gdr_vec3 n0 = in->normals[m0], n1 = in->normals[m1], n2 = in->normals[m2];
+            f->n0[0] = n0.x, f->n0[1] = n0.y, f->n0[2] = n0.z;
+            f->n1[0] = (double)n1.x - n0.x, f->n1[1] = (double)n1.y - n0.y, f->n1[2] = (double)n1.z - n0.z;
+            f->n2[0] = (double)n2.x - n0.x, f->n2[1] = (double)n2.y - n0.y, f->n2[2] = (double)n2.z - n0.z;
         }
     }
-    if (in->normals) {
-        const gdr_vec3 n0 = in->normals[m0], n1 = in->normals[m1], n2 = in->normals[m2], nb = in->normals[mb];
-        double dx = n0.x + u * ((double)n1.x - n0.x) + v * ((double)n2.x - n0.x) - nb.x;
-        double dy = n0.y + u * ((double)n1.y - n0.y) + v * ((double)n2.y - n0.y) - nb.y;
-        double dz = n0.z + u * ((double)n1.z - n0.z) + v * ((double)n2.z - n0.z) - nb.z;
-        error += (dx * dx + dy * dy + dz * dz) * area * NORMAL_WEIGHT;
-    }
-    return error * area;
+    return total;
 }
 
-/* The area of the triangles of a fan. */
-static double fan_area(const run *r, const uint32_t *fan, uint32_t n)
+/* The error of giving a fan corner the attributes of wedge wb at position q: its triangle's affine
+ * uv and normal, extrapolated over its plane to q, against wb's. Returns the area-weighted squared
+ * length; *slide2 gets the texture slide (squared mesh length). */
+static double corner_attribute_error(const run *r, const lod_simplify_corner *f, uint32_t wb, const double q[3],
+                                     double *slide2)
 {
-    double area = 0.0;
-    for (uint32_t i = 0; i < n; i++) {
-        uint32_t c = fan[i], base = c - c % 3;
-        double p[3][3], e1[3], e2[3], nrm[3];
-        for (uint32_t j = 0; j < 3; j++)
-            load(r, corner_position(r, base + j), p[j]);
-        sub(p[1], p[0], e1), sub(p[2], p[0], e2), cross(e1, e2, nrm);
-        area += 0.5 * sqrt(dot(nrm, nrm));
+    const lod_simplify_input *in = r->in;
+    *slide2 = 0.0;
+    if (f->inv_det == 0.0)
+        return 0.0;
+    double d[3];
+    sub(q, f->p0, d);
+    double r1 = dot(d, f->e1), r2 = dot(d, f->e2);
+    double u = (f->g22 * r1 - f->g12 * r2) * f->inv_det, v = (f->g11 * r2 - f->g12 * r1) * f->inv_det;
+    double error = 0.0;
+    const uint32_t mb = in->vertex_source[wb];
+    if (f->uv_scale > 0.0) {
+        const gdr_vec2 tb = in->uvs[mb];
+        double du = f->t0[0] + u * f->t1[0] + v * f->t2[0] - tb.x, dv = f->t0[1] + u * f->t1[1] + v * f->t2[1] - tb.y;
+        *slide2 = (du * du + dv * dv) * f->uv_scale;
+        error += *slide2 * UV_WEIGHT;
     }
-    return area;
+    if (in->normals) {
+        const gdr_vec3 nb = in->normals[mb];
+        double dx = f->n0[0] + u * f->n1[0] + v * f->n2[0] - nb.x;
+        double dy = f->n0[1] + u * f->n1[1] + v * f->n2[1] - nb.y;
+        double dz = f->n0[2] + u * f->n1[2] + v * f->n2[2] - nb.z;
+        error += (dx * dx + dy * dy + dz * dz) * f->area * NORMAL_WEIGHT;
+    }
+    return error * f->area;
 }
 
 /* The error of wedge wa taking wedge wb when a moves to q = b's position: over wa's triangles that
  * survive (those not holding b). */
-static double wedge_error(const run *r, const uint32_t *fan, uint32_t n, uint32_t wa, uint32_t wb, uint32_t b,
-                          const double q[3], double *slide2)
+static double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, const double q[3], double *slide2)
 {
     double error = 0.0;
     *slide2 = 0.0;
     for (uint32_t i = 0; i < n; i++) {
-        uint32_t c = fan[i];
-        if (r->s->tri[c] != wa || triangle_holds(r, c / 3, b))
+        const lod_simplify_corner *f = &r->s->info[i];
+        if (f->wedge != wa || f->holds_b)
             continue;
         double s2;
-        error += corner_attribute_error(r, c, wb, q, &s2);
+        error += corner_attribute_error(r, f, wb, q, &s2);
         *slide2 = s2 > *slide2 ? s2 : *slide2;
     }
     return error;
 }
 
-/* The cost of moving a (fan, its area, wedges) onto b, or INFINITY where it is not allowed: the
- * quadric's mean squared distance plus the attribute error's mean over a's fan (both squared
- * lengths); sets s->choice for a's wedges and *slide2 to the largest texture slide it charges. */
+/* The cost of moving a (fan prepared in s->info, its area, wedges) onto b, or INFINITY where it is
+ * not allowed: the quadric's mean squared distance plus the attribute error's mean over a's fan
+ * (both squared lengths); sets s->choice for a's wedges and *slide2 to the largest texture slide
+ * it charges. */
 static double pair_cost(run *r, uint32_t a, uint32_t b, const uint32_t *fan, uint32_t n, double area,
                         const uint32_t *wedges, uint32_t wedge_count, double *slide2)
 {
     lod_simplify_scratch *s = r->s;
     uint32_t edge_triangles = 0;
-    for (uint32_t i = 0; i < n; i++)
-        edge_triangles += triangle_holds(r, fan[i] / 3, b);
+    for (uint32_t i = 0; i < n; i++) {
+        lod_simplify_corner *f = &s->info[i];
+        f->holds_b = f->other[0] == b || f->other[1] == b;
+        edge_triangles += f->holds_b;
+    }
     if (edge_triangles == 0 || edge_triangles > 2 || ((s->flags[a] & FLAG_BORDER) && edge_triangles != 1))
         return INFINITY;
     double q[3];
@@ -278,13 +298,12 @@ static double pair_cost(run *r, uint32_t a, uint32_t b, const uint32_t *fan, uin
         double best_error = INFINITY, best_slide = 0.0, e, s2;
         /* the wedges of b that share a triangle along a-b with wa */
         for (uint32_t i = 0; i < n; i++) {
-            uint32_t c = fan[i], base = c - c % 3;
-            if (s->tri[c] != wa || !triangle_holds(r, c / 3, b))
+            if (s->info[i].wedge != wa || !s->info[i].holds_b)
                 continue;
+            uint32_t c = fan[i], base = c - c % 3;
             for (uint32_t j = 0; j < 3; j++) {
                 uint32_t wb = s->tri[base + j];
-                if (wedge_position(r, wb) == b && wb != best &&
-                    (e = wedge_error(r, fan, n, wa, wb, b, q, &s2)) < best_error)
+                if (wedge_position(r, wb) == b && wb != best && (e = wedge_error(r, n, wa, wb, q, &s2)) < best_error)
                     best = wb, best_error = e, best_slide = s2;
             }
         }
@@ -294,7 +313,7 @@ static double pair_cost(run *r, uint32_t a, uint32_t b, const uint32_t *fan, uin
                 b_wedges = gather_wedges(r, s->fan_b, m, s->wedges_b);
             }
             for (uint32_t j = 0; j < b_wedges; j++)
-                if ((e = wedge_error(r, fan, n, wa, s->wedges_b[j], b, q, &s2)) < best_error || best == NONE)
+                if ((e = wedge_error(r, n, wa, s->wedges_b[j], q, &s2)) < best_error || best == NONE)
                     best = s->wedges_b[j], best_error = e, best_slide = s2;
         }
         if (best == NONE)
@@ -381,7 +400,7 @@ static double best_collapse(run *r, uint32_t a, int valid, uint32_t *target)
         return INFINITY;
     uint32_t token, count = gather_neighbours(r, s->fan, n, s->neighbours, &token);
     uint32_t wedge_count = gather_wedges(r, s->fan, n, s->wedges);
-    double area = fan_area(r, s->fan, n);
+    double area = prepare_fan(r, s->fan, n);
     for (uint32_t i = 0; i < count; i++) {
         double s2;
         s->costs[i] = (float)pair_cost(r, a, s->neighbours[i], s->fan, n, area, s->wedges, wedge_count, &s2);
@@ -428,7 +447,7 @@ static void collapse(run *r, uint32_t a, uint32_t b)
     uint32_t n = gather_fan(r, a, s->fan);
     uint32_t wedge_count = gather_wedges(r, s->fan, n, s->wedges);
     double slide2;
-    pair_cost(r, a, b, s->fan, n, fan_area(r, s->fan, n), s->wedges, wedge_count, &slide2); /* sets s->choice */
+    pair_cost(r, a, b, s->fan, n, prepare_fan(r, s->fan, n), s->wedges, wedge_count, &slide2); /* sets s->choice */
     r->slide2 = (float)slide2 > r->slide2 ? (float)slide2 : r->slide2;
     for (uint32_t i = 0; i < n; i++) {
         uint32_t c = s->fan[i];
@@ -469,7 +488,7 @@ static int reserve(lod_simplify_scratch *s, const lod_simplify_input *in)
     return LOD_RESERVE(s, tri, nc) && LOD_RESERVE(s, next, nc) && LOD_RESERVE(s, alive, nc / 3 + 1) &&
            LOD_RESERVE(s, head, np) && LOD_RESERVE(s, quadric, np * QUADRIC_SIZE) && LOD_RESERVE(s, flags, np) &&
            LOD_RESERVE(s, mark, np) && LOD_RESERVE(s, pass, np) && LOD_RESERVE(s, heap, np) && LOD_RESERVE(s, fan, nc) &&
-           LOD_RESERVE(s, fan_b, nc) && LOD_RESERVE(s, neighbours, nc * 2) && LOD_RESERVE(s, near, nc * 2) &&
+           LOD_RESERVE(s, fan_b, nc) && LOD_RESERVE(s, info, nc) && LOD_RESERVE(s, neighbours, nc * 2) && LOD_RESERVE(s, near, nc * 2) &&
            LOD_RESERVE(s, order, nc * 2) && LOD_RESERVE(s, wedges, in->vertex_count) &&
            LOD_RESERVE(s, wedges_b, in->vertex_count) &&
            LOD_RESERVE(s, choice, in->vertex_count) && LOD_RESERVE(s, costs, nc * 2);
@@ -609,7 +628,7 @@ int lod_simplify(lod_simplify_scratch *s, const lod_simplify_input *in, uint32_t
                 s->flags[s->heap[i].position] &= (uint8_t)~FLAG_QUEUED;
             s->heap_count = 0;
         }
-        if (!s->heap_count) { /* a new pass: every position may move again */
+        if (!s->heap_count) { /* a new pass: every position is evaluated again and may move */
             if (res->collapses == pass_start)
                 break; /* the last pass moved nothing */
             pass_start = res->collapses;
@@ -660,6 +679,7 @@ void lod_simplify_scratch_free(lod_simplify_scratch *s)
     free(s->heap);
     free(s->fan);
     free(s->fan_b);
+    free(s->info);
     free(s->neighbours);
     free(s->near);
     free(s->order);

@@ -38,6 +38,16 @@ typedef struct lod_simplify_heap_item {
     uint32_t position;
 } lod_simplify_heap_item;
 
+/* One corner of the fan of the position being evaluated: its triangle's affine frame (p0 at the
+ * corner, edges e1 and e2, their Gram matrix), the uv and normal at the corner and their changes
+ * along e1 and e2, the area and the surface-to-uv area ratio (0: no uv field). */
+typedef struct lod_simplify_corner {
+    double p0[3], e1[3], e2[3], g11, g12, g22, inv_det, area, uv_scale;
+    double t0[2], t1[2], t2[2], n0[3], n1[3], n2[3];
+    uint32_t wedge, other[2]; /* the corner's wedge, the positions of the triangle's other corners */
+    int holds_b;              /* the triangle holds the position evaluated as target */
+} lod_simplify_corner;
+
 /* Scratch reused from group to group (one per worker). */
 typedef struct lod_simplify_scratch {
     uint32_t *tri;   /* corner -> wedge (mutated as positions move) */
@@ -65,6 +75,8 @@ typedef struct lod_simplify_scratch {
     size_t fan_cap, fan_b_cap, neighbours_cap, near_cap, order_cap, wedges_cap, wedges_b_cap, choice_cap;
     float *costs;
     size_t costs_cap;
+    lod_simplify_corner *info; /* per corner of the fan evaluated */
+    size_t info_cap;
 } lod_simplify_scratch;
 
 /* Simplifies towards target_index_count; writes the kept triangles (wedge ids, in input order) to
