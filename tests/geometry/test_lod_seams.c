@@ -40,10 +40,9 @@ static uint32_t add_charted_torus(gdr_scene *s, uint32_t segments, uint32_t side
     uint32_t n = m->index_count;
     gdr_vec3 *p = malloc(sizeof *p * n), *nr = malloc(sizeof *nr * n);
     gdr_vec2 *uv = malloc(sizeof *uv * n);
-    uint32_t *idx = malloc(sizeof *idx * n), *chart_of = malloc(sizeof *chart_of * (size_t)m->vertex_count * 4);
+    uint32_t *idx = malloc(sizeof *idx * n);
     uint32_t *slot = malloc(sizeof *slot * (size_t)m->vertex_count * CHARTS_U * CHARTS_V);
     memset(slot, 0xff, sizeof *slot * (size_t)m->vertex_count * CHARTS_U * CHARTS_V);
-    (void)chart_of;
     uint32_t count = 0;
     for (uint32_t i = 0; i < n; i += 3) {
         /* the chart of the triangle's centre, in the torus's (seam-free) parameter */
@@ -85,7 +84,7 @@ static uint32_t add_charted_torus(gdr_scene *s, uint32_t segments, uint32_t side
     }
     uint32_t out = 0;
     check_ok(gdr_scene_add_mesh(s, "charted", p, nr, uv, count, idx, n, &out, &err), &err, "charted torus");
-    free(p), free(nr), free(uv), free(idx), free(chart_of), free(slot);
+    free(p), free(nr), free(uv), free(idx), free(slot);
     gdr_scene_destroy(t);
     return out;
 }
