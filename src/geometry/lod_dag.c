@@ -585,6 +585,10 @@ static int setup(lod_build *b)
         if (!b->scratch[w].map)
             return 0;
         memset(b->scratch[w].map, 0xff, (size_t)mesh->vertex_count * sizeof *b->scratch[w].map);
+        b->scratch[w].position_map = malloc((size_t)b->position_count * sizeof *b->scratch[w].position_map);
+        if (!b->scratch[w].position_map)
+            return 0;
+        memset(b->scratch[w].position_map, 0xff, (size_t)b->position_count * sizeof *b->scratch[w].position_map);
     }
     return 1;
 }

@@ -1089,6 +1089,8 @@ int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *member
     s->top.limit = LOD_KEPT_FIRST;
     float to_simplified = s->gathered ? samples_to_simplified(b, s, local_count) : 0.0f;
     float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified, INFINITY);
+    if (to_full >= 0.0f && r->slide > to_full)
+        to_full = r->slide; /* the texture slides that far on the simplified surface */
     /* Measured again (the same largest distance), over the vertex grid the probes may have taken.
      * Not for the step's only group (the steps below one cluster measure the whole mesh each): no
      * neighbour can take its samples, and its error does not change: a lower floor only lets

@@ -1,6 +1,6 @@
 /* Simplifying one group of a DAG step: merge its clusters' triangles over a compact local vertex
- * list, simplify to about half with the shared border locked (meshoptimizer), check the border,
- * split into new clusters with their bounds. Runs as a thread-pool task; it writes only its own
+ * list, simplify to about half with the shared border locked (lod_simplify.c, across attribute
+ * seams), check the border, split into new clusters with their bounds (meshoptimizer). Runs as a thread-pool task; it writes only its own
  * group_result and its worker's scratch. */
 #include <float.h>
 #include <math.h>
@@ -178,7 +178,35 @@ static int reserve_group(lod_scratch *s, size_t triangles, uint32_t count)
     return LOD_RESERVE(s, spheres, (size_t)count * 2) && LOD_RESERVE(s, indices, index_count) &&
            LOD_RESERVE(s, simplified, index_count) && LOD_RESERVE(s, local_to_mesh, index_count) &&
            LOD_RESERVE(s, locked, index_count) && LOD_RESERVE(s, edges_in, index_count) &&
-           LOD_RESERVE(s, edges_out, index_count) && LOD_RESERVE(s, positions, index_count * 9);
+           LOD_RESERVE(s, edges_out, index_count) && LOD_RESERVE(s, positions, index_count * 3) &&
+           LOD_RESERVE(s, vertex_position, index_count) && LOD_RESERVE(s, local_positions, index_count * 3) &&
+           LOD_RESERVE(s, position_locked, index_count);
+}
+
+/* Local positions of the merged group: each local vertex's position (its welded position id's
+ * representative coordinates: near-equal positions are one) and which are shared with another group
+ * of the step (locked); fills s->positions per local vertex for the meshlet builder. Returns the
+ * local position count. */
+static uint32_t local_positions(lod_build *b, lod_scratch *s, uint32_t local_count)
+{
+    const gdr_vec3 *mesh_positions = b->mesh->positions;
+    uint32_t count = 0;
+    for (uint32_t l = 0; l < local_count; l++) {
+        uint32_t mv = s->local_to_mesh[l], id = b->position_id[mv];
+        s->map[mv] = UINT32_MAX;
+        const gdr_vec3 p = mesh_positions[b->sample_vertex[id]];
+        memcpy(s->positions + (size_t)l * 3, &p, sizeof p);
+        s->locked[l] = b->owner[id] == OWNER_SHARED;
+        if (s->position_map[id] == UINT32_MAX) {
+            s->position_map[id] = count;
+            memcpy(s->local_positions + (size_t)count * 3, &p, sizeof p);
+            s->position_locked[count++] = s->locked[l];
+        }
+        s->vertex_position[l] = s->position_map[id];
+    }
+    for (uint32_t l = 0; l < local_count; l++)
+        s->position_map[b->position_id[s->local_to_mesh[l]]] = UINT32_MAX;
+    return count;
 }
 
 void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker)
@@ -187,7 +215,6 @@ void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker)
     lod_scratch *s = &b->scratch[worker];
     group_result *r = &b->results[g];
     uint32_t first = b->member_start[g], count = b->member_start[g + 1] - first;
-    const gdr_vec3 *mesh_positions = b->mesh->positions;
 
     size_t triangles = 0;
     for (uint32_t i = 0; i < count; i++)
@@ -199,32 +226,23 @@ void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker)
         return;
     }
     uint32_t local_count = merge_members(b, s, b->members + first, count, 1);
-    /* Lock what other groups share. meshoptimizer 0.18 can only lock topological borders, which
-     * would also freeze the mesh's own open edges; instead each shared vertex gets two unused
-     * copies of its position, and the simplifier never moves a position held by more than two
-     * vertices. border_kept() checks that it held. */
-    uint32_t padded = local_count;
-    for (uint32_t l = 0; l < local_count; l++) {
-        uint32_t mv = s->local_to_mesh[l];
-        s->map[mv] = UINT32_MAX;
-        /* one vertex's coordinates for each position id: near-equal positions are one */
-        const gdr_vec3 p = mesh_positions[b->sample_vertex[b->position_id[mv]]];
-        memcpy(s->positions + (size_t)l * 3, &p, sizeof p);
-        s->locked[l] = b->owner[b->position_id[mv]] == OWNER_SHARED;
-    }
-    for (uint32_t l = 0; l < local_count; l++)
-        if (s->locked[l])
-            for (int copy = 0; copy < 2; copy++, padded++)
-                memcpy(s->positions + (size_t)padded * 3, s->positions + (size_t)l * 3, sizeof(float) * 3);
+    uint32_t position_count = local_positions(b, s, local_count);
 
     size_t target = (size_t)((double)triangles * b->opt.target_ratio) * 3;
     target = target < 3 ? 3 : target;
-    float relative_error = 0.0f;
-    size_t out_count = meshopt_simplify(s->simplified, s->indices, index_count, s->positions, padded,
-                                        sizeof(float) * 3, target, FLT_MAX, 0, &relative_error);
+    lod_simplify_input in = {.indices = s->indices, .index_count = index_count, .vertex_count = local_count,
+                             .vertex_position = s->vertex_position, .vertex_source = s->local_to_mesh,
+                             .uvs = b->mesh->uvs, .normals = b->mesh->normals, .position_count = position_count,
+                             .positions = s->local_positions, .locked = s->position_locked,
+                             .target_index_count = target};
+    lod_simplify_result out;
+    if (!lod_simplify(&s->simplify, &in, s->simplified, &out)) {
+        r->out_of_memory = 1;
+        return;
+    }
+    size_t out_count = out.index_count;
+    r->slide = out.slide;
     int enough = out_count > 0 && (double)out_count <= (double)index_count * LOD_MAX_KEPT_SHARE;
-    for (size_t i = 0; i < out_count && enough; i++)
-        enough = s->simplified[i] < local_count;
     if (enough && !border_kept(b, s, index_count, out_count)) {
         r->border_reject = 1;
         enough = 0;
@@ -325,6 +343,11 @@ void gdr_lod_scratch_free(lod_scratch *s)
     free(s->local_to_mesh);
     free(s->locked);
     free(s->positions);
+    free(s->vertex_position);
+    free(s->position_map);
+    free(s->local_positions);
+    free(s->position_locked);
+    lod_simplify_scratch_free(&s->simplify);
     free(s->indices);
     free(s->simplified);
     free(s->edges_in);

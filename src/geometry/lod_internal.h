@@ -14,6 +14,7 @@
 #include "core/progress.h"
 #include "gdr/thread_pool.h"
 #include "geometry/lod_grid.h"
+#include "geometry/lod_simplify.h"
 #include "gdr/geometry.h"
 #include "gdr/scene.h"
 
@@ -73,6 +74,16 @@ typedef struct lod_scratch {
     size_t locked_cap;
     float *positions;
     size_t positions_cap;
+    /* simplification over positions (lod_simplify.c): local vertex -> local position, mesh position id
+     * -> local position (UINT32_MAX when unused; position_count entries), per local position its
+     * coordinates and lock */
+    uint32_t *vertex_position, *position_map;
+    size_t vertex_position_cap;
+    float *local_positions;
+    size_t local_positions_cap;
+    uint8_t *position_locked;
+    size_t position_locked_cap;
+    lod_simplify_scratch simplify;
     unsigned int *indices, *simplified;
     size_t indices_cap, simplified_cap;
     uint64_t *edges_in, *edges_out;
@@ -119,6 +130,8 @@ typedef struct group_result {
     int out_of_memory;
     float error;       /* the larger of its deviation and the largest error its members came with */
     float deviation;   /* measured against the full-detail surface (lod_error.c) */
+    float slide;       /* the largest texture slide one of its collapses charged (lod_simplify.c): part of
+                          the error, as D2 is */
     gdr_vec4 sphere;
     uint32_t input_triangles;
     uint32_t group;         /* its id among the DAG's groups, once formed (or passed through) */

@@ -1,0 +1,691 @@
+/* Simplifying one group's triangles by half-edge collapses over positions (lod_simplify.h).
+ *
+ * A position a moves onto a neighbouring position b: every triangle holding both disappears, every
+ * other triangle around a takes, in place of its corner at a (a wedge wa), a wedge of b. That is
+ * the wedge wb that shares a triangle along the edge a-b with wa where there is one (the attribute
+ * field continues across the collapsed edge), else the wedge of b that best continues wa's field:
+ * wa's surviving triangles' affine uv and normal, extrapolated to b's position, compared with each
+ * wedge of b. The cost of a collapse is the mean squared distance of a's Garland-Heckbert quadric
+ * at b plus that attribute error averaged over a's fan (both squared lengths). A heap keeps each
+ * position's cheapest collapse as last evaluated; a popped position is evaluated again and moves
+ * only if it is still no dearer than the next one (lazy re-evaluation). Collapses run in passes: a
+ * position moved onto waits for the next pass, and a pass ends past 1.5 x the cost that would
+ * reach the target, so collapses spread over the group instead of piling onto a few positions.
+ * Single-threaded per group, ties broken by position index: the result does not depend on the
+ * thread count. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "geometry/lod_internal.h"
+#include "geometry/lod_simplify.h"
+
+#define NONE UINT32_MAX
+#define FLAG_REMOVED 1u
+#define FLAG_BORDER 2u /* on an open border (or a non-manifold edge): moves only along a border edge */
+#define FLAG_QUEUED 4u
+/* Weight of an open border's edge plane, per squared edge length: keeps borders in place against
+ * the area-weighted planes of the surface. */
+#define BORDER_WEIGHT 4.0
+/* A texture slide (mesh length) costs its square times this; a normal's change costs as a length
+ * of |delta n| times the square root of its triangle's area (a surface tilted by that angle over
+ * the triangle's size), squared, times NORMAL_WEIGHT. Chosen by measurement (docs/GEOMETRY.md). */
+#define UV_WEIGHT 0.5
+#define NORMAL_WEIGHT 0.1
+/* A triangle may turn by at most about 75 degrees in one collapse. */
+#define MIN_NORMAL_COS 0.25
+
+typedef struct run {
+    lod_simplify_scratch *s;
+    uint32_t pass;    /* a position moved onto in this pass neither moves nor is moved onto again */
+    const lod_simplify_input *in;
+    size_t triangles; /* alive */
+    float slide2;     /* the largest squared texture slide charged so far */
+} run;
+
+static inline uint32_t wedge_position(const run *r, uint32_t w) { return r->in->vertex_position[w]; }
+static inline uint32_t corner_position(const run *r, uint32_t c) { return wedge_position(r, r->s->tri[c]); }
+
+static inline void load(const run *r, uint32_t p, double out[3])
+{
+    const float *f = r->in->positions + (size_t)p * 3;
+    out[0] = f[0], out[1] = f[1], out[2] = f[2];
+}
+
+static inline void sub(const double a[3], const double b[3], double o[3])
+{
+    o[0] = a[0] - b[0], o[1] = a[1] - b[1], o[2] = a[2] - b[2];
+}
+static inline double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static inline void cross(const double a[3], const double b[3], double o[3])
+{
+    o[0] = a[1] * b[2] - a[2] * b[1], o[1] = a[2] * b[0] - a[0] * b[2], o[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* --- quadrics: a2 ab ac ad b2 bc bd c2 cd d2 of w (n.x + d)^2, and the sum of the weights w ------------ */
+#define QUADRIC_SIZE 11
+
+static void quadric_add_plane(double *q, const double n[3], double d, double w)
+{
+    q[0] += w * n[0] * n[0], q[1] += w * n[0] * n[1], q[2] += w * n[0] * n[2], q[3] += w * n[0] * d;
+    q[4] += w * n[1] * n[1], q[5] += w * n[1] * n[2], q[6] += w * n[1] * d;
+    q[7] += w * n[2] * n[2], q[8] += w * n[2] * d, q[9] += w * d * d, q[10] += w;
+}
+
+static double quadric_eval(const double *q, const double x[3])
+{
+    double e = q[0] * x[0] * x[0] + q[4] * x[1] * x[1] + q[7] * x[2] * x[2] + q[9];
+    e += 2.0 * (q[1] * x[0] * x[1] + q[2] * x[0] * x[2] + q[5] * x[1] * x[2]);
+    e += 2.0 * (q[3] * x[0] + q[6] * x[1] + q[8] * x[2]);
+    return e > 0.0 ? e : 0.0;
+}
+
+/* --- the heap ------------------------------------------------------------------------------------ */
+
+static int heap_less(const lod_simplify_heap_item *a, const lod_simplify_heap_item *b)
+{
+    return a->cost < b->cost || (a->cost == b->cost && a->position < b->position);
+}
+
+static void heap_push(lod_simplify_scratch *s, float cost, uint32_t position)
+{
+    size_t i = s->heap_count++;
+    lod_simplify_heap_item item = {cost, position};
+    while (i > 0 && heap_less(&item, &s->heap[(i - 1) / 2])) {
+        s->heap[i] = s->heap[(i - 1) / 2];
+        i = (i - 1) / 2;
+    }
+    s->heap[i] = item;
+}
+
+static lod_simplify_heap_item heap_pop(lod_simplify_scratch *s)
+{
+    lod_simplify_heap_item top = s->heap[0], last = s->heap[--s->heap_count];
+    size_t i = 0, n = s->heap_count;
+    for (;;) {
+        size_t c = 2 * i + 1;
+        if (c >= n)
+            break;
+        if (c + 1 < n && heap_less(&s->heap[c + 1], &s->heap[c]))
+            c++;
+        if (!heap_less(&s->heap[c], &last))
+            break;
+        s->heap[i] = s->heap[c];
+        i = c;
+    }
+    if (n)
+        s->heap[i] = last;
+    return top;
+}
+
+/* --- the corners around a position ---------------------------------------------------------------- */
+
+/* Gathers the corners of p's live triangles into s->fan (dropping dead ones from p's list). */
+static uint32_t gather_fan(run *r, uint32_t p, uint32_t *fan)
+{
+    lod_simplify_scratch *s = r->s;
+    uint32_t n = 0, *link = &s->head[p];
+    while (*link != NONE) {
+        uint32_t c = *link;
+        if (!s->alive[c / 3]) {
+            *link = s->next[c];
+            continue;
+        }
+        fan[n++] = c;
+        link = &s->next[c];
+    }
+    return n;
+}
+
+static int triangle_holds(const run *r, uint32_t t, uint32_t p)
+{
+    return corner_position(r, t * 3) == p || corner_position(r, t * 3 + 1) == p || corner_position(r, t * 3 + 2) == p;
+}
+
+/* The distinct neighbours of the position whose fan is given, marked with a fresh token. */
+static uint32_t gather_neighbours(run *r, const uint32_t *fan, uint32_t n, uint32_t *out, uint32_t *token)
+{
+    lod_simplify_scratch *s = r->s;
+    uint32_t k = 0, t = ++s->token;
+    if (n)
+        s->mark[corner_position(r, fan[0])] = t; /* not its own neighbour (a degenerate triangle) */
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t c = fan[i], base = c - c % 3;
+        for (uint32_t j = 1; j < 3; j++) {
+            uint32_t q = corner_position(r, base + (c % 3 + j) % 3);
+            if (s->mark[q] != t) {
+                s->mark[q] = t;
+                out[k++] = q;
+            }
+        }
+    }
+    *token = t;
+    return k;
+}
+
+static uint32_t gather_wedges(run *r, const uint32_t *fan, uint32_t n, uint32_t *out)
+{
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t w = r->s->tri[fan[i]], j = 0;
+        while (j < k && out[j] != w)
+            j++;
+        if (j == k)
+            out[k++] = w;
+    }
+    return k;
+}
+
+/* --- the attribute error ---------------------------------------------------------------------------- */
+
+/* Fills s->info for the fan of a position (its corners' triangles: their affine frames and
+ * attribute gradients, computed once for every collapse evaluated from it); returns its area. */
+static double prepare_fan(run *r, const uint32_t *fan, uint32_t n)
+{
+    const lod_simplify_input *in = r->in;
+    double total = 0.0;
+    for (uint32_t i = 0; i < n; i++) {
+        lod_simplify_corner *f = &r->s->info[i];
+        uint32_t c = fan[i], base = c - c % 3, w[3];
+        double p[3][3];
+        for (uint32_t j = 0; j < 3; j++) {
+            w[j] = r->s->tri[base + (c % 3 + j) % 3];
+            load(r, wedge_position(r, w[j]), p[j]);
+        }
+        f->wedge = w[0];
+        f->other[0] = wedge_position(r, w[1]), f->other[1] = wedge_position(r, w[2]);
+        memcpy(f->p0, p[0], sizeof f->p0);
+        sub(p[1], p[0], f->e1), sub(p[2], p[0], f->e2);
+        f->g11 = dot(f->e1, f->e1), f->g12 = dot(f->e1, f->e2), f->g22 = dot(f->e2, f->e2);
+        double det = f->g11 * f->g22 - f->g12 * f->g12;
+        f->area = det > 0.0 ? 0.5 * sqrt(det) : 0.0;
+        total += f->area;
+        f->inv_det = det > 1e-12 * f->g11 * f->g22 ? 1.0 / det : 0.0; /* 0: degenerate, no field */
+        const uint32_t m0 = in->vertex_source[w[0]], m1 = in->vertex_source[w[1]], m2 = in->vertex_source[w[2]];
+        f->uv_scale = 0.0;
+        if (in->uvs) {
+            const gdr_vec2 t0 = in->uvs[m0], t1 = in->uvs[m1], t2 = in->uvs[m2];
+            f->t0[0] = t0.x, f->t0[1] = t0.y;
+            f->t1[0] = (double)t1.x - t0.x, f->t1[1] = (double)t1.y - t0.y;
+            f->t2[0] = (double)t2.x - t0.x, f->t2[1] = (double)t2.y - t0.y;
+            double uv_area = 0.5 * fabs(f->t1[0] * f->t2[1] - f->t2[0] * f->t1[1]);
+            f->uv_scale = uv_area > 1e-20 ? f->area / uv_area : 0.0;
+        }
+        if (in->normals) {
+            const gdr_vec3 n0 = in->normals[m0], n1 = in->normals[m1], n2 = in->normals[m2];
+            f->n0[0] = n0.x, f->n0[1] = n0.y, f->n0[2] = n0.z;
+            f->n1[0] = (double)n1.x - n0.x, f->n1[1] = (double)n1.y - n0.y, f->n1[2] = (double)n1.z - n0.z;
+            f->n2[0] = (double)n2.x - n0.x, f->n2[1] = (double)n2.y - n0.y, f->n2[2] = (double)n2.z - n0.z;
+        }
+    }
+    return total;
+}
+
+/* The error of giving a fan corner the attributes of wedge wb at position q: its triangle's affine
+ * uv and normal, extrapolated over its plane to q, against wb's. Returns the area-weighted squared
+ * length; *slide2 gets the texture slide (squared mesh length). */
+static double corner_attribute_error(const run *r, const lod_simplify_corner *f, uint32_t wb, const double q[3],
+                                     double *slide2)
+{
+    const lod_simplify_input *in = r->in;
+    *slide2 = 0.0;
+    if (f->inv_det == 0.0)
+        return 0.0;
+    double d[3];
+    sub(q, f->p0, d);
+    double r1 = dot(d, f->e1), r2 = dot(d, f->e2);
+    double u = (f->g22 * r1 - f->g12 * r2) * f->inv_det, v = (f->g11 * r2 - f->g12 * r1) * f->inv_det;
+    double error = 0.0;
+    const uint32_t mb = in->vertex_source[wb];
+    if (f->uv_scale > 0.0) {
+        const gdr_vec2 tb = in->uvs[mb];
+        double du = f->t0[0] + u * f->t1[0] + v * f->t2[0] - tb.x, dv = f->t0[1] + u * f->t1[1] + v * f->t2[1] - tb.y;
+        *slide2 = (du * du + dv * dv) * f->uv_scale;
+        error += *slide2 * UV_WEIGHT;
+    }
+    if (in->normals) {
+        const gdr_vec3 nb = in->normals[mb];
+        double dx = f->n0[0] + u * f->n1[0] + v * f->n2[0] - nb.x;
+        double dy = f->n0[1] + u * f->n1[1] + v * f->n2[1] - nb.y;
+        double dz = f->n0[2] + u * f->n1[2] + v * f->n2[2] - nb.z;
+        error += (dx * dx + dy * dy + dz * dz) * f->area * NORMAL_WEIGHT;
+    }
+    return error * f->area;
+}
+
+/* The error of wedge wa taking wedge wb when a moves to q = b's position: over wa's triangles that
+ * survive (those not holding b). */
+static double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, const double q[3], double *slide2)
+{
+    double error = 0.0;
+    *slide2 = 0.0;
+    for (uint32_t i = 0; i < n; i++) {
+        const lod_simplify_corner *f = &r->s->info[i];
+        if (f->wedge != wa || f->holds_b)
+            continue;
+        double s2;
+        error += corner_attribute_error(r, f, wb, q, &s2);
+        *slide2 = s2 > *slide2 ? s2 : *slide2;
+    }
+    return error;
+}
+
+/* The cost of moving a (fan prepared in s->info, its area, wedges) onto b, or INFINITY where it is
+ * not allowed: the quadric's mean squared distance plus the attribute error's mean over a's fan
+ * (both squared lengths); sets s->choice for a's wedges and *slide2 to the largest texture slide
+ * it charges. */
+static double pair_cost(run *r, uint32_t a, uint32_t b, const uint32_t *fan, uint32_t n, double area,
+                        const uint32_t *wedges, uint32_t wedge_count, double *slide2)
+{
+    lod_simplify_scratch *s = r->s;
+    uint32_t edge_triangles = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        lod_simplify_corner *f = &s->info[i];
+        f->holds_b = f->other[0] == b || f->other[1] == b;
+        edge_triangles += f->holds_b;
+    }
+    if (edge_triangles == 0 || edge_triangles > 2 || ((s->flags[a] & FLAG_BORDER) && edge_triangles != 1))
+        return INFINITY;
+    double q[3];
+    load(r, b, q);
+    const double *qa = s->quadric + (size_t)a * QUADRIC_SIZE;
+    double cost = qa[10] > 0.0 ? quadric_eval(qa, q) / qa[10] : 0.0;
+    uint32_t b_wedges = NONE;
+    double attribute = 0.0;
+    *slide2 = 0.0;
+    for (uint32_t k = 0; k < wedge_count; k++) {
+        uint32_t wa = wedges[k], best = NONE;
+        double best_error = INFINITY, best_slide = 0.0, e, s2;
+        /* the wedges of b that share a triangle along a-b with wa */
+        for (uint32_t i = 0; i < n; i++) {
+            if (s->info[i].wedge != wa || !s->info[i].holds_b)
+                continue;
+            uint32_t c = fan[i], base = c - c % 3;
+            for (uint32_t j = 0; j < 3; j++) {
+                uint32_t wb = s->tri[base + j];
+                if (wedge_position(r, wb) == b && wb != best && (e = wedge_error(r, n, wa, wb, q, &s2)) < best_error)
+                    best = wb, best_error = e, best_slide = s2;
+            }
+        }
+        if (best == NONE) { /* a seam or hard-edge corner: the wedge of b that best continues wa */
+            if (b_wedges == NONE) {
+                uint32_t m = gather_fan(r, b, s->fan_b);
+                b_wedges = gather_wedges(r, s->fan_b, m, s->wedges_b);
+            }
+            for (uint32_t j = 0; j < b_wedges; j++)
+                if ((e = wedge_error(r, n, wa, s->wedges_b[j], q, &s2)) < best_error || best == NONE)
+                    best = s->wedges_b[j], best_error = e, best_slide = s2;
+        }
+        if (best == NONE)
+            return INFINITY;
+        s->choice[wa] = best;
+        attribute += best_error;
+        *slide2 = best_slide > *slide2 ? best_slide : *slide2;
+    }
+    return cost + (area > 0.0 ? attribute / area : 0.0);
+}
+
+/* --- validity ----------------------------------------------------------------------------------------- */
+
+/* No triangle around a (not holding b) flips, turns too far or collapses to zero area. */
+static int keeps_orientation(const run *r, uint32_t a, uint32_t b, const uint32_t *fan, uint32_t n)
+{
+    double pa[3], pb[3];
+    load(r, a, pa), load(r, b, pb);
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t c = fan[i], base = c - c % 3;
+        if (triangle_holds(r, c / 3, b))
+            continue;
+        double p1[3], p2[3], e1[3], e2[3], f1[3], f2[3], n0[3], n1[3];
+        load(r, corner_position(r, base + (c % 3 + 1) % 3), p1);
+        load(r, corner_position(r, base + (c % 3 + 2) % 3), p2);
+        sub(p1, pa, e1), sub(p2, pa, e2), sub(p1, pb, f1), sub(p2, pb, f2);
+        cross(e1, e2, n0), cross(f1, f2, n1);
+        double l0 = dot(n0, n0), l1 = dot(n1, n1);
+        if (l0 == 0.0)
+            continue; /* degenerate before: nothing to keep */
+        if (!(l1 > 0.0) || dot(n0, n1) <= MIN_NORMAL_COS * sqrt(l0 * l1))
+            return 0;
+    }
+    return 1;
+}
+
+/* The link condition (the positions next to both a and b are the third corners of the triangles
+ * along a-b), and no triangle that would repeat another by position. */
+static int keeps_topology(run *r, uint32_t a, uint32_t b, const uint32_t *fan, uint32_t n)
+{
+    lod_simplify_scratch *s = r->s;
+    uint32_t near_a, count = gather_neighbours(r, fan, n, s->neighbours, &near_a), third = ++s->token;
+    (void)count;
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t c = fan[i], base = c - c % 3;
+        if (!triangle_holds(r, c / 3, b))
+            continue;
+        for (uint32_t j = 0; j < 3; j++) {
+            uint32_t p = corner_position(r, base + j);
+            if (p != a && p != b)
+                s->mark[p] = third;
+        }
+    }
+    uint32_t *fan_b = s->fan_b, m = gather_fan(r, b, fan_b);
+    for (uint32_t i = 0; i < m; i++) {
+        uint32_t c = fan_b[i], base = c - c % 3;
+        uint32_t x = corner_position(r, base + (c % 3 + 1) % 3), y = corner_position(r, base + (c % 3 + 2) % 3);
+        if ((x != a && s->mark[x] == near_a) || (y != a && s->mark[y] == near_a))
+            return 0;
+        if (x == a || y == a || s->mark[x] != third || s->mark[y] != third)
+            continue;
+        /* b, x, y exists: a triangle a, x, y (either way round) would repeat it */
+        for (uint32_t k = 0; k < n; k++) {
+            uint32_t t = fan[k] / 3;
+            if (!triangle_holds(r, t, b) && triangle_holds(r, t, x) && triangle_holds(r, t, y))
+                return 0;
+        }
+    }
+    return 1;
+}
+
+/* --- collapses ------------------------------------------------------------------------------------------ */
+
+/* a's cheapest collapse; with `valid`, the cheapest that passes the checks. Returns its cost
+ * (INFINITY: none) and target. */
+static double best_collapse(run *r, uint32_t a, int valid, uint32_t *target)
+{
+    lod_simplify_scratch *s = r->s;
+    *target = NONE;
+    if (r->in->locked[a] || (s->flags[a] & FLAG_REMOVED) || (valid && s->pass[a] == r->pass))
+        return INFINITY;
+    uint32_t n = gather_fan(r, a, s->fan);
+    if (n == 0)
+        return INFINITY;
+    uint32_t token, count = gather_neighbours(r, s->fan, n, s->neighbours, &token);
+    uint32_t wedge_count = gather_wedges(r, s->fan, n, s->wedges);
+    double area = prepare_fan(r, s->fan, n);
+    for (uint32_t i = 0; i < count; i++) {
+        double s2;
+        s->costs[i] = (float)pair_cost(r, a, s->neighbours[i], s->fan, n, area, s->wedges, wedge_count, &s2);
+    }
+    /* the neighbours in order of cost (ties by index), the first that passes the checks */
+    uint32_t *order = s->order;
+    for (uint32_t i = 0; i < count; i++)
+        order[i] = s->neighbours[i];
+    float *cost = s->costs;
+    for (uint32_t i = 0; i < count; i++) {
+        uint32_t m = i;
+        for (uint32_t j = i + 1; j < count; j++)
+            if (cost[j] < cost[m] || (cost[j] == cost[m] && order[j] < order[m]))
+                m = j;
+        float tc = cost[i];
+        uint32_t to = order[i];
+        cost[i] = cost[m], order[i] = order[m], cost[m] = tc, order[m] = to;
+        if (!(cost[i] < INFINITY))
+            return INFINITY;
+        if (valid && s->pass[order[i]] == r->pass)
+            continue;
+        if (!valid || (keeps_orientation(r, a, order[i], s->fan, n) && keeps_topology(r, a, order[i], s->fan, n))) {
+            *target = order[i];
+            return cost[i];
+        }
+    }
+    return INFINITY;
+}
+
+static void queue(run *r, uint32_t p)
+{
+    uint32_t target;
+    double cost = best_collapse(r, p, 0, &target);
+    if (cost < INFINITY) {
+        heap_push(r->s, (float)cost, p);
+        r->s->flags[p] |= FLAG_QUEUED;
+    }
+}
+
+/* Moves a onto b (the checks passed). */
+static void collapse(run *r, uint32_t a, uint32_t b)
+{
+    lod_simplify_scratch *s = r->s;
+    uint32_t n = gather_fan(r, a, s->fan);
+    uint32_t wedge_count = gather_wedges(r, s->fan, n, s->wedges);
+    double slide2;
+    pair_cost(r, a, b, s->fan, n, prepare_fan(r, s->fan, n), s->wedges, wedge_count, &slide2); /* sets s->choice */
+    r->slide2 = (float)slide2 > r->slide2 ? (float)slide2 : r->slide2;
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t c = s->fan[i];
+        if (s->alive[c / 3] && triangle_holds(r, c / 3, b)) {
+            s->alive[c / 3] = 0;
+            r->triangles--;
+        }
+    }
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t c = s->fan[i];
+        if (!s->alive[c / 3])
+            continue;
+        s->tri[c] = s->choice[s->tri[c]];
+        s->next[c] = s->head[b];
+        s->head[b] = c;
+    }
+    s->head[a] = NONE;
+    s->flags[a] |= FLAG_REMOVED;
+    s->pass[b] = r->pass;
+    for (int k = 0; k < QUADRIC_SIZE; k++)
+        s->quadric[(size_t)b * QUADRIC_SIZE + k] += s->quadric[(size_t)a * QUADRIC_SIZE + k];
+    /* b and its neighbours changed: those not in the heap are evaluated again (those in it are, lazily,
+     * when they come up) */
+    uint32_t m = gather_fan(r, b, s->fan), token;
+    uint32_t *near = s->near; /* queue()'s walks overwrite s->neighbours */
+    uint32_t count = gather_neighbours(r, s->fan, m, s->neighbours, &token);
+    memcpy(near, s->neighbours, count * sizeof *near);
+    for (uint32_t i = 0; i < count; i++)
+        if (!(s->flags[near[i]] & FLAG_QUEUED) && s->pass[near[i]] != r->pass)
+            queue(r, near[i]);
+}
+
+/* --- setup ------------------------------------------------------------------------------------------------ */
+
+static int reserve(lod_simplify_scratch *s, const lod_simplify_input *in)
+{
+    size_t nc = in->index_count, np = in->position_count;
+    return LOD_RESERVE(s, tri, nc) && LOD_RESERVE(s, next, nc) && LOD_RESERVE(s, alive, nc / 3 + 1) &&
+           LOD_RESERVE(s, head, np) && LOD_RESERVE(s, quadric, np * QUADRIC_SIZE) && LOD_RESERVE(s, flags, np) &&
+           LOD_RESERVE(s, mark, np) && LOD_RESERVE(s, pass, np) && LOD_RESERVE(s, heap, np) && LOD_RESERVE(s, fan, nc) &&
+           LOD_RESERVE(s, fan_b, nc) && LOD_RESERVE(s, info, nc) && LOD_RESERVE(s, neighbours, nc * 2) && LOD_RESERVE(s, near, nc * 2) &&
+           LOD_RESERVE(s, order, nc * 2) && LOD_RESERVE(s, wedges, in->vertex_count) &&
+           LOD_RESERVE(s, wedges_b, in->vertex_count) &&
+           LOD_RESERVE(s, choice, in->vertex_count) && LOD_RESERVE(s, costs, nc * 2);
+}
+
+/* The k-th smallest of n values (reordering them). */
+static float select_kth(float *v, size_t n, size_t k)
+{
+    size_t lo = 0, hi = n - 1;
+    while (lo < hi) {
+        float pivot = v[lo + (hi - lo) / 2];
+        size_t i = lo, j = hi;
+        while (i <= j) {
+            while (v[i] < pivot)
+                i++;
+            while (v[j] > pivot)
+                j--;
+            if (i <= j) {
+                float t = v[i];
+                v[i] = v[j], v[j] = t;
+                i++;
+                if (j == 0)
+                    break;
+                j--;
+            }
+        }
+        if (k <= j)
+            hi = j;
+        else if (k >= i)
+            lo = i;
+        else
+            return v[k];
+    }
+    return v[k];
+}
+
+#define PASS_ERROR_BOUND 1.5f
+/* A pass moves positions up to PASS_ERROR_BOUND times the cost of the collapse that would, were
+ * they all independent, reach the target: collapses spread over the group instead of piling onto
+ * a few positions. */
+static float pass_limit(lod_simplify_scratch *s, size_t needed)
+{
+    if (needed >= s->heap_count)
+        return INFINITY;
+    for (size_t i = 0; i < s->heap_count; i++)
+        s->costs[i] = s->heap[i].cost;
+    return select_kth(s->costs, s->heap_count, needed) * PASS_ERROR_BOUND;
+}
+
+/* Corner lists. A triangle with two corners at one position (degenerate by position) stays: it
+ * closes the edges of its neighbours, and dropping it would open them. */
+static void build_lists(run *r)
+{
+    lod_simplify_scratch *s = r->s;
+    const lod_simplify_input *in = r->in;
+    size_t nt = in->index_count / 3;
+    memcpy(s->tri, in->indices, in->index_count * sizeof *s->tri);
+    for (uint32_t p = 0; p < in->position_count; p++)
+        s->head[p] = NONE, s->flags[p] = 0, s->mark[p] = 0, s->pass[p] = 0;
+    s->token = 0;
+    r->triangles = nt;
+    for (size_t t = nt; t-- > 0;) {
+        s->alive[t] = 1;
+        for (uint32_t j = 0; j < 3; j++) {
+            uint32_t c = (uint32_t)t * 3 + j, p = corner_position(r, c);
+            s->next[c] = s->head[p];
+            s->head[p] = c;
+        }
+    }
+}
+
+/* Area-weighted triangle planes, and for each open border edge (one triangle along it, or more than
+ * two: a non-manifold edge) a plane through it perpendicular to its triangle. */
+static void build_quadrics(run *r)
+{
+    lod_simplify_scratch *s = r->s;
+    const lod_simplify_input *in = r->in;
+    memset(s->quadric, 0, (size_t)in->position_count * QUADRIC_SIZE * sizeof *s->quadric);
+    size_t nt = in->index_count / 3;
+    for (size_t t = 0; t < nt; t++) {
+        if (!s->alive[t])
+            continue;
+        double p[3][3], e1[3], e2[3], nrm[3];
+        for (uint32_t j = 0; j < 3; j++)
+            load(r, corner_position(r, (uint32_t)t * 3 + j), p[j]);
+        sub(p[1], p[0], e1), sub(p[2], p[0], e2), cross(e1, e2, nrm);
+        double len = sqrt(dot(nrm, nrm));
+        if (len == 0.0)
+            continue;
+        for (int k = 0; k < 3; k++)
+            nrm[k] /= len;
+        for (uint32_t j = 0; j < 3; j++)
+            quadric_add_plane(s->quadric + (size_t)corner_position(r, (uint32_t)t * 3 + j) * QUADRIC_SIZE, nrm,
+                              -dot(nrm, p[0]), 0.5 * len);
+        for (uint32_t j = 0; j < 3; j++) {
+            uint32_t pa = corner_position(r, (uint32_t)t * 3 + j), pb = corner_position(r, (uint32_t)t * 3 + (j + 1) % 3);
+            uint32_t along = 0;
+            for (uint32_t c = s->head[pa]; c != NONE; c = s->next[c])
+                along += triangle_holds(r, c / 3, pb);
+            if (along == 2)
+                continue;
+            s->flags[pa] |= FLAG_BORDER;
+            s->flags[pb] |= FLAG_BORDER;
+            double e[3], m[3];
+            sub(p[(j + 1) % 3], p[j], e);
+            cross(e, nrm, m);
+            double ml = sqrt(dot(m, m));
+            if (ml == 0.0)
+                continue;
+            for (int k = 0; k < 3; k++)
+                m[k] /= ml;
+            double w = BORDER_WEIGHT * dot(e, e);
+            quadric_add_plane(s->quadric + (size_t)pa * QUADRIC_SIZE, m, -dot(m, p[j]), w);
+            quadric_add_plane(s->quadric + (size_t)pb * QUADRIC_SIZE, m, -dot(m, p[j]), w);
+        }
+    }
+}
+
+int lod_simplify(lod_simplify_scratch *s, const lod_simplify_input *in, uint32_t *out, lod_simplify_result *res)
+{
+    *res = (lod_simplify_result){0};
+    if (!reserve(s, in))
+        return 0;
+    run r = {.s = s, .in = in};
+    build_lists(&r);
+    build_quadrics(&r);
+    s->heap_count = 0;
+    r.pass = 1;
+    uint32_t pass_start = UINT32_MAX;
+    for (uint32_t p = 0; p < in->position_count; p++)
+        queue(&r, p);
+    size_t target = in->target_index_count / 3;
+    float limit = r.triangles > target ? pass_limit(s, (r.triangles - target) / 2) : INFINITY;
+    for (;;) {
+        if (s->heap_count && s->heap[0].cost > limit) { /* the pass is over */
+            for (size_t i = 0; i < s->heap_count; i++)
+                s->flags[s->heap[i].position] &= (uint8_t)~FLAG_QUEUED;
+            s->heap_count = 0;
+        }
+        if (!s->heap_count) { /* a new pass: every position is evaluated again and may move */
+            if (res->collapses == pass_start)
+                break; /* the last pass moved nothing */
+            pass_start = res->collapses;
+            r.pass++;
+            for (uint32_t p = 0; p < in->position_count; p++)
+                if (!(s->flags[p] & FLAG_QUEUED))
+                    queue(&r, p);
+            if (!s->heap_count)
+                break;
+            limit = r.triangles > target ? pass_limit(s, (r.triangles - target) / 2) : INFINITY;
+        }
+        if (r.triangles <= target)
+            break;
+        lod_simplify_heap_item item = heap_pop(s);
+        s->flags[item.position] &= (uint8_t)~FLAG_QUEUED;
+        uint32_t b;
+        double cost = best_collapse(&r, item.position, 1, &b);
+        if (!(cost < INFINITY))
+            continue; /* queued again when its neighbourhood changes */
+        if (s->heap_count && (float)cost > s->heap[0].cost) {
+            heap_push(s, (float)cost, item.position); /* dearer than it was: wait for its turn */
+            s->flags[item.position] |= FLAG_QUEUED;
+            continue;
+        }
+        collapse(&r, item.position, b);
+        res->collapses++;
+    }
+    size_t k = 0, nt = in->index_count / 3;
+    for (size_t t = 0; t < nt; t++)
+        if (s->alive[t])
+            for (uint32_t j = 0; j < 3; j++)
+                out[k++] = s->tri[t * 3 + j];
+    res->index_count = k;
+    res->slide = sqrtf(r.slide2);
+    return 1;
+}
+
+void lod_simplify_scratch_free(lod_simplify_scratch *s)
+{
+    free(s->tri);
+    free(s->next);
+    free(s->alive);
+    free(s->head);
+    free(s->quadric);
+    free(s->flags);
+    free(s->mark);
+    free(s->pass);
+    free(s->heap);
+    free(s->fan);
+    free(s->fan_b);
+    free(s->info);
+    free(s->neighbours);
+    free(s->near);
+    free(s->order);
+    free(s->wedges);
+    free(s->wedges_b);
+    free(s->choice);
+    free(s->costs);
+    memset(s, 0, sizeof *s);
+}
