@@ -196,8 +196,9 @@ static double build_once(gdr_mesh *mesh, uint32_t threads, double *level0, gdr_l
     if (gdr_meshlets_build(mesh, &(gdr_meshlet_options){.thread_count = threads}, &mesh->clusters, &err) != GDR_OK)
         die(mesh->name, err.message);
     double t1 = clock();
+    /* The set's meshes are drawn untextured: their uvs ignored, as gdr_scene_build_lod builds them. */
     if (gdr_mesh_build_lod_dag(mesh, &(gdr_lod_options){.thread_count = threads, .group_size = group_size,
-                                                     .no_progress = 1},
+                                                     .no_progress = 1, .ignore_uvs = 1},
                                stats, &err) !=
         GDR_OK)
         die(mesh->name, err.message);

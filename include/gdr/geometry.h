@@ -127,6 +127,9 @@ typedef struct gdr_lod_options {
                                 most this many triangles (or stops simplifying); 0:
                                 GDR_LOD_DEFAULT_ROOT_TRIANGLES; in [1, GDR_CLUSTER_MAX_TRIANGLES]
                                 (the largest: stop at one cluster, as before) */
+    int ignore_uvs;        /* 1: the uvs neither steer simplification nor enter the error (no
+                              material samples a texture through them). gdr_scene_build_lod sets it
+                              for each mesh none of whose instances has a textured material. */
 } gdr_lod_options;
 
 /* What a build did; for a scene, sums over the meshes built. */

@@ -878,18 +878,46 @@ typedef struct scene_job {
     gdr_scene *scene;
     const gdr_lod_options *opt;
     const uint32_t *small; /* mesh indices built one per task */
+    const uint8_t *textured; /* per mesh: an instance has a textured material */
     lod_progress *progress;
     gdr_lod_stats *stats;  /* per mesh */
     gdr_status *status;    /* per mesh */
     gdr_error *errors;     /* per mesh */
 } scene_job;
 
+/* Whether a material samples any texture (through the mesh's uvs). */
+static int material_textured(const gdr_material *m)
+{
+    return m->base_color_texture.texture != GDR_NO_INDEX || m->metallic_roughness_texture.texture != GDR_NO_INDEX ||
+           m->normal_texture.texture != GDR_NO_INDEX || m->occlusion_texture.texture != GDR_NO_INDEX ||
+           m->emissive_texture.texture != GDR_NO_INDEX;
+}
+
+/* textured[m] = 1 where an instance of mesh m has a textured material: only there do the uvs steer
+ * simplification and enter the error (an untextured mesh's uvs are never seen). */
+static void mark_textured_meshes(const gdr_scene *scene, uint8_t *textured)
+{
+    for (uint32_t i = 0; i < scene->instance_count; i++) {
+        const gdr_instance *in = &scene->instances[i];
+        if (in->mesh < scene->mesh_count && in->material < scene->material_count &&
+            material_textured(&scene->materials[in->material]))
+            textured[in->mesh] = 1;
+    }
+}
+
+/* Builds mesh m with the scene's options, its uvs ignored where nothing samples a texture. */
+static gdr_status build_scene_mesh(scene_job *job, uint32_t m, gdr_thread_pool *pool, uint32_t worker)
+{
+    gdr_lod_options o = *job->opt;
+    o.ignore_uvs = o.ignore_uvs || !job->textured[m];
+    return build_one(&job->scene->meshes[m], &o, pool, worker, job->progress, NULL, &job->stats[m], &job->errors[m]);
+}
+
 static void small_mesh_task(void *user, uint32_t i, uint32_t worker)
 {
     scene_job *job = user;
     uint32_t m = job->small[i];
-    job->status[m] = build_one(&job->scene->meshes[m], job->opt, NULL, worker, job->progress, NULL,
-                               &job->stats[m], &job->errors[m]);
+    job->status[m] = build_scene_mesh(job, m, NULL, worker);
 }
 
 static int needs_dag(const gdr_mesh *m) { return m->clusters.level0_cluster_count > 0 && m->clusters.group_count == 0; }
@@ -916,11 +944,12 @@ gdr_status gdr_scene_build_lod(gdr_scene *scene, const gdr_lod_options *options,
     uint32_t n = scene->mesh_count;
     uint32_t *small = malloc((n ? n : 1) * sizeof *small);
     uint8_t *built = calloc(n ? n : 1, 1);
+    uint8_t *textured = calloc(n ? n : 1, 1);
     gdr_lod_stats *mesh_stats = calloc(n ? n : 1, sizeof *mesh_stats);
     gdr_status *statuses = calloc(n ? n : 1, sizeof *statuses);
     gdr_error *errors = calloc(n ? n : 1, sizeof *errors);
     gdr_thread_pool *pool = NULL;
-    if (!small || !built || !mesh_stats || !statuses || !errors) {
+    if (!small || !built || !textured || !mesh_stats || !statuses || !errors) {
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "gdr_scene_build_lod: out of memory");
         goto done;
     }
@@ -941,12 +970,13 @@ gdr_status gdr_scene_build_lod(gdr_scene *scene, const gdr_lod_options *options,
     lod_progress progress;
     gdr_progress_begin(&progress.bar, "LOD DAG", total, o.no_progress);
     atomic_init(&progress.done, 0);
-    scene_job job = {.scene = scene, .opt = &o, .small = small, .progress = &progress, .stats = mesh_stats,
-                     .status = statuses, .errors = errors};
+    mark_textured_meshes(scene, textured);
+    scene_job job = {.scene = scene, .opt = &o, .small = small, .textured = textured, .progress = &progress,
+                     .stats = mesh_stats, .status = statuses, .errors = errors};
     gdr_thread_pool_run(pool, small_count, small_mesh_task, &job);
     for (uint32_t m = 0; m < n; m++)
         if (built[m] && scene->meshes[m].index_count / 3 >= LOD_SMALL_MESH_TRIANGLES)
-            statuses[m] = build_one(&scene->meshes[m], &o, pool, 0, &progress, NULL, &mesh_stats[m], &errors[m]);
+            statuses[m] = build_scene_mesh(&job, m, pool, 0);
     gdr_progress_end(&progress.bar);
     for (uint32_t m = 0; m < n && status == GDR_OK; m++)
         if (built[m] && statuses[m] != GDR_OK)
@@ -965,6 +995,7 @@ done:
     gdr_thread_pool_destroy(pool);
     free(small);
     free(built);
+    free(textured);
     free(mesh_stats);
     free(statuses);
     free(errors);

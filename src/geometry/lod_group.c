@@ -232,7 +232,7 @@ void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker)
     target = target < 3 ? 3 : target;
     lod_simplify_input in = {.indices = s->indices, .index_count = index_count, .vertex_count = local_count,
                              .vertex_position = s->vertex_position, .vertex_source = s->local_to_mesh,
-                             .uvs = b->mesh->uvs, .normals = b->mesh->normals, .position_count = position_count,
+                             .uvs = b->opt.ignore_uvs ? NULL : b->mesh->uvs, .normals = b->mesh->normals, .position_count = position_count,
                              .positions = s->local_positions, .locked = s->position_locked,
                              .target_index_count = target};
     lod_simplify_result out;
