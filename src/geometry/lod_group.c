@@ -178,7 +178,7 @@ static int reserve_group(lod_scratch *s, size_t triangles, uint32_t count)
     return LOD_RESERVE(s, spheres, (size_t)count * 2) && LOD_RESERVE(s, indices, index_count) &&
            LOD_RESERVE(s, simplified, index_count) && LOD_RESERVE(s, local_to_mesh, index_count) &&
            LOD_RESERVE(s, locked, index_count) && LOD_RESERVE(s, edges_in, index_count) &&
-           LOD_RESERVE(s, edges_out, index_count) && LOD_RESERVE(s, positions, index_count * 3) &&
+           LOD_RESERVE(s, edges_out, index_count) && LOD_RESERVE(s, positions, index_count * 9) &&
            LOD_RESERVE(s, vertex_position, index_count) && LOD_RESERVE(s, local_positions, index_count * 3) &&
            LOD_RESERVE(s, position_locked, index_count);
 }
@@ -206,6 +206,29 @@ static uint32_t local_positions(lod_build *b, lod_scratch *s, uint32_t local_cou
     }
     for (uint32_t l = 0; l < local_count; l++)
         s->position_map[b->position_id[s->local_to_mesh[l]]] = UINT32_MAX;
+    return count;
+}
+
+/* meshoptimizer 0.18's simplifier over the local vertices' positions, each shared position locked by
+ * two unused copies of it appended (0.18 never moves a position held by three or more vertices):
+ * the fallback where the collapses over positions stop short of the 85% a group needs and the group
+ * is the whole frontier (a lone cluster of a genus-1 mesh, where the flip and turn checks refuse what
+ * 0.18 does). Seam vertices then slide only along their seams, as before the seam-crossing
+ * simplifier. Returns the index
+ * count, 0 where it failed. */
+static size_t simplify_by_meshoptimizer(lod_scratch *s, size_t index_count, uint32_t local_count, size_t target)
+{
+    uint32_t padded = local_count;
+    for (uint32_t l = 0; l < local_count; l++)
+        if (s->locked[l])
+            for (int copy = 0; copy < 2; copy++, padded++)
+                memcpy(s->positions + (size_t)padded * 3, s->positions + (size_t)l * 3, sizeof(float) * 3);
+    float relative_error = 0.0f;
+    size_t count = meshopt_simplify(s->simplified, s->indices, index_count, s->positions, padded, sizeof(float) * 3,
+                                    target, FLT_MAX, 0, &relative_error);
+    for (size_t i = 0; i < count; i++)
+        if (s->simplified[i] >= local_count)
+            return 0;
     return count;
 }
 
@@ -243,6 +266,11 @@ void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker)
     size_t out_count = out.index_count;
     r->slide = out.slide;
     int enough = out_count > 0 && (double)out_count <= (double)index_count * LOD_MAX_KEPT_SHARE;
+    if (!enough && count == b->frontier_count) { /* the whole frontier: no neighbour to meet */
+        out_count = simplify_by_meshoptimizer(s, index_count, local_count, target);
+        r->slide = 0.0f;
+        enough = out_count > 0 && (double)out_count <= (double)index_count * LOD_MAX_KEPT_SHARE;
+    }
     if (enough && !border_kept(b, s, index_count, out_count)) {
         r->border_reject = 1;
         enough = 0;

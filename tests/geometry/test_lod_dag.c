@@ -657,9 +657,10 @@ static void test_meshes(void)
     m = &s->meshes[ground];
     /* Its open border is not locked (only what groups share is): the grid simplifies away. */
     CHECK(m->clusters.dag_depth >= 3 && m->clusters.groups[m->clusters.group_count - 1].cluster_count == 1);
-    /* The tetrahedra cannot simplify: passed through at step 0, left in the root when nothing else can. */
+    /* The tetrahedra cannot simplify while groups of them meet neighbours: passed through at step 0,
+     * stuck; once one group holds them all, the fallback simplifier removes pieces (its error measured). */
     CHECK(stats[8].passthrough_clusters > 0 && stats[8].stuck_groups > 0);
-    CHECK(stats[8].stop_counts[GDR_LOD_STOP_NO_PROGRESS] == 1 && stats[8].root_triangles >= 300 * 4);
+    CHECK(stats[8].root_triangles < 300 * 4);
     m = &s->meshes[tri];
     CHECK(m->clusters.cluster_count == 1 && m->clusters.group_count == 1 && m->clusters.dag_depth == 0);
     gdr_scene_destroy(s);
