@@ -178,6 +178,7 @@ typedef struct gdr_raster_stats {
     char reason[128];
     float sw_threshold_px;
     uint32_t sw_clusters, hw_clusters;
+    uint32_t sw_tiny_clusters; /* of sw_clusters, those drawn several to a workgroup (tiny ones) */
     uint64_t sw_triangles, hw_triangles;
     uint32_t overflow; /* clusters lost for want of room in the list (0 below 2^25) or beyond the
                           device's mesh launch limit (0 below 2^22) */

@@ -505,7 +505,10 @@ GDR_ASSERT_SIZE(GdrGpuPushConstants, 40);
  * atomicMax keeps the nearest; 0 is empty), the low word (slot << GDR_VISBUFFER_TRIANGLE_BITS) |
  * triangle, where slot indexes the frame's list of visible clusters (GdrGpuRasterCluster). The
  * cluster cull (clustercull.comp) appends software-rasterised clusters from the front of that list
- * and mesh-shader clusters from the back. */
+ * and mesh-shader clusters from the back; tiny software-rasterised clusters (GDR_SW_TINY_*) go to a
+ * second part of the list after those `capacity` entries, `tiny_capacity` entries long, which the
+ * compute rasteriser draws several to a workgroup (a tiny cluster that finds it full joins the
+ * front). Either way the slot is the entry's index in the whole list. */
 #define GDR_GPU_RASTER_FORWARD 0u /* the mesh shaders shade; no visibility buffer */
 #define GDR_GPU_RASTER_HW 1u      /* every cluster through the mesh shaders into the visibility buffer */
 #define GDR_GPU_RASTER_SW 2u      /* every cluster the compute rasteriser can take (see raster_bin.h) */
@@ -543,22 +546,30 @@ GDR_STRUCT_BEGIN(GdrGpuRasterCounters)
     gdr_uint resolve_x;     /* VkDispatchIndirectCommand of the phase's resolve: GDR_RESOLVE_TILE tiles of */
     gdr_uint resolve_y;     /* the screen in the first phase and in a later phase that drew something, */
     gdr_uint resolve_z;     /* else none */
-    gdr_uint reserved0;
+    gdr_uint tiny_clusters; /* entries of the tiny part (their triangles count in sw_triangles) */
+    gdr_uint tiny_used;     /* tiny entries reserved: tiny_clusters, or beyond tiny_capacity when full */
+    gdr_uint tiny_first;    /* first tiny entry of the current tiny dispatch (from the tiny part's start) */
+    gdr_uint tiny_dispatched; /* tiny entries launched by earlier dispatches of the frame */
+    gdr_uint tiny_x;        /* VkDispatchIndirectCommand of the tiny clusters: several per workgroup */
+    gdr_uint tiny_y;
+    gdr_uint tiny_z;
 GDR_STRUCT_END(GdrGpuRasterCounters)
-GDR_ASSERT_SIZE(GdrGpuRasterCounters, 88);
+GDR_ASSERT_SIZE(GdrGpuRasterCounters, 112);
+GDR_ASSERT_OFFSET(GdrGpuRasterCounters, tiny_x, 100);
 GDR_ASSERT_OFFSET(GdrGpuRasterCounters, resolve_x, 72);
 GDR_ASSERT_OFFSET(GdrGpuRasterCounters, dispatch_z, 8);
 
 /* Per-frame raster parameters, written by the CPU into its frame's slot. */
 GDR_STRUCT_BEGIN(GdrGpuRasterParams)
-    GDR_REF(RasterClustersRef) clusters; /* GdrGpuRasterCluster[capacity] */
+    GDR_REF(RasterClustersRef) clusters; /* GdrGpuRasterCluster[capacity + tiny_capacity] */
     GDR_REF(RasterCountersRef) counters; /* GdrGpuRasterCounters */
     gdr_uint mode;          /* GDR_GPU_RASTER_* */
     gdr_uint capacity;      /* entries of the cluster list, <= GDR_RASTER_MAX_CLUSTERS */
     float sw_threshold_px;  /* hybrid: clusters whose triangles are smaller go to the compute rasteriser */
     gdr_uint hw_launch_limit; /* the most mesh workgroups one launch may have (maxMeshWorkGroupTotalCount) */
     gdr_vec2 ndc_scale;     /* the projection's P[0][0] and P[1][1] (x and y from view space to NDC) */
-    gdr_uint64 reserved;
+    gdr_uint tiny_capacity; /* entries of the tiny part, after the first `capacity` (0: no tiny path) */
+    gdr_uint reserved;
 GDR_STRUCT_END(GdrGpuRasterParams)
 GDR_ASSERT_SIZE(GdrGpuRasterParams, 48);
 GDR_ASSERT_OFFSET(GdrGpuRasterParams, mode, 16);

@@ -50,15 +50,26 @@ GDR_SHARED_FN bool gdr_raster_bin_sw(gdr_uint mode, float threshold_px, gdr_vec3
 #include "gpu_shared/material_flags.h"
 #include "gpu_shared/visbuffer.h"
 
+/* Whether a cluster of these sizes is drawn several to a compute-raster workgroup. */
+bool gdr_raster_sw_tiny(uint vertex_count, uint triangle_count)
+{
+    return vertex_count <= GDR_SW_TINY_VERTICES && triangle_count <= GDR_SW_TINY_TRIANGLES;
+}
+
+/* Reserves `count` entries (the subgroup's) against `limit` with the counter `used`, and returns
+ * whether they fit; the caller then takes them from its end of the list. */
+#define GDR_RASTER_RESERVE(used, count, limit) (atomicAdd(used, count) + (count) <= (limit))
+
 /* The cluster cull (clustercull.comp), every invocation in uniform control flow, after the tests:
  * bins the invocation's cluster when visible and appends it to the frame's visible-cluster list,
- * compute-rasterised clusters at the front and mesh-shader clusters at the back (one atomic per end
- * and subgroup). Entries that do not fit are dropped and counted. Needs MeshletsRef and InstancesRef
- * (meshlet_payload.h, glsl_buffers.h). */
+ * compute-rasterised clusters at the front, mesh-shader clusters at the back and tiny
+ * compute-rasterised clusters in the tiny part after both (one atomic per part and subgroup; tiny
+ * clusters that find the tiny part full join the front). Entries that do not fit are dropped and
+ * counted. Needs MeshletsRef and InstancesRef (meshlet_payload.h, glsl_buffers.h). */
 void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint meshlet_index)
 {
     RasterParamsRef params = GDR_FRAME.raster;
-    bool sw = false;
+    bool sw = false, tiny = false;
     uint triangles = 0u;
     if (visible) {
         GdrGpuMeshlet meshlet = MeshletsRef(GDR_SCENE.meshlets).items[meshlet_index];
@@ -76,25 +87,40 @@ void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint m
             uint material = InstancesRef(GDR_SCENE.instances).items[instance].material;
             sw = !gdr_material_alpha_tested(g.flags, material) && !gdr_material_double_sided(g.flags, material);
         }
+        tiny = sw && params.value.tiny_capacity > 0u && gdr_raster_sw_tiny(meshlet.vertex_count, triangles);
     }
-    bool hw = visible && !sw;
     RasterCountersRef counters = RasterCountersRef(params.value.counters);
+    uvec4 tiny_ballot = subgroupBallot(tiny);
+    uint tiny_count = subgroupBallotBitCount(tiny_ballot);
+    uint tiny_base = 0u;
+    bool tiny_fits = false;
+    if (tiny_count > 0u && subgroupElect()) {
+        tiny_fits = GDR_RASTER_RESERVE(counters.value.tiny_used, tiny_count, params.value.tiny_capacity);
+        if (tiny_fits)
+            tiny_base = params.value.capacity + atomicAdd(counters.value.tiny_clusters, tiny_count);
+    }
+    tiny_fits = subgroupBroadcastFirst(tiny_fits);
+    tiny_base = subgroupBroadcastFirst(tiny_base);
+    tiny = tiny && tiny_fits;
+    sw = sw && !tiny;
+
+    bool hw = visible && !sw && !tiny;
     uvec4 sw_ballot = subgroupBallot(sw), hw_ballot = subgroupBallot(hw);
     uint sw_count = subgroupBallotBitCount(sw_ballot), hw_count = subgroupBallotBitCount(hw_ballot);
-    uint sw_triangles = subgroupAdd(sw ? triangles : 0u);
+    uint sw_triangles = subgroupAdd(sw || tiny ? triangles : 0u);
     uint hw_triangles = subgroupAdd(hw ? triangles : 0u);
     uint sw_base = 0u, hw_base = 0u;
     bool sw_fits = true, hw_fits = true;
     if (subgroupElect()) {
         if (sw_count > 0u) {
-            sw_fits = atomicAdd(counters.value.used, sw_count) + sw_count <= params.value.capacity;
+            sw_fits = GDR_RASTER_RESERVE(counters.value.used, sw_count, params.value.capacity);
             if (sw_fits)
                 sw_base = atomicAdd(counters.value.sw_clusters, sw_count);
             else
                 atomicAdd(counters.value.overflow, sw_count);
         }
         if (hw_count > 0u) {
-            hw_fits = atomicAdd(counters.value.used, hw_count) + hw_count <= params.value.capacity;
+            hw_fits = GDR_RASTER_RESERVE(counters.value.used, hw_count, params.value.capacity);
             if (hw_fits)
                 hw_base = params.value.capacity - atomicAdd(counters.value.hw_clusters, hw_count) - hw_count;
             else
@@ -110,6 +136,8 @@ void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint m
     sw_fits = subgroupBroadcastFirst(sw_fits);
     hw_fits = subgroupBroadcastFirst(hw_fits);
     RasterClustersRef list = RasterClustersRef(params.value.clusters);
+    if (tiny)
+        list.items[tiny_base + subgroupBallotExclusiveBitCount(tiny_ballot)] = GdrGpuRasterCluster(instance, meshlet_index);
     if (sw && sw_fits)
         list.items[sw_base + subgroupBallotExclusiveBitCount(sw_ballot)] = GdrGpuRasterCluster(instance, meshlet_index);
     if (hw && hw_fits)

@@ -41,6 +41,19 @@ static gdr_status gather_clusters(const gdr_scene *scene, const gdr_mesh_cluster
 }
 
 /* Cluster i of c with pool-global data offsets and its groups' LOD data inline. */
+/* The clusters of each mesh that the compute rasteriser draws several to a workgroup
+ * (raster_bin.h's gdr_raster_sw_tiny): they size the tiny part of the visible-cluster list. */
+static uint32_t *count_tiny_clusters(uint32_t mesh_count, const GdrGpuMesh *meshes, const GdrGpuMeshlet *meshlets)
+{
+    uint32_t *tiny = calloc(mesh_count ? mesh_count : 1, sizeof *tiny);
+    for (uint32_t m = 0; m < mesh_count && tiny; m++)
+        for (uint32_t i = 0; i < meshes[m].lod_cluster_count; i++) {
+            const GdrGpuMeshlet *k = &meshlets[meshes[m].meshlet_offset + i];
+            tiny[m] += k->vertex_count <= GDR_SW_TINY_VERTICES && k->triangle_count <= GDR_SW_TINY_TRIANGLES;
+        }
+    return tiny;
+}
+
 static GdrGpuMeshlet gpu_meshlet_from(const gdr_mesh_clusters *c, uint32_t i, uint32_t vertex_base, uint32_t byte_base)
 {
     const gdr_cluster *k = &c->clusters[i];
@@ -175,13 +188,19 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
         vertex_cursor += c->vertex_count;
         byte_cursor += c->triangle_byte_count;
     }
-    uint64_t instance_meshlets = 0, instance_lod_clusters = 0;
-    for (uint32_t i = 0; i < scene->instance_count; i++) {
+    uint64_t instance_meshlets = 0, instance_lod_clusters = 0, instance_tiny = 0;
+    uint32_t *tiny = status == GDR_OK ? count_tiny_clusters(scene->mesh_count, g->cpu_meshes, meshlets) : NULL;
+    if (status == GDR_OK && !tiny)
+        status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory");
+    for (uint32_t i = 0; i < scene->instance_count && tiny; i++) {
         instance_meshlets += g->cpu_meshes[scene->instances[i].mesh].meshlet_count;
         instance_lod_clusters += g->cpu_meshes[scene->instances[i].mesh].lod_cluster_count;
+        instance_tiny += tiny[scene->instances[i].mesh];
     }
+    free(tiny);
     g->instance_meshlet_count = instance_meshlets;
     g->instance_lod_cluster_count = instance_lod_clusters;
+    g->instance_tiny_cluster_count = instance_tiny;
     g->meshlet_count = (uint32_t)meshlet_total;
     const VkBufferUsageFlags usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     if (status == GDR_OK)

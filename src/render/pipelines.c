@@ -75,7 +75,10 @@ static const gdr_pipeline_entry entries[GDR_PIPE_COUNT] = {
                             .fragment = &gdr_shader_meshlet_visbuffer_frag,
                             .alpha_fragment = &gdr_shader_meshlet_visbuffer_alpha_frag, .targets = GDR_TARGETS_NONE,
                             .cull_back = true},
-    [GDR_PIPE_RASTER_SW] = {"raster_sw", GDR_NEEDS_VISIBILITY_BUFFER, .compute = &gdr_shader_raster_sw_comp},
+    [GDR_PIPE_RASTER_SW] = {"raster_sw", GDR_NEEDS_VISIBILITY_BUFFER, .compute = &gdr_shader_raster_sw_comp,
+                            .constants = {GDR_SW_RASTER_WORKGROUP_SIZE}, .constant_count = 1},
+    [GDR_PIPE_RASTER_SW_TINY] = {"raster_sw_tiny", GDR_NEEDS_VISIBILITY_BUFFER, .compute = &gdr_shader_raster_sw_comp,
+                                 .constants = {GDR_SW_TINY_LANES}, .constant_count = 1},
     [GDR_PIPE_RESOLVE] = {"resolve", GDR_NEEDS_VISIBILITY_BUFFER, .compute = &gdr_shader_visbuffer_resolve_comp,
                           .constants = {0}, .constant_count = 1},
 };

@@ -52,10 +52,20 @@ gdr_status gdr_visbuffer_set_scene(gdr_renderer *r, gdr_error *err)
     gdr_visbuffer *v = &r->vis;
     if (!v->supported)
         return GDR_OK;
-    /* Every cluster of every instance's DAG is the most one frame can draw. */
-    uint64_t total = r->scene.instance_lod_cluster_count;
-    v->capacity = (uint32_t)(total < GDR_RASTER_MAX_CLUSTERS ? (total ? total : 1) : GDR_RASTER_MAX_CLUSTERS);
-    return gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuRasterCluster) * (VkDeviceSize)v->capacity,
+    /* Every cluster of every instance's DAG is the most one frame can draw; the tiny ones go to the
+     * tiny part (or, when it is full, to the front). Both parts share the slots a visibility-buffer id
+     * can name, in proportion when the scene has more. */
+    uint64_t total = r->scene.instance_lod_cluster_count ? r->scene.instance_lod_cluster_count : 1;
+    uint64_t tiny = r->debug.tiny_raster_off        ? 0
+                    : r->debug.tiny_raster_capacity ? r->debug.tiny_raster_capacity
+                                                    : r->scene.instance_tiny_cluster_count;
+    if (total + tiny > GDR_RASTER_MAX_CLUSTERS) {
+        tiny = (uint64_t)((double)GDR_RASTER_MAX_CLUSTERS * (double)tiny / (double)(total + tiny));
+        total = GDR_RASTER_MAX_CLUSTERS - tiny;
+    }
+    v->capacity = (uint32_t)total;
+    v->tiny_capacity = (uint32_t)tiny;
+    return gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuRasterCluster) * ((VkDeviceSize)total + tiny),
                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                 GDR_VK_BUFFER_DEVICE, &v->clusters, err);
 }
@@ -148,6 +158,7 @@ void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_f
         .counters = v->counters.address,
         .mode = mode,
         .capacity = v->capacity,
+        .tiny_capacity = v->tiny_capacity,
         .sw_threshold_px = gdr_visbuffer_threshold(frame),
         .ndc_scale = {fabsf(projection.m[0]), fabsf(projection.m[5])},
         .hw_launch_limit = (uint32_t)(rows * GDR_MESH_GROUPS_PER_ROW),
@@ -192,11 +203,17 @@ void gdr_visbuffer_record_raster_hw(gdr_renderer *r, gdr_frame_slot *slot, const
     vkCmdEndRendering(cmd);
 }
 
-/* The compute rasteriser over the clusters at the front of the list. */
+/* The compute rasteriser over the tiny part of the list, several clusters per workgroup, then over
+ * the clusters at the front, one per workgroup. Both only add to the visibility buffer with atomics,
+ * so the second needs no barrier after the first. */
 void gdr_visbuffer_record_raster_sw(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
                                     VkCommandBuffer cmd)
 {
     (void)slot, (void)pass;
+    if (r->vis.tiny_capacity > 0) {
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->pipelines[GDR_PIPE_RASTER_SW_TINY]);
+        vkCmdDispatchIndirect(cmd, r->vis.counters.buffer, offsetof(GdrGpuRasterCounters, tiny_x));
+    }
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->pipelines[GDR_PIPE_RASTER_SW]);
     vkCmdDispatchIndirect(cmd, r->vis.counters.buffer, offsetof(GdrGpuRasterCounters, dispatch_x));
 }
@@ -224,7 +241,8 @@ void gdr_visbuffer_stats(gdr_renderer *r, uint32_t slot_index, gdr_frame_stats *
     GdrGpuRasterParams params;
     memcpy(&params, v->params[slot_index].mapped, sizeof params);
     stats->raster.sw_threshold_px = params.sw_threshold_px;
-    stats->raster.sw_clusters = counters.sw_clusters;
+    stats->raster.sw_clusters = counters.sw_clusters + counters.tiny_clusters;
+    stats->raster.sw_tiny_clusters = counters.tiny_clusters;
     stats->raster.hw_clusters = counters.hw_clusters;
     stats->raster.sw_triangles = counters.sw_triangles;
     stats->raster.hw_triangles = counters.hw_triangles;
@@ -266,9 +284,9 @@ gdr_status gdr_visbuffer_read_pixels(gdr_renderer *r, gdr_visbuffer_pixel *pixel
         pixels[p] = (gdr_visbuffer_pixel){0.0f, UINT32_MAX, 0, 0};
         if (depth_bits == 0)
             continue;
-        if (slot >= v->capacity) {
+        if (slot >= v->capacity + v->tiny_capacity) {
             status = gdr_error_set(err, GDR_ERROR_VULKAN, "visibility buffer: pixel %zu names slot %u of %u", p, slot,
-                                   v->capacity);
+                                   v->capacity + v->tiny_capacity);
             break;
         }
         const GdrGpuRasterCluster *entry = (const GdrGpuRasterCluster *)clusters.mapped + slot;

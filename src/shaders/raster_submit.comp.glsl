@@ -11,6 +11,13 @@
 
 layout(local_size_x = 1) in;
 
+// The workgroups of `groups`, in rows of GDR_SW_GROUPS_PER_ROW.
+uvec3 sw_dispatch(uint groups)
+{
+    uint rows = (groups + GDR_SW_GROUPS_PER_ROW - 1u) / GDR_SW_GROUPS_PER_ROW;
+    return uvec3(rows > 1u ? GDR_SW_GROUPS_PER_ROW : groups, rows, 1u);
+}
+
 void main()
 {
     RasterParamsRef params = GDR_FRAME.raster;
@@ -19,10 +26,20 @@ void main()
     uint count = counters.value.sw_clusters - first;
     counters.value.sw_first = first;
     counters.value.sw_dispatched = counters.value.sw_clusters;
-    uint rows = (count + GDR_SW_GROUPS_PER_ROW - 1u) / GDR_SW_GROUPS_PER_ROW;
-    counters.value.dispatch_x = rows > 1u ? GDR_SW_GROUPS_PER_ROW : count;
-    counters.value.dispatch_y = rows;
-    counters.value.dispatch_z = 1u;
+    uvec3 launch = sw_dispatch(count);
+    counters.value.dispatch_x = launch.x;
+    counters.value.dispatch_y = launch.y;
+    counters.value.dispatch_z = launch.z;
+
+    uint tiny_first = counters.value.tiny_dispatched;
+    uint tiny_count = counters.value.tiny_clusters - tiny_first;
+    counters.value.tiny_first = tiny_first;
+    counters.value.tiny_dispatched = counters.value.tiny_clusters;
+    const uint per_group = GDR_SW_RASTER_WORKGROUP_SIZE / GDR_SW_TINY_LANES;
+    launch = sw_dispatch((tiny_count + per_group - 1u) / per_group);
+    counters.value.tiny_x = launch.x;
+    counters.value.tiny_y = launch.y;
+    counters.value.tiny_z = launch.z;
 
     uint hw_total = counters.value.hw_clusters;
     uint hw_new = hw_total - counters.value.hw_dispatched;
@@ -32,12 +49,12 @@ void main()
     counters.value.hw_first = params.value.capacity - hw_total;
     counters.value.hw_count = hw_count;
     counters.value.hw_dispatched = hw_total;
-    rows = (hw_count + GDR_MESH_GROUPS_PER_ROW - 1u) / GDR_MESH_GROUPS_PER_ROW;
+    uint rows = (hw_count + GDR_MESH_GROUPS_PER_ROW - 1u) / GDR_MESH_GROUPS_PER_ROW;
     counters.value.draw_x = rows > 1u ? GDR_MESH_GROUPS_PER_ROW : hw_count;
     counters.value.draw_y = rows;
     counters.value.draw_z = 1u;
 
-    bool resolve = counters.value.phases == 0u || count > 0u || hw_count > 0u;
+    bool resolve = counters.value.phases == 0u || count > 0u || tiny_count > 0u || hw_count > 0u;
     uvec2 tiles = (uvec2(FrameGlobalsRef(push.globals).value.viewport) + GDR_RESOLVE_TILE - 1u) / GDR_RESOLVE_TILE;
     counters.value.resolve_x = resolve ? tiles.x : 0u;
     counters.value.resolve_y = resolve ? tiles.y : 0u;
