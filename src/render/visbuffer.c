@@ -54,13 +54,15 @@ gdr_status gdr_visbuffer_set_scene(gdr_renderer *r, gdr_error *err)
         return GDR_OK;
     /* Every cluster of every instance's DAG is the most one frame can draw; the tiny ones go to the
      * tiny part (or, when it is full, to the front). Both parts share the slots a visibility-buffer id
-     * can name, in proportion when the scene has more. */
+     * can name: beyond that, the tiny part gets all its clusters up to half of them. A large field of
+     * distant instances draws mostly its roots, tiny clusters, from a DAG of a thousand clusters each:
+     * a share in proportion would leave most of them to the front. */
     uint64_t total = r->scene.instance_lod_cluster_count ? r->scene.instance_lod_cluster_count : 1;
     uint64_t tiny = r->debug.tiny_raster_off        ? 0
                     : r->debug.tiny_raster_capacity ? r->debug.tiny_raster_capacity
                                                     : r->scene.instance_tiny_cluster_count;
     if (total + tiny > GDR_RASTER_MAX_CLUSTERS) {
-        tiny = (uint64_t)((double)GDR_RASTER_MAX_CLUSTERS * (double)tiny / (double)(total + tiny));
+        tiny = tiny < GDR_RASTER_MAX_CLUSTERS / 2 ? tiny : GDR_RASTER_MAX_CLUSTERS / 2;
         total = GDR_RASTER_MAX_CLUSTERS - tiny;
     }
     v->capacity = (uint32_t)total;
