@@ -46,15 +46,20 @@ GDR_SHARED_FN bool gdr_raster_bin_sw(gdr_uint mode, float threshold_px, gdr_vec3
            gdr_raster_triangle_px(c, r, triangle_count, ndc_scale.y * 0.5f * viewport_height) < threshold_px;
 }
 
+/* The tiny size class of a cluster of these sizes (GDR_SW_TINY_*): the smallest whose clusters are no
+ * larger, or GDR_SW_TINY_CLASSES for a cluster of a workgroup of its own. */
+GDR_SHARED_FN gdr_uint gdr_raster_tiny_class(gdr_uint vertex_count, gdr_uint triangle_count)
+{
+    gdr_uint size = vertex_count > triangle_count ? vertex_count : triangle_count;
+    gdr_uint k = 0u;
+    while (k < GDR_SW_TINY_CLASSES && size > (GDR_SW_TINY_LANES << k))
+        k++;
+    return k;
+}
+
 #ifdef GDR_GLSL
 #include "gpu_shared/material_flags.h"
 #include "gpu_shared/visbuffer.h"
-
-/* Whether a cluster of these sizes is drawn several to a compute-raster workgroup. */
-bool gdr_raster_sw_tiny(uint vertex_count, uint triangle_count)
-{
-    return vertex_count <= GDR_SW_TINY_VERTICES && triangle_count <= GDR_SW_TINY_TRIANGLES;
-}
 
 /* Reserves `count` entries (the subgroup's) against `limit` with the counter `used`, and returns
  * whether they fit; the caller then takes them from its end of the list. */
@@ -63,14 +68,14 @@ bool gdr_raster_sw_tiny(uint vertex_count, uint triangle_count)
 /* The cluster cull (clustercull.comp), every invocation in uniform control flow, after the tests:
  * bins the invocation's cluster when visible and appends it to the frame's visible-cluster list,
  * compute-rasterised clusters at the front, mesh-shader clusters at the back and tiny
- * compute-rasterised clusters in the tiny part after both (one atomic per part and subgroup; tiny
- * clusters that find the tiny part full join the front). Entries that do not fit are dropped and
+ * compute-rasterised clusters in the part of their size class after both (one atomic per part and
+ * subgroup; tiny clusters that find their part full join the front). Entries that do not fit are dropped and
  * counted. Needs MeshletsRef and InstancesRef (meshlet_payload.h, glsl_buffers.h). */
 void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint meshlet_index)
 {
     RasterParamsRef params = GDR_FRAME.raster;
-    bool sw = false, tiny = false;
-    uint triangles = 0u;
+    bool sw = false;
+    uint triangles = 0u, tiny_class = GDR_SW_TINY_CLASSES;
     if (visible) {
         GdrGpuMeshlet meshlet = MeshletsRef(GDR_SCENE.meshlets).items[meshlet_index];
         mat4 model = InstancesRef(GDR_SCENE.instances).items[instance].model;
@@ -87,22 +92,33 @@ void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint m
             uint material = InstancesRef(GDR_SCENE.instances).items[instance].material;
             sw = !gdr_material_alpha_tested(g.flags, material) && !gdr_material_double_sided(g.flags, material);
         }
-        tiny = sw && params.value.tiny_capacity > 0u && gdr_raster_sw_tiny(meshlet.vertex_count, triangles);
+        if (sw)
+            tiny_class = gdr_raster_tiny_class(meshlet.vertex_count, triangles);
     }
     RasterCountersRef counters = RasterCountersRef(params.value.counters);
-    uvec4 tiny_ballot = subgroupBallot(tiny);
-    uint tiny_count = subgroupBallotBitCount(tiny_ballot);
-    uint tiny_base = 0u;
-    bool tiny_fits = false;
-    if (tiny_count > 0u && subgroupElect()) {
-        tiny_fits = GDR_RASTER_RESERVE(counters.value.tiny_used, tiny_count, params.value.tiny_capacity);
-        if (tiny_fits)
-            tiny_base = params.value.capacity + atomicAdd(counters.value.tiny_clusters, tiny_count);
+    RasterClustersRef list = RasterClustersRef(params.value.clusters);
+    // The tiny classes first: a cluster whose part is full joins the front.
+    for (uint k = 0u; k < GDR_SW_TINY_CLASSES; k++) {
+        bool tiny = tiny_class == k && params.value.tiny_capacity[k] > 0u;
+        uvec4 ballot = subgroupBallot(tiny);
+        uint count = subgroupBallotBitCount(ballot);
+        if (count == 0u)
+            continue;
+        uint base = 0u;
+        bool fits = false;
+        if (subgroupElect()) {
+            fits = GDR_RASTER_RESERVE(counters.value.tiny_used[k], count, params.value.tiny_capacity[k]);
+            if (fits)
+                base = params.value.tiny_base[k] + atomicAdd(counters.value.tiny_clusters[k], count);
+        }
+        fits = subgroupBroadcastFirst(fits);
+        base = subgroupBroadcastFirst(base);
+        if (fits && tiny) {
+            list.items[base + subgroupBallotExclusiveBitCount(ballot)] = GdrGpuRasterCluster(instance, meshlet_index);
+            sw = false;
+        }
     }
-    tiny_fits = subgroupBroadcastFirst(tiny_fits);
-    tiny_base = subgroupBroadcastFirst(tiny_base);
-    tiny = tiny && tiny_fits;
-    sw = sw && !tiny;
+    bool tiny = tiny_class < GDR_SW_TINY_CLASSES && !sw;
 
     bool hw = visible && !sw && !tiny;
     uvec4 sw_ballot = subgroupBallot(sw), hw_ballot = subgroupBallot(hw);
@@ -135,9 +151,6 @@ void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint m
     hw_base = subgroupBroadcastFirst(hw_base);
     sw_fits = subgroupBroadcastFirst(sw_fits);
     hw_fits = subgroupBroadcastFirst(hw_fits);
-    RasterClustersRef list = RasterClustersRef(params.value.clusters);
-    if (tiny)
-        list.items[tiny_base + subgroupBallotExclusiveBitCount(tiny_ballot)] = GdrGpuRasterCluster(instance, meshlet_index);
     if (sw && sw_fits)
         list.items[sw_base + subgroupBallotExclusiveBitCount(sw_ballot)] = GdrGpuRasterCluster(instance, meshlet_index);
     if (hw && hw_fits)

@@ -2,7 +2,9 @@
 // The launches of one raster phase, one thread: from the clusters the cluster cull
 // appended since the last phase, the compute rasteriser's VkDispatchIndirectCommand (front of the
 // list) and the mesh shaders' VkDrawMeshTasksIndirectCommandEXT (back of the list), one workgroup per
-// cluster. Launches wider than a row use y; the shaders skip the tail of the last row. Mesh-shader
+// cluster, and a VkDispatchIndirectCommand per tiny size class over its part of the list, several
+// clusters per workgroup (raster_sw.comp's tiny variants). Launches wider than a row use y; the
+// shaders skip the tail of the last row. Mesh-shader
 // clusters beyond the device's launch limit are dropped and counted as overflow. And the resolve's
 // VkDispatchIndirectCommand: the whole screen in the frame's first phase and in a later phase with
 // clusters to draw, nothing otherwise (the visibility buffer has not changed since the last resolve).
@@ -31,15 +33,19 @@ void main()
     counters.value.dispatch_y = launch.y;
     counters.value.dispatch_z = launch.z;
 
-    uint tiny_first = counters.value.tiny_dispatched;
-    uint tiny_count = counters.value.tiny_clusters - tiny_first;
-    counters.value.tiny_first = tiny_first;
-    counters.value.tiny_dispatched = counters.value.tiny_clusters;
-    const uint per_group = GDR_SW_RASTER_WORKGROUP_SIZE / GDR_SW_TINY_LANES;
-    launch = sw_dispatch((tiny_count + per_group - 1u) / per_group);
-    counters.value.tiny_x = launch.x;
-    counters.value.tiny_y = launch.y;
-    counters.value.tiny_z = launch.z;
+    uint tiny_total = 0u;
+    for (uint k = 0u; k < GDR_SW_TINY_CLASSES; k++) {
+        uint tiny_first = counters.value.tiny_dispatched[k];
+        uint tiny_count = counters.value.tiny_clusters[k] - tiny_first;
+        counters.value.tiny_first[k] = tiny_first;
+        counters.value.tiny_dispatched[k] = counters.value.tiny_clusters[k];
+        uint per_group = GDR_SW_RASTER_WORKGROUP_SIZE / (GDR_SW_TINY_LANES << k);
+        launch = sw_dispatch((tiny_count + per_group - 1u) / per_group);
+        counters.value.tiny_launch[3u * k] = launch.x;
+        counters.value.tiny_launch[3u * k + 1u] = launch.y;
+        counters.value.tiny_launch[3u * k + 2u] = launch.z;
+        tiny_total += tiny_count;
+    }
 
     uint hw_total = counters.value.hw_clusters;
     uint hw_new = hw_total - counters.value.hw_dispatched;
@@ -54,7 +60,7 @@ void main()
     counters.value.draw_y = rows;
     counters.value.draw_z = 1u;
 
-    bool resolve = counters.value.phases == 0u || count > 0u || tiny_count > 0u || hw_count > 0u;
+    bool resolve = counters.value.phases == 0u || count > 0u || tiny_total > 0u || hw_count > 0u;
     uvec2 tiles = (uvec2(FrameGlobalsRef(push.globals).value.viewport) + GDR_RESOLVE_TILE - 1u) / GDR_RESOLVE_TILE;
     counters.value.resolve_x = resolve ? tiles.x : 0u;
     counters.value.resolve_y = resolve ? tiles.y : 0u;

@@ -1,9 +1,9 @@
 #version 460
 // The compute rasteriser: one workgroup per cluster that the cluster cull binned to it
 // (shared/raster_bin.h), the cluster's vertices transformed once into shared memory, then one
-// invocation per triangle. The tiny variant (CLUSTER_LANES = GDR_SW_TINY_LANES) draws the tiny part
-// of the list several clusters to a workgroup, CLUSTER_LANES invocations and a slice of the shared
-// vertices each; the rasterisation below is the same for both. Coverage follows Vulkan's rules as the hardware applies them, so the two
+// invocation per triangle. The tiny variants (one per size class, GDR_SW_TINY_*) draw their class's
+// part of the list several clusters to a workgroup, CLUSTER_LANES invocations and as many shared
+// vertices each; the rasterisation below is the same for all. Coverage follows Vulkan's rules as the hardware applies them, so the two
 // rasterisers agree pixel for pixel where their clusters meet:
 //  - the frame's viewport transform (negative height: framebuffer y down), vertices snapped to
 //    GDR_SW_SUBPIXEL_BITS fractional bits, rounding to nearest even;
@@ -22,8 +22,10 @@
 #include "gpu_shared/visbuffer.h"
 
 layout(local_size_x = GDR_SW_RASTER_WORKGROUP_SIZE) in;
-// Invocations per cluster: the whole workgroup, or GDR_SW_TINY_LANES for the tiny part.
+// Invocations per cluster: the whole workgroup, or GDR_SW_TINY_LANES << TINY_CLASS for a tiny class
+// (GDR_SW_TINY_CLASSES: none, the front of the list).
 layout(constant_id = 0) const uint CLUSTER_LANES = GDR_SW_RASTER_WORKGROUP_SIZE;
+layout(constant_id = 1) const uint TINY_CLASS = GDR_SW_TINY_CLASSES;
 const uint CLUSTERS_PER_GROUP = GDR_SW_RASTER_WORKGROUP_SIZE / CLUSTER_LANES;
 const uint SLICE_VERTICES = GDR_MESH_MAX_VERTICES / CLUSTERS_PER_GROUP; // each cluster's shared vertices
 
@@ -139,19 +141,20 @@ void raster_triangle(uvec3 corners, uint id, ivec2 size)
         raster_large(a, b, c, first, last, id);
 }
 
-// The entry of the workgroup's cluster, or this invocation's in the tiny variant, and its slot in
-// the list; false past the end of the current dispatch (the tail of the last row or workgroup).
+// The slot of the workgroup's cluster, or of this invocation's in a tiny variant, in the list; false
+// past the end of the current dispatch (the tail of the last row or workgroup).
 bool find_entry(RasterParamsRef params, out uint slot)
 {
     RasterCountersRef counters = RasterCountersRef(params.value.counters);
     uint group = gl_WorkGroupID.x + gl_WorkGroupID.y * GDR_SW_GROUPS_PER_ROW;
-    if (CLUSTERS_PER_GROUP == 1u) {
+    if (TINY_CLASS >= GDR_SW_TINY_CLASSES) {
         slot = counters.value.sw_first + group;
         return slot < counters.value.sw_clusters;
     }
-    uint index = counters.value.tiny_first + group * CLUSTERS_PER_GROUP + gl_LocalInvocationIndex / CLUSTER_LANES;
-    slot = params.value.capacity + index;
-    return index < counters.value.tiny_clusters;
+    uint index = counters.value.tiny_first[TINY_CLASS] + group * CLUSTERS_PER_GROUP +
+                 gl_LocalInvocationIndex / CLUSTER_LANES;
+    slot = params.value.tiny_base[TINY_CLASS] + index;
+    return index < counters.value.tiny_clusters[TINY_CLASS];
 }
 
 void main()
