@@ -26,22 +26,20 @@ typedef struct tiny_result {
     gdr_frame_stats stats;
 } tiny_result;
 
-static tiny_result results[3];
+/* Per renderer, the two frames of render_frames. */
+static tiny_result results[3][2];
 
-/* Two frames from `cameras` (the second with the first's occlusion history), read back, then the
- * overdraw view of the second camera. */
-static bool render_frames(gdr_renderer *r, const gdr_camera cameras[2], gdr_raster raster, tiny_result *out)
+/* One frame from `camera`, read back, then its overdraw view. */
+static bool render_frame(gdr_renderer *r, const gdr_camera *camera, gdr_raster raster, tiny_result *out)
 {
     gdr_error err = {0};
     gdr_frame_stats stats;
-    gdr_frame_desc frame = {.camera = cameras[0], .raster = raster, .lod_error_px = 1.0f};
-    bool ok = gdr_renderer_render(r, &frame, 1, &stats, &err) == GDR_OK;
-    frame.camera = cameras[1];
-    frame.read_back = true;
-    ok = ok && gdr_renderer_render(r, &frame, 1, &out->stats, &err) == GDR_OK &&
-         gdr_renderer_read_color(r, out->rgba, &err) == GDR_OK &&
-         gdr_visbuffer_read_depth(r, out->depth, &err) == GDR_OK &&
-         gdr_visbuffer_read_pixels(r, out->vis, &err) == GDR_OK;
+    gdr_frame_desc frame = {.camera = *camera, .raster = raster, .lod_error_px = 1.0f, .occlusion = GDR_CULL_ON,
+                            .read_back = true};
+    bool ok = gdr_renderer_render(r, &frame, 1, &out->stats, &err) == GDR_OK &&
+              gdr_renderer_read_color(r, out->rgba, &err) == GDR_OK &&
+              gdr_visbuffer_read_depth(r, out->depth, &err) == GDR_OK &&
+              gdr_visbuffer_read_pixels(r, out->vis, &err) == GDR_OK;
     frame.view = GDR_VIEW_MODE_OVERDRAW;
     ok = ok && gdr_renderer_render(r, &frame, 1, &stats, &err) == GDR_OK &&
          gdr_visbuffer_read_overdraw(r, out->overdraw, &err) == GDR_OK;
@@ -51,8 +49,15 @@ static bool render_frames(gdr_renderer *r, const gdr_camera cameras[2], gdr_rast
     return ok;
 }
 
+/* Two frames: the first without occlusion history (its late raster phase draws what the early one
+ * could not test), the second with the first's. */
+static bool render_frames(gdr_renderer *r, const gdr_camera cameras[2], gdr_raster raster, tiny_result out[2])
+{
+    return render_frame(r, &cameras[0], raster, &out[0]) && render_frame(r, &cameras[1], raster, &out[1]);
+}
+
 static bool render_with(const gdr_scene *scene, const gdr_renderer_debug *debug, const gdr_camera cameras[2],
-                        gdr_raster raster, tiny_result *out)
+                        gdr_raster raster, tiny_result out[2])
 {
     gdr_error err = {0};
     gdr_renderer *r = NULL;
@@ -92,8 +97,13 @@ static bool same_counts(const gdr_frame_stats *a, const gdr_frame_stats *b)
            a->raster.hw_triangles == b->raster.hw_triangles && a->raster.overflow == 0 && b->raster.overflow == 0;
 }
 
+static void check_frame(const char *spec, gdr_raster raster, int f, uint32_t *taken);
+
 /* Draws `scene` the three ways and compares; adds the tiny path's clusters per class to `taken`.
- * cameras: NULL for the scene's first camera and that camera moved sideways. */
+ * cameras: NULL for the scene's camera, after a first frame from close in front of the field's
+ * first row (lod-field: FIELD_NEAR of src/procedural/lod_field_scene.c), whose instance hides much
+ * of the field: the second frame's late raster phase draws what it reveals, tiny clusters among
+ * them, after the early phase's (each tiny part then has a second dispatch in the frame). */
 static void check_scene(const char *spec, const gdr_camera *cameras, gdr_raster raster, uint32_t *taken)
 {
     gdr_error err = {0};
@@ -107,22 +117,31 @@ static void check_scene(const char *spec, const gdr_camera *cameras, gdr_raster 
     gdr_camera own[2];
     if (!cameras && scene->camera_count > 0) {
         own[0] = own[1] = scene->cameras[0];
-        own[1].position.x += 0.5f;
+        own[0].position = (gdr_vec3){0, 1.5f, -2.5f};
+        own[0].rotation = gdr_quat_identity();
         cameras = own;
     }
     CHECK(cameras != NULL);
     const gdr_renderer_debug debugs[3] = {{0}, {.tiny_raster_off = true}, {.tiny_raster_capacity = FORCED_CAPACITY}};
     bool ok = cameras != NULL;
     for (int i = 0; i < 3 && ok; i++)
-        ok = render_with(scene, &debugs[i], cameras, raster, &results[i]);
+        ok = render_with(scene, &debugs[i], cameras, raster, results[i]);
     gdr_scene_destroy(scene);
     if (!ok)
         return;
-    const gdr_raster_stats *tiny = &results[0].stats.raster, *off = &results[1].stats.raster,
-                           *forced = &results[2].stats.raster;
-    printf("%s, %s: %u compute-rasterised clusters, %u of them tiny (%u/%u/%u of 8/16/32 invocations), %u mesh-shader; "
+    for (int f = 0; f < 2; f++)
+        check_frame(spec, raster, f, taken);
+}
+
+/* Frame `f` of the three renderers. */
+static void check_frame(const char *spec, gdr_raster raster, int f, uint32_t *taken)
+{
+    const tiny_result *with = &results[0][f];
+    const gdr_raster_stats *tiny = &with->stats.raster, *off = &results[1][f].stats.raster,
+                           *forced = &results[2][f].stats.raster;
+    printf("%s, %s, frame %d: %u compute-rasterised clusters, %u of them tiny (%u/%u/%u of 8/16/32 invocations), %u mesh-shader; "
            "without the tiny path %u tiny; forced to %u entries a class %u tiny\n",
-           spec, gdr_raster_name(raster), tiny->sw_clusters, tiny->sw_tiny_clusters, tiny->sw_tiny_class_clusters[0],
+           spec, gdr_raster_name(raster), f, tiny->sw_clusters, tiny->sw_tiny_clusters, tiny->sw_tiny_class_clusters[0],
            tiny->sw_tiny_class_clusters[1], tiny->sw_tiny_class_clusters[2], tiny->hw_clusters, off->sw_tiny_clusters,
            FORCED_CAPACITY, forced->sw_tiny_clusters);
     uint32_t tiny_sum = 0;
@@ -135,35 +154,38 @@ static void check_scene(const char *spec, const gdr_camera *cameras, gdr_raster 
     CHECK(off->sw_tiny_clusters == 0);
     CHECK(forced->sw_tiny_clusters < tiny->sw_tiny_clusters);
     taken[GDR_RASTER_TINY_CLASSES] += forced->sw_tiny_clusters;
-    CHECK(same_counts(&results[0].stats, &results[1].stats) && same_counts(&results[0].stats, &results[2].stats));
-    CHECK(tiny->sw_clusters + tiny->hw_clusters == results[0].stats.meshlets_visible);
+    CHECK(same_counts(&with->stats, &results[1][f].stats) && same_counts(&with->stats, &results[2][f].stats));
+    CHECK(tiny->sw_clusters + tiny->hw_clusters == with->stats.meshlets_visible);
     for (int i = 1; i < 3; i++) {
-        uint32_t n = differing(&results[0], &results[i]);
+        uint32_t n = differing(with, &results[i][f]);
         if (n) {
-            fprintf(stderr, "%s, %s: the frame %s differs from the tiny path's at %u pixels\n", spec,
-                    gdr_raster_name(raster), i == 1 ? "without the tiny path" : "with full tiny parts", n);
+            fprintf(stderr, "%s, %s, frame %d: the frame %s differs from the tiny path's at %u pixels\n", spec,
+                    gdr_raster_name(raster), f, i == 1 ? "without the tiny path" : "with full tiny parts", n);
             CHECK(false);
         }
     }
     uint32_t covered = 0;
     for (int p = 0; p < PIXELS; p++)
-        covered += results[0].vis[p].instance != UINT32_MAX;
-    printf("  %u of %u pixels covered\n", covered, PIXELS);
+        covered += with->vis[p].instance != UINT32_MAX;
+    printf("  %u of %u pixels covered; clusters drawn early %u, late %u\n", covered, PIXELS,
+           with->stats.occlusion.meshlets_early_drawn, with->stats.occlusion.meshlets_late_drawn);
+    taken[GDR_RASTER_TINY_CLASSES + 1] += with->stats.occlusion.meshlets_late_drawn;
     CHECK(covered > PIXELS / 10);
 }
 
 int main(void)
 {
     /* Per class, then (last) those of the forced-small parts: a subgroup's tiny clusters of a class
-     * take their part together or not at all, so a scene may fill it at once. */
-    uint32_t taken[GDR_RASTER_TINY_CLASSES + 1] = {0};
+     * take their part together or not at all, so a scene may fill it at once), and the clusters drawn
+     * by the late raster phase (a second dispatch of each part in the frame). */
+    uint32_t taken[GDR_RASTER_TINY_CLASSES + 2] = {0};
     /* A field of instances from its camera, most of them far: their DAGs' coarse end, roots of 4
      * triangles and the levels just above. */
     check_scene("lod-field:instances=2000,triangles=5000", NULL, GDR_RASTER_SW, taken);
     /* The demo scene from its camera: clusters of every size, in front of each other. */
     check_scene("demo:instances=144,seed=5", NULL, GDR_RASTER_SW, taken);
     check_scene("demo:instances=144,seed=5", NULL, GDR_RASTER_HYBRID, taken);
-    for (int k = 0; k <= GDR_RASTER_TINY_CLASSES; k++)
+    for (int k = 0; k < GDR_RASTER_TINY_CLASSES + 2; k++)
         CHECK(taken[k] > 0);
     return test_finish("test_gpu_raster_tiny");
 }
