@@ -547,14 +547,15 @@ GDR_STRUCT_BEGIN(GdrGpuRasterCounters)
     gdr_uint resolve_y;     /* the screen in the first phase and in a later phase that drew something, */
     gdr_uint resolve_z;     /* else none */
     /* Per tiny size class (the triangles of its clusters count in sw_triangles): */
-    gdr_uint tiny_clusters[GDR_SW_TINY_CLASSES];   /* entries of the class's part */
-    gdr_uint tiny_used[GDR_SW_TINY_CLASSES];       /* entries reserved: tiny_clusters, or more once full */
+    gdr_uint tiny_clusters[GDR_SW_TINY_CLASSES];   /* entries asked of the class's part: those beyond its
+                                                      tiny_capacity went to the front instead */
     gdr_uint tiny_first[GDR_SW_TINY_CLASSES];      /* first entry of the current dispatch (in the part) */
     gdr_uint tiny_dispatched[GDR_SW_TINY_CLASSES]; /* entries launched by earlier dispatches of the frame */
     gdr_uint tiny_launch[3 * GDR_SW_TINY_CLASSES]; /* a VkDispatchIndirectCommand per class */
+    gdr_uint reserved0;
 GDR_STRUCT_END(GdrGpuRasterCounters)
-GDR_ASSERT_SIZE(GdrGpuRasterCounters, 168);
-GDR_ASSERT_OFFSET(GdrGpuRasterCounters, tiny_launch, 132);
+GDR_ASSERT_SIZE(GdrGpuRasterCounters, 160);
+GDR_ASSERT_OFFSET(GdrGpuRasterCounters, tiny_launch, 120);
 GDR_ASSERT_OFFSET(GdrGpuRasterCounters, resolve_x, 72);
 GDR_ASSERT_OFFSET(GdrGpuRasterCounters, dispatch_z, 8);
 

@@ -61,15 +61,11 @@ GDR_SHARED_FN gdr_uint gdr_raster_tiny_class(gdr_uint vertex_count, gdr_uint tri
 #include "gpu_shared/material_flags.h"
 #include "gpu_shared/visbuffer.h"
 
-/* Reserves `count` entries (the subgroup's) against `limit` with the counter `used`, and returns
- * whether they fit; the caller then takes them from its end of the list. */
-#define GDR_RASTER_RESERVE(used, count, limit) (atomicAdd(used, count) + (count) <= (limit))
-
 /* The cluster cull (clustercull.comp), every invocation in uniform control flow, after the tests:
  * bins the invocation's cluster when visible and appends it to the frame's visible-cluster list,
  * compute-rasterised clusters at the front, mesh-shader clusters at the back and tiny
  * compute-rasterised clusters in the part of their size class after both (one atomic per part and
- * subgroup; tiny clusters that find their part full join the front). Entries that do not fit are dropped and
+ * subgroup; the tiny clusters beyond their part's end join the front). Entries that do not fit are dropped and
  * counted. Needs MeshletsRef and InstancesRef (meshlet_payload.h, glsl_buffers.h). */
 void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint meshlet_index)
 {
@@ -105,16 +101,11 @@ void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint m
         if (count == 0u)
             continue;
         uint base = 0u;
-        bool fits = false;
-        if (subgroupElect()) {
-            fits = GDR_RASTER_RESERVE(counters.value.tiny_used[k], count, params.value.tiny_capacity[k]);
-            if (fits)
-                base = params.value.tiny_base[k] + atomicAdd(counters.value.tiny_clusters[k], count);
-        }
-        fits = subgroupBroadcastFirst(fits);
-        base = subgroupBroadcastFirst(base);
-        if (fits && tiny) {
-            list.items[base + subgroupBallotExclusiveBitCount(ballot)] = GdrGpuRasterCluster(instance, meshlet_index);
+        if (subgroupElect())
+            base = atomicAdd(counters.value.tiny_clusters[k], count);
+        uint at = subgroupBroadcastFirst(base) + subgroupBallotExclusiveBitCount(ballot);
+        if (tiny && at < params.value.tiny_capacity[k]) {
+            list.items[params.value.tiny_base[k] + at] = GdrGpuRasterCluster(instance, meshlet_index);
             sw = false;
         }
     }
@@ -129,14 +120,14 @@ void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint m
     bool sw_fits = true, hw_fits = true;
     if (subgroupElect()) {
         if (sw_count > 0u) {
-            sw_fits = GDR_RASTER_RESERVE(counters.value.used, sw_count, params.value.capacity);
+            sw_fits = atomicAdd(counters.value.used, sw_count) + sw_count <= params.value.capacity;
             if (sw_fits)
                 sw_base = atomicAdd(counters.value.sw_clusters, sw_count);
             else
                 atomicAdd(counters.value.overflow, sw_count);
         }
         if (hw_count > 0u) {
-            hw_fits = GDR_RASTER_RESERVE(counters.value.used, hw_count, params.value.capacity);
+            hw_fits = atomicAdd(counters.value.used, hw_count) + hw_count <= params.value.capacity;
             if (hw_fits)
                 hw_base = params.value.capacity - atomicAdd(counters.value.hw_clusters, hw_count) - hw_count;
             else

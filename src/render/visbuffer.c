@@ -270,8 +270,11 @@ void gdr_visbuffer_stats(gdr_renderer *r, uint32_t slot_index, gdr_frame_stats *
     stats->raster.sw_clusters = counters.sw_clusters;
     stats->raster.sw_tiny_clusters = 0;
     for (uint32_t k = 0; k < GDR_SW_TINY_CLASSES; k++) {
-        stats->raster.sw_tiny_class_clusters[k] = counters.tiny_clusters[k];
-        stats->raster.sw_tiny_clusters += counters.tiny_clusters[k];
+        /* Those asked beyond the part's end went to the front, and count in sw_clusters there. */
+        uint32_t drawn = counters.tiny_clusters[k] < params.tiny_capacity[k] ? counters.tiny_clusters[k]
+                                                                             : params.tiny_capacity[k];
+        stats->raster.sw_tiny_class_clusters[k] = drawn;
+        stats->raster.sw_tiny_clusters += drawn;
     }
     stats->raster.sw_clusters += stats->raster.sw_tiny_clusters;
     stats->raster.hw_clusters = counters.hw_clusters;

@@ -35,10 +35,12 @@ void main()
 
     uint tiny_total = 0u;
     for (uint k = 0u; k < GDR_SW_TINY_CLASSES; k++) {
+        // Entries asked beyond the part's end went to the front.
+        uint tiny_end = min(counters.value.tiny_clusters[k], params.value.tiny_capacity[k]);
         uint tiny_first = counters.value.tiny_dispatched[k];
-        uint tiny_count = counters.value.tiny_clusters[k] - tiny_first;
+        uint tiny_count = tiny_end - tiny_first;
         counters.value.tiny_first[k] = tiny_first;
-        counters.value.tiny_dispatched[k] = counters.value.tiny_clusters[k];
+        counters.value.tiny_dispatched[k] = tiny_end;
         uint per_group = GDR_SW_RASTER_WORKGROUP_SIZE / (GDR_SW_TINY_LANES << k);
         launch = sw_dispatch((tiny_count + per_group - 1u) / per_group);
         counters.value.tiny_launch[3u * k] = launch.x;

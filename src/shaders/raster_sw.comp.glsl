@@ -154,7 +154,7 @@ bool find_entry(RasterParamsRef params, out uint slot)
     uint index = counters.value.tiny_first[TINY_CLASS] + group * CLUSTERS_PER_GROUP +
                  gl_LocalInvocationIndex / CLUSTER_LANES;
     slot = params.value.tiny_base[TINY_CLASS] + index;
-    return index < counters.value.tiny_clusters[TINY_CLASS];
+    return index < min(counters.value.tiny_clusters[TINY_CLASS], params.value.tiny_capacity[TINY_CLASS]);
 }
 
 void main()
