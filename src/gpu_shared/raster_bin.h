@@ -93,13 +93,15 @@ void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint m
     }
     RasterCountersRef counters = RasterCountersRef(params.value.counters);
     RasterClustersRef list = RasterClustersRef(params.value.clusters);
-    // The tiny classes first: a cluster whose part is full joins the front.
-    for (uint k = 0u; k < GDR_SW_TINY_CLASSES; k++) {
-        bool tiny = tiny_class == k && params.value.tiny_capacity[k] > 0u;
+    // The tiny classes first, those the subgroup has: a cluster beyond its part's end joins the front.
+    bool has_part = tiny_class < GDR_SW_TINY_CLASSES && params.value.tiny_capacity[tiny_class] > 0u;
+    uint classes = subgroupOr(has_part ? 1u << tiny_class : 0u);
+    while (classes != 0u) {
+        uint k = uint(findLSB(classes));
+        classes &= classes - 1u;
+        bool tiny = has_part && tiny_class == k;
         uvec4 ballot = subgroupBallot(tiny);
         uint count = subgroupBallotBitCount(ballot);
-        if (count == 0u)
-            continue;
         uint base = 0u;
         if (subgroupElect())
             base = atomicAdd(counters.value.tiny_clusters[k], count);
