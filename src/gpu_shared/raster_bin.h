@@ -65,8 +65,8 @@ GDR_SHARED_FN gdr_uint gdr_raster_tiny_class(gdr_uint vertex_count, gdr_uint tri
  * bins the invocation's cluster when visible and appends it to the frame's visible-cluster list,
  * compute-rasterised clusters at the front, mesh-shader clusters at the back and tiny
  * compute-rasterised clusters in the part of their size class after both (one atomic per part and
- * subgroup; the tiny clusters beyond their part's end join the front). Entries that do not fit are dropped and
- * counted. Needs MeshletsRef and InstancesRef (meshlet_payload.h, glsl_buffers.h). */
+ * subgroup; the tiny clusters beyond their part's end join the front). Entries that do not fit are
+ * dropped and counted. Needs MeshletsRef and InstancesRef (meshlet_payload.h, glsl_buffers.h). */
 void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint meshlet_index)
 {
     RasterParamsRef params = GDR_FRAME.raster;

@@ -3,8 +3,8 @@
 // (shared/raster_bin.h), the cluster's vertices transformed once into shared memory, then one
 // invocation per triangle. The tiny variants (one per size class, GDR_SW_TINY_*) draw their class's
 // part of the list several clusters to a workgroup, CLUSTER_LANES invocations and as many shared
-// vertices each; the rasterisation below is the same for all. Coverage follows Vulkan's rules as the hardware applies them, so the two
-// rasterisers agree pixel for pixel where their clusters meet:
+// vertices each; the rasterisation below is the same for all. Coverage follows Vulkan's rules as
+// the hardware applies them, so the two rasterisers agree pixel for pixel where their clusters meet:
 //  - the frame's viewport transform (negative height: framebuffer y down), vertices snapped to
 //    GDR_SW_SUBPIXEL_BITS fractional bits, rounding to nearest even;
 //  - back faces culled (front faces are counter-clockwise as seen), zero-area triangles draw nothing;
@@ -168,15 +168,15 @@ void main()
     VerticesRef vertices = GDR_SCENE.vertices;
     target_overdraw = GDR_FRAME.overdraw;
     triangle_bytes = GDR_SCENE.meshlet_triangles;
-    uint index;
-    bool has_entry = find_entry(params, index);
+    uint slot;
+    bool has_entry = find_entry(params, slot);
     // A workgroup of one cluster leaves as a whole; the tiny variant's idle slices wait at the barrier.
     if (CLUSTERS_PER_GROUP == 1u && !has_entry)
         return;
     GdrGpuMeshlet meshlet;
     mat4 model = mat4(1.0);
     if (has_entry) {
-        GdrGpuRasterCluster entry = RasterClustersRef(params.value.clusters).items[index];
+        GdrGpuRasterCluster entry = RasterClustersRef(params.value.clusters).items[slot];
         meshlet = meshlets.items[entry.meshlet];
         model = instances.items[entry.instance].model;
     } else {
@@ -206,6 +206,6 @@ void main()
     for (uint t = lane; t < meshlet.triangle_count; t += CLUSTER_LANES) {
         uint at = meshlet.triangle_offset + t * 3u;
         uvec3 corners = uvec3(triangle_byte(at), triangle_byte(at + 1u), triangle_byte(at + 2u));
-        raster_triangle(corners + slice, gdr_visbuffer_id(index, t), size);
+        raster_triangle(corners + slice, gdr_visbuffer_id(slot, t), size);
     }
 }

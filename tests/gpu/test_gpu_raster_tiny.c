@@ -139,17 +139,17 @@ static void check_frame(const char *spec, gdr_raster raster, int f, uint32_t *ta
     const tiny_result *with = &results[0][f];
     const gdr_raster_stats *tiny = &with->stats.raster, *off = &results[1][f].stats.raster,
                            *forced = &results[2][f].stats.raster;
-    printf("%s, %s, frame %d: %u compute-rasterised clusters, %u of them tiny (%u/%u/%u of 8/16/32 invocations), %u mesh-shader; "
-           "without the tiny path %u tiny; forced to %u entries a class %u tiny\n",
-           spec, gdr_raster_name(raster), f, tiny->sw_clusters, tiny->sw_tiny_clusters, tiny->sw_tiny_class_clusters[0],
-           tiny->sw_tiny_class_clusters[1], tiny->sw_tiny_class_clusters[2], tiny->hw_clusters, off->sw_tiny_clusters,
-           FORCED_CAPACITY, forced->sw_tiny_clusters);
+    const uint32_t *classes = tiny->sw_tiny_class_clusters;
+    printf("%s, %s, frame %d: %u compute-rasterised clusters, %u of them tiny (%u/%u/%u of 8/16/32 invocations), "
+           "%u mesh-shader; without the tiny path %u tiny; forced to %u entries a class %u tiny\n",
+           spec, gdr_raster_name(raster), f, tiny->sw_clusters, tiny->sw_tiny_clusters, classes[0], classes[1],
+           classes[2], tiny->hw_clusters, off->sw_tiny_clusters, FORCED_CAPACITY, forced->sw_tiny_clusters);
     uint32_t tiny_sum = 0;
     for (int k = 0; k < GDR_RASTER_TINY_CLASSES; k++) {
-        taken[k] += tiny->sw_tiny_class_clusters[k];
-        tiny_sum += tiny->sw_tiny_class_clusters[k];
+        taken[k] += classes[k];
+        tiny_sum += classes[k];
         /* The first FORCED_CAPACITY of a class fill its part, the rest go to the front. */
-        uint32_t fit = tiny->sw_tiny_class_clusters[k] < FORCED_CAPACITY ? tiny->sw_tiny_class_clusters[k] : FORCED_CAPACITY;
+        uint32_t fit = classes[k] < FORCED_CAPACITY ? classes[k] : FORCED_CAPACITY;
         CHECK(forced->sw_tiny_class_clusters[k] == fit);
     }
     CHECK(tiny->sw_tiny_clusters == tiny_sum && tiny_sum > 0 && tiny_sum <= tiny->sw_clusters);

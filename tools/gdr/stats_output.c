@@ -52,9 +52,9 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
         fprintf(out, "raster              %s (%s)\n", gdr_raster_name(s->raster.mode), s->raster.reason);
         if (s->raster.mode != GDR_RASTER_FORWARD) {
             const uint32_t *tiny = s->raster.sw_tiny_class_clusters;
-            fprintf(out, "raster_clusters     compute %u (%u tiny: %u/%u/%u of 8/16/32; %llu triangles), mesh shaders %u "
-                         "(%llu triangles)", s->raster.sw_clusters, s->raster.sw_tiny_clusters, tiny[0], tiny[1], tiny[2],
-                    (unsigned long long)s->raster.sw_triangles, s->raster.hw_clusters,
+            fprintf(out, "raster_clusters     compute %u (%u tiny: %u/%u/%u of 8/16/32; %llu triangles), "
+                         "mesh shaders %u (%llu triangles)", s->raster.sw_clusters, s->raster.sw_tiny_clusters, tiny[0],
+                    tiny[1], tiny[2], (unsigned long long)s->raster.sw_triangles, s->raster.hw_clusters,
                     (unsigned long long)s->raster.hw_triangles);
             if (s->raster.mode == GDR_RASTER_HYBRID)
                 fprintf(out, "; threshold %g px", (double)s->raster.sw_threshold_px);
