@@ -173,11 +173,15 @@ typedef struct gdr_pass_timing {
  * back-face culling) per rasteriser; the GPU time of the cluster cull (the per-cluster tests and
  * binning, with the launches), of the mesh-shader pass, of the compute rasteriser and of the
  * resolve, means over the frames (the four are part of the "draw" passes). */
+#define GDR_RASTER_TINY_CLASSES 3 /* = GDR_SW_TINY_CLASSES of the shaders */
 typedef struct gdr_raster_stats {
     gdr_raster mode;
     char reason[128];
     float sw_threshold_px;
     uint32_t sw_clusters, hw_clusters;
+    uint32_t sw_tiny_clusters; /* of sw_clusters, those drawn several to a workgroup (tiny ones) */
+    uint32_t sw_tiny_class_clusters[GDR_RASTER_TINY_CLASSES]; /* those of at most 8, 16, 32 vertices and
+                                                                  as many triangles */
     uint64_t sw_triangles, hw_triangles;
     uint32_t overflow; /* clusters lost for want of room in the list (0 below 2^25) or beyond the
                           device's mesh launch limit (0 below 2^22) */

@@ -58,6 +58,14 @@
 #define GDR_RASTER_MAX_CLUSTERS (1u << 25)
 #define GDR_SW_SUBPIXEL_BITS 8
 #define GDR_SW_GROUPS_PER_ROW 65535
+/* Tiny clusters (the coarse end of a distant instance's DAG) share a compute-raster workgroup, by
+ * size class: class k (0 <= k < GDR_SW_TINY_CLASSES) takes the clusters of at most
+ * GDR_SW_TINY_LANES << k vertices and as many triangles that no smaller class takes, with that many
+ * invocations each (one per vertex, then one per triangle) and as many vertices of the workgroup's
+ * shared memory: GDR_SW_RASTER_WORKGROUP_SIZE / (GDR_SW_TINY_LANES << k) clusters per workgroup.
+ * A workgroup of its own would keep 60 of 64 invocations idle for a root of 4 triangles. */
+#define GDR_SW_TINY_LANES 8u
+#define GDR_SW_TINY_CLASSES 3
 /* Mesh workgroups launched without a task shader (the visibility-buffer modes): maxMeshWorkGroupCount
  * is at least this in x and y on every device with mesh shaders. */
 #define GDR_MESH_GROUPS_PER_ROW 65535

@@ -505,7 +505,10 @@ GDR_ASSERT_SIZE(GdrGpuPushConstants, 40);
  * atomicMax keeps the nearest; 0 is empty), the low word (slot << GDR_VISBUFFER_TRIANGLE_BITS) |
  * triangle, where slot indexes the frame's list of visible clusters (GdrGpuRasterCluster). The
  * cluster cull (clustercull.comp) appends software-rasterised clusters from the front of that list
- * and mesh-shader clusters from the back. */
+ * and mesh-shader clusters from the back; tiny software-rasterised clusters go to the part of their
+ * size class (GDR_SW_TINY_*), after those `capacity` entries, which the compute rasteriser draws
+ * several to a workgroup (a tiny cluster that finds its part full joins the front). Either way the
+ * slot is the entry's index in the whole list. */
 #define GDR_GPU_RASTER_FORWARD 0u /* the mesh shaders shade; no visibility buffer */
 #define GDR_GPU_RASTER_HW 1u      /* every cluster through the mesh shaders into the visibility buffer */
 #define GDR_GPU_RASTER_SW 2u      /* every cluster the compute rasteriser can take (see raster_bin.h) */
@@ -543,24 +546,32 @@ GDR_STRUCT_BEGIN(GdrGpuRasterCounters)
     gdr_uint resolve_x;     /* VkDispatchIndirectCommand of the phase's resolve: GDR_RESOLVE_TILE tiles of */
     gdr_uint resolve_y;     /* the screen in the first phase and in a later phase that drew something, */
     gdr_uint resolve_z;     /* else none */
+    /* Per tiny size class (the triangles of its clusters count in sw_triangles): */
+    gdr_uint tiny_clusters[GDR_SW_TINY_CLASSES];   /* entries asked of the class's part: those beyond its
+                                                      tiny_capacity went to the front instead */
+    gdr_uint tiny_first[GDR_SW_TINY_CLASSES];      /* first entry of the current dispatch (in the part) */
+    gdr_uint tiny_dispatched[GDR_SW_TINY_CLASSES]; /* entries launched by earlier dispatches of the frame */
+    gdr_uint tiny_launch[3 * GDR_SW_TINY_CLASSES]; /* a VkDispatchIndirectCommand per class */
     gdr_uint reserved0;
 GDR_STRUCT_END(GdrGpuRasterCounters)
-GDR_ASSERT_SIZE(GdrGpuRasterCounters, 88);
+GDR_ASSERT_SIZE(GdrGpuRasterCounters, 160);
+GDR_ASSERT_OFFSET(GdrGpuRasterCounters, tiny_launch, 120);
 GDR_ASSERT_OFFSET(GdrGpuRasterCounters, resolve_x, 72);
 GDR_ASSERT_OFFSET(GdrGpuRasterCounters, dispatch_z, 8);
 
 /* Per-frame raster parameters, written by the CPU into its frame's slot. */
 GDR_STRUCT_BEGIN(GdrGpuRasterParams)
-    GDR_REF(RasterClustersRef) clusters; /* GdrGpuRasterCluster[capacity] */
+    GDR_REF(RasterClustersRef) clusters; /* GdrGpuRasterCluster[capacity + the tiny_capacity] */
     GDR_REF(RasterCountersRef) counters; /* GdrGpuRasterCounters */
     gdr_uint mode;          /* GDR_GPU_RASTER_* */
     gdr_uint capacity;      /* entries of the cluster list, <= GDR_RASTER_MAX_CLUSTERS */
     float sw_threshold_px;  /* hybrid: clusters whose triangles are smaller go to the compute rasteriser */
     gdr_uint hw_launch_limit; /* the most mesh workgroups one launch may have (maxMeshWorkGroupTotalCount) */
     gdr_vec2 ndc_scale;     /* the projection's P[0][0] and P[1][1] (x and y from view space to NDC) */
-    gdr_uint64 reserved;
+    gdr_uint tiny_capacity[GDR_SW_TINY_CLASSES]; /* entries of each tiny class's part (0: none) */
+    gdr_uint tiny_base[GDR_SW_TINY_CLASSES];     /* its first slot: capacity + the parts before it */
 GDR_STRUCT_END(GdrGpuRasterParams)
-GDR_ASSERT_SIZE(GdrGpuRasterParams, 48);
+GDR_ASSERT_SIZE(GdrGpuRasterParams, 64);
 GDR_ASSERT_OFFSET(GdrGpuRasterParams, mode, 16);
 GDR_ASSERT_OFFSET(GdrGpuRasterParams, ndc_scale, 32);
 

@@ -46,20 +46,32 @@ GDR_SHARED_FN bool gdr_raster_bin_sw(gdr_uint mode, float threshold_px, gdr_vec3
            gdr_raster_triangle_px(c, r, triangle_count, ndc_scale.y * 0.5f * viewport_height) < threshold_px;
 }
 
+/* The tiny size class of a cluster of these sizes (GDR_SW_TINY_*): the smallest whose clusters are no
+ * larger, or GDR_SW_TINY_CLASSES for a cluster of a workgroup of its own. */
+GDR_SHARED_FN gdr_uint gdr_raster_tiny_class(gdr_uint vertex_count, gdr_uint triangle_count)
+{
+    gdr_uint size = vertex_count > triangle_count ? vertex_count : triangle_count;
+    gdr_uint k = 0u;
+    while (k < GDR_SW_TINY_CLASSES && size > (GDR_SW_TINY_LANES << k))
+        k++;
+    return k;
+}
+
 #ifdef GDR_GLSL
 #include "gpu_shared/material_flags.h"
 #include "gpu_shared/visbuffer.h"
 
 /* The cluster cull (clustercull.comp), every invocation in uniform control flow, after the tests:
  * bins the invocation's cluster when visible and appends it to the frame's visible-cluster list,
- * compute-rasterised clusters at the front and mesh-shader clusters at the back (one atomic per end
- * and subgroup). Entries that do not fit are dropped and counted. Needs MeshletsRef and InstancesRef
- * (meshlet_payload.h, glsl_buffers.h). */
+ * compute-rasterised clusters at the front, mesh-shader clusters at the back and tiny
+ * compute-rasterised clusters in the part of their size class after both (one atomic per part and
+ * subgroup; the tiny clusters beyond their part's end join the front). Entries that do not fit are
+ * dropped and counted. Needs MeshletsRef and InstancesRef (meshlet_payload.h, glsl_buffers.h). */
 void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint meshlet_index)
 {
     RasterParamsRef params = GDR_FRAME.raster;
     bool sw = false;
-    uint triangles = 0u;
+    uint triangles = 0u, tiny_class = GDR_SW_TINY_CLASSES;
     if (visible) {
         GdrGpuMeshlet meshlet = MeshletsRef(GDR_SCENE.meshlets).items[meshlet_index];
         mat4 model = InstancesRef(GDR_SCENE.instances).items[instance].model;
@@ -76,12 +88,35 @@ void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint m
             uint material = InstancesRef(GDR_SCENE.instances).items[instance].material;
             sw = !gdr_material_alpha_tested(g.flags, material) && !gdr_material_double_sided(g.flags, material);
         }
+        if (sw)
+            tiny_class = gdr_raster_tiny_class(meshlet.vertex_count, triangles);
     }
-    bool hw = visible && !sw;
     RasterCountersRef counters = RasterCountersRef(params.value.counters);
+    RasterClustersRef list = RasterClustersRef(params.value.clusters);
+    // The tiny classes first, those the subgroup has: a cluster beyond its part's end joins the front.
+    bool has_part = tiny_class < GDR_SW_TINY_CLASSES && params.value.tiny_capacity[tiny_class] > 0u;
+    uint classes = subgroupOr(has_part ? 1u << tiny_class : 0u);
+    while (classes != 0u) {
+        uint k = uint(findLSB(classes));
+        classes &= classes - 1u;
+        bool tiny = has_part && tiny_class == k;
+        uvec4 ballot = subgroupBallot(tiny);
+        uint count = subgroupBallotBitCount(ballot);
+        uint base = 0u;
+        if (subgroupElect())
+            base = atomicAdd(counters.value.tiny_clusters[k], count);
+        uint at = subgroupBroadcastFirst(base) + subgroupBallotExclusiveBitCount(ballot);
+        if (tiny && at < params.value.tiny_capacity[k]) {
+            list.items[params.value.tiny_base[k] + at] = GdrGpuRasterCluster(instance, meshlet_index);
+            sw = false;
+        }
+    }
+    bool tiny = tiny_class < GDR_SW_TINY_CLASSES && !sw;
+
+    bool hw = visible && !sw && !tiny;
     uvec4 sw_ballot = subgroupBallot(sw), hw_ballot = subgroupBallot(hw);
     uint sw_count = subgroupBallotBitCount(sw_ballot), hw_count = subgroupBallotBitCount(hw_ballot);
-    uint sw_triangles = subgroupAdd(sw ? triangles : 0u);
+    uint sw_triangles = subgroupAdd(sw || tiny ? triangles : 0u);
     uint hw_triangles = subgroupAdd(hw ? triangles : 0u);
     uint sw_base = 0u, hw_base = 0u;
     bool sw_fits = true, hw_fits = true;
@@ -109,7 +144,6 @@ void gdr_raster_append(GdrGpuFrameGlobals g, bool visible, uint instance, uint m
     hw_base = subgroupBroadcastFirst(hw_base);
     sw_fits = subgroupBroadcastFirst(sw_fits);
     hw_fits = subgroupBroadcastFirst(hw_fits);
-    RasterClustersRef list = RasterClustersRef(params.value.clusters);
     if (sw && sw_fits)
         list.items[sw_base + subgroupBallotExclusiveBitCount(sw_ballot)] = GdrGpuRasterCluster(instance, meshlet_index);
     if (hw && hw_fits)

@@ -112,7 +112,8 @@ static const gdr_pass_template raster_hw = {
 
 static const gdr_pass_template raster_sw = {
     "raster_sw", gdr_visbuffer_record_raster_sw, GDR_RASTER_TIMER_SW,
-    .what = "the compute rasteriser over the front of the list into the visibility buffer",
+    .what = "the compute rasteriser into the visibility buffer: each tiny class's part of the list several "
+            "clusters to a workgroup, then the front one to a workgroup",
     .uses = {{GDR_RES_RASTER_COUNTERS, INDIRECT, INDIRECT_READ}, {GDR_RES_RASTER_COUNTERS, COMPUTE, READ},
              {GDR_RES_RASTER_CLUSTERS, COMPUTE, READ}, {GDR_RES_INSTANCES, COMPUTE, READ},
              {GDR_RES_VISBUFFER, COMPUTE, READ_WRITE}, OVERDRAW_COUNTS(COMPUTE)}};

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "gdr/geometry.h" /* gdr_lod_enclosing_sphere */
+#include "gpu_shared/raster_bin.h"
 #include "render/renderer_internal.h"
 #include "render/frame.h"
 #include "render/gpu_scene.h"
@@ -41,6 +42,21 @@ static gdr_status gather_clusters(const gdr_scene *scene, const gdr_mesh_cluster
 }
 
 /* Cluster i of c with pool-global data offsets and its groups' LOD data inline. */
+/* The clusters of each mesh per tiny size class (raster_bin.h), GDR_SW_TINY_CLASSES + 1 counts per
+ * mesh, the last the clusters of no class: the tiny classes' counts size their parts of the
+ * visible-cluster list. */
+static uint32_t *count_tiny_clusters(uint32_t mesh_count, const GdrGpuMesh *meshes, const GdrGpuMeshlet *meshlets)
+{
+    const uint32_t stride = GDR_SW_TINY_CLASSES + 1;
+    uint32_t *tiny = calloc((size_t)(mesh_count ? mesh_count : 1) * stride, sizeof *tiny);
+    for (uint32_t m = 0; m < mesh_count && tiny; m++)
+        for (uint32_t i = 0; i < meshes[m].lod_cluster_count; i++) {
+            const GdrGpuMeshlet *k = &meshlets[meshes[m].meshlet_offset + i];
+            tiny[m * stride + gdr_raster_tiny_class(k->vertex_count, k->triangle_count)]++;
+        }
+    return tiny;
+}
+
 static GdrGpuMeshlet gpu_meshlet_from(const gdr_mesh_clusters *c, uint32_t i, uint32_t vertex_base, uint32_t byte_base)
 {
     const gdr_cluster *k = &c->clusters[i];
@@ -175,13 +191,20 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
         vertex_cursor += c->vertex_count;
         byte_cursor += c->triangle_byte_count;
     }
-    uint64_t instance_meshlets = 0, instance_lod_clusters = 0;
-    for (uint32_t i = 0; i < scene->instance_count; i++) {
+    uint64_t instance_meshlets = 0, instance_lod_clusters = 0, instance_tiny[GDR_SW_TINY_CLASSES] = {0};
+    uint32_t *tiny = status == GDR_OK ? count_tiny_clusters(scene->mesh_count, g->cpu_meshes, meshlets) : NULL;
+    if (status == GDR_OK && !tiny)
+        status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory");
+    for (uint32_t i = 0; i < scene->instance_count && tiny; i++) {
         instance_meshlets += g->cpu_meshes[scene->instances[i].mesh].meshlet_count;
         instance_lod_clusters += g->cpu_meshes[scene->instances[i].mesh].lod_cluster_count;
+        for (uint32_t k = 0; k < GDR_SW_TINY_CLASSES; k++)
+            instance_tiny[k] += tiny[scene->instances[i].mesh * (GDR_SW_TINY_CLASSES + 1) + k];
     }
+    free(tiny);
     g->instance_meshlet_count = instance_meshlets;
     g->instance_lod_cluster_count = instance_lod_clusters;
+    memcpy(g->instance_tiny_cluster_count, instance_tiny, sizeof instance_tiny);
     g->meshlet_count = (uint32_t)meshlet_total;
     const VkBufferUsageFlags usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     if (status == GDR_OK)

@@ -28,4 +28,9 @@ _Static_assert(GDR_MESH_MAX_TRIANGLES <= (1u << GDR_VISBUFFER_TRIANGLE_BITS) &&
                "a visibility-buffer id holds a cluster slot and a triangle in 32 bits");
 _Static_assert(GDR_MESH_MAX_VERTICES <= GDR_SW_RASTER_WORKGROUP_SIZE,
                "the software rasteriser transforms a cluster's vertices in one step");
+_Static_assert(GDR_SW_RASTER_WORKGROUP_SIZE % GDR_SW_TINY_LANES == 0 &&
+                   (GDR_SW_TINY_LANES << (GDR_SW_TINY_CLASSES - 1)) < GDR_SW_RASTER_WORKGROUP_SIZE &&
+                   GDR_MESH_MAX_VERTICES == GDR_SW_RASTER_WORKGROUP_SIZE,
+               "every tiny class shares a workgroup, and its clusters' vertices fit their slices of the shared vertices");
+_Static_assert(GDR_RASTER_TINY_CLASSES == GDR_SW_TINY_CLASSES, "tiny classes: shaders and gdr/renderer.h");
 _Static_assert(GDR_LOD_TREE_LEVELS == GDR_LOD_NODE_MAX_LEVELS, "the traversal has a level for every level of a hierarchy");

@@ -75,10 +75,22 @@ static const gdr_pipeline_entry entries[GDR_PIPE_COUNT] = {
                             .fragment = &gdr_shader_meshlet_visbuffer_frag,
                             .alpha_fragment = &gdr_shader_meshlet_visbuffer_alpha_frag, .targets = GDR_TARGETS_NONE,
                             .cull_back = true},
-    [GDR_PIPE_RASTER_SW] = {"raster_sw", GDR_NEEDS_VISIBILITY_BUFFER, .compute = &gdr_shader_raster_sw_comp},
+    [GDR_PIPE_RASTER_SW] = {"raster_sw", GDR_NEEDS_VISIBILITY_BUFFER, .compute = &gdr_shader_raster_sw_comp,
+                            .constants = {GDR_SW_RASTER_WORKGROUP_SIZE, GDR_SW_TINY_CLASSES}, .constant_count = 2},
+    [GDR_PIPE_RASTER_SW_TINY] = {"raster_sw_tiny8", GDR_NEEDS_VISIBILITY_BUFFER, .compute = &gdr_shader_raster_sw_comp,
+                                 .constants = {GDR_SW_TINY_LANES, 0}, .constant_count = 2},
+    [GDR_PIPE_RASTER_SW_TINY + 1] = {"raster_sw_tiny16", GDR_NEEDS_VISIBILITY_BUFFER,
+                                     .compute = &gdr_shader_raster_sw_comp, .constants = {GDR_SW_TINY_LANES << 1, 1},
+                                     .constant_count = 2},
+    [GDR_PIPE_RASTER_SW_TINY + 2] = {"raster_sw_tiny32", GDR_NEEDS_VISIBILITY_BUFFER,
+                                     .compute = &gdr_shader_raster_sw_comp, .constants = {GDR_SW_TINY_LANES << 2, 2},
+                                     .constant_count = 2},
     [GDR_PIPE_RESOLVE] = {"resolve", GDR_NEEDS_VISIBILITY_BUFFER, .compute = &gdr_shader_visbuffer_resolve_comp,
                           .constants = {0}, .constant_count = 1},
 };
+
+_Static_assert(GDR_PIPE_RESOLVE - GDR_PIPE_RASTER_SW_TINY == GDR_SW_TINY_CLASSES,
+               "a compute-raster pipeline per tiny size class");
 
 const char *gdr_pipeline_id_name(gdr_pipeline_id id)
 {

@@ -24,7 +24,8 @@ typedef enum gdr_pipeline_id {
     GDR_PIPE_RASTER_SUBMIT = GDR_PIPE_CLUSTER_CULL + 3,
     GDR_PIPE_RASTER_HW,
     GDR_PIPE_RASTER_SW,
-    GDR_PIPE_RESOLVE,
+    GDR_PIPE_RASTER_SW_TINY,    /* the compute rasteriser's tiny variants, per size class (GDR_SW_TINY_CLASSES) */
+    GDR_PIPE_RESOLVE = GDR_PIPE_RASTER_SW_TINY + 3,
     GDR_PIPE_COUNT
 } gdr_pipeline_id;
 

@@ -17,6 +17,11 @@ typedef struct gdr_renderer_debug {
     /* A deliberately wrong LOD hierarchy (node spheres shrunk), to show that the image tests catch
      * a node test that is not conservative. */
     bool shrink_lod_nodes;
+    /* The compute rasteriser's tiny path (several tiny clusters per workgroup): off, every cluster
+     * then one to a workgroup as without it; or its part of the visible-cluster list forced small
+     * (0: sized from the scene), to show that the clusters that find it full are still drawn. */
+    bool tiny_raster_off;
+    uint32_t tiny_raster_capacity;
 } gdr_renderer_debug;
 
 /* Applies `debug` to the scenes set after this call (call it between gdr_renderer_create and

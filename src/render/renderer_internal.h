@@ -78,6 +78,7 @@ typedef struct gdr_gpu_scene {
     uint32_t traversal_levels;     /* levels of the deepest mesh hierarchy */
     uint64_t instance_meshlet_count; /* level-0 clusters summed over the instances (meshlets_total) */
     uint64_t instance_lod_cluster_count; /* every DAG cluster summed over the instances */
+    uint64_t instance_tiny_cluster_count[GDR_SW_TINY_CLASSES]; /* of those, the tiny ones per size class */
     uint64_t bytes;                /* device memory of the buffers above and the occlusion history */
     GdrGpuMesh *cpu_meshes;        /* host copies, for references and statistics */
     GdrGpuMeshlet *cpu_meshlets;

@@ -52,10 +52,40 @@ gdr_status gdr_visbuffer_set_scene(gdr_renderer *r, gdr_error *err)
     gdr_visbuffer *v = &r->vis;
     if (!v->supported)
         return GDR_OK;
-    /* Every cluster of every instance's DAG is the most one frame can draw. */
-    uint64_t total = r->scene.instance_lod_cluster_count;
-    v->capacity = (uint32_t)(total < GDR_RASTER_MAX_CLUSTERS ? (total ? total : 1) : GDR_RASTER_MAX_CLUSTERS);
-    return gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuRasterCluster) * (VkDeviceSize)v->capacity,
+    /* Every cluster of every instance's DAG is the most one frame can draw; the tiny ones go to the
+     * part of their size class (or, when it is full, to the front). All parts share the slots a
+     * visibility-buffer id can name: beyond that, the tiny parts keep all their clusters up to half of
+     * them (shared in proportion). A large field of distant instances draws mostly roots, tiny
+     * clusters, from DAGs of a thousand clusters each: a share in proportion to the whole DAG would
+     * leave most of them to the front. */
+    uint64_t total = r->scene.instance_lod_cluster_count ? r->scene.instance_lod_cluster_count : 1;
+    uint64_t tiny[GDR_SW_TINY_CLASSES], tiny_sum = 0;
+    for (uint32_t k = 0; k < GDR_SW_TINY_CLASSES; k++) {
+        tiny[k] = r->debug.tiny_raster_off        ? 0
+                  : r->debug.tiny_raster_capacity ? r->debug.tiny_raster_capacity
+                                                  : r->scene.instance_tiny_cluster_count[k];
+        tiny_sum += tiny[k];
+    }
+    if (total + tiny_sum > GDR_RASTER_MAX_CLUSTERS) {
+        const uint64_t half = GDR_RASTER_MAX_CLUSTERS / 2;
+        uint64_t kept = 0;
+        for (uint32_t k = 0; k < GDR_SW_TINY_CLASSES; k++) {
+            if (tiny_sum > half)
+                tiny[k] = (uint64_t)((double)half * (double)tiny[k] / (double)tiny_sum);
+            kept += tiny[k];
+        }
+        tiny_sum = kept;
+        total = GDR_RASTER_MAX_CLUSTERS - tiny_sum;
+    }
+    v->capacity = (uint32_t)total;
+    uint64_t base = total;
+    for (uint32_t k = 0; k < GDR_SW_TINY_CLASSES; k++) {
+        v->tiny_capacity[k] = (uint32_t)tiny[k];
+        v->tiny_base[k] = (uint32_t)base;
+        base += tiny[k];
+    }
+    v->slots = (uint32_t)base;
+    return gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuRasterCluster) * (VkDeviceSize)base,
                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                 GDR_VK_BUFFER_DEVICE, &v->clusters, err);
 }
@@ -152,6 +182,10 @@ void gdr_visbuffer_begin_frame(gdr_renderer *r, uint32_t slot_index, const gdr_f
         .ndc_scale = {fabsf(projection.m[0]), fabsf(projection.m[5])},
         .hw_launch_limit = (uint32_t)(rows * GDR_MESH_GROUPS_PER_ROW),
     };
+    for (uint32_t k = 0; k < GDR_SW_TINY_CLASSES; k++) {
+        params.tiny_capacity[k] = v->tiny_capacity[k];
+        params.tiny_base[k] = v->tiny_base[k];
+    }
     memcpy(v->params[slot_index].mapped, &params, sizeof params);
 }
 
@@ -192,11 +226,20 @@ void gdr_visbuffer_record_raster_hw(gdr_renderer *r, gdr_frame_slot *slot, const
     vkCmdEndRendering(cmd);
 }
 
-/* The compute rasteriser over the clusters at the front of the list. */
+/* The compute rasteriser over the tiny classes' parts of the list, several clusters per workgroup,
+ * then over the clusters at the front, one per workgroup. All only add to the visibility buffer with
+ * atomics, so none needs a barrier after another. */
 void gdr_visbuffer_record_raster_sw(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
                                     VkCommandBuffer cmd)
 {
     (void)slot, (void)pass;
+    for (uint32_t k = 0; k < GDR_SW_TINY_CLASSES; k++) {
+        if (r->vis.tiny_capacity[k] == 0)
+            continue;
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->pipelines[GDR_PIPE_RASTER_SW_TINY + k]);
+        vkCmdDispatchIndirect(cmd, r->vis.counters.buffer,
+                              offsetof(GdrGpuRasterCounters, tiny_launch) + sizeof(VkDispatchIndirectCommand) * k);
+    }
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->pipelines[GDR_PIPE_RASTER_SW]);
     vkCmdDispatchIndirect(cmd, r->vis.counters.buffer, offsetof(GdrGpuRasterCounters, dispatch_x));
 }
@@ -225,6 +268,15 @@ void gdr_visbuffer_stats(gdr_renderer *r, uint32_t slot_index, gdr_frame_stats *
     memcpy(&params, v->params[slot_index].mapped, sizeof params);
     stats->raster.sw_threshold_px = params.sw_threshold_px;
     stats->raster.sw_clusters = counters.sw_clusters;
+    stats->raster.sw_tiny_clusters = 0;
+    for (uint32_t k = 0; k < GDR_SW_TINY_CLASSES; k++) {
+        /* Those asked beyond the part's end went to the front, and count in sw_clusters there. */
+        uint32_t drawn = counters.tiny_clusters[k] < params.tiny_capacity[k] ? counters.tiny_clusters[k]
+                                                                             : params.tiny_capacity[k];
+        stats->raster.sw_tiny_class_clusters[k] = drawn;
+        stats->raster.sw_tiny_clusters += drawn;
+    }
+    stats->raster.sw_clusters += stats->raster.sw_tiny_clusters;
     stats->raster.hw_clusters = counters.hw_clusters;
     stats->raster.sw_triangles = counters.sw_triangles;
     stats->raster.hw_triangles = counters.hw_triangles;
@@ -266,9 +318,9 @@ gdr_status gdr_visbuffer_read_pixels(gdr_renderer *r, gdr_visbuffer_pixel *pixel
         pixels[p] = (gdr_visbuffer_pixel){0.0f, UINT32_MAX, 0, 0};
         if (depth_bits == 0)
             continue;
-        if (slot >= v->capacity) {
+        if (slot >= v->slots) {
             status = gdr_error_set(err, GDR_ERROR_VULKAN, "visibility buffer: pixel %zu names slot %u of %u", p, slot,
-                                   v->capacity);
+                                   v->slots);
             break;
         }
         const GdrGpuRasterCluster *entry = (const GdrGpuRasterCluster *)clusters.mapped + slot;

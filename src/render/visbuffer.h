@@ -4,13 +4,16 @@
  *  1. cluster_cull (clustercull.comp), launched indirectly over the instance cull's task commands:
  *     the per-cluster tests (shared/cluster_cull.h), then each visible cluster binned
  *     (shared/raster_bin.h) and appended to the frame's visible-cluster list, the compute
- *     rasteriser's at the front and the mesh shaders' at the back;
- *  2. raster_submit (raster_submit.comp) writes both launches: the compute rasteriser's
- *     VkDispatchIndirectCommand and the mesh shaders' VkDrawMeshTasksIndirectCommandEXT;
+ *     rasteriser's at the front (its tiny clusters to the parts of their size classes after the
+ *     list's `capacity` entries) and the mesh shaders' at the back;
+ *  2. raster_submit (raster_submit.comp) writes the launches: the compute rasteriser's
+ *     VkDispatchIndirectCommands (front, each tiny class) and the mesh shaders'
+ *     VkDrawMeshTasksIndirectCommandEXT;
  *  3. raster_hw: the mesh-shader pass without a task shader (meshlet_list.mesh), one workgroup per
  *     cluster at the back of the list; its fragments write (depth, id) with a 64-bit atomicMax
  *     (meshlet_visbuffer.frag), no attachments;
- *  4. raster_sw (raster_sw.comp), one workgroup per cluster at the front, the same atomics;
+ *  4. raster_sw (raster_sw.comp), the same atomics: its tiny variants over the tiny classes' parts of
+ *     the list, several clusters per workgroup, then one workgroup per cluster at the front;
  *  5. resolve (visbuffer_resolve.comp) shades every pixel into the colour image (a storage image);
  *     the depth stays in the visibility buffer, from which the depth pyramid is built.
  * The frame's clear pass zeroes the counters and the visibility buffer.
@@ -31,11 +34,14 @@ typedef struct gdr_visbuffer {
     bool supported;              /* mesh shaders and 64-bit buffer atomics */
     char missing[160];           /* why not, when not */
     gdr_vk_buffer pixels;        /* uint64 per pixel */
-    gdr_vk_buffer clusters;      /* GdrGpuRasterCluster[capacity], made with the scene */
+    gdr_vk_buffer clusters;      /* GdrGpuRasterCluster[slots], made with the scene */
     gdr_vk_buffer counters;      /* GdrGpuRasterCounters */
     gdr_vk_buffer params[GDR_FRAMES_IN_FLIGHT];            /* GdrGpuRasterParams, host-written */
     gdr_vk_buffer counters_readback[GDR_FRAMES_IN_FLIGHT]; /* the counters of the slot's last frame */
-    uint32_t capacity;
+    uint32_t capacity;           /* the front and back of the list */
+    uint32_t tiny_capacity[GDR_SW_TINY_CLASSES]; /* each tiny class's part after them (0: none) */
+    uint32_t tiny_base[GDR_SW_TINY_CLASSES];     /* the first slot of each */
+    uint32_t slots;              /* capacity and the tiny parts */
     uint32_t mode;               /* GDR_GPU_RASTER_* of the frames of the current render call */
     char reason[128];            /* why that mode */
     uint32_t slot_mode[GDR_FRAMES_IN_FLIGHT]; /* GDR_GPU_RASTER_* of the slot's last frame */

@@ -1,8 +1,10 @@
 #version 460
 // The compute rasteriser: one workgroup per cluster that the cluster cull binned to it
 // (shared/raster_bin.h), the cluster's vertices transformed once into shared memory, then one
-// invocation per triangle. Coverage follows Vulkan's rules as the hardware applies them, so the two
-// rasterisers agree pixel for pixel where their clusters meet:
+// invocation per triangle. The tiny variants (one per size class, GDR_SW_TINY_*) draw their class's
+// part of the list several clusters to a workgroup, CLUSTER_LANES invocations and as many shared
+// vertices each; the rasterisation below is the same for all. Coverage follows Vulkan's rules as
+// the hardware applies them, so the two rasterisers agree pixel for pixel where their clusters meet:
 //  - the frame's viewport transform (negative height: framebuffer y down), vertices snapped to
 //    GDR_SW_SUBPIXEL_BITS fractional bits, rounding to nearest even;
 //  - back faces culled (front faces are counter-clockwise as seen), zero-area triangles draw nothing;
@@ -20,6 +22,12 @@
 #include "gpu_shared/visbuffer.h"
 
 layout(local_size_x = GDR_SW_RASTER_WORKGROUP_SIZE) in;
+// Invocations per cluster: the whole workgroup, or GDR_SW_TINY_LANES << TINY_CLASS for a tiny class
+// (GDR_SW_TINY_CLASSES: none, the front of the list).
+layout(constant_id = 0) const uint CLUSTER_LANES = GDR_SW_RASTER_WORKGROUP_SIZE;
+layout(constant_id = 1) const uint TINY_CLASS = GDR_SW_TINY_CLASSES;
+const uint CLUSTERS_PER_GROUP = GDR_SW_RASTER_WORKGROUP_SIZE / CLUSTER_LANES;
+const uint SLICE_VERTICES = GDR_MESH_MAX_VERTICES / CLUSTERS_PER_GROUP; // each cluster's shared vertices
 
 const int SUBPIXEL = 1 << GDR_SW_SUBPIXEL_BITS;
 const int HALF_PIXEL = SUBPIXEL / 2;
@@ -94,6 +102,7 @@ int edge_bias(ivec2 d)
 GDR_DEFINE_RASTER(raster_small, int)
 GDR_DEFINE_RASTER(raster_large, int64_t)
 
+// corners: indices into the shared vertices (the cluster's slice).
 void raster_triangle(uvec3 corners, uint id, ivec2 size)
 {
     ivec2 a = corner_fixed[corners.x], b = corner_fixed[corners.y], c = corner_fixed[corners.z];
@@ -132,6 +141,22 @@ void raster_triangle(uvec3 corners, uint id, ivec2 size)
         raster_large(a, b, c, first, last, id);
 }
 
+// The slot of the workgroup's cluster, or of this invocation's in a tiny variant, in the list; false
+// past the end of the current dispatch (the tail of the last row or workgroup).
+bool find_entry(RasterParamsRef params, out uint slot)
+{
+    RasterCountersRef counters = RasterCountersRef(params.value.counters);
+    uint group = gl_WorkGroupID.x + gl_WorkGroupID.y * GDR_SW_GROUPS_PER_ROW;
+    if (TINY_CLASS >= GDR_SW_TINY_CLASSES) {
+        slot = counters.value.sw_first + group;
+        return slot < counters.value.sw_clusters;
+    }
+    uint index = counters.value.tiny_first[TINY_CLASS] + group * CLUSTERS_PER_GROUP +
+                 gl_LocalInvocationIndex / CLUSTER_LANES;
+    slot = params.value.tiny_base[TINY_CLASS] + index;
+    return index < min(counters.value.tiny_clusters[TINY_CLASS], params.value.tiny_capacity[TINY_CLASS]);
+}
+
 void main()
 {
     GdrGpuFrameGlobals g = FrameGlobalsRef(push.globals).value;
@@ -143,35 +168,44 @@ void main()
     VerticesRef vertices = GDR_SCENE.vertices;
     target_overdraw = GDR_FRAME.overdraw;
     triangle_bytes = GDR_SCENE.meshlet_triangles;
-    RasterCountersRef counters = RasterCountersRef(params.value.counters);
-    uint index = counters.value.sw_first + gl_WorkGroupID.x + gl_WorkGroupID.y * GDR_SW_GROUPS_PER_ROW;
-    if (index >= counters.value.sw_clusters)
-        return; // the tail of the last row
-    GdrGpuRasterCluster entry = RasterClustersRef(params.value.clusters).items[index];
-    GdrGpuMeshlet meshlet = meshlets.items[entry.meshlet];
-    mat4 model = instances.items[entry.instance].model;
-    uint lane = gl_LocalInvocationIndex;
+    uint slot;
+    bool has_entry = find_entry(params, slot);
+    // A workgroup of one cluster leaves as a whole; the tiny variant's idle slices wait at the barrier.
+    if (CLUSTERS_PER_GROUP == 1u && !has_entry)
+        return;
+    GdrGpuMeshlet meshlet;
+    mat4 model = mat4(1.0);
+    if (has_entry) {
+        GdrGpuRasterCluster entry = RasterClustersRef(params.value.clusters).items[slot];
+        meshlet = meshlets.items[entry.meshlet];
+        model = instances.items[entry.instance].model;
+    } else {
+        meshlet.vertex_count = 0u;
+        meshlet.triangle_count = 0u;
+    }
+    uint lane = gl_LocalInvocationIndex % CLUSTER_LANES;
+    uint slice = gl_LocalInvocationIndex / CLUSTER_LANES * SLICE_VERTICES;
     target_width = uint(g.viewport.x);
     count_overdraw = g.view_mode == GDR_VIEW_OVERDRAW;
 
     // The vertices, as the mesh shader transforms them, then the viewport transform.
     vec2 half_size = 0.5 * g.viewport;
-    if (lane < meshlet.vertex_count) {
-        uint vertex_index = vertex_refs.items[meshlet.vertex_offset + lane];
+    for (uint v = lane; v < meshlet.vertex_count; v += CLUSTER_LANES) {
+        uint vertex_index = vertex_refs.items[meshlet.vertex_offset + v];
         vec3 position = vertices.items[vertex_index].position;
         vec4 world = model * vec4(position, 1.0);
         vec4 clip = g.view_projection * world;
         vec3 ndc = clip.xyz / clip.w;
         vec2 framebuffer = vec2(half_size.x + half_size.x * ndc.x, half_size.y - half_size.y * ndc.y);
-        corner_fixed[lane] = ivec2(roundEven(framebuffer * float(SUBPIXEL)));
-        corner_float[lane] = vec3(framebuffer, ndc.z);
+        corner_fixed[slice + v] = ivec2(roundEven(framebuffer * float(SUBPIXEL)));
+        corner_float[slice + v] = vec3(framebuffer, ndc.z);
     }
     barrier();
 
     ivec2 size = ivec2(g.viewport);
-    for (uint t = lane; t < meshlet.triangle_count; t += GDR_SW_RASTER_WORKGROUP_SIZE) {
+    for (uint t = lane; t < meshlet.triangle_count; t += CLUSTER_LANES) {
         uint at = meshlet.triangle_offset + t * 3u;
         uvec3 corners = uvec3(triangle_byte(at), triangle_byte(at + 1u), triangle_byte(at + 2u));
-        raster_triangle(corners, gdr_visbuffer_id(index, t), size);
+        raster_triangle(corners + slice, gdr_visbuffer_id(slot, t), size);
     }
 }

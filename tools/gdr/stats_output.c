@@ -51,8 +51,10 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
                 s->task_workgroups, s->task_overflow);
         fprintf(out, "raster              %s (%s)\n", gdr_raster_name(s->raster.mode), s->raster.reason);
         if (s->raster.mode != GDR_RASTER_FORWARD) {
-            fprintf(out, "raster_clusters     compute %u (%llu triangles), mesh shaders %u (%llu triangles)",
-                    s->raster.sw_clusters, (unsigned long long)s->raster.sw_triangles, s->raster.hw_clusters,
+            const uint32_t *tiny = s->raster.sw_tiny_class_clusters;
+            fprintf(out, "raster_clusters     compute %u (%u tiny: %u/%u/%u of 8/16/32; %llu triangles), "
+                         "mesh shaders %u (%llu triangles)", s->raster.sw_clusters, s->raster.sw_tiny_clusters, tiny[0],
+                    tiny[1], tiny[2], (unsigned long long)s->raster.sw_triangles, s->raster.hw_clusters,
                     (unsigned long long)s->raster.hw_triangles);
             if (s->raster.mode == GDR_RASTER_HYBRID)
                 fprintf(out, "; threshold %g px", (double)s->raster.sw_threshold_px);
@@ -126,6 +128,10 @@ void stats_add_meshlet_json(cJSON *object, const gdr_frame_stats *s)
     if (s->raster.mode != GDR_RASTER_FORWARD) {
         cJSON_AddNumberToObject(object, "sw_threshold_px", s->raster.sw_threshold_px);
         cJSON_AddNumberToObject(object, "raster_sw_clusters", s->raster.sw_clusters);
+        cJSON_AddNumberToObject(object, "raster_sw_tiny_clusters", s->raster.sw_tiny_clusters);
+        cJSON *tiny = cJSON_AddArrayToObject(object, "raster_sw_tiny_class_clusters");
+        for (uint32_t k = 0; tiny && k < GDR_RASTER_TINY_CLASSES; k++)
+            cJSON_AddItemToArray(tiny, cJSON_CreateNumber(s->raster.sw_tiny_class_clusters[k]));
         cJSON_AddNumberToObject(object, "raster_hw_clusters", s->raster.hw_clusters);
         cJSON_AddNumberToObject(object, "raster_sw_triangles", (double)s->raster.sw_triangles);
         cJSON_AddNumberToObject(object, "raster_hw_triangles", (double)s->raster.hw_triangles);
