@@ -1,0 +1,33 @@
+/* Simplifying a group the edge-collapse simplifier cannot: by vertex clustering
+ * (meshopt_simplifySloppy). The DAG's steps only reach this where a whole step formed no group
+ * (lod_dag.c, sloppy_step): then the whole frontier is one group, nothing of it locked (it has no
+ * neighbour), and clustering its vertices on a grid merges what edge collapses never can: separate
+ * pieces, and positions held by many vertices. Its output's corners are vertices of its input
+ * (one kept per grid cell: meshoptimizer.h, "references vertices from the original vertex buffer"),
+ * so the group's new clusters are mesh vertices like every other cluster's, and their error is
+ * measured against level 0 like every other group's (lod_error.c), whatever the topology. */
+#include <float.h>
+
+#include "geometry/lod_internal.h"
+
+/* The shares of the input a sloppy group asks for, in turn: meshoptimizer 0.18 keeps the finest
+ * grid whose triangle count is at most the target and returns nothing where every such grid
+ * leaves no triangle, so a small group may need a larger target (a group is formed only when it
+ * keeps at most LOD_MAX_KEPT_SHARE of its triangles). */
+static const double sloppy_shares[] = {0.5, 0.65, 0.8};
+
+size_t gdr_lod_simplify_sloppy(lod_scratch *s, size_t index_count, uint32_t vertex_count)
+{
+    for (size_t i = 0; i < sizeof sloppy_shares / sizeof sloppy_shares[0]; i++) {
+        size_t target = (size_t)((double)(index_count / 3) * sloppy_shares[i]) * 3;
+        target = target < 3 ? 3 : target;
+        size_t out = meshopt_simplifySloppy(s->simplified, s->indices, index_count, s->positions, vertex_count,
+                                            sizeof(float) * 3, target, FLT_MAX, NULL);
+        for (size_t k = 0; k < out; k++)
+            if (s->simplified[k] >= vertex_count) /* never, by meshoptimizer's contract: then nothing */
+                return 0;
+        if (out > 0)
+            return out;
+    }
+    return 0;
+}
