@@ -3,9 +3,10 @@
  * time of the DAG build (one thread: gdr_mesh_build_lod_dag rebuilds each mesh's DAG), then the
  * sums. Public API only.
  *
- * usage: lod_levels FILE... */
+ * usage: lod_levels [--levels] FILE...   (--levels: each mesh's groups and errors by depth) */
 #define _POSIX_C_SOURCE 200809L
 #include <stdio.h>
+#include <string.h>
 #include <time.h>
 
 #include "gdr/geometry.h"
@@ -27,7 +28,28 @@ static const char *stop_name(const gdr_lod_stats *st)
                                                        : "none";
 }
 
-static int roots(const char *path)
+/* Per DAG depth: the groups formed there, the triangles of the clusters they made and their
+ * largest error in the mesh's bounding radius R. */
+static void print_levels(const gdr_mesh *mesh)
+{
+    const gdr_mesh_clusters *mc = &mesh->clusters;
+    for (uint32_t d = 0; d <= mc->dag_depth; d++) {
+        uint64_t groups = 0, made = 0;
+        float error = 0.0f;
+        for (uint32_t g = 0; g < mc->group_count; g++)
+            if (mc->groups[g].depth == d) {
+                groups++;
+                error = mc->groups[g].error > error ? mc->groups[g].error : error;
+            }
+        for (uint32_t c = 0; c < mc->cluster_count; c++)
+            if (mc->clusters[c].refined_group != GDR_NO_INDEX && mc->groups[mc->clusters[c].refined_group].depth == d)
+                made += mc->clusters[c].triangle_count;
+        printf("    depth %2u: %4llu groups, made %7llu tris, largest error %.4g R\n", d, (unsigned long long)groups,
+               (unsigned long long)made, (double)(error / mesh->bounds.w));
+    }
+}
+
+static int roots(const char *path, int levels)
 {
     gdr_load_options lo = {.no_cache = 1, .no_progress = 1};
     gdr_scene *scene = NULL;
@@ -51,6 +73,8 @@ static int roots(const char *path)
             return 1;
         }
         seconds += now() - t0;
+        if (levels)
+            print_levels(mesh);
         printf("  mesh %3u %-24.24s %8llu tris  %-14s depth %2u  root %3llu clusters / %6llu tris  sloppy %llu\n", m,
                mesh->name, (unsigned long long)st.input_triangles, stop_name(&st), st.max_depth,
                (unsigned long long)st.root_clusters, (unsigned long long)st.root_triangles,
@@ -73,8 +97,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: lod_levels FILE...\n");
         return 2;
     }
-    int status = 0;
-    for (int i = 1; i < argc; i++)
-        status |= roots(argv[i]);
+    int status = 0, levels = 0;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--levels") == 0)
+            levels = 1;
+        else
+            status |= roots(argv[i], levels);
+    }
     return status;
 }
