@@ -10,11 +10,12 @@
 
 #include "geometry/lod_internal.h"
 
-/* The shares of the input a sloppy group asks for, in turn: meshoptimizer 0.18 keeps the finest
- * grid whose triangle count is at most the target and returns nothing where every such grid
- * leaves no triangle, so a small group may need a larger target (a group is formed only when it
- * keeps at most LOD_MAX_KEPT_SHARE of its triangles). */
-static const double sloppy_shares[] = {0.5, 0.65, 0.8};
+/* The shares of the input a sloppy group asks for, in turn, until one keeps some triangles and at
+ * most LOD_MAX_KEPT_SHARE of them (the share a group must reach to form). meshoptimizer 0.18 keeps
+ * the finest grid it finds whose triangle count is at most the target, searching a few grid sizes,
+ * and returns nothing where every grid it tried left none; on a small group the count jumps between
+ * grid sizes, and another target leads its search to other sizes. */
+static const double sloppy_shares[] = {0.5, 0.65, 0.8, 0.35, 0.25, 0.15};
 
 size_t gdr_lod_simplify_sloppy(lod_scratch *s, size_t index_count, uint32_t vertex_count)
 {
@@ -26,7 +27,7 @@ size_t gdr_lod_simplify_sloppy(lod_scratch *s, size_t index_count, uint32_t vert
         for (size_t k = 0; k < out; k++)
             if (s->simplified[k] >= vertex_count) /* never, by meshoptimizer's contract: then nothing */
                 return 0;
-        if (out > 0)
+        if (out > 0 && (double)out <= (double)index_count * LOD_MAX_KEPT_SHARE)
             return out;
     }
     return 0;
