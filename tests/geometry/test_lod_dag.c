@@ -148,28 +148,40 @@ static uint32_t add_blob_and_boxes(gdr_scene *s, uint32_t boxes)
     return out;
 }
 
-/* `count` separate small closed boxes of different sizes on a grid, 3 units apart, each with hard
- * edges (a vertex per face corner, as gdr_procedural_box makes it): every corner position is held
- * by three vertices, which edge collapses never move, so nothing simplifies and nothing joins the
- * boxes. */
-static uint32_t add_separate_boxes(gdr_scene *s, uint32_t count)
+/* `count` separate small closed pieces of different sizes on a grid, 3 units apart, each with hard
+ * edges (a vertex per face corner): boxes (gdr_procedural_box) and tetrahedra in turn. Every corner
+ * position is held by three vertices, which meshoptimizer 0.18 never moves, a tetrahedron is the
+ * smallest closed surface, and nothing joins the pieces: edge collapses leave at least a
+ * tetrahedron per piece. */
+static uint32_t add_separate_pieces(gdr_scene *s, uint32_t count)
 {
+    static const gdr_vec3 corner[4] = {{0.4f, 0.4f, 0.4f}, {0.4f, -0.4f, -0.4f}, {-0.4f, 0.4f, -0.4f}, {-0.4f, -0.4f, 0.4f}};
+    static const uint32_t face[12] = {0, 1, 2, 0, 3, 1, 0, 2, 3, 1, 3, 2};
     gdr_scene *t = new_scene();
     gdr_error err = {0};
     uint32_t box;
     check_ok(gdr_procedural_box(t, (gdr_vec3){0.5f, 0.3f, 0.4f}, &box, &err), &err, "box");
     const gdr_mesh *mb = &t->meshes[box];
-    gdr_vec3 *p = malloc(sizeof *p * mb->vertex_count * count);
-    uint32_t *idx = malloc(sizeof *idx * mb->index_count * count);
+    gdr_vec3 *p = malloc(sizeof *p * (mb->vertex_count + 12) * count);
+    uint32_t *idx = malloc(sizeof *idx * (mb->index_count + 12) * count);
+    uint32_t v = 0, k = 0;
     for (uint32_t i = 0; i < count; i++) {
         gdr_vec3 o = {3.0f * (float)(i % 5), 3.0f * (float)(i / 5 % 5), 3.0f * (float)(i / 25)};
         float scale = 0.5f + 0.1f * (float)(i % 7);
-        for (uint32_t v = 0; v < mb->vertex_count; v++)
-            p[i * mb->vertex_count + v] = gdr_vec3_add(gdr_vec3_scale(mb->positions[v], scale), o);
-        for (uint32_t k = 0; k < mb->index_count; k++)
-            idx[i * mb->index_count + k] = i * mb->vertex_count + mb->indices[k];
+        if (i % 2 == 0) {
+            for (uint32_t j = 0; j < mb->vertex_count; j++)
+                p[v + j] = gdr_vec3_add(gdr_vec3_scale(mb->positions[j], scale), o);
+            for (uint32_t j = 0; j < mb->index_count; j++)
+                idx[k++] = v + mb->indices[j];
+            v += mb->vertex_count;
+        } else {
+            for (uint32_t j = 0; j < 12; j++, v++) { /* each face its own three vertices */
+                p[v] = gdr_vec3_add(gdr_vec3_scale(corner[face[j]], scale), o);
+                idx[k++] = v;
+            }
+        }
     }
-    uint32_t out = add_mesh(s, "separate", p, mb->vertex_count * count, idx, mb->index_count * count);
+    uint32_t out = add_mesh(s, "separate", p, v, idx, k);
     free(p);
     free(idx);
     gdr_scene_destroy(t);
@@ -903,15 +915,16 @@ static void test_error_bounds_deviation(void)
     gdr_scene_destroy(s);
 }
 
-/* A mesh of many separate pieces that edge collapses cannot simplify (hard-edged boxes): the steps
- * form no group, where the build used to stop with a root of every piece. Vertex clustering of the
+/* A mesh of many separate pieces that edge collapses cannot take below a tetrahedron each
+ * (hard-edged boxes and tetrahedra): the steps form no group, where the build used to stop with a
+ * root of every piece. Vertex clustering of the
  * whole frontier merges them, one ordinary group a step, down to one cluster and a root of at most
  * GDR_LOD_DEFAULT_ROOT_TRIANGLES triangles; every cut still deviates from full detail by at most
  * what it states (measured by brute force), is an exact cover and opens no edge. */
 static void test_separate_pieces(void)
 {
     gdr_scene *s = new_scene();
-    uint32_t separate = add_separate_boxes(s, 50);
+    uint32_t separate = add_separate_pieces(s, 60);
     gdr_mesh *m = &s->meshes[separate];
     build_level0(m);
     gdr_lod_options o = {.thread_count = 2, .no_progress = 1};
