@@ -145,6 +145,8 @@ typedef struct gdr_lod_stats {
     uint64_t stuck_groups;            /* groups not formed (too little reduction), regrouped later */
     uint64_t border_rejects;          /* of those, simplifications that moved a locked border */
     uint64_t passthrough_clusters;    /* clusters copied unchanged at step 0 (sharing their data) */
+    uint64_t sloppy_groups;           /* whole-frontier groups simplified by vertex clustering, where a
+                                         step formed no group (separate pieces, stuck seams) */
 } gdr_lod_stats;
 
 /* Builds the LOD DAG of `mesh` over its level-0 clusters (gdr_meshlets_build), appending the

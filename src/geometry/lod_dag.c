@@ -631,6 +631,37 @@ static gdr_status step(lod_build *b, lod_stage *prev, lod_stage *cur, uint32_t d
     return GDR_OK;
 }
 
+/* Where step cur formed no group (prev is finished and empty by then): the step again as one
+ * group over the whole frontier, simplified by vertex clustering (lod_sloppy.c), which merges
+ * separate pieces that edge collapses never join. An ordinary group otherwise: its error measured
+ * against level 0, its sphere enclosing, nothing locked (it has no neighbour). Sets *progressed
+ * when it formed. */
+static gdr_status sloppy_step(lod_build *b, lod_stage *prev, lod_stage *cur, uint32_t depth, int *progressed,
+                              gdr_error *err)
+{
+    stage_free(cur);
+    uint32_t n = b->frontier_count;
+    *cur = (lod_stage){.depth = depth, .parts = 1, .groups = 1};
+    cur->members = malloc((size_t)n * sizeof *cur->members);
+    cur->start = malloc(2 * sizeof *cur->start);
+    cur->results = calloc(1, sizeof *cur->results);
+    cur->measured = malloc(sizeof *cur->measured);
+    if (!cur->members || !cur->start || !cur->results || !cur->measured)
+        return out_of_memory(b, err);
+    memcpy(cur->members, b->frontier, (size_t)n * sizeof *cur->members);
+    cur->start[0] = 0;
+    cur->start[1] = n;
+    mark_shared(b, cur, 0);
+    b->sloppy = 1;
+    run_job(b, prev, cur, 0);
+    b->sloppy = 0;
+    if (stage_out_of_memory(cur))
+        return out_of_memory(b, err);
+    *progressed = cur->results[0].formed;
+    b->stats.sloppy_groups += (uint64_t)*progressed;
+    return GDR_OK;
+}
+
 /* Whether the frontier `current` is one cluster of at most opt.root_triangles triangles: the root.
  * One full cluster is not the end: an instance a pixel or two across would still draw its 60-124
  * triangles, so the lone cluster is simplified further, step by step (one group, nothing locked),
@@ -677,6 +708,10 @@ static gdr_status run_steps(lod_build *b, uint32_t **frontier, uint32_t *depth, 
             goto oom;
         int progressed = 0;
         if ((status = step(b, &prev, &cur, *depth, &progressed, err)) != GDR_OK)
+            goto done;
+        /* Edge collapses are stuck (separate pieces, seams): vertex clustering over the whole
+         * frontier, down to one cluster and on to the small root. */
+        if (!progressed && (status = sloppy_step(b, &prev, &cur, *depth, &progressed, err)) != GDR_OK)
             goto done;
         if (!progressed) {
             *stop = b->frontier_count == 1 ? GDR_LOD_STOP_SINGLE_CLUSTER : GDR_LOD_STOP_NO_PROGRESS;
@@ -812,6 +847,7 @@ static void stats_add(gdr_lod_stats *sum, const gdr_lod_stats *s)
     sum->stuck_groups += s->stuck_groups;
     sum->border_rejects += s->border_rejects;
     sum->passthrough_clusters += s->passthrough_clusters;
+    sum->sloppy_groups += s->sloppy_groups;
 }
 
 /* Builds one mesh's DAG with `pool` (NULL: on the calling thread, as worker `worker`). */

@@ -258,8 +258,10 @@ void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker)
                              .uvs = b->opt.ignore_uvs ? NULL : b->mesh->uvs, .normals = b->mesh->normals, .position_count = position_count,
                              .positions = s->local_positions, .locked = s->position_locked,
                              .target_index_count = target};
-    lod_simplify_result out;
-    if (!lod_simplify(&s->simplify, &in, s->simplified, &out)) {
+    lod_simplify_result out = {0};
+    if (b->sloppy) /* a step that formed no group, again as one whole-frontier group (lod_sloppy.c) */
+        out.index_count = gdr_lod_simplify_sloppy(s, index_count, local_count);
+    else if (!lod_simplify(&s->simplify, &in, s->simplified, &out)) {
         r->out_of_memory = 1;
         return;
     }

@@ -226,6 +226,7 @@ typedef struct lod_build {
     uint32_t measured_count;
     const uint32_t *measured_members, *measured_member_start;
     group_result *measured_results;
+    int sloppy;     /* the step's one group is the whole frontier, simplified by lod_sloppy.c */
     int lone_group; /* one group is measured, on the calling thread outside any job */
     /* the next step's partition, when it runs as task 0 of the job: the simplification tasks wait
      * for it (partitioned set under partition_lock) */
@@ -288,6 +289,10 @@ void gdr_lod_measure_group_task(void *user, uint32_t i, uint32_t worker);
 /* A group's sphere (into r), over its members and the groups they came from. */
 void gdr_lod_group_sphere(lod_build *b, lod_scratch *s, const uint32_t *members, uint32_t count, group_result *r);
 void gdr_lod_result_free(group_result *r);
+/* lod_sloppy.c: simplifies s->indices (index_count, over s->positions' vertex_count vertices) into
+ * s->simplified by vertex clustering, which merges separate pieces; returns the index count (0:
+ * nothing left). For the groups of a step where edge collapses formed none (lod_build.sloppy). */
+size_t gdr_lod_simplify_sloppy(lod_scratch *s, size_t index_count, uint32_t vertex_count);
 
 /* lod_error.c: the samples of the full-detail surface and the groups' measured deviation. */
 int gdr_lod_error_setup(lod_build *b); /* after position ids and the owner table; 0: out of memory */
