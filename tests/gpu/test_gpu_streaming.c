@@ -1,7 +1,9 @@
 /* Streaming in the renderer (docs/STREAMING.md) on the default device (lavapipe in CI), validation
- * on: `unique-field` written with one group a page, drawn by a renderer whose page pool holds one
- * slot more than the view that needs most (at most a tenth of the pages' bytes) and copies at most
- * 256 KiB a frame. Along still views and a path, every
+ * on: `unique-field` written with one group a page, drawn at 1 px by a renderer whose page pool holds
+ * one slot more than the view that needs most, fewer than the three views' pages together (the sets
+ * computed, not only their sizes) and at most a tenth of the pages' bytes, and copies at most 256 KiB
+ * a frame. The scene (20 meshes of 40,000 triangles) is chosen so that those premises hold, and
+ * the test checks them. Along still views and a path, every
  * frame's drawn clusters are the CPU's cut over the groups the renderer reports resident (exactly
  * one cluster on every DAG path: no hole, no crack), the pool stays within the budget, each frame's
  * uploads within theirs, no page in use is evicted, and each still view converges to the image of
@@ -63,7 +65,7 @@ static gdr_frame_desc view_frame(int v)
     static const float yaws[VIEWS] = {0.0f, 0.0f, 0.0f};
     return (gdr_frame_desc){.camera = test_look(positions[v], yaws[v], -0.1f, 1.0f, 0.1f),
                             .pipeline = GDR_PIPELINE_MESH, .cull = GDR_CULL_OFF, .occlusion = GDR_CULL_OFF,
-                            .lod_error_px = getenv("LODPX") ? (float)atof(getenv("LODPX")) : 2.0f, .record_visible_meshlets = true, .read_back = true};
+                            .lod_error_px = 1.0f, .record_visible_meshlets = true, .read_back = true};
 }
 
 /* The pages of every mesh numbered one after another: mesh m's from base[m], base[mesh_count] in
@@ -136,9 +138,6 @@ static uint32_t pool_slots(const gdr_scene *scene, const char *path, uint64_t sl
         for (uint32_t p = 0; p < pages; p++)
             together += one[p] && !all[p], all[p] |= one[p];
         printf("view %d needs %u slots\n", v, needed);
-        for (uint32_t m = 0; getenv("DBG") && m < gdr_paged_cache_mesh_count(cache); m++)
-            for (uint32_t p = 1; p < gdr_paged_cache_mesh(cache, m)->page_count; p++)
-                if (one[base[m] + p]) printf("  mesh %u page %u\n", m, p);
         most = needed > most ? needed : most;
     }
     printf("the three views together need %u slots of %u pages; the pool has %u\n", together, pages, most + 1);
@@ -498,7 +497,6 @@ static void run(const gdr_scene *scene, const char *path)
      * fits, the three together do not (pool_slots checks both), so the still views evict. */
     uint64_t slot = 0, total = pool_bytes(path, &slot);
     uint64_t budget = pool_slots(scene, path, slot, total) * slot;
-    if (getenv("PROBE")) { printf("slot %llu total %llu tenth %llu slots\n", (unsigned long long)slot, (unsigned long long)total, (unsigned long long)(total / 10 / slot)); return; }
     /* The small pool streams a scene read without its geometry; the run with room for everything streams
      * the whole scene. */
     gdr_scene *paged = read_for_streaming(path);
@@ -541,7 +539,7 @@ int main(void)
     gdr_scene *scene = NULL;
     gdr_error err = {0};
     gdr_load_options load = {.no_progress = 1};
-    CHECK(gdr_scene_load(getenv("SCENE") ? getenv("SCENE") : "unique-field:meshes=12,triangles=20000,seed=3", &load, &scene, &err) == GDR_OK);
+    CHECK(gdr_scene_load("unique-field:meshes=20,triangles=40000,seed=3", &load, &scene, &err) == GDR_OK);
     char path[256];
     const char *tmp = getenv("TMPDIR");
     snprintf(path, sizeof path, "%s/gdr_gpu_streaming_%ld.gdrc", tmp ? tmp : "/tmp", (long)getpid());
