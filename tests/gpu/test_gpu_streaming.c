@@ -1,7 +1,9 @@
 /* Streaming in the renderer (docs/STREAMING.md) on the default device (lavapipe in CI), validation
- * on: `unique-field` written with one group a page, drawn by a renderer whose page pool holds one
- * slot more than the view that needs most (at most a tenth of the pages' bytes) and copies at most
- * 256 KiB a frame. Along still views and a path, every
+ * on: `unique-field` written with one group a page, drawn at 1 px by a renderer whose page pool holds
+ * one slot more than the view that needs most, fewer than the three views' pages together (the sets
+ * computed, not only their sizes) and at most a tenth of the pages' bytes, and copies at most 256 KiB
+ * a frame. The scene (20 meshes of 40,000 triangles) is chosen so that those premises hold, and
+ * the test checks them. Along still views and a path, every
  * frame's drawn clusters are the CPU's cut over the groups the renderer reports resident (exactly
  * one cluster on every DAG path: no hole, no crack), the pool stays within the budget, each frame's
  * uploads within theirs, no page in use is evicted, and each still view converges to the image of
@@ -63,25 +65,34 @@ static gdr_frame_desc view_frame(int v)
     static const float yaws[VIEWS] = {0.0f, 0.0f, 0.0f};
     return (gdr_frame_desc){.camera = test_look(positions[v], yaws[v], -0.1f, 1.0f, 0.1f),
                             .pipeline = GDR_PIPELINE_MESH, .cull = GDR_CULL_OFF, .occlusion = GDR_CULL_OFF,
-                            .lod_error_px = 2.0f, .record_visible_meshlets = true, .read_back = true};
+                            .lod_error_px = 1.0f, .record_visible_meshlets = true, .read_back = true};
 }
 
-/* The pool slots view v's full cut needs: the pages of the groups its clusters belong to, and the
- * pages of those groups' ancestors (the closure). */
-static uint32_t slots_needed(const gdr_scene *scene, const char *path, const gdr_frame_desc *frame)
+/* The pages of every mesh numbered one after another: mesh m's from base[m], base[mesh_count] in
+ * all. NULL where the allocation fails. */
+static uint32_t *page_bases(const gdr_paged_cache *cache)
 {
-    gdr_paged_cache *cache = NULL;
-    gdr_error err = {0};
-    if (gdr_paged_cache_open(path, &cache, &err) != GDR_OK)
-        return 0;
+    uint32_t meshes = gdr_paged_cache_mesh_count(cache);
+    uint32_t *base = malloc(sizeof *base * (meshes + 1));
+    for (uint32_t m = 0; base && m <= meshes; m++)
+        base[m] = m ? base[m - 1] + gdr_paged_cache_mesh(cache, m - 1)->page_count : 0;
+    return base;
+}
+
+/* The pool slots a view's full cut needs, marked in `set` (indexed as page_bases numbers the pages):
+ * the pages of the groups its clusters belong to, and the pages of those groups' ancestors (the
+ * closure). Returns how many it marked that were not marked before. */
+static uint32_t mark_view_pages(const gdr_scene *scene, const gdr_paged_cache *cache, const uint32_t *base,
+                                const gdr_frame_desc *frame, uint8_t *set)
+{
     gdr_mat4 projection = gdr_perspective_reverse_z_infinite(frame->camera.yfov, (float)WIDTH / HEIGHT,
                                                              frame->camera.znear);
-    uint32_t needed = 0;
+    uint32_t added = 0;
     for (uint32_t m = 0; m < scene->mesh_count; m++) {
         const gdr_mesh_clusters *c = &scene->meshes[m].clusters;
         const gdr_paged_mesh *pm = gdr_paged_cache_mesh(cache, m);
-        uint8_t *cut = malloc(c->cluster_count), *page = calloc(pm->page_count, 1), *group = calloc(c->group_count, 1);
-        for (uint32_t i = 0; cut && page && group && i < scene->instance_count; i++) {
+        uint8_t *cut = malloc(c->cluster_count), *group = calloc(c->group_count, 1);
+        for (uint32_t i = 0; cut && group && i < scene->instance_count; i++) {
             if (scene->instances[i].mesh != m)
                 continue;
             gdr_lod_view view = {.transform = scene->instances[i].transform, .camera_position = frame->camera.position,
@@ -97,15 +108,43 @@ static uint32_t slots_needed(const gdr_scene *scene, const char *path, const gdr
             for (uint32_t g = 0; g < c->group_count; g++)
                 for (uint32_t e = 0; group[g] && e < pm->groups[g].parent_count; e++)
                     group[pm->parents[pm->groups[g].parent_first + e]] = 1;
-        for (uint32_t g = 0; group && page && g < c->group_count; g++)
-            if (group[g] && !page[pm->groups[g].page]) {
-                page[pm->groups[g].page] = 1;
-                needed++;
+        for (uint32_t g = 0; group && g < c->group_count; g++)
+            if (group[g] && !set[base[m] + pm->groups[g].page]) {
+                set[base[m] + pm->groups[g].page] = 1;
+                added++;
             }
-        free(cut), free(page), free(group);
+        free(cut), free(group);
     }
+    return added;
+}
+
+/* The pool's slots: one more than the view that needs most, provided the three views' pages
+ * together need more than that (so the still views must evict) and the pool is at most a tenth of
+ * the pages' bytes. 0 where the scene does not meet those premises. */
+static uint32_t pool_slots(const gdr_scene *scene, const char *path, uint64_t slot, uint64_t total)
+{
+    gdr_paged_cache *cache = NULL;
+    gdr_error err = {0};
+    if (gdr_paged_cache_open(path, &cache, &err) != GDR_OK)
+        return 0;
+    uint32_t *base = page_bases(cache);
+    uint32_t pages = base ? base[gdr_paged_cache_mesh_count(cache)] : 0;
+    uint8_t *all = calloc(pages + 1, 1), *one = calloc(pages + 1, 1);
+    uint32_t most = 0, together = 0;
+    for (int v = 0; base && all && one && v < VIEWS; v++) {
+        gdr_frame_desc frame = view_frame(v);
+        memset(one, 0, pages);
+        uint32_t needed = mark_view_pages(scene, cache, base, &frame, one);
+        for (uint32_t p = 0; p < pages; p++)
+            together += one[p] && !all[p], all[p] |= one[p];
+        printf("view %d needs %u slots\n", v, needed);
+        most = needed > most ? needed : most;
+    }
+    printf("the three views together need %u slots of %u pages; the pool has %u\n", together, pages, most + 1);
+    free(all), free(one), free(base);
     gdr_paged_cache_close(cache);
-    return needed;
+    CHECK(most + 1 < together && (most + 1) * slot <= total / 10);
+    return most + 1 < together && (most + 1) * slot <= total / 10 ? most + 1 : 0;
 }
 
 /* One frame: its image, and its drawn clusters against the CPU's cut over the groups the renderer
@@ -293,8 +332,33 @@ static void camera_path(const gdr_scene *scene, gdr_renderer *r, uint64_t budget
     free(image);
 }
 
-/* A byte of a page view 0's full cut needs flipped on disk: refused by name, its group stays
- * absent, every frame's cut stays exact. */
+/* The finest group of mesh m that a frame's full cut draws (over all of the mesh's instances), or
+ * UINT32_MAX where it draws none. */
+static uint32_t finest_drawn_group(const gdr_scene *scene, uint32_t m, const gdr_frame_desc *frame)
+{
+    gdr_mat4 projection = gdr_perspective_reverse_z_infinite(frame->camera.yfov, (float)WIDTH / HEIGHT,
+                                                             frame->camera.znear);
+    const gdr_mesh_clusters *c = &scene->meshes[m].clusters;
+    uint8_t *cut = malloc(c->cluster_count);
+    uint32_t group = UINT32_MAX;
+    for (uint32_t i = 0; cut && i < scene->instance_count; i++) {
+        if (scene->instances[i].mesh != m)
+            continue;
+        gdr_lod_view view = {.transform = scene->instances[i].transform, .camera_position = frame->camera.position,
+                             .projection_y = fabsf(projection.m[5]), .viewport_height = HEIGHT,
+                             .znear = frame->camera.znear, .threshold = frame->lod_error_px};
+        gdr_lod_cut_select(c, &view, cut);
+        for (uint32_t k = 0; k < c->cluster_count; k++)
+            if (cut[k] && (group == UINT32_MAX || c->groups[c->clusters[k].group].depth < c->groups[group].depth))
+                group = c->clusters[k].group;
+    }
+    free(cut);
+    return group;
+}
+
+/* A byte of a page view 0's full cut needs flipped on disk (the page of the finest group view 0
+ * draws of the first mesh where that page is not the pinned page 0): refused by name, its group
+ * stays absent, every frame's cut stays exact. */
 static void damaged_page(const gdr_scene *scene, const gdr_scene *paged, const char *path, uint64_t budget)
 {
     gdr_paged_cache *cache = NULL;
@@ -302,28 +366,20 @@ static void damaged_page(const gdr_scene *scene, const gdr_scene *paged, const c
     CHECK(gdr_paged_cache_open(path, &cache, &err) == GDR_OK);
     if (!cache)
         return;
-    /* The finest group of mesh 0 that view 0 draws: its page. */
     gdr_frame_desc frame = view_frame(0);
-    gdr_mat4 projection = gdr_perspective_reverse_z_infinite(frame.camera.yfov, (float)WIDTH / HEIGHT, frame.camera.znear);
-    uint32_t instance = 0;
-    while (scene->instances[instance].mesh != 0)
-        instance++;
-    const gdr_mesh_clusters *c = &scene->meshes[0].clusters;
-    gdr_lod_view view = {.transform = scene->instances[instance].transform, .camera_position = frame.camera.position,
-                         .projection_y = fabsf(projection.m[5]), .viewport_height = HEIGHT,
-                         .znear = frame.camera.znear, .threshold = frame.lod_error_px};
-    uint8_t *cut = malloc(c->cluster_count);
-    uint32_t group = UINT32_MAX;
-    gdr_lod_cut_select(c, &view, cut);
-    for (uint32_t k = 0; cut && k < c->cluster_count; k++)
-        if (cut[k] && (group == UINT32_MAX || c->groups[c->clusters[k].group].depth < c->groups[group].depth))
-            group = c->clusters[k].group;
-    free(cut);
-    const gdr_paged_mesh *pm = gdr_paged_cache_mesh(cache, 0);
-    uint32_t page = group == UINT32_MAX ? 0 : pm->groups[group].page;
+    uint32_t mesh = 0, group = UINT32_MAX, page = 0;
+    for (uint32_t m = 0; page == 0 && m < scene->mesh_count; m++) {
+        mesh = m;
+        group = finest_drawn_group(scene, m, &frame);
+        page = group == UINT32_MAX ? 0 : gdr_paged_cache_mesh(cache, m)->groups[group].page;
+    }
+    const gdr_paged_mesh *pm = gdr_paged_cache_mesh(cache, mesh);
+    const gdr_mesh_clusters *c = &scene->meshes[mesh].clusters;
     uint64_t offset = pm->pages[page].offset + pm->pages[page].stored_size / 2;
     gdr_paged_cache_close(cache);
     CHECK(group != UINT32_MAX && page != 0);
+    if (group == UINT32_MAX || page == 0)
+        return;
     FILE *f = fopen(path, "r+b");
     int byte = EOF;
     if (f && fseek(f, (long)offset, SEEK_SET) == 0 && (byte = fgetc(f)) != EOF && fseek(f, (long)offset, SEEK_SET) == 0)
@@ -341,12 +397,12 @@ static void damaged_page(const gdr_scene *scene, const gdr_scene *paged, const c
     for (uint32_t i = 0; r && image && i < 20 && draw(scene, r, &frame, image, &stats, &check); i++)
         check_budgets(&stats, budget);
     char expected[64];
-    snprintf(expected, sizeof expected, "mesh 0 page %u", page);
-    printf("damaged page %u of mesh 0 (group %u): %u refused, \"%s\"\n", page, group, stats.streaming.pages_refused,
-           stats.streaming.refused);
+    snprintf(expected, sizeof expected, "mesh %u page %u", mesh, page);
+    printf("damaged page %u of mesh %u (group %u): %u refused, \"%s\"\n", page, mesh, group,
+           stats.streaming.pages_refused, stats.streaming.refused);
     CHECK(stats.streaming.pages_refused >= 1 && strstr(stats.streaming.refused, path) &&
           strstr(stats.streaming.refused, expected));
-    CHECK(r && resident && gdr_renderer_read_residency(r, 0, resident, &err) == GDR_OK && !resident[group]);
+    CHECK(r && resident && gdr_renderer_read_residency(r, mesh, resident, &err) == GDR_OK && !resident[group]);
     CHECK(!check.full && check.drawn > 0 && check.evicted_in_use == 0);
     history_free(&check);
     free(image), free(resident);
@@ -438,21 +494,14 @@ static void run(const gdr_scene *scene, const char *path)
     gdr_renderer_destroy(whole);
 
     /* A pool one slot larger than the view that needs most (at most a tenth of the pages): each view
-     * fits, the three together do not, so the still views evict. */
+     * fits, the three together do not (pool_slots checks both), so the still views evict. */
     uint64_t slot = 0, total = pool_bytes(path, &slot);
-    uint32_t most = 0;
-    for (int v = 0; v < VIEWS; v++) {
-        gdr_frame_desc frame = view_frame(v);
-        uint32_t needed = slots_needed(scene, path, &frame);
-        printf("view %d needs %u slots\n", v, needed);
-        most = needed > most ? needed : most;
-    }
-    uint64_t budget = (most + 1) * slot < total / 10 ? (most + 1) * slot : total / 10;
+    uint64_t budget = pool_slots(scene, path, slot, total) * slot;
     /* The small pool streams a scene read without its geometry; the run with room for everything streams
      * the whole scene. */
     gdr_scene *paged = read_for_streaming(path);
-    gdr_renderer *r = paged ? streamed_renderer(paged, path, budget) : NULL;
-    CHECK(r && total > 0);
+    gdr_renderer *r = paged && budget ? streamed_renderer(paged, path, budget) : NULL;
+    CHECK(r && total > 0 && budget > 0);
     if (r && reference) {
         uint64_t evictions = still_views(scene, r, budget, reference, "small pool");
         CHECK(evictions > 0); /* the views need more than the pool holds */
@@ -477,9 +526,9 @@ static void run(const gdr_scene *scene, const char *path)
     printf("a 1 KiB budget: %s\n", err.message);
     gdr_renderer_destroy(small);
 
-    if (paged)
+    if (paged && budget)
         truncated_while_streaming(scene, paged, path, budget);
-    if (paged)
+    if (paged && budget)
         damaged_page(scene, paged, path, budget);
     gdr_scene_destroy(paged);
     free(reference);
@@ -490,7 +539,7 @@ int main(void)
     gdr_scene *scene = NULL;
     gdr_error err = {0};
     gdr_load_options load = {.no_progress = 1};
-    CHECK(gdr_scene_load("unique-field:meshes=12,triangles=20000,seed=3", &load, &scene, &err) == GDR_OK);
+    CHECK(gdr_scene_load("unique-field:meshes=20,triangles=40000,seed=3", &load, &scene, &err) == GDR_OK);
     char path[256];
     const char *tmp = getenv("TMPDIR");
     snprintf(path, sizeof path, "%s/gdr_gpu_streaming_%ld.gdrc", tmp ? tmp : "/tmp", (long)getpid());
