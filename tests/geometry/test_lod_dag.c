@@ -1242,6 +1242,66 @@ static void test_error_between_probes(void)
     gdr_scene_destroy(s);
 }
 
+/* The uvs steer simplification only where a texture reads them: a scene's mesh whose instance has an
+ * untextured material builds the DAG of the mesh built alone with ignore_uvs, bit for bit in its
+ * groups' errors; with a textured material, the DAG with its uvs. The blob's spherical uv map is far
+ * from affine, so the two differ. */
+static uint32_t add_blob_instance(gdr_scene *s, int textured)
+{
+    gdr_error err = {0};
+    uint32_t blob, material, texture = GDR_NO_INDEX;
+    check_ok(gdr_procedural_blob(s, 4, &blob, &err), &err, "blob");
+    gdr_material m = gdr_material_default();
+    if (textured) {
+        const uint8_t texels[4 * 4] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 255};
+        check_ok(gdr_scene_add_texture(s, "checker", 2, 2, texels, 1, &texture, &err), &err, "texture");
+        m.base_color_texture.texture = texture;
+    }
+    check_ok(gdr_scene_add_material(s, &m, &material, &err), &err, "material");
+    gdr_instance in = {.transform = gdr_mat4_identity(), .mesh = blob, .material = material,
+                       .color = {1, 1, 1, 1}};
+    check_ok(gdr_scene_add_instance(s, &in, &err), &err, "instance");
+    return blob;
+}
+
+static int same_errors(const gdr_mesh_clusters *a, const gdr_mesh_clusters *b)
+{
+    if (a->group_count != b->group_count || a->cluster_count != b->cluster_count)
+        return 0;
+    for (uint32_t g = 0; g < a->group_count; g++)
+        if (memcmp(&a->groups[g].error, &b->groups[g].error, sizeof a->groups[g].error) != 0)
+            return 0;
+    return 1;
+}
+
+static void test_uvs_where_textured(void)
+{
+    gdr_error err = {0};
+    gdr_scene *plain = new_scene(), *textured = new_scene(), *alone = new_scene();
+    uint32_t p = add_blob_instance(plain, 0), t = add_blob_instance(textured, 1);
+    gdr_lod_options o = {.thread_count = 2, .no_progress = 1};
+    check_ok(gdr_scene_build_lod(plain, &o, NULL, &err), &err, "untextured scene");
+    check_ok(gdr_scene_build_lod(textured, &o, NULL, &err), &err, "textured scene");
+    uint32_t with, without;
+    check_ok(gdr_procedural_blob(alone, 4, &with, &err), &err, "blob");
+    check_ok(gdr_procedural_blob(alone, 4, &without, &err), &err, "blob");
+    build_level0(&alone->meshes[with]);
+    build_level0(&alone->meshes[without]);
+    check_ok(gdr_mesh_build_lod_dag(&alone->meshes[with], &o, NULL, &err), &err, "with uvs");
+    gdr_lod_options no_uvs = o;
+    no_uvs.ignore_uvs = 1;
+    check_ok(gdr_mesh_build_lod_dag(&alone->meshes[without], &no_uvs, NULL, &err), &err, "without uvs");
+    const gdr_mesh_clusters *cp = &plain->meshes[p].clusters, *ct = &textured->meshes[t].clusters;
+    const gdr_mesh_clusters *cw = &alone->meshes[with].clusters, *cn = &alone->meshes[without].clusters;
+    printf("blob: %u / %u groups with / without uvs\n", cw->group_count, cn->group_count);
+    CHECK(!same_errors(cw, cn));
+    CHECK(same_errors(cp, cn)); /* untextured: the uvs ignored */
+    CHECK(same_errors(ct, cw)); /* textured: the uvs steer */
+    gdr_scene_destroy(plain);
+    gdr_scene_destroy(textured);
+    gdr_scene_destroy(alone);
+}
+
 int main(void)
 {
     test_meshes();
@@ -1254,6 +1314,7 @@ int main(void)
     test_seams_welded();
     test_error_between_probes();
     test_scene();
+    test_uvs_where_textured();
     test_bad_input();
     return test_finish("test_lod_dag");
 }
