@@ -59,20 +59,6 @@ gdr_status gdr_import_file(const char *path, const gdr_import_options *options, 
     return status == GDR_OK ? compress_textures(path, out, err) : status;
 }
 
-static void warn(const gdr_load_options *o, const char *format, ...) __attribute__((format(printf, 2, 3)));
-static void warn(const gdr_load_options *o, const char *format, ...)
-{
-    char message[GDR_ERROR_MESSAGE_MAX + 128];
-    va_list args;
-    va_start(args, format);
-    vsnprintf(message, sizeof message, format, args);
-    va_end(args);
-    if (o->warning)
-        o->warning(o->warning_user, message);
-    else
-        fprintf(stderr, "gdr: warning: %s\n", message);
-}
-
 /* After a cache read: clusters for a cache that had none, and the PVS handed out (or freed). */
 static gdr_status finish_cache_read(const char *path, gdr_scene **out, gdr_pvs *pvs, gdr_pvs **out_pvs,
                                     gdr_error *err)
@@ -91,23 +77,6 @@ static gdr_status finish_cache_read(const char *path, gdr_scene **out, gdr_pvs *
     return status;
 }
 
-/* Every warning of an import goes to the caller's sink and into the report the cache keeps. */
-typedef struct warning_collector {
-    const gdr_load_options *options;
-    gdr_import_report *report;
-} warning_collector;
-
-static void collect_warning(void *user, const char *message)
-{
-    warning_collector *c = user;
-    gdr_error ignored;
-    gdr_io_report_add(c->report, message, strlen(message), &ignored); /* out of memory: said, not kept */
-    if (c->options->warning)
-        c->options->warning(c->options->warning_user, message);
-    else
-        fprintf(stderr, "gdr: warning: %s\n", message);
-}
-
 /* Where the cache of `path` goes: next to it for ".", else in cache_dir or the per-user folder
  * (*dir, created and checked). 0: no cache (no folder to be had; said when there is a reason). */
 static int cache_location(const char *path, const gdr_load_options *options, char *dir, char *cache)
@@ -121,7 +90,7 @@ static int cache_location(const char *path, const gdr_load_options *options, cha
         return 0; /* no HOME or XDG_CACHE_HOME: nowhere to keep one */
     gdr_error dir_err;
     if (gdr_io_cache_dir_prepare(dir, &dir_err) != GDR_OK) {
-        warn(options, "%s", dir_err.message);
+        gdr_io_load_warn(options, "%s", dir_err.message);
         return 0;
     }
     return gdr_cache_path_for(path, dir, cache, PATH_MAX) != 0;
@@ -142,7 +111,7 @@ static int read_cached(const char *path, const char *cache, const gdr_load_optio
     if (read != GDR_OK) {
         /* Stale: rebuilt without a word; gone meanwhile (another gdr evicted it): the same; else said. */
         if (read != GDR_ERROR_STALE && access(cache, F_OK) == 0)
-            warn(options, "%s; rebuilding it", cache_err.message);
+            gdr_io_load_warn(options, "%s; rebuilding it", cache_err.message);
         return 0;
     }
     gdr_io_cache_touch(cache); /* used now: the last to be evicted */
@@ -184,7 +153,7 @@ static void write_cache(const char *path, const char *cache, const char *dir, co
     report->cache_path = strdup(cache);
     report->cache_state = written ? GDR_CACHE_WRITTEN : GDR_CACHE_NOT_WRITTEN;
     if (!written)
-        warn(options, "cache not written: %s", write_err.message);
+        gdr_io_load_warn(options, "cache not written: %s", write_err.message);
     else if (dir[0])
         gdr_io_cache_evict(dir, gdr_io_cache_limit(options->cache_max_bytes), cache);
 }
@@ -223,8 +192,8 @@ gdr_status gdr_scene_load_file(const char *path, const gdr_load_options *options
         gdr_import_report_free(&local);
         return status;
     }
-    warning_collector collector = {options, report};
-    gdr_import_options import = {.warning = collect_warning, .warning_user = &collector,
+    gdr_io_report_collector collector = {options, report};
+    gdr_import_options import = {.warning = gdr_io_report_collect, .warning_user = &collector,
                                  .no_progress = options->no_progress, .budget = options->budget,
                                  .allow_outside_files = options->allow_outside_files};
     gdr_import_result result = {0};

@@ -1,5 +1,6 @@
 /* An import's report (gdr_import_report): its warnings and cameras, kept in the cache (section
  * 'REPT') so that a cached run says what the import said. */
+#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -138,4 +139,28 @@ gdr_status gdr_io_report_untemplate(gdr_import_report *report, const char *sourc
     char folder[4096];
     folder_of(source ? source : "", folder, sizeof folder);
     return rewrite(report, SOURCE_MARK, source ? source : "(its source)", FOLDER_MARK, folder, err);
+}
+
+void gdr_io_load_warn(const gdr_load_options *o, const char *format, ...)
+{
+    char message[GDR_ERROR_MESSAGE_MAX + 128];
+    va_list args;
+    va_start(args, format);
+    vsnprintf(message, sizeof message, format, args);
+    va_end(args);
+    if (o->warning)
+        o->warning(o->warning_user, message);
+    else
+        fprintf(stderr, "gdr: warning: %s\n", message);
+}
+
+void gdr_io_report_collect(void *user, const char *message)
+{
+    gdr_io_report_collector *c = user;
+    gdr_error ignored;
+    gdr_io_report_add(c->report, message, strlen(message), &ignored); /* out of memory: said, not kept */
+    if (c->options->warning)
+        c->options->warning(c->options->warning_user, message);
+    else
+        fprintf(stderr, "gdr: warning: %s\n", message);
 }

@@ -3,7 +3,6 @@
  * quantized, written with pages: what gdr build --pages writes) where no fresh one is found. The
  * paged cache sits beside the loader's own cache for the source, as FILE.pages.gdrc, so that it
  * follows wherever the loader puts its caches and never replaces the cache of the whole scene. */
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,20 +16,6 @@
 #include "io/io_internal.h"
 #include "io/loaders.h"
 
-static void warn(const gdr_load_options *o, const char *format, ...) __attribute__((format(printf, 2, 3)));
-static void warn(const gdr_load_options *o, const char *format, ...)
-{
-    char message[GDR_ERROR_MESSAGE_MAX + 128];
-    va_list args;
-    va_start(args, format);
-    vsnprintf(message, sizeof message, format, args);
-    va_end(args);
-    if (o->warning)
-        o->warning(o->warning_user, message);
-    else
-        fprintf(stderr, "gdr: warning: %s\n", message);
-}
-
 /* FILE.gdrc -> FILE.pages.gdrc; 0 when it does not fit. */
 static int paged_name(const char *candidate, char *out, size_t size)
 {
@@ -39,20 +24,6 @@ static int paged_name(const char *candidate, char *out, size_t size)
         return 0;
     int written = snprintf(out, size, "%.*s.pages.gdrc", (int)(n - 5), candidate);
     return written > 0 && (size_t)written < size;
-}
-
-/* The import's warnings go to the caller's sink and into the report the paged cache keeps. */
-typedef struct paged_warnings {
-    const gdr_load_options *options;
-    gdr_import_report *report;
-} paged_warnings;
-
-static void keep_warning(void *user, const char *message)
-{
-    paged_warnings *w = user;
-    gdr_error ignored;
-    gdr_io_report_add(w->report, message, strlen(message), &ignored); /* out of memory: said, not kept */
-    warn(w->options, "%s", message);
 }
 
 /* The scene as gdr build --pages stores it: imported (its files listed in *sources, its warnings in
@@ -67,8 +38,8 @@ static gdr_status build_scene(const char *spec, const gdr_load_options *o, bool 
         plain.report = NULL;
         status = gdr_scene_load(spec, &plain, scene, err);
     } else {
-        paged_warnings kept = {o, report};
-        gdr_import_options import = {.warning = keep_warning, .warning_user = &kept,
+        gdr_io_report_collector kept = {o, report};
+        gdr_import_options import = {.warning = gdr_io_report_collect, .warning_user = &kept,
                                      .no_progress = o->no_progress, .sources = sources, .budget = o->budget,
                                      .allow_outside_files = o->allow_outside_files};
         gdr_import_result result = {0};
@@ -119,7 +90,7 @@ static int builtin_candidate(const char *spec, const gdr_load_options *o, char *
         return 0;
     gdr_error dir_err;
     if (gdr_io_cache_dir_prepare(folder, &dir_err) != GDR_OK) {
-        warn(o, "%s", dir_err.message);
+        gdr_io_load_warn(o, "%s", dir_err.message);
         return 0;
     }
     return gdr_cache_path_for(spec, folder, out, PATH_MAX) != 0;
@@ -180,7 +151,7 @@ gdr_status gdr_io_load_paged(const char *spec, const gdr_load_options *o, char (
             return GDR_OK;
         }
         if (read != GDR_ERROR_STALE)
-            warn(o, "%s; rebuilding it", read_err.message);
+            gdr_io_load_warn(o, "%s; rebuilding it", read_err.message);
     }
     int written = write_paged(spec, o, builtin, build_options, paths, n, err);
     if (written < 0)
