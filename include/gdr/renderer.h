@@ -271,6 +271,13 @@ typedef struct gdr_streaming_stats {
     uint32_t wanted_pages;
     uint32_t settled_frames;
     uint32_t lod_error_changes;   /* times the threshold's factor changed since the scene was set */
+    /* The LOD nodes' absent counts, updated from the groups whose residency changed in the frame:
+     * those groups, the node updates (each changed group's leaves and their ancestors), and the
+     * counts uploaded (words) in how many copies (runs of consecutive nodes). */
+    uint32_t node_groups_changed;
+    uint32_t node_updates;
+    uint32_t node_words_uploaded;
+    uint32_t node_copies;
     char refused[GDR_ERROR_MESSAGE_MAX];          /* the last refused page's message (file, mesh, page, why) */
 } gdr_streaming_stats;
 

@@ -152,3 +152,23 @@ gdr_status gdr_renderer_read_residency(gdr_renderer *r, uint32_t mesh, uint8_t *
     gdr_vk_buffer_destroy(r->ctx, &readback);
     return status;
 }
+
+gdr_status gdr_renderer_debug_read_node_counts(gdr_renderer *r, uint32_t mesh, uint32_t *counts, gdr_error *err)
+{
+    gdr_gpu_scene *g = &r->scene;
+    if (!r->has_scene || mesh >= g->mesh_count)
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "read_node_counts: mesh %u of %u", mesh, g->mesh_count);
+    const GdrGpuMesh *m = &g->cpu_meshes[mesh];
+    if (m->lod_node_count == 0)
+        return GDR_OK;
+    if (vkDeviceWaitIdle(r->ctx->device) != VK_SUCCESS)
+        return gdr_error_set(err, GDR_ERROR_VULKAN, "read_node_counts: vkDeviceWaitIdle failed");
+    gdr_vk_buffer readback = {0};
+    gdr_status status = gdr_vk_buffer_read_back(&r->allocator, g->node_absent_refined.buffer,
+                                                sizeof *counts * m->lod_node_offset,
+                                                sizeof *counts * m->lod_node_count, &readback, err);
+    if (status == GDR_OK)
+        memcpy(counts, readback.mapped, sizeof *counts * m->lod_node_count);
+    gdr_vk_buffer_destroy(r->ctx, &readback);
+    return status;
+}

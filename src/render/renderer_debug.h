@@ -37,4 +37,10 @@ gdr_status gdr_renderer_debug_set_residency(gdr_renderer *renderer, uint32_t mes
                                                     const uint8_t *group_resident,
                                                     const uint32_t *node_absent_refined, gdr_error *err);
 
+/* Tests: reads back mesh `mesh`'s LOD nodes' absent counts as the GPU holds them (lod_node_count
+ * words): with gdr_renderer_read_residency, a check that the incremental updates of a streamed
+ * scene's counts equal gdr_lod_nodes_count_absent_refined over its page table. Waits for the GPU. */
+gdr_status gdr_renderer_debug_read_node_counts(gdr_renderer *renderer, uint32_t mesh, uint32_t *counts,
+                                               gdr_error *err);
+
 #endif

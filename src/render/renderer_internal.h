@@ -149,12 +149,12 @@ typedef struct gdr_streaming {
     uint64_t staging_bytes;             /* each frame slot's staging buffer */
     uint32_t *slot_page;                /* per pool slot: the global page the GPU may read there, or UINT32_MAX */
     uint32_t *page_base;                /* per mesh + 1: its first global page */
-    uint8_t *mesh_dirty;                /* meshes whose node counts change this frame ... */
+    uint8_t *mesh_dirty;                /* meshes whose absent groups change this frame ... */
     uint32_t *dirty_list, dirty_count;  /* ... listed */
-    VkBufferCopy *copies;               /* scratch: a frame's copy regions (groups + slots + meshes) */
+    VkBufferCopy *copies;               /* scratch: a frame's copy regions (groups + slots + nodes) */
     uint32_t *words;                    /* scratch: a frame's page-table words (3 x groups) */
-    uint8_t *resident;                  /* scratch: a group per mesh's group */
-    uint32_t *absent;                   /* scratch: a count per mesh's LOD node */
+    struct gdr_node_counts *node_counts; /* the LOD nodes' absent counts, updated per changed group */
+    struct gdr_node_run *node_runs;     /* scratch: a frame's runs of changed counts */
     struct gdr_page_result *pending;    /* read and checked, waiting for upload room, in load order */
     uint32_t pending_count, pending_capacity;
     struct gdr_stream_request *requests; /* scratch: GDR_STREAM_REQUEST_CAPACITY */

@@ -16,6 +16,7 @@
 #include "gdr/paged_cache.h"
 #include "geometry/lod_cut.h"
 #include "render/renderer_internal.h"
+#include "stream/node_counts.h"
 #include "stream/page_loader.h"
 #include "stream/residency.h"
 #include "render/page_table.h"
@@ -80,7 +81,7 @@ static uint64_t default_budget(const gdr_renderer *r)
 
 static gdr_status alloc_tables(gdr_streaming *s, const gdr_scene *scene, gdr_error *err)
 {
-    uint32_t meshes = scene->mesh_count, largest_groups = 1, largest_nodes = 1;
+    uint32_t meshes = scene->mesh_count;
     s->page_base = malloc(sizeof *s->page_base * ((size_t)meshes + 1));
     s->mesh_dirty = calloc(meshes ? meshes : 1, 1);
     s->dirty_list = malloc(sizeof *s->dirty_list * (meshes ? meshes : 1));
@@ -90,22 +91,20 @@ static gdr_status alloc_tables(gdr_streaming *s, const gdr_scene *scene, gdr_err
     for (uint32_t m = 0; m < meshes; m++) {
         s->page_base[m] = pages;
         pages += paged_mesh(s, m)->page_count;
-        const gdr_mesh_clusters *c = &scene->meshes[m].clusters;
-        largest_groups = c->group_count > largest_groups ? c->group_count : largest_groups;
-        largest_nodes = c->lod_node_count > largest_nodes ? c->lod_node_count : largest_nodes;
     }
     s->page_base[meshes] = pages;
     s->slot_page = malloc(sizeof *s->slot_page * (s->slot_count ? s->slot_count : 1));
-    s->resident = malloc(largest_groups);
-    s->absent = malloc(sizeof *s->absent * largest_nodes);
     s->requests = malloc(sizeof *s->requests * GDR_STREAM_REQUEST_CAPACITY);
     s->loads = malloc(sizeof *s->loads * (s->slot_count ? s->slot_count : 1));
-    uint64_t groups = 0;
-    for (uint32_t m = 0; m < meshes; m++)
+    uint64_t groups = 0, nodes = 0;
+    for (uint32_t m = 0; m < meshes; m++) {
         groups += scene->meshes[m].clusters.group_count;
-    s->copies = malloc(sizeof *s->copies * (groups + s->slot_count + meshes + 1));
+        nodes += scene->meshes[m].clusters.lod_node_count;
+    }
+    /* Copies: a page's data per slot, its records per group, a run of node counts per node at most. */
+    s->copies = malloc(sizeof *s->copies * (groups + s->slot_count + nodes + 1));
     s->words = malloc(sizeof *s->words * (3 * groups + 1));
-    if (!s->slot_page || !s->resident || !s->absent || !s->requests || !s->loads || !s->copies || !s->words)
+    if (!s->slot_page || !s->requests || !s->loads || !s->copies || !s->words)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "streaming: out of memory for %u slots", s->slot_count);
     for (uint32_t i = 0; i < s->slot_count; i++)
         s->slot_page[i] = UINT32_MAX;
@@ -225,8 +224,9 @@ void gdr_streaming_destroy(gdr_renderer *r)
     gdr_residency_destroy(s->residency); /* the paged cache stays open: it is the caller's */
     if (r->ctx)
         gdr_vk_buffer_destroy(r->ctx, &s->pool);
-    free(s->pending), free(s->slot_page), free(s->page_base), free(s->mesh_dirty), free(s->resident);
-    free(s->absent), free(s->requests), free(s->loads), free(s->dirty_list), free(s->copies), free(s->words);
+    gdr_node_counts_destroy(s->node_counts);
+    free(s->pending), free(s->slot_page), free(s->page_base), free(s->mesh_dirty), free(s->node_runs);
+    free(s->requests), free(s->loads), free(s->dirty_list), free(s->copies), free(s->words);
     memset(s, 0, sizeof *s);
 }
 
@@ -237,6 +237,14 @@ static void mark_dirty(gdr_streaming *s, uint32_t mesh)
     if (!s->mesh_dirty[mesh])
         s->dirty_list[s->dirty_count++] = mesh;
     s->mesh_dirty[mesh] = 1;
+}
+
+/* A group's page-table word changes: its node counts follow (node_counts.h). */
+static void set_group(gdr_streaming *s, uint32_t mesh, uint32_t group, bool resident)
+{
+    uint32_t touched = gdr_node_counts_set(s->node_counts, mesh, group, resident);
+    s->stats.node_groups_changed++;
+    s->stats.node_updates += touched;
 }
 
 static void *stage(gdr_frame_slot *slot, stream_copies *c, uint64_t bytes)
@@ -318,6 +326,7 @@ static void stage_page(gdr_renderer *r, gdr_frame_slot *slot, stream_copies *c, 
         c->records[c->record_count++] = (VkBufferCopy){from, sizeof(GdrGpuMeshlet) * (uint64_t)first, bytes};
         c->resident_words[c->resident_count] = g->cpu_meshes[page->mesh].page_table_offset + group;
         c->resident_slots[c->resident_count++] = pool_slot;
+        set_group(s, page->mesh, group, true);
     }
     s->slot_page[pool_slot] = s->page_base[page->mesh] + page->page;
     mark_dirty(s, page->mesh);
@@ -366,8 +375,10 @@ static void find_evictions(gdr_renderer *r, stream_copies *c)
             continue;
         const gdr_paged_mesh *pm = paged_mesh(s, m);
         const gdr_page_info *info = &pm->pages[local];
-        for (uint32_t k = info->first; k < info->first + info->group_count; k++)
+        for (uint32_t k = info->first; k < info->first + info->group_count; k++) {
             c->absent_words[c->absent_count++] = r->scene.cpu_meshes[m].page_table_offset + pm->page_groups[k];
+            set_group(s, m, pm->page_groups[k], false);
+        }
         s->slot_page[slot] = UINT32_MAX;
         mark_dirty(s, m);
     }
@@ -442,7 +453,8 @@ static void upload_pending(gdr_renderer *r, gdr_frame_slot *slot, stream_copies 
     s->stats.upload_bytes = bytes;
 }
 
-/* The node counts of every mesh whose residency changed, and the scene's absent total. */
+/* The node counts that changed (node_counts.h), a copy per run of consecutive nodes, and the absent
+ * groups of every mesh whose residency changed. */
 static gdr_status stage_node_counts(gdr_renderer *r, gdr_frame_slot *slot, stream_copies *c, gdr_error *err)
 {
     gdr_streaming *s = &r->stream;
@@ -450,20 +462,18 @@ static gdr_status stage_node_counts(gdr_renderer *r, gdr_frame_slot *slot, strea
     for (uint32_t i = 0; i < s->dirty_count && status == GDR_OK; i++) {
         uint32_t m = s->dirty_list[i];
         s->mesh_dirty[m] = 0;
-        const gdr_mesh_clusters *mc = &s->scene->meshes[m].clusters;
-        uint32_t absent = 0;
-        for (uint32_t group = 0; group < mc->group_count; group++) {
-            s->resident[group] = (uint8_t)gdr_residency_group_resident(s->residency, m, group);
-            absent += !s->resident[group];
-        }
-        gdr_lod_nodes_count_absent_refined(mc, s->resident, s->absent);
-        uint64_t bytes = 4ull * mc->lod_node_count;
-        uint64_t from = c->staged;
-        memcpy(stage(slot, c, bytes), s->absent, bytes);
-        c->nodes[c->node_count++] = (VkBufferCopy){from, 4ull * r->scene.cpu_meshes[m].lod_node_offset, bytes};
-        status = gdr_page_table_set_absent(r, m, absent, err);
+        status = gdr_page_table_set_absent(r, m, gdr_node_counts_absent_groups(s->node_counts, m), err);
     }
     s->dirty_count = 0;
+    uint32_t words = 0, runs = gdr_node_counts_take_changes(s->node_counts, s->node_runs, &words);
+    const uint32_t *counts = gdr_node_counts_words(s->node_counts);
+    for (uint32_t i = 0; i < runs; i++) {
+        uint64_t bytes = 4ull * s->node_runs[i].count, from = c->staged;
+        memcpy(stage(slot, c, bytes), counts + s->node_runs[i].first, bytes);
+        c->nodes[c->node_count++] = (VkBufferCopy){from, 4ull * s->node_runs[i].first, bytes};
+    }
+    s->stats.node_words_uploaded = words;
+    s->stats.node_copies = runs;
     return status;
 }
 
@@ -559,6 +569,7 @@ gdr_status gdr_streaming_begin_frame(gdr_renderer *r, gdr_frame_slot *slot, gdr_
     uint32_t frame = ++s->frame;
     s->stats.uploads = 0;
     s->stats.upload_bytes = 0;
+    s->stats.node_groups_changed = s->stats.node_updates = 0;
     uint32_t request_count = slot->stream_results ? read_slot_results(r, slot) : 0;
     request_count = fit_cut_to_pool(r, slot, request_count);
     uint32_t load_count = 0;
@@ -586,6 +597,31 @@ gdr_status gdr_streaming_begin_frame(gdr_renderer *r, gdr_frame_slot *slot, gdr_
     return status;
 }
 
+/* The node counts over the scene's hierarchies, every group absent (as the page table starts). */
+static gdr_status create_node_counts(gdr_renderer *r, gdr_error *err)
+{
+    gdr_streaming *s = &r->stream;
+    gdr_gpu_scene *g = &r->scene;
+    uint32_t meshes = s->scene->mesh_count;
+    const gdr_mesh_clusters **clusters = malloc(sizeof *clusters * (meshes ? meshes : 1));
+    uint32_t *offsets = malloc(sizeof *offsets * (meshes ? meshes : 1));
+    gdr_status status = GDR_OK;
+    if (!clusters || !offsets)
+        status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "streaming: out of memory for the node counts");
+    for (uint32_t m = 0; status == GDR_OK && m < meshes; m++) {
+        clusters[m] = &s->scene->meshes[m].clusters;
+        offsets[m] = g->cpu_meshes[m].lod_node_offset;
+    }
+    if (status == GDR_OK)
+        status = gdr_node_counts_create(clusters, offsets, meshes, &s->node_counts, err);
+    uint32_t nodes = status == GDR_OK ? gdr_node_counts_node_total(s->node_counts) : 0;
+    if (status == GDR_OK && !(s->node_runs = malloc(sizeof *s->node_runs * (nodes ? nodes : 1))))
+        status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "streaming: out of memory for the node counts");
+    free(clusters);
+    free(offsets);
+    return status;
+}
+
 /* Before the first frame: every group absent, then every mesh's coarsest page (pinned) read, checked
  * and copied, waiting for them: the first frame draws every mesh at its coarsest at least. */
 gdr_status gdr_streaming_start(gdr_renderer *r, gdr_error *err)
@@ -600,6 +636,8 @@ gdr_status gdr_streaming_start(gdr_renderer *r, gdr_error *err)
     gdr_status status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->page_table, 0, absent,
                                              sizeof *absent * g->group_total, err);
     free(absent);
+    if (status == GDR_OK)
+        status = create_node_counts(r, err);
     bool wait = s->wait_for_loads;
     s->wait_for_loads = true;
     gdr_frame_slot *slot = &r->slots[0];

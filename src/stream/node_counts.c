@@ -1,0 +1,226 @@
+/* The LOD nodes' absent counts, updated per changed group (node_counts.h). For each group, the
+ * leaves holding clusters made from it and how many (the group's references); for each node, its
+ * parent. A group's change adds or takes its references' counts along each leaf's path to the root. */
+#include "stream/node_counts.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "geometry/lod_cut.h"
+
+#define NO_NODE UINT32_MAX
+
+/* One reference of a group: `count` clusters of leaf `leaf` (global node) were made from it. */
+typedef struct node_ref {
+    uint32_t leaf, count;
+} node_ref;
+
+struct gdr_node_counts {
+    uint32_t mesh_count, node_total, group_total;
+    uint32_t *group_base;          /* per mesh + 1: its first global group */
+    uint32_t *parent;              /* per global node: its parent, NO_NODE for a root */
+    uint32_t *ref_first, *ref_len; /* per global group: its references in refs */
+    node_ref *refs;
+    uint32_t *counts;              /* per global node */
+    uint8_t *resident;             /* per global group */
+    uint32_t *absent;              /* per mesh: absent groups */
+    uint8_t *changed;              /* per global node: listed in changed_list */
+    uint32_t *changed_list, changed_count;
+};
+
+static void mark_changed(gdr_node_counts *nc, uint32_t node)
+{
+    if (!nc->changed[node]) {
+        nc->changed[node] = 1;
+        nc->changed_list[nc->changed_count++] = node;
+    }
+}
+
+/* The parents of mesh m's nodes. A child always comes after its parent (breadth first); children
+ * that do not, or lie beyond the mesh's nodes, are left out (a checked hierarchy has none), so that
+ * every walk up ends. */
+static void link_parents(gdr_node_counts *nc, const gdr_mesh_clusters *c, uint32_t offset)
+{
+    for (uint32_t n = 0; n < c->lod_node_count; n++) {
+        const gdr_lod_node *node = &c->lod_nodes[n];
+        if (node->flags & GDR_LOD_NODE_LEAF)
+            continue;
+        for (uint32_t k = node->first; k < node->first + node->count && k < c->lod_node_count; k++)
+            if (k > n)
+                nc->parent[offset + k] = offset + n;
+    }
+}
+
+/* Calls visit(nc, global group, global leaf) for every cluster of every leaf of mesh m that has a
+ * refined group. */
+static void for_each_ref(gdr_node_counts *nc, const gdr_mesh_clusters *c, uint32_t offset, uint32_t group_base,
+                         void (*visit)(gdr_node_counts *, uint32_t, uint32_t))
+{
+    for (uint32_t n = 0; n < c->lod_node_count; n++) {
+        const gdr_lod_node *node = &c->lod_nodes[n];
+        if (!(node->flags & GDR_LOD_NODE_LEAF))
+            continue;
+        for (uint32_t i = node->first; i < node->first + node->count && i < c->cluster_count; i++) {
+            uint32_t r = c->clusters[i].refined_group;
+            if (r != GDR_NO_INDEX && r < c->group_count)
+                visit(nc, group_base + r, offset + n);
+        }
+    }
+}
+
+static void count_ref(gdr_node_counts *nc, uint32_t group, uint32_t leaf)
+{
+    (void)leaf;
+    nc->ref_len[group]++;
+}
+
+/* Leaves are visited in order, so a leaf's clusters of one group are consecutive references. */
+static void add_ref(gdr_node_counts *nc, uint32_t group, uint32_t leaf)
+{
+    node_ref *list = nc->refs + nc->ref_first[group];
+    uint32_t *len = &nc->ref_len[group];
+    if (*len > 0 && list[*len - 1].leaf == leaf)
+        list[*len - 1].count++;
+    else
+        list[(*len)++] = (node_ref){leaf, 1};
+}
+
+static gdr_status build_refs(gdr_node_counts *nc, const gdr_mesh_clusters *const *meshes, const uint32_t *offsets,
+                             gdr_error *err)
+{
+    for (uint32_t m = 0; m < nc->mesh_count; m++)
+        for_each_ref(nc, meshes[m], offsets[m], nc->group_base[m], count_ref);
+    uint64_t total = 0;
+    for (uint32_t g = 0; g < nc->group_total; g++) {
+        nc->ref_first[g] = (uint32_t)total;
+        total += nc->ref_len[g];
+        nc->ref_len[g] = 0;
+    }
+    if (total > UINT32_MAX || !(nc->refs = malloc(sizeof *nc->refs * (total ? total : 1))))
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "node counts: out of memory for %llu references",
+                             (unsigned long long)total);
+    for (uint32_t m = 0; m < nc->mesh_count; m++)
+        for_each_ref(nc, meshes[m], offsets[m], nc->group_base[m], add_ref);
+    return GDR_OK;
+}
+
+static gdr_status allocate(gdr_node_counts *nc, const gdr_mesh_clusters *const *meshes, const uint32_t *offsets,
+                           gdr_error *err)
+{
+    uint64_t groups = 0, nodes = 0;
+    for (uint32_t m = 0; m < nc->mesh_count; m++) {
+        groups += meshes[m]->group_count;
+        uint64_t end = (uint64_t)offsets[m] + meshes[m]->lod_node_count;
+        nodes = end > nodes ? end : nodes;
+    }
+    if (groups > UINT32_MAX / 2 || nodes > UINT32_MAX / 2)
+        return gdr_error_set(err, GDR_ERROR_CAPACITY, "node counts: %llu groups, %llu nodes",
+                             (unsigned long long)groups, (unsigned long long)nodes);
+    nc->group_total = (uint32_t)groups;
+    nc->node_total = (uint32_t)nodes;
+    size_t g = groups ? groups : 1, n = nodes ? nodes : 1;
+    nc->group_base = malloc(sizeof *nc->group_base * ((size_t)nc->mesh_count + 1));
+    nc->parent = malloc(sizeof *nc->parent * n);
+    nc->ref_first = malloc(sizeof *nc->ref_first * g);
+    nc->ref_len = calloc(g, sizeof *nc->ref_len);
+    nc->counts = calloc(n, sizeof *nc->counts);
+    nc->resident = calloc(g, 1);
+    nc->absent = calloc(nc->mesh_count ? nc->mesh_count : 1, sizeof *nc->absent);
+    nc->changed = calloc(n, 1);
+    nc->changed_list = malloc(sizeof *nc->changed_list * n);
+    if (!nc->group_base || !nc->parent || !nc->ref_first || !nc->ref_len || !nc->counts || !nc->resident ||
+        !nc->absent || !nc->changed || !nc->changed_list)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "node counts: out of memory for %llu nodes",
+                             (unsigned long long)nodes);
+    return GDR_OK;
+}
+
+gdr_status gdr_node_counts_create(const gdr_mesh_clusters *const *meshes, const uint32_t *node_offsets,
+                                  uint32_t mesh_count, gdr_node_counts **out, gdr_error *err)
+{
+    *out = NULL;
+    gdr_node_counts *nc = calloc(1, sizeof *nc);
+    if (!nc)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "node counts: out of memory");
+    nc->mesh_count = mesh_count;
+    gdr_status status = allocate(nc, meshes, node_offsets, err);
+    if (status == GDR_OK) {
+        uint32_t groups = 0;
+        for (uint32_t m = 0; m < mesh_count; m++) {
+            nc->group_base[m] = groups;
+            groups += meshes[m]->group_count;
+            nc->absent[m] = meshes[m]->group_count;
+        }
+        nc->group_base[mesh_count] = groups;
+        memset(nc->parent, 0xff, sizeof *nc->parent * nc->node_total);
+        for (uint32_t m = 0; m < mesh_count; m++)
+            link_parents(nc, meshes[m], node_offsets[m]);
+        status = build_refs(nc, meshes, node_offsets, err);
+    }
+    if (status != GDR_OK) {
+        gdr_node_counts_destroy(nc);
+        return status;
+    }
+    /* Every group absent: the whole counts, every node changed. */
+    for (uint32_t m = 0; m < mesh_count; m++) {
+        gdr_lod_nodes_count_absent_refined(meshes[m], nc->resident + nc->group_base[m], nc->counts + node_offsets[m]);
+        for (uint32_t n = 0; n < meshes[m]->lod_node_count; n++)
+            mark_changed(nc, node_offsets[m] + n);
+    }
+    *out = nc;
+    return GDR_OK;
+}
+
+void gdr_node_counts_destroy(gdr_node_counts *nc)
+{
+    if (!nc)
+        return;
+    free(nc->group_base), free(nc->parent), free(nc->ref_first), free(nc->ref_len), free(nc->refs);
+    free(nc->counts), free(nc->resident), free(nc->absent), free(nc->changed), free(nc->changed_list);
+    free(nc);
+}
+
+uint32_t gdr_node_counts_set(gdr_node_counts *nc, uint32_t mesh, uint32_t group, bool resident)
+{
+    uint32_t g = nc->group_base[mesh] + group, touched = 0;
+    if (group >= nc->group_base[mesh + 1] - nc->group_base[mesh] || nc->resident[g] == resident)
+        return 0;
+    nc->resident[g] = resident;
+    nc->absent[mesh] += resident ? (uint32_t)-1 : 1u;
+    const node_ref *refs = nc->refs + nc->ref_first[g];
+    for (uint32_t i = 0; i < nc->ref_len[g]; i++) {
+        /* The leaf and each ancestor count these clusters once. */
+        for (uint32_t node = refs[i].leaf; node != NO_NODE; node = nc->parent[node], touched++) {
+            nc->counts[node] += resident ? (uint32_t)0 - refs[i].count : refs[i].count;
+            mark_changed(nc, node);
+        }
+    }
+    return touched;
+}
+
+const uint32_t *gdr_node_counts_words(const gdr_node_counts *nc) { return nc->counts; }
+uint32_t gdr_node_counts_absent_groups(const gdr_node_counts *nc, uint32_t mesh) { return nc->absent[mesh]; }
+uint32_t gdr_node_counts_node_total(const gdr_node_counts *nc) { return nc->node_total; }
+
+static int compare_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+uint32_t gdr_node_counts_take_changes(gdr_node_counts *nc, gdr_node_run *runs, uint32_t *words)
+{
+    qsort(nc->changed_list, nc->changed_count, sizeof *nc->changed_list, compare_u32);
+    uint32_t count = 0;
+    for (uint32_t i = 0; i < nc->changed_count; i++) {
+        uint32_t node = nc->changed_list[i];
+        nc->changed[node] = 0;
+        if (count > 0 && runs[count - 1].first + runs[count - 1].count == node)
+            runs[count - 1].count++;
+        else
+            runs[count++] = (gdr_node_run){node, 1};
+    }
+    *words = nc->changed_count;
+    nc->changed_count = 0;
+    return count;
+}
