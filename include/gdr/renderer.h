@@ -278,6 +278,13 @@ typedef struct gdr_streaming_stats {
     uint32_t node_updates;
     uint32_t node_words_uploaded;
     uint32_t node_copies;
+    /* The page loader: pages and bytes it read from the file since the scene was set, the
+     * milliseconds some worker was reading or decoding, its throughput (MB/s of file bytes per
+     * second of that busy time), and its queue depth now (loads waiting for a worker or being read). */
+    uint64_t loader_pages, loader_bytes_read;
+    double loader_busy_ms;
+    double loader_mb_s;
+    uint32_t loader_queue_depth;
     char refused[GDR_ERROR_MESSAGE_MAX];          /* the last refused page's message (file, mesh, page, why) */
 } gdr_streaming_stats;
 

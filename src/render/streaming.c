@@ -558,6 +558,12 @@ static void update_stats(gdr_streaming *s)
     s->stats.uploads_total += s->stats.uploads;
     s->stats.upload_bytes_total += s->stats.upload_bytes;
     s->stats.evictions_total += rs.evictions;
+    gdr_page_loader_stats ls = gdr_page_loader_get_stats(s->loader);
+    s->stats.loader_pages = ls.pages_read;
+    s->stats.loader_bytes_read = ls.bytes_read;
+    s->stats.loader_busy_ms = 1e3 * ls.busy_s;
+    s->stats.loader_mb_s = ls.busy_s > 0.0 ? 1e-6 * (double)ls.bytes_read / ls.busy_s : 0.0;
+    s->stats.loader_queue_depth = ls.queued + ls.reading;
 }
 
 gdr_status gdr_streaming_begin_frame(gdr_renderer *r, gdr_frame_slot *slot, gdr_error *err)

@@ -5,6 +5,7 @@
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 struct gdr_page_loader {
@@ -17,7 +18,38 @@ struct gdr_page_loader {
     uint8_t *finished;
     uint32_t capacity, submitted, taken, collected;
     int quit;
+    /* Throughput: the stored and decoded bytes of the pages read, and the time at least one worker
+     * was reading or decoding (busy), which excludes the time the queue stood empty. */
+    uint64_t bytes_read, bytes_decoded, pages_read;
+    uint32_t busy_workers;
+    double busy_since, busy_s;
 };
+
+static double now_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* A worker starts or ends a page (under the lock). */
+static void busy_begin(gdr_page_loader *l)
+{
+    if (l->busy_workers++ == 0)
+        l->busy_since = now_s();
+}
+
+static void busy_end(gdr_page_loader *l, const gdr_stream_load *load)
+{
+    const gdr_paged_mesh *pm = gdr_paged_cache_mesh(l->cache, load->mesh);
+    if (pm && load->page < pm->page_count) {
+        l->bytes_read += pm->pages[load->page].stored_size;
+        l->bytes_decoded += gdr_page_pool_bytes(&pm->pages[load->page]);
+        l->pages_read++;
+    }
+    if (--l->busy_workers == 0)
+        l->busy_s += now_s() - l->busy_since;
+}
 
 static void *loader_main(void *user)
 {
@@ -30,12 +62,14 @@ static void *loader_main(void *user)
             break;
         uint32_t index = l->taken++;
         gdr_stream_load load = l->jobs[index].load;
+        busy_begin(l);
         pthread_mutex_unlock(&l->lock);
         gdr_page_result result = {.load = load};
         result.status = gdr_paged_cache_read_page(l->cache, load.mesh, load.page, &result.page, &result.error);
         pthread_mutex_lock(&l->lock);
         l->jobs[index] = result; /* the arrays may have moved meanwhile: index, not pointer */
         l->finished[index] = 1;
+        busy_end(l, &load);
         pthread_cond_broadcast(&l->done);
     }
     pthread_mutex_unlock(&l->lock);
@@ -154,4 +188,16 @@ uint32_t gdr_page_loader_pending(gdr_page_loader *l)
     uint32_t n = l->submitted - l->collected;
     pthread_mutex_unlock(&l->lock);
     return n;
+}
+
+gdr_page_loader_stats gdr_page_loader_get_stats(gdr_page_loader *l)
+{
+    pthread_mutex_lock(&l->lock);
+    gdr_page_loader_stats st = {.bytes_read = l->bytes_read, .bytes_decoded = l->bytes_decoded,
+                                .pages_read = l->pages_read, .busy_s = l->busy_s, .queued = l->submitted - l->taken,
+                                .reading = l->busy_workers, .threads = l->thread_count};
+    if (l->busy_workers)
+        st.busy_s += now_s() - l->busy_since;
+    pthread_mutex_unlock(&l->lock);
+    return st;
 }

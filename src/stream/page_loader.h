@@ -31,6 +31,15 @@ gdr_status gdr_page_loader_submit(gdr_page_loader *loader, const gdr_stream_load
  * with gdr_page_free); stops at the first unfinished load unless wait_all, which waits for it.
  * Returns how many. */
 uint32_t gdr_page_loader_collect(gdr_page_loader *loader, int wait_all, gdr_page_result *out, uint32_t capacity);
+/* What the loader did since it was created: the pages read (checked or not), their bytes in the
+ * file and decoded, and the seconds at least one worker was busy (bytes_read / busy_s: its
+ * throughput while it had work); and now: loads waiting for a worker, pages being read. */
+typedef struct gdr_page_loader_stats {
+    uint64_t bytes_read, bytes_decoded, pages_read;
+    double busy_s;
+    uint32_t queued, reading, threads;
+} gdr_page_loader_stats;
+gdr_page_loader_stats gdr_page_loader_get_stats(gdr_page_loader *loader);
 /* Loads submitted and not yet collected. */
 uint32_t gdr_page_loader_pending(gdr_page_loader *loader);
 

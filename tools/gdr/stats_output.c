@@ -190,6 +190,9 @@ void stats_print_streaming(FILE *out, const gdr_streaming_stats *st)
     fprintf(out, "streaming cut       threshold %g px (x %g to fit the pool, %u changes), %u pages wanted of %u slots, "
             "settled %u frames\n", (double)st->lod_error_px, (double)st->lod_error_scale, st->lod_error_changes,
             st->wanted_pages, st->slot_count, st->settled_frames);
+    fprintf(out, "streaming loader    %llu pages, %llu bytes read in %.1f ms busy: %.1f MB/s; %u in its queue\n",
+            (unsigned long long)st->loader_pages, (unsigned long long)st->loader_bytes_read, st->loader_busy_ms,
+            st->loader_mb_s, st->loader_queue_depth);
     fprintf(out, "streaming totals    %llu uploads (%llu bytes), %llu evictions, %u pages refused%s%s\n",
             (unsigned long long)st->uploads_total, (unsigned long long)st->upload_bytes_total,
             (unsigned long long)st->evictions_total, st->pages_refused, st->pages_refused ? ": " : "",
@@ -212,7 +215,12 @@ static void add_streaming_json(cJSON *object, const gdr_streaming_stats *st)
         {"evictions_total", (double)st->evictions_total}, {"evicted_in_use", (double)st->evicted_in_use},
         {"pages_refused", st->pages_refused}, {"lod_error_px", st->lod_error_px},
         {"lod_error_scale", st->lod_error_scale}, {"lod_error_changes", st->lod_error_changes},
-        {"wanted_pages", st->wanted_pages}, {"settled_frames", st->settled_frames}};
+        {"wanted_pages", st->wanted_pages}, {"settled_frames", st->settled_frames},
+        {"node_groups_changed", st->node_groups_changed}, {"node_updates", st->node_updates},
+        {"node_words_uploaded", st->node_words_uploaded}, {"node_copies", st->node_copies},
+        {"loader_pages", (double)st->loader_pages}, {"loader_bytes_read", (double)st->loader_bytes_read},
+        {"loader_busy_ms", st->loader_busy_ms}, {"loader_mb_s", st->loader_mb_s},
+        {"loader_queue_depth", st->loader_queue_depth}};
     for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++)
         cJSON_AddNumberToObject(o, fields[i].name, fields[i].value);
 }
