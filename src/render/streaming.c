@@ -628,6 +628,20 @@ static gdr_status create_node_counts(gdr_renderer *r, gdr_error *err)
     return status;
 }
 
+/* The GPU memory that stays resident beside the pool, and the scene's source triangles. */
+static void count_resident_tables(gdr_renderer *r)
+{
+    gdr_streaming *s = &r->stream;
+    const gdr_gpu_scene *g = &r->scene;
+    s->stats.cluster_record_bytes = sizeof(GdrGpuMeshlet) * (uint64_t)g->meshlet_count;
+    s->stats.hierarchy_bytes = sizeof(GdrGpuLodNode) * (uint64_t)g->node_total;
+    s->stats.node_count_bytes = 4ull * g->node_total;
+    s->stats.page_table_bytes = 4ull * g->group_total * (2 + GDR_FRAMES_IN_FLIGHT); /* words, stamps, lists */
+    s->stats.source_triangles = 0;
+    for (uint32_t m = 0; m < g->mesh_count; m++)
+        s->stats.source_triangles += paged_mesh(s, m)->source_triangles;
+}
+
 /* Before the first frame: every group absent, then every mesh's coarsest page (pinned) read, checked
  * and copied, waiting for them: the first frame draws every mesh at its coarsest at least. */
 gdr_status gdr_streaming_start(gdr_renderer *r, gdr_error *err)
@@ -644,6 +658,7 @@ gdr_status gdr_streaming_start(gdr_renderer *r, gdr_error *err)
     free(absent);
     if (status == GDR_OK)
         status = create_node_counts(r, err);
+    count_resident_tables(r);
     bool wait = s->wait_for_loads;
     s->wait_for_loads = true;
     gdr_frame_slot *slot = &r->slots[0];
