@@ -102,8 +102,8 @@ static int load_all(gdr_paged_cache *pc, uint32_t threads, loader_run *run)
     }
     uint32_t n = 0;
     for (uint32_t m = 0; m < gdr_paged_cache_mesh_count(pc); m++)
-        for (uint32_t p = 0; p < gdr_paged_cache_mesh(pc, m)->page_count; p++)
-            loads[n++] = (gdr_stream_load){m, p, n};
+        for (uint32_t p = 0; p < gdr_paged_cache_mesh(pc, m)->page_count; p++, n++)
+            loads[n] = (gdr_stream_load){m, p, n}; /* the slot is not used: nothing goes to a pool */
     *run = (loader_run){0};
     double t0 = now_s();
     int ok = gdr_page_loader_submit(loader, loads, n, &err) == GDR_OK;
