@@ -92,6 +92,15 @@ int cache_spool_hash_into(const cache_spool *spool, void *hash)
     return ok;
 }
 
+/* Gives the disk blocks of bytes [from, to) of the spool back (they are in the output now), so that
+ * the disk holds each byte once, in the spool or in the file, and the spools' copy needs no room of
+ * its own. Where the file system cannot, the blocks go when the spool is closed. */
+static void release(const cache_spool *spool, uint64_t from, uint64_t to)
+{
+    if (to > from)
+        (void)fallocate(spool->fd, FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE, (off_t)from, (off_t)(to - from));
+}
+
 /* The copy through a buffer, from byte `at` on (where copy_file_range cannot go on). */
 static int copy_by_reading(const cache_spool *spool, uint64_t at, int fd)
 {
@@ -100,6 +109,8 @@ static int copy_by_reading(const cache_spool *spool, uint64_t at, int fd)
     while (ok && at < spool->size) {
         size_t n = spool->size - at < SPOOL_CHUNK ? (size_t)(spool->size - at) : SPOOL_CHUNK;
         ok = gdr_io_pread_exact(spool->fd, buffer, n, at) == n && cache_write_all(fd, buffer, n);
+        if (ok)
+            release(spool, at, at + n);
         at += n;
     }
     free(buffer);
@@ -108,15 +119,18 @@ static int copy_by_reading(const cache_spool *spool, uint64_t at, int fd)
 
 int cache_spool_copy(const cache_spool *spool, int fd)
 {
-    /* In the kernel where it can (no copy through user memory), else through a buffer. */
+    /* In the kernel where it can (no copy through user memory), else through a buffer; 64 MiB at a
+     * time, each given back once copied. */
     loff_t at = 0;
     while ((uint64_t)at < spool->size) {
-        size_t n = spool->size - (uint64_t)at < (1u << 30) ? (size_t)(spool->size - (uint64_t)at) : (1u << 30);
+        size_t n = spool->size - (uint64_t)at < (64u << 20) ? (size_t)(spool->size - (uint64_t)at) : (64u << 20);
+        loff_t from = at;
         ssize_t done = copy_file_range(spool->fd, &at, fd, NULL, n, 0);
         if (done < 0 && errno == EINTR)
             continue;
         if (done <= 0)
             return copy_by_reading(spool, (uint64_t)at, fd);
+        release(spool, (uint64_t)from, (uint64_t)at);
     }
     return 1;
 }
