@@ -214,6 +214,47 @@ typedef struct gdr_cache_write_options {
 GDR_API gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_cache_write_options *options,
                                    gdr_error *err);
 
+/* Writing a scene mesh by mesh (docs/CACHE_FORMAT.md, "Writing mesh by mesh"): the same file as
+ * gdr_cache_write with pages, made without holding every mesh at once. `make` builds mesh `index`
+ * into a new scene holding that one mesh, ready to be written (clusters, LOD DAG and hierarchy built,
+ * vertices on their grid), with `threads` threads of its own at most; it is called from several
+ * threads at once, for different meshes, each mesh once. The writer serialises the mesh, hands its
+ * section parts to temporary files beside the output, and destroys it: memory holds the meshes in
+ * flight and the page index, not the scene. */
+typedef gdr_status gdr_cache_mesh_fn(void *user, uint32_t index, uint32_t threads, gdr_scene **out, gdr_error *err);
+
+typedef struct gdr_cache_mesh_source {
+    gdr_cache_mesh_fn *make;
+    void *user;
+    uint32_t thread_count; /* 0: one per processor; meshes built at once: min(thread_count, meshes),
+                              each given thread_count / that many threads. The file does not depend on it. */
+    int no_progress;       /* 1: never draw a progress bar */
+} gdr_cache_mesh_source;
+
+/* Writes the scene whose meshes `meshes` makes, one by one, and whose other parts (materials,
+ * textures, instances, cameras; mesh_count) `skeleton` holds (its meshes' arrays are not read), to
+ * path, with options->page_bytes set (else GDR_ERROR_INVALID_ARGUMENT). The bytes are those
+ * gdr_cache_write writes for the whole scene, whatever the thread count. A failing mesh stops the
+ * build: its error, prefixed with "meshes[N]: ", is returned and nothing is written. */
+GDR_API gdr_status gdr_cache_write_meshes(const char *path, const gdr_scene *skeleton,
+                                          const gdr_cache_mesh_source *meshes, const gdr_cache_write_options *options,
+                                          gdr_error *err);
+
+/* What gdr_cache_build_paged takes; zero-initialise, every field has a default. */
+typedef struct gdr_paged_build_options {
+    uint32_t page_bytes;   /* 0: GDR_PAGE_BYTES_DEFAULT; else in [GDR_PAGE_BYTES_MIN, GDR_PAGE_BYTES_MAX] */
+    uint32_t thread_count; /* 0: one per processor (gdr_cache_mesh_source.thread_count) */
+    int no_progress;       /* 1: never draw a progress bar */
+} gdr_paged_build_options;
+
+/* Writes the paged cache of a built-in scene (`spec`, as gdr_scene_load takes it) to path: the
+ * bytes gdr_cache_write writes (with page_bytes, an empty source list) for the scene gdr_scene_load
+ * makes with its vertices on their grids (gdr_scene_quantize_vertices), built mesh by mesh with
+ * gdr_cache_write_meshes. The unique field is made one mesh at a time, so that memory follows the
+ * meshes in flight; other scenes are made whole first. A file: GDR_ERROR_INVALID_ARGUMENT. */
+GDR_API gdr_status gdr_cache_build_paged(const char *spec, const char *path, const gdr_paged_build_options *options,
+                                         gdr_error *err);
+
 /* Reads a whole regular file of at most max_size bytes into *out (malloc'ed, one NUL byte after the
  * data, which may hold NUL bytes of its own). A FIFO, device, socket or directory is refused at once
  * ("not a regular file"), never waited on; a larger file is refused before it is read. For the

@@ -71,6 +71,16 @@ typedef struct gdr_unique_field_desc {
 GDR_API gdr_status gdr_scene_create_unique_field(const gdr_unique_field_desc *desc, gdr_scene **out,
                                                  gdr_error *err);
 
+/* The same scene one mesh at a time, for a cache written mesh by mesh (gdr_cache_write_meshes):
+ * the skeleton holds every instance and the camera and, for each mesh, its name only (a scene whose
+ * geometry_in_pages is set: no arrays); gdr_scene_create_unique_field_mesh makes mesh `mesh` alone in
+ * a scene of its own, its vertices and triangles those gdr_scene_create_unique_field gives it, without
+ * clusters. Invalid desc: GDR_ERROR_INVALID_ARGUMENT, as gdr_scene_create_unique_field says it. */
+GDR_API gdr_status gdr_scene_create_unique_field_skeleton(const gdr_unique_field_desc *desc, gdr_scene **out,
+                                                          gdr_error *err);
+GDR_API gdr_status gdr_scene_create_unique_field_mesh(const gdr_unique_field_desc *desc, uint32_t mesh,
+                                                      gdr_scene **out, gdr_error *err);
+
 /* --- Occlusion scene: a wall of buildings in front of many small objects -----------------------
  *
  * Right-handed, Y up; the default camera stands at (0, 1.7, 0) looking down -Z. Instances, in

@@ -29,11 +29,6 @@ const char *gdr_cache_build_options(void)
 
 /* --- writing --------------------------------------------------------------------------------- */
 
-typedef struct section_entry {
-    uint32_t id, flags;
-    uint64_t offset, size, checksum;
-} section_entry;
-
 /* Where the serialised file goes: whole in memory, written at the end (a device or FIFO, written in
  * place, cannot seek back to its header), or section by section into the temporary file, its header
  * and table written last, so that memory holds one section at a time and a cache of pages may grow
@@ -109,8 +104,7 @@ static gdr_status check_reader_limits(const char *path, const gdr_scene *s, bool
     return GDR_OK;
 }
 
-/* The header and section table (`count` entries) of a file of `size` bytes. */
-static void put_header(uint8_t *head, const section_entry *entries, uint32_t count, uint64_t size)
+void cache_put_header(uint8_t *head, const section_entry *entries, uint32_t count, uint64_t size)
 {
     memset(head, 0, CACHE_HEADER_SIZE);
     uint8_t *table = head + CACHE_HEADER_SIZE;
@@ -169,7 +163,7 @@ static gdr_status serialise(const char *path, const cache_write_input *in, uint3
                                "hold (the whole reader's limit)", path, (unsigned long long)*size,
                                (unsigned long long)gdr_io_max_file_size);
     if (status == GDR_OK) {
-        put_header(head, entries, count, *size);
+        cache_put_header(head, entries, count, *size);
         if (sink->failed || !finish_file(&w, sink, head, head_size))
             status = gdr_error_set(err, GDR_ERROR_IO, "%s: write failed: %s", path, strerror(errno));
     }

@@ -177,6 +177,16 @@ typedef struct cache_write_input {
 
 typedef struct cache_read_state cache_read_state; /* cache_sections.c */
 
+/* One entry of the section table. */
+typedef struct section_entry {
+    uint32_t id, flags;
+    uint64_t offset, size, checksum;
+} section_entry;
+
+/* The header and section table (`count` entries) of a file of `size` bytes into `head`
+ * (CACHE_HEADER_SIZE + count * CACHE_ENTRY_SIZE bytes). */
+void cache_put_header(uint8_t *head, const section_entry *entries, uint32_t count, uint64_t size);
+
 /* One section: its id and flags, and how it is written and read. */
 typedef struct cache_section {
     uint32_t id;    /* four ASCII characters, the first in the lowest byte */

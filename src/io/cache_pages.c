@@ -371,7 +371,8 @@ static void put_mesh_groups(writer *w, const gdr_mesh_clusters *mc, const mesh_p
     free(page_of);
 }
 
-static void put_mesh_index(writer *w, const gdr_mesh *mesh, const mesh_pages *mp, uint64_t *page_offset)
+/* A mesh's entry of the index; its pages' offsets counted from `page_offset` on. */
+static void put_mesh_index(writer *w, const gdr_mesh *mesh, const mesh_pages *mp, uint64_t page_offset)
 {
     const gdr_mesh_clusters *mc = &mesh->clusters;
     uint32_t *first = NULL, *edges = NULL, edge_count = 0;
@@ -391,7 +392,7 @@ static void put_mesh_index(writer *w, const gdr_mesh *mesh, const mesh_pages *mp
     free(first), free(edges);
     for (uint32_t p = 0; p < mp->page_count; p++) {
         const encoded_page *e = &mp->pages[p];
-        put_u64(w, *page_offset);
+        put_u64(w, page_offset);
         put_u32(w, e->size);
         put_u32(w, e->first);
         put_u32(w, e->group_count);
@@ -399,43 +400,85 @@ static void put_mesh_index(writer *w, const gdr_mesh *mesh, const mesh_pages *mp
         put_u32(w, e->vertex_count);
         put_u32(w, e->triangle_count);
         put_u64(w, e->checksum);
-        *page_offset += e->size;
+        page_offset += e->size;
     }
+}
+
+int cache_pages_encode_mesh(const gdr_mesh *mesh, uint32_t page_bytes, cache_mesh_pages *out)
+{
+    *out = (cache_mesh_pages){0};
+    mesh_pages mp;
+    if (!build_mesh_pages(mesh, page_bytes, &mp))
+        return 0;
+    put_mesh_index(&out->index, mesh, &mp, 0);
+    out->page_count = mp.page_count;
+    out->page_table = out->index.size - (size_t)mp.page_count * CACHE_PAGE_INFO_RECORD;
+    for (uint32_t p = 0; p < mp.page_count; p++)
+        put(&out->pages, mp.pages[p].bytes, mp.pages[p].size);
+    free_mesh_pages(&mp);
+    if (out->index.failed || out->pages.failed) {
+        cache_pages_free_mesh(out);
+        return 0;
+    }
+    return 1;
+}
+
+void cache_pages_rebase(cache_mesh_pages *mp, uint64_t base)
+{
+    for (uint32_t p = 0; p < mp->page_count; p++) {
+        uint8_t *at = mp->index.data + mp->page_table + (size_t)p * CACHE_PAGE_INFO_RECORD;
+        uint64_t offset;
+        memcpy(&offset, at, 8);
+        offset += base;
+        memcpy(at, &offset, 8);
+    }
+}
+
+void cache_pages_free_mesh(cache_mesh_pages *mp)
+{
+    free(mp->index.data);
+    free(mp->pages.data);
+    *mp = (cache_mesh_pages){0};
+}
+
+void cache_pages_put_header(writer *w, uint32_t mesh_count, uint32_t page_bytes, uint64_t index_size,
+                            uint64_t index_hash)
+{
+    put_u32(w, CACHE_PAGES_VERSION);
+    put_u32(w, mesh_count);
+    put_u32(w, page_bytes);
+    put_u32(w, 0);
+    put_u64(w, index_size);
+    put_u64(w, index_hash);
 }
 
 void cache_pages_write(writer *w, const gdr_scene *scene, uint32_t page_bytes)
 {
-    mesh_pages *mp = calloc(scene->mesh_count ? scene->mesh_count : 1, sizeof *mp);
+    cache_mesh_pages *mp = calloc(scene->mesh_count ? scene->mesh_count : 1, sizeof *mp);
     int ok = mp != NULL;
     for (uint32_t m = 0; ok && m < scene->mesh_count; m++)
-        ok = build_mesh_pages(&scene->meshes[m], page_bytes, &mp[m]);
-    /* The index's size does not depend on the offsets in it: write it once to learn the size,
-     * then again with the pages' offsets after it. */
+        ok = cache_pages_encode_mesh(&scene->meshes[m], page_bytes, &mp[m]);
+    /* The index's size does not depend on the offsets in it: the pages start right after it. */
     writer index = {0};
-    uint64_t page_offset = 0;
+    uint64_t page_offset = CACHE_PAGES_HEADER;
     for (uint32_t m = 0; ok && m < scene->mesh_count; m++)
-        put_mesh_index(&index, &scene->meshes[m], &mp[m], &page_offset);
-    page_offset = CACHE_PAGES_HEADER + index.size;
-    index.size = 0;
-    for (uint32_t m = 0; ok && m < scene->mesh_count; m++)
-        put_mesh_index(&index, &scene->meshes[m], &mp[m], &page_offset);
+        page_offset += mp[m].index.size;
+    for (uint32_t m = 0; ok && m < scene->mesh_count; m++) {
+        cache_pages_rebase(&mp[m], page_offset);
+        page_offset += mp[m].pages.size;
+        put(&index, mp[m].index.data, mp[m].index.size);
+    }
     if (!ok || index.failed) {
         w->failed = 1;
     } else {
-        put_u32(w, CACHE_PAGES_VERSION);
-        put_u32(w, scene->mesh_count);
-        put_u32(w, page_bytes);
-        put_u32(w, 0);
-        put_u64(w, index.size);
-        put_u64(w, gdr_io_hash(index.data, index.size));
+        cache_pages_put_header(w, scene->mesh_count, page_bytes, index.size, gdr_io_hash(index.data, index.size));
         put(w, index.data, index.size);
         for (uint32_t m = 0; m < scene->mesh_count; m++)
-            for (uint32_t p = 0; p < mp[m].page_count; p++)
-                put(w, mp[m].pages[p].bytes, mp[m].pages[p].size);
+            put(w, mp[m].pages.data, mp[m].pages.size);
     }
     free(index.data);
     for (uint32_t m = 0; mp && m < scene->mesh_count; m++)
-        free_mesh_pages(&mp[m]);
+        cache_pages_free_mesh(&mp[m]);
     free(mp);
 }
 

@@ -22,6 +22,25 @@
  * without one has no groups and no pages). `page_bytes`: the raw bytes a page is filled to. */
 void cache_pages_write(writer *w, const gdr_scene *scene, uint32_t page_bytes);
 
+/* One mesh's part of the section, for a writer that takes a scene mesh by mesh: its entry of the
+ * index, whose page offsets count from its own first page until cache_pages_rebase adds where that
+ * page lies in the section, and its pages' bytes. The section is the header, every mesh's index
+ * entry, then every mesh's pages, in mesh order. */
+typedef struct cache_mesh_pages {
+    writer index;
+    writer pages;
+    uint32_t page_count;
+    size_t page_table; /* where the index entry's page records start */
+} cache_mesh_pages;
+
+/* 0 when out of memory (*out then empty). */
+int cache_pages_encode_mesh(const gdr_mesh *mesh, uint32_t page_bytes, cache_mesh_pages *out);
+void cache_pages_rebase(cache_mesh_pages *mp, uint64_t base);
+void cache_pages_free_mesh(cache_mesh_pages *mp);
+/* The section's header: the index that follows it has `index_size` bytes and XXH3 `index_hash`. */
+void cache_pages_put_header(writer *w, uint32_t mesh_count, uint32_t page_bytes, uint64_t index_size,
+                            uint64_t index_hash);
+
 /* The page index of a section, checked: offsets (made absolute by adding `section_offset`) lie in
  * the section after the index, in order, without overlap; every group sits in exactly one page,
  * which names it; counts agree. `meshes` gets mesh_count entries (freed with

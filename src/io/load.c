@@ -97,6 +97,23 @@ bool gdr_scene_spec_is_builtin(const char *spec)
     return find_builtin(spec, &options) != BUILTIN_NONE;
 }
 
+static gdr_status parse_unique_field(const char *text, gdr_unique_field_desc *d, gdr_error *err)
+{
+    scene_option o[] = {{"meshes", &d->meshes, NULL, 1, 100000},
+                        {"seed", &d->seed, NULL, 1, 16000000},
+                        {"triangles", &d->triangles, NULL, 1000, 16000000},
+                        {"spacing", NULL, &d->spacing, 0, 0}};
+    return parse_options(builtin_names[BUILTIN_UNIQUE_FIELD], text, o, 4, err);
+}
+
+gdr_status gdr_io_unique_field_spec(const char *spec, gdr_unique_field_desc *d, bool *is_unique, gdr_error *err)
+{
+    const char *text;
+    *d = (gdr_unique_field_desc){0};
+    *is_unique = find_builtin(spec, &text) == BUILTIN_UNIQUE_FIELD;
+    return *is_unique ? parse_unique_field(text, d, err) : GDR_OK;
+}
+
 static gdr_status create_builtin(builtin_scene which, const char *text, gdr_scene **out, gdr_error *err)
 {
     const char *name = builtin_names[which];
@@ -121,11 +138,7 @@ static gdr_status create_builtin(builtin_scene which, const char *text, gdr_scen
     }
     if (which == BUILTIN_UNIQUE_FIELD) {
         gdr_unique_field_desc d = {0};
-        scene_option o[] = {{"meshes", &d.meshes, NULL, 1, 100000},
-                            {"seed", &d.seed, NULL, 1, 16000000},
-                            {"triangles", &d.triangles, NULL, 1000, 16000000},
-                            {"spacing", NULL, &d.spacing, 0, 0}};
-        status = parse_options(name, text, o, 4, err);
+        status = parse_unique_field(text, &d, err);
         return status == GDR_OK ? gdr_scene_create_unique_field(&d, out, err) : status;
     }
     if (which == BUILTIN_ROOMS) {

@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "core/output_file.h"
 #include "gdr/geometry.h"
 #include "gdr/io.h"
 #include "gdr/paged_cache.h"
@@ -26,57 +27,49 @@ static int paged_name(const char *candidate, char *out, size_t size)
     return written > 0 && (size_t)written < size;
 }
 
-/* The scene as gdr build --pages stores it: imported (its files listed in *sources, its warnings in
- * *report) or made, then its vertices on their grids. */
-static gdr_status build_scene(const char *spec, const gdr_load_options *o, bool builtin, gdr_scene **scene,
-                              gdr_source_list *sources, gdr_import_report *report, gdr_error *err)
+/* The first of `paths` where a file can be written (made and removed again); -1 when none. */
+static int writable_path(char (*paths)[PATH_MAX], int count, gdr_error *err)
 {
-    gdr_status status;
-    if (builtin) {
-        gdr_load_options plain = *o;
-        plain.geometry_in_pages = 0, plain.pvs = NULL, plain.sources = NULL, plain.cache_path = NULL;
-        plain.report = NULL;
-        status = gdr_scene_load(spec, &plain, scene, err);
-    } else {
-        gdr_io_report_collector kept = {o, report};
-        gdr_import_options import = {.warning = gdr_io_report_collect, .warning_user = &kept,
-                                     .no_progress = o->no_progress, .sources = sources, .budget = o->budget,
-                                     .allow_outside_files = o->allow_outside_files};
-        gdr_import_result result = {0};
-        status = gdr_import_file(spec, &import, scene, &result, err);
-        report->file_cameras = result.file_cameras;
+    for (int i = 0; i < count; i++) {
+        gdr_output_file probe;
+        if (gdr_output_open(paths[i], &probe, err) == GDR_OK) {
+            gdr_output_close(&probe, false, paths[i], &(gdr_error){0});
+            return i;
+        }
     }
-    if (status == GDR_OK && (status = gdr_scene_quantize_vertices(*scene, err)) != GDR_OK) {
-        gdr_scene_destroy(*scene);
-        *scene = NULL;
-    }
-    return status;
+    return -1;
 }
 
-/* Builds the scene and writes it to the first of `paths` that takes it; its index, or -1. */
+/* Builds the scene and writes it, mesh by mesh (paged_build.c), to the first of `paths` that takes
+ * it; its index, or -1. */
 static int write_paged(const char *spec, const gdr_load_options *o, bool builtin, const char *build_options,
                        char (*paths)[PATH_MAX], int count, gdr_error *err)
 {
     gdr_source_list sources = {0};
     gdr_import_report report = {0}, kept = {0};
-    gdr_scene *scene = NULL;
-    int written = -1;
     gdr_error write_err = {0};
-    if (build_scene(spec, o, builtin, &scene, &sources, &report, err) == GDR_OK &&
-        gdr_io_report_template(&report, spec, &kept, err) == GDR_OK) {
+    int written = writable_path(paths, count, &write_err);
+    if (written < 0) {
+        gdr_error_set(err, GDR_ERROR_IO, "%s: streaming needs its paged cache, which could not be written: %s",
+                      spec, count ? write_err.message : "no cache folder (give one: --cache-dir DIR)");
+        return -1;
+    }
+    gdr_io_paged_source src;
+    gdr_status status = gdr_io_paged_source_open(spec, o, builtin, &src, &sources, &report, err);
+    if (status == GDR_OK)
+        status = gdr_io_report_template(&report, spec, &kept, err);
+    if (status == GDR_OK) {
         gdr_cache_write_options write = {.source = {build_options, &sources}, .page_bytes = GDR_PAGE_BYTES_DEFAULT,
                                          .report = &kept};
-        for (int i = 0; i < count && written < 0; i++)
-            written = gdr_cache_write(paths[i], scene, &write, &write_err) == GDR_OK ? i : -1;
-        if (written < 0)
-            gdr_error_set(err, GDR_ERROR_IO, "%s: streaming needs its paged cache, which could not be written: %s",
-                          spec, count ? write_err.message : "no cache folder (give one: --cache-dir DIR)");
+        if (gdr_io_paged_source_write(&src, paths[written], &write, 0, o->no_progress, &write_err) != GDR_OK)
+            status = gdr_error_set(err, write_err.status, "%s: streaming needs its paged cache, which could not be "
+                                   "written: %s", spec, write_err.message);
     }
-    gdr_scene_destroy(scene);
+    gdr_io_paged_source_close(&src);
     gdr_source_list_free(&sources);
     gdr_import_report_free(&report);
     gdr_import_report_free(&kept);
-    return written;
+    return status == GDR_OK ? written : -1;
 }
 
 /* A built-in scene's cache file: in cache_dir, else in the per-user cache folder (created and

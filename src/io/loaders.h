@@ -9,6 +9,7 @@
 #include <stdint.h>
 
 #include "gdr/io.h"
+#include "gdr/procedural.h"
 
 /* --- importers ------------------------------------------------------------------------------ */
 
@@ -79,6 +80,30 @@ gdr_status gdr_cache_read_for_streaming(const char *path, const char *build_opti
  * built, are kept in it and said again when it is read (into `report`, which may be NULL). */
 gdr_status gdr_io_load_paged(const char *spec, const gdr_load_options *options, char (*candidates)[PATH_MAX], int count,
                              gdr_scene **out, gdr_pvs **out_pvs, gdr_import_report *report, gdr_error *err);
+
+/* Whether `spec` names the built-in unique-field scene (*is_unique), its options then parsed into *d
+ * (a bad option: GDR_ERROR_INVALID_ARGUMENT, as gdr_scene_load says it). */
+gdr_status gdr_io_unique_field_spec(const char *spec, gdr_unique_field_desc *d, bool *is_unique, gdr_error *err);
+
+/* A scene's paged cache made mesh by mesh (paged_build.c): the unique field one mesh at a time,
+ * any other scene made or imported whole first (as gdr_scene_load would: clusters and LOD DAG),
+ * then each mesh taken out of it, moved onto its grid, written and freed. */
+typedef struct gdr_io_paged_source {
+    gdr_scene *skeleton;          /* every part but the meshes' geometry (or, whole, the scene itself) */
+    gdr_unique_field_desc unique; /* with `generated` */
+    int generated;                /* 1: the unique field, each mesh made when it is written */
+} gdr_io_paged_source;
+
+/* Makes the source: a built-in scene (`builtin`), or an imported file whose files are listed in
+ * *sources and whose warnings go to *report. */
+gdr_status gdr_io_paged_source_open(const char *spec, const gdr_load_options *o, bool builtin,
+                                    gdr_io_paged_source *src, gdr_source_list *sources, gdr_import_report *report,
+                                    gdr_error *err);
+/* Writes it to path with gdr_cache_write_meshes (`write` with page_bytes set); once only: a scene
+ * made whole gives its meshes away while it is written. threads 0: one per processor. */
+gdr_status gdr_io_paged_source_write(gdr_io_paged_source *src, const char *path, const gdr_cache_write_options *write,
+                                     uint32_t threads, int no_progress, gdr_error *err);
+void gdr_io_paged_source_close(gdr_io_paged_source *src);
 
 /* Parses a cache from memory without any staleness check (the fuzz target uses this); out_pvs as
  * in gdr_cache_read. */

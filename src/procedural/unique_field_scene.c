@@ -105,6 +105,29 @@ static gdr_unique_field_desc unique_field_desc_defaults(const gdr_unique_field_d
     return d;
 }
 
+/* The tube is about 2.8 times longer around the ring than it is round: square-ish quads. */
+static void lattice(const gdr_unique_field_desc *d, uint32_t *segments, uint32_t *sides)
+{
+    *sides = (uint32_t)lround(sqrt((double)d->triangles / 5.6));
+    *segments = (uint32_t)lround((double)d->triangles / (2.0 * *sides));
+}
+
+/* The instances and the camera, after the meshes. */
+static gdr_status add_unique_view(gdr_scene *scene, const gdr_unique_field_desc *d, gdr_error *err)
+{
+    gdr_status status = GDR_OK;
+    for (uint32_t m = 0; m < d->meshes && status == GDR_OK; m++)
+        status = add_unique_instance(scene, d, m, err);
+    if (status == GDR_OK) {
+        /* Behind the first row, raised and looking down the field. */
+        gdr_camera camera = {.name = "unique-field", .position = {0.0f, 3.5f, 0.0f},
+                             .rotation = gdr_quat_from_axis_angle((gdr_vec3){1, 0, 0}, -0.35f),
+                             .yfov = 60.0f * PI_F / 180.0f, .znear = 0.1f, .zfar = 0.0f, .aspect = 0.0f};
+        status = gdr_scene_add_camera(scene, &camera, err);
+    }
+    return status;
+}
+
 gdr_status gdr_scene_create_unique_field(const gdr_unique_field_desc *desc_in, gdr_scene **out, gdr_error *err)
 {
     *out = NULL;
@@ -115,22 +138,61 @@ gdr_status gdr_scene_create_unique_field(const gdr_unique_field_desc *desc_in, g
     gdr_scene *scene;
     if ((status = gdr_scene_create(&scene, err)) != GDR_OK)
         return status;
-    /* The tube is about 2.8 times longer around the ring than it is round: square-ish quads. */
-    uint32_t sides = (uint32_t)lround(sqrt((double)d.triangles / 5.6));
-    uint32_t segments = (uint32_t)lround((double)d.triangles / (2.0 * sides));
+    uint32_t segments, sides;
+    lattice(&d, &segments, &sides);
     for (uint32_t m = 0; m < d.meshes && status == GDR_OK; m++)
         status = add_unique_mesh(scene, d.seed, m, segments, sides, err);
-    for (uint32_t m = 0; m < d.meshes && status == GDR_OK; m++)
-        status = add_unique_instance(scene, &d, m, err);
-    if (status == GDR_OK) {
-        /* Behind the first row, raised and looking down the field. */
-        gdr_camera camera = {.name = "unique-field", .position = {0.0f, 3.5f, 0.0f},
-                             .rotation = gdr_quat_from_axis_angle((gdr_vec3){1, 0, 0}, -0.35f),
-                             .yfov = 60.0f * PI_F / 180.0f, .znear = 0.1f, .zfar = 0.0f, .aspect = 0.0f};
-        status = gdr_scene_add_camera(scene, &camera, err);
-    }
+    if (status == GDR_OK)
+        status = add_unique_view(scene, &d, err);
     if (status == GDR_OK)
         status = gdr_scene_build_clusters(scene, NULL, err);
+    if (status != GDR_OK) {
+        gdr_scene_destroy(scene);
+        return status;
+    }
+    *out = scene;
+    return GDR_OK;
+}
+
+gdr_status gdr_scene_create_unique_field_skeleton(const gdr_unique_field_desc *desc_in, gdr_scene **out,
+                                                  gdr_error *err)
+{
+    *out = NULL;
+    gdr_unique_field_desc d = unique_field_desc_defaults(desc_in);
+    gdr_status status = check_desc(&d, err);
+    gdr_scene *scene = NULL;
+    if (status == GDR_OK && (status = gdr_scene_create(&scene, err)) == GDR_OK)
+        scene->geometry_in_pages = 1; /* names only: each mesh's geometry comes from the _mesh call */
+    for (uint32_t m = 0; m < d.meshes && status == GDR_OK; m++) {
+        char name[GDR_NAME_MAX];
+        snprintf(name, sizeof name, "unique_%u", m);
+        status = gdr_scene_add_paged_mesh(scene, name, 0, 0, (gdr_vec4){0}, err);
+    }
+    if (status == GDR_OK)
+        status = add_unique_view(scene, &d, err);
+    if (status != GDR_OK) {
+        gdr_scene_destroy(scene);
+        return status;
+    }
+    *out = scene;
+    return GDR_OK;
+}
+
+gdr_status gdr_scene_create_unique_field_mesh(const gdr_unique_field_desc *desc_in, uint32_t mesh, gdr_scene **out,
+                                              gdr_error *err)
+{
+    *out = NULL;
+    gdr_unique_field_desc d = unique_field_desc_defaults(desc_in);
+    gdr_status status = check_desc(&d, err);
+    if (status == GDR_OK && mesh >= d.meshes)
+        status = gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "unique-field: mesh %u of %u", mesh, d.meshes);
+    gdr_scene *scene = NULL;
+    if (status == GDR_OK)
+        status = gdr_scene_create(&scene, err);
+    uint32_t segments, sides;
+    lattice(&d, &segments, &sides);
+    if (status == GDR_OK)
+        status = add_unique_mesh(scene, d.seed, mesh, segments, sides, err);
     if (status != GDR_OK) {
         gdr_scene_destroy(scene);
         return status;

@@ -16,7 +16,7 @@
 static void build_usage(void)
 {
     fputs("usage: gdr build INPUT -o OUTPUT.gdrc [--pvs] [--pvs-cell M] [--pvs-samples N] [--pages[=KIB]]\n"
-          "                 [--no-progress] [--strict] [--budget KEY=N,...] [--allow-outside-files]\n"
+          "                 [--no-progress] [--strict] [--budget KEY=N,...] [--allow-outside-files] [--threads N]\n"
           "  INPUT: a .gltf, .glb or .obj file, a .gdrc cache, or a built-in scene: 'demo', 'lod-field',\n"
           "         'occlusion', 'unique-field' or 'rooms', each with optional ':key=value,...' (see gdr --help)\n"
           "  --strict: every warning of the import is an error: nothing is written, exit status 4\n"
@@ -27,7 +27,9 @@ static void build_usage(void)
           "  --pages[=KIB]: also store the geometry in compressed pages of KIB kibibytes (default 128),\n"
           "         read on demand for streaming (docs/CACHE_FORMAT.md, section 'PAGE'); the vertices are\n"
           "         first moved onto a 16-bit grid per mesh (gdr_scene_quantize_vertices), which the pages\n"
-          "         store as integers\n",
+          "         store as integers; a built-in scene is then built and written mesh by mesh, several\n"
+          "         meshes at once (the unique field one mesh at a time: memory follows the meshes in flight)\n"
+          "  --threads N: threads of that build (default: one per processor; the file does not depend on it)\n",
           stderr);
 }
 
@@ -47,11 +49,22 @@ static gdr_status quantize(gdr_scene *scene, gdr_error *err)
     return status;
 }
 
+/* A built-in scene with pages: built and written mesh by mesh (gdr_cache_build_paged). */
+static int build_paged(const char *input, const char *output, uint32_t page_bytes, uint32_t threads, int no_progress)
+{
+    gdr_error err = {0};
+    gdr_paged_build_options options = {.page_bytes = page_bytes, .thread_count = threads, .no_progress = no_progress};
+    if (gdr_cache_build_paged(input, output, &options, &err) != GDR_OK)
+        return cli_load_failed(input, &err);
+    printf("%s: written mesh by mesh with pages of %u KiB\n", output, page_bytes / 1024);
+    return 0;
+}
+
 int gdr_cmd_build(int argc, char **argv)
 {
     const char *input = NULL, *output = NULL;
     int no_progress = 0, pvs_wanted = 0, allow_outside_files = 0;
-    uint32_t page_bytes = 0, pvs_samples = 0;
+    uint32_t page_bytes = 0, pvs_samples = 0, threads = 0;
     float pvs_cell = 0.0f;
     gdr_budget budget = {0};
     cli_warnings warnings = {0};
@@ -88,6 +101,10 @@ int gdr_cmd_build(int argc, char **argv)
                 return 2;
             }
             page_bytes = (uint32_t)kib * 1024u;
+        } else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
+            if (!cli_parse_u32(argv[i], argv[i + 1], 1, 256, &threads))
+                return 2;
+            i++;
         } else if (strcmp(argv[i], "--allow-outside-files") == 0) {
             allow_outside_files = 1;
         } else if (strcmp(argv[i], "--budget") == 0 && i + 1 < argc) {
@@ -110,6 +127,8 @@ int gdr_cmd_build(int argc, char **argv)
         return 2;
     }
     gdr_error err = {0};
+    if (page_bytes && !pvs_wanted && gdr_scene_spec_is_builtin(input))
+        return build_paged(input, output, page_bytes, threads, no_progress);
     gdr_scene *scene = NULL;
     gdr_source_list sources = {0};
     gdr_status status;
