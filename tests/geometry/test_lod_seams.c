@@ -11,11 +11,8 @@
 
 #include "gdr/geometry.h"
 #include "gdr/scene.h"
-#include "procedural/procedural_meshes.h"
+#include "charted_torus.h"
 #include "test_util.h"
-
-#define CHARTS_U 12u
-#define CHARTS_V 6u
 
 static void check_ok(gdr_status s, const gdr_error *err, const char *what)
 {
@@ -23,70 +20,6 @@ static void check_ok(gdr_status s, const gdr_error *err, const char *what)
         fprintf(stderr, "%s: %s\n", what, err->message);
         exit(1);
     }
-}
-
-/* The torus's triangles, each chart (a cell of CHARTS_U x CHARTS_V in the torus's own uv) with its
- * own copy of every vertex it uses: uv in the chart's atlas tile (mirrored in u on odd charts), the
- * smooth normal, except that odd chart rows tilt theirs (a hard normal edge along each row
- * border). */
-static uint32_t add_charted_torus(gdr_scene *s, uint32_t segments, uint32_t sides)
-{
-    gdr_scene *t = NULL;
-    gdr_error err = {0};
-    uint32_t torus;
-    check_ok(gdr_scene_create(&t, &err), &err, "scene");
-    check_ok(gdr_procedural_torus(t, 1.0f, 0.35f, segments, sides, &torus, &err), &err, "torus");
-    const gdr_mesh *m = &t->meshes[torus];
-    uint32_t n = m->index_count;
-    gdr_vec3 *p = malloc(sizeof *p * n), *nr = malloc(sizeof *nr * n);
-    gdr_vec2 *uv = malloc(sizeof *uv * n);
-    uint32_t *idx = malloc(sizeof *idx * n);
-    uint32_t *slot = malloc(sizeof *slot * (size_t)m->vertex_count * CHARTS_U * CHARTS_V);
-    memset(slot, 0xff, sizeof *slot * (size_t)m->vertex_count * CHARTS_U * CHARTS_V);
-    uint32_t count = 0;
-    for (uint32_t i = 0; i < n; i += 3) {
-        /* the chart of the triangle's centre, in the torus's (seam-free) parameter */
-        float cu = 0.0f, cv = 0.0f;
-        for (int k = 0; k < 3; k++) {
-            gdr_vec3 q = m->positions[m->indices[i + k]];
-            cu += atan2f(q.z, q.x);
-            float ring = sqrtf(q.x * q.x + q.z * q.z) - 1.0f;
-            cv += atan2f(q.y, ring);
-        }
-        /* centres of triangles spanning the angle's wrap fall back into range below */
-        float fu = cu / 3.0f / 6.2831853f + 0.5f, fv = cv / 3.0f / 6.2831853f + 0.5f;
-        uint32_t gu = (uint32_t)(fu * CHARTS_U) % CHARTS_U, gv = (uint32_t)(fv * CHARTS_V) % CHARTS_V;
-        uint32_t chart = gv * CHARTS_U + gu;
-        for (int k = 0; k < 3; k++) {
-            uint32_t v = m->indices[i + k];
-            uint32_t *sl = &slot[(size_t)v * CHARTS_U * CHARTS_V + chart];
-            if (*sl == UINT32_MAX) {
-                gdr_vec3 q = m->positions[v];
-                float lu = atan2f(q.z, q.x) / 6.2831853f + 0.5f, ring = sqrtf(q.x * q.x + q.z * q.z) - 1.0f;
-                float lv = atan2f(q.y, ring) / 6.2831853f + 0.5f;
-                lu = lu * CHARTS_U - (float)gu, lv = lv * CHARTS_V - (float)gv;
-                lu -= roundf(lu - 0.5f), lv -= roundf(lv - 0.5f); /* into the chart's cell across the wrap */
-                if (chart % 2)
-                    lu = 1.0f - lu;
-                *sl = count;
-                p[count] = q;
-                uv[count] = (gdr_vec2){((float)gu + lu) / CHARTS_U, ((float)gv + lv) / CHARTS_V};
-                gdr_vec3 nn = m->normals[v];
-                if (gv % 2) {
-                    nn = (gdr_vec3){nn.x + 0.5f, nn.y, nn.z};
-                    float l = sqrtf(nn.x * nn.x + nn.y * nn.y + nn.z * nn.z);
-                    nn = (gdr_vec3){nn.x / l, nn.y / l, nn.z / l};
-                }
-                nr[count++] = nn;
-            }
-            idx[i + k] = *sl;
-        }
-    }
-    uint32_t out = 0;
-    check_ok(gdr_scene_add_mesh(s, "charted", p, nr, uv, count, idx, n, &out, &err), &err, "charted torus");
-    free(p), free(nr), free(uv), free(idx), free(slot);
-    gdr_scene_destroy(t);
-    return out;
 }
 
 /* The level a cluster was made at: 0, or one more than the depth of the group that made it. */
