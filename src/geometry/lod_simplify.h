@@ -29,7 +29,8 @@ typedef struct lod_simplify_input {
 typedef struct lod_simplify_result {
     size_t index_count;  /* triangles kept, written as wedge ids */
     uint32_t collapses;
-    float slide;         /* the largest texture slide a collapse charged (mesh units) */
+    float slide;         /* the largest texture slide of an output triangle: charged by a collapse to one
+                            of its corners' wedges, at most its longest edge (mesh units) */
 } lod_simplify_result;
 
 /* A position's cheapest collapse as last evaluated (the heap holds at most one per position). */
@@ -75,6 +76,10 @@ typedef struct lod_simplify_scratch {
     size_t fan_cap, fan_b_cap, neighbours_cap, near_cap, order_cap, wedges_cap, wedges_b_cap, choice_cap;
     float *costs;
     size_t costs_cap;
+    /* per wedge: the largest texture slide (mesh length) a collapse charged to a corner taking it
+     * (wedge_slide), and of the collapse evaluated, the slide charged to it taking its choice */
+    float *wedge_slide, *choice_slide;
+    size_t wedge_slide_cap, choice_slide_cap;
     lod_simplify_corner *info; /* per corner of the fan evaluated */
     size_t info_cap;
 } lod_simplify_scratch;
