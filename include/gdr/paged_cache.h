@@ -4,11 +4,12 @@
  * A cache written with gdr_cache_write_options.page_bytes holds, next to the rest of the scene (and
  * the whole geometry only with whole_geometry), every mesh's LOD DAG groups in pages: a page holds
  * whole groups (coarsest first, so a mesh's page 0 holds its root group), compressed
- * (meshoptimizer's vertex and index codecs, then zstd where it pays) and checksummed on its own. gdr_paged_cache_open reads only the file's header, section
- * table, instances and the page index (group headers and where every page lies); pages are read
- * one at a time with positioned reads (pread), each checked before it is decoded. The file is
- * untrusted: every count, offset and index is checked, and a damaged page is refused with an
- * error naming the file, the mesh and the page, while the other pages stay readable. */
+ * (meshoptimizer's vertex and index codecs, then zstd where it pays) and checksummed on its own.
+ * gdr_paged_cache_open reads only the file's header, section table, instances and the page index
+ * (group headers and where every page lies); pages are read one at a time with positioned reads
+ * (pread), each checked before it is decoded. The file is untrusted: every count, offset and index
+ * is checked, and a damaged page is refused with an error naming the file, the mesh and the page,
+ * while the other pages stay readable. */
 #ifndef GDR_PAGED_CACHE_H
 #define GDR_PAGED_CACHE_H
 
