@@ -183,7 +183,7 @@ GDR_API gdr_status gdr_texture_decode_level(const gdr_texture *t, uint32_t level
 
 /* --- processed-scene cache ------------------------------------------------------------------ */
 
-#define GDR_CACHE_FORMAT_VERSION 10u
+#define GDR_CACHE_FORMAT_VERSION 11u
 
 /* What a cache was built from: the build options (a string that changes whenever the processing
  * would produce different data, e.g. "import=1") and the source files. */
@@ -206,7 +206,14 @@ typedef struct gdr_cache_write_options {
                                 mesh's LOD DAG groups in pages filled to this many raw bytes, in
                                 [GDR_PAGE_BYTES_MIN, GDR_PAGE_BYTES_MAX] (gdr/paged_cache.h;
                                 GDR_PAGE_BYTES_DEFAULT is the measured choice), read on demand by
-                                gdr_paged_cache_open; out of range: GDR_ERROR_INVALID_ARGUMENT */
+                                gdr_paged_cache_open; out of range: GDR_ERROR_INVALID_ARGUMENT.
+                                The pages then hold the only copy of the geometry: the sections of the
+                                whole geometry ('GEOM', 'VCOL', 'CLGM') are left out, so the file is the
+                                pages and what stays resident beside them, and it is read for
+                                streaming only (gdr_cache_read_for_streaming; the whole read refuses
+                                it by name) */
+    int whole_geometry;      /* with page_bytes: also keep the whole geometry beside the pages, so that
+                                the file is read whole too (3.4 times larger on the unique field) */
 } gdr_cache_write_options;
 
 /* Writes scene to path through a temporary file in the same folder and a rename. options: NULL for
@@ -245,6 +252,7 @@ typedef struct gdr_paged_build_options {
     uint32_t page_bytes;   /* 0: GDR_PAGE_BYTES_DEFAULT; else in [GDR_PAGE_BYTES_MIN, GDR_PAGE_BYTES_MAX] */
     uint32_t thread_count; /* 0: one per processor (gdr_cache_mesh_source.thread_count) */
     int no_progress;       /* 1: never draw a progress bar */
+    int whole_geometry;    /* 1: the whole geometry beside the pages (gdr_cache_write_options) */
 } gdr_paged_build_options;
 
 /* Writes the paged cache of a built-in scene (`spec`, as gdr_scene_load takes it) to path: the

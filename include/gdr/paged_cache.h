@@ -1,14 +1,15 @@
 /* gdr paged cache: a scene cache's geometry in pages, read on demand (docs/CACHE_FORMAT.md,
  * section 'PAGE'; docs/STREAMING.md).
  *
- * A cache written with gdr_cache_write_options.page_bytes holds, next to the whole scene, every
- * mesh's LOD DAG groups in pages: a page holds whole groups (coarsest first, so a mesh's page 0
- * holds its root group), compressed (meshoptimizer's vertex and index codecs, then zstd where it
- * pays) and checksummed on its own. gdr_paged_cache_open reads only the file's header, section
- * table, instances and the page index (group headers and where every page lies); pages are read
- * one at a time with positioned reads (pread), each checked before it is decoded. The file is
- * untrusted: every count, offset and index is checked, and a damaged page is refused with an
- * error naming the file, the mesh and the page, while the other pages stay readable. */
+ * A cache written with gdr_cache_write_options.page_bytes holds, next to the rest of the scene (and
+ * the whole geometry only with whole_geometry), every mesh's LOD DAG groups in pages: a page holds
+ * whole groups (coarsest first, so a mesh's page 0 holds its root group), compressed
+ * (meshoptimizer's vertex and index codecs, then zstd where it pays) and checksummed on its own.
+ * gdr_paged_cache_open reads only the file's header, section table, instances and the page index
+ * (group headers and where every page lies); pages are read one at a time with positioned reads
+ * (pread), each checked before it is decoded. The file is untrusted: every count, offset and index
+ * is checked, and a damaged page is refused with an error naming the file, the mesh and the page,
+ * while the other pages stay readable. */
 #ifndef GDR_PAGED_CACHE_H
 #define GDR_PAGED_CACHE_H
 
@@ -109,6 +110,9 @@ GDR_API const gdr_instance *gdr_paged_cache_instances(const gdr_paged_cache *cac
 GDR_API uint64_t gdr_paged_cache_bytes_read(const gdr_paged_cache *cache);
 /* The page bytes the file holds (the 'PAGE' section), for bytes per source triangle. */
 GDR_API uint64_t gdr_paged_cache_page_bytes(const gdr_paged_cache *cache);
+/* 1 when the pages hold the only copy of the geometry (the file has no whole geometry beside them:
+ * gdr_cache_write_options.whole_geometry was 0), so that the file is read for streaming only. */
+GDR_API int gdr_paged_cache_pages_only(const gdr_paged_cache *cache);
 
 /* Reads page `page` of mesh `mesh` with one positioned read, checks its checksum and every count,
  * offset and index in it, and decodes it into *out (freed with gdr_page_free). Safe to call from

@@ -104,7 +104,7 @@ static gdr_status check_reader_limits(const char *path, const gdr_scene *s, bool
     return GDR_OK;
 }
 
-void cache_put_header(uint8_t *head, const section_entry *entries, uint32_t count, uint64_t size)
+void cache_put_header(uint8_t *head, const section_entry *entries, uint32_t count, uint64_t size, uint32_t flags)
 {
     memset(head, 0, CACHE_HEADER_SIZE);
     uint8_t *table = head + CACHE_HEADER_SIZE;
@@ -120,7 +120,7 @@ void cache_put_header(uint8_t *head, const section_entry *entries, uint32_t coun
     store_u32(head + 8, GDR_CACHE_FORMAT_VERSION);
     store_u32(head + 12, CACHE_HEADER_SIZE);
     store_u32(head + 16, count);
-    store_u32(head + 20, 0);
+    store_u32(head + 20, flags);
     store_u64(head + 24, size);
     store_u64(head + 32, gdr_io_hash(table, (size_t)count * CACHE_ENTRY_SIZE));
     store_u64(head + 40, gdr_io_hash(head, 40));
@@ -163,7 +163,7 @@ static gdr_status serialise(const char *path, const cache_write_input *in, uint3
                                "hold (the whole reader's limit)", path, (unsigned long long)*size,
                                (unsigned long long)gdr_io_max_file_size);
     if (status == GDR_OK) {
-        cache_put_header(head, entries, count, *size);
+        cache_put_header(head, entries, count, *size, in->pages_only ? CACHE_FLAG_PAGES_ONLY : 0);
         if (sink->failed || !finish_file(&w, sink, head, head_size))
             status = gdr_error_set(err, GDR_ERROR_IO, "%s: write failed: %s", path, strerror(errno));
     }
@@ -182,7 +182,7 @@ gdr_status gdr_cache_write(const char *path, const gdr_scene *scene, const gdr_c
     if (limits != GDR_OK)
         return limits;
     /* The table has exactly one entry per section: no byte of the file lies outside a checksum. */
-    cache_write_input in = {scene, &options->source, options->report, options->pvs, options->page_bytes};
+    cache_write_input in = cache_write_input_of(scene, options);
     uint32_t expected = 0;
     for (uint32_t k = 0; k < CACHE_SECTION_COUNT; k++) {
         const cache_section *sec = &gdr_cache_sections[k];
@@ -307,13 +307,12 @@ static gdr_status fetch_section(container_source *src, int known, uint64_t offse
 }
 
 gdr_status cache_parse_header(const char *name, const uint8_t *h, uint64_t size, uint32_t *out_count,
-                               uint64_t *out_table_hash, gdr_error *err)
+                               uint64_t *out_table_hash, uint32_t *out_flags, gdr_error *err)
 {
     if (memcmp(h, CACHE_MAGIC, 8) != 0)
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: not a gdr cache (bad magic)", name);
     reader r = {h, CACHE_HEADER_SIZE, 8, 0};
-    uint32_t version = get_u32(&r), header_size = get_u32(&r), count = get_u32(&r);
-    (void)get_u32(&r);
+    uint32_t version = get_u32(&r), header_size = get_u32(&r), count = get_u32(&r), flags = get_u32(&r);
     uint64_t file_size = get_u64(&r), table_hash = get_u64(&r), header_hash = get_u64(&r);
     if (version != GDR_CACHE_FORMAT_VERSION)
         return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "%s: cache format version %u, this build reads %u; rebuild it",
@@ -331,8 +330,13 @@ gdr_status cache_parse_header(const char *name, const uint8_t *h, uint64_t size,
     for (unsigned i = 48; i < CACHE_HEADER_SIZE; i++)
         if (h[i] != 0)
             return gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: corrupted: reserved header byte %u is not zero", name, i);
+    if (flags & ~CACHE_FLAG_PAGES_ONLY)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: header flags 0x%x: unknown to this build (it knows 0x%x)", name,
+                             flags, CACHE_FLAG_PAGES_ONLY);
     *out_count = count;
     *out_table_hash = table_hash;
+    if (out_flags)
+        *out_flags = flags;
     return GDR_OK;
 }
 
@@ -366,6 +370,27 @@ static gdr_status parse_entry(container_source *src, const uint8_t *e, uint64_t 
     return GDR_OK;
 }
 
+/* Every required section is there; the whole geometry exactly when the header does not say that the
+ * pages hold it alone, and then the pages. */
+static gdr_status check_sections_present(const char *name, const cache_view *v, gdr_error *err)
+{
+    int pages_only = (v->flags & CACHE_FLAG_PAGES_ONLY) != 0;
+    char text[5];
+    if (pages_only && !v->present[CACHE_PAGES])
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: its header says its geometry is in its pages alone, and it "
+                             "has no section 'PAGE'", name);
+    for (int k = 0; k < CACHE_SECTION_COUNT; k++) {
+        const cache_section *sec = &gdr_cache_sections[k];
+        fourcc_text(sec->id, text);
+        if (sec->whole_geometry && pages_only && v->present[k])
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section '%s' in a cache whose header says its geometry is "
+                                 "in its pages alone", name, text);
+        if (!v->present[k] && !sec->optional && !(sec->whole_geometry && pages_only))
+            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section '%s' is missing", name, text);
+    }
+    return GDR_OK;
+}
+
 /* Header, table and the sections the read needs into v. With the whole file, every byte after the
  * table is accounted for (check_coverage); read from the file, only the sections read are checked. */
 static gdr_status parse_container(container_source *src, cache_view *v, gdr_error *err)
@@ -380,7 +405,7 @@ static gdr_status parse_container(container_source *src, cache_view *v, gdr_erro
     uint64_t table_hash = 0;
     gdr_status status = source_read(src, h, CACHE_HEADER_SIZE, 0, err);
     if (status == GDR_OK)
-        status = cache_parse_header(name, h, src->size, &count, &table_hash, err);
+        status = cache_parse_header(name, h, src->size, &count, &table_hash, &v->flags, err);
     uint8_t *table = status == GDR_OK ? malloc((size_t)count * CACHE_ENTRY_SIZE + 1) : NULL;
     if (status == GDR_OK && !table)
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory for the section table", name);
@@ -395,12 +420,8 @@ static gdr_status parse_container(container_source *src, cache_view *v, gdr_erro
     free(table);
     if (status == GDR_OK && src->data)
         status = check_coverage(name, src->data, (size_t)src->size, table_end, ranges, count, err);
-    for (int k = 0; k < CACHE_SECTION_COUNT && status == GDR_OK; k++)
-        if (!v->present[k] && !gdr_cache_sections[k].optional) {
-            char text[5];
-            fourcc_text(gdr_cache_sections[k].id, text);
-            status = gdr_error_set(err, GDR_ERROR_PARSE, "%s: section '%s' is missing", name, text);
-        }
+    if (status == GDR_OK)
+        status = check_sections_present(name, v, err);
     v->data = src->data;
     v->size = (size_t)src->size;
     return status;
@@ -807,7 +828,7 @@ static gdr_status read_source_section(const char *path, int fd, uint64_t size, u
     uint64_t table_hash;
     if (size < CACHE_HEADER_SIZE || gdr_io_pread_exact(fd, h, CACHE_HEADER_SIZE, 0) != CACHE_HEADER_SIZE)
         return gdr_error_set(err, GDR_ERROR_CORRUPT, "%s: truncated", path);
-    gdr_status status = cache_parse_header(path, h, size, &count, &table_hash, err);
+    gdr_status status = cache_parse_header(path, h, size, &count, &table_hash, NULL, err);
     if (status != GDR_OK)
         return status;
     uint8_t *table = malloc((size_t)count * CACHE_ENTRY_SIZE + 1);

@@ -16,6 +16,7 @@
 #define CACHE_ENTRY_SIZE 32u
 #define CACHE_MAX_SECTIONS 1024u
 #define CACHE_SECTION_REQUIRED 1u /* table flag: a reader that does not know the section must refuse the file */
+#define CACHE_FLAG_PAGES_ONLY 1u  /* header flag: the geometry is in section 'PAGE' alone (no GEOM, VCOL, CLGM) */
 #define CACHE_MAX_TEXTURE_SIDE 32768u /* the largest texture side the reader accepts (and the writer writes) */
 
 /* --- writing: a growing buffer; `failed` once memory ran out ---------------------------------- */
@@ -173,7 +174,16 @@ typedef struct cache_write_input {
     const gdr_import_report *report; /* NULL: a report with no warnings */
     const gdr_pvs *pvs; /* NULL: no PVIS section */
     uint32_t page_bytes; /* 0: no PAGE section */
+    int pages_only;      /* the pages hold the only copy of the geometry: GEOM, VCOL, CLGM left out */
 } cache_write_input;
+
+/* The input of a write with these options: a cache with pages keeps its geometry in them alone
+ * unless asked for the whole geometry too. */
+static inline cache_write_input cache_write_input_of(const gdr_scene *scene, const gdr_cache_write_options *o)
+{
+    return (cache_write_input){scene, &o->source, o->report, o->pvs, o->page_bytes,
+                               o->page_bytes != 0 && !o->whole_geometry};
+}
 
 typedef struct cache_read_state cache_read_state; /* cache_sections.c */
 
@@ -184,8 +194,8 @@ typedef struct section_entry {
 } section_entry;
 
 /* The header and section table (`count` entries) of a file of `size` bytes into `head`
- * (CACHE_HEADER_SIZE + count * CACHE_ENTRY_SIZE bytes). */
-void cache_put_header(uint8_t *head, const section_entry *entries, uint32_t count, uint64_t size);
+ * (CACHE_HEADER_SIZE + count * CACHE_ENTRY_SIZE bytes); `flags`: CACHE_FLAG_PAGES_ONLY or 0. */
+void cache_put_header(uint8_t *head, const section_entry *entries, uint32_t count, uint64_t size, uint32_t flags);
 
 /* One section: its id and flags, and how it is written and read. */
 typedef struct cache_section {
@@ -200,6 +210,8 @@ typedef struct cache_section {
      * (SRCE, for staleness; REPT, the import's report). */
     gdr_status (*read)(cache_read_state *st, reader *r, gdr_error *err);
     int in_pages; /* geometry the pages hold too: a read for streaming leaves it in the file */
+    int whole_geometry; /* the whole geometry (GEOM, VCOL, CLGM): in every file but one whose geometry is
+                           in its pages alone (CACHE_FLAG_PAGES_ONLY), which must not have it */
 } cache_section;
 
 extern const cache_section gdr_cache_sections[CACHE_SECTION_COUNT];
@@ -210,13 +222,14 @@ typedef struct cache_view {
     size_t size;
     reader sections[CACHE_SECTION_COUNT];
     int present[CACHE_SECTION_COUNT];
+    uint32_t flags; /* the header's: CACHE_FLAG_PAGES_ONLY or 0 */
 } cache_view;
 
 /* The checks of the header's CACHE_HEADER_SIZE bytes `h` of a file of `size` bytes (magic, version,
- * checksum, size, reserved bytes; the table fits): the whole-file, the streaming and the paged
- * readers share them. Out: the table's entry count and checksum. */
+ * checksum, size, flags, reserved bytes; the table fits): the whole-file, the streaming and the
+ * paged readers share them. Out: the table's entry count and checksum, the flags (may be NULL). */
 gdr_status cache_parse_header(const char *name, const uint8_t *h, uint64_t size, uint32_t *out_count,
-                              uint64_t *out_table_hash, gdr_error *err);
+                              uint64_t *out_table_hash, uint32_t *out_flags, gdr_error *err);
 
 /* Builds the scene (and the PVS when out_pvs is not NULL) from the sections, each read and checked
  * by its description, in table order. With `paged`, the sections marked in_pages are not read (their

@@ -21,7 +21,8 @@
 #include "io/cache_spool.h"
 #include "io/io_internal.h"
 
-/* The sections whose bytes are one part per mesh, in mesh order, and nothing else. */
+/* The sections whose bytes are one part per mesh, in mesh order, and nothing else (those of the whole
+ * geometry only where the file has them). */
 static const int per_mesh_sections[] = {CACHE_MESHES, CACHE_GEOMETRY, CACHE_COLORS, CACHE_CLUSTERS,
                                         CACHE_CLUSTER_DATA, CACHE_CLUSTER_GEOMETRY, CACHE_HIERARCHY};
 enum { PER_MESH = sizeof per_mesh_sections / sizeof per_mesh_sections[0], PAGE_SPOOL = PER_MESH };
@@ -48,6 +49,11 @@ typedef struct build_job {
     gdr_progress progress;
 } build_job;
 
+static int section_present(int k, const cache_write_input *in)
+{
+    return !gdr_cache_sections[k].present || gdr_cache_sections[k].present(in);
+}
+
 static void free_parts(mesh_parts *p)
 {
     for (int k = 0; k < PER_MESH; k++)
@@ -71,7 +77,8 @@ static gdr_status make_parts(build_job *job, uint32_t i, mesh_parts *p, gdr_erro
         status = sec->check ? sec->check(&in, job->path, err) : GDR_OK;
     }
     for (int k = 0; k < PER_MESH && status == GDR_OK; k++)
-        gdr_cache_sections[per_mesh_sections[k]].write(&p->parts[k], &in);
+        if (section_present(per_mesh_sections[k], &in))
+            gdr_cache_sections[per_mesh_sections[k]].write(&p->parts[k], &in);
     for (int k = 0; k < PER_MESH && status == GDR_OK; k++)
         if (p->parts[k].failed)
             status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory serialising the mesh", job->path);
@@ -243,7 +250,7 @@ static gdr_status write_file(build_job *job, gdr_error *err)
     if (status == GDR_OK)
         status = gdr_output_open(job->path, &out, err);
     if (status == GDR_OK) {
-        cache_put_header(head, entries, count, size);
+        cache_put_header(head, entries, count, size, job->in->pages_only ? CACHE_FLAG_PAGES_ONLY : 0);
         int ok = fflush(out.file) == 0 && put_file(fileno(out.file), head, head_size, sections, entries, count);
         if (!ok)
             status = gdr_error_set(err, GDR_ERROR_IO, "%s: write failed: %s", job->path, strerror(errno));
@@ -313,7 +320,7 @@ gdr_status gdr_cache_write_meshes(const char *path, const gdr_scene *skeleton, c
     options = options ? options : &defaults;
     if (!skeleton || !meshes || !meshes->make)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: no scene or mesh source", path);
-    cache_write_input in = {skeleton, &options->source, options->report, options->pvs, options->page_bytes};
+    cache_write_input in = cache_write_input_of(skeleton, options);
     gdr_status status = check_skeleton(&in, path, err);
     if (status != GDR_OK)
         return status;

@@ -257,11 +257,19 @@ static gdr_status get_mesh_record(cache_read_state *st, uint32_t i, mesh_record 
     return GDR_OK;
 }
 
+static gdr_status add_paged_meshes(cache_read_state *st, gdr_error *err);
+
+/* Read for streaming, the meshes are made from these records alone (GEOM may not be in the file);
+ * else GEOM's reader makes them. */
 static gdr_status read_meshes(cache_read_state *st, reader *r, gdr_error *err)
 {
     st->meshes = *r;
-    return expect_records(st, r, FOURCC('M', 'E', 'S', 'H'), st->mesh_count, MESH_RECORD, err);
+    gdr_status status = expect_records(st, r, FOURCC('M', 'E', 'S', 'H'), st->mesh_count, MESH_RECORD, err);
+    return status == GDR_OK && st->paged ? add_paged_meshes(st, err) : status;
 }
+
+/* A file without the whole geometry: written with pages alone, unless asked for it. */
+static int has_whole_geometry(const cache_write_input *in) { return !in->pages_only; }
 
 static void write_geometry(writer *w, const cache_write_input *in)
 {
@@ -380,7 +388,7 @@ static gdr_status add_paged_meshes(cache_read_state *st, gdr_error *err)
 static gdr_status read_geometry(cache_read_state *st, reader *geo, gdr_error *err)
 {
     if (st->paged)
-        return add_paged_meshes(st, err);
+        return GDR_OK; /* the meshes were made from their MESH records */
     for (uint32_t i = 0; i < st->mesh_count; i++) {
         gdr_status status = read_one_mesh(st, geo, i, err);
         if (status != GDR_OK)
@@ -917,35 +925,42 @@ static gdr_status read_pages(cache_read_state *st, reader *r, gdr_error *err)
 
 #define REQUIRED CACHE_SECTION_REQUIRED
 const cache_section gdr_cache_sections[CACHE_SECTION_COUNT] = {
-    [CACHE_SOURCE] = {FOURCC('S', 'R', 'C', 'E'), 0, 1, NULL, NULL, write_source, NULL, 0},
-    [CACHE_REPORT] = {FOURCC('R', 'E', 'P', 'T'), REQUIRED, 0, NULL, NULL, write_report, NULL, 0},
-    [CACHE_SCENE] = {FOURCC('S', 'C', 'N', 'E'), REQUIRED, 0, NULL, NULL, write_scene, read_scene, 0},
+    [CACHE_SOURCE] = {FOURCC('S', 'R', 'C', 'E'), 0, 1, NULL, NULL, write_source, NULL, 0, 0},
+    [CACHE_REPORT] = {FOURCC('R', 'E', 'P', 'T'), REQUIRED, 0, NULL, NULL, write_report, NULL, 0, 0},
+    [CACHE_SCENE] = {FOURCC('S', 'C', 'N', 'E'), REQUIRED, 0, NULL, NULL, write_scene, read_scene, 0, 0},
     [CACHE_TEXTURES] = {FOURCC('T', 'E', 'X', 'R'), REQUIRED, 0, NULL, check_texture_sides, write_textures,
-                        read_textures, 0},
-    [CACHE_PIXELS] = {FOURCC('T', 'X', 'P', 'X'), REQUIRED, 0, NULL, NULL, write_pixels, read_pixels, 0},
-    [CACHE_MESHES] = {FOURCC('M', 'E', 'S', 'H'), REQUIRED, 0, NULL, NULL, write_meshes, read_meshes, 0},
-    [CACHE_GEOMETRY] = {FOURCC('G', 'E', 'O', 'M'), REQUIRED, 0, NULL, NULL, write_geometry, read_geometry, 1},
-    [CACHE_COLORS] = {FOURCC('V', 'C', 'O', 'L'), REQUIRED, 0, NULL, NULL, write_colors, read_colors, 1},
-    [CACHE_CLUSTERS] = {FOURCC('C', 'L', 'U', 'S'), REQUIRED, 0, NULL, NULL, write_cluster_counts, read_cluster_counts, 0},
+                        read_textures, 0, 0},
+    [CACHE_PIXELS] = {FOURCC('T', 'X', 'P', 'X'), REQUIRED, 0, NULL, NULL, write_pixels, read_pixels, 0, 0},
+    [CACHE_MESHES] = {FOURCC('M', 'E', 'S', 'H'), REQUIRED, 0, NULL, NULL, write_meshes, read_meshes, 0, 0},
+    [CACHE_GEOMETRY] = {FOURCC('G', 'E', 'O', 'M'), REQUIRED, 0, has_whole_geometry, NULL, write_geometry,
+                        read_geometry, 1, 1},
+    [CACHE_COLORS] = {FOURCC('V', 'C', 'O', 'L'), REQUIRED, 0, has_whole_geometry, NULL, write_colors, read_colors, 1,
+                      1},
+    [CACHE_CLUSTERS] = {FOURCC('C', 'L', 'U', 'S'), REQUIRED, 0, NULL, NULL, write_cluster_counts, read_cluster_counts, 0, 0},
     [CACHE_CLUSTER_DATA] = {FOURCC('C', 'L', 'D', 'T'), REQUIRED, 0, NULL, NULL, write_cluster_records,
-                            read_cluster_data, 0},
-    [CACHE_CLUSTER_GEOMETRY] = {FOURCC('C', 'L', 'G', 'M'), REQUIRED, 0, NULL, NULL, write_cluster_geometry,
-                                read_cluster_geometry, 1},
+                            read_cluster_data, 0, 0},
+    [CACHE_CLUSTER_GEOMETRY] = {FOURCC('C', 'L', 'G', 'M'), REQUIRED, 0, has_whole_geometry, NULL,
+                                write_cluster_geometry, read_cluster_geometry, 1, 1},
     [CACHE_HIERARCHY] = {FOURCC('L', 'O', 'D', 'H'), REQUIRED, 0, NULL, check_hierarchy_present, write_hierarchy,
-                         read_hierarchy, 0},
-    [CACHE_MATERIALS] = {FOURCC('M', 'A', 'T', 'L'), REQUIRED, 0, NULL, check_materials, write_materials, read_materials, 0},
-    [CACHE_INSTANCES] = {FOURCC('I', 'N', 'S', 'T'), REQUIRED, 0, NULL, NULL, write_instances, read_instances, 0},
-    [CACHE_CAMERAS] = {FOURCC('C', 'A', 'M', 'R'), REQUIRED, 0, NULL, NULL, write_cameras, read_cameras, 0},
+                         read_hierarchy, 0, 0},
+    [CACHE_MATERIALS] = {FOURCC('M', 'A', 'T', 'L'), REQUIRED, 0, NULL, check_materials, write_materials, read_materials, 0, 0},
+    [CACHE_INSTANCES] = {FOURCC('I', 'N', 'S', 'T'), REQUIRED, 0, NULL, NULL, write_instances, read_instances, 0, 0},
+    [CACHE_CAMERAS] = {FOURCC('C', 'A', 'M', 'R'), REQUIRED, 0, NULL, NULL, write_cameras, read_cameras, 0, 0},
     /* optional: readers that predate it skip it */
     [CACHE_PVS] = {FOURCC('P', 'V', 'I', 'S'), 0, 1, cache_pvs_present, cache_pvs_check, cache_pvs_write, read_pvs,
-                   0},
-    [CACHE_PAGES] = {FOURCC('P', 'A', 'G', 'E'), 0, 1, has_pages, check_page_bytes, write_pages, read_pages, 1},
+                   0, 0},
+    [CACHE_PAGES] = {FOURCC('P', 'A', 'G', 'E'), 0, 1, has_pages, check_page_bytes, write_pages, read_pages, 1, 0},
 };
 #undef REQUIRED
 
 gdr_status gdr_cache_read_sections(const char *name, cache_view *v, int paged, gdr_scene **out, gdr_pvs **out_pvs,
                                    gdr_error *err)
 {
+    if (!paged && (v->flags & CACHE_FLAG_PAGES_ONLY))
+        return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "%s: its geometry is in its pages alone (a cache for "
+                             "streaming): stream it (gdr render --geometry-budget MIB), or use the source or a "
+                             "cache with the whole geometry (gdr build without --pages, or with --pages "
+                             "--whole-geometry)", name);
     cache_read_state st = {.name = name, .file = v->data, .out_pvs = out_pvs, .paged = paged};
     gdr_status status = gdr_scene_create(&st.scene, err);
     for (uint32_t k = 0; k < CACHE_SECTION_COUNT && status == GDR_OK; k++)

@@ -135,7 +135,8 @@ gdr_status gdr_cache_build_paged(const char *spec, const char *path, const gdr_p
     gdr_status status = gdr_io_paged_source_open(spec, &load, true, &src, NULL, NULL, err);
     gdr_source_list none = {0};
     gdr_cache_write_options write = {.source = {gdr_cache_build_options(), &none},
-                                     .page_bytes = options->page_bytes ? options->page_bytes : GDR_PAGE_BYTES_DEFAULT};
+                                     .page_bytes = options->page_bytes ? options->page_bytes : GDR_PAGE_BYTES_DEFAULT,
+                                     .whole_geometry = options->whole_geometry};
     if (status == GDR_OK)
         status = gdr_io_paged_source_write(&src, path, &write, options->thread_count, options->no_progress, err);
     gdr_io_paged_source_close(&src);

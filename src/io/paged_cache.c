@@ -26,6 +26,7 @@ struct gdr_paged_cache {
     gdr_instance *instances;
     gdr_paged_mesh *meshes;
     uint64_t page_section_size;
+    uint32_t header_flags; /* CACHE_FLAG_PAGES_ONLY: the pages hold the only copy of the geometry */
 };
 
 typedef struct section_ref {
@@ -61,7 +62,7 @@ static gdr_status read_table(gdr_paged_cache *pc, section_ref *scne, section_ref
     uint64_t table_hash = 0;
     gdr_status status = read_at(pc, h, CACHE_HEADER_SIZE, 0, "header", err);
     if (status == GDR_OK)
-        status = cache_parse_header(pc->name, h, pc->file_size, &count, &table_hash, err);
+        status = cache_parse_header(pc->name, h, pc->file_size, &count, &table_hash, &pc->header_flags, err);
     if (status != GDR_OK)
         return status;
     uint8_t *table = malloc((size_t)count * CACHE_ENTRY_SIZE + 1);
@@ -257,6 +258,7 @@ const gdr_instance *gdr_paged_cache_instances(const gdr_paged_cache *pc, uint32_
 }
 uint64_t gdr_paged_cache_bytes_read(const gdr_paged_cache *pc) { return atomic_load(&pc->bytes_read); }
 uint64_t gdr_paged_cache_page_bytes(const gdr_paged_cache *pc) { return pc->page_section_size; }
+int gdr_paged_cache_pages_only(const gdr_paged_cache *pc) { return (pc->header_flags & CACHE_FLAG_PAGES_ONLY) != 0; }
 
 gdr_status gdr_paged_cache_read_page(gdr_paged_cache *pc, uint32_t mesh, uint32_t page, gdr_page *out,
                                      gdr_error *err)

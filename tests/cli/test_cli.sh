@@ -147,6 +147,27 @@ grep -q '^cache: *[1-9][0-9]* bytes, [0-9.]* bytes per source triangle$' "$work/
     { echo "FAIL: info cache bytes: $(cat "$work/stdout")"; failures=$((failures + 1)); }
 grep -q '^vertices: *3 of 3 meshes on a grid' "$work/stdout" ||
     { echo "FAIL: build --pages did not quantize: $(cat "$work/stdout")"; failures=$((failures + 1)); }
+grep -q '^geometry: *in the pages alone' "$work/stdout" ||
+    { echo "FAIL: info geometry of a paged cache: $(cat "$work/stdout")"; failures=$((failures + 1)); }
+# The cache whose geometry is in its pages alone: refused whole, saying how to read it; with the whole
+# geometry beside the pages (--whole-geometry) it renders whole too; streamed, the two give the same
+# image, byte for byte, which is the whole render's.
+expect 1 "a cache of pages alone rendered whole" "$gdr" render "$work/unique.gdrc" $tiny
+grep -q 'pages alone.*--geometry-budget' "$work/stderr" || { echo "FAIL: pages alone whole: $(cat "$work/stderr")"; failures=$((failures + 1)); }
+expect 2 "--whole-geometry without pages" "$gdr" build unique-field:meshes=1,triangles=1000 -o "$work/bad.gdrc" --whole-geometry
+expect 0 "build with the whole geometry" "$gdr" build unique-field:meshes=3,triangles=2000 -o "$work/unique-whole.gdrc" \
+    --pages=16 --whole-geometry --no-progress
+expect 0 "info with the whole geometry" "$gdr" info "$work/unique-whole.gdrc"
+grep -q '^geometry: *whole, and in the pages' "$work/stdout" || { echo "FAIL: info geometry: $(cat "$work/stdout")"; failures=$((failures + 1)); }
+for layout in unique unique-whole; do
+    expect 0 "stream $layout" "$gdr" render "$work/$layout.gdrc" $tiny --geometry-budget 1 --frames 12 --validate \
+        --out "$work/$layout-streamed.png"
+done
+expect 0 "render with the whole geometry" "$gdr" render "$work/unique-whole.gdrc" $tiny --out "$work/unique-whole.png"
+cmp -s "$work/unique-streamed.png" "$work/unique-whole-streamed.png" ||
+    { echo "FAIL: the two layouts stream different images"; failures=$((failures + 1)); }
+cmp -s "$work/unique-streamed.png" "$work/unique-whole.png" ||
+    { echo "FAIL: the pages alone stream another image than the whole render"; failures=$((failures + 1)); }
 expect 0 "info of a cache without pages" "$gdr" info "$work/field.gdrc"
 grep -q '^pages: *none' "$work/stdout" || { echo "FAIL: info no pages: $(cat "$work/stdout")"; failures=$((failures + 1)); }
 expect 2 "page size too small" "$gdr" build unique-field:meshes=1,triangles=1000 -o "$work/bad.gdrc" --pages=1
@@ -171,9 +192,17 @@ cp "$paged" "$work/paged-before.gdrc" 2>/dev/null
 expect 0 "stream the glTF again" "$gdr" render "$engine" $tiny --geometry-budget 64 --cache-dir "$work/cache" --frames 30 \
     --out "$work/engine-again.png"
 cmp -s "$paged" "$work/paged-before.gdrc" || { echo "FAIL: the paged cache was rebuilt"; failures=$((failures + 1)); }
-expect 0 "the paged cache whole" "$gdr" render "$paged" $tiny --out "$work/engine-whole.png"
+expect 1 "the paged cache whole" "$gdr" render "$paged" $tiny --out "$work/engine-whole.png"
+grep -q 'pages alone' "$work/stderr" || { echo "FAIL: paged cache whole: $(cat "$work/stderr")"; failures=$((failures + 1)); }
+expect 0 "the glTF with its whole geometry and pages" "$gdr" build "$engine" -o "$work/engine-whole.gdrc" --pages \
+    --whole-geometry --no-progress
+expect 0 "that cache whole" "$gdr" render "$work/engine-whole.gdrc" $tiny --out "$work/engine-whole.png"
 cmp -s "$work/engine-streamed.png" "$work/engine-whole.png" ||
     { echo "FAIL: the streamed glTF's image is not its cache's"; failures=$((failures + 1)); }
+expect 0 "that cache streamed" "$gdr" render "$work/engine-whole.gdrc" $tiny --geometry-budget 64 --frames 30 \
+    --out "$work/engine-whole-streamed.png"
+cmp -s "$work/engine-streamed.png" "$work/engine-whole-streamed.png" ||
+    { echo "FAIL: the two layouts of the glTF stream different images"; failures=$((failures + 1)); }
 expect 0 "stream an OBJ" "$gdr" render /usr/share/assimp/models/OBJ/WusonOBJ.obj $tiny --geometry-budget 8 \
     --cache-dir "$work/cache" --frames 10 --validate
 expect 1 "stream without a cache" "$gdr" render "$engine" $tiny --geometry-budget 8 --no-cache

@@ -118,6 +118,23 @@ for at in 0 4 8 12 20 36; do
         "$gdr" render "$work/mutant.gdrc" --geometry-budget 8 $tiny --out "$work/mutant.png"
     check "no image for the damaged cache (index byte $at)" test ! -e "$work/mutant.png"
 done
+# The cache holds its geometry in its pages alone: rendered whole, rebuilt from or cut short, it is
+# refused by name (exit 1), never read past its end, no image written.
+# shellcheck disable=SC2086
+expect 1 "pages alone rendered whole" "paged.gdrc: its geometry is in its pages alone" \
+    "$gdr" render "$work/paged.gdrc" $tiny --out "$work/mutant.png"
+expect 1 "pages alone rebuilt from" "paged.gdrc: its geometry is in its pages alone" \
+    "$gdr" build "$work/paged.gdrc" -o "$work/rebuilt.gdrc"
+check "nothing rebuilt from the pages alone" test ! -e "$work/rebuilt.gdrc"
+size=$(wc -c <"$work/paged.gdrc")
+for cut in 40 $((size / 2)) $((size - 1)); do
+    head -c "$cut" "$work/paged.gdrc" >"$work/mutant.gdrc"
+    # shellcheck disable=SC2086
+    expect 1 "pages alone cut to $cut bytes, streamed" "mutant.gdrc: truncated" \
+        "$gdr" render "$work/mutant.gdrc" --geometry-budget 8 $tiny --out "$work/mutant.png"
+    expect 1 "pages alone cut to $cut bytes, info" "mutant.gdrc: truncated" "$gdr" info "$work/mutant.gdrc"
+done
+check "no image for a cut cache" test ! -e "$work/mutant.png"
 
 # FIFOs as the program's own inputs: refused at once, never waited on (expect's timeout fails a hang).
 mkfifo "$work/path.fifo"

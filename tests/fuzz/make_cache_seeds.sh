@@ -20,6 +20,10 @@ cd "$here/corpus/obj" && "$gdr" build quad.obj -o "$work/b.gdrc" --no-progress >
 "$gdr" build tri.obj -o "$work/c.gdrc" --pvs --no-progress >/dev/null
 "$gdr" build "$work/c.gdrc" -o "$work/pvs.gdrc" --no-progress >/dev/null
 "$gdr" build unique-field:meshes=2,triangles=1000 -o "$work/paged.gdrc" --pages=4 --no-progress >/dev/null
+# A smaller one with the whole geometry beside its pages (the one above has its pages alone: read
+# for streaming only); under the fuzzer's 64 KiB inputs.
+"$gdr" build unique-field:meshes=1,triangles=1000 -o "$work/paged-whole.gdrc" --pages=4 --whole-geometry \
+    --no-progress >/dev/null
 # A cache that keeps its import's warnings (section 'REPT'): an OBJ statement gdr ignores.
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nbevel on\n' >"$work/warned.obj"
 cd "$work" && "$gdr" build warned.obj -o "$work/d.gdrc" --no-progress >/dev/null 2>&1
@@ -29,5 +33,5 @@ models=/usr/share/assimp/models/glTF2/BoxTextured-glTF
 cp "$models/BoxTextured.gltf" "$models/BoxTextured0.bin" "$models/CesiumLogoFlat.png" "$work/"
 "$gdr" build "$work/BoxTextured.gltf" -o "$work/d.gdrc" --no-progress >/dev/null
 "$gdr" build "$work/d.gdrc" -o "$work/textured.gdrc" --no-progress >/dev/null
-for name in nodes quad pvs paged warned textured; do seed $name; done
+for name in nodes quad pvs paged paged-whole warned textured; do seed $name; done
 ls -l "$here/corpus/cache"

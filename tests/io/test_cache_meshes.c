@@ -48,7 +48,7 @@ static int same_file(const char *a, const char *b)
 }
 
 /* What gdr build --pages wrote before: the whole scene made, quantized, gdr_cache_write. */
-static void write_whole(const char *spec, const char *path, uint32_t page_bytes)
+static void write_whole(const char *spec, const char *path, uint32_t page_bytes, int whole_geometry)
 {
     gdr_error err = {0};
     gdr_scene *scene = NULL;
@@ -56,7 +56,8 @@ static void write_whole(const char *spec, const char *path, uint32_t page_bytes)
     CHECK(gdr_scene_load(spec, &load, &scene, &err) == GDR_OK);
     CHECK(scene && gdr_scene_quantize_vertices(scene, &err) == GDR_OK);
     gdr_source_list none = {0};
-    gdr_cache_write_options write = {.source = {gdr_cache_build_options(), &none}, .page_bytes = page_bytes};
+    gdr_cache_write_options write = {.source = {gdr_cache_build_options(), &none}, .page_bytes = page_bytes,
+                                     .whole_geometry = whole_geometry};
     CHECK(scene && gdr_cache_write(path, scene, &write, &err) == GDR_OK);
     gdr_scene_destroy(scene);
 }
@@ -78,24 +79,34 @@ static void check_pages_read(const char *path)
     gdr_paged_cache_close(pc);
 }
 
-/* The spec written mesh by mesh with 1, 2 and 4 threads: each file equals the whole-scene one. */
-static void check_equal(const char *spec, uint32_t page_bytes)
+/* One layout of the file written mesh by mesh with 1, 2 and 4 threads: each equals the whole-scene one. */
+static void check_equal_layout(const char *spec, uint32_t page_bytes, int whole_geometry)
 {
     char whole[1024], meshes[1024];
     snprintf(whole, sizeof whole, "%s/meshes-whole.gdrc", GDR_IO_TEST_TMP);
     snprintf(meshes, sizeof meshes, "%s/meshes-by-mesh.gdrc", GDR_IO_TEST_TMP);
-    write_whole(spec, whole, page_bytes);
+    write_whole(spec, whole, page_bytes, whole_geometry);
     static const uint32_t threads[] = {1, 2, 4};
     for (int t = 0; t < 3; t++) {
         gdr_error err = {0};
         unlink(meshes);
-        gdr_paged_build_options o = {.page_bytes = page_bytes, .thread_count = threads[t], .no_progress = 1};
+        gdr_paged_build_options o = {.page_bytes = page_bytes, .thread_count = threads[t], .no_progress = 1,
+                                     .whole_geometry = whole_geometry};
         CHECK(gdr_cache_build_paged(spec, meshes, &o, &err) == GDR_OK);
         if (!same_file(whole, meshes))
-            fprintf(stderr, "%s, %u threads: not the whole scene's file\n", spec, threads[t]);
+            fprintf(stderr, "%s, %u threads, whole geometry %d: not the whole scene's file\n", spec, threads[t],
+                    whole_geometry);
         CHECK(same_file(whole, meshes));
     }
     check_pages_read(meshes);
+}
+
+/* The spec written mesh by mesh with 1, 2 and 4 threads: each file equals the whole-scene one, with
+ * the geometry in the pages alone and with the whole geometry beside them. */
+static void check_equal(const char *spec, uint32_t page_bytes)
+{
+    for (int whole_geometry = 0; whole_geometry <= 1; whole_geometry++)
+        check_equal_layout(spec, page_bytes, whole_geometry);
 }
 
 /* gdr_scene_load for streaming a built-in scene builds its paged cache in the cache folder: the file
@@ -106,7 +117,7 @@ static void check_load_paged(void)
     snprintf(folder, sizeof folder, "%s/meshes-cache", GDR_IO_TEST_TMP);
     snprintf(whole, sizeof whole, "%s/meshes-whole.gdrc", GDR_IO_TEST_TMP);
     const char *spec = "unique-field:meshes=4,triangles=6000,seed=9";
-    write_whole(spec, whole, GDR_PAGE_BYTES_DEFAULT);
+    write_whole(spec, whole, GDR_PAGE_BYTES_DEFAULT, 0);
     gdr_error err = {0};
     gdr_scene *scene = NULL;
     gdr_load_options load = {.no_progress = 1, .geometry_in_pages = 1, .cache_dir = folder,

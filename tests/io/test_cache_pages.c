@@ -260,11 +260,17 @@ int main(void)
     CHECK(gdr_cache_write(path, scene, &bad, &err) == GDR_ERROR_INVALID_ARGUMENT);
     /* Pages of about three groups: several pages per mesh, several groups per page. */
     gdr_cache_write_options write = {.page_bytes = 48u << 10};
-    CHECK(gdr_cache_write(path, scene, &write, &err) == GDR_OK);
-    /* The whole-file reader still reads it (and checks the page index). */
+    /* With the whole geometry beside the pages, the whole-file reader reads it (and checks the page
+     * index); with the pages alone it refuses it, saying how to read it. */
+    gdr_cache_write_options whole = {.page_bytes = 48u << 10, .whole_geometry = 1};
+    CHECK(gdr_cache_write(path, scene, &whole, &err) == GDR_OK);
     gdr_scene *again = NULL;
     CHECK(gdr_cache_read(path, NULL, &again, NULL, &err) == GDR_OK);
     gdr_scene_destroy(again);
+    CHECK(gdr_cache_write(path, scene, &write, &err) == GDR_OK);
+    again = NULL;
+    CHECK_FAILS(gdr_cache_read(path, NULL, &again, NULL, &err), err, GDR_ERROR_INVALID_ARGUMENT);
+    CHECK(again == NULL && strstr(err.message, "pages alone") && strstr(err.message, "--geometry-budget"));
 
     size_t size = 0;
     uint8_t *bytes = read_file(path, &size);

@@ -57,7 +57,23 @@ static void print_cache_bytes(const char *path, uint64_t source_triangles)
     printf("pages:       %llu pages of %llu groups, %llu bytes, %.1f bytes per source triangle (opening read %llu)\n",
            (unsigned long long)pages, (unsigned long long)groups, (unsigned long long)bytes,
            (double)bytes / (double)source_triangles, (unsigned long long)gdr_paged_cache_bytes_read(paged));
+    printf("geometry:    %s\n", gdr_paged_cache_pages_only(paged) ? "in the pages alone (read for streaming only)"
+                                                                     : "whole, and in the pages");
     gdr_paged_cache_close(paged);
+}
+
+/* Whether `input` is a .gdrc whose geometry is in its pages alone: then it is read as for streaming
+ * (everything printed here comes from the records that read takes). */
+static int cache_pages_only(const char *input)
+{
+    size_t length = strlen(input);
+    gdr_paged_cache *paged = NULL;
+    gdr_error err = {0};
+    if (length <= 5 || strcmp(input + length - 5, ".gdrc") != 0 || gdr_paged_cache_open(input, &paged, &err) != GDR_OK)
+        return 0;
+    int only = gdr_paged_cache_pages_only(paged);
+    gdr_paged_cache_close(paged);
+    return only;
 }
 
 /* Where the scene's cache is: read, written, not written, or none. */
@@ -141,6 +157,7 @@ int gdr_cmd_info(int argc, char **argv)
     gdr_scene *scene = NULL;
     gdr_pvs *pvs = NULL;
     options.pvs = &pvs; /* a cache's precomputed visibility is described too */
+    options.geometry_in_pages = cache_pages_only(input);
     gdr_status status = gdr_scene_load(input, &options, &scene, &err);
     int strict = status == GDR_OK ? cli_strict_check(&warnings, input) : 0;
     if (status != GDR_OK || strict) {
