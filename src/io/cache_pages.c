@@ -18,10 +18,12 @@
 _Static_assert(sizeof(gdr_page_vertex) == sizeof(gdr_vertex_bytes) &&
                    offsetof(gdr_page_vertex, normal) == offsetof(gdr_vertex_bytes, normal) &&
                    offsetof(gdr_page_vertex, uv) == offsetof(gdr_vertex_bytes, uv),
-               "a decoded page vertex is compared as gdr_vertex_bytes");
+               "a decoded page vertex is compared and decoded as gdr_vertex_bytes");
 #define PAGE_FLAG_ZSTD 1u
 #define PAGE_FLAG_QUANTIZED 2u /* the vertices as integers on the grid the body gives (gdr_quantized_vertex) */
 #define PAGE_GRID_BLOCK 32u    /* that grid: i32 position exponent, f32 x3 origin, i32 uv exponent, f32 x2 origin, u32 0 */
+/* Slots a decoded page's vertex array has after its last cluster's vertices (expand_cluster). */
+#define CACHE_PAGE_SPARE_VERTICES 3u
 /* zstd level of the page bodies: 3 measured as good as 9 here on these bodies (docs/CACHE_FORMAT.md). */
 #define PAGE_ZSTD_LEVEL 3
 /* zstd is kept only when it saves at least this share of the body (else decoding it costs for nothing). */
@@ -749,35 +751,47 @@ static gdr_status decode_clusters(const char *where, reader *r, const gdr_paged_
     return GDR_OK;
 }
 
+/* Where a page vertex stands in the cluster being expanded: (c + 1) << 32 | its index in cluster
+ * c's vertex list, once cluster c used it. */
+typedef uint64_t vertex_mark;
+
+/* The corners of a triangle in the order that starts at corner `first`, winding kept. */
+static const uint8_t ROTATED[3][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}};
+
 /* One cluster's vertex list and local triangles from its triangles' page vertex indices: local
- * indices in order of first use (how the writer's clusters list their vertices). `local_of` and
- * `stamp` are per page vertex; stamp[u] == c + 1 marks u as seen in cluster c. */
+ * indices in order of first use (how the writer's clusters list their vertices), each triangle in
+ * its canonical rotation. Without branches on whether a corner is new (a coin toss the predictor
+ * loses): every corner's vertex is written to the next free slot of the list, and only a new one
+ * moves the list on; a later new vertex, or the next cluster, overwrites the others (the page's
+ * vertex array has CACHE_PAGE_SPARE_VERTICES spare slots after its last cluster). */
 static gdr_status expand_cluster(const char *where, uint32_t c, const uint32_t *indices, const gdr_page_vertex *unique,
-                                 uint32_t unique_count, uint32_t *local_of, uint32_t *stamp, gdr_page *out,
-                                 gdr_error *err)
+                                 uint32_t unique_count, vertex_mark *mark, gdr_page *out, gdr_error *err)
 {
     const gdr_page_cluster *pc = &out->clusters[c];
-    uint32_t seen = 0;
+    gdr_page_vertex *list = out->vertices + pc->vertex_offset;
+    uint8_t *triangles = out->triangles + pc->triangle_offset;
+    uint32_t seen = 0, stamp = c + 1;
     for (uint32_t t = 0; t < pc->triangle_count; t++) {
         const uint32_t *corners = indices + 3 * t;
         if (corners[0] >= unique_count || corners[1] >= unique_count || corners[2] >= unique_count)
             return PAGE_ERR("%s: cluster %u triangle %u: a vertex beyond the page's %u", where, c, t, unique_count);
         /* The canonical rotation, whatever rotation the index codec chose. */
-        uint32_t first = gdr_triangle_first_corner((const gdr_vertex_bytes *)&unique[corners[0]],
-                                                   (const gdr_vertex_bytes *)&unique[corners[1]],
-                                                   (const gdr_vertex_bytes *)&unique[corners[2]]);
+        const uint8_t *order = ROTATED[gdr_triangle_first_corner((const gdr_vertex_bytes *)&unique[corners[0]],
+                                                                 (const gdr_vertex_bytes *)&unique[corners[1]],
+                                                                 (const gdr_vertex_bytes *)&unique[corners[2]])];
         for (uint32_t k = 0; k < 3; k++) {
-            uint32_t u = corners[(first + k) % 3];
-            if (stamp[u] != c + 1) {
-                if (seen == pc->vertex_count)
-                    return PAGE_ERR("%s: cluster %u: its triangles use more than its %u vertices", where, c,
-                                    pc->vertex_count);
-                stamp[u] = c + 1;
-                local_of[u] = seen;
-                out->vertices[pc->vertex_offset + seen++] = unique[u];
-            }
-            out->triangles[pc->triangle_offset + 3 * t + k] = (uint8_t)local_of[u];
+            uint32_t u = corners[order[k]];
+            vertex_mark m = mark[u];
+            uint32_t fresh = (uint32_t)(m >> 32) != stamp, keep = fresh - 1u; /* all ones when seen before */
+            uint32_t local = (seen & ~keep) | ((uint32_t)m & keep);
+            list[seen] = unique[u];
+            mark[u] = (vertex_mark)stamp << 32 | local;
+            triangles[3 * t + k] = (uint8_t)local;
+            seen += fresh;
         }
+        /* At most 3 past the list's end before this test: the spare slots. */
+        if (seen > pc->vertex_count)
+            return PAGE_ERR("%s: cluster %u: its triangles use more than its %u vertices", where, c, pc->vertex_count);
     }
     if (seen != pc->vertex_count)
         return PAGE_ERR("%s: cluster %u: its triangles use %u of its %u vertices", where, c, seen, pc->vertex_count);
@@ -789,15 +803,15 @@ static gdr_status expand_clusters(const char *where, const uint32_t *indices, co
                                   uint32_t unique_count, gdr_page *out, gdr_error *err)
 {
     out->triangles = calloc(out->triangle_byte_count ? out->triangle_byte_count : 1, 1);
-    uint32_t *local_of = malloc(sizeof *local_of * unique_count), *stamp = calloc(unique_count, sizeof *stamp);
+    vertex_mark *mark = calloc(unique_count, sizeof *mark);
     gdr_status status = GDR_OK;
-    if (!out->triangles || !local_of || !stamp)
+    if (!out->triangles || !mark)
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: %u triangle bytes", where, out->triangle_byte_count);
     for (uint32_t c = 0; c < out->cluster_count && status == GDR_OK; c++) {
-        status = expand_cluster(where, c, indices, unique, unique_count, local_of, stamp, out, err);
+        status = expand_cluster(where, c, indices, unique, unique_count, mark, out, err);
         indices += 3 * out->clusters[c].triangle_count;
     }
-    free(local_of), free(stamp);
+    free(mark);
     return status;
 }
 
@@ -823,10 +837,23 @@ static int decode_quantized(gdr_page_vertex *vertices, uint32_t unique, const ui
 {
     gdr_quantized_vertex *q = malloc(sizeof *q * unique);
     int ok = q && meshopt_decodeVertexBuffer(q, unique, sizeof *q, vstream, vs) == 0;
-    for (uint32_t v = 0; ok && v < unique; v++)
-        gdr_vertex_decode(grid, &q[v], &vertices[v].position, &vertices[v].normal, &vertices[v].uv);
+    if (ok)
+        gdr_vertex_decode_many(grid, q, unique, (gdr_vertex_bytes *)vertices);
     free(q);
     return ok;
+}
+
+/* Whether none of n floats is an infinity or a NaN (exponent bits not all ones), on their bits:
+ * integer work without a branch per float. */
+static int finite_float_bits(const float *v, size_t n)
+{
+    uint32_t bad = 0;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t bits;
+        memcpy(&bits, &v[i], sizeof bits);
+        bad |= (~bits & 0x7f800000u) == 0;
+    }
+    return !bad;
 }
 
 /* The vertex stream holds the page's `unique` vertices (floats, or integers on `grid` when it is not
@@ -837,7 +864,7 @@ static gdr_status decode_streams(const char *where, reader *r, uint32_t unique, 
 {
     const uint8_t *vstream = take(r, vs), *istream = take(r, is);
     gdr_page_vertex *vertices = malloc(sizeof *vertices * unique);
-    out->vertices = malloc(sizeof *out->vertices * pi->vertex_count);
+    out->vertices = malloc(sizeof *out->vertices * ((size_t)pi->vertex_count + CACHE_PAGE_SPARE_VERTICES));
     uint32_t *indices = malloc(sizeof *indices * 3 * (size_t)pi->triangle_count);
     gdr_status status = GDR_OK;
     if (!vertices || !out->vertices || !indices)
@@ -849,7 +876,7 @@ static gdr_status decode_streams(const char *where, reader *r, uint32_t unique, 
         status = PAGE_ERR("%s: vertex stream does not decode", where);
     else if (meshopt_decodeIndexBuffer(indices, 3 * (size_t)pi->triangle_count, 4, istream, is) != 0)
         status = PAGE_ERR("%s: index stream does not decode", where);
-    else if (!finite_floats(&vertices[0].position.x, (size_t)unique * 8))
+    else if (!(grid && gdr_vertex_grid_finite(grid)) && !finite_float_bits(&vertices[0].position.x, (size_t)unique * 8))
         status = PAGE_ERR("%s: a vertex is not finite", where);
     out->vertex_count = pi->vertex_count;
     if (status == GDR_OK)
