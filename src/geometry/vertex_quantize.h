@@ -47,17 +47,23 @@ static inline uint64_t gdr_vertex_bytes_key(const gdr_vertex_bytes *v)
  * bytes compare lowest (memcmp), the earliest on a tie. The pages' index codec may rotate a
  * triangle's corners; a quantized mesh's triangles are stored in this rotation and a page's are
  * put back into it when decoded, so both draw the same corners in the same order (the rasteriser's
- * interpolation depends on it). */
+ * interpolation depends on it). `key`: the corners' gdr_vertex_bytes_key, worked out once per
+ * vertex where vertices are shared by many triangles. */
+static inline uint32_t gdr_triangle_first_corner_keyed(const gdr_vertex_bytes *const corner[3], const uint64_t key[3])
+{
+    uint32_t first = 0;
+    for (uint32_t k = 1; k < 3; k++)
+        if (key[k] != key[first] ? key[k] < key[first] : memcmp(corner[k], corner[first], sizeof **corner) < 0)
+            first = k;
+    return first;
+}
+
 static inline uint32_t gdr_triangle_first_corner(const gdr_vertex_bytes *a, const gdr_vertex_bytes *b,
                                                  const gdr_vertex_bytes *c)
 {
     const gdr_vertex_bytes *corner[3] = {a, b, c};
     uint64_t key[3] = {gdr_vertex_bytes_key(a), gdr_vertex_bytes_key(b), gdr_vertex_bytes_key(c)};
-    uint32_t first = 0;
-    for (uint32_t k = 1; k < 3; k++)
-        if (key[k] != key[first] ? key[k] < key[first] : memcmp(corner[k], corner[first], sizeof *a) < 0)
-            first = k;
-    return first;
+    return gdr_triangle_first_corner_keyed(corner, key);
 }
 
 /* The floats of an encoded vertex. Any integers decode to a unit normal; positions and uvs are

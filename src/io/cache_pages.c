@@ -22,8 +22,6 @@ _Static_assert(sizeof(gdr_page_vertex) == sizeof(gdr_vertex_bytes) &&
 #define PAGE_FLAG_ZSTD 1u
 #define PAGE_FLAG_QUANTIZED 2u /* the vertices as integers on the grid the body gives (gdr_quantized_vertex) */
 #define PAGE_GRID_BLOCK 32u    /* that grid: i32 position exponent, f32 x3 origin, i32 uv exponent, f32 x2 origin, u32 0 */
-/* Slots a decoded page's vertex array has after its last cluster's vertices (expand_cluster). */
-#define CACHE_PAGE_SPARE_VERTICES 3u
 /* zstd level of the page bodies: 3 measured as good as 9 here on these bodies (docs/CACHE_FORMAT.md). */
 #define PAGE_ZSTD_LEVEL 3
 /* zstd is kept only when it saves at least this share of the body (else decoding it costs for nothing). */
@@ -758,60 +756,86 @@ typedef uint64_t vertex_mark;
 /* The corners of a triangle in the order that starts at corner `first`, winding kept. */
 static const uint8_t ROTATED[3][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}};
 
-/* One cluster's vertex list and local triangles from its triangles' page vertex indices: local
- * indices in order of first use (how the writer's clusters list their vertices), each triangle in
- * its canonical rotation. Without branches on whether a corner is new (a coin toss the predictor
- * loses): every corner's vertex is written to the next free slot of the list, and only a new one
- * moves the list on; a later new vertex, or the next cluster, overwrites the others (the page's
- * vertex array has CACHE_PAGE_SPARE_VERTICES spare slots after its last cluster). */
-static gdr_status expand_cluster(const char *where, uint32_t c, const uint32_t *indices, const gdr_page_vertex *unique,
-                                 uint32_t unique_count, vertex_mark *mark, gdr_page *out, gdr_error *err)
+/* Each triangle's page vertex indices put into its canonical rotation in place, whatever rotation
+ * the index codec chose (keys: each page vertex's gdr_vertex_bytes_key). Returns the first triangle
+ * with a corner beyond the page's vertices (it and those after it are left alone), else the count.
+ * A pass of its own: no triangle waits on another. */
+static uint32_t rotate_triangles(uint32_t *corners, uint32_t triangle_count, const gdr_page_vertex *unique,
+                                 const uint64_t *keys, uint32_t unique_count)
+{
+    for (uint32_t t = 0; t < triangle_count; t++, corners += 3) {
+        uint32_t was[3] = {corners[0], corners[1], corners[2]};
+        if (was[0] >= unique_count || was[1] >= unique_count || was[2] >= unique_count)
+            return t;
+        const gdr_vertex_bytes *v[3] = {(const gdr_vertex_bytes *)&unique[was[0]],
+                                        (const gdr_vertex_bytes *)&unique[was[1]],
+                                        (const gdr_vertex_bytes *)&unique[was[2]]};
+        uint64_t key[3] = {keys[was[0]], keys[was[1]], keys[was[2]]};
+        const uint8_t *order = ROTATED[gdr_triangle_first_corner_keyed(v, key)];
+        for (uint32_t k = 0; k < 3; k++)
+            corners[k] = was[order[k]];
+    }
+    return triangle_count;
+}
+
+/* One cluster's vertex list and local triangles from its triangles' page vertex indices: each
+ * triangle in its canonical rotation, local indices in order of first use (how the writer's clusters
+ * list their vertices). Without a branch on whether a corner is new (a coin toss the predictor
+ * loses): every corner's page vertex is written to the next free slot of the list, and only a new
+ * one moves the list on. `corners` is rotated in place. */
+static gdr_status expand_cluster(const char *where, uint32_t c, uint32_t *corners, const gdr_page_vertex *unique,
+                                 const uint64_t *keys, uint32_t unique_count, vertex_mark *mark, gdr_page *out,
+                                 gdr_error *err)
 {
     const gdr_page_cluster *pc = &out->clusters[c];
-    gdr_page_vertex *list = out->vertices + pc->vertex_offset;
+    uint32_t valid = rotate_triangles(corners, pc->triangle_count, unique, keys, unique_count);
+    /* A triangle adds at most 3 vertices, and the list is checked against the cluster's count (at
+     * most GDR_CLUSTER_MAX_VERTICES) after each. */
+    uint32_t list[GDR_CLUSTER_MAX_VERTICES + 3];
     uint8_t *triangles = out->triangles + pc->triangle_offset;
     uint32_t seen = 0, stamp = c + 1;
-    for (uint32_t t = 0; t < pc->triangle_count; t++) {
-        const uint32_t *corners = indices + 3 * t;
-        if (corners[0] >= unique_count || corners[1] >= unique_count || corners[2] >= unique_count)
-            return PAGE_ERR("%s: cluster %u triangle %u: a vertex beyond the page's %u", where, c, t, unique_count);
-        /* The canonical rotation, whatever rotation the index codec chose. */
-        const uint8_t *order = ROTATED[gdr_triangle_first_corner((const gdr_vertex_bytes *)&unique[corners[0]],
-                                                                 (const gdr_vertex_bytes *)&unique[corners[1]],
-                                                                 (const gdr_vertex_bytes *)&unique[corners[2]])];
+    for (uint32_t t = 0; t < valid; t++) {
         for (uint32_t k = 0; k < 3; k++) {
-            uint32_t u = corners[order[k]];
+            uint32_t u = corners[3 * t + k];
             vertex_mark m = mark[u];
             uint32_t fresh = (uint32_t)(m >> 32) != stamp, keep = fresh - 1u; /* all ones when seen before */
             uint32_t local = (seen & ~keep) | ((uint32_t)m & keep);
-            list[seen] = unique[u];
+            list[seen] = u;
             mark[u] = (vertex_mark)stamp << 32 | local;
             triangles[3 * t + k] = (uint8_t)local;
             seen += fresh;
         }
-        /* At most 3 past the list's end before this test: the spare slots. */
         if (seen > pc->vertex_count)
             return PAGE_ERR("%s: cluster %u: its triangles use more than its %u vertices", where, c, pc->vertex_count);
     }
+    if (valid < pc->triangle_count)
+        return PAGE_ERR("%s: cluster %u triangle %u: a vertex beyond the page's %u", where, c, valid, unique_count);
     if (seen != pc->vertex_count)
         return PAGE_ERR("%s: cluster %u: its triangles use %u of its %u vertices", where, c, seen, pc->vertex_count);
+    gdr_page_vertex *vertices = out->vertices + pc->vertex_offset;
+    for (uint32_t i = 0; i < seen; i++)
+        vertices[i] = unique[list[i]];
     return GDR_OK;
 }
 
-/* The clusters' vertices and triangles from the page's vertices and triangles. */
-static gdr_status expand_clusters(const char *where, const uint32_t *indices, const gdr_page_vertex *unique,
+/* The clusters' vertices and triangles from the page's vertices and triangles (`indices`, used up). */
+static gdr_status expand_clusters(const char *where, uint32_t *indices, const gdr_page_vertex *unique,
                                   uint32_t unique_count, gdr_page *out, gdr_error *err)
 {
     out->triangles = calloc(out->triangle_byte_count ? out->triangle_byte_count : 1, 1);
     vertex_mark *mark = calloc(unique_count, sizeof *mark);
+    uint64_t *keys = malloc(sizeof *keys * unique_count);
     gdr_status status = GDR_OK;
-    if (!out->triangles || !mark)
+    if (!out->triangles || !mark || !keys)
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: %u triangle bytes", where, out->triangle_byte_count);
+    for (uint32_t u = 0; status == GDR_OK && u < unique_count; u++)
+        keys[u] = gdr_vertex_bytes_key((const gdr_vertex_bytes *)&unique[u]);
     for (uint32_t c = 0; c < out->cluster_count && status == GDR_OK; c++) {
-        status = expand_cluster(where, c, indices, unique, unique_count, mark, out, err);
+        status = expand_cluster(where, c, indices, unique, keys, unique_count, mark, out, err);
         indices += 3 * out->clusters[c].triangle_count;
     }
     free(mark);
+    free(keys);
     return status;
 }
 
@@ -864,7 +888,7 @@ static gdr_status decode_streams(const char *where, reader *r, uint32_t unique, 
 {
     const uint8_t *vstream = take(r, vs), *istream = take(r, is);
     gdr_page_vertex *vertices = malloc(sizeof *vertices * unique);
-    out->vertices = malloc(sizeof *out->vertices * ((size_t)pi->vertex_count + CACHE_PAGE_SPARE_VERTICES));
+    out->vertices = malloc(sizeof *out->vertices * pi->vertex_count);
     uint32_t *indices = malloc(sizeof *indices * 3 * (size_t)pi->triangle_count);
     gdr_status status = GDR_OK;
     if (!vertices || !out->vertices || !indices)
