@@ -134,6 +134,17 @@ void gdr_vertex_decode(const gdr_vertex_quantization *q, const gdr_quantized_ver
     *normal = oct_decode(v->normal);
 }
 
+/* yes ? a : b on the bits, without a branch (whether a normal is folded is a coin toss). */
+static float select_float(int yes, float a, float b)
+{
+    uint32_t ua, ub, mask = 0u - (uint32_t)(yes != 0);
+    memcpy(&ua, &a, sizeof ua);
+    memcpy(&ub, &b, sizeof ub);
+    ua = (ua & mask) | (ub & ~mask);
+    memcpy(&a, &ua, sizeof a);
+    return a;
+}
+
 /* Vertices decoded together: each step of oct_decode as a loop over a block of them, of the same
  * operations in the same order (so the same bits), which compilers turn into vector instructions
  * (the divisions and the square root dominate a vertex). */
@@ -151,11 +162,13 @@ static void decode_normals(const gdr_quantized_vertex *in, gdr_vertex_bytes *out
         y[i] /= NORMAL_MAX;
     }
     for (int i = 0; i < DECODE_BLOCK; i++) {
+        /* oct_decode's steps without a branch: x is never -0 (it is an integer's quotient, or -1),
+         * so sign_of(x) is copysignf(1, x); the fold is a select on the bits. */
         float cx = x[i] < -1.0f ? -1.0f : x[i], cy = y[i] < -1.0f ? -1.0f : y[i];
         float cz = 1.0f - fabsf(cx) - fabsf(cy);
-        float fx = (1.0f - fabsf(cy)) * (cx < 0.0f ? -1.0f : 1.0f), fy = (1.0f - fabsf(cx)) * (cy < 0.0f ? -1.0f : 1.0f);
-        x[i] = cz < 0.0f ? fx : cx;
-        y[i] = cz < 0.0f ? fy : cy;
+        float fx = (1.0f - fabsf(cy)) * copysignf(1.0f, cx), fy = (1.0f - fabsf(cx)) * copysignf(1.0f, cy);
+        x[i] = select_float(cz < 0.0f, fx, cx);
+        y[i] = select_float(cz < 0.0f, fy, cy);
         z[i] = cz;
     }
     for (int i = 0; i < DECODE_BLOCK; i++)
@@ -164,17 +177,36 @@ static void decode_normals(const gdr_quantized_vertex *in, gdr_vertex_bytes *out
         out[i].normal = (gdr_vec3){x[i] / length[i] + 0.0f, y[i] / length[i] + 0.0f, z[i] / length[i] + 0.0f};
 }
 
+/* Positions and uvs of a block of vertices whose grid has exact steps (no ldexpf fallback): the
+ * products are computed apart from the sums, as grid_value does. */
+static void decode_grid_block(const gdr_vertex_quantization *q, grid_steps s, const gdr_quantized_vertex *in,
+                              gdr_vertex_bytes *out)
+{
+    for (int i = 0; i < DECODE_BLOCK; i++) {
+        float p[3], t[2];
+        for (int k = 0; k < 3; k++)
+            p[k] = (float)in[i].position[k] * s.position;
+        for (int k = 0; k < 2; k++)
+            t[k] = (float)in[i].uv[k] * s.uv;
+        out[i].position = (gdr_vec3){q->position_origin.x + p[0], q->position_origin.y + p[1],
+                                     q->position_origin.z + p[2]};
+        out[i].uv = (gdr_vec2){q->uv_origin.x + t[0], q->uv_origin.y + t[1]};
+    }
+}
+
 void gdr_vertex_decode_many(const gdr_vertex_quantization *q, const gdr_quantized_vertex *in, size_t count,
                             gdr_vertex_bytes *out)
 {
     grid_steps s = steps_of(q);
-    size_t blocks = count / DECODE_BLOCK * DECODE_BLOCK;
-    for (size_t i = 0; i < count; i++)
-        decode_grid(q, s, &in[i], &out[i].position, &out[i].uv);
-    for (size_t i = 0; i < blocks; i += DECODE_BLOCK)
+    size_t blocks = s.position != 0.0f && s.uv != 0.0f ? count / DECODE_BLOCK * DECODE_BLOCK : 0;
+    for (size_t i = 0; i < blocks; i += DECODE_BLOCK) {
+        decode_grid_block(q, s, in + i, out + i);
         decode_normals(in + i, out + i);
-    for (size_t i = blocks; i < count; i++)
+    }
+    for (size_t i = blocks; i < count; i++) {
+        decode_grid(q, s, &in[i], &out[i].position, &out[i].uv);
         out[i].normal = oct_decode(in[i].normal);
+    }
 }
 
 int gdr_vertex_grid_finite(const gdr_vertex_quantization *q)

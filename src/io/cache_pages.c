@@ -753,8 +753,19 @@ static gdr_status decode_clusters(const char *where, reader *r, const gdr_paged_
  * c's vertex list, once cluster c used it. */
 typedef uint64_t vertex_mark;
 
-/* The corners of a triangle in the order that starts at corner `first`, winding kept. */
-static const uint8_t ROTATED[3][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}};
+/* yes ? a : b for yes 0 or 1, as arithmetic: compilers turn a ?: on an unpredictable condition
+ * (which corner of a triangle is lowest, whether a vertex is new) into a branch that mispredicts. */
+static inline uint32_t select_u32(uint32_t yes, uint32_t a, uint32_t b)
+{
+    uint32_t mask = 0u - yes;
+    return (a & mask) | (b & ~mask);
+}
+
+static inline uint64_t select_u64(uint32_t yes, uint64_t a, uint64_t b)
+{
+    uint64_t mask = 0u - (uint64_t)yes;
+    return (a & mask) | (b & ~mask);
+}
 
 /* Each triangle's page vertex indices put into its canonical rotation in place, whatever rotation
  * the index codec chose (keys: each page vertex's gdr_vertex_bytes_key). Returns the first triangle
@@ -764,16 +775,24 @@ static uint32_t rotate_triangles(uint32_t *corners, uint32_t triangle_count, con
                                  const uint64_t *keys, uint32_t unique_count)
 {
     for (uint32_t t = 0; t < triangle_count; t++, corners += 3) {
-        uint32_t was[3] = {corners[0], corners[1], corners[2]};
-        if (was[0] >= unique_count || was[1] >= unique_count || was[2] >= unique_count)
+        uint32_t a = corners[0], b = corners[1], c = corners[2];
+        if (a >= unique_count || b >= unique_count || c >= unique_count)
             return t;
-        const gdr_vertex_bytes *v[3] = {(const gdr_vertex_bytes *)&unique[was[0]],
-                                        (const gdr_vertex_bytes *)&unique[was[1]],
-                                        (const gdr_vertex_bytes *)&unique[was[2]]};
-        uint64_t key[3] = {keys[was[0]], keys[was[1]], keys[was[2]]};
-        const uint8_t *order = ROTATED[gdr_triangle_first_corner_keyed(v, key)];
-        for (uint32_t k = 0; k < 3; k++)
-            corners[k] = was[order[k]];
+        uint64_t ka = keys[a], kb = keys[b], kc = keys[c];
+        uint32_t second, third; /* whether the canonical rotation starts at corner b, at corner c */
+        if (ka != kb && kb != kc && ka != kc) {
+            /* Distinct keys decide alone. */
+            second = kb < ka;
+            third = kc < select_u64(second, kb, ka);
+        } else {
+            const gdr_vertex_bytes *v[3] = {(const gdr_vertex_bytes *)&unique[a], (const gdr_vertex_bytes *)&unique[b],
+                                            (const gdr_vertex_bytes *)&unique[c]};
+            uint32_t first = gdr_triangle_first_corner_keyed(v, (uint64_t[3]){ka, kb, kc});
+            second = first == 1, third = first == 2;
+        }
+        corners[0] = select_u32(third, c, select_u32(second, b, a));
+        corners[1] = select_u32(third, a, select_u32(second, c, b));
+        corners[2] = select_u32(third, b, select_u32(second, a, c));
     }
     return triangle_count;
 }
@@ -798,8 +817,7 @@ static gdr_status expand_cluster(const char *where, uint32_t c, uint32_t *corner
         for (uint32_t k = 0; k < 3; k++) {
             uint32_t u = corners[3 * t + k];
             vertex_mark m = mark[u];
-            uint32_t fresh = (uint32_t)(m >> 32) != stamp, keep = fresh - 1u; /* all ones when seen before */
-            uint32_t local = (seen & ~keep) | ((uint32_t)m & keep);
+            uint32_t fresh = (uint32_t)(m >> 32) != stamp, local = select_u32(fresh, seen, (uint32_t)m);
             list[seen] = u;
             mark[u] = (vertex_mark)stamp << 32 | local;
             triangles[3 * t + k] = (uint8_t)local;
