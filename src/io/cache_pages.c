@@ -775,9 +775,13 @@ static gdr_status decode_clusters(const char *where, reader *r, const gdr_paged_
     return GDR_OK;
 }
 
-/* Where a page vertex stands in the cluster being expanded: (c + 1) << 32 | its index in cluster
- * c's vertex list, once cluster c used it. */
-typedef uint64_t vertex_mark;
+/* Where each page vertex stands in the cluster being expanded: cluster[u] == c + 1 once cluster c
+ * used it, local[u] its index in that cluster's vertex list. Two arrays, not one record: whether a
+ * corner is new then depends only on earlier stores of a constant, not on the list's length, so
+ * the corners do not wait on each other through memory. */
+typedef struct vertex_marks {
+    uint32_t *cluster, *local;
+} vertex_marks;
 
 /* yes ? a : b for yes 0 or 1, as arithmetic: compilers turn a ?: on an unpredictable condition
  * (which corner of a triangle is lowest, whether a vertex is new) into a branch that mispredicts. */
@@ -829,7 +833,7 @@ static uint32_t rotate_triangles(uint32_t *corners, uint32_t triangle_count, con
  * loses): every corner's page vertex is written to the next free slot of the list, and only a new
  * one moves the list on. `corners` is rotated in place. */
 static gdr_status expand_cluster(const char *where, uint32_t c, uint32_t *corners, const gdr_page_vertex *unique,
-                                 const uint64_t *keys, uint32_t unique_count, vertex_mark *mark, gdr_page *out,
+                                 const uint64_t *keys, uint32_t unique_count, const vertex_marks *mark, gdr_page *out,
                                  gdr_error *err)
 {
     const gdr_page_cluster *pc = &out->clusters[c];
@@ -842,10 +846,10 @@ static gdr_status expand_cluster(const char *where, uint32_t c, uint32_t *corner
     for (uint32_t t = 0; t < valid; t++) {
         for (uint32_t k = 0; k < 3; k++) {
             uint32_t u = corners[3 * t + k];
-            vertex_mark m = mark[u];
-            uint32_t fresh = (uint32_t)(m >> 32) != stamp, local = select_u32(fresh, seen, (uint32_t)m);
+            uint32_t fresh = mark->cluster[u] != stamp, local = select_u32(fresh, seen, mark->local[u]);
             list[seen] = u;
-            mark[u] = (vertex_mark)stamp << 32 | local;
+            mark->cluster[u] = stamp;
+            mark->local[u] = local;
             triangles[3 * t + k] = (uint8_t)local;
             seen += fresh;
         }
@@ -867,18 +871,19 @@ static gdr_status expand_clusters(const char *where, uint32_t *indices, const gd
                                   uint32_t unique_count, gdr_page *out, gdr_error *err)
 {
     out->triangles = calloc(out->triangle_byte_count ? out->triangle_byte_count : 1, 1);
-    vertex_mark *mark = calloc(unique_count, sizeof *mark);
+    vertex_marks mark = {calloc(unique_count, sizeof *mark.cluster), malloc(sizeof *mark.local * unique_count)};
     uint64_t *keys = malloc(sizeof *keys * unique_count);
     gdr_status status = GDR_OK;
-    if (!out->triangles || !mark || !keys)
+    if (!out->triangles || !mark.cluster || !mark.local || !keys)
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: %u triangle bytes", where, out->triangle_byte_count);
     for (uint32_t u = 0; status == GDR_OK && u < unique_count; u++)
         keys[u] = gdr_vertex_bytes_key((const gdr_vertex_bytes *)&unique[u]);
     for (uint32_t c = 0; c < out->cluster_count && status == GDR_OK; c++) {
-        status = expand_cluster(where, c, indices, unique, keys, unique_count, mark, out, err);
+        status = expand_cluster(where, c, indices, unique, keys, unique_count, &mark, out, err);
         indices += 3 * out->clusters[c].triangle_count;
     }
-    free(mark);
+    free(mark.cluster);
+    free(mark.local);
     free(keys);
     return status;
 }
