@@ -842,14 +842,15 @@ static gdr_status expand_cluster(const char *where, uint32_t c, uint32_t *corner
      * most GDR_CLUSTER_MAX_VERTICES) after each. */
     uint32_t list[GDR_CLUSTER_MAX_VERTICES + 3];
     uint8_t *triangles = out->triangles + pc->triangle_offset;
-    uint32_t seen = 0, stamp = c + 1;
+    /* The arrays in locals: a byte store may alias any pointer held in memory. */
+    uint32_t *marked = mark->cluster, *local_of = mark->local, seen = 0, stamp = c + 1;
     for (uint32_t t = 0; t < valid; t++) {
         for (uint32_t k = 0; k < 3; k++) {
             uint32_t u = corners[3 * t + k];
-            uint32_t fresh = mark->cluster[u] != stamp, local = select_u32(fresh, seen, mark->local[u]);
+            uint32_t fresh = marked[u] != stamp, local = select_u32(fresh, seen, local_of[u]);
             list[seen] = u;
-            mark->cluster[u] = stamp;
-            mark->local[u] = local;
+            marked[u] = stamp;
+            local_of[u] = local;
             triangles[3 * t + k] = (uint8_t)local;
             seen += fresh;
         }
