@@ -1,8 +1,9 @@
-/* Decoding alone (docs/STREAMING.md, "The loader thread"): every page of a paged cache read into
- * memory once, then checked and decoded on one thread `--rounds` times, without the file system
- * or the loader's threads in the way; prints MB/s of stored and of decoded bytes per second of the
- * thread's CPU time (less disturbed than wall time by other work on a shared machine), and a hash of every decoded byte (clusters, vertices, triangles, in page order) so that
- * two builds can be shown to decode the same pages to the same bytes.
+/* Decoding alone (docs/STREAMING.md, "Decoding a page"): every page of a paged cache read into
+ * memory once, then checked and decoded on one thread `--rounds` times, without the file system or
+ * the loader's threads in the way; prints MB/s of stored and of decoded bytes per second of the
+ * thread's CPU time (less disturbed than wall time by other work on a shared machine), and a hash
+ * of every decoded byte (clusters, vertices, triangles, in page order) so that two builds can be
+ * shown to decode the same pages to the same bytes.
  *     page_decode_bench CACHE.gdrc [--rounds N]
  * CPU figures on a shared machine: compare builds within one session, run after run. */
 #include <stdio.h>

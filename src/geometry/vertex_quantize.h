@@ -33,7 +33,7 @@ typedef struct gdr_vertex_bytes {
 
 /* The first 8 bytes of a vertex as a big-endian integer: two vertices whose keys differ compare
  * (memcmp) as their keys do, and only equal keys need the whole memcmp. Distinct vertices nearly
- * always differ in these bytes (the low bytes of position x and y). */
+ * always differ in these bytes (position x and y, each float's low byte first as memcmp reads it). */
 static inline uint64_t gdr_vertex_bytes_key(const gdr_vertex_bytes *v)
 {
     uint8_t b[8];

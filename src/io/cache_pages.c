@@ -872,7 +872,7 @@ static gdr_status expand_clusters(const char *where, uint32_t *indices, const gd
                                   uint32_t unique_count, gdr_page *out, gdr_error *err)
 {
     out->triangles = calloc(out->triangle_byte_count ? out->triangle_byte_count : 1, 1);
-    vertex_marks mark = {calloc(unique_count, sizeof *mark.cluster), malloc(sizeof *mark.local * unique_count)};
+    vertex_marks mark = {calloc(unique_count, sizeof *mark.cluster), calloc(unique_count, sizeof *mark.local)};
     uint64_t *keys = malloc(sizeof *keys * unique_count);
     gdr_status status = GDR_OK;
     if (!out->triangles || !mark.cluster || !mark.local || !keys)
@@ -950,7 +950,8 @@ static gdr_status decode_streams(const char *where, reader *r, uint32_t unique, 
         status = PAGE_ERR("%s: vertex stream does not decode", where);
     else if (meshopt_decodeIndexBuffer(indices, 3 * (size_t)pi->triangle_count, 4, istream, is) != 0)
         status = PAGE_ERR("%s: index stream does not decode", where);
-    else if (!(grid && gdr_vertex_grid_finite(grid)) && !finite_float_bits(&vertices[0].position.x, (size_t)unique * 8))
+    else if (!(grid && gdr_vertex_grid_finite(grid)) &&
+             !finite_float_bits(&vertices[0].position.x, (size_t)unique * 8))
         status = PAGE_ERR("%s: a vertex is not finite", where);
     out->vertex_count = pi->vertex_count;
     if (status == GDR_OK)
