@@ -164,7 +164,7 @@ static void decode_normals(const gdr_quantized_vertex *in, gdr_vertex_bytes *out
     for (int i = 0; i < DECODE_BLOCK; i++) {
         /* oct_decode's steps without a branch: x is never -0 (it is an integer's quotient, or -1),
          * so sign_of(x) is copysignf(1, x); the fold is a select on the bits. */
-        float cx = x[i] < -1.0f ? -1.0f : x[i], cy = y[i] < -1.0f ? -1.0f : y[i];
+        float cx = select_float(x[i] < -1.0f, -1.0f, x[i]), cy = select_float(y[i] < -1.0f, -1.0f, y[i]);
         float cz = 1.0f - fabsf(cx) - fabsf(cy);
         float fx = (1.0f - fabsf(cy)) * copysignf(1.0f, cx), fy = (1.0f - fabsf(cx)) * copysignf(1.0f, cy);
         x[i] = select_float(cz < 0.0f, fx, cx);
