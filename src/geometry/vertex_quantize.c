@@ -37,9 +37,14 @@ static void oct_encode(gdr_vec3 n, int16_t out[2])
     out[1] = (int16_t)lrintf(fminf(fmaxf(y, -1.0f), 1.0f) * NORMAL_MAX);
 }
 
+/* The octahedral pair back to a unit vector; inline arithmetic only (no libm calls: it runs once
+ * per vertex of every page read). v < -1 ? -1 : v is fmaxf(v, -1) for the quotients here, which are
+ * never NaN. */
 static gdr_vec3 oct_decode(const int16_t in[2])
 {
-    float x = fmaxf((float)in[0] / NORMAL_MAX, -1.0f), y = fmaxf((float)in[1] / NORMAL_MAX, -1.0f);
+    float x = (float)in[0] / NORMAL_MAX, y = (float)in[1] / NORMAL_MAX;
+    x = x < -1.0f ? -1.0f : x;
+    y = y < -1.0f ? -1.0f : y;
     float z = 1.0f - fabsf(x) - fabsf(y);
     if (z < 0.0f)
         oct_fold(&x, &y);
@@ -55,7 +60,38 @@ static int64_t grid_index(float v, float origin, int exponent, uint32_t max)
     return q >= 0.0 && q <= (double)max ? (int64_t)q : -1;
 }
 
-static float grid_value(float origin, int exponent, uint32_t q) { return origin + ldexpf((float)q, exponent); }
+/* 2^exponent where a float holds it exactly, else 0. Then (float)q * step is ldexpf((float)q,
+ * exponent) bit for bit: both are the one correctly rounded product of the same two values (an
+ * overflow to infinity included). One per grid, not an ldexpf per coordinate. */
+static float grid_step(int exponent) { return exponent >= -149 && exponent <= 127 ? ldexpf(1.0f, exponent) : 0.0f; }
+
+/* origin + q * 2^exponent. The product is a statement of its own so that a compiler contracting
+ * within an expression cannot fuse it with the sum (the result must not depend on the build). */
+static float grid_value(float origin, float step, int exponent, uint32_t q)
+{
+    float offset = step != 0.0f ? (float)q * step : ldexpf((float)q, exponent);
+    return origin + offset;
+}
+
+/* A grid's steps, computed once for many vertices. */
+typedef struct grid_steps {
+    float position, uv;
+} grid_steps;
+
+static grid_steps steps_of(const gdr_vertex_quantization *q)
+{
+    return (grid_steps){grid_step(q->position_exponent), grid_step(q->uv_exponent)};
+}
+
+static void decode_grid(const gdr_vertex_quantization *q, grid_steps s, const gdr_quantized_vertex *v,
+                        gdr_vec3 *position, gdr_vec2 *uv)
+{
+    int pe = q->position_exponent, te = q->uv_exponent;
+    *position = (gdr_vec3){grid_value(q->position_origin.x, s.position, pe, v->position[0]),
+                           grid_value(q->position_origin.y, s.position, pe, v->position[1]),
+                           grid_value(q->position_origin.z, s.position, pe, v->position[2])};
+    *uv = (gdr_vec2){grid_value(q->uv_origin.x, s.uv, te, v->uv[0]), grid_value(q->uv_origin.y, s.uv, te, v->uv[1])};
+}
 
 /* The nearest grid point of each value; 0 when one lies outside the grid's range. */
 static int encode_nearest(const gdr_vertex_quantization *q, gdr_vec3 position, gdr_vec3 normal, gdr_vec2 uv,
@@ -94,12 +130,97 @@ int gdr_vertex_encode(const gdr_vertex_quantization *q, gdr_vec3 position, gdr_v
 void gdr_vertex_decode(const gdr_vertex_quantization *q, const gdr_quantized_vertex *v, gdr_vec3 *position,
                        gdr_vec3 *normal, gdr_vec2 *uv)
 {
-    *position = (gdr_vec3){grid_value(q->position_origin.x, q->position_exponent, v->position[0]),
-                           grid_value(q->position_origin.y, q->position_exponent, v->position[1]),
-                           grid_value(q->position_origin.z, q->position_exponent, v->position[2])};
-    *uv = (gdr_vec2){grid_value(q->uv_origin.x, q->uv_exponent, v->uv[0]),
-                     grid_value(q->uv_origin.y, q->uv_exponent, v->uv[1])};
+    decode_grid(q, steps_of(q), v, position, uv);
     *normal = oct_decode(v->normal);
+}
+
+/* yes ? a : b on the bits, without a branch (whether a normal is folded is a coin toss). */
+static float select_float(int yes, float a, float b)
+{
+    uint32_t ua, ub, mask = 0u - (uint32_t)(yes != 0);
+    memcpy(&ua, &a, sizeof ua);
+    memcpy(&ub, &b, sizeof ub);
+    ua = (ua & mask) | (ub & ~mask);
+    memcpy(&a, &ua, sizeof a);
+    return a;
+}
+
+/* Vertices decoded together: each step of oct_decode as a loop over a block of them, of the same
+ * operations in the same order (so the same bits), which compilers turn into vector instructions
+ * (the divisions and the square root dominate a vertex). */
+#define DECODE_BLOCK 8
+
+static void decode_normals(const gdr_quantized_vertex *in, gdr_vertex_bytes *out)
+{
+    float x[DECODE_BLOCK], y[DECODE_BLOCK], z[DECODE_BLOCK], length[DECODE_BLOCK];
+    for (int i = 0; i < DECODE_BLOCK; i++) {
+        x[i] = (float)in[i].normal[0];
+        y[i] = (float)in[i].normal[1];
+    }
+    for (int i = 0; i < DECODE_BLOCK; i++) {
+        x[i] /= NORMAL_MAX;
+        y[i] /= NORMAL_MAX;
+    }
+    for (int i = 0; i < DECODE_BLOCK; i++) {
+        /* oct_decode's steps without a branch: x is never -0 (it is an integer's quotient, or -1),
+         * so sign_of(x) is copysignf(1, x); the fold is a select on the bits. */
+        float cx = select_float(x[i] < -1.0f, -1.0f, x[i]), cy = select_float(y[i] < -1.0f, -1.0f, y[i]);
+        float cz = 1.0f - fabsf(cx) - fabsf(cy);
+        float fx = (1.0f - fabsf(cy)) * copysignf(1.0f, cx), fy = (1.0f - fabsf(cx)) * copysignf(1.0f, cy);
+        x[i] = select_float(cz < 0.0f, fx, cx);
+        y[i] = select_float(cz < 0.0f, fy, cy);
+        z[i] = cz;
+    }
+    for (int i = 0; i < DECODE_BLOCK; i++)
+        length[i] = sqrtf(x[i] * x[i] + y[i] * y[i] + z[i] * z[i]);
+    for (int i = 0; i < DECODE_BLOCK; i++)
+        out[i].normal = (gdr_vec3){x[i] / length[i] + 0.0f, y[i] / length[i] + 0.0f, z[i] / length[i] + 0.0f};
+}
+
+/* Positions and uvs of a block of vertices whose grid has exact steps (no ldexpf fallback): the
+ * products are computed apart from the sums, as grid_value does. */
+static void decode_grid_block(const gdr_vertex_quantization *q, grid_steps s, const gdr_quantized_vertex *in,
+                              gdr_vertex_bytes *out)
+{
+    for (int i = 0; i < DECODE_BLOCK; i++) {
+        float p[3], t[2];
+        for (int k = 0; k < 3; k++)
+            p[k] = (float)in[i].position[k] * s.position;
+        for (int k = 0; k < 2; k++)
+            t[k] = (float)in[i].uv[k] * s.uv;
+        out[i].position = (gdr_vec3){q->position_origin.x + p[0], q->position_origin.y + p[1],
+                                     q->position_origin.z + p[2]};
+        out[i].uv = (gdr_vec2){q->uv_origin.x + t[0], q->uv_origin.y + t[1]};
+    }
+}
+
+void gdr_vertex_decode_many(const gdr_vertex_quantization *q, const gdr_quantized_vertex *in, size_t count,
+                            gdr_vertex_bytes *out)
+{
+    grid_steps s = steps_of(q);
+    size_t blocks = s.position != 0.0f && s.uv != 0.0f ? count / DECODE_BLOCK * DECODE_BLOCK : 0;
+    for (size_t i = 0; i < blocks; i += DECODE_BLOCK) {
+        decode_grid_block(q, s, in + i, out + i);
+        decode_normals(in + i, out + i);
+    }
+    for (size_t i = blocks; i < count; i++) {
+        decode_grid(q, s, &in[i], &out[i].position, &out[i].uv);
+        out[i].normal = oct_decode(in[i].normal);
+    }
+}
+
+int gdr_vertex_grid_finite(const gdr_vertex_quantization *q)
+{
+    /* The stored integers' largest values: uint16 positions, uint32 uvs. */
+    gdr_quantized_vertex largest = {.position = {UINT16_MAX, UINT16_MAX, UINT16_MAX}, .uv = {UINT32_MAX, UINT32_MAX}};
+    gdr_vertex_bytes low, high;
+    gdr_vertex_decode(q, &(gdr_quantized_vertex){0}, &low.position, &low.normal, &low.uv);
+    gdr_vertex_decode(q, &largest, &high.position, &high.normal, &high.uv);
+    const float *l = &low.position.x, *h = &high.position.x;
+    for (int i = 0; i < 8; i++)
+        if (!isfinite(l[i]) || !isfinite(h[i]))
+            return 0;
+    return 1;
 }
 
 /* --- choosing a mesh's grid ------------------------------------------------------------------------ */

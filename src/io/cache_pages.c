@@ -3,6 +3,7 @@
  * (meshoptimizer's vertex codec) and triangles (its index codec), then zstd over the three where
  * that pays; the page index with every group's header. Layout: docs/CACHE_FORMAT.md, 'PAGE'. */
 #include <math.h>
+#include <pthread.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,7 +19,7 @@
 _Static_assert(sizeof(gdr_page_vertex) == sizeof(gdr_vertex_bytes) &&
                    offsetof(gdr_page_vertex, normal) == offsetof(gdr_vertex_bytes, normal) &&
                    offsetof(gdr_page_vertex, uv) == offsetof(gdr_vertex_bytes, uv),
-               "a decoded page vertex is compared as gdr_vertex_bytes");
+               "a decoded page vertex is compared and decoded as gdr_vertex_bytes");
 #define PAGE_FLAG_ZSTD 1u
 #define PAGE_FLAG_QUANTIZED 2u /* the vertices as integers on the grid the body gives (gdr_quantized_vertex) */
 #define PAGE_GRID_BLOCK 32u    /* that grid: i32 position exponent, f32 x3 origin, i32 uv exponent, f32 x2 origin, u32 0 */
@@ -675,6 +676,29 @@ gdr_status cache_pages_parse_index(const char *name, const uint8_t *index, uint6
 
 /* --- reading: one page ---------------------------------------------------------------------------- */
 
+/* One zstd decompression context per thread, made on its first compressed page and freed when the
+ * thread ends: setting one up for every page cost a few percent of decoding. NULL when none can be
+ * had (then each page makes its own, as ZSTD_decompress does). */
+static pthread_key_t dctx_key;
+static pthread_once_t dctx_once = PTHREAD_ONCE_INIT;
+static int dctx_key_made;
+
+static void free_dctx(void *dctx) { ZSTD_freeDCtx(dctx); }
+
+static void make_dctx_key(void) { dctx_key_made = pthread_key_create(&dctx_key, free_dctx) == 0; }
+
+static ZSTD_DCtx *thread_dctx(void)
+{
+    if (pthread_once(&dctx_once, make_dctx_key) != 0 || !dctx_key_made)
+        return NULL;
+    ZSTD_DCtx *dctx = pthread_getspecific(dctx_key);
+    if (!dctx && (dctx = ZSTD_createDCtx()) != NULL && pthread_setspecific(dctx_key, dctx) != 0) {
+        ZSTD_freeDCtx(dctx);
+        dctx = NULL;
+    }
+    return dctx;
+}
+
 /* The body as stored (raw or zstd) into exactly body_size bytes; *owned when it had to be inflated. */
 static gdr_status page_body(const char *where, const uint8_t *stored, size_t stored_size, uint32_t flags,
                             uint32_t body_size, const uint8_t **body, uint8_t **owned, gdr_error *err)
@@ -692,7 +716,9 @@ static gdr_status page_body(const char *where, const uint8_t *stored, size_t sto
     *owned = malloc(body_size ? body_size : 1);
     if (!*owned)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: %u bytes", where, body_size);
-    size_t n = ZSTD_decompress(*owned, body_size, stored, stored_size);
+    ZSTD_DCtx *dctx = thread_dctx();
+    size_t n = dctx ? ZSTD_decompressDCtx(dctx, *owned, body_size, stored, stored_size)
+                    : ZSTD_decompress(*owned, body_size, stored, stored_size);
     if (ZSTD_isError(n) || n != body_size) {
         free(*owned);
         *owned = NULL;
@@ -749,55 +775,117 @@ static gdr_status decode_clusters(const char *where, reader *r, const gdr_paged_
     return GDR_OK;
 }
 
-/* One cluster's vertex list and local triangles from its triangles' page vertex indices: local
- * indices in order of first use (how the writer's clusters list their vertices). `local_of` and
- * `stamp` are per page vertex; stamp[u] == c + 1 marks u as seen in cluster c. */
-static gdr_status expand_cluster(const char *where, uint32_t c, const uint32_t *indices, const gdr_page_vertex *unique,
-                                 uint32_t unique_count, uint32_t *local_of, uint32_t *stamp, gdr_page *out,
+/* Where each page vertex stands in the cluster being expanded: cluster[u] == c + 1 once cluster c
+ * used it, local[u] its index in that cluster's vertex list. Two arrays, not one record: whether a
+ * corner is new then depends only on earlier stores of a constant, not on the list's length, so
+ * the corners do not wait on each other through memory. */
+typedef struct vertex_marks {
+    uint32_t *cluster, *local;
+} vertex_marks;
+
+/* yes ? a : b for yes 0 or 1, as arithmetic: compilers turn a ?: on an unpredictable condition
+ * (which corner of a triangle is lowest, whether a vertex is new) into a branch that mispredicts. */
+static inline uint32_t select_u32(uint32_t yes, uint32_t a, uint32_t b)
+{
+    uint32_t mask = 0u - yes;
+    return (a & mask) | (b & ~mask);
+}
+
+static inline uint64_t select_u64(uint32_t yes, uint64_t a, uint64_t b)
+{
+    uint64_t mask = 0u - (uint64_t)yes;
+    return (a & mask) | (b & ~mask);
+}
+
+/* Each triangle's page vertex indices put into its canonical rotation in place, whatever rotation
+ * the index codec chose (keys: each page vertex's gdr_vertex_bytes_key). Returns the first triangle
+ * with a corner beyond the page's vertices (it and those after it are left alone), else the count.
+ * A pass of its own: no triangle waits on another. */
+static uint32_t rotate_triangles(uint32_t *corners, uint32_t triangle_count, const gdr_page_vertex *unique,
+                                 const uint64_t *keys, uint32_t unique_count)
+{
+    for (uint32_t t = 0; t < triangle_count; t++, corners += 3) {
+        uint32_t a = corners[0], b = corners[1], c = corners[2];
+        if (a >= unique_count || b >= unique_count || c >= unique_count)
+            return t;
+        uint64_t ka = keys[a], kb = keys[b], kc = keys[c];
+        uint32_t second, third; /* whether the canonical rotation starts at corner b, at corner c */
+        if (ka != kb && kb != kc && ka != kc) {
+            /* Distinct keys decide alone. */
+            second = kb < ka;
+            third = kc < select_u64(second, kb, ka);
+        } else {
+            const gdr_vertex_bytes *v[3] = {(const gdr_vertex_bytes *)&unique[a], (const gdr_vertex_bytes *)&unique[b],
+                                            (const gdr_vertex_bytes *)&unique[c]};
+            uint32_t first = gdr_triangle_first_corner_keyed(v, (uint64_t[3]){ka, kb, kc});
+            second = first == 1, third = first == 2;
+        }
+        corners[0] = select_u32(third, c, select_u32(second, b, a));
+        corners[1] = select_u32(third, a, select_u32(second, c, b));
+        corners[2] = select_u32(third, b, select_u32(second, a, c));
+    }
+    return triangle_count;
+}
+
+/* One cluster's vertex list and local triangles from its triangles' page vertex indices: each
+ * triangle in its canonical rotation, local indices in order of first use (how the writer's clusters
+ * list their vertices). Without a branch on whether a corner is new (a coin toss the predictor
+ * loses): every corner's page vertex is written to the next free slot of the list, and only a new
+ * one moves the list on. `corners` is rotated in place. */
+static gdr_status expand_cluster(const char *where, uint32_t c, uint32_t *corners, const gdr_page_vertex *unique,
+                                 const uint64_t *keys, uint32_t unique_count, const vertex_marks *mark, gdr_page *out,
                                  gdr_error *err)
 {
     const gdr_page_cluster *pc = &out->clusters[c];
-    uint32_t seen = 0;
-    for (uint32_t t = 0; t < pc->triangle_count; t++) {
-        const uint32_t *corners = indices + 3 * t;
-        if (corners[0] >= unique_count || corners[1] >= unique_count || corners[2] >= unique_count)
-            return PAGE_ERR("%s: cluster %u triangle %u: a vertex beyond the page's %u", where, c, t, unique_count);
-        /* The canonical rotation, whatever rotation the index codec chose. */
-        uint32_t first = gdr_triangle_first_corner((const gdr_vertex_bytes *)&unique[corners[0]],
-                                                   (const gdr_vertex_bytes *)&unique[corners[1]],
-                                                   (const gdr_vertex_bytes *)&unique[corners[2]]);
+    uint32_t valid = rotate_triangles(corners, pc->triangle_count, unique, keys, unique_count);
+    /* A triangle adds at most 3 vertices, and the list is checked against the cluster's count (at
+     * most GDR_CLUSTER_MAX_VERTICES) after each. */
+    uint32_t list[GDR_CLUSTER_MAX_VERTICES + 3];
+    uint8_t *triangles = out->triangles + pc->triangle_offset;
+    /* The arrays in locals: a byte store may alias any pointer held in memory. */
+    uint32_t *marked = mark->cluster, *local_of = mark->local, seen = 0, stamp = c + 1;
+    for (uint32_t t = 0; t < valid; t++) {
         for (uint32_t k = 0; k < 3; k++) {
-            uint32_t u = corners[(first + k) % 3];
-            if (stamp[u] != c + 1) {
-                if (seen == pc->vertex_count)
-                    return PAGE_ERR("%s: cluster %u: its triangles use more than its %u vertices", where, c,
-                                    pc->vertex_count);
-                stamp[u] = c + 1;
-                local_of[u] = seen;
-                out->vertices[pc->vertex_offset + seen++] = unique[u];
-            }
-            out->triangles[pc->triangle_offset + 3 * t + k] = (uint8_t)local_of[u];
+            uint32_t u = corners[3 * t + k];
+            uint32_t fresh = marked[u] != stamp, local = select_u32(fresh, seen, local_of[u]);
+            list[seen] = u;
+            marked[u] = stamp;
+            local_of[u] = local;
+            triangles[3 * t + k] = (uint8_t)local;
+            seen += fresh;
         }
+        if (seen > pc->vertex_count)
+            return PAGE_ERR("%s: cluster %u: its triangles use more than its %u vertices", where, c, pc->vertex_count);
     }
+    if (valid < pc->triangle_count)
+        return PAGE_ERR("%s: cluster %u triangle %u: a vertex beyond the page's %u", where, c, valid, unique_count);
     if (seen != pc->vertex_count)
         return PAGE_ERR("%s: cluster %u: its triangles use %u of its %u vertices", where, c, seen, pc->vertex_count);
+    gdr_page_vertex *vertices = out->vertices + pc->vertex_offset;
+    for (uint32_t i = 0; i < seen; i++)
+        vertices[i] = unique[list[i]];
     return GDR_OK;
 }
 
-/* The clusters' vertices and triangles from the page's vertices and triangles. */
-static gdr_status expand_clusters(const char *where, const uint32_t *indices, const gdr_page_vertex *unique,
+/* The clusters' vertices and triangles from the page's vertices and triangles (`indices`, used up). */
+static gdr_status expand_clusters(const char *where, uint32_t *indices, const gdr_page_vertex *unique,
                                   uint32_t unique_count, gdr_page *out, gdr_error *err)
 {
     out->triangles = calloc(out->triangle_byte_count ? out->triangle_byte_count : 1, 1);
-    uint32_t *local_of = malloc(sizeof *local_of * unique_count), *stamp = calloc(unique_count, sizeof *stamp);
+    vertex_marks mark = {calloc(unique_count, sizeof *mark.cluster), calloc(unique_count, sizeof *mark.local)};
+    uint64_t *keys = malloc(sizeof *keys * unique_count);
     gdr_status status = GDR_OK;
-    if (!out->triangles || !local_of || !stamp)
+    if (!out->triangles || !mark.cluster || !mark.local || !keys)
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: %u triangle bytes", where, out->triangle_byte_count);
+    for (uint32_t u = 0; status == GDR_OK && u < unique_count; u++)
+        keys[u] = gdr_vertex_bytes_key((const gdr_vertex_bytes *)&unique[u]);
     for (uint32_t c = 0; c < out->cluster_count && status == GDR_OK; c++) {
-        status = expand_cluster(where, c, indices, unique, unique_count, local_of, stamp, out, err);
+        status = expand_cluster(where, c, indices, unique, keys, unique_count, &mark, out, err);
         indices += 3 * out->clusters[c].triangle_count;
     }
-    free(local_of), free(stamp);
+    free(mark.cluster);
+    free(mark.local);
+    free(keys);
     return status;
 }
 
@@ -823,10 +911,23 @@ static int decode_quantized(gdr_page_vertex *vertices, uint32_t unique, const ui
 {
     gdr_quantized_vertex *q = malloc(sizeof *q * unique);
     int ok = q && meshopt_decodeVertexBuffer(q, unique, sizeof *q, vstream, vs) == 0;
-    for (uint32_t v = 0; ok && v < unique; v++)
-        gdr_vertex_decode(grid, &q[v], &vertices[v].position, &vertices[v].normal, &vertices[v].uv);
+    if (ok)
+        gdr_vertex_decode_many(grid, q, unique, (gdr_vertex_bytes *)vertices);
     free(q);
     return ok;
+}
+
+/* Whether none of n floats is an infinity or a NaN (exponent bits not all ones), on their bits:
+ * integer work without a branch per float. */
+static int finite_float_bits(const float *v, size_t n)
+{
+    uint32_t bad = 0;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t bits;
+        memcpy(&bits, &v[i], sizeof bits);
+        bad |= (~bits & 0x7f800000u) == 0;
+    }
+    return !bad;
 }
 
 /* The vertex stream holds the page's `unique` vertices (floats, or integers on `grid` when it is not
@@ -849,7 +950,8 @@ static gdr_status decode_streams(const char *where, reader *r, uint32_t unique, 
         status = PAGE_ERR("%s: vertex stream does not decode", where);
     else if (meshopt_decodeIndexBuffer(indices, 3 * (size_t)pi->triangle_count, 4, istream, is) != 0)
         status = PAGE_ERR("%s: index stream does not decode", where);
-    else if (!finite_floats(&vertices[0].position.x, (size_t)unique * 8))
+    else if (!(grid && gdr_vertex_grid_finite(grid)) &&
+             !finite_float_bits(&vertices[0].position.x, (size_t)unique * 8))
         status = PAGE_ERR("%s: a vertex is not finite", where);
     out->vertex_count = pi->vertex_count;
     if (status == GDR_OK)
