@@ -152,13 +152,18 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
         vertex_total += clusters[m]->vertex_count;
         byte_total += clusters[m]->triangle_byte_count;
     }
-    if (meshlet_total > UINT32_MAX / 2 || vertex_total > UINT32_MAX / 2 || byte_total > UINT32_MAX / 2)
-        return gdr_error_set(err, GDR_ERROR_CAPACITY, "scene: %llu clusters exceed the cluster pool's 32-bit offsets",
-                             (unsigned long long)meshlet_total);
     /* Streamed: the clusters' vertex lists and triangles arrive with their pages (streaming.c), which
-     * set the records' offsets; until then no record is drawn (its group is absent). */
+     * set the records' offsets into the pool's slots; until then no record is drawn (its group is
+     * absent). The whole scene's vertex lists and triangles are never in one buffer then: only the
+     * records count against the 32-bit offsets. */
     if (g->streamed)
         vertex_total = byte_total = 0;
+    if (meshlet_total > UINT32_MAX / 2 || vertex_total > UINT32_MAX / 2 || byte_total > UINT32_MAX / 2)
+        return gdr_error_set(err, GDR_ERROR_CAPACITY,
+                             "scene: %llu clusters, %llu vertex references, %llu triangle bytes: past the cluster "
+                             "pool's 32-bit offsets",
+                             (unsigned long long)meshlet_total, (unsigned long long)vertex_total,
+                             (unsigned long long)byte_total);
     uint64_t word_total = (byte_total + 3) / 4;
     GdrGpuMeshlet *meshlets = calloc(meshlet_total ? meshlet_total : 1, sizeof *meshlets);
     uint32_t *vertex_refs = malloc(sizeof(uint32_t) * (vertex_total ? vertex_total : 1));
