@@ -174,6 +174,22 @@ expect 2 "page size too small" "$gdr" build unique-field:meshes=1,triangles=1000
 # Streaming: a paged cache renders within a budget and reports its pool; anything else is refused.
 expect 0 "render streamed" "$gdr" render "$work/unique.gdrc" $tiny --geometry-budget 1 --upload-budget 1 --frames 4 --validate
 grep -q '^streaming pool' "$work/stdout" || { echo "FAIL: streamed render printed no pool: $(cat "$work/stdout")"; failures=$((failures + 1)); }
+# --settle: each pose of a path drawn until streaming settles, its row the settled frame (nothing asked
+# for, copied or moved); without it the first pose's frame still asks for pages.
+printf 'gdr-camera-path 1\n0 3.5 2 -0.174108 0 0 0.984727\n3 3.5 -6 -0.174108 0 0 0.984727\n' > "$work/settle.path"
+for settle in "" "--settle 60"; do
+    expect 0 "stream a path $settle" "$gdr" render "$work/unique.gdrc" $tiny --geometry-budget 1 --camera-path "$work/settle.path" \
+        $settle --stats "$work/settle.json" --validate
+    python3 - "$work/settle.json" "$settle" <<'PY' || failures=$((failures + 1))
+import json, sys
+rows = json.load(open(sys.argv[1]))["path"]
+settled = [r["requests"] == 0 and r["uploads"] == 0 and r["evictions"] == 0 for r in rows]
+if len(rows) != 2 or (sys.argv[2] != "") != all(settled):
+    print(f"FAIL: --settle '{sys.argv[2]}': rows {rows}")
+    sys.exit(1)
+PY
+done
+expect 2 "--settle without a path" "$gdr" render "$work/unique.gdrc" $tiny --geometry-budget 1 --settle 5
 # Streaming any scene: a built-in scene, a glTF and an OBJ without a prior gdr build get their paged
 # cache built in the cache folder (once: a second run reads it), and a glTF streamed with room for
 # everything converges to the image of that cache uploaded whole; --no-cache cannot stream a file.

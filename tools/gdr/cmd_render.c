@@ -56,7 +56,7 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
             continue;
         /* The options that take a value (an unknown one is reported as such). */
         static const char *const known[] = {
-            "--out", "-o", "--stats", "--width", "--height", "--frames", "--camera-path", "--camera",
+            "--out", "-o", "--stats", "--width", "--height", "--frames", "--camera-path", "--settle", "--camera",
             "--camera-index", "--cull", "--meshlet-cull", "--cone-cull", "--triangle-cull", "--occlusion",
             "--lod-hierarchy", "--pipeline", "--raster", "--sw-threshold", "--view", "--lod-error",
             "--min-screen-size", "--clip-plane", "--lod-depth", "--device", "--geometry-budget",
@@ -76,6 +76,8 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
             ok = o->frames_given = cli_parse_u32(arg, value, 1, 100000, &o->frames);
         else if (strcmp(arg, "--camera-path") == 0)
             o->camera_path = value;
+        else if (strcmp(arg, "--settle") == 0)
+            ok = cli_parse_u32(arg, value, 1, 100000, &o->settle_frames);
         else if (strcmp(arg, "--camera") == 0)
             ok = o->has_camera = cli_parse_camera(arg, value, &o->camera_position, &o->camera_rotation);
         else if (strcmp(arg, "--camera-index") == 0)
@@ -179,9 +181,30 @@ gdr_frame_desc render_options_frame(const render_options *o, gdr_camera camera)
                             .min_screen_size = o->min_screen_size, .clip_plane = o->clip_plane, .pvs = o->pvs};
 }
 
+/* Whether a streamed frame left nothing to do: no page asked for, being read, waiting or copied. */
+static bool streaming_settled(const gdr_frame_stats *stats)
+{
+    const gdr_streaming_stats *st = &stats->streaming;
+    return st->requests == 0 && st->loads == 0 && st->uploads == 0 && st->pending == 0 && st->deferred == 0;
+}
+
+/* One pose: one frame, or with --settle N frames at the pose until streaming settles (at most N),
+ * then one more, whose figures are the pose's (the converged frame at that pose). */
+static gdr_status render_pose(gdr_renderer *renderer, gdr_frame_desc *frame, const render_options *o,
+                              gdr_frame_stats *stats, gdr_error *err)
+{
+    gdr_status status = gdr_renderer_render(renderer, frame, 1, stats, err);
+    for (uint32_t n = 0; o->settle_frames && n < o->settle_frames && status == GDR_OK && !streaming_settled(stats); n++)
+        status = gdr_renderer_render(renderer, frame, 1, stats, err);
+    if (o->settle_frames && status == GDR_OK)
+        status = gdr_renderer_render(renderer, frame, 1, stats, err);
+    return status;
+}
+
 /* The frames asked for: o->frames of one view, or with a camera path (path->count > 0) one frame per
- * pose (the path repeated to make --frames N, N the path's length by default), each frame's figures
- * a row of *rows (malloc'ed; the JSON's "path"); the statistics are the last call's. */
+ * pose (the path repeated to make --frames N, N the path's length by default; with --settle, each
+ * pose's settled frame), each frame's figures a row of *rows (malloc'ed; the JSON's "path"); the
+ * statistics are the last call's. */
 static gdr_status render_frames(gdr_renderer *renderer, gdr_frame_desc *frame, const render_options *o,
                                 const camera_path *path, gdr_frame_stats *stats, stats_path_frame **rows,
                                 gdr_error *err)
@@ -198,7 +221,7 @@ static gdr_status render_frames(gdr_renderer *renderer, gdr_frame_desc *frame, c
         frame->camera.position = path->poses[f % path->count].position;
         frame->camera.rotation = path->poses[f % path->count].rotation;
         frame->read_back = read_back && f + 1 == frames;
-        status = gdr_renderer_render(renderer, frame, 1, stats, err);
+        status = render_pose(renderer, frame, o, stats, err);
         if (status == GDR_OK)
             (*rows)[f] = stats_path_row(stats);
     }
@@ -221,6 +244,10 @@ int gdr_cmd_render(int argc, char **argv)
     int usage = render_options_parse("render", argc, argv, &o, NULL, NULL);
     if (usage)
         return usage;
+    if (o.settle_frames && !o.camera_path) {
+        fprintf(stderr, "gdr render: --settle needs --camera-path (it settles each pose of the path)\n");
+        return 2;
+    }
     gdr_error err = {0};
     gdr_scene *scene = NULL;
     gdr_pvs *pvs = NULL;
