@@ -16,7 +16,7 @@
 #include "gdr/paged_cache.h"
 #include "geometry/lod_cut.h"
 #include "render/renderer_internal.h"
-#include "stream/node_counts.h"
+#include "render/node_counts.h"
 #include "stream/page_loader.h"
 #include "stream/residency.h"
 #include "render/page_table.h"

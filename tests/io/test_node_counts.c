@@ -17,7 +17,7 @@
 
 #include "gdr/io.h"
 #include "geometry/lod_cut.h"
-#include "stream/node_counts.h"
+#include "render/node_counts.h"
 #include "test_util.h"
 
 #define BATCHES 60

@@ -1,7 +1,7 @@
 /* The LOD nodes' absent counts, updated per changed group (node_counts.h). For each group, the
  * leaves holding clusters made from it and how many (the group's references); for each node, its
  * parent. A group's change adds or takes its references' counts along each leaf's path to the root. */
-#include "stream/node_counts.h"
+#include "render/node_counts.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -5,8 +5,8 @@
  * number of such clusters below it. Setting a group walks up from those leaves: the work and the
  * words to upload follow the changed groups, not the mesh. The changed words come back as runs of
  * consecutive nodes, for one copy each. */
-#ifndef GDR_STREAM_NODE_COUNTS_H
-#define GDR_STREAM_NODE_COUNTS_H
+#ifndef GDR_RENDER_NODE_COUNTS_H
+#define GDR_RENDER_NODE_COUNTS_H
 
 #include <stdbool.h>
 #include <stdint.h>
