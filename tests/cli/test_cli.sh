@@ -190,6 +190,7 @@ if len(rows) != 2 or (sys.argv[2] != "") != all(settled):
 PY
 done
 expect 2 "--settle without a path" "$gdr" render "$work/unique.gdrc" $tiny --geometry-budget 1 --settle 5
+expect 2 "--settle in the viewer" "$gdr" view "$work/unique.gdrc" $tiny --geometry-budget 1 --settle 5
 # Streaming any scene: a built-in scene, a glTF and an OBJ without a prior gdr build get their paged
 # cache built in the cache folder (once: a second run reads it), and a glTF streamed with room for
 # everything converges to the image of that cache uploaded whole; --no-cache cannot stream a file.
