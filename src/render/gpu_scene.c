@@ -286,11 +286,31 @@ static void size_queues(gdr_renderer *r, const gdr_scene *scene, const gdr_mesh_
     g->traversal_capacity = g->traversal_capacity ? g->traversal_capacity : 1;
 }
 
+/* One buffer of cluster spheres for every leaf of the scene, grown to the largest leaf, instead of
+ * an allocation per leaf. */
+typedef struct sphere_scratch {
+    gdr_vec4 *spheres;
+    uint32_t capacity;
+} sphere_scratch;
+
+/* Room for `count` spheres, or NULL without memory (the leaf keeps its LOD sphere, which holds them). */
+static gdr_vec4 *scratch_spheres(sphere_scratch *s, uint32_t count)
+{
+    if (count > s->capacity) {
+        gdr_vec4 *grown = realloc(s->spheres, sizeof *grown * count);
+        if (!grown)
+            return NULL;
+        s->spheres = grown;
+        s->capacity = count;
+    }
+    return s->spheres;
+}
+
 /* Mesh c's nodes for the GPU: each gdr_lod_node's bytes, then its culling sphere, which encloses its
  * clusters' spheres (leaf) or its children's culling spheres (inner node). Children follow their
  * parent in the array (the root is node 0), so one pass from the end finds every child's first;
  * a node whose children do not follow it keeps its LOD sphere, which also holds them. */
-static void gpu_lod_nodes(const gdr_mesh_clusters *c, GdrGpuLodNode *out)
+static void gpu_lod_nodes(const gdr_mesh_clusters *c, GdrGpuLodNode *out, sphere_scratch *scratch)
 {
     gdr_vec4 spheres[GDR_LOD_NODE_MAX_CHILDREN];
     for (uint32_t n = c->lod_node_count; n-- > 0;) {
@@ -299,12 +319,11 @@ static void gpu_lod_nodes(const gdr_mesh_clusters *c, GdrGpuLodNode *out)
         out[n].bounds = node->sphere;
         bool leaf = (node->flags & GDR_LOD_NODE_LEAF) != 0;
         if (leaf && (uint64_t)node->first + node->count <= c->cluster_count) {
-            gdr_vec4 *cluster_spheres = malloc(sizeof *cluster_spheres * (node->count ? node->count : 1));
+            gdr_vec4 *cluster_spheres = scratch_spheres(scratch, node->count);
             for (uint32_t i = 0; cluster_spheres && i < node->count; i++)
                 cluster_spheres[i] = c->clusters[node->first + i].sphere;
             if (cluster_spheres && node->count)
                 out[n].bounds = gdr_lod_enclosing_sphere(cluster_spheres, node->count);
-            free(cluster_spheres);
         } else if (!leaf && node->first > n && node->count <= GDR_LOD_NODE_MAX_CHILDREN &&
                    (uint64_t)node->first + node->count <= c->lod_node_count && node->count) {
             for (uint32_t i = 0; i < node->count; i++)
@@ -331,6 +350,7 @@ static gdr_status upload_lod_nodes(gdr_renderer *r, const gdr_scene *scene, cons
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory for %llu LOD nodes",
                              (unsigned long long)total);
     uint32_t cursor = 0;
+    sphere_scratch scratch = {0};
     for (uint32_t m = 0; m < scene->mesh_count; m++) {
         const gdr_mesh_clusters *c = clusters[m];
         g->cpu_meshes[m].lod_node_offset = cursor;
@@ -339,9 +359,10 @@ static gdr_status upload_lod_nodes(gdr_renderer *r, const gdr_scene *scene, cons
         bool traversed = g->cpu_meshes[m].lod_task_count > GDR_TRAVERSE_MIN_TASKS; /* as drawcull.comp decides */
         if (traversed && c->lod_node_levels > g->traversal_levels)
             g->traversal_levels = c->lod_node_levels;
-        gpu_lod_nodes(c, nodes + cursor);
+        gpu_lod_nodes(c, nodes + cursor, &scratch);
         cursor += c->lod_node_count;
     }
+    free(scratch.spheres);
     /* TRANSFER_SRC: tests read the pool back. */
     const VkBufferUsageFlags usage =
         VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
