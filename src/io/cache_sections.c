@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "io/cache_decode.h"
 #include "gdr/geometry.h"
 #include "io/cache_internal.h"
 #include "io/cache_pages.h"
@@ -558,30 +559,70 @@ static gdr_status read_mesh_cluster_counts(cache_read_state *st, uint32_t m, gdr
     return GDR_OK;
 }
 
+/* Where each mesh's records lie in CLDT, for the meshes decoded at once. */
+typedef struct cluster_decode {
+    cache_read_state *st;
+    const reader *data;
+    size_t *at; /* per mesh: its records' offset in data */
+} cluster_decode;
+
+static gdr_status decode_mesh_clusters(void *user, uint32_t m, gdr_error *err)
+{
+    const cluster_decode *d = user;
+    gdr_mesh *mesh = &d->st->scene->meshes[m];
+    if (mesh->clusters.cluster_count == 0)
+        return GDR_OK;
+    reader r = {d->data->data, d->data->size, d->at[m], 0};
+    return read_mesh_clusters(d->st->name, &r, m, mesh, &mesh->clusters, err);
+}
+
+/* One mesh's counts, checked against what is left of the section, and its arrays; *at its records. */
+static gdr_status place_mesh_clusters(cache_read_state *st, reader *data, uint32_t m, size_t *at, gdr_error *err)
+{
+    gdr_mesh_clusters *c = &st->scene->meshes[m].clusters; /* owned by the scene from here: freed with it */
+    gdr_status status = read_mesh_cluster_counts(st, m, c, err);
+    if (status != GDR_OK)
+        return status;
+    uint64_t need = (uint64_t)c->cluster_count * CLUSTER_RECORD + (uint64_t)c->group_count * GROUP_RECORD;
+    if (need > data->size - data->at)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLDT': mesh %u: %u clusters and %u groups run "
+                             "past the section", st->name, m, c->cluster_count, c->group_count);
+    *at = data->at;
+    data->at += (size_t)need;
+    if (c->cluster_count == 0)
+        return GDR_OK;
+    c->clusters = malloc(sizeof(gdr_cluster) * (size_t)c->cluster_count);
+    c->groups = c->group_count ? malloc(sizeof(gdr_cluster_group) * (size_t)c->group_count) : NULL;
+    if (!c->clusters || (c->group_count && !c->groups))
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: mesh %u: out of memory for %u clusters", st->name, m,
+                             c->cluster_count);
+    return GDR_OK;
+}
+
+/* Every mesh's counts and place first, in order, up to the first that fails; then the records of the
+ * meshes placed, decoded at once (cache_decode.c). A failure of an earlier mesh's records comes
+ * before a later mesh's counts, as when each mesh was read whole before the next. */
 static gdr_status read_cluster_data(cache_read_state *st, reader *data, gdr_error *err)
 {
-    const char *name = st->name;
-    for (uint32_t m = 0; m < st->mesh_count; m++) {
-        gdr_mesh_clusters *c = &st->scene->meshes[m].clusters; /* owned by the scene from here: freed with it */
-        gdr_status status = read_mesh_cluster_counts(st, m, c, err);
-        if (status != GDR_OK)
-            return status;
-        uint64_t need = (uint64_t)c->cluster_count * CLUSTER_RECORD + (uint64_t)c->group_count * GROUP_RECORD;
-        if (need > data->size - data->at)
-            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLDT': mesh %u: %u clusters and %u groups run "
-                                 "past the section", name, m, c->cluster_count, c->group_count);
-        if (c->cluster_count == 0)
-            continue;
-        c->clusters = malloc(sizeof(gdr_cluster) * (size_t)c->cluster_count);
-        c->groups = c->group_count ? malloc(sizeof(gdr_cluster_group) * (size_t)c->group_count) : NULL;
-        if (!c->clusters || (c->group_count && !c->groups))
-            return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: mesh %u: out of memory for %u clusters", name, m,
-                                 c->cluster_count);
-        status = read_mesh_clusters(name, data, m, &st->scene->meshes[m], c, err);
-        if (status != GDR_OK)
-            return status;
+    size_t *at = malloc(sizeof *at * (st->mesh_count ? st->mesh_count : 1));
+    if (!at)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory for %u meshes", st->name,
+                             st->mesh_count);
+    gdr_status placed = GDR_OK;
+    uint32_t ready = 0;
+    uint64_t records = 0;
+    for (; ready < st->mesh_count && placed == GDR_OK; ready++) {
+        placed = place_mesh_clusters(st, data, ready, &at[ready], err);
+        records += st->scene->meshes[ready].clusters.cluster_count;
     }
-    return expect_end(st, data, "CLDT", err);
+    if (placed != GDR_OK)
+        ready--; /* the failed mesh is not decoded */
+    cluster_decode d = {st, data, at};
+    gdr_status status = cache_decode_meshes(ready, records, decode_mesh_clusters, &d, err);
+    free(at);
+    if (status != GDR_OK)
+        return status;
+    return placed != GDR_OK ? placed : expect_end(st, data, "CLDT", err);
 }
 
 #define CLGM(fmt, ...) gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLGM': mesh %u" fmt, name, m, __VA_ARGS__)
