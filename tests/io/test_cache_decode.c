@@ -1,10 +1,12 @@
-/* The cluster records (CLDT) decoded on several threads (src/io/cache_decode.c) give the scene the
- * serial decode gives, and a damaged file the same refusal:
+/* The cluster records (CLDT) and hierarchies (LODH) decoded on several threads (src/io/cache_decode.c)
+ * give the scene the serial decode gives, and a damaged file the same refusal:
  * - five meshes of `unique-field` written whole and read back from memory with one thread and with
- *   four: every mesh's counts, clusters and groups byte for byte equal, and equal to those written;
+ *   four: every mesh's counts, clusters, groups and hierarchy nodes byte for byte equal, and equal to
+ *   those written;
  * - records damaged in meshes 1 and 3 (a cluster of no vertices, checksums made right again): both
  *   decodes refuse the file naming mesh 1, the first in mesh order, with the same message; damaged
- *   in mesh 3 alone, both name mesh 3. */
+ *   in mesh 3 alone, both name mesh 3; likewise a hierarchy node whose children lie past the mesh's
+ *   nodes in meshes 1 and 3, then 3. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -17,6 +19,7 @@
 
 #define CLUSTER_RECORD 72 /* bytes of a cluster's record in CLDT (docs/CACHE_FORMAT.md) */
 #define GROUP_RECORD 32   /* bytes of a group's */
+#define NODE_RECORD 48    /* bytes of a hierarchy node's in LODH, after each mesh's 8 bytes of counts */
 
 static uint8_t *read_file(const char *path, size_t *size)
 {
@@ -81,7 +84,9 @@ static int same_clusters(const gdr_mesh_clusters *a, const gdr_mesh_clusters *b)
     return a->cluster_count == b->cluster_count && a->group_count == b->group_count &&
            a->level0_cluster_count == b->level0_cluster_count && a->dag_depth == b->dag_depth &&
            memcmp(a->clusters, b->clusters, sizeof *a->clusters * a->cluster_count) == 0 &&
-           memcmp(a->groups, b->groups, sizeof *a->groups * a->group_count) == 0;
+           memcmp(a->groups, b->groups, sizeof *a->groups * a->group_count) == 0 &&
+           a->lod_node_count == b->lod_node_count && a->lod_node_levels == b->lod_node_levels &&
+           memcmp(a->lod_nodes, b->lod_nodes, sizeof *a->lod_nodes * a->lod_node_count) == 0;
 }
 
 static void test_equal(const gdr_scene *written, const uint8_t *data, size_t size)
@@ -100,27 +105,37 @@ static void test_equal(const gdr_scene *written, const uint8_t *data, size_t siz
     gdr_scene_destroy(parallel);
 }
 
-/* A copy of the file with the first cluster of each mesh in `meshes` given no vertices. */
-static uint8_t *damaged(const gdr_scene *s, const uint8_t *data, size_t size, const uint32_t *meshes, uint32_t n)
+/* A copy of the file with the first cluster of each mesh in `meshes` given no vertices (in CLDT), or
+ * its first hierarchy node children past the mesh's nodes (in LODH). */
+static uint8_t *damaged(const gdr_scene *s, const uint8_t *data, size_t size, const uint32_t *meshes, uint32_t n,
+                        const char *section)
 {
     uint8_t *copy = malloc(size);
     memcpy(copy, data, size);
-    uint64_t cldt = section_offset(copy, "CLDT");
+    int cldt = strcmp(section, "CLDT") == 0;
+    uint64_t start = section_offset(copy, section);
     for (uint32_t k = 0; k < n; k++) {
-        uint64_t at = cldt;
-        for (uint32_t m = 0; m < meshes[k]; m++)
-            at += (uint64_t)s->meshes[m].clusters.cluster_count * CLUSTER_RECORD +
-                  (uint64_t)s->meshes[m].clusters.group_count * GROUP_RECORD;
-        memset(copy + at + 8, 0, 4); /* vertex_count */
+        uint64_t at = start;
+        for (uint32_t m = 0; m < meshes[k]; m++) {
+            const gdr_mesh_clusters *c = &s->meshes[m].clusters;
+            at += cldt ? (uint64_t)c->cluster_count * CLUSTER_RECORD + (uint64_t)c->group_count * GROUP_RECORD
+                       : 8 + (uint64_t)c->lod_node_count * NODE_RECORD;
+        }
+        if (cldt) {
+            memset(copy + at + 8, 0, 4); /* vertex_count */
+        } else {
+            uint32_t past = s->meshes[meshes[k]].clusters.lod_node_count + 7;
+            memcpy(copy + at + 8 + 24, &past, 4); /* node 0's first child */
+        }
     }
     fix_checksums(copy, size);
     return copy;
 }
 
 static void test_refused(const gdr_scene *s, const uint8_t *data, size_t size, const uint32_t *meshes, uint32_t n,
-                         const char *expect)
+                         const char *section, const char *expect)
 {
-    uint8_t *copy = damaged(s, data, size, meshes, n);
+    uint8_t *copy = damaged(s, data, size, meshes, n, section);
     gdr_error serial = {0}, parallel = {0};
     gdr_scene *out = NULL;
     CHECK(read_with(1, copy, size, &out, &serial) == GDR_ERROR_PARSE && !out);
@@ -145,8 +160,10 @@ int main(void)
     if (data) {
         test_equal(scene, data, size);
         const uint32_t both[] = {1, 3}, last[] = {3};
-        test_refused(scene, data, size, both, 2, "mesh 1 cluster 0");
-        test_refused(scene, data, size, last, 1, "mesh 3 cluster 0");
+        test_refused(scene, data, size, both, 2, "CLDT", "'CLDT': mesh 1 cluster 0");
+        test_refused(scene, data, size, last, 1, "CLDT", "'CLDT': mesh 3 cluster 0");
+        test_refused(scene, data, size, both, 2, "LODH", "'LODH': mesh 1:");
+        test_refused(scene, data, size, last, 1, "LODH", "'LODH': mesh 3:");
     }
     free(data);
     remove(path);
