@@ -6,6 +6,11 @@
 #include "render/cluster_records.h"
 
 #include <math.h>
+#include <stdbool.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gdr/geometry.h" /* gdr_lod_enclosing_sphere */
 
 GdrGpuMeshlet gdr_cluster_record(const gdr_mesh_clusters *c, uint32_t i, uint32_t vertex_base, uint32_t byte_base)
 {
@@ -86,4 +91,83 @@ void gdr_cluster_records_fill(GdrGpuMeshlet *out, const gdr_cluster_record_layou
         return;
     }
     gdr_thread_pool_run(pool, (uint32_t)tasks, fill_chunk, &job);
+}
+
+/* One buffer of cluster spheres for every leaf of the scene, grown to the largest leaf, instead of
+ * an allocation per leaf. */
+typedef struct sphere_scratch {
+    gdr_vec4 *spheres;
+    uint32_t capacity;
+} sphere_scratch;
+
+/* Room for `count` spheres, or NULL without memory (the leaf keeps its LOD sphere, which holds them). */
+static gdr_vec4 *scratch_spheres(sphere_scratch *s, uint32_t count)
+{
+    if (count > s->capacity) {
+        gdr_vec4 *grown = realloc(s->spheres, sizeof *grown * count);
+        if (!grown)
+            return NULL;
+        s->spheres = grown;
+        s->capacity = count;
+    }
+    return s->spheres;
+}
+
+/* Mesh c's nodes for the GPU: each gdr_lod_node's bytes, then its culling sphere, which encloses its
+ * clusters' spheres (leaf) or its children's culling spheres (inner node). Children follow their
+ * parent in the array (the root is node 0), so one pass from the end finds every child's first;
+ * a node whose children do not follow it keeps its LOD sphere, which also holds them. */
+static void mesh_node_records(const gdr_mesh_clusters *c, GdrGpuLodNode *out, sphere_scratch *scratch)
+{
+    gdr_vec4 spheres[GDR_LOD_NODE_MAX_CHILDREN];
+    for (uint32_t n = c->lod_node_count; n-- > 0;) {
+        const gdr_lod_node *node = &c->lod_nodes[n];
+        memcpy(&out[n], node, sizeof *node);
+        out[n].bounds = node->sphere;
+        bool leaf = (node->flags & GDR_LOD_NODE_LEAF) != 0;
+        if (leaf && (uint64_t)node->first + node->count <= c->cluster_count) {
+            gdr_vec4 *cluster_spheres = scratch_spheres(scratch, node->count);
+            for (uint32_t i = 0; cluster_spheres && i < node->count; i++)
+                cluster_spheres[i] = c->clusters[node->first + i].sphere;
+            if (cluster_spheres && node->count)
+                out[n].bounds = gdr_lod_enclosing_sphere(cluster_spheres, node->count);
+        } else if (!leaf && node->first > n && node->count <= GDR_LOD_NODE_MAX_CHILDREN &&
+                   (uint64_t)node->first + node->count <= c->lod_node_count && node->count) {
+            for (uint32_t i = 0; i < node->count; i++)
+                spheres[i] = out[node->first + i].bounds;
+            out[n].bounds = gdr_lod_enclosing_sphere(spheres, node->count);
+        }
+    }
+}
+
+typedef struct node_job {
+    GdrGpuLodNode *out;
+    const gdr_mesh_clusters *const *clusters;
+    const uint32_t *first;
+    sphere_scratch *scratch; /* per worker */
+} node_job;
+
+static void node_task(void *user, uint32_t mesh, uint32_t worker)
+{
+    const node_job *job = user;
+    mesh_node_records(job->clusters[mesh], job->out + job->first[mesh], &job->scratch[worker]);
+}
+
+void gdr_lod_node_records_fill(GdrGpuLodNode *out, const gdr_mesh_clusters *const *clusters, const uint32_t *first,
+                               uint32_t mesh_count, gdr_thread_pool *pool)
+{
+    uint32_t workers = pool ? gdr_thread_pool_thread_count(pool) : 1;
+    sphere_scratch *scratch = pool ? calloc(workers, sizeof *scratch) : NULL;
+    sphere_scratch one = {0};
+    node_job job = {out, clusters, first, scratch ? scratch : &one};
+    if (scratch && mesh_count > 1) {
+        gdr_thread_pool_run(pool, mesh_count, node_task, &job);
+    } else {
+        for (uint32_t m = 0; m < mesh_count; m++)
+            node_task(&job, m, 0);
+    }
+    for (uint32_t w = 0; scratch && w < workers; w++)
+        free(scratch[w].spheres);
+    free(scratch);
+    free(one.spheres);
 }

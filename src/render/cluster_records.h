@@ -1,5 +1,5 @@
-/* The GPU records of every cluster of a scene (GdrGpuMeshlet), filled in parallel chunks
- * (cluster_records.c). */
+/* The GPU records of every cluster of a scene (GdrGpuMeshlet) and of every LOD hierarchy node
+ * (GdrGpuLodNode), filled on a thread pool (cluster_records.c). */
 #ifndef GDR_RENDER_CLUSTER_RECORDS_H
 #define GDR_RENDER_CLUSTER_RECORDS_H
 
@@ -24,5 +24,11 @@ GdrGpuMeshlet gdr_cluster_record(const gdr_mesh_clusters *c, uint32_t i, uint32_
  * The bytes are the same either way: each record depends only on its own cluster. */
 void gdr_cluster_records_fill(GdrGpuMeshlet *out, const gdr_cluster_record_layout *layout, uint32_t chunk,
                               gdr_thread_pool *pool);
+
+/* Every mesh's hierarchy nodes for the GPU (GdrGpuLodNode: each gdr_lod_node's bytes, then its
+ * culling sphere, which encloses its clusters' spheres or its children's culling spheres), mesh m's
+ * at out + first[m], a mesh a task on the pool's threads (pool NULL: in order on this thread). */
+void gdr_lod_node_records_fill(GdrGpuLodNode *out, const gdr_mesh_clusters *const *clusters, const uint32_t *first,
+                               uint32_t mesh_count, gdr_thread_pool *pool);
 
 #endif

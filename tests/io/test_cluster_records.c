@@ -2,7 +2,9 @@
  * renderer's set-up) are byte for byte the records built one by one in order: on the meshes of a
  * small `unique-field` with a mesh without clusters between them (first records shared), with the
  * offsets of a whole upload and of a streamed one (0), for chunks of one cluster, of a few (ranges
- * that span meshes), of about a mesh and of more than the whole, with and without a thread pool. */
+ * that span meshes), of about a mesh and of more than the whole, with and without a thread pool.
+ * The hierarchy nodes' records (GdrGpuLodNode) filled a mesh a task on four threads are byte for
+ * byte those filled in order on one, each beginning with its gdr_lod_node's bytes. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -47,6 +49,32 @@ static int check_layout(const gdr_cluster_record_layout *l, uint32_t total, gdr_
     return differ;
 }
 
+static void check_nodes(const gdr_mesh_clusters *const *clusters, uint32_t mesh_count, gdr_thread_pool *pool)
+{
+    uint32_t first[MESHES], total = 0;
+    for (uint32_t m = 0; m < mesh_count; m++) {
+        first[m] = total;
+        total += clusters[m]->lod_node_count;
+    }
+    GdrGpuLodNode *serial = calloc(total, sizeof *serial), *parallel = calloc(total, sizeof *parallel);
+    CHECK(serial && parallel && total > 0);
+    if (!serial || !parallel)
+        return;
+    gdr_lod_node_records_fill(serial, clusters, first, mesh_count, NULL);
+    gdr_lod_node_records_fill(parallel, clusters, first, mesh_count, pool);
+    uint32_t differ = 0, copied = 0;
+    for (uint32_t m = 0; m < mesh_count; m++)
+        for (uint32_t n = 0; n < clusters[m]->lod_node_count; n++) {
+            differ += memcmp(&serial[first[m] + n], &parallel[first[m] + n], sizeof *serial) != 0;
+            copied += memcmp(&parallel[first[m] + n], &clusters[m]->lod_nodes[n], sizeof(gdr_lod_node)) == 0;
+        }
+    printf("%u hierarchy nodes: %u differ between one thread and four, %u begin with their node\n", total, differ,
+           copied);
+    CHECK(differ == 0 && copied == total);
+    free(serial);
+    free(parallel);
+}
+
 int main(void)
 {
     gdr_error err = {0};
@@ -75,6 +103,7 @@ int main(void)
     int differ = check_layout(&whole, total, pool) + check_layout(&streamed, total, pool);
     printf("%u clusters in %u meshes: %d fills of 20 differ from the serial records\n", total, MESHES, differ);
     CHECK(differ == 0);
+    check_nodes(clusters, MESHES, pool);
     gdr_thread_pool_destroy(pool);
     gdr_scene_destroy(scene);
     return test_finish("test_cluster_records");
