@@ -10,7 +10,7 @@ src=$root/src
 mkdir -p "$work"
 sources="$src/io/file.c $src/io/budget.c $src/io/mesh_clean.c $src/io/image.c $src/io/image_png.c
  $src/io/image_jpeg.c $src/io/gltf.c $src/io/gltf_buffers.c
- $src/io/obj.c $src/io/cache.c $src/io/cache_sections.c $src/scene/scene.c $(ls "$src"/geometry/*.c)
+ $src/io/obj.c $src/io/cache.c $src/io/cache_sections.c $src/io/cache_decode.c $src/scene/scene.c $(ls "$src"/geometry/*.c)
  $src/core/thread_pool.c $src/core/error.c $src/core/progress.c $src/core/output_file.c $src/math/vector.c
  $src/math/matrix.c $src/math/quaternion.c $src/math/projection.c $src/math/frustum.c $src/cull/pvs_blob.c
  $src/cull/pvs_query.c"

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "io/cache_decode.h"
 #include "gdr/geometry.h"
 #include "io/cache_internal.h"
 #include "io/cache_pages.h"
@@ -558,30 +559,70 @@ static gdr_status read_mesh_cluster_counts(cache_read_state *st, uint32_t m, gdr
     return GDR_OK;
 }
 
+/* Where each mesh's records lie in CLDT, for the meshes decoded at once. */
+typedef struct cluster_decode {
+    cache_read_state *st;
+    const reader *data;
+    size_t *at; /* per mesh: its records' offset in data */
+} cluster_decode;
+
+static gdr_status decode_mesh_clusters(void *user, uint32_t m, gdr_error *err)
+{
+    const cluster_decode *d = user;
+    gdr_mesh *mesh = &d->st->scene->meshes[m];
+    if (mesh->clusters.cluster_count == 0)
+        return GDR_OK;
+    reader r = {d->data->data, d->data->size, d->at[m], 0};
+    return read_mesh_clusters(d->st->name, &r, m, mesh, &mesh->clusters, err);
+}
+
+/* One mesh's counts, checked against what is left of the section, and its arrays; *at its records. */
+static gdr_status place_mesh_clusters(cache_read_state *st, reader *data, uint32_t m, size_t *at, gdr_error *err)
+{
+    gdr_mesh_clusters *c = &st->scene->meshes[m].clusters; /* owned by the scene from here: freed with it */
+    gdr_status status = read_mesh_cluster_counts(st, m, c, err);
+    if (status != GDR_OK)
+        return status;
+    uint64_t need = (uint64_t)c->cluster_count * CLUSTER_RECORD + (uint64_t)c->group_count * GROUP_RECORD;
+    if (need > data->size - data->at)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLDT': mesh %u: %u clusters and %u groups run "
+                             "past the section", st->name, m, c->cluster_count, c->group_count);
+    *at = data->at;
+    data->at += (size_t)need;
+    if (c->cluster_count == 0)
+        return GDR_OK;
+    c->clusters = malloc(sizeof(gdr_cluster) * (size_t)c->cluster_count);
+    c->groups = c->group_count ? malloc(sizeof(gdr_cluster_group) * (size_t)c->group_count) : NULL;
+    if (!c->clusters || (c->group_count && !c->groups))
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: mesh %u: out of memory for %u clusters", st->name, m,
+                             c->cluster_count);
+    return GDR_OK;
+}
+
+/* Every mesh's counts and place first, in order, up to the first that fails; then the records of the
+ * meshes placed, decoded at once (cache_decode.c). A failure of an earlier mesh's records comes
+ * before a later mesh's counts, as when each mesh was read whole before the next. */
 static gdr_status read_cluster_data(cache_read_state *st, reader *data, gdr_error *err)
 {
-    const char *name = st->name;
-    for (uint32_t m = 0; m < st->mesh_count; m++) {
-        gdr_mesh_clusters *c = &st->scene->meshes[m].clusters; /* owned by the scene from here: freed with it */
-        gdr_status status = read_mesh_cluster_counts(st, m, c, err);
-        if (status != GDR_OK)
-            return status;
-        uint64_t need = (uint64_t)c->cluster_count * CLUSTER_RECORD + (uint64_t)c->group_count * GROUP_RECORD;
-        if (need > data->size - data->at)
-            return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLDT': mesh %u: %u clusters and %u groups run "
-                                 "past the section", name, m, c->cluster_count, c->group_count);
-        if (c->cluster_count == 0)
-            continue;
-        c->clusters = malloc(sizeof(gdr_cluster) * (size_t)c->cluster_count);
-        c->groups = c->group_count ? malloc(sizeof(gdr_cluster_group) * (size_t)c->group_count) : NULL;
-        if (!c->clusters || (c->group_count && !c->groups))
-            return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: mesh %u: out of memory for %u clusters", name, m,
-                                 c->cluster_count);
-        status = read_mesh_clusters(name, data, m, &st->scene->meshes[m], c, err);
-        if (status != GDR_OK)
-            return status;
+    size_t *at = malloc(sizeof *at * (st->mesh_count ? st->mesh_count : 1));
+    if (!at)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory for %u meshes", st->name,
+                             st->mesh_count);
+    gdr_status placed = GDR_OK;
+    uint32_t ready = 0;
+    uint64_t records = 0;
+    for (; ready < st->mesh_count && placed == GDR_OK; ready++) {
+        placed = place_mesh_clusters(st, data, ready, &at[ready], err);
+        records += st->scene->meshes[ready].clusters.cluster_count;
     }
-    return expect_end(st, data, "CLDT", err);
+    if (placed != GDR_OK)
+        ready--; /* the failed mesh is not decoded */
+    cluster_decode d = {st, data, at};
+    gdr_status status = cache_decode_meshes(ready, records, decode_mesh_clusters, &d, err);
+    free(at);
+    if (status != GDR_OK)
+        return status;
+    return placed != GDR_OK ? placed : expect_end(st, data, "CLDT", err);
 }
 
 #define CLGM(fmt, ...) gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLGM': mesh %u" fmt, name, m, __VA_ARGS__)
@@ -669,7 +710,9 @@ static void write_hierarchy(writer *w, const cache_write_input *in)
     }
 }
 
-static gdr_status read_mesh_hierarchy(cache_read_state *st, reader *r, uint32_t m, gdr_error *err)
+/* Mesh m's node count and levels, checked against its clusters and what is left of the section, and
+ * its node array; *at its nodes, which the reader skips. */
+static gdr_status place_mesh_hierarchy(cache_read_state *st, reader *r, uint32_t m, size_t *at, gdr_error *err)
 {
     gdr_mesh_clusters *c = &st->scene->meshes[m].clusters;
     uint32_t node_count = get_u32(r), levels = get_u32(r);
@@ -678,6 +721,8 @@ static gdr_status read_mesh_hierarchy(cache_read_state *st, reader *r, uint32_t 
         return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'LODH': mesh %u: %u nodes for %u clusters "
                              "(the section holds %zu more bytes)", st->name, m, node_count, c->cluster_count,
                              r->failed ? (size_t)0 : r->size - r->at);
+    *at = r->at;
+    r->at += (size_t)node_count * NODE_RECORD;
     if (node_count == 0)
         return GDR_OK;
     c->lod_nodes = malloc(sizeof *c->lod_nodes * node_count); /* owned by the scene from here */
@@ -686,33 +731,65 @@ static gdr_status read_mesh_hierarchy(cache_read_state *st, reader *r, uint32_t 
                              st->name, m, node_count);
     c->lod_node_count = node_count;
     c->lod_node_levels = levels;
-    for (uint32_t k = 0; k < node_count; k++) {
-        gdr_lod_node *n = &c->lod_nodes[k];
-        get_f32s(r, &n->sphere.x, 4);
-        get_f32s(r, &n->max_error, 1);
-        get_f32s(r, &n->min_refined_error, 1);
-        n->first = get_u32(r);
-        n->count = get_u32(r);
-        n->group = get_u32(r);
-        n->flags = get_u32(r);
-        n->reserved[0] = get_u32(r);
-        n->reserved[1] = get_u32(r);
-    }
-    char what[192];
-    if (!gdr_mesh_clusters_check_hierarchy(c, what, sizeof what))
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'LODH': mesh %u: %s", st->name, m, what);
     return GDR_OK;
 }
 
-/* Every hierarchy is checked whole (gdr_mesh_clusters_check_hierarchy) against the clusters read. */
+typedef struct hierarchy_decode {
+    cache_read_state *st;
+    const reader *data;
+    size_t *at; /* per mesh: its nodes' offset in data */
+} hierarchy_decode;
+
+/* Mesh m's nodes, then the whole hierarchy checked against the mesh's clusters. */
+static gdr_status decode_mesh_hierarchy(void *user, uint32_t m, gdr_error *err)
+{
+    const hierarchy_decode *d = user;
+    gdr_mesh_clusters *c = &d->st->scene->meshes[m].clusters;
+    if (c->lod_node_count == 0)
+        return GDR_OK;
+    reader r = {d->data->data, d->data->size, d->at[m], 0};
+    for (uint32_t k = 0; k < c->lod_node_count; k++) {
+        gdr_lod_node *n = &c->lod_nodes[k];
+        get_f32s(&r, &n->sphere.x, 4);
+        get_f32s(&r, &n->max_error, 1);
+        get_f32s(&r, &n->min_refined_error, 1);
+        n->first = get_u32(&r);
+        n->count = get_u32(&r);
+        n->group = get_u32(&r);
+        n->flags = get_u32(&r);
+        n->reserved[0] = get_u32(&r);
+        n->reserved[1] = get_u32(&r);
+    }
+    char what[192];
+    if (!gdr_mesh_clusters_check_hierarchy(c, what, sizeof what))
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'LODH': mesh %u: %s", d->st->name, m, what);
+    return GDR_OK;
+}
+
+/* Every hierarchy is checked whole (gdr_mesh_clusters_check_hierarchy) against the clusters read:
+ * every mesh's count placed first, in order, up to the first that fails, then the meshes placed
+ * decoded and checked at once (cache_decode.c), the first failure in mesh order refusing the file. */
 static gdr_status read_hierarchy(cache_read_state *st, reader *r, gdr_error *err)
 {
-    for (uint32_t m = 0; m < st->mesh_count; m++) {
-        gdr_status status = read_mesh_hierarchy(st, r, m, err);
-        if (status != GDR_OK)
-            return status;
+    size_t *at = malloc(sizeof *at * (st->mesh_count ? st->mesh_count : 1));
+    if (!at)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory for %u meshes", st->name,
+                             st->mesh_count);
+    gdr_status placed = GDR_OK;
+    uint32_t ready = 0;
+    uint64_t records = 0;
+    for (; ready < st->mesh_count && placed == GDR_OK; ready++) {
+        placed = place_mesh_hierarchy(st, r, ready, &at[ready], err);
+        records += st->scene->meshes[ready].clusters.lod_node_count + st->scene->meshes[ready].clusters.cluster_count;
     }
-    return expect_end(st, r, "LODH", err);
+    if (placed != GDR_OK)
+        ready--; /* the failed mesh is not decoded */
+    hierarchy_decode d = {st, r, at};
+    gdr_status status = cache_decode_meshes(ready, records, decode_mesh_hierarchy, &d, err);
+    free(at);
+    if (status != GDR_OK)
+        return status;
+    return placed != GDR_OK ? placed : expect_end(st, r, "LODH", err);
 }
 
 /* --- MATL: materials --------------------------------------------------------------------------- */

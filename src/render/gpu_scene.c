@@ -3,10 +3,12 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "gdr/geometry.h" /* gdr_lod_enclosing_sphere */
 #include "gpu_shared/raster_bin.h"
 #include "render/renderer_internal.h"
+#include "render/cluster_records.h"
 #include "render/frame.h"
 #include "render/gpu_scene.h"
 #include "render/page_table.h"
@@ -41,7 +43,6 @@ static gdr_status gather_clusters(const gdr_scene *scene, const gdr_mesh_cluster
     return GDR_OK;
 }
 
-/* Cluster i of c with pool-global data offsets and its groups' LOD data inline. */
 /* The clusters of each mesh per tiny size class (raster_bin.h), GDR_SW_TINY_CLASSES + 1 counts per
  * mesh, the last the clusters of no class: the tiny classes' counts size their parts of the
  * visible-cluster list. */
@@ -55,30 +56,6 @@ static uint32_t *count_tiny_clusters(uint32_t mesh_count, const GdrGpuMesh *mesh
             tiny[m * stride + gdr_raster_tiny_class(k->vertex_count, k->triangle_count)]++;
         }
     return tiny;
-}
-
-static GdrGpuMeshlet gpu_meshlet_from(const gdr_mesh_clusters *c, uint32_t i, uint32_t vertex_base, uint32_t byte_base)
-{
-    const gdr_cluster *k = &c->clusters[i];
-    GdrGpuMeshlet m = {
-        .vertex_offset = vertex_base + k->vertex_offset, .triangle_offset = byte_base + k->triangle_offset,
-        .vertex_count = k->vertex_count, .triangle_count = k->triangle_count, .sphere = k->sphere,
-        .cone_apex = k->cone_apex, .cone_cutoff = k->cone_cutoff, .cone_axis = k->cone_axis,
-        .group = k->group, .refined_group = k->refined_group,
-        .group_depth = 0, .refined_depth = -1, .group_error = INFINITY, .refined_error = 0.0f};
-    if (k->group != GDR_NO_INDEX) {
-        const gdr_cluster_group *g = &c->groups[k->group];
-        m.group_depth = (int32_t)g->depth;
-        m.group_sphere = g->sphere;
-        m.group_error = g->error;
-    }
-    if (k->refined_group != GDR_NO_INDEX) {
-        const gdr_cluster_group *g = &c->groups[k->refined_group];
-        m.refined_depth = (int32_t)g->depth;
-        m.refined_sphere = g->sphere;
-        m.refined_error = g->error;
-    }
-    return m;
 }
 
 /* The root chain (GdrGpuMesh.root_chain): from a root group of one cluster, the lone clusters it was
@@ -140,10 +117,53 @@ static void set_root_shortcut(const gdr_mesh_clusters *c, GdrGpuMesh *mesh)
     mesh->root_chain = root_chain(c);
 }
 
+#define RECORD_CHUNK 16384u /* clusters a task: 2 MiB of records */
+
+/* The records of every cluster (cluster_records.c): mesh m's from the sum of the clusters, vertex
+ * references and triangle bytes before it (those offsets 0 when streamed: the pages set them). */
+static gdr_status fill_records(uint32_t mesh_count, const gdr_mesh_clusters *const *clusters, bool streamed,
+                               GdrGpuMeshlet *out, gdr_thread_pool *pool, gdr_error *err)
+{
+    size_t n = mesh_count ? mesh_count : 1;
+    uint32_t *first = malloc(3 * sizeof *first * n);
+    if (!first)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory");
+    uint32_t *vertex_base = first + n, *byte_base = first + 2 * n;
+    uint32_t records = 0, vertices = 0, bytes = 0;
+    for (uint32_t m = 0; m < mesh_count; m++) {
+        first[m] = records;
+        vertex_base[m] = streamed ? 0 : vertices;
+        byte_base[m] = streamed ? 0 : bytes;
+        records += clusters[m]->cluster_count;
+        vertices += clusters[m]->vertex_count;
+        bytes += clusters[m]->triangle_byte_count;
+    }
+    gdr_cluster_record_layout layout = {clusters, first, vertex_base, byte_base, mesh_count};
+    gdr_cluster_records_fill(out, &layout, RECORD_CHUNK, pool);
+    free(first);
+    return GDR_OK;
+}
+
+/* The set-up's threads, one per processor, where the scene has enough clusters to gain from them;
+ * NULL (the work done on this thread, the same bytes) otherwise or without threads. */
+static gdr_thread_pool *setup_pool(const gdr_mesh_clusters *const *clusters, uint32_t mesh_count)
+{
+    uint64_t records = 0;
+    for (uint32_t m = 0; m < mesh_count; m++)
+        records += clusters[m]->cluster_count;
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    uint32_t threads = cpus < 1 ? 1 : cpus > GDR_THREAD_POOL_MAX_THREADS ? GDR_THREAD_POOL_MAX_THREADS : (uint32_t)cpus;
+    gdr_thread_pool *pool = NULL;
+    gdr_error ignored = {0};
+    if (threads > 1 && records >= 2 * RECORD_CHUNK)
+        (void)gdr_thread_pool_create(threads, &pool, &ignored);
+    return pool;
+}
+
 /* The cluster pool: GdrGpuMeshlet[] with pool-global offsets, global vertex indices, and the
  * triangle bytes packed into words. Fills the meshes' meshlet fields and the task capacity. */
 static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const gdr_mesh_clusters *const *clusters,
-                                  gdr_error *err)
+                                  gdr_thread_pool *pool, gdr_error *err)
 {
     gdr_gpu_scene *g = &r->scene;
     uint64_t meshlet_total = 0, vertex_total = 0, byte_total = 0;
@@ -171,6 +191,8 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
     gdr_status status = GDR_OK;
     if (!meshlets || !vertex_refs || !words)
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory");
+    if (status == GDR_OK)
+        status = fill_records(scene->mesh_count, clusters, g->streamed, meshlets, pool, err);
     uint32_t meshlet_cursor = 0, vertex_cursor = 0, byte_cursor = 0;
     for (uint32_t m = 0; m < scene->mesh_count && status == GDR_OK; m++) {
         const gdr_mesh_clusters *c = clusters[m];
@@ -180,8 +202,6 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
         mesh->task_count = (c->level0_cluster_count + GDR_TASK_WORKGROUP_SIZE - 1) / GDR_TASK_WORKGROUP_SIZE;
         mesh->lod_cluster_count = c->cluster_count;
         mesh->lod_task_count = (c->cluster_count + GDR_TASK_WORKGROUP_SIZE - 1) / GDR_TASK_WORKGROUP_SIZE;
-        for (uint32_t i = 0; i < c->cluster_count; i++)
-            meshlets[meshlet_cursor + i] = gpu_meshlet_from(c, i, vertex_cursor, byte_cursor);
         if (c->group_count > 0)
             set_root_shortcut(c, mesh);
         meshlet_cursor += c->cluster_count;
@@ -274,38 +294,10 @@ static void size_queues(gdr_renderer *r, const gdr_scene *scene, const gdr_mesh_
     g->traversal_capacity = g->traversal_capacity ? g->traversal_capacity : 1;
 }
 
-/* Mesh c's nodes for the GPU: each gdr_lod_node's bytes, then its culling sphere, which encloses its
- * clusters' spheres (leaf) or its children's culling spheres (inner node). Children follow their
- * parent in the array (the root is node 0), so one pass from the end finds every child's first;
- * a node whose children do not follow it keeps its LOD sphere, which also holds them. */
-static void gpu_lod_nodes(const gdr_mesh_clusters *c, GdrGpuLodNode *out)
-{
-    gdr_vec4 spheres[GDR_LOD_NODE_MAX_CHILDREN];
-    for (uint32_t n = c->lod_node_count; n-- > 0;) {
-        const gdr_lod_node *node = &c->lod_nodes[n];
-        memcpy(&out[n], node, sizeof *node);
-        out[n].bounds = node->sphere;
-        bool leaf = (node->flags & GDR_LOD_NODE_LEAF) != 0;
-        if (leaf && (uint64_t)node->first + node->count <= c->cluster_count) {
-            gdr_vec4 *cluster_spheres = malloc(sizeof *cluster_spheres * (node->count ? node->count : 1));
-            for (uint32_t i = 0; cluster_spheres && i < node->count; i++)
-                cluster_spheres[i] = c->clusters[node->first + i].sphere;
-            if (cluster_spheres && node->count)
-                out[n].bounds = gdr_lod_enclosing_sphere(cluster_spheres, node->count);
-            free(cluster_spheres);
-        } else if (!leaf && node->first > n && node->count <= GDR_LOD_NODE_MAX_CHILDREN &&
-                   (uint64_t)node->first + node->count <= c->lod_node_count && node->count) {
-            for (uint32_t i = 0; i < node->count; i++)
-                spheres[i] = out[node->first + i].bounds;
-            out[n].bounds = gdr_lod_enclosing_sphere(spheres, node->count);
-        }
-    }
-}
-
-/* The LOD hierarchy pool: every mesh's nodes (gpu_lod_nodes, mesh-local indices), one after another.
+/* The LOD hierarchy pool: every mesh's nodes (gdr_lod_node_records_fill, mesh-local indices), one after another.
  * Fills the meshes' lod_node fields. */
 static gdr_status upload_lod_nodes(gdr_renderer *r, const gdr_scene *scene, const gdr_mesh_clusters *const *clusters,
-                                   gdr_error *err)
+                                   gdr_thread_pool *pool, gdr_error *err)
 {
     gdr_gpu_scene *g = &r->scene;
     uint64_t total = 0;
@@ -318,18 +310,26 @@ static gdr_status upload_lod_nodes(gdr_renderer *r, const gdr_scene *scene, cons
     if (!nodes)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory for %llu LOD nodes",
                              (unsigned long long)total);
+    uint32_t *first = malloc(sizeof *first * (scene->mesh_count ? scene->mesh_count : 1));
+    if (!first) {
+        free(nodes);
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory for %llu LOD nodes",
+                             (unsigned long long)total);
+    }
     uint32_t cursor = 0;
     for (uint32_t m = 0; m < scene->mesh_count; m++) {
         const gdr_mesh_clusters *c = clusters[m];
+        first[m] = cursor;
         g->cpu_meshes[m].lod_node_offset = cursor;
         g->cpu_meshes[m].lod_node_count = c->lod_node_count;
         g->cpu_meshes[m].lod_node_levels = c->lod_node_levels;
         bool traversed = g->cpu_meshes[m].lod_task_count > GDR_TRAVERSE_MIN_TASKS; /* as drawcull.comp decides */
         if (traversed && c->lod_node_levels > g->traversal_levels)
             g->traversal_levels = c->lod_node_levels;
-        gpu_lod_nodes(c, nodes + cursor);
         cursor += c->lod_node_count;
     }
+    gdr_lod_node_records_fill(nodes, clusters, first, scene->mesh_count, pool);
+    free(first);
     /* TRANSFER_SRC: tests read the pool back. */
     const VkBufferUsageFlags usage =
         VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
@@ -406,10 +406,12 @@ gdr_status gdr_gpu_scene_upload(gdr_renderer *r, const gdr_scene *scene, gdr_err
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory");
     if (status == GDR_OK)
         status = gather_clusters(scene, clusters, err);
+    gdr_thread_pool *pool = status == GDR_OK ? setup_pool(clusters, scene->mesh_count) : NULL;
     if (status == GDR_OK)
-        status = upload_clusters(r, scene, clusters, err);
+        status = upload_clusters(r, scene, clusters, pool, err);
     if (status == GDR_OK)
-        status = upload_lod_nodes(r, scene, clusters, err);
+        status = upload_lod_nodes(r, scene, clusters, pool, err);
+    gdr_thread_pool_destroy(pool);
     if (status == GDR_OK)
         status = gdr_page_table_create(r, clusters, scene->mesh_count, err);
     if (status == GDR_OK)

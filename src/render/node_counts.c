@@ -208,9 +208,24 @@ static int compare_u32(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* The changed nodes in ascending order into changed_list: sorted where they are few, read off the
+ * flags in one pass where they are many (the first frame changes every node: a sort of the whole
+ * scene's nodes would cost O(n log n) where the pass costs O(n)). */
+static void order_changes(gdr_node_counts *nc)
+{
+    if (nc->changed_count < nc->node_total / 16) {
+        qsort(nc->changed_list, nc->changed_count, sizeof *nc->changed_list, compare_u32);
+        return;
+    }
+    uint32_t at = 0;
+    for (uint32_t node = 0; node < nc->node_total; node++)
+        if (nc->changed[node])
+            nc->changed_list[at++] = node;
+}
+
 uint32_t gdr_node_counts_take_changes(gdr_node_counts *nc, gdr_node_run *runs, uint32_t *words)
 {
-    qsort(nc->changed_list, nc->changed_count, sizeof *nc->changed_list, compare_u32);
+    order_changes(nc);
     uint32_t count = 0;
     for (uint32_t i = 0; i < nc->changed_count; i++) {
         uint32_t node = nc->changed_list[i];
