@@ -271,10 +271,10 @@ static double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, co
 
 /* The cost of moving a (fan prepared in s->info, its area, wedges) onto b, or INFINITY where it is
  * not allowed: the quadric's mean squared distance plus the attribute error's mean over a's fan
- * (both squared lengths); sets s->choice for a's wedges and *slide2 to the largest texture slide
- * it charges. */
+ * (both squared lengths); sets s->choice for a's wedges and s->choice_slide to the texture slide
+ * each of them is charged taking it. */
 static double pair_cost(run *r, uint32_t a, uint32_t b, const uint32_t *fan, uint32_t n, double area,
-                        const uint32_t *wedges, uint32_t wedge_count, double *slide2)
+                        const uint32_t *wedges, uint32_t wedge_count)
 {
     lod_simplify_scratch *s = r->s;
     uint32_t edge_triangles = 0;
@@ -291,7 +291,6 @@ static double pair_cost(run *r, uint32_t a, uint32_t b, const uint32_t *fan, uin
     double cost = qa[10] > 0.0 ? quadric_eval(qa, q) / qa[10] : 0.0;
     uint32_t b_wedges = NONE;
     double attribute = 0.0;
-    *slide2 = 0.0;
     for (uint32_t k = 0; k < wedge_count; k++) {
         uint32_t wa = wedges[k], best = NONE;
         double best_error = INFINITY, best_slide = 0.0, e, s2;
@@ -320,7 +319,6 @@ static double pair_cost(run *r, uint32_t a, uint32_t b, const uint32_t *fan, uin
         s->choice[wa] = best;
         s->choice_slide[wa] = (float)sqrt(best_slide);
         attribute += best_error;
-        *slide2 = best_slide > *slide2 ? best_slide : *slide2;
     }
     return cost + (area > 0.0 ? attribute / area : 0.0);
 }
@@ -401,10 +399,8 @@ static double best_collapse(run *r, uint32_t a, int valid, uint32_t *target)
     uint32_t token, count = gather_neighbours(r, s->fan, n, s->neighbours, &token);
     uint32_t wedge_count = gather_wedges(r, s->fan, n, s->wedges);
     double area = prepare_fan(r, s->fan, n);
-    for (uint32_t i = 0; i < count; i++) {
-        double s2;
-        s->costs[i] = (float)pair_cost(r, a, s->neighbours[i], s->fan, n, area, s->wedges, wedge_count, &s2);
-    }
+    for (uint32_t i = 0; i < count; i++)
+        s->costs[i] = (float)pair_cost(r, a, s->neighbours[i], s->fan, n, area, s->wedges, wedge_count);
     /* the neighbours in order of cost (ties by index), the first that passes the checks */
     uint32_t *order = s->order;
     for (uint32_t i = 0; i < count; i++)
@@ -446,8 +442,7 @@ static void collapse(run *r, uint32_t a, uint32_t b)
     lod_simplify_scratch *s = r->s;
     uint32_t n = gather_fan(r, a, s->fan);
     uint32_t wedge_count = gather_wedges(r, s->fan, n, s->wedges);
-    double slide2;
-    pair_cost(r, a, b, s->fan, n, prepare_fan(r, s->fan, n), s->wedges, wedge_count, &slide2); /* sets s->choice */
+    pair_cost(r, a, b, s->fan, n, prepare_fan(r, s->fan, n), s->wedges, wedge_count); /* sets s->choice */
     for (uint32_t k = 0; k < wedge_count; k++) { /* the slide charged to the wedges a's corners take */
         uint32_t wb = s->choice[s->wedges[k]];
         float slide = s->choice_slide[s->wedges[k]];
