@@ -55,16 +55,19 @@ static inline int test_write_file(const char *path, const void *data, size_t siz
     return fclose(f) == 0 && written == size;
 }
 
+/* A whole file's bytes (malloc'ed, one byte to spare; *size set), or NULL (*size 0). */
 static inline uint8_t *test_read_file(const char *path, size_t *size)
 {
+    *size = 0;
     FILE *f = fopen(path, "rb");
     if (!f)
         return NULL;
     fseek(f, 0, SEEK_END);
     long n = ftell(f);
     fseek(f, 0, SEEK_SET);
-    uint8_t *data = malloc((size_t)n + 1);
-    *size = fread(data, 1, (size_t)n, f);
+    uint8_t *data = n >= 0 ? malloc((size_t)n + 1) : NULL;
+    if (data)
+        *size = fread(data, 1, (size_t)n, f);
     fclose(f);
     return data;
 }

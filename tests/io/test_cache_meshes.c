@@ -14,32 +14,14 @@
 #include "gdr/io.h"
 #include "gdr/paged_cache.h"
 #include "gdr/procedural.h"
+#include "io_test_helpers.h"
 #include "test_util.h"
-
-static uint8_t *read_file(const char *path, size_t *size)
-{
-    *size = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    uint8_t *bytes = malloc(n > 0 ? (size_t)n : 1);
-    if (bytes && fread(bytes, 1, (size_t)n, f) != (size_t)n) {
-        free(bytes);
-        bytes = NULL;
-    }
-    fclose(f);
-    *size = bytes ? (size_t)n : 0;
-    return bytes;
-}
 
 /* The two files hold the same bytes. */
 static int same_file(const char *a, const char *b)
 {
     size_t na, nb;
-    uint8_t *x = read_file(a, &na), *y = read_file(b, &nb);
+    uint8_t *x = test_read_file(a, &na), *y = test_read_file(b, &nb);
     int same = x && y && na == nb && memcmp(x, y, na) == 0;
     if (!same)
         fprintf(stderr, "%s (%zu bytes) and %s (%zu bytes) differ\n", a, na, b, nb);

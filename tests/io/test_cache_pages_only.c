@@ -19,29 +19,11 @@
 #include "gdr/io.h"
 #include "gdr/paged_cache.h"
 #include "io/loaders.h"
+#include "io_test_helpers.h"
 #include "test_util.h"
 
 #define FLAGS_AT 20u
 #define PAGES_ONLY 1u
-
-static uint8_t *read_file(const char *path, size_t *size)
-{
-    *size = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    uint8_t *bytes = malloc(n > 0 ? (size_t)n : 1);
-    if (bytes && fread(bytes, 1, (size_t)n, f) != (size_t)n) {
-        free(bytes);
-        bytes = NULL;
-    }
-    fclose(f);
-    *size = bytes ? (size_t)n : 0;
-    return bytes;
-}
 
 static void write_file(const char *path, const uint8_t *bytes, size_t size)
 {
@@ -346,7 +328,7 @@ int main(void)
     CHECK(gdr_cache_write(full, scene, &whole, &err) == GDR_OK);
     gdr_scene_destroy(scene);
     size_t only_size = 0, full_size = 0;
-    uint8_t *only_bytes = read_file(only, &only_size), *full_bytes = read_file(full, &full_size);
+    uint8_t *only_bytes = test_read_file(only, &only_size), *full_bytes = test_read_file(full, &full_size);
     CHECK(only_bytes && full_bytes);
     if (only_bytes && full_bytes) {
         check_sections(only_bytes, only_size, full_bytes, full_size);

@@ -17,6 +17,7 @@
 #include "gdr/paged_cache.h"
 #include "io/cache_pages.h"
 #include "io/io_internal.h"
+#include "io_test_helpers.h"
 #include "test_util.h"
 
 #define ROUNDS 7
@@ -73,23 +74,6 @@ static uint64_t floor_all(const stored_pages *sp, ZSTD_DCtx *dctx, uint8_t *scra
     return total;
 }
 
-static uint8_t *read_whole(const char *path, size_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    uint8_t *bytes = NULL;
-    long n = -1;
-    if (f && fseek(f, 0, SEEK_END) == 0 && (n = ftell(f)) > 0 && fseek(f, 0, SEEK_SET) == 0)
-        bytes = malloc((size_t)n);
-    if (bytes && fread(bytes, 1, (size_t)n, f) != (size_t)n) {
-        free(bytes);
-        bytes = NULL;
-    }
-    if (f)
-        fclose(f);
-    *size = bytes ? (size_t)n : 0;
-    return bytes;
-}
-
 int main(void)
 {
     gdr_scene *scene = NULL;
@@ -107,7 +91,7 @@ int main(void)
     gdr_paged_cache *pc = NULL;
     CHECK(gdr_paged_cache_open(path, &pc, &err) == GDR_OK);
     stored_pages sp = {0};
-    sp.file = read_whole(path, &sp.size);
+    sp.file = test_read_file(path, &sp.size);
     size_t scratch_size = CACHE_PAGE_MAX_RAW;
     uint8_t *scratch = malloc(scratch_size);
     ZSTD_DCtx *dctx = ZSTD_createDCtx();
