@@ -160,6 +160,58 @@ static gdr_thread_pool *setup_pool(const gdr_mesh_clusters *const *clusters, uin
     return pool;
 }
 
+/* Each mesh's cluster fields, offsets and root shortcut; whole (not streamed): its vertex references
+ * and triangle bytes packed into words at the pool's offsets. */
+static void pack_meshes(gdr_gpu_scene *g, uint32_t mesh_count, const gdr_mesh_clusters *const *clusters,
+                        uint32_t *vertex_refs, uint32_t *words)
+{
+    uint32_t meshlet_cursor = 0, vertex_cursor = 0, byte_cursor = 0;
+    for (uint32_t m = 0; m < mesh_count; m++) {
+        const gdr_mesh_clusters *c = clusters[m];
+        GdrGpuMesh *mesh = &g->cpu_meshes[m];
+        mesh->meshlet_offset = meshlet_cursor;
+        mesh->meshlet_count = c->level0_cluster_count;
+        mesh->task_count = (c->level0_cluster_count + GDR_TASK_WORKGROUP_SIZE - 1) / GDR_TASK_WORKGROUP_SIZE;
+        mesh->lod_cluster_count = c->cluster_count;
+        mesh->lod_task_count = (c->cluster_count + GDR_TASK_WORKGROUP_SIZE - 1) / GDR_TASK_WORKGROUP_SIZE;
+        if (c->group_count > 0)
+            set_root_shortcut(c, mesh);
+        meshlet_cursor += c->cluster_count;
+        if (g->streamed)
+            continue;
+        for (uint32_t v = 0; v < c->vertex_count; v++)
+            vertex_refs[vertex_cursor + v] = mesh->vertex_offset + c->vertices[v];
+        for (uint32_t b = 0; b < c->triangle_byte_count; b++) {
+            uint32_t at = byte_cursor + b;
+            words[at / 4] |= (uint32_t)c->triangles[b] << (8 * (at % 4));
+        }
+        vertex_cursor += c->vertex_count;
+        byte_cursor += c->triangle_byte_count;
+    }
+}
+
+/* The clusters every instance brings (level 0, the whole DAG, the tiny classes), for statistics and
+ * the task capacity. */
+static gdr_status count_instance_clusters(gdr_gpu_scene *g, const gdr_scene *scene, const GdrGpuMeshlet *meshlets,
+                                          gdr_error *err)
+{
+    uint64_t instance_meshlets = 0, instance_lod_clusters = 0, instance_tiny[GDR_SW_TINY_CLASSES] = {0};
+    uint32_t *tiny = count_tiny_clusters(scene->mesh_count, g->cpu_meshes, meshlets);
+    if (!tiny)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory");
+    for (uint32_t i = 0; i < scene->instance_count; i++) {
+        instance_meshlets += g->cpu_meshes[scene->instances[i].mesh].meshlet_count;
+        instance_lod_clusters += g->cpu_meshes[scene->instances[i].mesh].lod_cluster_count;
+        for (uint32_t k = 0; k < GDR_SW_TINY_CLASSES; k++)
+            instance_tiny[k] += tiny[scene->instances[i].mesh * (GDR_SW_TINY_CLASSES + 1) + k];
+    }
+    free(tiny);
+    g->instance_meshlet_count = instance_meshlets;
+    g->instance_lod_cluster_count = instance_lod_clusters;
+    memcpy(g->instance_tiny_cluster_count, instance_tiny, sizeof instance_tiny);
+    return GDR_OK;
+}
+
 /* The cluster pool: GdrGpuMeshlet[] with pool-global offsets, global vertex indices, and the
  * triangle bytes packed into words. Fills the meshes' meshlet fields and the task capacity. */
 static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const gdr_mesh_clusters *const *clusters,
@@ -193,43 +245,10 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory");
     if (status == GDR_OK)
         status = fill_records(scene->mesh_count, clusters, g->streamed, meshlets, pool, err);
-    uint32_t meshlet_cursor = 0, vertex_cursor = 0, byte_cursor = 0;
-    for (uint32_t m = 0; m < scene->mesh_count && status == GDR_OK; m++) {
-        const gdr_mesh_clusters *c = clusters[m];
-        GdrGpuMesh *mesh = &g->cpu_meshes[m];
-        mesh->meshlet_offset = meshlet_cursor;
-        mesh->meshlet_count = c->level0_cluster_count;
-        mesh->task_count = (c->level0_cluster_count + GDR_TASK_WORKGROUP_SIZE - 1) / GDR_TASK_WORKGROUP_SIZE;
-        mesh->lod_cluster_count = c->cluster_count;
-        mesh->lod_task_count = (c->cluster_count + GDR_TASK_WORKGROUP_SIZE - 1) / GDR_TASK_WORKGROUP_SIZE;
-        if (c->group_count > 0)
-            set_root_shortcut(c, mesh);
-        meshlet_cursor += c->cluster_count;
-        if (g->streamed)
-            continue;
-        for (uint32_t v = 0; v < c->vertex_count; v++)
-            vertex_refs[vertex_cursor + v] = mesh->vertex_offset + c->vertices[v];
-        for (uint32_t b = 0; b < c->triangle_byte_count; b++) {
-            uint32_t at = byte_cursor + b;
-            words[at / 4] |= (uint32_t)c->triangles[b] << (8 * (at % 4));
-        }
-        vertex_cursor += c->vertex_count;
-        byte_cursor += c->triangle_byte_count;
-    }
-    uint64_t instance_meshlets = 0, instance_lod_clusters = 0, instance_tiny[GDR_SW_TINY_CLASSES] = {0};
-    uint32_t *tiny = status == GDR_OK ? count_tiny_clusters(scene->mesh_count, g->cpu_meshes, meshlets) : NULL;
-    if (status == GDR_OK && !tiny)
-        status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory");
-    for (uint32_t i = 0; i < scene->instance_count && tiny; i++) {
-        instance_meshlets += g->cpu_meshes[scene->instances[i].mesh].meshlet_count;
-        instance_lod_clusters += g->cpu_meshes[scene->instances[i].mesh].lod_cluster_count;
-        for (uint32_t k = 0; k < GDR_SW_TINY_CLASSES; k++)
-            instance_tiny[k] += tiny[scene->instances[i].mesh * (GDR_SW_TINY_CLASSES + 1) + k];
-    }
-    free(tiny);
-    g->instance_meshlet_count = instance_meshlets;
-    g->instance_lod_cluster_count = instance_lod_clusters;
-    memcpy(g->instance_tiny_cluster_count, instance_tiny, sizeof instance_tiny);
+    if (status == GDR_OK)
+        pack_meshes(g, scene->mesh_count, clusters, vertex_refs, words);
+    if (status == GDR_OK)
+        status = count_instance_clusters(g, scene, meshlets, err);
     g->meshlet_count = (uint32_t)meshlet_total;
     const VkBufferUsageFlags usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     if (status == GDR_OK)
