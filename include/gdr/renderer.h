@@ -120,6 +120,11 @@ typedef struct gdr_frame_desc {
      * DAG (gdr/geometry.h, "LOD hierarchy"), testing nodes by LOD error, frustum and (late phase)
      * occlusion, instead of testing every cluster of the DAG (OFF). DEFAULT: on. The cut is the same. */
     gdr_cull_mode lod_hierarchy;
+    /* With the LOD cut by error in the visibility-buffer modes of the mesh pipeline: an instance of a
+     * mesh with a DAG whose whole mesh projects within min(lod_error_px, 1) pixels is drawn as one
+     * splat, its point level (docs/GEOMETRY.md, "The point level"), instead of its root clusters.
+     * DEFAULT: on. */
+    gdr_cull_mode point_level;
     /* Two-phase occlusion culling against the depth pyramid (indirect pipeline: instances, mesh
      * pipeline: instances, nodes and clusters; off when cull is off). DEFAULT: on for the indirect
      * pipeline, off for the mesh pipeline, where the H100 measurements found it slower on every
@@ -334,6 +339,7 @@ typedef struct gdr_frame_stats {
     uint32_t instances_invalid;
     uint32_t instances_screen_size_culled;
     uint32_t instances_clip_plane_culled;
+    uint32_t instances_points;  /* visible instances drawn as their point level (frame desc point_level) */
     uint64_t triangles;         /* drawn in the last frame */
     uint32_t draws;             /* indirect draw commands executed in the last frame */
     uint32_t draw_calls;        /* draw calls the CPU recorded per frame */

@@ -71,8 +71,15 @@ GDR_STRUCT_BEGIN(GdrGpuMesh)
     gdr_uint lod_node_count;    /* >= 1 for a mesh with clusters; node 0 of the mesh is its root */
     gdr_uint lod_node_levels;   /* levels of the mesh's hierarchy (a traversal level by level needs this many steps) */
     gdr_uint page_table_offset; /* the mesh's groups' words in GdrGpuScene.page_table (shared/residency.h) */
+    /* The point level (shared/point_level.h): below the root, an instance whose whole mesh projects
+     * within a pixel is one splat at its bounding sphere's centre. point_error: its deviation, the
+     * bounds' radius (every point of the mesh lies that near the centre); 0: no point level.
+     * point_radius: the splat's radius, that of a disc whose area is the mesh's mean projected area. */
+    float point_error;
+    float point_radius;
+    gdr_uint point_pad[2];
 GDR_STRUCT_END(GdrGpuMesh)
-GDR_ASSERT_SIZE(GdrGpuMesh, 96);
+GDR_ASSERT_SIZE(GdrGpuMesh, 112);
 GDR_ASSERT_OFFSET(GdrGpuMesh, bounds, 16);
 GDR_ASSERT_OFFSET(GdrGpuMesh, task_count, 36);
 GDR_ASSERT_OFFSET(GdrGpuMesh, root_refined_sphere, 64);
@@ -350,9 +357,10 @@ GDR_STRUCT_BEGIN(GdrGpuDrawStats)
     gdr_uint instances_screen_size_culled;
     gdr_uint instances_clip_plane_culled;
     gdr_uint instances_pvs_culled;  /* valid, in the frustum, not listed by the camera's PVS cell */
+    gdr_uint instances_points;      /* visible instances drawn as their point level (GDR_FRAME_POINTS) */
 GDR_STRUCT_END(GdrGpuDrawStats)
 GDR_ASSERT_SIZE(GdrGpuDrawStats, 64 + 8 * GDR_LOD_STATS_DEPTHS + 96 + 32 * GDR_LOD_TREE_LEVELS + 32 + 32 +
-                                     4 * GDR_LOD_TREE_LEVELS + 4);
+                                     4 * GDR_LOD_TREE_LEVELS + 8);
 GDR_ASSERT_OFFSET(GdrGpuDrawStats, draw_count, 0);
 GDR_ASSERT_OFFSET(GdrGpuDrawStats, task_groups_x, 16);
 
@@ -474,6 +482,8 @@ GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, viewport, 208);
 #define GDR_FRAME_VERTEX_COLORS 16384u /* some mesh has vertex colours (GdrGpuScene.vertex_colors) */
 #define GDR_FRAME_PARTIAL_RESIDENCY 2048u /* some LOD group is absent: read the page table (shared/residency.h) */
 #define GDR_FRAME_PVS 32768u          /* the instance cull drops instances GdrGpuFrameBuffers.pvs_visible does not list */
+#define GDR_FRAME_POINTS 65536u       /* visibility-buffer modes, LOD by error: instances within a pixel are
+                                         drawn as their point level by the instance cull (shared/point_level.h) */
 #define GDR_FRAME_DIRECT_CLUSTERS 1024u /* visibility-buffer modes: the instance cull tests the clusters of an
                                            instance that needs at most GDR_DIRECT_CLUSTERS of them and bins
                                            them itself, instead of a task command for the cluster cull */

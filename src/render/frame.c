@@ -6,6 +6,7 @@
 #include "render/renderer_internal.h"
 #include "render/frame.h"
 #include "render/frame_record.h"
+#include "gpu_shared/point_level.h"
 
 void gdr_frame_matrices(const gdr_renderer *r, const gdr_camera *camera, gdr_mat4 *projection, gdr_mat4 *view)
 {
@@ -57,6 +58,15 @@ static uint32_t frame_flags(const gdr_frame_desc *frame, bool lod, bool occlusio
            (frame->record_visible_meshlets ? GDR_FRAME_RECORD_MESHLETS : 0u) | (lod ? GDR_FRAME_LOD : 0u) |
            (lod && frame->lod_fixed_depth ? GDR_FRAME_LOD_DEPTH : 0u) | (occlusion ? GDR_FRAME_OCCLUSION : 0u) |
            (history ? GDR_FRAME_HISTORY : 0u) | (hierarchy ? GDR_FRAME_LOD_HIERARCHY : 0u);
+}
+
+/* Whether the frame draws instances within a pixel as their point level (shared/point_level.h):
+ * the visibility buffer's modes of the mesh pipeline, the LOD cut by error, a perspective camera. */
+static bool points_drawn(const gdr_renderer *r, const gdr_frame_desc *frame, gdr_pipeline pipeline, bool ortho)
+{
+    bool by_error = !frame->lod_fixed_depth && frame->lod_error_px > 0.0f;
+    return pipeline == GDR_PIPELINE_MESH && r->vis.mode != GDR_GPU_RASTER_FORWARD && by_error && !ortho &&
+           frame->point_level != GDR_CULL_OFF && r->scene.instance_count <= GDR_POINT_MAX_INSTANCES;
 }
 
 /* The levels of the LOD hierarchy traversal a frame runs: the deepest hierarchy's, where the mesh
@@ -119,7 +129,8 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
                  (r->materials.scene_flags & GDR_MATERIALS_VERTEX_COLORS ? GDR_FRAME_VERTEX_COLORS : 0u) |
                  (slot->pvs_cell_found && pipeline != GDR_PIPELINE_CPU ? GDR_FRAME_PVS : 0u) |
                  (pipeline == GDR_PIPELINE_MESH && r->vis.mode != GDR_GPU_RASTER_FORWARD ? GDR_FRAME_DIRECT_CLUSTERS
-                                                                                        : 0u),
+                                                                                        : 0u) |
+                 (points_drawn(r, frame, pipeline, ortho) ? GDR_FRAME_POINTS : 0u),
         .view_mode = (uint32_t)frame->view,
         .task_capacity = r->scene.task_capacity,
         .viewport = {(float)r->width, (float)r->height},

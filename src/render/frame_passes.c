@@ -62,11 +62,12 @@ static const gdr_pass_template draw_indexed = {
 static const gdr_pass_template cull_tasks = {
     "instance_cull", gdr_pass_record_instance_cull,
     .what = "instances (late phase: those the early one deferred): frustum, occlusion, LOD root shortcut; "
-            "appends task commands",
+            "appends task commands; draws the point level's splats",
     .uses = {{GDR_RES_DRAW_STATS, INDIRECT, INDIRECT_READ}, {GDR_RES_INSTANCES, COMPUTE, READ},
              {GDR_RES_OCCLUDED, COMPUTE, READ_WRITE}, HZB_READ(COMPUTE),
              {GDR_RES_TASKS, COMPUTE, WRITE}, {GDR_RES_DRAW_STATS, COMPUTE, READ_WRITE},
-             {GDR_RES_DRAWS, COMPUTE, WRITE}, {GDR_RES_TRAVERSAL, COMPUTE, WRITE, .flags = GDR_USE_TRAVERSAL}}};
+             {GDR_RES_DRAWS, COMPUTE, WRITE}, {GDR_RES_TRAVERSAL, COMPUTE, WRITE, .flags = GDR_USE_TRAVERSAL},
+             {GDR_RES_VISBUFFER, COMPUTE, READ_WRITE, .flags = GDR_USE_VISBUFFER}}};
 
 static const gdr_pass_template lod_traverse = {
     "lod_traverse", gdr_pass_record_lod_traverse,

@@ -78,7 +78,9 @@ void gdr_pass_record_clear(gdr_renderer *r, gdr_frame_slot *slot, const gdr_fram
 void gdr_pass_record_instance_cull(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame_pass *pass,
                                    VkCommandBuffer cmd)
 {
-    gdr_pipeline_id first = slot->plan.config.pipeline == GDR_PIPELINE_MESH ? GDR_PIPE_CULL_TASKS : GDR_PIPE_CULL_DRAWS;
+    gdr_pipeline_id first = slot->plan.config.pipeline != GDR_PIPELINE_MESH ? GDR_PIPE_CULL_DRAWS
+                            : slot->plan.config.visbuffer            ? GDR_PIPE_CULL_POINTS
+                                                                     : GDR_PIPE_CULL_TASKS;
     bind_compute(r, cmd, first + pass->phase);
     if (pass->phase == GDR_PHASE_LATE) /* the instances the early phase deferred */
         vkCmdDispatchIndirect(cmd, slot->draw_stats.buffer, offsetof(GdrGpuDrawStats, late_instances));

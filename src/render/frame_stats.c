@@ -40,6 +40,7 @@ static void fill_gpu_driven(const gdr_frame_slot *slot, const GdrGpuDrawStats *g
     stats->instances_invalid = gpu->instances_invalid;
     stats->instances_screen_size_culled = gpu->instances_screen_size_culled;
     stats->instances_clip_plane_culled = gpu->instances_clip_plane_culled;
+    stats->instances_points = gpu->instances_points;
     stats->draws = slot->pipeline == GDR_PIPELINE_MESH
                        ? gpu->task_groups_x * gpu->task_groups_y + gpu->late_task_groups_x * gpu->late_task_groups_y
                        : gpu->draw_count + gpu->late_draw_count;

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "gdr/geometry.h" /* gdr_lod_enclosing_sphere */
+#include "gpu_shared/point_level.h"
 #include "gpu_shared/raster_bin.h"
 #include "render/renderer_internal.h"
 #include "render/cluster_records.h"
@@ -360,6 +361,31 @@ static gdr_status upload_lod_nodes(gdr_renderer *r, const gdr_scene *scene, cons
     return status;
 }
 
+/* The surface area of a mesh's triangles (mesh units squared). */
+static float surface_area(const gdr_mesh *mesh)
+{
+    double area = 0.0;
+    for (uint32_t t = 0; t + 2 < mesh->index_count; t += 3) {
+        gdr_vec3 a = mesh->positions[mesh->indices[t]], b = mesh->positions[mesh->indices[t + 1]];
+        gdr_vec3 c = mesh->positions[mesh->indices[t + 2]];
+        gdr_vec3 u = {b.x - a.x, b.y - a.y, b.z - a.z}, v = {c.x - a.x, c.y - a.y, c.z - a.z};
+        double x = (double)u.y * v.z - (double)u.z * v.y, y = (double)u.z * v.x - (double)u.x * v.z;
+        double z = (double)u.x * v.y - (double)u.y * v.x;
+        area += 0.5 * sqrt(x * x + y * y + z * z);
+    }
+    return (float)area;
+}
+
+/* The point level of a mesh with a LOD DAG whose triangles are at hand (shared/point_level.h); a
+ * streamed mesh, whose triangles stay in the file, has none. */
+static void set_point_level(const gdr_mesh *mesh, bool streamed, GdrGpuMesh *out)
+{
+    if (streamed || mesh->clusters.group_count == 0 || !(mesh->bounds.w > 0.0f))
+        return;
+    out->point_error = mesh->bounds.w;
+    out->point_radius = gdr_point_radius(surface_area(mesh), mesh->bounds.w);
+}
+
 /* Every mesh's vertices and indices into the pool's arrays, the meshes' offsets and the instances
  * into the host copies. */
 static void merge_geometry(gdr_renderer *r, const gdr_scene *scene, GdrGpuVertex *vertices, uint32_t *indices)
@@ -370,6 +396,7 @@ static void merge_geometry(gdr_renderer *r, const gdr_scene *scene, GdrGpuVertex
         const gdr_mesh *mesh = &scene->meshes[m];
         g->cpu_meshes[m] = (GdrGpuMesh){.vertex_offset = vertex_cursor, .first_index = index_cursor,
                                         .index_count = mesh->index_count, .bounds = mesh->bounds};
+        set_point_level(mesh, g->streamed, &g->cpu_meshes[m]);
         if (g->streamed) /* no vertex pipeline: the vertices come with the pages */
             continue;
         for (uint32_t v = 0; v < mesh->vertex_count; v++)

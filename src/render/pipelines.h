@@ -26,7 +26,8 @@ typedef enum gdr_pipeline_id {
     GDR_PIPE_RASTER_SW,
     GDR_PIPE_RASTER_SW_TINY,    /* the compute rasteriser's tiny variants, per size class (GDR_SW_TINY_CLASSES) */
     GDR_PIPE_RESOLVE = GDR_PIPE_RASTER_SW_TINY + 3,
-    GDR_PIPE_COUNT
+    GDR_PIPE_CULL_POINTS,       /* the visibility buffer's instance cull: task commands and point splats, per phase */
+    GDR_PIPE_COUNT = GDR_PIPE_CULL_POINTS + 3
 } gdr_pipeline_id;
 
 /* What a pipeline needs of the device beyond Vulkan 1.3. */

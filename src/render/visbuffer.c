@@ -9,6 +9,7 @@
 #include "vk/vk_pipeline.h"
 #include "render/frame.h"
 #include "render/frame_record.h"
+#include "gpu_shared/point_level.h"
 
 gdr_status gdr_visbuffer_create(gdr_renderer *r, bool disabled, gdr_error *err)
 {
@@ -318,13 +319,24 @@ gdr_status gdr_visbuffer_read_pixels(gdr_renderer *r, gdr_visbuffer_pixel *pixel
         pixels[p] = (gdr_visbuffer_pixel){0.0f, UINT32_MAX, 0, 0};
         if (depth_bits == 0)
             continue;
+        memcpy(&pixels[p].depth, &depth_bits, sizeof depth_bits);
+        if ((id & ((1u << GDR_VISBUFFER_TRIANGLE_BITS) - 1u)) == GDR_VISBUFFER_POINT_TRIANGLE) {
+            if (slot >= r->scene.instance_count) {
+                status = gdr_error_set(err, GDR_ERROR_VULKAN, "visibility buffer: pixel %zu names point %u of %u", p,
+                                       slot, r->scene.instance_count);
+                break;
+            }
+            pixels[p].instance = slot; /* a point level's splat: the instance, no cluster */
+            pixels[p].meshlet = UINT32_MAX;
+            pixels[p].triangle = GDR_VISBUFFER_POINT_TRIANGLE;
+            continue;
+        }
         if (slot >= v->slots) {
             status = gdr_error_set(err, GDR_ERROR_VULKAN, "visibility buffer: pixel %zu names slot %u of %u", p, slot,
                                    v->slots);
             break;
         }
         const GdrGpuRasterCluster *entry = (const GdrGpuRasterCluster *)clusters.mapped + slot;
-        memcpy(&pixels[p].depth, &depth_bits, sizeof depth_bits);
         pixels[p].instance = entry->instance;
         pixels[p].meshlet = entry->meshlet;
         pixels[p].triangle = id & ((1u << GDR_VISBUFFER_TRIANGLE_BITS) - 1u);

@@ -86,8 +86,8 @@ void gdr_visbuffer_stats(gdr_renderer *r, uint32_t slot_index, gdr_frame_stats *
 typedef struct gdr_visbuffer_pixel {
     float depth;       /* 0: empty */
     uint32_t instance; /* UINT32_MAX when empty */
-    uint32_t meshlet;  /* global cluster index */
-    uint32_t triangle;
+    uint32_t meshlet;  /* global cluster index; UINT32_MAX for a point level's splat */
+    uint32_t triangle; /* GDR_VISBUFFER_POINT_TRIANGLE for a point level's splat */
 } gdr_visbuffer_pixel;
 
 /* Reads back the visibility buffer of the last frame (width * height pixels, rows top first). */

@@ -8,6 +8,9 @@
 // group's), or as the root of its LOD hierarchy queued for the traversal (lodtraverse.comp).
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#ifdef GDR_POINT_SPLATS
+#extension GL_EXT_shader_atomic_int64 : require
+#endif
 
 #include "gpu_shared/glsl_buffers.h"
 #include "math/cull_math.h"
@@ -17,6 +20,9 @@
 #include "gpu_shared/meshlet_payload.h"
 #include "gpu_shared/cluster_cull.h"
 #include "gpu_shared/raster_bin.h"
+#ifdef GDR_POINT_SPLATS
+#include "gpu_shared/point_level.h"
+#endif
 
 layout(local_size_x = GDR_CULL_WORKGROUP_SIZE) in;
 layout(constant_id = 0) const bool EMIT_TASKS = false;
@@ -195,6 +201,21 @@ void main()
         visible = visible && !occluded;
     }
 
+    // The point level (the visibility buffer's variant): an instance within a pixel is its splat,
+    // drawn here; its clusters are not.
+    bool point = false;
+#ifdef GDR_POINT_SPLATS
+    point = visible && (g.flags & GDR_FRAME_POINTS) != 0u &&
+            gdr_point_level_passes(mesh.bounds, mesh.point_error, model[0].xyz, model[1].xyz, model[2].xyz,
+                                   model[3].xyz, g.camera_position.xyz, g.lod_znear, g.lod_projection_scale,
+                                   g.lod_threshold);
+    if (point)
+        gdr_point_splat(g, id, world_center,
+                        mesh.point_radius * gdr_max_axis_scale(model[0].xyz, model[1].xyz, model[2].xyz));
+    GDR_COUNT(stats, instances_points, point);
+#endif
+    bool clusters = visible && !point;
+
     uvec4 ballot = subgroupBallot(visible);
     uint subgroup_count = subgroupBallotBitCount(ballot);
     // The meshlet pipeline counts the triangles its mesh shader emits instead.
@@ -212,11 +233,11 @@ void main()
     base = subgroupBroadcastFirst(base);
     if (EMIT_TASKS) {
         bool traverse = false;
-        GdrTaskRange range = visible ? task_range(g, mesh_index, mesh, model, traverse) : GdrTaskRange(0u, 0u, 0u, 0u);
+        GdrTaskRange range = clusters ? task_range(g, mesh_index, mesh, model, traverse) : GdrTaskRange(0u, 0u, 0u, 0u);
         bool direct_frame = (g.flags & GDR_FRAME_DIRECT_CLUSTERS) != 0u;
-        bool direct = direct_frame && visible && !traverse && range.count <= GDR_DIRECT_CLUSTERS;
-        gdr_append_tasks(g, PHASE, visible && !direct, id, range);
-        gdr_queue_visits(g, PHASE, 0u, traverse && visible ? 1u : 0u, id, 0u, 0u);
+        bool direct = direct_frame && clusters && !traverse && range.count <= GDR_DIRECT_CLUSTERS;
+        gdr_append_tasks(g, PHASE, clusters && !direct, id, range);
+        gdr_queue_visits(g, PHASE, 0u, traverse && clusters ? 1u : 0u, id, 0u, 0u);
         if (direct_frame)
             cull_direct_clusters(g, direct, id, range);
         // The visible instances, for read-backs (each is drawn in one phase only).

@@ -18,6 +18,7 @@
 #include "gpu_shared/meshlet_payload.h"
 #include "gpu_shared/shading.h"
 #include "gpu_shared/visbuffer.h"
+#include "gpu_shared/point_level.h"
 
 layout(local_size_x = GDR_RESOLVE_TILE, local_size_y = GDR_RESOLVE_TILE) in;
 layout(set = 0, binding = 1, rgba8) uniform writeonly image2D color_target;
@@ -34,10 +35,37 @@ vec3 barycentrics(vec3 x_row, vec3 y_row)
     return b / (b.x + b.y + b.z);
 }
 
+// Shades a pixel of instance `index`'s point level (shared/point_level.h): a disc facing the eye
+// at the bounding sphere's centre, the material read at its coarsest mip (derivatives of a whole
+// texture per pixel: the texture's mean), the instance colour without vertex colours.
+vec4 shade_point(FrameGlobalsRef globals, uint index)
+{
+    GdrGpuInstance instance = InstancesRef(GDR_SCENE.instances).items[index];
+    GdrGpuMesh mesh = MeshesRef(GDR_SCENE.meshes).items[instance.mesh];
+    vec3 position = (instance.model * vec4(mesh.bounds.xyz, 1.0)).xyz;
+    vec3 n = normalize(globals.value.eye_position.xyz - position);
+    if (globals.value.view_mode != GDR_VIEW_SHADED) {
+        uint root = mesh.meshlet_offset + mesh.root_first;
+        vec3 albedo = gdr_view_albedo(globals.value.view_mode, instance.color.rgb, index, root, 0u,
+                                      MeshletsRef(GDR_SCENE.meshlets).items[root].group_depth + 1);
+        return gdr_shade(globals.value.light_direction.xyz, n, position, albedo);
+    }
+    // One pixel's step along the view's right and down axes at the centre's distance.
+    mat4 view = globals.value.view;
+    float pixel = length(globals.value.eye_position.xyz - position) / globals.value.lod_projection_scale;
+    vec3 right = vec3(view[0][0], view[1][0], view[2][0]) * pixel;
+    vec3 down = -vec3(view[0][1], view[1][1], view[2][1]) * pixel;
+    GdrSurfacePoint point = GdrSurfacePoint(position, n, vec2(0.5), instance.color, vec2(1.0, 0.0), vec2(0.0, 1.0),
+                                            right, down);
+    return gdr_shade_material(instance.material, point, globals);
+}
+
 // Shades the pixel whose centre is `centre` (framebuffer pixels, y down) from its id.
 vec4 shade_pixel(FrameGlobalsRef globals, vec2 viewport, vec2 centre, uint id)
 {
     uint triangle = id & GDR_VISBUFFER_TRIANGLE_MASK;
+    if (triangle == GDR_VISBUFFER_POINT_TRIANGLE)
+        return shade_point(globals, id >> GDR_VISBUFFER_TRIANGLE_BITS);
     GdrGpuRasterCluster entry =
         RasterClustersRef(RasterParamsRef(GDR_FRAME.raster).value.clusters).items[id >> GDR_VISBUFFER_TRIANGLE_BITS];
     MeshletsRef meshlets = MeshletsRef(GDR_SCENE.meshlets);

@@ -112,7 +112,10 @@ static void run_scene(const char *spec)
     for (size_t k = 0; whole && r && a && b && k < sizeof cases / sizeof cases[0]; k++) {
         gdr_frame_desc frame = {.camera = nearer(scene, 0.7f), .pipeline = GDR_PIPELINE_MESH,
                                 .read_back = true, .lod_error_px = 1.0f, .raster = cases[k].raster,
-                                .occlusion = cases[k].occlusion, .view = cases[k].view};
+                                .occlusion = cases[k].occlusion, .view = cases[k].view,
+                                /* a streamed mesh has no point level (its triangles stay in the
+                                 * file: docs/GEOMETRY.md, "The point level"): both draw without */
+                                .point_level = GDR_CULL_OFF};
         gdr_frame_stats ws = {0}, ss = {0};
         /* Then four more frames each: occlusion culling tests against the frame before, and both
          * reach the same history. */

@@ -66,7 +66,7 @@ typedef struct bench_options {
     uint32_t lod_error_count;
     bool occlusion_modes[2], occlusion_given;
     uint32_t occlusion_count;
-    bool validate, has_camera, record_every_frame, lod_hierarchy;
+    bool validate, has_camera, record_every_frame, lod_hierarchy, point_level;
     gdr_pipeline pipelines[3];
     uint32_t pipeline_count;
     gdr_vec3 camera_position;
@@ -121,6 +121,8 @@ static bool parse_option(const char *arg, const char *value, bench_options *o)
         return o->has_camera = cli_parse_camera(arg, value, &o->camera_position, &o->camera_rotation);
     if (strcmp(arg, "--lod-hierarchy") == 0)
         return cli_parse_on_off(arg, value, &o->lod_hierarchy);
+    if (strcmp(arg, "--point-level") == 0)
+        return cli_parse_on_off(arg, value, &o->point_level);
     if (strcmp(arg, "--lod-errors") == 0)
         return parse_lod_errors(value, o->lod_errors, &o->lod_error_count);
     if (strcmp(arg, "--occlusion") == 0)
@@ -147,7 +149,7 @@ static int parse_bench_options(int argc, char **argv, bench_options *o)
 {
     *o = (bench_options){.sizes = {1000, 10000, 100000, 1000000}, .size_count = 4, .frames = 20, .width = 1920,
                          .height = 1080, .lod_errors = {1.0f}, .lod_error_count = 1, .occlusion_modes = {true, false},
-                         .occlusion_count = 1, .lod_hierarchy = true, .pipelines = {GDR_PIPELINE_DEFAULT},
+                         .occlusion_count = 1, .lod_hierarchy = true, .point_level = true, .pipelines = {GDR_PIPELINE_DEFAULT},
                          .pipeline_count = 1};
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i], *value;
@@ -162,7 +164,7 @@ static int parse_bench_options(int argc, char **argv, bench_options *o)
         /* The options that take a value (an unknown one is reported as such). */
         static const char *const known[] = {
             "--sizes", "--frames", "--width", "--height", "--device", "--camera", "--json", "--scene",
-            "--camera-path", "--plot", "--plot-from", "--lod-hierarchy", "--lod-errors", "--occlusion",
+            "--camera-path", "--plot", "--plot-from", "--lod-hierarchy", "--point-level", "--lod-errors", "--occlusion",
             "--pipelines", NULL};
         if (!(value = cli_known_value("bench", known, argc, argv, &i)) || !parse_option(arg, value, o))
             return 2;
@@ -182,7 +184,8 @@ static gdr_frame_desc run_frame(const bench_options *o, const gdr_scene *scene, 
                             .occlusion = !o->occlusion_given ? GDR_CULL_DEFAULT
                                          : occlusion         ? GDR_CULL_ON
                                                              : GDR_CULL_OFF,
-                            .lod_hierarchy = o->lod_hierarchy ? GDR_CULL_ON : GDR_CULL_OFF};
+                            .lod_hierarchy = o->lod_hierarchy ? GDR_CULL_ON : GDR_CULL_OFF,
+                            .point_level = o->point_level ? GDR_CULL_ON : GDR_CULL_OFF};
     if (o->has_camera) {
         frame.camera.position = o->camera_position;
         frame.camera.rotation = o->camera_rotation;

@@ -18,7 +18,7 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
 {
     *o = (render_options){.width = 1280, .height = 720, .frames = 1, .cull = true, .meshlet_cull = true,
                           .cone_cull = true, .triangle_cull = true, .lod_error = 1.0f, .occlusion = true,
-                          .lod_hierarchy = true};
+                          .lod_hierarchy = true, .point_level = true};
     o->load.warning = cli_warning;
     o->load.warning_user = &o->warnings;
     o->load.report = &o->report;
@@ -58,7 +58,7 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
         static const char *const known[] = {
             "--out", "-o", "--stats", "--width", "--height", "--frames", "--camera-path", "--settle", "--camera",
             "--camera-index", "--cull", "--meshlet-cull", "--cone-cull", "--triangle-cull", "--occlusion",
-            "--lod-hierarchy", "--pipeline", "--raster", "--sw-threshold", "--view", "--lod-error",
+            "--lod-hierarchy", "--point-level", "--pipeline", "--raster", "--sw-threshold", "--view", "--lod-error",
             "--min-screen-size", "--clip-plane", "--lod-depth", "--device", "--geometry-budget",
             "--upload-budget", "--cache-dir", "--cache-max", "--budget", "--pvs", NULL};
         if (!(value = cli_known_value(command, known, argc, argv, &i)))
@@ -99,6 +99,8 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
         }
         else if (strcmp(arg, "--lod-hierarchy") == 0)
             ok = cli_parse_on_off(arg, value, &o->lod_hierarchy);
+        else if (strcmp(arg, "--point-level") == 0)
+            ok = cli_parse_on_off(arg, value, &o->point_level);
         else if (strcmp(arg, "--pipeline") == 0)
             ok = cli_parse_pipeline(arg, value, &o->pipeline);
         else if (strcmp(arg, "--raster") == 0)
@@ -178,6 +180,7 @@ gdr_frame_desc render_options_frame(const render_options *o, gdr_camera camera)
                                          : o->occlusion       ? GDR_CULL_ON
                                                              : GDR_CULL_OFF,
                             .lod_hierarchy = o->lod_hierarchy ? GDR_CULL_ON : GDR_CULL_OFF,
+                            .point_level = o->point_level ? GDR_CULL_ON : GDR_CULL_OFF,
                             .min_screen_size = o->min_screen_size, .clip_plane = o->clip_plane, .pvs = o->pvs};
 }
 

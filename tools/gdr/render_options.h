@@ -14,7 +14,7 @@ typedef struct render_options {
     const char *stats_json;
     uint32_t width, height, frames, camera_index;
     bool has_camera, has_camera_index, cull, validate;
-    bool meshlet_cull, cone_cull, triangle_cull, occlusion, occlusion_given, lod_hierarchy;
+    bool meshlet_cull, cone_cull, triangle_cull, occlusion, occlusion_given, lod_hierarchy, point_level;
     gdr_pipeline pipeline;
     gdr_cull_mode pvs;     /* --pvs on|off; DEFAULT when not given */
     gdr_raster raster;

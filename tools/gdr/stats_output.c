@@ -37,6 +37,8 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
     if (s->instances_invalid || s->instances_screen_size_culled || s->instances_clip_plane_culled)
         fprintf(out, "instances_culled    %u invalid or empty bounds, %u by screen size, %u behind the clip plane\n",
                 s->instances_invalid, s->instances_screen_size_culled, s->instances_clip_plane_culled);
+    if (s->instances_points)
+        fprintf(out, "instances_points    %u (drawn as their point level)\n", s->instances_points);
     stats_print_pvs(out, &s->pvs);
     fprintf(out, "triangles           %llu\n", (unsigned long long)s->triangles);
     if (s->pipeline == GDR_PIPELINE_MESH) {
@@ -293,6 +295,7 @@ char *stats_to_json(const stats_context *context, const gdr_frame_stats *s)
     cJSON_AddNumberToObject(root, "instances_invalid", s->instances_invalid);
     cJSON_AddNumberToObject(root, "instances_screen_size_culled", s->instances_screen_size_culled);
     cJSON_AddNumberToObject(root, "instances_clip_plane_culled", s->instances_clip_plane_culled);
+    cJSON_AddNumberToObject(root, "instances_points", s->instances_points);
     cJSON_AddStringToObject(root, "pvs", pvs_state(&s->pvs));
     cJSON_AddBoolToObject(root, "pvs_cell_found", s->pvs.cell_found);
     cJSON_AddNumberToObject(root, "pvs_cells", s->pvs.cells);
