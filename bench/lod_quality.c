@@ -231,6 +231,28 @@ static build_figures build_gdr(gdr_mesh *mesh, int repeat)
     return f;
 }
 
+/* FNV-1a over n bytes, continuing from h. */
+static uint64_t fnv1a(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *b = data;
+    for (size_t i = 0; i < n; i++)
+        h = (h ^ b[i]) * 0x100000001b3ull;
+    return h;
+}
+
+/* A hash of every byte of the DAG (clusters, vertices, triangles, groups, hierarchy): a change meant
+ * to keep the build's output can be checked bit for bit. */
+static uint64_t dag_hash(const gdr_mesh_clusters *c)
+{
+    uint64_t h = 0xcbf29ce484222325ull;
+    h = fnv1a(h, c->clusters, (size_t)c->cluster_count * sizeof *c->clusters);
+    h = fnv1a(h, c->vertices, (size_t)c->vertex_count * sizeof *c->vertices);
+    h = fnv1a(h, c->triangles, c->triangle_byte_count);
+    h = fnv1a(h, c->groups, (size_t)c->group_count * sizeof *c->groups);
+    h = fnv1a(h, c->lod_nodes, (size_t)c->lod_node_count * sizeof *c->lod_nodes);
+    return fnv1a(h, &c->dag_depth, sizeof c->dag_depth);
+}
+
 /* gdr's DAG as a flat_dag (refined error 0 for level 0, group error infinite for the root). */
 static flat_dag flatten(const gdr_mesh *mesh)
 {
@@ -467,6 +489,7 @@ static void measure_mesh(const char *name, const char *dir, int repeat, int do_s
            triangles / f.seconds[2] / 1e6, f.seconds[1] / f.seconds[2], f.peak_heap / triangles,
            (unsigned long long)f.stats.cluster_count, f.half_full * 100, f.stats.max_depth,
            (double)f.stats.dag_triangles / triangles);
+    printf("  DAG hash %016llx\n", (unsigned long long)dag_hash(&m->clusters));
     print_views(m);
     flat_dag other = {0};
     int has_other = dir && read_dag(dir, m, &other);

@@ -162,6 +162,32 @@ static uint32_t gather_neighbours(run *r, const uint32_t *fan, uint32_t n, uint3
     return k;
 }
 
+/* gather_neighbours for a position a's evaluation: also counts, per neighbour, the triangles of the
+ * fan that hold it (each triangle once), into s->edge_count. */
+static uint32_t gather_candidates(run *r, uint32_t a, const uint32_t *fan, uint32_t n, uint32_t *out)
+{
+    lod_simplify_scratch *s = r->s;
+    uint32_t k = 0, t = ++s->token;
+    s->mark[a] = t; /* not its own neighbour (a degenerate triangle) */
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t c = fan[i], base = c - c % 3;
+        uint32_t x = corner_position(r, base + (c % 3 + 1) % 3), y = corner_position(r, base + (c % 3 + 2) % 3);
+        for (uint32_t j = 0; j < 2; j++) {
+            uint32_t q = j ? y : x;
+            if (q == a || (j && y == x))
+                continue;
+            if (s->mark[q] != t) {
+                s->mark[q] = t;
+                s->slot[q] = k;
+                s->edge_count[k] = 0;
+                out[k++] = q;
+            }
+            s->edge_count[s->slot[q]]++;
+        }
+    }
+    return k;
+}
+
 static uint32_t gather_wedges(run *r, const uint32_t *fan, uint32_t n, uint32_t *out)
 {
     uint32_t k = 0;
@@ -269,26 +295,47 @@ static double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, co
     return error;
 }
 
-/* The cost of moving a (fan prepared in s->info, its area, wedges) onto b, or INFINITY where it is
- * not allowed: the quadric's mean squared distance plus the attribute error's mean over a's fan
- * (both squared lengths); sets s->choice for a's wedges and s->choice_slide to the texture slide
- * each of them is charged taking it. */
-static double pair_cost(run *r, uint32_t a, uint32_t b, const uint32_t *fan, uint32_t n, double area,
-                        const uint32_t *wedges, uint32_t wedge_count)
+/* The geometric part of the cost of moving a onto b, whose edge with a holds edge_triangles of a's
+ * triangles: the quadric's mean squared distance at b, or INFINITY where the collapse is not allowed
+ * (no triangle along a-b, or more than two; a border position not along a border edge). The whole
+ * cost is never below it (the attribute error is a sum of squares), so it orders the candidates
+ * before their attribute errors are computed. */
+static double pair_geometry(const run *r, uint32_t a, uint32_t b, uint32_t edge_triangles)
 {
-    lod_simplify_scratch *s = r->s;
-    uint32_t edge_triangles = 0;
-    for (uint32_t i = 0; i < n; i++) {
-        lod_simplify_corner *f = &s->info[i];
-        f->holds_b = f->other[0] == b || f->other[1] == b;
-        edge_triangles += f->holds_b;
-    }
+    const lod_simplify_scratch *s = r->s;
     if (edge_triangles == 0 || edge_triangles > 2 || ((s->flags[a] & FLAG_BORDER) && edge_triangles != 1))
         return INFINITY;
     double q[3];
     load(r, b, q);
     const double *qa = s->quadric + (size_t)a * QUADRIC_SIZE;
-    double cost = qa[10] > 0.0 ? quadric_eval(qa, q) / qa[10] : 0.0;
+    return qa[10] > 0.0 ? quadric_eval(qa, q) / qa[10] : 0.0;
+}
+
+/* The triangles of a's fan that hold b (each once, however many of its corners lie at b). */
+static uint32_t edge_triangles(const run *r, uint32_t b, const uint32_t *fan, uint32_t n)
+{
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t c = fan[i], base = c - c % 3;
+        k += corner_position(r, base + (c % 3 + 1) % 3) == b || corner_position(r, base + (c % 3 + 2) % 3) == b;
+    }
+    return k;
+}
+
+/* The cost of moving a (fan prepared in s->info, its area, wedges) onto b, its geometric part
+ * (pair_geometry, finite) given: that plus the attribute error's mean over a's fan (both squared
+ * lengths); sets s->choice for a's wedges and s->choice_slide to the texture slide each of them is
+ * charged taking it. */
+static double pair_cost(run *r, uint32_t b, double geometry, const uint32_t *fan, uint32_t n, double area,
+                        const uint32_t *wedges, uint32_t wedge_count)
+{
+    lod_simplify_scratch *s = r->s;
+    for (uint32_t i = 0; i < n; i++) {
+        lod_simplify_corner *f = &s->info[i];
+        f->holds_b = f->other[0] == b || f->other[1] == b;
+    }
+    double q[3];
+    load(r, b, q);
     uint32_t b_wedges = NONE;
     double attribute = 0.0;
     for (uint32_t k = 0; k < wedge_count; k++) {
@@ -320,7 +367,7 @@ static double pair_cost(run *r, uint32_t a, uint32_t b, const uint32_t *fan, uin
         s->choice_slide[wa] = (float)sqrt(best_slide);
         attribute += best_error;
     }
-    return cost + (area > 0.0 ? attribute / area : 0.0);
+    return geometry + (area > 0.0 ? attribute / area : 0.0);
 }
 
 /* --- validity ----------------------------------------------------------------------------------------- */
@@ -385,6 +432,50 @@ static int keeps_topology(run *r, uint32_t a, uint32_t b, const uint32_t *fan, u
 
 /* --- collapses ------------------------------------------------------------------------------------------ */
 
+/* One evaluation of a position a: its fan, neighbours and wedges; per neighbour the cost of moving
+ * onto it as far as computed (exact[i]: the whole cost, else its geometric part, a lower bound);
+ * the fan's attribute frames once the first whole cost needs them. */
+typedef struct evaluation {
+    uint32_t a, n, count, wedge_count;
+    double area; /* the fan's area, once prepared (prepared) */
+    int prepared;
+} evaluation;
+
+/* Neighbour i's whole cost (as the float the order compares). */
+static void settle_cost(run *r, evaluation *e, uint32_t i)
+{
+    lod_simplify_scratch *s = r->s;
+    if (!e->prepared) {
+        e->area = prepare_fan(r, s->fan, e->n);
+        e->prepared = 1;
+    }
+    s->costs[i] = (float)pair_cost(r, s->neighbours[i], s->geometry[i], s->fan, e->n, e->area, s->wedges,
+                                   e->wedge_count);
+    s->exact[i] = 1;
+}
+
+/* The neighbour not yet taken with the smallest cost (ties by position index), INFINITY's included,
+ * or NONE when all are taken. A geometric part is a lower bound of its whole cost (both as floats),
+ * so only the candidate that leads by its lower bound has its whole cost computed; the order is the
+ * one the whole costs give. */
+static uint32_t next_cheapest(run *r, evaluation *e)
+{
+    lod_simplify_scratch *s = r->s;
+    for (;;) {
+        uint32_t m = NONE;
+        for (uint32_t j = 0; j < e->count; j++) {
+            if (s->taken[j])
+                continue;
+            if (m == NONE || s->costs[j] < s->costs[m] ||
+                (s->costs[j] == s->costs[m] && s->neighbours[j] < s->neighbours[m]))
+                m = j;
+        }
+        if (m == NONE || s->exact[m])
+            return m;
+        settle_cost(r, e, m);
+    }
+}
+
 /* a's cheapest collapse; with `valid`, the cheapest that passes the checks. Returns its cost
  * (INFINITY: none) and target. */
 static double best_collapse(run *r, uint32_t a, int valid, uint32_t *target)
@@ -393,34 +484,28 @@ static double best_collapse(run *r, uint32_t a, int valid, uint32_t *target)
     *target = NONE;
     if (r->in->locked[a] || (s->flags[a] & FLAG_REMOVED) || (valid && s->pass[a] == r->pass))
         return INFINITY;
-    uint32_t n = gather_fan(r, a, s->fan);
-    if (n == 0)
+    evaluation e = {.a = a, .n = gather_fan(r, a, s->fan)};
+    if (e.n == 0)
         return INFINITY;
-    uint32_t token, count = gather_neighbours(r, s->fan, n, s->neighbours, &token);
-    uint32_t wedge_count = gather_wedges(r, s->fan, n, s->wedges);
-    double area = prepare_fan(r, s->fan, n);
-    for (uint32_t i = 0; i < count; i++)
-        s->costs[i] = (float)pair_cost(r, a, s->neighbours[i], s->fan, n, area, s->wedges, wedge_count);
+    e.count = gather_candidates(r, a, s->fan, e.n, s->neighbours);
+    e.wedge_count = gather_wedges(r, s->fan, e.n, s->wedges);
+    for (uint32_t i = 0; i < e.count; i++) {
+        s->geometry[i] = pair_geometry(r, a, s->neighbours[i], s->edge_count[i]);
+        s->costs[i] = (float)s->geometry[i];
+        s->exact[i] = !(s->geometry[i] < INFINITY);
+        s->taken[i] = 0;
+    }
     /* the neighbours in order of cost (ties by index), the first that passes the checks */
-    uint32_t *order = s->order;
-    for (uint32_t i = 0; i < count; i++)
-        order[i] = s->neighbours[i];
-    float *cost = s->costs;
-    for (uint32_t i = 0; i < count; i++) {
-        uint32_t m = i;
-        for (uint32_t j = i + 1; j < count; j++)
-            if (cost[j] < cost[m] || (cost[j] == cost[m] && order[j] < order[m]))
-                m = j;
-        float tc = cost[i];
-        uint32_t to = order[i];
-        cost[i] = cost[m], order[i] = order[m], cost[m] = tc, order[m] = to;
-        if (!(cost[i] < INFINITY))
+    for (uint32_t m; (m = next_cheapest(r, &e)) != NONE;) {
+        s->taken[m] = 1;
+        uint32_t b = s->neighbours[m];
+        if (!(s->costs[m] < INFINITY))
             return INFINITY;
-        if (valid && s->pass[order[i]] == r->pass)
+        if (valid && s->pass[b] == r->pass)
             continue;
-        if (!valid || (keeps_orientation(r, a, order[i], s->fan, n) && keeps_topology(r, a, order[i], s->fan, n))) {
-            *target = order[i];
-            return cost[i];
+        if (!valid || (keeps_orientation(r, a, b, s->fan, e.n) && keeps_topology(r, a, b, s->fan, e.n))) {
+            *target = b;
+            return s->costs[m];
         }
     }
     return INFINITY;
@@ -442,7 +527,8 @@ static void collapse(run *r, uint32_t a, uint32_t b)
     lod_simplify_scratch *s = r->s;
     uint32_t n = gather_fan(r, a, s->fan);
     uint32_t wedge_count = gather_wedges(r, s->fan, n, s->wedges);
-    pair_cost(r, a, b, s->fan, n, prepare_fan(r, s->fan, n), s->wedges, wedge_count); /* sets s->choice */
+    pair_cost(r, b, pair_geometry(r, a, b, edge_triangles(r, b, s->fan, n)), s->fan, n, prepare_fan(r, s->fan, n), s->wedges,
+              wedge_count); /* sets s->choice */
     for (uint32_t k = 0; k < wedge_count; k++) { /* the slide charged to the wedges a's corners take */
         uint32_t wb = s->choice[s->wedges[k]];
         float slide = s->choice_slide[s->wedges[k]];
@@ -488,9 +574,11 @@ static int reserve(lod_simplify_scratch *s, const lod_simplify_input *in)
            LOD_RESERVE(s, head, np) && LOD_RESERVE(s, quadric, np * QUADRIC_SIZE) && LOD_RESERVE(s, flags, np) &&
            LOD_RESERVE(s, mark, np) && LOD_RESERVE(s, pass, np) && LOD_RESERVE(s, heap, np) && LOD_RESERVE(s, fan, nc) &&
            LOD_RESERVE(s, fan_b, nc) && LOD_RESERVE(s, info, nc) && LOD_RESERVE(s, neighbours, nc * 2) && LOD_RESERVE(s, near, nc * 2) &&
-           LOD_RESERVE(s, order, nc * 2) && LOD_RESERVE(s, wedges, in->vertex_count) &&
+           LOD_RESERVE(s, wedges, in->vertex_count) &&
            LOD_RESERVE(s, wedges_b, in->vertex_count) &&
            LOD_RESERVE(s, choice, in->vertex_count) && LOD_RESERVE(s, costs, nc * 2) &&
+           LOD_RESERVE(s, geometry, nc * 2) && LOD_RESERVE(s, exact, nc * 2) && LOD_RESERVE(s, taken, nc * 2) &&
+           LOD_RESERVE(s, edge_count, nc * 2) && LOD_RESERVE(s, slot, np) &&
            LOD_RESERVE(s, wedge_slide, in->vertex_count) && LOD_RESERVE(s, choice_slide, in->vertex_count);
 }
 
@@ -711,12 +799,16 @@ void lod_simplify_scratch_free(lod_simplify_scratch *s)
     free(s->info);
     free(s->neighbours);
     free(s->near);
-    free(s->order);
     free(s->wedges);
     free(s->wedges_b);
     free(s->choice);
     free(s->wedge_slide);
     free(s->choice_slide);
     free(s->costs);
+    free(s->geometry);
+    free(s->exact);
+    free(s->taken);
+    free(s->edge_count);
+    free(s->slot);
     memset(s, 0, sizeof *s);
 }

@@ -72,10 +72,20 @@ typedef struct lod_simplify_scratch {
     size_t heap_cap, heap_count;
     /* one evaluation: the moving position's corners, neighbours, wedges, the target's wedges, and
      * per wedge the wedge it takes */
-    uint32_t *fan, *fan_b, *neighbours, *near, *order, *wedges, *wedges_b, *choice;
-    size_t fan_cap, fan_b_cap, neighbours_cap, near_cap, order_cap, wedges_cap, wedges_b_cap, choice_cap;
+    uint32_t *fan, *fan_b, *neighbours, *near, *wedges, *wedges_b, *choice;
+    size_t fan_cap, fan_b_cap, neighbours_cap, near_cap, wedges_cap, wedges_b_cap, choice_cap;
     float *costs;
     size_t costs_cap;
+    /* per neighbour of the position evaluated: the geometric part of its cost, whether costs holds
+     * the whole cost (else the geometric part), whether the order has taken it */
+    double *geometry;
+    size_t geometry_cap;
+    uint8_t *exact, *taken;
+    size_t exact_cap, taken_cap;
+    uint32_t *edge_count; /* per neighbour: the fan's triangles that hold it */
+    size_t edge_count_cap;
+    uint32_t *slot;       /* per position: its index among the neighbours gathered (with mark) */
+    size_t slot_cap;
     /* per wedge: the largest texture slide (mesh length) a collapse charged to a corner taking it
      * (wedge_slide), and of the collapse evaluated, the slide charged to it taking its choice */
     float *wedge_slide, *choice_slide;
