@@ -246,33 +246,48 @@ static double prepare_fan(run *r, const uint32_t *fan, uint32_t n)
     return total;
 }
 
-/* The error of giving a fan corner the attributes of wedge wb at position q: its triangle's affine
- * uv and normal, extrapolated over its plane to q, against wb's. Returns the area-weighted squared
- * length; *slide2 gets the texture slide (squared mesh length). */
-static double corner_attribute_error(const run *r, const lod_simplify_corner *f, uint32_t wb, const double q[3],
-                                     double *slide2)
+/* For each corner of the fan whose triangle survives moving onto the target (not holds_b), its
+ * triangle's affine uv and normal extrapolated over its plane to q, the target's position (once per
+ * target: every wedge of the target is compared with them). */
+static void extrapolate_fan(const run *r, uint32_t n, const double q[3])
+{
+    for (uint32_t i = 0; i < n; i++) {
+        lod_simplify_corner *f = &r->s->info[i];
+        if (f->holds_b || f->inv_det == 0.0)
+            continue;
+        double d[3];
+        sub(q, f->p0, d);
+        double r1 = dot(d, f->e1), r2 = dot(d, f->e2);
+        double u = (f->g22 * r1 - f->g12 * r2) * f->inv_det, v = (f->g11 * r2 - f->g12 * r1) * f->inv_det;
+        if (f->uv_scale > 0.0)
+            for (int k = 0; k < 2; k++)
+                f->uv_at_q[k] = f->t0[k] + u * f->t1[k] + v * f->t2[k];
+        if (r->in->normals)
+            for (int k = 0; k < 3; k++)
+                f->normal_at_q[k] = f->n0[k] + u * f->n1[k] + v * f->n2[k];
+    }
+}
+
+/* The error of giving a fan corner the attributes of wedge wb at the target (extrapolate_fan):
+ * its triangle's uv and normal there against wb's. Returns the area-weighted squared length;
+ * *slide2 gets the texture slide (squared mesh length). */
+static double corner_attribute_error(const run *r, const lod_simplify_corner *f, uint32_t wb, double *slide2)
 {
     const lod_simplify_input *in = r->in;
     *slide2 = 0.0;
     if (f->inv_det == 0.0)
         return 0.0;
-    double d[3];
-    sub(q, f->p0, d);
-    double r1 = dot(d, f->e1), r2 = dot(d, f->e2);
-    double u = (f->g22 * r1 - f->g12 * r2) * f->inv_det, v = (f->g11 * r2 - f->g12 * r1) * f->inv_det;
     double error = 0.0;
     const uint32_t mb = in->vertex_source[wb];
     if (f->uv_scale > 0.0) {
         const gdr_vec2 tb = in->uvs[mb];
-        double du = f->t0[0] + u * f->t1[0] + v * f->t2[0] - tb.x, dv = f->t0[1] + u * f->t1[1] + v * f->t2[1] - tb.y;
+        double du = f->uv_at_q[0] - tb.x, dv = f->uv_at_q[1] - tb.y;
         *slide2 = (du * du + dv * dv) * f->uv_scale;
         error += *slide2 * UV_WEIGHT;
     }
     if (in->normals) {
         const gdr_vec3 nb = in->normals[mb];
-        double dx = f->n0[0] + u * f->n1[0] + v * f->n2[0] - nb.x;
-        double dy = f->n0[1] + u * f->n1[1] + v * f->n2[1] - nb.y;
-        double dz = f->n0[2] + u * f->n1[2] + v * f->n2[2] - nb.z;
+        double dx = f->normal_at_q[0] - nb.x, dy = f->normal_at_q[1] - nb.y, dz = f->normal_at_q[2] - nb.z;
         error += (dx * dx + dy * dy + dz * dz) * f->area * NORMAL_WEIGHT;
     }
     return error * f->area;
@@ -280,7 +295,7 @@ static double corner_attribute_error(const run *r, const lod_simplify_corner *f,
 
 /* The error of wedge wa taking wedge wb when a moves to q = b's position: over wa's triangles that
  * survive (those not holding b). */
-static double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, const double q[3], double *slide2)
+static double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, double *slide2)
 {
     double error = 0.0;
     *slide2 = 0.0;
@@ -289,7 +304,7 @@ static double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, co
         if (f->wedge != wa || f->holds_b)
             continue;
         double s2;
-        error += corner_attribute_error(r, f, wb, q, &s2);
+        error += corner_attribute_error(r, f, wb, &s2);
         *slide2 = s2 > *slide2 ? s2 : *slide2;
     }
     return error;
@@ -336,6 +351,7 @@ static double pair_cost(run *r, uint32_t b, double geometry, const uint32_t *fan
     }
     double q[3];
     load(r, b, q);
+    extrapolate_fan(r, n, q);
     uint32_t b_wedges = NONE;
     double attribute = 0.0;
     for (uint32_t k = 0; k < wedge_count; k++) {
@@ -348,7 +364,7 @@ static double pair_cost(run *r, uint32_t b, double geometry, const uint32_t *fan
             uint32_t c = fan[i], base = c - c % 3;
             for (uint32_t j = 0; j < 3; j++) {
                 uint32_t wb = s->tri[base + j];
-                if (wedge_position(r, wb) == b && wb != best && (e = wedge_error(r, n, wa, wb, q, &s2)) < best_error)
+                if (wedge_position(r, wb) == b && wb != best && (e = wedge_error(r, n, wa, wb, &s2)) < best_error)
                     best = wb, best_error = e, best_slide = s2;
             }
         }
@@ -358,7 +374,7 @@ static double pair_cost(run *r, uint32_t b, double geometry, const uint32_t *fan
                 b_wedges = gather_wedges(r, s->fan_b, m, s->wedges_b);
             }
             for (uint32_t j = 0; j < b_wedges; j++)
-                if ((e = wedge_error(r, n, wa, s->wedges_b[j], q, &s2)) < best_error || best == NONE)
+                if ((e = wedge_error(r, n, wa, s->wedges_b[j], &s2)) < best_error || best == NONE)
                     best = s->wedges_b[j], best_error = e, best_slide = s2;
         }
         if (best == NONE)
