@@ -40,6 +40,7 @@ typedef struct run {
     uint32_t pass;    /* a position moved onto in this pass neither moves nor is moved onto again */
     const lod_simplify_input *in;
     size_t triangles; /* alive */
+    int failed;       /* out of memory */
 } run;
 
 static inline uint32_t wedge_position(const run *r, uint32_t w) { return r->in->vertex_position[w]; }
@@ -118,6 +119,20 @@ static lod_simplify_heap_item heap_pop(lod_simplify_scratch *s)
 }
 
 /* --- the corners around a position ---------------------------------------------------------------- */
+
+/* Room for evaluating a fan of n corners: its frames, and its at most 2n neighbours with their
+ * costs. Sized by the largest fan met rather than the group's corners: a position's fan is a few
+ * triangles. Returns 0 (and marks the run failed) when out of memory. */
+static int reserve_fan(run *r, uint32_t n)
+{
+    lod_simplify_scratch *s = r->s;
+    size_t m = (size_t)n * 2;
+    int ok = LOD_RESERVE(s, info, n) && LOD_RESERVE(s, neighbours, m) && LOD_RESERVE(s, near, m) &&
+             LOD_RESERVE(s, costs, m) && LOD_RESERVE(s, geometry, m) && LOD_RESERVE(s, exact, m) &&
+             LOD_RESERVE(s, taken, m) && LOD_RESERVE(s, edge_count, m);
+    r->failed |= !ok;
+    return ok;
+}
 
 /* Gathers the corners of p's live triangles into s->fan (dropping dead ones from p's list). */
 static uint32_t gather_fan(run *r, uint32_t p, uint32_t *fan)
@@ -501,7 +516,7 @@ static double best_collapse(run *r, uint32_t a, int valid, uint32_t *target)
     if (r->in->locked[a] || (s->flags[a] & FLAG_REMOVED) || (valid && s->pass[a] == r->pass))
         return INFINITY;
     evaluation e = {.a = a, .n = gather_fan(r, a, s->fan)};
-    if (e.n == 0)
+    if (e.n == 0 || !reserve_fan(r, e.n))
         return INFINITY;
     e.count = gather_candidates(r, a, s->fan, e.n, s->neighbours);
     e.wedge_count = gather_wedges(r, s->fan, e.n, s->wedges);
@@ -542,6 +557,8 @@ static void collapse(run *r, uint32_t a, uint32_t b)
 {
     lod_simplify_scratch *s = r->s;
     uint32_t n = gather_fan(r, a, s->fan);
+    if (!reserve_fan(r, n))
+        return;
     uint32_t wedge_count = gather_wedges(r, s->fan, n, s->wedges);
     pair_cost(r, b, pair_geometry(r, a, b, edge_triangles(r, b, s->fan, n)), s->fan, n, prepare_fan(r, s->fan, n), s->wedges,
               wedge_count); /* sets s->choice */
@@ -573,6 +590,8 @@ static void collapse(run *r, uint32_t a, uint32_t b)
     /* b and its neighbours changed: those not in the heap are evaluated again (those in it are, lazily,
      * when they come up) */
     uint32_t m = gather_fan(r, b, s->fan), token;
+    if (!reserve_fan(r, m))
+        return;
     uint32_t *near = s->near; /* queue()'s walks overwrite s->neighbours */
     uint32_t count = gather_neighbours(r, s->fan, m, s->neighbours, &token);
     memcpy(near, s->neighbours, count * sizeof *near);
@@ -589,12 +608,9 @@ static int reserve(lod_simplify_scratch *s, const lod_simplify_input *in)
     return LOD_RESERVE(s, tri, nc) && LOD_RESERVE(s, next, nc) && LOD_RESERVE(s, alive, nc / 3 + 1) &&
            LOD_RESERVE(s, head, np) && LOD_RESERVE(s, quadric, np * QUADRIC_SIZE) && LOD_RESERVE(s, flags, np) &&
            LOD_RESERVE(s, mark, np) && LOD_RESERVE(s, pass, np) && LOD_RESERVE(s, heap, np) && LOD_RESERVE(s, fan, nc) &&
-           LOD_RESERVE(s, fan_b, nc) && LOD_RESERVE(s, info, nc) && LOD_RESERVE(s, neighbours, nc * 2) && LOD_RESERVE(s, near, nc * 2) &&
-           LOD_RESERVE(s, wedges, in->vertex_count) &&
+           LOD_RESERVE(s, fan_b, nc) && LOD_RESERVE(s, wedges, in->vertex_count) &&
            LOD_RESERVE(s, wedges_b, in->vertex_count) &&
-           LOD_RESERVE(s, choice, in->vertex_count) && LOD_RESERVE(s, costs, nc * 2) &&
-           LOD_RESERVE(s, geometry, nc * 2) && LOD_RESERVE(s, exact, nc * 2) && LOD_RESERVE(s, taken, nc * 2) &&
-           LOD_RESERVE(s, edge_count, nc * 2) && LOD_RESERVE(s, slot, np) &&
+           LOD_RESERVE(s, choice, in->vertex_count) && LOD_RESERVE(s, costs, np) && LOD_RESERVE(s, slot, np) &&
            LOD_RESERVE(s, wedge_slide, in->vertex_count) && LOD_RESERVE(s, choice_slide, in->vertex_count);
 }
 
@@ -755,7 +771,7 @@ int lod_simplify(lod_simplify_scratch *s, const lod_simplify_input *in, uint32_t
         queue(&r, p);
     size_t target = in->target_index_count / 3;
     float limit = r.triangles > target ? pass_limit(s, (r.triangles - target) / 2) : INFINITY;
-    for (;;) {
+    while (!r.failed) {
         if (s->heap_count && s->heap[0].cost > limit) { /* the pass is over */
             for (size_t i = 0; i < s->heap_count; i++)
                 s->flags[s->heap[i].position] &= (uint8_t)~FLAG_QUEUED;
@@ -789,6 +805,8 @@ int lod_simplify(lod_simplify_scratch *s, const lod_simplify_input *in, uint32_t
         collapse(&r, item.position, b);
         res->collapses++;
     }
+    if (r.failed)
+        return 0;
     size_t k = 0, nt = in->index_count / 3;
     for (size_t t = 0; t < nt; t++)
         if (s->alive[t])
