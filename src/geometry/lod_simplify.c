@@ -40,6 +40,7 @@ typedef struct run {
     uint32_t pass;    /* a position moved onto in this pass neither moves nor is moved onto again */
     const lod_simplify_input *in;
     size_t triangles; /* alive */
+    int failed;       /* out of memory */
 } run;
 
 static inline uint32_t wedge_position(const run *r, uint32_t w) { return r->in->vertex_position[w]; }
@@ -118,6 +119,20 @@ static lod_simplify_heap_item heap_pop(lod_simplify_scratch *s)
 }
 
 /* --- the corners around a position ---------------------------------------------------------------- */
+
+/* Room for evaluating a fan of n corners: its frames, and its at most 2n neighbours with their
+ * costs. Sized by the largest fan met rather than the group's corners: a position's fan is a few
+ * triangles. Returns 0 (and marks the run failed) when out of memory. */
+static int reserve_fan(run *r, uint32_t n)
+{
+    lod_simplify_scratch *s = r->s;
+    size_t m = (size_t)n * 2;
+    int ok = LOD_RESERVE(s, info, n) && LOD_RESERVE(s, neighbours, m) && LOD_RESERVE(s, near, m) &&
+             LOD_RESERVE(s, costs, m) && LOD_RESERVE(s, geometry, m) && LOD_RESERVE(s, exact, m) &&
+             LOD_RESERVE(s, taken, m) && LOD_RESERVE(s, edge_count, m);
+    r->failed |= !ok;
+    return ok;
+}
 
 /* Gathers the corners of p's live triangles into s->fan (dropping dead ones from p's list). */
 static uint32_t gather_fan(run *r, uint32_t p, uint32_t *fan)
@@ -246,33 +261,48 @@ static double prepare_fan(run *r, const uint32_t *fan, uint32_t n)
     return total;
 }
 
-/* The error of giving a fan corner the attributes of wedge wb at position q: its triangle's affine
- * uv and normal, extrapolated over its plane to q, against wb's. Returns the area-weighted squared
- * length; *slide2 gets the texture slide (squared mesh length). */
-static double corner_attribute_error(const run *r, const lod_simplify_corner *f, uint32_t wb, const double q[3],
-                                     double *slide2)
+/* For each corner of the fan whose triangle survives moving onto the target (not holds_b), its
+ * triangle's affine uv and normal extrapolated over its plane to q, the target's position (once per
+ * target: every wedge of the target is compared with them). */
+static void extrapolate_fan(const run *r, uint32_t n, const double q[3])
+{
+    for (uint32_t i = 0; i < n; i++) {
+        lod_simplify_corner *f = &r->s->info[i];
+        if (f->holds_b || f->inv_det == 0.0)
+            continue;
+        double d[3];
+        sub(q, f->p0, d);
+        double r1 = dot(d, f->e1), r2 = dot(d, f->e2);
+        double u = (f->g22 * r1 - f->g12 * r2) * f->inv_det, v = (f->g11 * r2 - f->g12 * r1) * f->inv_det;
+        if (f->uv_scale > 0.0)
+            for (int k = 0; k < 2; k++)
+                f->uv_at_q[k] = f->t0[k] + u * f->t1[k] + v * f->t2[k];
+        if (r->in->normals)
+            for (int k = 0; k < 3; k++)
+                f->normal_at_q[k] = f->n0[k] + u * f->n1[k] + v * f->n2[k];
+    }
+}
+
+/* The error of giving a fan corner the attributes of wedge wb at the target (extrapolate_fan):
+ * its triangle's uv and normal there against wb's. Returns the area-weighted squared length;
+ * *slide2 gets the texture slide (squared mesh length). */
+static double corner_attribute_error(const run *r, const lod_simplify_corner *f, uint32_t wb, double *slide2)
 {
     const lod_simplify_input *in = r->in;
     *slide2 = 0.0;
     if (f->inv_det == 0.0)
         return 0.0;
-    double d[3];
-    sub(q, f->p0, d);
-    double r1 = dot(d, f->e1), r2 = dot(d, f->e2);
-    double u = (f->g22 * r1 - f->g12 * r2) * f->inv_det, v = (f->g11 * r2 - f->g12 * r1) * f->inv_det;
     double error = 0.0;
     const uint32_t mb = in->vertex_source[wb];
     if (f->uv_scale > 0.0) {
         const gdr_vec2 tb = in->uvs[mb];
-        double du = f->t0[0] + u * f->t1[0] + v * f->t2[0] - tb.x, dv = f->t0[1] + u * f->t1[1] + v * f->t2[1] - tb.y;
+        double du = f->uv_at_q[0] - tb.x, dv = f->uv_at_q[1] - tb.y;
         *slide2 = (du * du + dv * dv) * f->uv_scale;
         error += *slide2 * UV_WEIGHT;
     }
     if (in->normals) {
         const gdr_vec3 nb = in->normals[mb];
-        double dx = f->n0[0] + u * f->n1[0] + v * f->n2[0] - nb.x;
-        double dy = f->n0[1] + u * f->n1[1] + v * f->n2[1] - nb.y;
-        double dz = f->n0[2] + u * f->n1[2] + v * f->n2[2] - nb.z;
+        double dx = f->normal_at_q[0] - nb.x, dy = f->normal_at_q[1] - nb.y, dz = f->normal_at_q[2] - nb.z;
         error += (dx * dx + dy * dy + dz * dz) * f->area * NORMAL_WEIGHT;
     }
     return error * f->area;
@@ -280,7 +310,7 @@ static double corner_attribute_error(const run *r, const lod_simplify_corner *f,
 
 /* The error of wedge wa taking wedge wb when a moves to q = b's position: over wa's triangles that
  * survive (those not holding b). */
-static double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, const double q[3], double *slide2)
+static double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, double *slide2)
 {
     double error = 0.0;
     *slide2 = 0.0;
@@ -289,7 +319,7 @@ static double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, co
         if (f->wedge != wa || f->holds_b)
             continue;
         double s2;
-        error += corner_attribute_error(r, f, wb, q, &s2);
+        error += corner_attribute_error(r, f, wb, &s2);
         *slide2 = s2 > *slide2 ? s2 : *slide2;
     }
     return error;
@@ -336,6 +366,7 @@ static double pair_cost(run *r, uint32_t b, double geometry, const uint32_t *fan
     }
     double q[3];
     load(r, b, q);
+    extrapolate_fan(r, n, q);
     uint32_t b_wedges = NONE;
     double attribute = 0.0;
     for (uint32_t k = 0; k < wedge_count; k++) {
@@ -348,7 +379,7 @@ static double pair_cost(run *r, uint32_t b, double geometry, const uint32_t *fan
             uint32_t c = fan[i], base = c - c % 3;
             for (uint32_t j = 0; j < 3; j++) {
                 uint32_t wb = s->tri[base + j];
-                if (wedge_position(r, wb) == b && wb != best && (e = wedge_error(r, n, wa, wb, q, &s2)) < best_error)
+                if (wedge_position(r, wb) == b && wb != best && (e = wedge_error(r, n, wa, wb, &s2)) < best_error)
                     best = wb, best_error = e, best_slide = s2;
             }
         }
@@ -358,7 +389,7 @@ static double pair_cost(run *r, uint32_t b, double geometry, const uint32_t *fan
                 b_wedges = gather_wedges(r, s->fan_b, m, s->wedges_b);
             }
             for (uint32_t j = 0; j < b_wedges; j++)
-                if ((e = wedge_error(r, n, wa, s->wedges_b[j], q, &s2)) < best_error || best == NONE)
+                if ((e = wedge_error(r, n, wa, s->wedges_b[j], &s2)) < best_error || best == NONE)
                     best = s->wedges_b[j], best_error = e, best_slide = s2;
         }
         if (best == NONE)
@@ -485,7 +516,7 @@ static double best_collapse(run *r, uint32_t a, int valid, uint32_t *target)
     if (r->in->locked[a] || (s->flags[a] & FLAG_REMOVED) || (valid && s->pass[a] == r->pass))
         return INFINITY;
     evaluation e = {.a = a, .n = gather_fan(r, a, s->fan)};
-    if (e.n == 0)
+    if (e.n == 0 || !reserve_fan(r, e.n))
         return INFINITY;
     e.count = gather_candidates(r, a, s->fan, e.n, s->neighbours);
     e.wedge_count = gather_wedges(r, s->fan, e.n, s->wedges);
@@ -526,6 +557,8 @@ static void collapse(run *r, uint32_t a, uint32_t b)
 {
     lod_simplify_scratch *s = r->s;
     uint32_t n = gather_fan(r, a, s->fan);
+    if (!reserve_fan(r, n))
+        return;
     uint32_t wedge_count = gather_wedges(r, s->fan, n, s->wedges);
     pair_cost(r, b, pair_geometry(r, a, b, edge_triangles(r, b, s->fan, n)), s->fan, n, prepare_fan(r, s->fan, n), s->wedges,
               wedge_count); /* sets s->choice */
@@ -557,6 +590,8 @@ static void collapse(run *r, uint32_t a, uint32_t b)
     /* b and its neighbours changed: those not in the heap are evaluated again (those in it are, lazily,
      * when they come up) */
     uint32_t m = gather_fan(r, b, s->fan), token;
+    if (!reserve_fan(r, m))
+        return;
     uint32_t *near = s->near; /* queue()'s walks overwrite s->neighbours */
     uint32_t count = gather_neighbours(r, s->fan, m, s->neighbours, &token);
     memcpy(near, s->neighbours, count * sizeof *near);
@@ -573,12 +608,9 @@ static int reserve(lod_simplify_scratch *s, const lod_simplify_input *in)
     return LOD_RESERVE(s, tri, nc) && LOD_RESERVE(s, next, nc) && LOD_RESERVE(s, alive, nc / 3 + 1) &&
            LOD_RESERVE(s, head, np) && LOD_RESERVE(s, quadric, np * QUADRIC_SIZE) && LOD_RESERVE(s, flags, np) &&
            LOD_RESERVE(s, mark, np) && LOD_RESERVE(s, pass, np) && LOD_RESERVE(s, heap, np) && LOD_RESERVE(s, fan, nc) &&
-           LOD_RESERVE(s, fan_b, nc) && LOD_RESERVE(s, info, nc) && LOD_RESERVE(s, neighbours, nc * 2) && LOD_RESERVE(s, near, nc * 2) &&
-           LOD_RESERVE(s, wedges, in->vertex_count) &&
+           LOD_RESERVE(s, fan_b, nc) && LOD_RESERVE(s, wedges, in->vertex_count) &&
            LOD_RESERVE(s, wedges_b, in->vertex_count) &&
-           LOD_RESERVE(s, choice, in->vertex_count) && LOD_RESERVE(s, costs, nc * 2) &&
-           LOD_RESERVE(s, geometry, nc * 2) && LOD_RESERVE(s, exact, nc * 2) && LOD_RESERVE(s, taken, nc * 2) &&
-           LOD_RESERVE(s, edge_count, nc * 2) && LOD_RESERVE(s, slot, np) &&
+           LOD_RESERVE(s, choice, in->vertex_count) && LOD_RESERVE(s, costs, np) && LOD_RESERVE(s, slot, np) &&
            LOD_RESERVE(s, wedge_slide, in->vertex_count) && LOD_RESERVE(s, choice_slide, in->vertex_count);
 }
 
@@ -739,7 +771,7 @@ int lod_simplify(lod_simplify_scratch *s, const lod_simplify_input *in, uint32_t
         queue(&r, p);
     size_t target = in->target_index_count / 3;
     float limit = r.triangles > target ? pass_limit(s, (r.triangles - target) / 2) : INFINITY;
-    for (;;) {
+    while (!r.failed) {
         if (s->heap_count && s->heap[0].cost > limit) { /* the pass is over */
             for (size_t i = 0; i < s->heap_count; i++)
                 s->flags[s->heap[i].position] &= (uint8_t)~FLAG_QUEUED;
@@ -773,6 +805,8 @@ int lod_simplify(lod_simplify_scratch *s, const lod_simplify_input *in, uint32_t
         collapse(&r, item.position, b);
         res->collapses++;
     }
+    if (r.failed)
+        return 0;
     size_t k = 0, nt = in->index_count / 3;
     for (size_t t = 0; t < nt; t++)
         if (s->alive[t])

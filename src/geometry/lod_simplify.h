@@ -41,10 +41,12 @@ typedef struct lod_simplify_heap_item {
 
 /* One corner of the fan of the position being evaluated: its triangle's affine frame (p0 at the
  * corner, edges e1 and e2, their Gram matrix), the uv and normal at the corner and their changes
- * along e1 and e2, the area and the surface-to-uv area ratio (0: no uv field). */
+ * along e1 and e2, the area and the surface-to-uv area ratio (0: no uv field), and where the
+ * triangle survives the collapse evaluated, its uv and normal at the target's position. */
 typedef struct lod_simplify_corner {
     double p0[3], e1[3], e2[3], g11, g12, g22, inv_det, area, uv_scale;
     double t0[2], t1[2], t2[2], n0[3], n1[3], n2[3];
+    double uv_at_q[2], normal_at_q[3]; /* the uv and normal extrapolated to the target evaluated */
     uint32_t wedge, other[2]; /* the corner's wedge, the positions of the triangle's other corners */
     int holds_b;              /* the triangle holds the position evaluated as target */
 } lod_simplify_corner;
