@@ -8,7 +8,8 @@
  *  - an upper bound of the largest distance from probe points of the simplified triangles (grids
  *    of 3 steps an edge, 8 where the deviation is largest) to S0: the distance to the level-0 triangles around the position a
  *    walk ends at, or where that looks far off, to all level-0 triangles around the group's
- *    samples (a distance to some triangles of S0 is never below the distance to S0).
+ *    samples or around its simplified corners (a distance to some triangles of S0 is never below
+ *    the distance to S0).
  * The group's error is the larger of its deviation and the errors of the groups its members came
  * from. Every level-0 position stays a sample at every step (that is what the proof needs). The
  * group's farthest samples (above its floor: members' errors and D2) are listed for lod_redirect.c,
@@ -623,38 +624,89 @@ static int compare_u32(const void *x, const void *y)
     return a < b ? -1 : a > b;
 }
 
-/* A grid over the level-0 triangles around the group's samples (each once). Returns 0 when out of
- * memory. */
-static int build_region(const lod_build *b, lod_scratch *s)
+/* The level-0 triangles around `count` positions (position(b, s, i) for i < count), at most `limit`
+ * of each position's, each once, into refs (adjacency entries without their corner), their corners
+ * as mesh vertex indices into corners, and a grid over them. Returns 0 when out of memory. */
+typedef uint32_t region_position_fn(const lod_build *b, const lod_scratch *s, size_t i);
+static int build_triangle_region(const lod_build *b, lod_scratch *s, region_position_fn *position, size_t count,
+                                 uint32_t limit, uint32_t **refs, size_t *refs_cap, uint32_t **corners,
+                                 size_t *corners_cap, lod_triangle_grid *grid)
 {
     size_t n = 0;
-    for (uint32_t i = 0; i < s->gathered; i++)
-        n += b->adjacency_start[s->sample_ids[i] + 1] - b->adjacency_start[s->sample_ids[i]];
-    if (!LOD_RESERVE(s, region_refs, n + 1))
+    for (size_t i = 0; i < count; i++) {
+        uint32_t p = position(b, s, i), around = b->adjacency_start[p + 1] - b->adjacency_start[p];
+        n += around < limit ? around : limit;
+    }
+    if (!gdr_lod_reserve(refs, refs_cap, n + 1, sizeof **refs))
         return 0;
     n = 0;
-    for (uint32_t i = 0; i < s->gathered; i++)
-        for (uint32_t k = b->adjacency_start[s->sample_ids[i]]; k < b->adjacency_start[s->sample_ids[i] + 1]; k++)
-            s->region_refs[n++] = b->adjacency[k] >> 2; /* the triangle, whichever corner */
-    qsort(s->region_refs, n, sizeof *s->region_refs, compare_u32);
+    for (size_t i = 0; i < count; i++) {
+        uint32_t p = position(b, s, i), around = b->adjacency_start[p + 1] - b->adjacency_start[p];
+        for (uint32_t k = b->adjacency_start[p]; k < b->adjacency_start[p] + (around < limit ? around : limit); k++)
+            (*refs)[n++] = b->adjacency[k] >> 2; /* the triangle, whichever corner */
+    }
+    qsort(*refs, n, sizeof **refs, compare_u32);
     size_t unique = 0;
     for (size_t i = 0; i < n; i++)
-        if (i == 0 || s->region_refs[i] != s->region_refs[i - 1])
-            s->region_refs[unique++] = s->region_refs[i];
+        if (i == 0 || (*refs)[i] != (*refs)[i - 1])
+            (*refs)[unique++] = (*refs)[i];
     /* The triangles' corners as mesh vertex indices, over the mesh's own positions: a group near the
      * DAG's root gathers most of the mesh, and a copy of its corners' positions would cost each
      * worker 36 bytes per level-0 triangle. */
-    if (!LOD_RESERVE(s, region_corners, unique * 3 + 1))
+    if (!gdr_lod_reserve(corners, corners_cap, unique * 3 + 1, sizeof **corners))
         return 0;
     for (size_t i = 0; i < unique; i++) {
-        const gdr_cluster *c = ring_cluster(b, s->region_refs[i] << 2);
-        const uint8_t *t = ring_triangle(b, c, s->region_refs[i] << 2);
+        const gdr_cluster *c = ring_cluster(b, (*refs)[i] << 2);
+        const uint8_t *t = ring_triangle(b, c, (*refs)[i] << 2);
         const uint32_t *v = gdr_lod_cluster_vertices(b, c);
         for (int k = 0; k < 3; k++)
-            s->region_corners[i * 3 + (size_t)k] = v[t[k]];
+            (*corners)[i * 3 + (size_t)k] = v[t[k]];
     }
+    return lod_triangle_grid_build(grid, &b->mesh->positions[0].x, *corners, (uint32_t)unique);
+}
+
+static uint32_t sample_position(const lod_build *b, const lod_scratch *s, size_t i)
+{
+    (void)b;
+    return s->sample_ids[i];
+}
+
+/* The i-th distinct position of the simplified triangles' corners (span_positions). */
+static uint32_t corner_position(const lod_build *b, const lod_scratch *s, size_t i)
+{
+    (void)b;
+    return s->span_positions[i];
+}
+
+/* The level-0 triangles around the group's samples. */
+static int build_region(const lod_build *b, lod_scratch *s)
+{
     s->region_built = 1;
-    return lod_triangle_grid_build(&s->region_grid, &b->mesh->positions[0].x, s->region_corners, (uint32_t)unique);
+    return build_triangle_region(b, s, sample_position, s->gathered, UINT32_MAX, &s->region_refs, &s->region_refs_cap,
+                                 &s->region_corners, &s->region_corners_cap, &s->region_grid);
+}
+
+/* The level-0 triangles around the simplified triangles' corners (up to LOD_RING_LIMIT of each: a
+ * fan's hub is a corner of every group around it): a corner's sample may belong to
+ * a neighbouring group while the level-0 surface a simplified triangle spans lies around its
+ * corners (a rail of level-0 strips from end to end, whose corners' samples went to the groups at
+ * its ends, was bounded 1.03 units off where it lies within 0.003). A grid of its own: one grid
+ * over both would crowd the cells where a group's triangles lie over another part (a fan on a
+ * plate), whose triangles a cell lists only up to a limit (lod_grid.c). */
+static int build_span(const lod_build *b, lod_scratch *s)
+{
+    s->span_built = 1;
+    size_t corners = (size_t)s->out_triangle_count * 3, unique = 0;
+    if (!LOD_RESERVE(s, span_positions, corners + 1))
+        return 0;
+    for (size_t i = 0; i < corners; i++)
+        s->span_positions[i] = b->position_id[s->local_to_mesh[s->out_corners[i]]];
+    qsort(s->span_positions, corners, sizeof *s->span_positions, compare_u32);
+    for (size_t i = 0; i < corners; i++) /* each position once: a hub's fan is listed once */
+        if (i == 0 || s->span_positions[i] != s->span_positions[i - 1])
+            s->span_positions[unique++] = s->span_positions[i];
+    return build_triangle_region(b, s, corner_position, unique, LOD_RING_LIMIT, &s->span_refs, &s->span_refs_cap, &s->span_corners,
+                                 &s->span_corners_cap, &s->span_grid);
 }
 
 /* What probing a group's simplified triangles needs. */
@@ -731,24 +783,25 @@ static float walk_bound_d2(probe_state *ps, walk_end *at, gdr_vec3 p, uint32_t *
 /* Upper bound (squared) of the distance from p to S0: to the level-0 triangles around the position
  * a walk ends at (the position nearest to p among its neighbours; on a regular surface the triangle
  * nearest to p is among these). Where that bound is more than twice the largest distance so far,
- * the exact distance to the level-0 triangles around the group's samples is taken instead (the
- * walk can stop far away on meshes of long thin triangles). *at receives where the walk ended (the
+ * the exact distance to the level-0 triangles around the group's samples or around its simplified
+ * corners is taken instead (the walk can stop far away on meshes of long thin triangles). *at receives where the walk ended (the
  * next probe of the triangle starts there). */
 static float probe_d2(probe_state *ps, walk_end *at, gdr_vec3 p, uint32_t *triangle)
 {
     float d = walk_bound_d2(ps, at, p, triangle);
     if (d <= 4.0f * ps->worst || ps->failed) /* squared: up to twice the largest so far */
         return d;
-    if (!ps->s->region_built && !build_region(ps->b, ps->s)) {
+    if ((!ps->s->region_built && !build_region(ps->b, ps->s)) || (!ps->s->span_built && !build_span(ps->b, ps->s))) {
         ps->failed = 1;
         return d;
     }
-    float exact;
+    float exact, spanned;
     uint32_t nearest = lod_triangle_grid_nearest(&ps->s->region_grid, p, point_triangle_d2, &exact);
-    if (!(exact < d))
+    uint32_t nearest_spanned = lod_triangle_grid_nearest(&ps->s->span_grid, p, point_triangle_d2, &spanned);
+    if (!(exact < d) && !(spanned < d))
         return d;
-    *triangle = ps->s->region_refs[nearest];
-    return exact;
+    *triangle = spanned < exact ? ps->s->span_refs[nearest_spanned] : ps->s->region_refs[nearest];
+    return spanned < exact ? spanned : exact;
 }
 
 /* A triangle's coarse probes decide whether it is refined: refined unless its largest is below this
@@ -965,6 +1018,7 @@ static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor,
     probe_state ps = {b, s, floor * floor, 0.0f, 0.0f, 0};
     float cap2 = cap * cap;
     s->region_built = 0;
+    s->span_built = 0;
     s->grid_holds_samples = 0;
     if (!LOD_RESERVE(s, coarse_d2, (size_t)s->out_triangle_count + 1) ||
         !LOD_RESERVE(s, edge_d2, (size_t)s->out_triangle_count * 3 + 1))

@@ -400,6 +400,10 @@ void gdr_lod_scratch_free(lod_scratch *s)
     lod_triangle_grid_free(&s->region_grid);
     free(s->region_refs);
     free(s->region_corners);
+    lod_triangle_grid_free(&s->span_grid);
+    free(s->span_refs);
+    free(s->span_positions);
+    free(s->span_corners);
     free(s->coarse_d2);
     free(s->edge_d2);
     free(s->range_kept);

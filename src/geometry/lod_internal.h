@@ -112,6 +112,11 @@ typedef struct lod_scratch {
     size_t region_refs_cap, region_corners_cap;
     lod_triangle_grid region_grid;
     int region_built;
+    uint32_t *span_refs, *span_corners; /* level-0 triangles around its simplified triangles' corners */
+    uint32_t *span_positions;           /* those corners' positions, each once */
+    size_t span_refs_cap, span_corners_cap, span_positions_cap;
+    lod_triangle_grid span_grid;
+    int span_built;
     int grid_holds_samples; /* `grid` was rebuilt over sample_points (lod_error.c, nearest_sample) */
     float *coarse_d2; /* per simplified triangle: its largest coarse probe distance, squared */
     size_t coarse_d2_cap;
