@@ -474,6 +474,9 @@ GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, viewport, 208);
 #define GDR_FRAME_VERTEX_COLORS 16384u /* some mesh has vertex colours (GdrGpuScene.vertex_colors) */
 #define GDR_FRAME_PARTIAL_RESIDENCY 2048u /* some LOD group is absent: read the page table (shared/residency.h) */
 #define GDR_FRAME_PVS 32768u          /* the instance cull drops instances GdrGpuFrameBuffers.pvs_visible does not list */
+#define GDR_FRAME_PAGED_RECORDS 65536u /* streamed, some group absent: the records of absent groups are not on the
+                                          GPU, so clusters are reached only through the hierarchy's leaves of
+                                          resident groups (never a flat range over a mesh's clusters) */
 #define GDR_FRAME_DIRECT_CLUSTERS 1024u /* visibility-buffer modes: the instance cull tests the clusters of an
                                            instance that needs at most GDR_DIRECT_CLUSTERS of them and bins
                                            them itself, instead of a task command for the cluster cull */

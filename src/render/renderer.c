@@ -345,9 +345,9 @@ static gdr_status check_frame(gdr_renderer *r, const gdr_frame_desc *frame, uint
     gdr_status status = resolve_pipeline(r, frame, pipeline, reason, reason_size, err);
     /* Streamed geometry is drawn only through the LOD cut over resident groups. */
     if (status == GDR_OK && r->scene.streamed && (*pipeline != GDR_PIPELINE_MESH || frame->lod_fixed_depth ||
-                                                  !(frame->lod_error_px > 0.0f)))
+                                                  !(frame->lod_error_px > 0.0f) || frame->lod_hierarchy == GDR_CULL_OFF))
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: a streamed scene draws with the mesh pipeline "
-                             "and a LOD cut by error (lod_error_px > 0)");
+                             "and a LOD cut by error (lod_error_px > 0) through the LOD hierarchy (lod_hierarchy on)");
     if (status == GDR_OK)
         status = gdr_visbuffer_resolve_mode(r, frame, *pipeline, &r->vis.mode, r->vis.reason, sizeof r->vis.reason, err);
     if (status == GDR_OK && frame->record_visible_meshlets && !r->visible_meshlets.buffer) {

@@ -6,10 +6,11 @@
  * Each pool slot holds one page: its vertices (GdrGpuVertex), then its cluster vertex list (one
  * word per vertex: the vertex's index in the pool), then its triangle bytes. The scene's vertex,
  * vertex-list and triangle references all point at the pool's start, so a slot's data is addressed
- * by offsets within it, and the shaders read streamed clusters as they read uploaded ones. The
- * cluster records (GdrGpuMeshlet) of every cluster stay resident; a page's arrival rewrites the
- * offsets of its clusters' records and marks its groups resident in the page table; an eviction
- * marks them absent. */
+ * by offsets within it, and the shaders read streamed clusters as they read uploaded ones. A page's
+ * arrival writes its clusters' records (GdrGpuMeshlet, from the page's own records, with offsets
+ * into the slot) and marks its groups resident in the page table; an eviction marks them absent.
+ * The records of absent groups are never read (GDR_FRAME_PAGED_RECORDS), so none is uploaded before
+ * its page. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -19,7 +20,9 @@
 #include "render/node_counts.h"
 #include "stream/page_loader.h"
 #include "stream/residency.h"
+#include "render/cluster_records.h"
 #include "render/page_table.h"
+#include "render/root_shortcut.h"
 #include "render/streaming.h"
 
 /* What one frame copies: regions into the pool, the records and the node counts, words to fill in the
@@ -254,8 +257,49 @@ static void *stage(gdr_frame_slot *slot, stream_copies *c, uint64_t bytes)
     return at;
 }
 
-/* The decoded page against what the scene says its groups hold (cluster by cluster) and the slot's
- * size. NULL when it matches, else what differs. */
+/* Group `group`'s first refinement in c (they are in group order), or c->refinement_count. */
+static uint32_t first_refinement(const gdr_mesh_clusters *c, uint32_t group)
+{
+    uint32_t lo = 0, hi = c->refinement_count;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (c->refinements[mid].group < group)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* A group's clusters in a page (`count` of them at pc) against its refinements in a scene read for
+ * streaming: the same refined groups in the same order of first use, as many clusters of each. */
+static bool refinements_match(const gdr_mesh_clusters *c, uint32_t group, const gdr_page_cluster *pc, uint32_t count)
+{
+    uint32_t first = first_refinement(c, group), end = first, seen[GDR_CLUSTER_MAX_TRIANGLES], n = 0;
+    while (end < c->refinement_count && c->refinements[end].group == group)
+        end++;
+    for (uint32_t i = 0; i < count; i++) {
+        uint32_t r = pc[i].refined_group, k = 0;
+        if (r == GDR_NO_INDEX)
+            continue;
+        while (k < n && c->refinements[first + k].refined_group != r)
+            k++;
+        if (k == n) { /* first use: the next refinement's */
+            if (first + n >= end || c->refinements[first + n].refined_group != r || n == GDR_CLUSTER_MAX_TRIANGLES)
+                return false;
+            seen[n++] = 0;
+        }
+        seen[k]++;
+    }
+    for (uint32_t k = 0; k < n; k++)
+        if (seen[k] != c->refinements[first + k].cluster_count)
+            return false;
+    return first + n == end;
+}
+
+/* The decoded page against what the scene says its groups hold (cluster by cluster where the scene
+ * has its clusters, else each group's refinements) and the slot's size. NULL when it matches, else
+ * what differs. */
 static const char *page_mismatch(const gdr_streaming *s, const gdr_page *page)
 {
     const gdr_paged_mesh *pm = paged_mesh(s, page->mesh);
@@ -268,6 +312,15 @@ static const char *page_mismatch(const gdr_streaming *s, const gdr_page *page)
     uint32_t j = 0;
     for (uint32_t k = info->first; k < info->first + info->group_count; k++) {
         const gdr_cluster_group *group = &c->groups[pm->page_groups[k]];
+        if (!c->clusters) {
+            for (uint32_t i = 0; i < group->cluster_count; i++)
+                if (page->clusters[j + i].group != pm->page_groups[k])
+                    return "clusters differ from the scene's";
+            if (!refinements_match(c, pm->page_groups[k], &page->clusters[j], group->cluster_count))
+                return "its clusters' refined groups differ from the scene's";
+            j += group->cluster_count;
+            continue;
+        }
         for (uint32_t i = group->first_cluster; i < group->first_cluster + group->cluster_count; i++, j++) {
             const gdr_page_cluster *pc = &page->clusters[j];
             if (pc->group != pm->page_groups[k] || pc->vertex_count != c->clusters[i].vertex_count ||
@@ -278,11 +331,48 @@ static const char *page_mismatch(const gdr_streaming *s, const gdr_page *page)
     return NULL;
 }
 
+/* Page 0 of a mesh (its root group and the coarsest groups) against mesh-local cluster indices: the
+ * refined groups root_shortcut.h walks, known for the clusters of the page's groups. */
+typedef struct page_refined {
+    const gdr_mesh_clusters *clusters;
+    const gdr_paged_mesh *mesh;
+    const gdr_page *page;
+} page_refined;
+
+static uint32_t refined_in_page(const void *user, uint32_t cluster, bool *known)
+{
+    const page_refined *p = user;
+    const gdr_page_info *info = &p->mesh->pages[p->page->page];
+    uint32_t j = 0;
+    for (uint32_t k = info->first; k < info->first + info->group_count; k++) {
+        const gdr_cluster_group *g = &p->clusters->groups[p->mesh->page_groups[k]];
+        if (cluster >= g->first_cluster && cluster - g->first_cluster < g->cluster_count) {
+            *known = true;
+            return p->page->clusters[j + cluster - g->first_cluster].refined_group;
+        }
+        j += g->cluster_count;
+    }
+    *known = false;
+    return GDR_NO_INDEX;
+}
+
 /* Bytes a page's copy stages: its data and its clusters' records. */
 static uint64_t page_upload_bytes(const gdr_page *page)
 {
     return (uint64_t)page->vertex_count * (sizeof(GdrGpuVertex) + 4) + page->triangle_byte_count +
            (uint64_t)page->cluster_count * sizeof(GdrGpuMeshlet);
+}
+
+/* A page's cluster as the GPU reads it: its record with offsets into the slot's vertex list (in
+ * words) and triangle bytes, and its groups' LOD data from the scene's groups. */
+static GdrGpuMeshlet page_record(const gdr_mesh_clusters *c, const gdr_page_cluster *pc, uint32_t list_base,
+                                 uint32_t triangle_base)
+{
+    gdr_cluster k = {.vertex_offset = pc->vertex_offset, .triangle_offset = pc->triangle_offset,
+                     .vertex_count = pc->vertex_count, .triangle_count = pc->triangle_count, .sphere = pc->sphere,
+                     .cone_apex = pc->cone_apex, .cone_axis = pc->cone_axis, .cone_cutoff = pc->cone_cutoff,
+                     .group = pc->group, .refined_group = pc->refined_group};
+    return gdr_cluster_record_of(c, &k, list_base, triangle_base);
 }
 
 /* Stages page `page` for pool slot `pool_slot`: its data, its clusters' records with offsets into the
@@ -316,13 +406,11 @@ static void stage_page(gdr_renderer *r, gdr_frame_slot *slot, stream_copies *c, 
         uint32_t group = pm->page_groups[k];
         const gdr_cluster_group *gr = &mc->groups[group];
         uint32_t first = g->cpu_meshes[page->mesh].meshlet_offset + gr->first_cluster;
-        for (uint32_t i = 0; i < gr->cluster_count; i++, j++) {
-            g->cpu_meshlets[first + i].vertex_offset = list_base + page->clusters[j].vertex_offset;
-            g->cpu_meshlets[first + i].triangle_offset = triangle_base + page->clusters[j].triangle_offset;
-        }
         uint64_t bytes = sizeof(GdrGpuMeshlet) * (uint64_t)gr->cluster_count;
         uint64_t from = c->staged;
-        memcpy(stage(slot, c, bytes), &g->cpu_meshlets[first], bytes);
+        GdrGpuMeshlet *records = stage(slot, c, bytes);
+        for (uint32_t i = 0; i < gr->cluster_count; i++, j++)
+            records[i] = page_record(mc, &page->clusters[j], list_base, triangle_base);
         c->records[c->record_count++] = (VkBufferCopy){from, sizeof(GdrGpuMeshlet) * (uint64_t)first, bytes};
         c->resident_words[c->resident_count] = g->cpu_meshes[page->mesh].page_table_offset + group;
         c->resident_slots[c->resident_count++] = pool_slot;
@@ -330,6 +418,11 @@ static void stage_page(gdr_renderer *r, gdr_frame_slot *slot, stream_copies *c, 
     }
     s->slot_page[pool_slot] = s->page_base[page->mesh] + page->page;
     mark_dirty(s, page->mesh);
+    if (page->page == 0 && mc->group_count > 0) { /* the root's records arrive: its shortcut and chain */
+        page_refined p = {mc, pm, page};
+        gdr_root_shortcut_set(mc, refined_in_page, &p, &g->cpu_meshes[page->mesh]);
+        s->meshes_changed = true;
+    }
 }
 
 /* --- the frame's work ------------------------------------------------------------------------- */
@@ -684,6 +777,11 @@ gdr_status gdr_streaming_start(gdr_renderer *r, gdr_error *err)
     }
     slot->stream_results = false;
     s->wait_for_loads = wait;
+    /* The meshes' root shortcuts came with their pages 0. */
+    if (status == GDR_OK && s->meshes_changed)
+        status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->meshes, 0, g->cpu_meshes,
+                                      sizeof(GdrGpuMesh) * g->mesh_count, err);
+    s->meshes_changed = false;
     for (uint32_t m = 0; status == GDR_OK && m < g->mesh_count; m++)
         if (gdr_residency_page_slot(s->residency, m, 0) == UINT32_MAX && paged_mesh(s, m)->page_count)
             status = gdr_error_set(err, GDR_ERROR_PARSE, "streaming: mesh %u's coarsest page could not be read: %s", m,

@@ -78,8 +78,11 @@ GdrTaskRange task_range(GdrGpuFrameGlobals g, uint mesh_index, GdrGpuMesh mesh, 
     uint chained = root_chain_cluster(g, mesh_index, mesh, model);
     if (chained != GDR_GPU_NO_GROUP)
         return gdr_task_range(mesh.meshlet_offset + chained, 1u, GDR_TASK_LOD_ACCEPTED);
+    // Where the records of absent groups are not on the GPU, every mesh is traversed: a flat range
+    // would read them.
+    bool paged = (g.flags & GDR_FRAME_PAGED_RECORDS) != 0u;
     traverse = (g.flags & GDR_FRAME_LOD_HIERARCHY) != 0u && mesh.lod_node_count > 0u &&
-               mesh.lod_task_count > GDR_TRAVERSE_MIN_TASKS;
+               (mesh.lod_task_count > GDR_TRAVERSE_MIN_TASKS || paged);
     return traverse ? GdrTaskRange(0u, 0u, 0u, 0u) : gdr_task_range(mesh.meshlet_offset, mesh.lod_cluster_count, 0u);
 }
 

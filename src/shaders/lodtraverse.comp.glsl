@@ -55,11 +55,13 @@ void main()
     bool in_level = visit_of_invocation(g, stats, level, visit);
     GdrGpuLodNode node;
     GdrGpuMesh mesh;
+    uint mesh_index = 0u;
     bool lod_culled = false, frustum_culled = false, occluded = false;
     vec3 world_center = vec3(0.0);
     float radius = 0.0;
     if (in_level) {
         GdrGpuInstance instance = GDR_SCENE.instances.items[visit.instance];
+        mesh_index = instance.mesh;
         mesh = GDR_SCENE.meshes.items[instance.mesh];
         node = GDR_SCENE.lod_nodes.items[mesh.lod_node_offset + visit.node];
         if ((g.flags & GDR_FRAME_DEBUG_SHRINK_NODES) != 0u) {
@@ -86,11 +88,15 @@ void main()
         occluded = deferred;
     }
     bool passes = in_level && !lod_culled && !frustum_culled && !occluded;
+    // A leaf of an absent group draws none of its clusters (an absent group counts as passing); where
+    // the records of absent groups are not on the GPU, its clusters are not tested at all.
+    bool paged_out = (g.flags & GDR_FRAME_PAGED_RECORDS) != 0u && gdr_group_absent(g, mesh_index, node.group);
     bool leaf = passes && (node.flags & GDR_GPU_LOD_NODE_LEAF) != 0u;
+    bool emits = leaf && !paged_out;
     gdr_queue_visits(g, PHASE, level + 1u, passes && !leaf ? node.count : 0u, visit.instance, node.first, visit.flags);
-    GdrTaskRange range = leaf ? gdr_task_range(mesh.meshlet_offset + node.first, node.count, visit.flags)
-                              : GdrTaskRange(0u, 0u, 0u, 0u);
-    gdr_append_tasks(g, PHASE, leaf, visit.instance, range);
+    GdrTaskRange range = emits ? gdr_task_range(mesh.meshlet_offset + node.first, node.count, visit.flags)
+                               : GdrTaskRange(0u, 0u, 0u, 0u);
+    gdr_append_tasks(g, PHASE, emits, visit.instance, range);
     GDR_COUNT(stats, nodes_tested, in_level);
     GDR_COUNT(stats, nodes_lod_culled, lod_culled);
     GDR_COUNT(stats, nodes_frustum_culled, frustum_culled);

@@ -22,6 +22,7 @@
 #include "gdr/paged_cache.h"
 #include "geometry/lod_cut.h"
 #include "gpu_test_util.h"
+#include "render/renderer_debug.h"
 #include "stream/residency.h"
 #include "io/loaders.h"
 
@@ -252,6 +253,9 @@ static uint64_t pool_bytes(const char *path, uint64_t *slot)
     return total;
 }
 
+/* A renderer streaming `scene` from the cache at `path` within `budget` bytes. The records of the
+ * clusters of absent groups are poisoned (renderer_debug.h): a shader reading one would draw it, and
+ * the drawn clusters would differ from the CPU's cut. */
 static gdr_renderer *streamed_renderer(const gdr_scene *scene, const char *path, uint64_t budget)
 {
     gdr_error err = {0};
@@ -259,8 +263,9 @@ static gdr_renderer *streamed_renderer(const gdr_scene *scene, const char *path,
     gdr_renderer_desc desc = {.width = WIDTH, .height = HEIGHT, .validate = true};
     gdr_streaming_desc stream = {.cache = gpu_test_paged_cache(path), .geometry_budget_bytes = budget,
                                  .upload_budget_bytes = UPLOAD_BUDGET, .wait_for_loads = true};
-    if (gdr_renderer_create(&desc, &r, &err) != GDR_OK ||
-        gdr_renderer_set_scene_streamed(r, scene, &stream, &err) != GDR_OK) {
+    if (gdr_renderer_create(&desc, &r, &err) == GDR_OK)
+        gdr_renderer_set_debug(r, &(gdr_renderer_debug){.poison_absent_records = true});
+    if (!r || gdr_renderer_set_scene_streamed(r, scene, &stream, &err) != GDR_OK) {
         fprintf(stderr, "streamed renderer: %s\n", err.message);
         gdr_renderer_destroy(r);
         return NULL;
@@ -463,9 +468,18 @@ static gdr_scene *read_for_streaming(const char *path)
         fclose(f);
     CHECK(gdr_cache_read_for_streaming(path, NULL, &paged, NULL, &bytes_read, &err) == GDR_OK && paged &&
           paged->geometry_in_pages && paged->meshes[0].positions == NULL && paged->meshes[0].clusters.triangles == NULL);
-    printf("read for streaming: %llu of the file's %llu bytes\n", (unsigned long long)bytes_read,
-           (unsigned long long)file_size);
+    /* No cluster record is read (the pages hold them): the scene has none, and the bytes read are
+     * fewer than its records alone would take (72 bytes a cluster in CLDT). */
+    uint64_t clusters = 0, with_records = 0;
+    for (uint32_t m = 0; paged && m < paged->mesh_count; m++) {
+        clusters += paged->meshes[m].clusters.cluster_count;
+        with_records += paged->meshes[m].clusters.clusters != NULL;
+    }
+    printf("read for streaming: %llu of the file's %llu bytes, %llu clusters, %llu meshes with their records\n",
+           (unsigned long long)bytes_read, (unsigned long long)file_size, (unsigned long long)clusters,
+           (unsigned long long)with_records);
     CHECK(bytes_read > 0 && bytes_read < file_size / 8);
+    CHECK(clusters > 0 && with_records == 0 && bytes_read < 72 * clusters);
     gdr_renderer *whole = NULL;
     gdr_renderer_desc desc = {.width = WIDTH, .height = HEIGHT, .validate = true};
     CHECK(paged && gdr_renderer_create(&desc, &whole, &err) == GDR_OK);
@@ -509,11 +523,16 @@ static void run(const gdr_scene *scene, const char *path)
     }
     gdr_renderer_destroy(r);
 
-    /* Room for everything: the same images, nothing evicted. */
+    /* Room for everything: the same images, nothing evicted; the scene read without its records too. */
     r = streamed_renderer(scene, path, 2 * total);
     CHECK(r != NULL);
     if (r && reference)
         CHECK(still_views(scene, r, 2 * total, reference, "everything") == 0);
+    gdr_renderer_destroy(r);
+    r = paged ? streamed_renderer(paged, path, 2 * total) : NULL;
+    CHECK(r != NULL);
+    if (r && reference)
+        CHECK(still_views(scene, r, 2 * total, reference, "everything, without the records") == 0);
     gdr_renderer_destroy(r);
 
     /* A budget below the coarsest pages is refused. */

@@ -60,18 +60,18 @@ static void fix_header(uint8_t *data)
  * whole geometry more. */
 static void check_sections(const uint8_t *only, size_t only_size, const uint8_t *full, size_t full_size)
 {
-    static const char *const geometry[] = {"GEOM", "VCOL", "CLGM"};
+    static const char *const geometry[] = {"GEOM", "VCOL", "CLGM", "CLDT"};
     CHECK(get32(only + FLAGS_AT) == PAGES_ONLY && get32(full + FLAGS_AT) == 0);
     CHECK(entry_of(only, "PAGE") != NULL && entry_of(full, "PAGE") != NULL);
     uint64_t geometry_bytes = 0;
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < 4; k++) {
         CHECK(entry_of(only, geometry[k]) == NULL);
         const uint8_t *e = entry_of(full, geometry[k]);
         CHECK(e != NULL);
         geometry_bytes += e ? get64(e + 16) : 0;
     }
     uint32_t count = get32(only + 16);
-    CHECK(count + 3 == get32(full + 16));
+    CHECK(count + 4 == get32(full + 16));
     for (uint32_t i = 0; i < count; i++) {
         const uint8_t *e = only + 64 + (size_t)i * 32;
         char id[5] = {0};
@@ -82,7 +82,7 @@ static void check_sections(const uint8_t *only, size_t only_size, const uint8_t 
             CHECK(memcmp(only + get64(e + 8), full + get64(f + 8), (size_t)get64(e + 16)) == 0);
     }
     /* The file is its sections, the table and under 8 bytes of padding each, nothing more. */
-    CHECK(full_size - only_size >= geometry_bytes + 3 * 32 && full_size - only_size < geometry_bytes + 3 * 40);
+    CHECK(full_size - only_size >= geometry_bytes + 4 * 32 && full_size - only_size < geometry_bytes + 4 * 40);
     printf("pages alone: %zu bytes, with the whole geometry %zu (its sections %llu)\n", only_size, full_size,
            (unsigned long long)geometry_bytes);
 }
@@ -100,7 +100,10 @@ static int same_records(const gdr_scene *a, const gdr_scene *b)
             memcmp(&x->quantization, &y->quantization, sizeof x->quantization) != 0 ||
             p->cluster_count != q->cluster_count || p->group_count != q->group_count ||
             p->lod_node_count != q->lod_node_count ||
-            memcmp(p->clusters, q->clusters, sizeof *p->clusters * p->cluster_count) != 0 ||
+            (p->clusters || q->clusters) != 0 || p->refinement_count != q->refinement_count ||
+            memcmp(p->size_classes, q->size_classes, sizeof p->size_classes) != 0 ||
+            memcmp(p->refinements, q->refinements, sizeof *p->refinements * p->refinement_count) != 0 ||
+            memcmp(p->group_bounds, q->group_bounds, sizeof *p->group_bounds * p->group_count) != 0 ||
             memcmp(p->groups, q->groups, sizeof *p->groups * p->group_count) != 0 ||
             memcmp(p->lod_nodes, q->lod_nodes, sizeof *p->lod_nodes * p->lod_node_count) != 0)
             return 0;
@@ -147,7 +150,19 @@ static void check_streamed(const char *only, const char *full)
     CHECK(gdr_cache_read_for_streaming(only, NULL, &a, NULL, &read_a, &err) == GDR_OK);
     CHECK(gdr_cache_read_for_streaming(full, NULL, &b, NULL, &read_b, &err) == GDR_OK);
     CHECK(a && b && a->geometry_in_pages && same_records(a, b));
-    CHECK(read_a + 3 * 32 == read_b); /* the same reads but three table entries: none of the whole geometry */
+    /* The same reads but four table entries: none of the whole geometry, no cluster record (CLDT). */
+    CHECK(read_a + 4 * 32 == read_b);
+    /* No per-cluster record in the scene or among the bytes read: the pages hold them. */
+    uint64_t clusters = 0, without = 0;
+    for (uint32_t m = 0; a && m < a->mesh_count; m++) {
+        const gdr_mesh_clusters *c = &a->meshes[m].clusters;
+        clusters += c->cluster_count;
+        without += c->cluster_count > 0 && !c->clusters && c->group_bounds && c->refinements;
+    }
+    printf("read for streaming: %llu bytes for %llu clusters, %llu of %u meshes without their records\n",
+           (unsigned long long)read_a, (unsigned long long)clusters, (unsigned long long)without,
+           a ? a->mesh_count : 0);
+    CHECK(a && clusters > 0 && without == a->mesh_count && read_a < 72 * clusters);
     gdr_scene_destroy(a);
     gdr_scene_destroy(b);
     gdr_paged_cache *pa = NULL, *pb = NULL;
