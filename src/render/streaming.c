@@ -507,8 +507,8 @@ static gdr_status collect_loads(gdr_streaming *s, gdr_error *err)
             continue;
         }
         if (why)
-            snprintf(s->stats.refused, sizeof s->stats.refused, "mesh %u page %u: %s", result.load.mesh,
-                     result.load.page, why);
+            snprintf(s->stats.refused, sizeof s->stats.refused, "%s: mesh %u page %u: %s",
+                     gdr_paged_cache_path(s->cache), result.load.mesh, result.load.page, why);
         else
             snprintf(s->stats.refused, sizeof s->stats.refused, "%s", result.error.message);
         s->stats.pages_refused++;

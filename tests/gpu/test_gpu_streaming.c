@@ -24,6 +24,7 @@
 #include "gpu_test_util.h"
 #include "render/renderer_debug.h"
 #include "stream/residency.h"
+#include "io/io_internal.h"
 #include "io/loaders.h"
 
 #define WIDTH 160
@@ -414,6 +415,145 @@ static void damaged_page(const gdr_scene *scene, const gdr_scene *paged, const c
     gdr_renderer_destroy(r);
 }
 
+/* The bytes of the file at `path` (*size of them), or NULL. */
+static uint8_t *read_file(const char *path, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    uint8_t *data = NULL;
+    long n = f && fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    if (n > 0 && fseek(f, 0, SEEK_SET) == 0 && (data = malloc((size_t)n)) && fread(data, 1, (size_t)n, f) != (size_t)n) {
+        free(data);
+        data = NULL;
+    }
+    if (f)
+        fclose(f);
+    *size = data ? (size_t)n : 0;
+    return data;
+}
+
+/* The table entry of section `id` in a cache's bytes (docs/CACHE_FORMAT.md: 32-byte entries at 64). */
+static uint8_t *section_entry(uint8_t *data, const char *id)
+{
+    uint32_t count;
+    memcpy(&count, data + 16, 4);
+    for (uint32_t i = 0; i < count; i++)
+        if (memcmp(data + 64 + 32 * (size_t)i, id, 4) == 0)
+            return data + 64 + 32 * (size_t)i;
+    return NULL;
+}
+
+/* Section 'CLGR' of the cache `from` written over that of `to`, of the same size, with every checksum
+ * made right: `to`'s pages with `from`'s account of the clusters' refined groups. */
+static int splice_groups(const char *from, const char *to)
+{
+    size_t a_size = 0, b_size = 0;
+    uint8_t *a = read_file(from, &a_size), *b = read_file(to, &b_size);
+    uint8_t *ea = a ? section_entry(a, "CLGR") : NULL, *eb = b ? section_entry(b, "CLGR") : NULL;
+    uint64_t a_at = 0, b_at = 0, a_bytes = 0, b_bytes = 0;
+    if (ea && eb) {
+        memcpy(&a_at, ea + 8, 8), memcpy(&a_bytes, ea + 16, 8);
+        memcpy(&b_at, eb + 8, 8), memcpy(&b_bytes, eb + 16, 8);
+    }
+    int ok = ea && eb && a_bytes == b_bytes && memcmp(a + a_at, b + b_at, a_bytes) != 0;
+    if (ok) {
+        memcpy(b + b_at, a + a_at, a_bytes);
+        uint64_t h = gdr_io_hash(b + b_at, b_bytes);
+        memcpy(eb + 24, &h, 8);
+        uint32_t count;
+        memcpy(&count, b + 16, 4);
+        h = gdr_io_hash(b + 64, 32 * (size_t)count);
+        memcpy(b + 32, &h, 8);
+        h = gdr_io_hash(b, 40);
+        memcpy(b + 40, &h, 8);
+        FILE *f = fopen(to, "wb");
+        ok = f && fwrite(b, 1, b_size, f) == b_size;
+        if (f)
+            fclose(f);
+    }
+    free(a), free(b);
+    return ok;
+}
+
+/* A group of mesh m that view 0's cut loads (a parent of the finest group it draws, made from it)
+ * outside page 0, with a refined group that at least two of its clusters were made from: *cluster
+ * the first of them. UINT32_MAX when there is none. */
+static uint32_t group_with_shared_refinement(const gdr_scene *scene, gdr_paged_cache *cache, uint32_t m,
+                                             uint32_t *cluster)
+{
+    gdr_frame_desc frame = view_frame(0);
+    const gdr_mesh_clusters *c = &scene->meshes[m].clusters;
+    const gdr_paged_mesh *pm = gdr_paged_cache_mesh(cache, m);
+    uint32_t finest = finest_drawn_group(scene, m, &frame);
+    if (finest == UINT32_MAX)
+        return UINT32_MAX;
+    for (uint32_t e = 0; e < pm->groups[finest].parent_count; e++) {
+        uint32_t p = pm->parents[pm->groups[finest].parent_first + e];
+        const gdr_cluster_group *g = &c->groups[p];
+        for (uint32_t i = g->first_cluster; pm->groups[p].page != 0 && i < g->first_cluster + g->cluster_count; i++)
+            for (uint32_t j = i + 1; j < g->first_cluster + g->cluster_count; j++)
+                if (c->clusters[i].refined_group != GDR_NO_INDEX &&
+                    c->clusters[i].refined_group == c->clusters[j].refined_group) {
+                    *cluster = i;
+                    return p;
+                }
+    }
+    return UINT32_MAX;
+}
+
+static gdr_scene *read_for_streaming(const char *path);
+
+/* A page whose records disagree with the file's account of its clusters ('CLGR'), every checksum
+ * right: one cluster of a group view 0 loads written as made from nothing in the pages alone. The
+ * page is refused naming the file, the mesh and the page; the frames go on drawing exact cuts. */
+static void damaged_records(gdr_scene *scene, const char *path, uint64_t budget)
+{
+    gdr_paged_cache *cache = NULL;
+    gdr_error err = {0};
+    CHECK(gdr_paged_cache_open(path, &cache, &err) == GDR_OK);
+    uint32_t mesh = 0, group = UINT32_MAX, cluster = 0, page = 0;
+    for (uint32_t m = 0; cache && group == UINT32_MAX && m < scene->mesh_count; m++) {
+        mesh = m;
+        group = group_with_shared_refinement(scene, cache, m, &cluster);
+        page = group == UINT32_MAX ? 0 : gdr_paged_cache_mesh(cache, m)->groups[group].page;
+    }
+    gdr_paged_cache_close(cache);
+    CHECK(group != UINT32_MAX && page != 0);
+    if (group == UINT32_MAX)
+        return;
+    char copy[300];
+    snprintf(copy, sizeof copy, "%s.records.gdrc", path);
+    gdr_cluster *k = &scene->meshes[mesh].clusters.clusters[cluster];
+    uint32_t refined = k->refined_group;
+    k->refined_group = GDR_NO_INDEX;
+    gdr_cache_write_options write = {.page_bytes = GDR_PAGE_BYTES_MIN};
+    CHECK(gdr_cache_write(copy, scene, &write, &err) == GDR_OK);
+    k->refined_group = refined;
+    CHECK(splice_groups(path, copy));
+
+    gdr_scene *paged = read_for_streaming(copy);
+    gdr_renderer *r = paged ? streamed_renderer(paged, copy, budget) : NULL;
+    CHECK(r != NULL);
+    uint8_t *image = malloc(WIDTH * HEIGHT * 4);
+    gdr_frame_desc frame = view_frame(0);
+    gdr_frame_stats stats = {0};
+    frame_check check;
+    history_init(scene, &check);
+    for (uint32_t i = 0; r && image && i < 20 && draw(scene, r, &frame, image, &stats, &check); i++)
+        check_budgets(&stats, budget);
+    char expected[64];
+    snprintf(expected, sizeof expected, "mesh %u page %u: ", mesh, page);
+    printf("damaged records in page %u of mesh %u (group %u, cluster %u): %u refused, \"%s\"\n", page, mesh, group,
+           cluster, stats.streaming.pages_refused, stats.streaming.refused);
+    CHECK(stats.streaming.pages_refused >= 1 && strstr(stats.streaming.refused, copy) &&
+          strstr(stats.streaming.refused, expected) && strstr(stats.streaming.refused, "refined groups"));
+    CHECK(check.drawn > 0 && check.evicted_in_use == 0);
+    history_free(&check);
+    free(image);
+    gdr_renderer_destroy(r);
+    gdr_scene_destroy(paged);
+    unlink(copy);
+}
+
 /* The file cut short while the renderer streams from it (after the open, before the views load
  * their pages): the pages past the end are refused, naming the file and the page, and the frames go
  * on drawing the exact cut over what is resident. Works on a copy of the cache. */
@@ -492,7 +632,7 @@ static gdr_scene *read_for_streaming(const char *path)
     return paged;
 }
 
-static void run(const gdr_scene *scene, const char *path)
+static void run(gdr_scene *scene, const char *path)
 {
     uint8_t *reference = malloc(VIEWS * WIDTH * HEIGHT * 4);
     gdr_renderer *whole = gpu_test_renderer(WIDTH, HEIGHT, scene);
@@ -545,6 +685,8 @@ static void run(const gdr_scene *scene, const char *path)
     printf("a 1 KiB budget: %s\n", err.message);
     gdr_renderer_destroy(small);
 
+    if (paged && budget)
+        damaged_records(scene, path, budget);
     if (paged && budget)
         truncated_while_streaming(scene, paged, path, budget);
     if (paged && budget)
