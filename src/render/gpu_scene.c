@@ -47,16 +47,21 @@ static gdr_status gather_clusters(const gdr_scene *scene, const gdr_mesh_cluster
 /* The clusters of each mesh per tiny size class (raster_bin.h), GDR_SW_TINY_CLASSES + 1 counts per
  * mesh, the last the clusters of no class: the tiny classes' counts size their parts of the
  * visible-cluster list. From the records, or (meshlets NULL: streamed, the records are in the pages)
- * from the meshes' size classes, whose bounds are powers of two as the tiny classes' are. */
+ * from the clusters, or where the scene was read for streaming without them, from the meshes' size
+ * classes, whose bounds are powers of two as the tiny classes' are. */
 _Static_assert((GDR_SW_TINY_LANES & (GDR_SW_TINY_LANES - 1)) == 0, "tiny classes bounded by powers of two");
 static uint32_t *count_tiny_clusters(uint32_t mesh_count, const GdrGpuMesh *meshes, const GdrGpuMeshlet *meshlets,
                                      const gdr_mesh_clusters *const *clusters)
 {
     const uint32_t stride = GDR_SW_TINY_CLASSES + 1;
     uint32_t *tiny = calloc((size_t)(mesh_count ? mesh_count : 1) * stride, sizeof *tiny);
-    for (uint32_t m = 0; m < mesh_count && tiny && !meshlets; m++)
-        for (uint32_t b = 0; b < GDR_CLUSTER_SIZE_CLASSES; b++) /* sizes (2^(b-1), 2^b]: one tiny class */
-            tiny[m * stride + gdr_raster_tiny_class(1u << b, 1u << b)] += clusters[m]->size_classes[b];
+    for (uint32_t m = 0; m < mesh_count && tiny && !meshlets; m++) {
+        const gdr_mesh_clusters *c = clusters[m];
+        for (uint32_t i = 0; c->clusters && i < c->cluster_count; i++) /* a scene loaded whole, streamed */
+            tiny[m * stride + gdr_raster_tiny_class(c->clusters[i].vertex_count, c->clusters[i].triangle_count)]++;
+        for (uint32_t b = 0; !c->clusters && b < GDR_CLUSTER_SIZE_CLASSES; b++) /* (2^(b-1), 2^b]: one class */
+            tiny[m * stride + gdr_raster_tiny_class(1u << b, 1u << b)] += c->size_classes[b];
+    }
     for (uint32_t m = 0; m < mesh_count && tiny && meshlets; m++)
         for (uint32_t i = 0; i < meshes[m].lod_cluster_count; i++) {
             const GdrGpuMeshlet *k = &meshlets[meshes[m].meshlet_offset + i];

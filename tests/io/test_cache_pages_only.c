@@ -322,6 +322,51 @@ static void check_damage(const char *only, const char *bad, const uint8_t *bytes
     gdr_paged_cache_close(pages);
 }
 
+/* What 'CLGR' gives a scene read for streaming, against the clusters it was written from: the groups,
+ * each group's cluster bounds (the enclosing sphere of its clusters' spheres, to the bit), its
+ * refinements (refined groups in order of first use, with their clusters) and the size classes. */
+static void check_groups_from_clusters(const gdr_scene *scene, const char *path)
+{
+    gdr_error err = {0};
+    gdr_scene *s = NULL;
+    CHECK(gdr_cache_read_for_streaming(path, NULL, &s, NULL, NULL, &err) == GDR_OK && s);
+    uint32_t wrong = 0, refinements = 0;
+    for (uint32_t m = 0; s && m < scene->mesh_count; m++) {
+        const gdr_mesh_clusters *c = &scene->meshes[m].clusters, *r = &s->meshes[m].clusters;
+        uint32_t classes[GDR_CLUSTER_SIZE_CLASSES] = {0}, k = 0;
+        for (uint32_t i = 0; i < c->cluster_count; i++)
+            classes[gdr_cluster_size_class(c->clusters[i].vertex_count, c->clusters[i].triangle_count)]++;
+        wrong += memcmp(classes, r->size_classes, sizeof classes) != 0;
+        wrong += memcmp(c->groups, r->groups, sizeof *c->groups * c->group_count) != 0;
+        for (uint32_t g = 0; g < c->group_count; g++) {
+            const gdr_cluster_group *gr = &c->groups[g];
+            gdr_vec4 spheres[256];
+            uint32_t refined[256], counts[256], n = 0;
+            for (uint32_t i = 0; i < gr->cluster_count && i < 256; i++) {
+                const gdr_cluster *cl = &c->clusters[gr->first_cluster + i];
+                spheres[i] = cl->sphere;
+                uint32_t j = 0;
+                while (j < n && refined[j] != cl->refined_group)
+                    j++;
+                if (cl->refined_group != GDR_NO_INDEX && j == n)
+                    refined[n] = cl->refined_group, counts[n++] = 0;
+                if (cl->refined_group != GDR_NO_INDEX)
+                    counts[j]++;
+            }
+            gdr_vec4 bounds = gdr_lod_enclosing_sphere(spheres, gr->cluster_count < 256 ? gr->cluster_count : 256);
+            wrong += memcmp(&bounds, &r->group_bounds[g], sizeof bounds) != 0;
+            for (uint32_t j = 0; j < n; j++, k++)
+                wrong += k >= r->refinement_count || r->refinements[k].group != g ||
+                         r->refinements[k].refined_group != refined[j] || r->refinements[k].cluster_count != counts[j];
+        }
+        wrong += k != r->refinement_count;
+        refinements += r->refinement_count;
+    }
+    printf("CLGR against the clusters: %u refinements, %u differences\n", refinements, wrong);
+    CHECK(s && refinements > 0 && wrong == 0);
+    gdr_scene_destroy(s);
+}
+
 int main(void)
 {
     gdr_scene *scene = NULL;
@@ -341,6 +386,7 @@ int main(void)
     whole.whole_geometry = 1;
     CHECK(gdr_cache_write(only, scene, &write, &err) == GDR_OK);
     CHECK(gdr_cache_write(full, scene, &whole, &err) == GDR_OK);
+    check_groups_from_clusters(scene, only);
     gdr_scene_destroy(scene);
     size_t only_size = 0, full_size = 0;
     uint8_t *only_bytes = test_read_file(only, &only_size), *full_bytes = test_read_file(full, &full_size);
