@@ -75,8 +75,10 @@ static void fill_chunk(void *user, uint32_t task, uint32_t worker)
     uint64_t end = at + job->chunk < job->total ? at + job->chunk : job->total;
     for (uint32_t m = mesh_of(l, at); at < end && m < l->mesh_count; m++) {
         const gdr_mesh_clusters *c = l->clusters[m];
-        for (uint32_t i = (uint32_t)(at - l->first[m]); i < c->cluster_count && at < end; i++, at++)
+        for (uint32_t i = (uint32_t)(at - l->first[m]); i < c->cluster_count && at < end; i++, at++) {
             job->out[at] = gdr_cluster_record(c, i, l->vertex_base[m], l->byte_base[m]);
+            job->out[at].cluster_id = (uint32_t)at;
+        }
     }
 }
 

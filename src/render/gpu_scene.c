@@ -208,6 +208,9 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
                              (unsigned long long)meshlet_total, (unsigned long long)vertex_total,
                              (unsigned long long)byte_total);
     uint64_t word_total = (byte_total + 3) / 4;
+    /* The records' buffer: every cluster's, or streamed, the record pool: each pool slot's room for
+     * its page's records. */
+    uint64_t record_slots = g->streamed ? (uint64_t)r->stream.slot_count * r->stream.records_per_slot : meshlet_total;
     /* Streamed: no record is uploaded here; a page's arrival writes its clusters' (streaming.c), and
      * the records of absent groups are never read (GDR_FRAME_PAGED_RECORDS). */
     GdrGpuMeshlet *meshlets = g->streamed ? NULL : calloc(meshlet_total ? meshlet_total : 1, sizeof *meshlets);
@@ -225,7 +228,7 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
     g->meshlet_count = (uint32_t)meshlet_total;
     const VkBufferUsageFlags usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     if (status == GDR_OK)
-        status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuMeshlet) * (meshlet_total ? meshlet_total : 1), usage,
+        status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuMeshlet) * (record_slots ? record_slots : 1), usage,
                                       GDR_VK_BUFFER_DEVICE, &g->meshlets, err);
     if (status == GDR_OK && !g->streamed)
         status = gdr_vk_buffer_create(&r->allocator, sizeof(uint32_t) * (vertex_total ? vertex_total : 1), usage,
@@ -236,7 +239,7 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
     if (status == GDR_OK && !g->streamed)
         status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->meshlets, 0, meshlets, sizeof(GdrGpuMeshlet) * meshlet_total, err);
     if (status == GDR_OK && g->streamed && r->debug.poison_absent_records)
-        status = upload_poison_records(r, meshlet_total, err);
+        status = upload_poison_records(r, record_slots, err);
     if (status == GDR_OK && !g->streamed)
         status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->meshlet_vertices, 0, vertex_refs,
                                       sizeof(uint32_t) * vertex_total, err);
@@ -324,6 +327,8 @@ static gdr_status upload_lod_nodes(gdr_renderer *r, const gdr_scene *scene, cons
         cursor += c->lod_node_count;
     }
     gdr_lod_node_records_fill(nodes, clusters, first, scene->mesh_count, pool);
+    if (g->streamed)
+        gdr_streaming_leaves_in_pages(r, nodes, first);
     free(first);
     /* TRANSFER_SRC: tests read the pool back. */
     const VkBufferUsageFlags usage =

@@ -501,8 +501,11 @@ gdr_status gdr_renderer_read_visible_meshlets(gdr_renderer *r, gdr_visible_meshl
                                                 &readback, err);
     for (uint32_t i = 0; status == GDR_OK && i < *count; i++) {
         const uint32_t *pair = (const uint32_t *)readback.mapped + 2 * i;
-        uint32_t mesh = r->scene.cpu_instances[pair[0]].mesh;
-        meshlets[i] = (gdr_visible_meshlet){pair[0], pair[1] - r->scene.cpu_meshes[mesh].meshlet_offset};
+        uint32_t mesh = r->scene.cpu_instances[pair[0]].mesh, record_mesh = mesh;
+        /* Streamed, a record of the record pool: its slot's page says which cluster. */
+        uint32_t cluster = r->scene.streamed ? gdr_streaming_record_cluster(r, pair[1], &record_mesh)
+                                             : pair[1] - r->scene.cpu_meshes[mesh].meshlet_offset;
+        meshlets[i] = (gdr_visible_meshlet){pair[0], record_mesh == mesh ? cluster : UINT32_MAX};
     }
     gdr_vk_buffer_destroy(r->ctx, &readback);
     return status;

@@ -91,9 +91,14 @@ static gdr_status alloc_tables(gdr_streaming *s, const gdr_scene *scene, gdr_err
     if (!s->page_base || !s->mesh_dirty || !s->dirty_list)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "streaming: out of memory");
     uint32_t pages = 0;
+    s->records_per_slot = 1;
     for (uint32_t m = 0; m < meshes; m++) {
+        const gdr_paged_mesh *pm = paged_mesh(s, m);
         s->page_base[m] = pages;
-        pages += paged_mesh(s, m)->page_count;
+        pages += pm->page_count;
+        for (uint32_t p = 0; p < pm->page_count; p++)
+            s->records_per_slot = pm->pages[p].cluster_count > s->records_per_slot ? pm->pages[p].cluster_count
+                                                                                  : s->records_per_slot;
     }
     s->page_base[meshes] = pages;
     s->slot_page = malloc(sizeof *s->slot_page * (s->slot_count ? s->slot_count : 1));
@@ -401,28 +406,80 @@ static void stage_page(gdr_renderer *r, gdr_frame_slot *slot, stream_copies *c, 
     const gdr_page_info *info = &pm->pages[page->page];
     const gdr_mesh_clusters *mc = &s->scene->meshes[page->mesh].clusters;
     uint32_t list_base = (uint32_t)((base + sizeof(GdrGpuVertex) * nv) / 4), triangle_base = (uint32_t)(base + 36ull * nv);
+    /* The page's records, in page order, into the slot's place in the record pool. */
+    uint64_t bytes = sizeof(GdrGpuMeshlet) * (uint64_t)page->cluster_count, from = c->staged;
+    GdrGpuMeshlet *records = stage(slot, c, bytes);
     uint32_t j = 0;
     for (uint32_t k = info->first; k < info->first + info->group_count; k++) {
         uint32_t group = pm->page_groups[k];
         const gdr_cluster_group *gr = &mc->groups[group];
-        uint32_t first = g->cpu_meshes[page->mesh].meshlet_offset + gr->first_cluster;
-        uint64_t bytes = sizeof(GdrGpuMeshlet) * (uint64_t)gr->cluster_count;
-        uint64_t from = c->staged;
-        GdrGpuMeshlet *records = stage(slot, c, bytes);
-        for (uint32_t i = 0; i < gr->cluster_count; i++, j++)
-            records[i] = page_record(mc, &page->clusters[j], list_base, triangle_base);
-        c->records[c->record_count++] = (VkBufferCopy){from, sizeof(GdrGpuMeshlet) * (uint64_t)first, bytes};
+        uint32_t cluster_id = g->cpu_meshes[page->mesh].meshlet_offset + gr->first_cluster;
+        for (uint32_t i = 0; i < gr->cluster_count; i++, j++) {
+            records[j] = page_record(mc, &page->clusters[j], list_base, triangle_base);
+            records[j].cluster_id = cluster_id + i;
+        }
         c->resident_words[c->resident_count] = g->cpu_meshes[page->mesh].page_table_offset + group;
         c->resident_slots[c->resident_count++] = pool_slot;
         set_group(s, page->mesh, group, true);
     }
+    c->records[c->record_count++] =
+        (VkBufferCopy){from, sizeof(GdrGpuMeshlet) * (uint64_t)pool_slot * s->records_per_slot, bytes};
     s->slot_page[pool_slot] = s->page_base[page->mesh] + page->page;
     mark_dirty(s, page->mesh);
     if (page->page == 0 && mc->group_count > 0) { /* the root's records arrive: its shortcut and chain */
         page_refined p = {mc, pm, page};
-        gdr_root_shortcut_set(mc, refined_in_page, &p, &g->cpu_meshes[page->mesh]);
+        GdrGpuMesh *mesh = &g->cpu_meshes[page->mesh];
+        gdr_root_shortcut_set(mc, refined_in_page, &p, mesh);
+        /* The root group leads page 0: its records lead the slot's (pinned: the slot stays). No root
+         * chain: its clusters' records do not lie one before the other in the pool. */
+        mesh->root_first = pool_slot * s->records_per_slot;
+        mesh->root_chain = 0;
         s->meshes_changed = true;
     }
+}
+
+void gdr_streaming_leaves_in_pages(gdr_renderer *r, GdrGpuLodNode *nodes, const uint32_t *first)
+{
+    const gdr_streaming *s = &r->stream;
+    for (uint32_t m = 0; m < s->scene->mesh_count; m++) {
+        const gdr_mesh_clusters *c = &s->scene->meshes[m].clusters;
+        const gdr_paged_mesh *pm = paged_mesh(s, m);
+        uint32_t *at = c->group_count ? malloc(sizeof *at * c->group_count) : NULL;
+        for (uint32_t p = 0; at && p < pm->page_count; p++) {
+            uint32_t offset = 0;
+            for (uint32_t k = pm->pages[p].first; k < pm->pages[p].first + pm->pages[p].group_count; k++) {
+                at[pm->page_groups[k]] = offset;
+                offset += c->groups[pm->page_groups[k]].cluster_count;
+            }
+        }
+        for (uint32_t n = 0; at && n < c->lod_node_count; n++) {
+            GdrGpuLodNode *node = &nodes[first[m] + n];
+            if ((node->flags & GDR_GPU_LOD_NODE_LEAF) && node->group < c->group_count)
+                node->first = at[node->group];
+        }
+        free(at);
+    }
+}
+
+uint32_t gdr_streaming_record_cluster(const gdr_renderer *r, uint32_t record, uint32_t *mesh)
+{
+    const gdr_streaming *s = &r->stream;
+    uint32_t slot = record / s->records_per_slot, j = record % s->records_per_slot;
+    uint32_t page = slot < s->slot_count ? s->slot_page[slot] : UINT32_MAX;
+    if (page == UINT32_MAX)
+        return UINT32_MAX;
+    uint32_t m = page_mesh(s, r->scene.mesh_count, page);
+    const gdr_paged_mesh *pm = paged_mesh(s, m);
+    const gdr_page_info *info = &pm->pages[page - s->page_base[m]];
+    const gdr_mesh_clusters *c = &s->scene->meshes[m].clusters;
+    *mesh = m;
+    for (uint32_t k = info->first; k < info->first + info->group_count; k++) {
+        const gdr_cluster_group *g = &c->groups[pm->page_groups[k]];
+        if (j < g->cluster_count)
+            return g->first_cluster + j;
+        j -= g->cluster_count;
+    }
+    return UINT32_MAX;
 }
 
 /* --- the frame's work ------------------------------------------------------------------------- */
@@ -726,7 +783,7 @@ static void count_resident_tables(gdr_renderer *r)
 {
     gdr_streaming *s = &r->stream;
     const gdr_gpu_scene *g = &r->scene;
-    s->stats.cluster_record_bytes = sizeof(GdrGpuMeshlet) * (uint64_t)g->meshlet_count;
+    s->stats.cluster_record_bytes = sizeof(GdrGpuMeshlet) * (uint64_t)s->slot_count * s->records_per_slot;
     s->stats.hierarchy_bytes = sizeof(GdrGpuLodNode) * (uint64_t)g->node_total;
     s->stats.node_count_bytes = 4ull * g->node_total;
     s->stats.page_table_bytes = 4ull * g->group_total * (2 + GDR_FRAMES_IN_FLIGHT); /* words, stamps, lists */

@@ -88,13 +88,17 @@ void main()
         occluded = deferred;
     }
     bool passes = in_level && !lod_culled && !frustum_culled && !occluded;
-    // A leaf of an absent group draws none of its clusters (an absent group counts as passing); where
-    // the records of absent groups are not on the GPU, its clusters are not tested at all.
-    bool paged_out = (g.flags & GDR_FRAME_PAGED_RECORDS) != 0u && gdr_group_absent(g, mesh_index, node.group);
+    // Streamed, the records live in their pages' slots: a leaf's clusters are records node.first ..
+    // of its group's slot (the page-table word), and a leaf of an absent group, which draws none of
+    // its clusters (an absent group counts as passing), emits none.
+    bool paged = (g.flags & GDR_FRAME_PAGED_RECORDS) != 0u;
     bool leaf = passes && (node.flags & GDR_GPU_LOD_NODE_LEAF) != 0u;
-    bool emits = leaf && !paged_out;
+    uint slot = paged && leaf ? UintsRef(GDR_SCENE.page_table).items[mesh.page_table_offset + node.group]
+                              : GDR_GPU_PAGE_ABSENT;
+    bool emits = leaf && !(paged && slot == GDR_GPU_PAGE_ABSENT);
+    uint first = paged ? slot * g.records_per_slot + node.first : mesh.meshlet_offset + node.first;
     gdr_queue_visits(g, PHASE, level + 1u, passes && !leaf ? node.count : 0u, visit.instance, node.first, visit.flags);
-    GdrTaskRange range = emits ? gdr_task_range(mesh.meshlet_offset + node.first, node.count, visit.flags)
+    GdrTaskRange range = emits ? gdr_task_range(first, node.count, visit.flags)
                                : GdrTaskRange(0u, 0u, 0u, 0u);
     gdr_append_tasks(g, PHASE, emits, visit.instance, range);
     GDR_COUNT(stats, nodes_tested, in_level);

@@ -502,6 +502,34 @@ static uint32_t group_with_shared_refinement(const gdr_scene *scene, gdr_paged_c
 
 static gdr_scene *read_for_streaming(const char *path);
 
+/* The cluster records of a streamed scene live in the record pool: room for the largest page's
+ * records beside each pool slot, so they follow the pool, not the scene (before, a record per
+ * cluster of the scene). */
+static void check_record_pool(const gdr_scene *scene, gdr_renderer *r, const char *path)
+{
+    gdr_paged_cache *cache = NULL;
+    gdr_error err = {0};
+    uint32_t largest = 0;
+    uint64_t clusters = 0;
+    CHECK(gdr_paged_cache_open(path, &cache, &err) == GDR_OK);
+    for (uint32_t m = 0; cache && m < gdr_paged_cache_mesh_count(cache); m++) {
+        const gdr_paged_mesh *pm = gdr_paged_cache_mesh(cache, m);
+        for (uint32_t p = 0; p < pm->page_count; p++)
+            largest = pm->pages[p].cluster_count > largest ? pm->pages[p].cluster_count : largest;
+        clusters += scene->meshes[m].clusters.cluster_count;
+    }
+    gdr_paged_cache_close(cache);
+    gdr_frame_desc frame = view_frame(0);
+    gdr_frame_stats stats = {0};
+    CHECK(gdr_renderer_render(r, &frame, 1, &stats, &err) == GDR_OK);
+    const gdr_streaming_stats *st = &stats.streaming;
+    printf("record pool: %llu bytes for %u slots of %u records (the scene's %llu clusters: %llu bytes)\n",
+           (unsigned long long)st->cluster_record_bytes, st->slot_count, largest, (unsigned long long)clusters,
+           (unsigned long long)(clusters * 128u)); /* 128 bytes a record (GdrGpuMeshlet) */
+    CHECK(st->cluster_record_bytes == (uint64_t)st->slot_count * largest * 128u);
+    CHECK(st->cluster_record_bytes < clusters * 128u);
+}
+
 /* A page whose records disagree with the file's account of its clusters ('CLGR'), every checksum
  * right: one cluster of a group view 0 loads written as made from nothing in the pages alone. The
  * page is refused naming the file, the mesh and the page; the frames go on drawing exact cuts. */
@@ -660,6 +688,7 @@ static void run(gdr_scene *scene, const char *path)
         uint64_t evictions = still_views(scene, r, budget, reference, "small pool");
         CHECK(evictions > 0); /* the views need more than the pool holds */
         camera_path(scene, r, budget);
+        check_record_pool(scene, r, path);
     }
     gdr_renderer_destroy(r);
 

@@ -19,8 +19,10 @@
 static void fill_serial(GdrGpuMeshlet *out, const gdr_cluster_record_layout *l)
 {
     for (uint32_t m = 0; m < l->mesh_count; m++)
-        for (uint32_t i = 0; i < l->clusters[m]->cluster_count; i++)
+        for (uint32_t i = 0; i < l->clusters[m]->cluster_count; i++) {
             out[l->first[m] + i] = gdr_cluster_record(l->clusters[m], i, l->vertex_base[m], l->byte_base[m]);
+            out[l->first[m] + i].cluster_id = l->first[m] + i;
+        }
 }
 
 static int check_layout(const gdr_cluster_record_layout *l, uint32_t total, gdr_thread_pool *pool)
