@@ -22,9 +22,9 @@ typedef struct gdr_renderer_debug {
      * (0: sized from the scene), to show that the clusters that find it full are still drawn. */
     bool tiny_raster_off;
     uint32_t tiny_raster_capacity;
-    /* Streamed: every cluster's record set up as one that any test would find drawn (no group, no
-     * refined group, no triangles, a sphere over everything) until its page writes it, to show that
-     * no shader reads the records of absent groups (they are not uploaded otherwise). */
+    /* Streamed: every record of the record pool set up as one that any test would find drawn (no
+     * group, no refined group, no triangles, a sphere over everything) until a page writes it, to
+     * show that no shader reads a record no resident page wrote (none is uploaded otherwise). */
     bool poison_absent_records;
 } gdr_renderer_debug;
 
