@@ -93,8 +93,9 @@ void main()
     // its clusters (an absent group counts as passing), emits none.
     bool paged = (g.flags & GDR_FRAME_PAGED_RECORDS) != 0u;
     bool leaf = passes && (node.flags & GDR_GPU_LOD_NODE_LEAF) != 0u;
-    uint slot = paged && leaf ? UintsRef(GDR_SCENE.page_table).items[mesh.page_table_offset + node.group]
-                              : GDR_GPU_PAGE_ABSENT;
+    uint slot = paged && leaf && node.group != GDR_GPU_NO_GROUP
+                    ? UintsRef(GDR_SCENE.page_table).items[mesh.page_table_offset + node.group]
+                    : GDR_GPU_PAGE_ABSENT;
     bool emits = leaf && !(paged && slot == GDR_GPU_PAGE_ABSENT);
     uint first = paged ? slot * g.records_per_slot + node.first : mesh.meshlet_offset + node.first;
     gdr_queue_visits(g, PHASE, level + 1u, passes && !leaf ? node.count : 0u, visit.instance, node.first, visit.flags);
