@@ -6,11 +6,12 @@
  * Each pool slot holds one page: its vertices (GdrGpuVertex), then its cluster vertex list (one
  * word per vertex: the vertex's index in the pool), then its triangle bytes. The scene's vertex,
  * vertex-list and triangle references all point at the pool's start, so a slot's data is addressed
- * by offsets within it, and the shaders read streamed clusters as they read uploaded ones. A page's
- * arrival writes its clusters' records (GdrGpuMeshlet, from the page's own records, with offsets
- * into the slot) and marks its groups resident in the page table; an eviction marks them absent.
- * The records of absent groups are never read (GDR_FRAME_PAGED_RECORDS), so none is uploaded before
- * its page. */
+ * by offsets within it, and the shaders read streamed clusters as they read uploaded ones. The
+ * cluster records (GdrGpuMeshlet) live in the record pool: records_per_slot of them beside each slot.
+ * A page's arrival writes its clusters' records there (from the page's own records, with offsets into
+ * the slot) and marks its groups resident in the page table, each word its slot; an eviction marks
+ * them absent. The traversal finds a leaf's records at its group's slot (GDR_FRAME_PAGED_RECORDS)
+ * and never reads a record no resident page wrote. */
 #include <stdlib.h>
 #include <string.h>
 
