@@ -183,7 +183,7 @@ GDR_API gdr_status gdr_texture_decode_level(const gdr_texture *t, uint32_t level
 
 /* --- processed-scene cache ------------------------------------------------------------------ */
 
-#define GDR_CACHE_FORMAT_VERSION 11u
+#define GDR_CACHE_FORMAT_VERSION 12u
 
 /* What a cache was built from: the build options (a string that changes whenever the processing
  * would produce different data, e.g. "import=1") and the source files. */

@@ -83,6 +83,16 @@ typedef struct gdr_lod_node {
 #define GDR_LOD_NODE_MAX_LEVELS 32u
 #define GDR_LOD_LEAF_CLUSTERS_NO_DAG 4u /* clusters per leaf of a mesh without a DAG */
 
+/* What a group's clusters were made from: `cluster_count` clusters of group `group` have refined
+ * group `refined_group` (gdr_mesh_clusters.refinements; cache section 'CLGR'). */
+typedef struct gdr_cluster_refinement {
+    uint32_t group, refined_group, cluster_count;
+} gdr_cluster_refinement;
+
+/* Clusters by size, the larger of their vertex and triangle counts: class b holds the sizes in
+ * (2^(b-1), 2^b] (class 0: size 1), so the last holds up to 128 >= GDR_CLUSTER_MAX_TRIANGLES. */
+#define GDR_CLUSTER_SIZE_CLASSES 8u
+
 typedef struct gdr_mesh_clusters {
     gdr_cluster *clusters;
     uint32_t cluster_count;
@@ -98,7 +108,23 @@ typedef struct gdr_mesh_clusters {
                                       (NULL, 0) only where a build failed */
     uint32_t lod_node_count;
     uint32_t lod_node_levels;      /* levels of lod_nodes: 1 for a root alone, at most GDR_LOD_NODE_MAX_LEVELS */
+    /* A mesh read for streaming (gdr_scene.geometry_in_pages) holds no per-cluster array (clusters
+     * NULL, cluster_count still its count: the records are in the pages) but these, which stand in for
+     * what is read from the clusters otherwise; NULL and 0 in a mesh that holds its clusters. */
+    gdr_vec4 *group_bounds;        /* per group: gdr_lod_enclosing_sphere of its clusters' spheres, in order */
+    gdr_cluster_refinement *refinements; /* per group in order, its clusters' refined groups in order of first use */
+    uint32_t refinement_count;
+    uint32_t size_classes[GDR_CLUSTER_SIZE_CLASSES]; /* clusters per size class */
 } gdr_mesh_clusters;
+
+/* The size class of a cluster of `vertex_count` vertices and `triangle_count` triangles. */
+static inline uint32_t gdr_cluster_size_class(uint32_t vertex_count, uint32_t triangle_count)
+{
+    uint32_t size = vertex_count > triangle_count ? vertex_count : triangle_count, b = 0;
+    while (b + 1 < GDR_CLUSTER_SIZE_CLASSES && size > (1u << b))
+        b++;
+    return b;
+}
 
 GDR_API void gdr_mesh_clusters_free(gdr_mesh_clusters *clusters);
 

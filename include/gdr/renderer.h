@@ -290,10 +290,12 @@ typedef struct gdr_streaming_stats {
     double loader_busy_ms;
     double loader_mb_s;
     uint32_t loader_queue_depth;
-    /* What stays on the GPU beside the pool, whatever is resident (docs/STREAMING.md, "What stays
-     * resident"): every cluster's record, every mesh's LOD hierarchy, the nodes' absent counts, and
-     * the page table with the groups' frame stamps and each frame slot's list of groups drawn; and
-     * the source triangles of the scene's meshes (level 0 of each, once per mesh). */
+    /* The record pool (cluster_record_bytes: room for its page's cluster records beside each pool
+     * slot, which follows the pool, not the scene) and what stays on the GPU beside the pool,
+     * whatever is resident (docs/STREAMING.md, "What stays resident"): every mesh's LOD hierarchy,
+     * the nodes' absent counts, and the page table with the groups' frame stamps and each frame
+     * slot's list of groups drawn; and the source triangles of the scene's meshes (level 0 of each,
+     * once per mesh). */
     uint64_t cluster_record_bytes, hierarchy_bytes, node_count_bytes, page_table_bytes;
     uint64_t source_triangles;
     char refused[GDR_ERROR_MESSAGE_MAX];          /* the last refused page's message (file, mesh, page, why) */

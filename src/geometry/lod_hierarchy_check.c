@@ -15,6 +15,32 @@ static int contains(gdr_vec4 outer, gdr_vec4 inner)
 
 #define FAIL(...) do { snprintf(what, what_size, __VA_ARGS__); return 0; } while (0)
 
+/* A leaf of a mesh without its clusters (read for streaming): its group's refinements stand for its
+ * clusters' refined groups (the pages are checked against them as they arrive). The refinements are
+ * in group order, so a binary search finds the group's. */
+static int check_leaf_refinements(const gdr_mesh_clusters *c, uint32_t i, char *what, size_t what_size)
+{
+    const gdr_lod_node *n = &c->lod_nodes[i];
+    uint32_t lo = 0, hi = c->refinement_count, refined = 0;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (c->refinements[mid].group < n->group)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    for (uint32_t k = lo; k < c->refinement_count && c->refinements[k].group == n->group; k++) {
+        const gdr_cluster_refinement *f = &c->refinements[k];
+        if (f->refined_group >= c->group_count || !contains(n->sphere, c->groups[f->refined_group].sphere) ||
+            !(n->min_refined_error <= c->groups[f->refined_group].error))
+            FAIL("node %u: does not contain refined group %u's sphere or error", i, f->refined_group);
+        refined += f->cluster_count;
+    }
+    if (refined < n->count && n->min_refined_error != 0.0f)
+        FAIL("node %u: a cluster has no refined group, the refined error bound is not 0", i);
+    return 1;
+}
+
 /* A leaf's own bounds: its clusters, their groups and refined groups. */
 static int check_leaf(const gdr_mesh_clusters *c, uint32_t i, uint8_t *seen, char *what, size_t what_size)
 {
@@ -34,6 +60,8 @@ static int check_leaf(const gdr_mesh_clusters *c, uint32_t i, uint8_t *seen, cha
         if (!contains(n->sphere, g->sphere) || !(n->max_error >= g->error))
             FAIL("node %u: does not contain its group %u's sphere or error", i, n->group);
     }
+    if (!c->clusters) /* read for streaming: the pages hold the clusters */
+        return c->group_count ? check_leaf_refinements(c, i, what, what_size) : 1;
     for (uint32_t k = n->first; k < n->first + n->count; k++) {
         const gdr_cluster *cl = &c->clusters[k];
         if (c->group_count == 0 && seen[k]++)

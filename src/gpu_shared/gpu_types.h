@@ -101,7 +101,9 @@ GDR_STRUCT_BEGIN(GdrGpuMeshlet)
     gdr_uint refined_group;   /* mesh-local group index, or GDR_GPU_NO_GROUP */
     gdr_int group_depth;      /* DAG depth of the group (0 without one): the cluster's LOD level */
     gdr_int refined_depth;    /* DAG depth of the refined group, -1 without one */
-    gdr_uint reserved0;
+    gdr_uint cluster_id;      /* its index among the records of the scene uploaded whole (meshlet_offset +
+                                 cluster): the debug views colour by it, so that a streamed scene's records,
+                                 which live in their pages' slots, colour alike */
     gdr_vec4 group_sphere;    /* mesh space */
     gdr_vec4 refined_sphere;  /* mesh space */
     float group_error;        /* mesh space; INFINITY for the root group and without a group */
@@ -453,7 +455,8 @@ GDR_STRUCT_BEGIN(GdrGpuFrameGlobals)
      * times P[1][1] * 0.5 * viewport height. */
     float lod_znear;
     gdr_uint orthographic;    /* 1: an orthographic camera */
-    gdr_uint reserved6;
+    gdr_uint records_per_slot; /* GDR_FRAME_PAGED_RECORDS: a pool slot's room in the record pool (the
+                                  records of the page in slot s start at s x records_per_slot) */
     gdr_uint reserved7;
 GDR_STRUCT_END(GdrGpuFrameGlobals)
 GDR_ASSERT_SIZE(GdrGpuFrameGlobals, 432);
@@ -484,6 +487,10 @@ GDR_ASSERT_OFFSET(GdrGpuFrameGlobals, viewport, 208);
 #define GDR_FRAME_PVS 32768u          /* the instance cull drops instances GdrGpuFrameBuffers.pvs_visible does not list */
 #define GDR_FRAME_POINTS 65536u       /* visibility-buffer modes, LOD by error: instances within a pixel are
                                          drawn as their point level by the instance cull (shared/point_level.h) */
+#define GDR_FRAME_PAGED_RECORDS 131072u /* streamed: the cluster records live in a pool of their pages' slots
+                                          (records_per_slot each), so clusters are reached only through the
+                                          hierarchy's leaves of resident groups, a leaf's at its group's slot
+                                          (never a flat range over a mesh's clusters) */
 #define GDR_FRAME_DIRECT_CLUSTERS 1024u /* visibility-buffer modes: the instance cull tests the clusters of an
                                            instance that needs at most GDR_DIRECT_CLUSTERS of them and bins
                                            them itself, instead of a task command for the cluster cull */

@@ -23,7 +23,7 @@
 
 /* The sections whose bytes are one part per mesh, in mesh order, and nothing else (those of the whole
  * geometry only where the file has them). */
-static const int per_mesh_sections[] = {CACHE_MESHES, CACHE_GEOMETRY, CACHE_COLORS, CACHE_CLUSTERS,
+static const int per_mesh_sections[] = {CACHE_MESHES, CACHE_GEOMETRY, CACHE_COLORS, CACHE_CLUSTERS, CACHE_CLUSTER_GROUPS,
                                         CACHE_CLUSTER_DATA, CACHE_CLUSTER_GEOMETRY, CACHE_HIERARCHY};
 enum { PER_MESH = sizeof per_mesh_sections / sizeof per_mesh_sections[0], PAGE_SPOOL = PER_MESH };
 

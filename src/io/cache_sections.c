@@ -23,7 +23,8 @@ enum { TEXTURE_REF_RECORD = 4 * 4 + 4 * 4, QUANTIZATION_RECORD = 4 + 4 + 12 + 4 
 
 enum { MESH_RECORD = 64 + 8 + 16 + QUANTIZATION_RECORD, MATERIAL_RECORD = 64 + 16 + 5 * TEXTURE_REF_RECORD + 12 + 5 * 4 + 8, INSTANCE_RECORD = CACHE_INSTANCE_RECORD,
        CAMERA_RECORD = 64 + 12 + 16 + 20, TEXTURE_RECORD = 64 + 16, CLUSTERS_RECORD = 6 * 4,
-       CLUSTER_RECORD = 4 * 4 + 16 + 12 + 12 + 4 + 3 * 4, GROUP_RECORD = 16 + 4 + 3 * 4,
+       CLUSTER_RECORD = 4 * 4 + 16 + 12 + 12 + 4 + 3 * 4, GROUP_RECORD = 16 + 4 + 3 * 4 + 16,
+       REFINEMENT_RECORD = 3 * 4, SIZE_CLASSES_RECORD = 4 * GDR_CLUSTER_SIZE_CLASSES,
        NODE_RECORD = 16 + 4 + 4 + 4 * 4 + 2 * 4 };
 
 /* What the sections read so far hand to the ones after them. */
@@ -35,7 +36,7 @@ struct cache_read_state {
     uint32_t mesh_count, material_count, instance_count, camera_count, texture_count; /* SCNE */
     reader textures;  /* TEXR, read again with TXPX */
     reader meshes;    /* MESH, read again with GEOM */
-    reader clusters;  /* CLUS, read again with CLDT and CLGM */
+    reader clusters;  /* CLUS, read again with CLGR */
     int paged;        /* the geometry stays in the file's pages: GEOM, VCOL, CLGM and PAGE are not read */
 };
 
@@ -439,14 +440,86 @@ static void write_cluster_records(writer *w, const cache_write_input *in)
             put_u32(w, cl->refined_group);
             put_u32(w, cl->reserved);
         }
+    }
+}
+
+/* Group g's clusters' spheres enclosed (gdr_lod_enclosing_sphere, in cluster order, into `spheres`,
+ * room for the group's clusters): what the hierarchy's leaf of g bounds its clusters with. */
+static gdr_vec4 group_cluster_bounds(const gdr_mesh_clusters *c, const gdr_cluster_group *g, gdr_vec4 *spheres)
+{
+    for (uint32_t i = 0; i < g->cluster_count; i++)
+        spheres[i] = c->clusters[g->first_cluster + i].sphere;
+    return g->cluster_count ? gdr_lod_enclosing_sphere(spheres, g->cluster_count) : g->sphere;
+}
+
+/* Group g's refinements (its clusters' refined groups in order of first use, with their counts),
+ * written where w is not NULL; counted into *count. `refined` and `clusters`: room for the group's
+ * clusters. */
+static void put_group_refinements(writer *w, const gdr_mesh_clusters *c, uint32_t g, uint32_t *refined,
+                                  uint32_t *clusters, uint32_t *count)
+{
+    const gdr_cluster_group *gr = &c->groups[g];
+    uint32_t n = 0;
+    for (uint32_t i = gr->first_cluster; i < gr->first_cluster + gr->cluster_count; i++) {
+        uint32_t r = c->clusters[i].refined_group, k = 0;
+        if (r == GDR_NO_INDEX)
+            continue;
+        while (k < n && refined[k] != r)
+            k++;
+        if (k == n)
+            refined[n] = r, clusters[n++] = 0;
+        clusters[k]++;
+    }
+    for (uint32_t k = 0; k < n; k++) {
+        if (w) {
+            put_u32(w, g);
+            put_u32(w, refined[k]);
+            put_u32(w, clusters[k]);
+        }
+        ++*count;
+    }
+}
+
+/* CLGR: per mesh, what the clusters say about their groups, for a reader without the clusters. */
+static void write_cluster_groups(writer *w, const cache_write_input *in)
+{
+    const gdr_scene *s = in->scene;
+    for (uint32_t i = 0; i < s->mesh_count && !w->failed; i++) {
+        const gdr_mesh_clusters *c = &s->meshes[i].clusters;
+        uint32_t largest = 1;
+        for (uint32_t k = 0; k < c->group_count; k++)
+            largest = c->groups[k].cluster_count > largest ? c->groups[k].cluster_count : largest;
+        gdr_vec4 *spheres = malloc(sizeof *spheres * largest);
+        uint32_t *refined = malloc(2 * sizeof *refined * largest);
+        if (!spheres || !refined) {
+            free(spheres), free(refined);
+            w->failed = 1;
+            return;
+        }
+        uint32_t classes[GDR_CLUSTER_SIZE_CLASSES] = {0};
+        for (uint32_t k = 0; k < c->cluster_count; k++)
+            classes[gdr_cluster_size_class(c->clusters[k].vertex_count, c->clusters[k].triangle_count)]++;
+        for (uint32_t b = 0; b < GDR_CLUSTER_SIZE_CLASSES; b++)
+            put_u32(w, classes[b]);
         for (uint32_t k = 0; k < c->group_count; k++) {
             const gdr_cluster_group *g = &c->groups[k];
+            gdr_vec4 bounds = group_cluster_bounds(c, g, spheres);
             put_f32s(w, &g->sphere.x, 4);
             put_f32s(w, &g->error, 1);
             put_u32(w, g->depth);
             put_u32(w, g->first_cluster);
             put_u32(w, g->cluster_count);
+            put_f32s(w, &bounds.x, 4);
         }
+        uint32_t refinements = 0;
+        for (uint32_t k = 0; k < c->group_count; k++)
+            put_group_refinements(NULL, c, k, refined, refined + largest, &refinements);
+        put_u32(w, refinements);
+        refinements = 0;
+        for (uint32_t k = 0; k < c->group_count; k++)
+            put_group_refinements(w, c, k, refined, refined + largest, &refinements);
+        free(spheres);
+        free(refined);
     }
 }
 
@@ -502,7 +575,7 @@ static gdr_status read_cluster_record(const char *name, reader *r, uint32_t m, u
     return GDR_OK;
 }
 
-/* Reads one mesh's cluster and group records (counts already set in c, arrays allocated) and checks
+/* Reads one mesh's cluster records (counts and groups already read, the array allocated) and checks
  * every offset, count and index against the limits, the counts and the mesh. */
 static gdr_status read_mesh_clusters(const char *name, reader *r, uint32_t m, const gdr_mesh *mesh,
                                      gdr_mesh_clusters *c, gdr_error *err)
@@ -514,19 +587,6 @@ static gdr_status read_mesh_clusters(const char *name, reader *r, uint32_t m, co
             return status;
         if (k < c->level0_cluster_count)
             level0_triangles += c->clusters[k].triangle_count;
-    }
-    for (uint32_t k = 0; k < c->group_count; k++) {
-        gdr_cluster_group *g = &c->groups[k];
-        get_f32s(r, &g->sphere.x, 4);
-        get_f32s(r, &g->error, 1);
-        g->depth = get_u32(r);
-        g->first_cluster = get_u32(r);
-        g->cluster_count = get_u32(r);
-        if (bad_sphere(&g->sphere) || isnan(g->error))
-            return CLDT(" group %u: sphere or error is not a number", k);
-        if ((uint64_t)g->first_cluster + g->cluster_count > c->cluster_count)
-            return CLDT(" group %u: clusters %u (+%u) lie outside the mesh's %u", k, g->first_cluster,
-                        g->cluster_count, c->cluster_count);
     }
     if (r->failed) /* the caller checked the sizes: only a programming error gets here */
         return CLDT(" %s", "runs past the section");
@@ -559,50 +619,127 @@ static gdr_status read_mesh_cluster_counts(cache_read_state *st, uint32_t m, gdr
     return GDR_OK;
 }
 
-/* Where each mesh's records lie in CLDT, for the meshes decoded at once. */
-typedef struct cluster_decode {
+/* --- CLGR (per mesh: its groups and what its clusters say of them) ------------------------------- */
+
+#define CLGR(fmt, ...) gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLGR': mesh %u" fmt, name, m, __VA_ARGS__)
+
+/* Where each mesh's part of a section lies, for the meshes decoded at once. */
+typedef struct mesh_decode {
     cache_read_state *st;
     const reader *data;
-    size_t *at; /* per mesh: its records' offset in data */
-} cluster_decode;
+    size_t *at; /* per mesh: its part's offset in data */
+} mesh_decode;
 
-static gdr_status decode_mesh_clusters(void *user, uint32_t m, gdr_error *err)
+/* Mesh m's groups (and, for a streamed scene, the clusters' bounds per group), checked. */
+static gdr_status read_mesh_groups(const char *name, reader *r, uint32_t m, gdr_mesh_clusters *c, bool keep,
+                                   gdr_error *err)
 {
-    const cluster_decode *d = user;
-    gdr_mesh *mesh = &d->st->scene->meshes[m];
-    if (mesh->clusters.cluster_count == 0)
-        return GDR_OK;
-    reader r = {d->data->data, d->data->size, d->at[m], 0};
-    return read_mesh_clusters(d->st->name, &r, m, mesh, &mesh->clusters, err);
+    for (uint32_t k = 0; k < c->group_count; k++) {
+        gdr_cluster_group *g = &c->groups[k];
+        gdr_vec4 bounds;
+        get_f32s(r, &g->sphere.x, 4);
+        get_f32s(r, &g->error, 1);
+        g->depth = get_u32(r);
+        g->first_cluster = get_u32(r);
+        g->cluster_count = get_u32(r);
+        get_f32s(r, &bounds.x, 4);
+        if (bad_sphere(&g->sphere) || isnan(g->error) || bad_sphere(&bounds))
+            return CLGR(" group %u: sphere, bounds or error is not a number", k);
+        if ((uint64_t)g->first_cluster + g->cluster_count > c->cluster_count)
+            return CLGR(" group %u: clusters %u (+%u) lie outside the mesh's %u", k, g->first_cluster,
+                        g->cluster_count, c->cluster_count);
+        if (keep)
+            c->group_bounds[k] = bounds;
+    }
+    return GDR_OK;
 }
 
-/* One mesh's counts, checked against what is left of the section, and its arrays; *at its records. */
-static gdr_status place_mesh_clusters(cache_read_state *st, reader *data, uint32_t m, size_t *at, gdr_error *err)
+/* Mesh m's refinements: per group in order, refined groups that exist, other than the group, each
+ * with clusters, adding up to at most the group's clusters. */
+static gdr_status read_mesh_refinements(const char *name, reader *r, uint32_t m, gdr_mesh_clusters *c,
+                                        uint32_t count, bool keep, gdr_error *err)
 {
+    uint32_t group = 0;
+    uint64_t used = 0;
+    for (uint32_t k = 0; k < count; k++) {
+        gdr_cluster_refinement f = {get_u32(r), get_u32(r), get_u32(r)};
+        if (f.group != group)
+            used = 0;
+        if (f.group < group || f.group >= c->group_count || f.refined_group >= c->group_count ||
+            f.refined_group == f.group || f.cluster_count == 0 ||
+            used + f.cluster_count > c->groups[f.group].cluster_count)
+            return CLGR(" refinement %u: group %u, refined group %u, %u clusters: out of order or beyond the "
+                        "mesh's %u groups and their clusters", k, f.group, f.refined_group, f.cluster_count,
+                        c->group_count);
+        group = f.group;
+        used += f.cluster_count;
+        if (keep)
+            c->refinements[k] = f;
+    }
+    return GDR_OK;
+}
+
+static gdr_status decode_mesh_groups(void *user, uint32_t m, gdr_error *err)
+{
+    const mesh_decode *d = user;
+    const char *name = d->st->name;
+    gdr_mesh_clusters *c = &d->st->scene->meshes[m].clusters;
+    reader r = {d->data->data, d->data->size, d->at[m], 0};
+    uint64_t classes = 0;
+    for (uint32_t b = 0; b < GDR_CLUSTER_SIZE_CLASSES; b++) {
+        uint32_t n = get_u32(&r);
+        classes += n;
+        if (d->st->paged)
+            c->size_classes[b] = n;
+    }
+    if (classes != c->cluster_count)
+        return CLGR(": its size classes hold %llu clusters, the mesh %u", (unsigned long long)classes,
+                    c->cluster_count);
+    gdr_status status = read_mesh_groups(name, &r, m, c, d->st->paged, err);
+    uint32_t count = get_u32(&r);
+    if (status == GDR_OK)
+        status = read_mesh_refinements(name, &r, m, c, count, d->st->paged, err);
+    if (status == GDR_OK && r.failed) /* the caller checked the sizes */
+        return CLGR(" %s", "runs past the section");
+    return status;
+}
+
+/* One mesh's counts (CLUS), its part of CLGR placed against what is left of the section, and its
+ * arrays; *at its part. A streamed scene keeps the clusters' bounds per group and the refinements. */
+static gdr_status place_mesh_groups(cache_read_state *st, reader *data, uint32_t m, size_t *at, gdr_error *err)
+{
+    const char *name = st->name;
     gdr_mesh_clusters *c = &st->scene->meshes[m].clusters; /* owned by the scene from here: freed with it */
     gdr_status status = read_mesh_cluster_counts(st, m, c, err);
     if (status != GDR_OK)
         return status;
-    uint64_t need = (uint64_t)c->cluster_count * CLUSTER_RECORD + (uint64_t)c->group_count * GROUP_RECORD;
-    if (need > data->size - data->at)
-        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLDT': mesh %u: %u clusters and %u groups run "
-                             "past the section", st->name, m, c->cluster_count, c->group_count);
     *at = data->at;
-    data->at += (size_t)need;
-    if (c->cluster_count == 0)
-        return GDR_OK;
-    c->clusters = malloc(sizeof(gdr_cluster) * (size_t)c->cluster_count);
-    c->groups = c->group_count ? malloc(sizeof(gdr_cluster_group) * (size_t)c->group_count) : NULL;
-    if (!c->clusters || (c->group_count && !c->groups))
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: mesh %u: out of memory for %u clusters", st->name, m,
-                             c->cluster_count);
+    uint64_t head = SIZE_CLASSES_RECORD + (uint64_t)c->group_count * GROUP_RECORD;
+    if (head + 4 > data->size - data->at)
+        return CLGR(": %u groups run past the section", c->group_count);
+    data->at += (size_t)head;
+    uint32_t refinements = get_u32(data);
+    if ((uint64_t)refinements * REFINEMENT_RECORD > data->size - data->at)
+        return CLGR(": %u refinements run past the section", refinements);
+    data->at += (size_t)refinements * REFINEMENT_RECORD;
+    bool keep = st->paged;
+    c->groups = c->group_count ? malloc(sizeof *c->groups * (size_t)c->group_count) : NULL;
+    c->group_bounds = keep && c->group_count ? malloc(sizeof *c->group_bounds * (size_t)c->group_count) : NULL;
+    c->refinements = keep && refinements ? malloc(sizeof *c->refinements * (size_t)refinements) : NULL;
+    c->refinement_count = keep ? refinements : 0;
+    if ((c->group_count && (!c->groups || (keep && !c->group_bounds))) || (keep && refinements && !c->refinements))
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: mesh %u: out of memory for %u groups", name, m,
+                             c->group_count);
     return GDR_OK;
 }
+#undef CLGR
 
-/* Every mesh's counts and place first, in order, up to the first that fails; then the records of the
- * meshes placed, decoded at once (cache_decode.c). A failure of an earlier mesh's records comes
- * before a later mesh's counts, as when each mesh was read whole before the next. */
-static gdr_status read_cluster_data(cache_read_state *st, reader *data, gdr_error *err)
+/* Every mesh's counts and place first, in order, up to the first that fails; then the meshes
+ * placed, decoded at once (cache_decode.c). A failure of an earlier mesh's data comes before a later
+ * mesh's counts, as when each mesh was read whole before the next. */
+static gdr_status read_in_meshes(cache_read_state *st, reader *data, const char *id,
+                                 gdr_status (*place)(cache_read_state *, reader *, uint32_t, size_t *, gdr_error *),
+                                 cache_mesh_decode_fn *decode, bool by_clusters, gdr_error *err)
 {
     size_t *at = malloc(sizeof *at * (st->mesh_count ? st->mesh_count : 1));
     if (!at)
@@ -612,17 +749,61 @@ static gdr_status read_cluster_data(cache_read_state *st, reader *data, gdr_erro
     uint32_t ready = 0;
     uint64_t records = 0;
     for (; ready < st->mesh_count && placed == GDR_OK; ready++) {
-        placed = place_mesh_clusters(st, data, ready, &at[ready], err);
-        records += st->scene->meshes[ready].clusters.cluster_count;
+        placed = place(st, data, ready, &at[ready], err);
+        const gdr_mesh_clusters *c = &st->scene->meshes[ready].clusters;
+        records += by_clusters ? c->cluster_count : c->group_count;
     }
     if (placed != GDR_OK)
         ready--; /* the failed mesh is not decoded */
-    cluster_decode d = {st, data, at};
-    gdr_status status = cache_decode_meshes(ready, records, decode_mesh_clusters, &d, err);
+    mesh_decode d = {st, data, at};
+    gdr_status status = cache_decode_meshes(ready, records, decode, &d, err);
     free(at);
     if (status != GDR_OK)
         return status;
-    return placed != GDR_OK ? placed : expect_end(st, data, "CLDT", err);
+    return placed != GDR_OK ? placed : expect_end(st, data, id, err);
+}
+
+static gdr_status read_cluster_groups(cache_read_state *st, reader *data, gdr_error *err)
+{
+    return read_in_meshes(st, data, "CLGR", place_mesh_groups, decode_mesh_groups, false, err);
+}
+
+/* --- CLDT (per mesh: its cluster records; absent where the pages alone hold them) ---------------- */
+
+static gdr_status decode_mesh_clusters(void *user, uint32_t m, gdr_error *err)
+{
+    const mesh_decode *d = user;
+    gdr_mesh *mesh = &d->st->scene->meshes[m];
+    if (mesh->clusters.cluster_count == 0)
+        return GDR_OK;
+    reader r = {d->data->data, d->data->size, d->at[m], 0};
+    return read_mesh_clusters(d->st->name, &r, m, mesh, &mesh->clusters, err);
+}
+
+/* One mesh's records placed against what is left of the section, and its array; *at its records. */
+static gdr_status place_mesh_clusters(cache_read_state *st, reader *data, uint32_t m, size_t *at, gdr_error *err)
+{
+    gdr_mesh_clusters *c = &st->scene->meshes[m].clusters;
+    uint64_t need = (uint64_t)c->cluster_count * CLUSTER_RECORD;
+    if (need > data->size - data->at)
+        return gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLDT': mesh %u: %u clusters run past the section",
+                             st->name, m, c->cluster_count);
+    *at = data->at;
+    data->at += (size_t)need;
+    if (c->cluster_count == 0)
+        return GDR_OK;
+    c->clusters = malloc(sizeof(gdr_cluster) * (size_t)c->cluster_count);
+    if (!c->clusters)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: mesh %u: out of memory for %u clusters", st->name, m,
+                             c->cluster_count);
+    return GDR_OK;
+}
+
+static gdr_status read_cluster_data(cache_read_state *st, reader *data, gdr_error *err)
+{
+    if (st->paged)
+        return GDR_OK; /* the pages hold the records */
+    return read_in_meshes(st, data, "CLDT", place_mesh_clusters, decode_mesh_clusters, true, err);
 }
 
 #define CLGM(fmt, ...) gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLGM': mesh %u" fmt, name, m, __VA_ARGS__)
@@ -1014,8 +1195,10 @@ const cache_section gdr_cache_sections[CACHE_SECTION_COUNT] = {
     [CACHE_COLORS] = {FOURCC('V', 'C', 'O', 'L'), REQUIRED, 0, has_whole_geometry, NULL, write_colors, read_colors, 1,
                       1},
     [CACHE_CLUSTERS] = {FOURCC('C', 'L', 'U', 'S'), REQUIRED, 0, NULL, NULL, write_cluster_counts, read_cluster_counts, 0, 0},
-    [CACHE_CLUSTER_DATA] = {FOURCC('C', 'L', 'D', 'T'), REQUIRED, 0, NULL, NULL, write_cluster_records,
-                            read_cluster_data, 0, 0},
+    [CACHE_CLUSTER_GROUPS] = {FOURCC('C', 'L', 'G', 'R'), REQUIRED, 0, NULL, NULL, write_cluster_groups,
+                              read_cluster_groups, 0, 0},
+    [CACHE_CLUSTER_DATA] = {FOURCC('C', 'L', 'D', 'T'), REQUIRED, 0, has_whole_geometry, NULL, write_cluster_records,
+                            read_cluster_data, 1, 1},
     [CACHE_CLUSTER_GEOMETRY] = {FOURCC('C', 'L', 'G', 'M'), REQUIRED, 0, has_whole_geometry, NULL,
                                 write_cluster_geometry, read_cluster_geometry, 1, 1},
     [CACHE_HIERARCHY] = {FOURCC('L', 'O', 'D', 'H'), REQUIRED, 0, NULL, check_hierarchy_present, write_hierarchy,

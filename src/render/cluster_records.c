@@ -14,20 +14,25 @@
 
 GdrGpuMeshlet gdr_cluster_record(const gdr_mesh_clusters *c, uint32_t i, uint32_t vertex_base, uint32_t byte_base)
 {
-    const gdr_cluster *k = &c->clusters[i];
+    return gdr_cluster_record_of(c, &c->clusters[i], vertex_base, byte_base);
+}
+
+GdrGpuMeshlet gdr_cluster_record_of(const gdr_mesh_clusters *c, const gdr_cluster *k, uint32_t vertex_base,
+                                    uint32_t byte_base)
+{
     GdrGpuMeshlet m = {
         .vertex_offset = vertex_base + k->vertex_offset, .triangle_offset = byte_base + k->triangle_offset,
         .vertex_count = k->vertex_count, .triangle_count = k->triangle_count, .sphere = k->sphere,
         .cone_apex = k->cone_apex, .cone_cutoff = k->cone_cutoff, .cone_axis = k->cone_axis,
         .group = k->group, .refined_group = k->refined_group,
         .group_depth = 0, .refined_depth = -1, .group_error = INFINITY, .refined_error = 0.0f};
-    if (k->group != GDR_NO_INDEX) {
+    if (k->group != GDR_NO_INDEX && k->group < c->group_count) {
         const gdr_cluster_group *g = &c->groups[k->group];
         m.group_depth = (int32_t)g->depth;
         m.group_sphere = g->sphere;
         m.group_error = g->error;
     }
-    if (k->refined_group != GDR_NO_INDEX) {
+    if (k->refined_group != GDR_NO_INDEX && k->refined_group < c->group_count) {
         const gdr_cluster_group *g = &c->groups[k->refined_group];
         m.refined_depth = (int32_t)g->depth;
         m.refined_sphere = g->sphere;
@@ -70,8 +75,10 @@ static void fill_chunk(void *user, uint32_t task, uint32_t worker)
     uint64_t end = at + job->chunk < job->total ? at + job->chunk : job->total;
     for (uint32_t m = mesh_of(l, at); at < end && m < l->mesh_count; m++) {
         const gdr_mesh_clusters *c = l->clusters[m];
-        for (uint32_t i = (uint32_t)(at - l->first[m]); i < c->cluster_count && at < end; i++, at++)
+        for (uint32_t i = (uint32_t)(at - l->first[m]); i < c->cluster_count && at < end; i++, at++) {
             job->out[at] = gdr_cluster_record(c, i, l->vertex_base[m], l->byte_base[m]);
+            job->out[at].cluster_id = (uint32_t)at;
+        }
     }
 }
 
@@ -125,7 +132,10 @@ static void mesh_node_records(const gdr_mesh_clusters *c, GdrGpuLodNode *out, sp
         memcpy(&out[n], node, sizeof *node);
         out[n].bounds = node->sphere;
         bool leaf = (node->flags & GDR_LOD_NODE_LEAF) != 0;
-        if (leaf && (uint64_t)node->first + node->count <= c->cluster_count) {
+        if (leaf && !c->clusters) { /* read for streaming: the file holds the bounds of a group's clusters */
+            if (c->group_bounds && node->group < c->group_count)
+                out[n].bounds = c->group_bounds[node->group];
+        } else if (leaf && (uint64_t)node->first + node->count <= c->cluster_count) {
             gdr_vec4 *cluster_spheres = scratch_spheres(scratch, node->count);
             for (uint32_t i = 0; cluster_spheres && i < node->count; i++)
                 cluster_spheres[i] = c->clusters[node->first + i].sphere;

@@ -18,6 +18,9 @@ typedef struct gdr_cluster_record_layout {
 
 /* Cluster i of c with pool-global data offsets and its groups' LOD data inline. */
 GdrGpuMeshlet gdr_cluster_record(const gdr_mesh_clusters *c, uint32_t i, uint32_t vertex_base, uint32_t byte_base);
+/* The same for cluster k of c (c's own, or one of a page's): its groups' LOD data from c's groups. */
+GdrGpuMeshlet gdr_cluster_record_of(const gdr_mesh_clusters *c, const gdr_cluster *k, uint32_t vertex_base,
+                                    uint32_t byte_base);
 
 /* Every mesh's records into out (sum of the meshes' cluster counts, zeroed by the caller), in chunks
  * of `chunk` clusters on the pool's threads; pool NULL fills them in order on the calling thread.

@@ -124,6 +124,7 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .flags = frame_flags(frame, lod, occlusion, history, traversal_levels(r, frame, pipeline) > 0) |
                  (r->debug.shrink_lod_nodes ? GDR_FRAME_DEBUG_SHRINK_NODES : 0u) |
                  (r->scene.absent_groups > 0 ? GDR_FRAME_PARTIAL_RESIDENCY : 0u) |
+                 (r->scene.streamed ? GDR_FRAME_PAGED_RECORDS : 0u) |
                  (r->materials.scene_flags & GDR_MATERIALS_MASKED ? GDR_FRAME_ALPHA_TEST : 0u) |
                  (r->materials.scene_flags & GDR_MATERIALS_DOUBLE_SIDED ? GDR_FRAME_DOUBLE_SIDED : 0u) |
                  (r->materials.scene_flags & GDR_MATERIALS_VERTEX_COLORS ? GDR_FRAME_VERTEX_COLORS : 0u) |
@@ -138,6 +139,7 @@ static void write_globals(gdr_renderer *r, gdr_frame_slot *slot, const gdr_frame
         .lod_projection_scale = fabsf(projection.m[5]) * 0.5f * (float)r->height * (ortho ? lod_znear : 1.0f),
         .lod_depth = frame->lod_depth > INT32_MAX ? INT32_MAX : (int32_t)frame->lod_depth,
         .traversal_capacity = r->scene.traversal_capacity,
+        .records_per_slot = r->scene.streamed ? r->stream.records_per_slot : 0u,
         .occluded_node_capacity = r->occlusion.occluded_node_capacity,
         .min_screen_size = frame->min_screen_size,
         .clip_plane = frame->clip_plane,

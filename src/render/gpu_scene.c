@@ -13,6 +13,7 @@
 #include "render/frame.h"
 #include "render/gpu_scene.h"
 #include "render/page_table.h"
+#include "render/root_shortcut.h"
 #include "render/streaming.h"
 
 static GdrGpuInstance gpu_instance_from(const gdr_scene *scene, const gdr_instance *instance)
@@ -46,76 +47,28 @@ static gdr_status gather_clusters(const gdr_scene *scene, const gdr_mesh_cluster
 
 /* The clusters of each mesh per tiny size class (raster_bin.h), GDR_SW_TINY_CLASSES + 1 counts per
  * mesh, the last the clusters of no class: the tiny classes' counts size their parts of the
- * visible-cluster list. */
-static uint32_t *count_tiny_clusters(uint32_t mesh_count, const GdrGpuMesh *meshes, const GdrGpuMeshlet *meshlets)
+ * visible-cluster list. From the records, or (meshlets NULL: streamed, the records are in the pages)
+ * from the clusters, or where the scene was read for streaming without them, from the meshes' size
+ * classes, whose bounds are powers of two as the tiny classes' are. */
+_Static_assert((GDR_SW_TINY_LANES & (GDR_SW_TINY_LANES - 1)) == 0, "tiny classes bounded by powers of two");
+static uint32_t *count_tiny_clusters(uint32_t mesh_count, const GdrGpuMesh *meshes, const GdrGpuMeshlet *meshlets,
+                                     const gdr_mesh_clusters *const *clusters)
 {
     const uint32_t stride = GDR_SW_TINY_CLASSES + 1;
     uint32_t *tiny = calloc((size_t)(mesh_count ? mesh_count : 1) * stride, sizeof *tiny);
-    for (uint32_t m = 0; m < mesh_count && tiny; m++)
+    for (uint32_t m = 0; m < mesh_count && tiny && !meshlets; m++) {
+        const gdr_mesh_clusters *c = clusters[m];
+        for (uint32_t i = 0; c->clusters && i < c->cluster_count; i++) /* a scene loaded whole, streamed */
+            tiny[m * stride + gdr_raster_tiny_class(c->clusters[i].vertex_count, c->clusters[i].triangle_count)]++;
+        for (uint32_t b = 0; !c->clusters && b < GDR_CLUSTER_SIZE_CLASSES; b++) /* (2^(b-1), 2^b]: one class */
+            tiny[m * stride + gdr_raster_tiny_class(1u << b, 1u << b)] += c->size_classes[b];
+    }
+    for (uint32_t m = 0; m < mesh_count && tiny && meshlets; m++)
         for (uint32_t i = 0; i < meshes[m].lod_cluster_count; i++) {
             const GdrGpuMeshlet *k = &meshlets[meshes[m].meshlet_offset + i];
             tiny[m * stride + gdr_raster_tiny_class(k->vertex_count, k->triangle_count)]++;
         }
     return tiny;
-}
-
-/* The root chain (GdrGpuMesh.root_chain): from a root group of one cluster, the lone clusters it was
- * made from, step by step, while each is its group's only cluster and lies just before the one
- * made from it. Such a group was the whole frontier of its step (its step made one cluster, the
- * next frontier whole), so every other group of the DAG is below the group it was made from: where
- * that group passes, the cut is this one cluster. */
-static uint32_t root_chain(const gdr_mesh_clusters *c)
-{
-    const gdr_cluster_group *root = &c->groups[c->group_count - 1];
-    if (root->cluster_count != 1)
-        return 0;
-    uint32_t chain = 1, at = root->first_cluster;
-    while (chain < GDR_LOD_ROOT_CHAIN && at > 0) {
-        uint32_t from = c->clusters[at].refined_group;
-        if (from == GDR_NO_INDEX || c->groups[from].cluster_count != 1 || c->groups[from].first_cluster != at - 1)
-            break;
-        at--;
-        chain++;
-    }
-    return chain;
-}
-
-/* The root shortcut of a mesh with a DAG (GdrGpuMesh.root_*): the root group is the last one. */
-static void set_root_shortcut(const gdr_mesh_clusters *c, GdrGpuMesh *mesh)
-{
-    const gdr_cluster_group *root = &c->groups[c->group_count - 1];
-    mesh->root_first = root->first_cluster;
-    mesh->root_cluster_count = root->cluster_count;
-    /* Each distinct refined group once: the root's clusters come from a handful of groups. */
-    gdr_vec4 spheres[64];
-    uint32_t seen[64], n = 0;
-    float error = 0.0f;
-    bool fits = true;
-    for (uint32_t i = root->first_cluster; i < root->first_cluster + root->cluster_count && fits; i++) {
-        uint32_t refined = c->clusters[i].refined_group;
-        if (refined == GDR_NO_INDEX)
-            continue; /* always passes */
-        bool known = false;
-        for (uint32_t j = 0; j < n && !known; j++)
-            known = seen[j] == refined;
-        if (known)
-            continue;
-        if (n == 64) {
-            fits = false;
-            break;
-        }
-        seen[n] = refined;
-        spheres[n++] = c->groups[refined].sphere;
-        error = fmaxf(error, c->groups[refined].error);
-    }
-    if (!fits) { /* no shortcut: the per-cluster test decides */
-        mesh->root_cluster_count = 0;
-        return;
-    }
-    /* One refined group: its own sphere, so that the shortcut tests what the cluster test would. */
-    mesh->root_refined_sphere = n > 1 ? gdr_lod_enclosing_sphere(spheres, n) : n ? spheres[0] : (gdr_vec4){0, 0, 0, 0};
-    mesh->root_refined_error = error;
-    mesh->root_chain = root_chain(c);
 }
 
 #define RECORD_CHUNK 16384u /* clusters a task: 2 MiB of records */
@@ -175,8 +128,8 @@ static void pack_meshes(gdr_gpu_scene *g, uint32_t mesh_count, const gdr_mesh_cl
         mesh->task_count = (c->level0_cluster_count + GDR_TASK_WORKGROUP_SIZE - 1) / GDR_TASK_WORKGROUP_SIZE;
         mesh->lod_cluster_count = c->cluster_count;
         mesh->lod_task_count = (c->cluster_count + GDR_TASK_WORKGROUP_SIZE - 1) / GDR_TASK_WORKGROUP_SIZE;
-        if (c->group_count > 0)
-            set_root_shortcut(c, mesh);
+        if (c->group_count > 0 && !g->streamed) /* streamed: when its page 0 arrives (streaming.c) */
+            gdr_root_shortcut_set(c, gdr_cluster_refined_of_clusters, c, mesh);
         meshlet_cursor += c->cluster_count;
         if (g->streamed)
             continue;
@@ -194,10 +147,10 @@ static void pack_meshes(gdr_gpu_scene *g, uint32_t mesh_count, const gdr_mesh_cl
 /* The clusters every instance brings (level 0, the whole DAG, the tiny classes), for statistics and
  * the task capacity. */
 static gdr_status count_instance_clusters(gdr_gpu_scene *g, const gdr_scene *scene, const GdrGpuMeshlet *meshlets,
-                                          gdr_error *err)
+                                          const gdr_mesh_clusters *const *clusters, gdr_error *err)
 {
     uint64_t instance_meshlets = 0, instance_lod_clusters = 0, instance_tiny[GDR_SW_TINY_CLASSES] = {0};
-    uint32_t *tiny = count_tiny_clusters(scene->mesh_count, g->cpu_meshes, meshlets);
+    uint32_t *tiny = count_tiny_clusters(scene->mesh_count, g->cpu_meshes, meshlets, clusters);
     if (!tiny)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory");
     for (uint32_t i = 0; i < scene->instance_count; i++) {
@@ -211,6 +164,24 @@ static gdr_status count_instance_clusters(gdr_gpu_scene *g, const gdr_scene *sce
     g->instance_lod_cluster_count = instance_lod_clusters;
     memcpy(g->instance_tiny_cluster_count, instance_tiny, sizeof instance_tiny);
     return GDR_OK;
+}
+
+/* Tests (renderer_debug.h): every record of a streamed scene one that would be drawn wherever it is
+ * read, until its page arrives. */
+static gdr_status upload_poison_records(gdr_renderer *r, uint64_t count, gdr_error *err)
+{
+    GdrGpuMeshlet *poison = malloc(sizeof *poison * (count ? count : 1));
+    if (!poison)
+        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory");
+    for (uint64_t i = 0; i < count; i++)
+        poison[i] = (GdrGpuMeshlet){.sphere = {0.0f, 0.0f, 0.0f, 1.0e30f}, .cone_cutoff = 1.0f,
+                                    .group = GDR_GPU_NO_GROUP, .refined_group = GDR_GPU_NO_GROUP, .refined_depth = -1,
+                                    .group_sphere = {0.0f, 0.0f, 0.0f, 1.0f}, .refined_sphere = {0.0f, 0.0f, 0.0f, 1.0f},
+                                    .group_error = INFINITY, .refined_error = 0.0f};
+    gdr_status status = gdr_vk_buffer_upload(r->ctx, &r->staging, &r->scene.meshlets, 0, poison,
+                                             sizeof *poison * count, err);
+    free(poison);
+    return status;
 }
 
 /* The cluster pool: GdrGpuMeshlet[] with pool-global offsets, global vertex indices, and the
@@ -238,22 +209,27 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
                              (unsigned long long)meshlet_total, (unsigned long long)vertex_total,
                              (unsigned long long)byte_total);
     uint64_t word_total = (byte_total + 3) / 4;
-    GdrGpuMeshlet *meshlets = calloc(meshlet_total ? meshlet_total : 1, sizeof *meshlets);
+    /* The records' buffer: every cluster's, or streamed, the record pool: each pool slot's room for
+     * its page's records. */
+    uint64_t record_slots = g->streamed ? (uint64_t)r->stream.slot_count * r->stream.records_per_slot : meshlet_total;
+    /* Streamed: no record is uploaded here; a page's arrival writes its clusters' (streaming.c), and
+     * the records of absent groups are never read (GDR_FRAME_PAGED_RECORDS). */
+    GdrGpuMeshlet *meshlets = g->streamed ? NULL : calloc(meshlet_total ? meshlet_total : 1, sizeof *meshlets);
     uint32_t *vertex_refs = malloc(sizeof(uint32_t) * (vertex_total ? vertex_total : 1));
     uint32_t *words = calloc(word_total ? word_total : 1, sizeof(uint32_t));
     gdr_status status = GDR_OK;
-    if (!meshlets || !vertex_refs || !words)
+    if ((!meshlets && !g->streamed) || !vertex_refs || !words)
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "scene upload: out of memory");
-    if (status == GDR_OK)
+    if (status == GDR_OK && !g->streamed)
         status = fill_records(scene->mesh_count, clusters, g->streamed, meshlets, pool, err);
     if (status == GDR_OK)
         pack_meshes(g, scene->mesh_count, clusters, vertex_refs, words);
     if (status == GDR_OK)
-        status = count_instance_clusters(g, scene, meshlets, err);
+        status = count_instance_clusters(g, scene, meshlets, clusters, err);
     g->meshlet_count = (uint32_t)meshlet_total;
     const VkBufferUsageFlags usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     if (status == GDR_OK)
-        status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuMeshlet) * (meshlet_total ? meshlet_total : 1), usage,
+        status = gdr_vk_buffer_create(&r->allocator, sizeof(GdrGpuMeshlet) * (record_slots ? record_slots : 1), usage,
                                       GDR_VK_BUFFER_DEVICE, &g->meshlets, err);
     if (status == GDR_OK && !g->streamed)
         status = gdr_vk_buffer_create(&r->allocator, sizeof(uint32_t) * (vertex_total ? vertex_total : 1), usage,
@@ -261,8 +237,10 @@ static gdr_status upload_clusters(gdr_renderer *r, const gdr_scene *scene, const
     if (status == GDR_OK && !g->streamed)
         status = gdr_vk_buffer_create(&r->allocator, sizeof(uint32_t) * (word_total ? word_total : 1), usage,
                                       GDR_VK_BUFFER_DEVICE, &g->meshlet_triangles, err);
-    if (status == GDR_OK)
+    if (status == GDR_OK && !g->streamed)
         status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->meshlets, 0, meshlets, sizeof(GdrGpuMeshlet) * meshlet_total, err);
+    if (status == GDR_OK && g->streamed && r->debug.poison_absent_records)
+        status = upload_poison_records(r, record_slots, err);
     if (status == GDR_OK && !g->streamed)
         status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->meshlet_vertices, 0, vertex_refs,
                                       sizeof(uint32_t) * vertex_total, err);
@@ -343,12 +321,15 @@ static gdr_status upload_lod_nodes(gdr_renderer *r, const gdr_scene *scene, cons
         g->cpu_meshes[m].lod_node_offset = cursor;
         g->cpu_meshes[m].lod_node_count = c->lod_node_count;
         g->cpu_meshes[m].lod_node_levels = c->lod_node_levels;
-        bool traversed = g->cpu_meshes[m].lod_task_count > GDR_TRAVERSE_MIN_TASKS; /* as drawcull.comp decides */
+        /* As drawcull.comp decides: a streamed scene traverses every mesh (GDR_FRAME_PAGED_RECORDS). */
+        bool traversed = g->cpu_meshes[m].lod_task_count > GDR_TRAVERSE_MIN_TASKS || g->streamed;
         if (traversed && c->lod_node_levels > g->traversal_levels)
             g->traversal_levels = c->lod_node_levels;
         cursor += c->lod_node_count;
     }
     gdr_lod_node_records_fill(nodes, clusters, first, scene->mesh_count, pool);
+    if (g->streamed)
+        gdr_streaming_leaves_in_pages(r, nodes, first);
     free(first);
     /* TRANSFER_SRC: tests read the pool back. */
     const VkBufferUsageFlags usage =

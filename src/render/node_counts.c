@@ -51,38 +51,61 @@ static void link_parents(gdr_node_counts *nc, const gdr_mesh_clusters *c, uint32
     }
 }
 
-/* Calls visit(nc, global group, global leaf) for every cluster of every leaf of mesh m that has a
- * refined group. */
+/* Leaf n's refinements in a mesh read for streaming (no clusters): visit(group of each, leaf, its
+ * clusters). The refinements are in group order: a binary search finds the leaf's group's. */
+static void for_each_leaf_refinement(gdr_node_counts *nc, const gdr_mesh_clusters *c, uint32_t n, uint32_t offset,
+                                     uint32_t group_base, void (*visit)(gdr_node_counts *, uint32_t, uint32_t, uint32_t))
+{
+    uint32_t group = c->lod_nodes[n].group, lo = 0, hi = c->refinement_count;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (c->refinements[mid].group < group)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    for (uint32_t k = lo; k < c->refinement_count && c->refinements[k].group == group; k++)
+        if (c->refinements[k].refined_group < c->group_count)
+            visit(nc, group_base + c->refinements[k].refined_group, offset + n, c->refinements[k].cluster_count);
+}
+
+/* Calls visit(nc, global group, global leaf, clusters) for the clusters of every leaf of mesh m
+ * that have a refined group: one cluster at a time, or where the mesh was read for streaming,
+ * its leaf's group's refinements (how many of its clusters came from each group). */
 static void for_each_ref(gdr_node_counts *nc, const gdr_mesh_clusters *c, uint32_t offset, uint32_t group_base,
-                         void (*visit)(gdr_node_counts *, uint32_t, uint32_t))
+                         void (*visit)(gdr_node_counts *, uint32_t, uint32_t, uint32_t))
 {
     for (uint32_t n = 0; n < c->lod_node_count; n++) {
         const gdr_lod_node *node = &c->lod_nodes[n];
         if (!(node->flags & GDR_LOD_NODE_LEAF))
             continue;
+        if (!c->clusters) {
+            for_each_leaf_refinement(nc, c, n, offset, group_base, visit);
+            continue;
+        }
         for (uint32_t i = node->first; i < node->first + node->count && i < c->cluster_count; i++) {
             uint32_t r = c->clusters[i].refined_group;
             if (r != GDR_NO_INDEX && r < c->group_count)
-                visit(nc, group_base + r, offset + n);
+                visit(nc, group_base + r, offset + n, 1);
         }
     }
 }
 
-static void count_ref(gdr_node_counts *nc, uint32_t group, uint32_t leaf)
+static void count_ref(gdr_node_counts *nc, uint32_t group, uint32_t leaf, uint32_t clusters)
 {
-    (void)leaf;
+    (void)leaf, (void)clusters;
     nc->ref_len[group]++;
 }
 
 /* Leaves are visited in order, so a leaf's clusters of one group are consecutive references. */
-static void add_ref(gdr_node_counts *nc, uint32_t group, uint32_t leaf)
+static void add_ref(gdr_node_counts *nc, uint32_t group, uint32_t leaf, uint32_t clusters)
 {
     node_ref *list = nc->refs + nc->ref_first[group];
     uint32_t *len = &nc->ref_len[group];
     if (*len > 0 && list[*len - 1].leaf == leaf)
-        list[*len - 1].count++;
+        list[*len - 1].count += clusters;
     else
-        list[(*len)++] = (node_ref){leaf, 1};
+        list[(*len)++] = (node_ref){leaf, clusters};
 }
 
 static gdr_status build_refs(gdr_node_counts *nc, const gdr_mesh_clusters *const *meshes, const uint32_t *offsets,
@@ -135,6 +158,17 @@ static gdr_status allocate(gdr_node_counts *nc, const gdr_mesh_clusters *const *
     return GDR_OK;
 }
 
+/* Mesh m's counts with every group absent, from its groups' references. */
+static void count_absent_from_refs(gdr_node_counts *nc, uint32_t m)
+{
+    for (uint32_t g = nc->group_base[m]; g < nc->group_base[m + 1]; g++)
+        for (uint32_t i = 0; i < nc->ref_len[g]; i++) {
+            const node_ref *ref = &nc->refs[nc->ref_first[g] + i];
+            for (uint32_t node = ref->leaf; node != NO_NODE; node = nc->parent[node])
+                nc->counts[node] += ref->count;
+        }
+}
+
 gdr_status gdr_node_counts_create(const gdr_mesh_clusters *const *meshes, const uint32_t *node_offsets,
                                   uint32_t mesh_count, gdr_node_counts **out, gdr_error *err)
 {
@@ -161,9 +195,14 @@ gdr_status gdr_node_counts_create(const gdr_mesh_clusters *const *meshes, const 
         gdr_node_counts_destroy(nc);
         return status;
     }
-    /* Every group absent: the whole counts, every node changed. */
+    /* Every group absent: the whole counts, every node changed. A mesh read for streaming has no
+     * clusters to count: each group's references add up the same counts along their paths. */
     for (uint32_t m = 0; m < mesh_count; m++) {
-        gdr_lod_nodes_count_absent_refined(meshes[m], nc->resident + nc->group_base[m], nc->counts + node_offsets[m]);
+        if (meshes[m]->clusters)
+            gdr_lod_nodes_count_absent_refined(meshes[m], nc->resident + nc->group_base[m],
+                                               nc->counts + node_offsets[m]);
+        else
+            count_absent_from_refs(nc, m);
         for (uint32_t n = 0; n < meshes[m]->lod_node_count; n++)
             mark_changed(nc, node_offsets[m] + n);
     }

@@ -345,9 +345,9 @@ static gdr_status check_frame(gdr_renderer *r, const gdr_frame_desc *frame, uint
     gdr_status status = resolve_pipeline(r, frame, pipeline, reason, reason_size, err);
     /* Streamed geometry is drawn only through the LOD cut over resident groups. */
     if (status == GDR_OK && r->scene.streamed && (*pipeline != GDR_PIPELINE_MESH || frame->lod_fixed_depth ||
-                                                  !(frame->lod_error_px > 0.0f)))
+                                                  !(frame->lod_error_px > 0.0f) || frame->lod_hierarchy == GDR_CULL_OFF))
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "render: a streamed scene draws with the mesh pipeline "
-                             "and a LOD cut by error (lod_error_px > 0)");
+                             "and a LOD cut by error (lod_error_px > 0) through the LOD hierarchy (lod_hierarchy on)");
     if (status == GDR_OK)
         status = gdr_visbuffer_resolve_mode(r, frame, *pipeline, &r->vis.mode, r->vis.reason, sizeof r->vis.reason, err);
     if (status == GDR_OK && frame->record_visible_meshlets && !r->visible_meshlets.buffer) {
@@ -501,8 +501,11 @@ gdr_status gdr_renderer_read_visible_meshlets(gdr_renderer *r, gdr_visible_meshl
                                                 &readback, err);
     for (uint32_t i = 0; status == GDR_OK && i < *count; i++) {
         const uint32_t *pair = (const uint32_t *)readback.mapped + 2 * i;
-        uint32_t mesh = r->scene.cpu_instances[pair[0]].mesh;
-        meshlets[i] = (gdr_visible_meshlet){pair[0], pair[1] - r->scene.cpu_meshes[mesh].meshlet_offset};
+        uint32_t mesh = r->scene.cpu_instances[pair[0]].mesh, record_mesh = mesh;
+        /* Streamed, a record of the record pool: its slot's page says which cluster. */
+        uint32_t cluster = r->scene.streamed ? gdr_streaming_record_cluster(r, pair[1], &record_mesh)
+                                             : pair[1] - r->scene.cpu_meshes[mesh].meshlet_offset;
+        meshlets[i] = (gdr_visible_meshlet){pair[0], record_mesh == mesh ? cluster : UINT32_MAX};
     }
     gdr_vk_buffer_destroy(r->ctx, &readback);
     return status;

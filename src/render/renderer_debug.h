@@ -22,6 +22,10 @@ typedef struct gdr_renderer_debug {
      * (0: sized from the scene), to show that the clusters that find it full are still drawn. */
     bool tiny_raster_off;
     uint32_t tiny_raster_capacity;
+    /* Streamed: every record of the record pool set up as one that any test would find drawn (no
+     * group, no refined group, no triangles, a sphere over everything) until a page writes it, to
+     * show that no shader reads a record no resident page wrote (none is uploaded otherwise). */
+    bool poison_absent_records;
 } gdr_renderer_debug;
 
 /* Applies `debug` to the scenes set after this call (call it between gdr_renderer_create and

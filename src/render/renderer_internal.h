@@ -139,6 +139,8 @@ typedef struct gdr_frame_slot {
 typedef struct gdr_streaming {
     bool enabled;
     bool wait_for_loads;
+    bool meshes_changed;    /* a page 0 set its mesh's root shortcut: the meshes are uploaded again */
+    uint32_t records_per_slot; /* the most clusters a page holds: a slot's room in the record pool */
     const gdr_scene *scene;             /* the caller's: clusters and LOD hierarchies */
     struct gdr_paged_cache *cache;
     struct gdr_residency *residency;

@@ -7,9 +7,11 @@
  * word per vertex: the vertex's index in the pool), then its triangle bytes. The scene's vertex,
  * vertex-list and triangle references all point at the pool's start, so a slot's data is addressed
  * by offsets within it, and the shaders read streamed clusters as they read uploaded ones. The
- * cluster records (GdrGpuMeshlet) of every cluster stay resident; a page's arrival rewrites the
- * offsets of its clusters' records and marks its groups resident in the page table; an eviction
- * marks them absent. */
+ * cluster records (GdrGpuMeshlet) live in the record pool: records_per_slot of them beside each slot.
+ * A page's arrival writes its clusters' records there (from the page's own records, with offsets into
+ * the slot) and marks its groups resident in the page table, each word its slot; an eviction marks
+ * them absent. The traversal finds a leaf's records at its group's slot (GDR_FRAME_PAGED_RECORDS)
+ * and never reads a record no resident page wrote. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -19,7 +21,9 @@
 #include "render/node_counts.h"
 #include "stream/page_loader.h"
 #include "stream/residency.h"
+#include "render/cluster_records.h"
 #include "render/page_table.h"
+#include "render/root_shortcut.h"
 #include "render/streaming.h"
 
 /* What one frame copies: regions into the pool, the records and the node counts, words to fill in the
@@ -88,9 +92,14 @@ static gdr_status alloc_tables(gdr_streaming *s, const gdr_scene *scene, gdr_err
     if (!s->page_base || !s->mesh_dirty || !s->dirty_list)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "streaming: out of memory");
     uint32_t pages = 0;
+    s->records_per_slot = 1;
     for (uint32_t m = 0; m < meshes; m++) {
+        const gdr_paged_mesh *pm = paged_mesh(s, m);
         s->page_base[m] = pages;
-        pages += paged_mesh(s, m)->page_count;
+        pages += pm->page_count;
+        for (uint32_t p = 0; p < pm->page_count; p++)
+            s->records_per_slot = pm->pages[p].cluster_count > s->records_per_slot ? pm->pages[p].cluster_count
+                                                                                  : s->records_per_slot;
     }
     s->page_base[meshes] = pages;
     s->slot_page = malloc(sizeof *s->slot_page * (s->slot_count ? s->slot_count : 1));
@@ -254,8 +263,49 @@ static void *stage(gdr_frame_slot *slot, stream_copies *c, uint64_t bytes)
     return at;
 }
 
-/* The decoded page against what the scene says its groups hold (cluster by cluster) and the slot's
- * size. NULL when it matches, else what differs. */
+/* Group `group`'s first refinement in c (they are in group order), or c->refinement_count. */
+static uint32_t first_refinement(const gdr_mesh_clusters *c, uint32_t group)
+{
+    uint32_t lo = 0, hi = c->refinement_count;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (c->refinements[mid].group < group)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* A group's clusters in a page (`count` of them at pc) against its refinements in a scene read for
+ * streaming: the same refined groups in the same order of first use, as many clusters of each. */
+static bool refinements_match(const gdr_mesh_clusters *c, uint32_t group, const gdr_page_cluster *pc, uint32_t count)
+{
+    uint32_t first = first_refinement(c, group), end = first, seen[GDR_CLUSTER_MAX_TRIANGLES], n = 0;
+    while (end < c->refinement_count && c->refinements[end].group == group)
+        end++;
+    for (uint32_t i = 0; i < count; i++) {
+        uint32_t r = pc[i].refined_group, k = 0;
+        if (r == GDR_NO_INDEX)
+            continue;
+        while (k < n && c->refinements[first + k].refined_group != r)
+            k++;
+        if (k == n) { /* first use: the next refinement's */
+            if (first + n >= end || c->refinements[first + n].refined_group != r || n == GDR_CLUSTER_MAX_TRIANGLES)
+                return false;
+            seen[n++] = 0;
+        }
+        seen[k]++;
+    }
+    for (uint32_t k = 0; k < n; k++)
+        if (seen[k] != c->refinements[first + k].cluster_count)
+            return false;
+    return first + n == end;
+}
+
+/* The decoded page against what the scene says its groups hold (cluster by cluster where the scene
+ * has its clusters, else each group's refinements) and the slot's size. NULL when it matches, else
+ * what differs. */
 static const char *page_mismatch(const gdr_streaming *s, const gdr_page *page)
 {
     const gdr_paged_mesh *pm = paged_mesh(s, page->mesh);
@@ -268,6 +318,15 @@ static const char *page_mismatch(const gdr_streaming *s, const gdr_page *page)
     uint32_t j = 0;
     for (uint32_t k = info->first; k < info->first + info->group_count; k++) {
         const gdr_cluster_group *group = &c->groups[pm->page_groups[k]];
+        if (!c->clusters) {
+            for (uint32_t i = 0; i < group->cluster_count; i++)
+                if (page->clusters[j + i].group != pm->page_groups[k])
+                    return "clusters differ from the scene's";
+            if (!refinements_match(c, pm->page_groups[k], &page->clusters[j], group->cluster_count))
+                return "its clusters' refined groups differ from the scene's";
+            j += group->cluster_count;
+            continue;
+        }
         for (uint32_t i = group->first_cluster; i < group->first_cluster + group->cluster_count; i++, j++) {
             const gdr_page_cluster *pc = &page->clusters[j];
             if (pc->group != pm->page_groups[k] || pc->vertex_count != c->clusters[i].vertex_count ||
@@ -278,11 +337,48 @@ static const char *page_mismatch(const gdr_streaming *s, const gdr_page *page)
     return NULL;
 }
 
+/* Page 0 of a mesh (its root group and the coarsest groups) against mesh-local cluster indices: the
+ * refined groups root_shortcut.h walks, known for the clusters of the page's groups. */
+typedef struct page_refined {
+    const gdr_mesh_clusters *clusters;
+    const gdr_paged_mesh *mesh;
+    const gdr_page *page;
+} page_refined;
+
+static uint32_t refined_in_page(const void *user, uint32_t cluster, bool *known)
+{
+    const page_refined *p = user;
+    const gdr_page_info *info = &p->mesh->pages[p->page->page];
+    uint32_t j = 0;
+    for (uint32_t k = info->first; k < info->first + info->group_count; k++) {
+        const gdr_cluster_group *g = &p->clusters->groups[p->mesh->page_groups[k]];
+        if (cluster >= g->first_cluster && cluster - g->first_cluster < g->cluster_count) {
+            *known = true;
+            return p->page->clusters[j + cluster - g->first_cluster].refined_group;
+        }
+        j += g->cluster_count;
+    }
+    *known = false;
+    return GDR_NO_INDEX;
+}
+
 /* Bytes a page's copy stages: its data and its clusters' records. */
 static uint64_t page_upload_bytes(const gdr_page *page)
 {
     return (uint64_t)page->vertex_count * (sizeof(GdrGpuVertex) + 4) + page->triangle_byte_count +
            (uint64_t)page->cluster_count * sizeof(GdrGpuMeshlet);
+}
+
+/* A page's cluster as the GPU reads it: its record with offsets into the slot's vertex list (in
+ * words) and triangle bytes, and its groups' LOD data from the scene's groups. */
+static GdrGpuMeshlet page_record(const gdr_mesh_clusters *c, const gdr_page_cluster *pc, uint32_t list_base,
+                                 uint32_t triangle_base)
+{
+    gdr_cluster k = {.vertex_offset = pc->vertex_offset, .triangle_offset = pc->triangle_offset,
+                     .vertex_count = pc->vertex_count, .triangle_count = pc->triangle_count, .sphere = pc->sphere,
+                     .cone_apex = pc->cone_apex, .cone_axis = pc->cone_axis, .cone_cutoff = pc->cone_cutoff,
+                     .group = pc->group, .refined_group = pc->refined_group};
+    return gdr_cluster_record_of(c, &k, list_base, triangle_base);
 }
 
 /* Stages page `page` for pool slot `pool_slot`: its data, its clusters' records with offsets into the
@@ -311,25 +407,80 @@ static void stage_page(gdr_renderer *r, gdr_frame_slot *slot, stream_copies *c, 
     const gdr_page_info *info = &pm->pages[page->page];
     const gdr_mesh_clusters *mc = &s->scene->meshes[page->mesh].clusters;
     uint32_t list_base = (uint32_t)((base + sizeof(GdrGpuVertex) * nv) / 4), triangle_base = (uint32_t)(base + 36ull * nv);
+    /* The page's records, in page order, into the slot's place in the record pool. */
+    uint64_t bytes = sizeof(GdrGpuMeshlet) * (uint64_t)page->cluster_count, from = c->staged;
+    GdrGpuMeshlet *records = stage(slot, c, bytes);
     uint32_t j = 0;
     for (uint32_t k = info->first; k < info->first + info->group_count; k++) {
         uint32_t group = pm->page_groups[k];
         const gdr_cluster_group *gr = &mc->groups[group];
-        uint32_t first = g->cpu_meshes[page->mesh].meshlet_offset + gr->first_cluster;
+        uint32_t cluster_id = g->cpu_meshes[page->mesh].meshlet_offset + gr->first_cluster;
         for (uint32_t i = 0; i < gr->cluster_count; i++, j++) {
-            g->cpu_meshlets[first + i].vertex_offset = list_base + page->clusters[j].vertex_offset;
-            g->cpu_meshlets[first + i].triangle_offset = triangle_base + page->clusters[j].triangle_offset;
+            records[j] = page_record(mc, &page->clusters[j], list_base, triangle_base);
+            records[j].cluster_id = cluster_id + i;
         }
-        uint64_t bytes = sizeof(GdrGpuMeshlet) * (uint64_t)gr->cluster_count;
-        uint64_t from = c->staged;
-        memcpy(stage(slot, c, bytes), &g->cpu_meshlets[first], bytes);
-        c->records[c->record_count++] = (VkBufferCopy){from, sizeof(GdrGpuMeshlet) * (uint64_t)first, bytes};
         c->resident_words[c->resident_count] = g->cpu_meshes[page->mesh].page_table_offset + group;
         c->resident_slots[c->resident_count++] = pool_slot;
         set_group(s, page->mesh, group, true);
     }
+    c->records[c->record_count++] =
+        (VkBufferCopy){from, sizeof(GdrGpuMeshlet) * (uint64_t)pool_slot * s->records_per_slot, bytes};
     s->slot_page[pool_slot] = s->page_base[page->mesh] + page->page;
     mark_dirty(s, page->mesh);
+    if (page->page == 0 && mc->group_count > 0) { /* the root's records arrive: its shortcut and chain */
+        page_refined p = {mc, pm, page};
+        GdrGpuMesh *mesh = &g->cpu_meshes[page->mesh];
+        gdr_root_shortcut_set(mc, refined_in_page, &p, mesh);
+        /* The root group leads page 0: its records lead the slot's (pinned: the slot stays). No root
+         * chain: its clusters' records do not lie one before the other in the pool. */
+        mesh->root_first = pool_slot * s->records_per_slot;
+        mesh->root_chain = 0;
+        s->meshes_changed = true;
+    }
+}
+
+void gdr_streaming_leaves_in_pages(gdr_renderer *r, GdrGpuLodNode *nodes, const uint32_t *first)
+{
+    const gdr_streaming *s = &r->stream;
+    for (uint32_t m = 0; m < s->scene->mesh_count; m++) {
+        const gdr_mesh_clusters *c = &s->scene->meshes[m].clusters;
+        const gdr_paged_mesh *pm = paged_mesh(s, m);
+        uint32_t *at = c->group_count ? malloc(sizeof *at * c->group_count) : NULL;
+        for (uint32_t p = 0; at && p < pm->page_count; p++) {
+            uint32_t offset = 0;
+            for (uint32_t k = pm->pages[p].first; k < pm->pages[p].first + pm->pages[p].group_count; k++) {
+                at[pm->page_groups[k]] = offset;
+                offset += c->groups[pm->page_groups[k]].cluster_count;
+            }
+        }
+        for (uint32_t n = 0; at && n < c->lod_node_count; n++) {
+            GdrGpuLodNode *node = &nodes[first[m] + n];
+            if ((node->flags & GDR_GPU_LOD_NODE_LEAF) && node->group < c->group_count)
+                node->first = at[node->group];
+        }
+        free(at);
+    }
+}
+
+uint32_t gdr_streaming_record_cluster(const gdr_renderer *r, uint32_t record, uint32_t *mesh)
+{
+    const gdr_streaming *s = &r->stream;
+    uint32_t slot = record / s->records_per_slot, j = record % s->records_per_slot;
+    uint32_t page = slot < s->slot_count ? s->slot_page[slot] : UINT32_MAX;
+    if (page == UINT32_MAX)
+        return UINT32_MAX;
+    uint32_t m = page_mesh(s, r->scene.mesh_count, page);
+    const gdr_paged_mesh *pm = paged_mesh(s, m);
+    const gdr_page_info *info = &pm->pages[page - s->page_base[m]];
+    const gdr_mesh_clusters *c = &s->scene->meshes[m].clusters;
+    *mesh = m;
+    for (uint32_t k = info->first; k < info->first + info->group_count; k++) {
+        const gdr_cluster_group *g = &c->groups[pm->page_groups[k]];
+        if (j < g->cluster_count)
+            return g->first_cluster + j;
+        j -= g->cluster_count;
+    }
+    return UINT32_MAX;
 }
 
 /* --- the frame's work ------------------------------------------------------------------------- */
@@ -414,8 +565,8 @@ static gdr_status collect_loads(gdr_streaming *s, gdr_error *err)
             continue;
         }
         if (why)
-            snprintf(s->stats.refused, sizeof s->stats.refused, "mesh %u page %u: %s", result.load.mesh,
-                     result.load.page, why);
+            snprintf(s->stats.refused, sizeof s->stats.refused, "%s: mesh %u page %u: %s",
+                     gdr_paged_cache_path(s->cache), result.load.mesh, result.load.page, why);
         else
             snprintf(s->stats.refused, sizeof s->stats.refused, "%s", result.error.message);
         s->stats.pages_refused++;
@@ -633,7 +784,7 @@ static void count_resident_tables(gdr_renderer *r)
 {
     gdr_streaming *s = &r->stream;
     const gdr_gpu_scene *g = &r->scene;
-    s->stats.cluster_record_bytes = sizeof(GdrGpuMeshlet) * (uint64_t)g->meshlet_count;
+    s->stats.cluster_record_bytes = sizeof(GdrGpuMeshlet) * (uint64_t)s->slot_count * s->records_per_slot;
     s->stats.hierarchy_bytes = sizeof(GdrGpuLodNode) * (uint64_t)g->node_total;
     s->stats.node_count_bytes = 4ull * g->node_total;
     s->stats.page_table_bytes = 4ull * g->group_total * (2 + GDR_FRAMES_IN_FLIGHT); /* words, stamps, lists */
@@ -684,6 +835,11 @@ gdr_status gdr_streaming_start(gdr_renderer *r, gdr_error *err)
     }
     slot->stream_results = false;
     s->wait_for_loads = wait;
+    /* The meshes' root shortcuts came with their pages 0. */
+    if (status == GDR_OK && s->meshes_changed)
+        status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->meshes, 0, g->cpu_meshes,
+                                      sizeof(GdrGpuMesh) * g->mesh_count, err);
+    s->meshes_changed = false;
     for (uint32_t m = 0; status == GDR_OK && m < g->mesh_count; m++)
         if (gdr_residency_page_slot(s->residency, m, 0) == UINT32_MAX && paged_mesh(s, m)->page_count)
             status = gdr_error_set(err, GDR_ERROR_PARSE, "streaming: mesh %u's coarsest page could not be read: %s", m,

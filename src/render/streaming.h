@@ -12,5 +12,12 @@ gdr_status gdr_streaming_start(gdr_renderer *r, gdr_error *err);
 gdr_status gdr_streaming_slot_create(gdr_renderer *r, gdr_frame_slot *slot, gdr_error *err);
 gdr_status gdr_streaming_begin_frame(gdr_renderer *r, gdr_frame_slot *slot, gdr_error *err);
 void gdr_streaming_destroy(gdr_renderer *r);
+/* The hierarchy's leaves for the record pool: each leaf's first cluster (mesh m's nodes at
+ * nodes + first[m]) becomes its group's first record within its page, whose slot holds the page's
+ * records in page order. */
+void gdr_streaming_leaves_in_pages(gdr_renderer *r, GdrGpuLodNode *nodes, const uint32_t *first);
+/* The mesh-local cluster of record `record` of the record pool (its slot's page's), *mesh its mesh;
+ * UINT32_MAX where the slot holds no page or the page no such record. */
+uint32_t gdr_streaming_record_cluster(const gdr_renderer *r, uint32_t record, uint32_t *mesh);
 
 #endif

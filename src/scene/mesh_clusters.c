@@ -13,5 +13,7 @@ void gdr_mesh_clusters_free(gdr_mesh_clusters *clusters)
     free(clusters->triangles);
     free(clusters->groups);
     free(clusters->lod_nodes);
+    free(clusters->group_bounds);
+    free(clusters->refinements);
     memset(clusters, 0, sizeof *clusters);
 }

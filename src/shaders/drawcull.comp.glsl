@@ -76,16 +76,21 @@ GdrTaskRange task_range(GdrGpuFrameGlobals g, uint mesh_index, GdrGpuMesh mesh, 
         return gdr_task_range(mesh.meshlet_offset, mesh.meshlet_count, 0u);
     if ((g.flags & GDR_FRAME_LOD_DEPTH) != 0u)
         return gdr_task_range(mesh.meshlet_offset, mesh.lod_cluster_count, 0u);
+    // Streamed (GDR_FRAME_PAGED_RECORDS): root_first is the root's first record in the record pool.
+    bool paged = (g.flags & GDR_FRAME_PAGED_RECORDS) != 0u;
+    uint base = paged ? 0u : mesh.meshlet_offset;
     if (mesh.root_cluster_count > 0u &&
         gdr_lod_group_projected_error(mesh.root_refined_sphere, mesh.root_refined_error, model[0].xyz, model[1].xyz,
                                       model[2].xyz, model[3].xyz, g.camera_position.xyz, g.lod_znear,
                                       g.lod_projection_scale) <= g.lod_threshold)
-        return gdr_task_range(mesh.meshlet_offset + mesh.root_first, mesh.root_cluster_count, GDR_TASK_LOD_ACCEPTED);
+        return gdr_task_range(base + mesh.root_first, mesh.root_cluster_count, GDR_TASK_LOD_ACCEPTED);
     uint chained = root_chain_cluster(g, mesh_index, mesh, model);
     if (chained != GDR_GPU_NO_GROUP)
         return gdr_task_range(mesh.meshlet_offset + chained, 1u, GDR_TASK_LOD_ACCEPTED);
+    // Where the records live in their pages' slots, every mesh is traversed: a flat range would read
+    // records that are not there.
     traverse = (g.flags & GDR_FRAME_LOD_HIERARCHY) != 0u && mesh.lod_node_count > 0u &&
-               mesh.lod_task_count > GDR_TRAVERSE_MIN_TASKS;
+               (mesh.lod_task_count > GDR_TRAVERSE_MIN_TASKS || paged);
     return traverse ? GdrTaskRange(0u, 0u, 0u, 0u) : gdr_task_range(mesh.meshlet_offset, mesh.lod_cluster_count, 0u);
 }
 

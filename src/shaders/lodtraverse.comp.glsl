@@ -55,11 +55,13 @@ void main()
     bool in_level = visit_of_invocation(g, stats, level, visit);
     GdrGpuLodNode node;
     GdrGpuMesh mesh;
+    uint mesh_index = 0u;
     bool lod_culled = false, frustum_culled = false, occluded = false;
     vec3 world_center = vec3(0.0);
     float radius = 0.0;
     if (in_level) {
         GdrGpuInstance instance = GDR_SCENE.instances.items[visit.instance];
+        mesh_index = instance.mesh;
         mesh = GDR_SCENE.meshes.items[instance.mesh];
         node = GDR_SCENE.lod_nodes.items[mesh.lod_node_offset + visit.node];
         if ((g.flags & GDR_FRAME_DEBUG_SHRINK_NODES) != 0u) {
@@ -86,11 +88,20 @@ void main()
         occluded = deferred;
     }
     bool passes = in_level && !lod_culled && !frustum_culled && !occluded;
+    // Streamed, the records live in their pages' slots: a leaf's clusters are records node.first ..
+    // of its group's slot (the page-table word), and a leaf of an absent group, which draws none of
+    // its clusters (an absent group counts as passing), emits none.
+    bool paged = (g.flags & GDR_FRAME_PAGED_RECORDS) != 0u;
     bool leaf = passes && (node.flags & GDR_GPU_LOD_NODE_LEAF) != 0u;
+    uint slot = paged && leaf && node.group != GDR_GPU_NO_GROUP
+                    ? UintsRef(GDR_SCENE.page_table).items[mesh.page_table_offset + node.group]
+                    : GDR_GPU_PAGE_ABSENT;
+    bool emits = leaf && !(paged && slot == GDR_GPU_PAGE_ABSENT);
+    uint first = paged ? slot * g.records_per_slot + node.first : mesh.meshlet_offset + node.first;
     gdr_queue_visits(g, PHASE, level + 1u, passes && !leaf ? node.count : 0u, visit.instance, node.first, visit.flags);
-    GdrTaskRange range = leaf ? gdr_task_range(mesh.meshlet_offset + node.first, node.count, visit.flags)
-                              : GdrTaskRange(0u, 0u, 0u, 0u);
-    gdr_append_tasks(g, PHASE, leaf, visit.instance, range);
+    GdrTaskRange range = emits ? gdr_task_range(first, node.count, visit.flags)
+                               : GdrTaskRange(0u, 0u, 0u, 0u);
+    gdr_append_tasks(g, PHASE, emits, visit.instance, range);
     GDR_COUNT(stats, nodes_tested, in_level);
     GDR_COUNT(stats, nodes_lod_culled, lod_culled);
     GDR_COUNT(stats, nodes_frustum_culled, frustum_culled);

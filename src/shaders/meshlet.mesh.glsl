@@ -127,7 +127,7 @@ void main()
         uint why = cull ? triangle_culled(screen[corners.x], screen[corners.y], screen[corners.z]) : 0u;
         why = why == 1u && double_sided ? 0u : why;
         gl_MeshPrimitivesEXT[t].gl_CullPrimitiveEXT = why != 0u;
-        out_color[t] = vec4(gdr_view_albedo(g.view_mode, instance.color.rgb, instance_index, meshlet_index, t,
+        out_color[t] = vec4(gdr_view_albedo(g.view_mode, instance.color.rgb, instance_index, meshlet.cluster_id, t,
                                             meshlet.group_depth), 1.0);
         out_material[t] = instance.material;
 #ifdef GDR_MESH_FROM_LIST

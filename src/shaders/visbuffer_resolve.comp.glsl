@@ -102,8 +102,9 @@ vec4 shade_pixel(FrameGlobalsRef globals, vec2 viewport, vec2 centre, uint id)
     vec3 position = world * b;
     GdrGpuInstance instance = InstancesRef(GDR_SCENE.instances).items[entry.instance];
     if (globals.value.view_mode != GDR_VIEW_SHADED) {
-        vec3 albedo = gdr_view_albedo(globals.value.view_mode, instance.color.rgb, entry.instance, entry.meshlet,
-                                      triangle, meshlets.items[entry.meshlet].group_depth);
+        GdrGpuMeshlet record = meshlets.items[entry.meshlet];
+        vec3 albedo = gdr_view_albedo(globals.value.view_mode, instance.color.rgb, entry.instance, record.cluster_id,
+                                      triangle, record.group_depth);
         return gdr_shade(globals.value.light_direction.xyz, n, position, albedo);
     }
     // The derivatives, analytically from the triangle: the barycentrics of the next pixel centre to

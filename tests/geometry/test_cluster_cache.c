@@ -155,12 +155,12 @@ static uint32_t get32(const uint8_t *p)
     return v;
 }
 
-enum { CLUSTER_BYTES = 72 }; /* docs/CACHE_FORMAT.md: one cluster record in CLDT */
+enum { CLUSTER_BYTES = 72, GROUP_BYTES = 48 }; /* docs/CACHE_FORMAT.md: a cluster record in CLDT, a group's in CLGR */
 #define NODE(i) (8 + 48 * (i))  /* LODH: node i of the first mesh */
 
 typedef struct corruption {
     const char *what;     /* expected in the message */
-    const char *section;  /* "CLUS", "CLDT", "CLGM" or "LODH" */
+    const char *section;  /* "CLUS", "CLGR", "CLDT", "CLGM" or "LODH" */
     uint32_t at;          /* byte offset in the section */
     uint32_t value;       /* written as u32, or as the low byte when byte is set */
     int byte;
@@ -207,12 +207,21 @@ static void test_group_corruption(void)
     CHECK(gdr_cache_write(path, s, NULL, &err) == GDR_OK);
     size_t size = 0;
     uint8_t *good = read_whole(path, &size), *bad = malloc(size);
-    uint32_t g = s->meshes[0].clusters.cluster_count * CLUSTER_BYTES;
+    /* CLGR (docs/CACHE_FORMAT.md): 8 size classes, then 48-byte groups, then the refinements: group 1's
+     * two clusters were made from group 0, one 12-byte entry. */
+    uint32_t g = 4 * 8, f = g + 2 * GROUP_BYTES;
     const corruption cases[] = {
-        {"section 'CLDT': mesh 0 group 0: sphere or error is not a number", "CLDT", g + 16, 0x7fc00000u, 0},
-        {"section 'CLDT': mesh 0 group 1: sphere or error is not a number", "CLDT", g + 32 + 12, 0xbf800000u, 0},
-        {"section 'CLDT': mesh 0 group 1: clusters 22 (+3) lie outside the mesh's 24", "CLDT", g + 32 + 28, 3, 0},
-        {"section 'CLDT': mesh 0 group 0: clusters 4294967295 (+22)", "CLDT", g + 24, UINT32_MAX, 0},
+        {"section 'CLGR': mesh 0 group 0: sphere, bounds or error is not a number", "CLGR", g + 16, 0x7fc00000u, 0},
+        {"section 'CLGR': mesh 0 group 1: sphere, bounds or error is not a number", "CLGR", g + GROUP_BYTES + 12,
+         0xbf800000u, 0},
+        {"section 'CLGR': mesh 0 group 0: sphere, bounds or error is not a number", "CLGR", g + 32, 0x7f800000u, 0},
+        {"section 'CLGR': mesh 0 group 1: clusters 22 (+3) lie outside the mesh's 24", "CLGR", g + GROUP_BYTES + 28, 3,
+         0},
+        {"section 'CLGR': mesh 0 group 0: clusters 4294967295 (+22)", "CLGR", g + 24, UINT32_MAX, 0},
+        {"section 'CLGR': mesh 0: 1000000000 refinements run past the section", "CLGR", f, 1000000000u, 0},
+        {"section 'CLGR': mesh 0 refinement 0: group 1, refined group 1, 2 clusters", "CLGR", f + 8, 1, 0},
+        {"section 'CLGR': mesh 0 refinement 0: group 1, refined group 0, 3 clusters", "CLGR", f + 12, 3, 0},
+        {"section 'CLGR': mesh 0 refinement 0: group 2, refined group 0", "CLGR", f + 4, 2, 0},
         {"section 'CLDT': mesh 0 cluster 23: group 2 / refined group 0 does not exist (2 groups)", "CLDT",
          23 * CLUSTER_BYTES + 60, 2, 0},
         /* The hierarchy (docs/CACHE_FORMAT.md, LODH): node count, levels, then 48-byte nodes: the root
@@ -278,8 +287,9 @@ static void test_corruption(void)
         {"section 'CLUS': mesh 0: 22 clusters (23 of level 0)", "CLUS", 4, c->cluster_count + 1, 0},
         {"section 'CLUS': mesh 0: 0 clusters (22 of level 0)", "CLUS", 0, 0, 0},
         {"section 'CLUS': mesh 0: 22 clusters (0 of level 0)", "CLUS", 4, 0, 0},
-        {"section 'CLDT': mesh 0: 1000000000 clusters and 0 groups run past", "CLUS", 0, 1000000000u, 0},
-        {"section 'CLDT': mesh 0: 22 clusters and 1 groups run past", "CLUS", 16, 1, 0},
+        {"section 'CLGR': mesh 0: its size classes hold 22 clusters, the mesh 1000000000", "CLUS", 0, 1000000000u, 0},
+        {"section 'CLGR': mesh 0: 1 groups run past the section", "CLUS", 16, 1, 0},
+        {"section 'CLGR': mesh 0: its size classes hold 23 clusters, the mesh 22", "CLGR", 0, 1, 0}, /* none of size 1 */
         {"section 'CLDT': mesh 0 cluster 21: vertices", "CLUS", 8, c->vertex_count - 1, 0},
         {"section 'CLDT': mesh 0 cluster 21: triangle bytes at", "CLUS", 12, c->triangle_byte_count - 4, 0},
     };

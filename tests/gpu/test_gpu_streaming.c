@@ -22,7 +22,9 @@
 #include "gdr/paged_cache.h"
 #include "geometry/lod_cut.h"
 #include "gpu_test_util.h"
+#include "render/renderer_debug.h"
 #include "stream/residency.h"
+#include "io/io_internal.h"
 #include "io/loaders.h"
 
 #define WIDTH 160
@@ -252,6 +254,9 @@ static uint64_t pool_bytes(const char *path, uint64_t *slot)
     return total;
 }
 
+/* A renderer streaming `scene` from the cache at `path` within `budget` bytes. The records of the
+ * clusters of absent groups are poisoned (renderer_debug.h): a shader reading one would draw it, and
+ * the drawn clusters would differ from the CPU's cut. */
 static gdr_renderer *streamed_renderer(const gdr_scene *scene, const char *path, uint64_t budget)
 {
     gdr_error err = {0};
@@ -259,8 +264,9 @@ static gdr_renderer *streamed_renderer(const gdr_scene *scene, const char *path,
     gdr_renderer_desc desc = {.width = WIDTH, .height = HEIGHT, .validate = true};
     gdr_streaming_desc stream = {.cache = gpu_test_paged_cache(path), .geometry_budget_bytes = budget,
                                  .upload_budget_bytes = UPLOAD_BUDGET, .wait_for_loads = true};
-    if (gdr_renderer_create(&desc, &r, &err) != GDR_OK ||
-        gdr_renderer_set_scene_streamed(r, scene, &stream, &err) != GDR_OK) {
+    if (gdr_renderer_create(&desc, &r, &err) == GDR_OK)
+        gdr_renderer_set_debug(r, &(gdr_renderer_debug){.poison_absent_records = true});
+    if (!r || gdr_renderer_set_scene_streamed(r, scene, &stream, &err) != GDR_OK) {
         fprintf(stderr, "streamed renderer: %s\n", err.message);
         gdr_renderer_destroy(r);
         return NULL;
@@ -409,6 +415,173 @@ static void damaged_page(const gdr_scene *scene, const gdr_scene *paged, const c
     gdr_renderer_destroy(r);
 }
 
+/* The bytes of the file at `path` (*size of them), or NULL. */
+static uint8_t *read_file(const char *path, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    uint8_t *data = NULL;
+    long n = f && fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    if (n > 0 && fseek(f, 0, SEEK_SET) == 0 && (data = malloc((size_t)n)) && fread(data, 1, (size_t)n, f) != (size_t)n) {
+        free(data);
+        data = NULL;
+    }
+    if (f)
+        fclose(f);
+    *size = data ? (size_t)n : 0;
+    return data;
+}
+
+/* The table entry of section `id` in a cache's bytes (docs/CACHE_FORMAT.md: 32-byte entries at 64). */
+static uint8_t *section_entry(uint8_t *data, const char *id)
+{
+    uint32_t count;
+    memcpy(&count, data + 16, 4);
+    for (uint32_t i = 0; i < count; i++)
+        if (memcmp(data + 64 + 32 * (size_t)i, id, 4) == 0)
+            return data + 64 + 32 * (size_t)i;
+    return NULL;
+}
+
+/* Section 'CLGR' of the cache `from` written over that of `to`, of the same size, with every checksum
+ * made right: `to`'s pages with `from`'s account of the clusters' refined groups. */
+static int splice_groups(const char *from, const char *to)
+{
+    size_t a_size = 0, b_size = 0;
+    uint8_t *a = read_file(from, &a_size), *b = read_file(to, &b_size);
+    uint8_t *ea = a ? section_entry(a, "CLGR") : NULL, *eb = b ? section_entry(b, "CLGR") : NULL;
+    uint64_t a_at = 0, b_at = 0, a_bytes = 0, b_bytes = 0;
+    if (ea && eb) {
+        memcpy(&a_at, ea + 8, 8), memcpy(&a_bytes, ea + 16, 8);
+        memcpy(&b_at, eb + 8, 8), memcpy(&b_bytes, eb + 16, 8);
+    }
+    int ok = ea && eb && a_bytes == b_bytes && memcmp(a + a_at, b + b_at, a_bytes) != 0;
+    if (ok) {
+        memcpy(b + b_at, a + a_at, a_bytes);
+        uint64_t h = gdr_io_hash(b + b_at, b_bytes);
+        memcpy(eb + 24, &h, 8);
+        uint32_t count;
+        memcpy(&count, b + 16, 4);
+        h = gdr_io_hash(b + 64, 32 * (size_t)count);
+        memcpy(b + 32, &h, 8);
+        h = gdr_io_hash(b, 40);
+        memcpy(b + 40, &h, 8);
+        FILE *f = fopen(to, "wb");
+        ok = f && fwrite(b, 1, b_size, f) == b_size;
+        if (f)
+            fclose(f);
+    }
+    free(a), free(b);
+    return ok;
+}
+
+/* A group of mesh m that view 0's cut loads (a parent of the finest group it draws, made from it)
+ * outside page 0, with a refined group that at least two of its clusters were made from: *cluster
+ * the first of them. UINT32_MAX when there is none. */
+static uint32_t group_with_shared_refinement(const gdr_scene *scene, gdr_paged_cache *cache, uint32_t m,
+                                             uint32_t *cluster)
+{
+    gdr_frame_desc frame = view_frame(0);
+    const gdr_mesh_clusters *c = &scene->meshes[m].clusters;
+    const gdr_paged_mesh *pm = gdr_paged_cache_mesh(cache, m);
+    uint32_t finest = finest_drawn_group(scene, m, &frame);
+    if (finest == UINT32_MAX)
+        return UINT32_MAX;
+    for (uint32_t e = 0; e < pm->groups[finest].parent_count; e++) {
+        uint32_t p = pm->parents[pm->groups[finest].parent_first + e];
+        const gdr_cluster_group *g = &c->groups[p];
+        for (uint32_t i = g->first_cluster; pm->groups[p].page != 0 && i < g->first_cluster + g->cluster_count; i++)
+            for (uint32_t j = i + 1; j < g->first_cluster + g->cluster_count; j++)
+                if (c->clusters[i].refined_group != GDR_NO_INDEX &&
+                    c->clusters[i].refined_group == c->clusters[j].refined_group) {
+                    *cluster = i;
+                    return p;
+                }
+    }
+    return UINT32_MAX;
+}
+
+static gdr_scene *read_for_streaming(const char *path);
+
+/* The cluster records of a streamed scene live in the record pool: room for the largest page's
+ * records beside each pool slot, so they follow the pool, not the scene (before, a record per
+ * cluster of the scene). */
+static void check_record_pool(const gdr_scene *scene, gdr_renderer *r, const char *path)
+{
+    gdr_paged_cache *cache = NULL;
+    gdr_error err = {0};
+    uint32_t largest = 0;
+    uint64_t clusters = 0;
+    CHECK(gdr_paged_cache_open(path, &cache, &err) == GDR_OK);
+    for (uint32_t m = 0; cache && m < gdr_paged_cache_mesh_count(cache); m++) {
+        const gdr_paged_mesh *pm = gdr_paged_cache_mesh(cache, m);
+        for (uint32_t p = 0; p < pm->page_count; p++)
+            largest = pm->pages[p].cluster_count > largest ? pm->pages[p].cluster_count : largest;
+        clusters += scene->meshes[m].clusters.cluster_count;
+    }
+    gdr_paged_cache_close(cache);
+    gdr_frame_desc frame = view_frame(0);
+    gdr_frame_stats stats = {0};
+    CHECK(gdr_renderer_render(r, &frame, 1, &stats, &err) == GDR_OK);
+    const gdr_streaming_stats *st = &stats.streaming;
+    printf("record pool: %llu bytes for %u slots of %u records (the scene's %llu clusters: %llu bytes)\n",
+           (unsigned long long)st->cluster_record_bytes, st->slot_count, largest, (unsigned long long)clusters,
+           (unsigned long long)(clusters * 128u)); /* 128 bytes a record (GdrGpuMeshlet) */
+    CHECK(st->cluster_record_bytes == (uint64_t)st->slot_count * largest * 128u);
+    CHECK(st->cluster_record_bytes < clusters * 128u);
+}
+
+/* A page whose records disagree with the file's account of its clusters ('CLGR'), every checksum
+ * right: one cluster of a group view 0 loads written as made from nothing in the pages alone. The
+ * page is refused naming the file, the mesh and the page; the frames go on drawing exact cuts. */
+static void damaged_records(gdr_scene *scene, const char *path, uint64_t budget)
+{
+    gdr_paged_cache *cache = NULL;
+    gdr_error err = {0};
+    CHECK(gdr_paged_cache_open(path, &cache, &err) == GDR_OK);
+    uint32_t mesh = 0, group = UINT32_MAX, cluster = 0, page = 0;
+    for (uint32_t m = 0; cache && group == UINT32_MAX && m < scene->mesh_count; m++) {
+        mesh = m;
+        group = group_with_shared_refinement(scene, cache, m, &cluster);
+        page = group == UINT32_MAX ? 0 : gdr_paged_cache_mesh(cache, m)->groups[group].page;
+    }
+    gdr_paged_cache_close(cache);
+    CHECK(group != UINT32_MAX && page != 0);
+    if (group == UINT32_MAX)
+        return;
+    char copy[300];
+    snprintf(copy, sizeof copy, "%s.records.gdrc", path);
+    gdr_cluster *k = &scene->meshes[mesh].clusters.clusters[cluster];
+    uint32_t refined = k->refined_group;
+    k->refined_group = GDR_NO_INDEX;
+    gdr_cache_write_options write = {.page_bytes = GDR_PAGE_BYTES_MIN};
+    CHECK(gdr_cache_write(copy, scene, &write, &err) == GDR_OK);
+    k->refined_group = refined;
+    CHECK(splice_groups(path, copy));
+
+    gdr_scene *paged = read_for_streaming(copy);
+    gdr_renderer *r = paged ? streamed_renderer(paged, copy, budget) : NULL;
+    CHECK(r != NULL);
+    uint8_t *image = malloc(WIDTH * HEIGHT * 4);
+    gdr_frame_desc frame = view_frame(0);
+    gdr_frame_stats stats = {0};
+    frame_check check;
+    history_init(scene, &check);
+    for (uint32_t i = 0; r && image && i < 20 && draw(scene, r, &frame, image, &stats, &check); i++)
+        check_budgets(&stats, budget);
+    char expected[64];
+    snprintf(expected, sizeof expected, "mesh %u page %u: ", mesh, page);
+    printf("damaged records in page %u of mesh %u (group %u, cluster %u): %u refused, \"%s\"\n", page, mesh, group,
+           cluster, stats.streaming.pages_refused, stats.streaming.refused);
+    CHECK(stats.streaming.pages_refused >= 1 && strstr(stats.streaming.refused, copy) &&
+          strstr(stats.streaming.refused, expected) && strstr(stats.streaming.refused, "refined groups"));
+    CHECK(check.drawn > 0 && check.evicted_in_use == 0);
+    history_free(&check);
+    free(image);
+    gdr_renderer_destroy(r);
+    gdr_scene_destroy(paged);
+    unlink(copy);
+}
+
 /* The file cut short while the renderer streams from it (after the open, before the views load
  * their pages): the pages past the end are refused, naming the file and the page, and the frames go
  * on drawing the exact cut over what is resident. Works on a copy of the cache. */
@@ -463,9 +636,18 @@ static gdr_scene *read_for_streaming(const char *path)
         fclose(f);
     CHECK(gdr_cache_read_for_streaming(path, NULL, &paged, NULL, &bytes_read, &err) == GDR_OK && paged &&
           paged->geometry_in_pages && paged->meshes[0].positions == NULL && paged->meshes[0].clusters.triangles == NULL);
-    printf("read for streaming: %llu of the file's %llu bytes\n", (unsigned long long)bytes_read,
-           (unsigned long long)file_size);
+    /* No cluster record is read (the pages hold them): the scene has none, and the bytes read are
+     * fewer than its records alone would take (72 bytes a cluster in CLDT). */
+    uint64_t clusters = 0, with_records = 0;
+    for (uint32_t m = 0; paged && m < paged->mesh_count; m++) {
+        clusters += paged->meshes[m].clusters.cluster_count;
+        with_records += paged->meshes[m].clusters.clusters != NULL;
+    }
+    printf("read for streaming: %llu of the file's %llu bytes, %llu clusters, %llu meshes with their records\n",
+           (unsigned long long)bytes_read, (unsigned long long)file_size, (unsigned long long)clusters,
+           (unsigned long long)with_records);
     CHECK(bytes_read > 0 && bytes_read < file_size / 8);
+    CHECK(clusters > 0 && with_records == 0 && bytes_read < 72 * clusters);
     gdr_renderer *whole = NULL;
     gdr_renderer_desc desc = {.width = WIDTH, .height = HEIGHT, .validate = true};
     CHECK(paged && gdr_renderer_create(&desc, &whole, &err) == GDR_OK);
@@ -478,7 +660,7 @@ static gdr_scene *read_for_streaming(const char *path)
     return paged;
 }
 
-static void run(const gdr_scene *scene, const char *path)
+static void run(gdr_scene *scene, const char *path)
 {
     uint8_t *reference = malloc(VIEWS * WIDTH * HEIGHT * 4);
     gdr_renderer *whole = gpu_test_renderer(WIDTH, HEIGHT, scene);
@@ -506,14 +688,20 @@ static void run(const gdr_scene *scene, const char *path)
         uint64_t evictions = still_views(scene, r, budget, reference, "small pool");
         CHECK(evictions > 0); /* the views need more than the pool holds */
         camera_path(scene, r, budget);
+        check_record_pool(scene, r, path);
     }
     gdr_renderer_destroy(r);
 
-    /* Room for everything: the same images, nothing evicted. */
+    /* Room for everything: the same images, nothing evicted; the scene read without its records too. */
     r = streamed_renderer(scene, path, 2 * total);
     CHECK(r != NULL);
     if (r && reference)
         CHECK(still_views(scene, r, 2 * total, reference, "everything") == 0);
+    gdr_renderer_destroy(r);
+    r = paged ? streamed_renderer(paged, path, 2 * total) : NULL;
+    CHECK(r != NULL);
+    if (r && reference)
+        CHECK(still_views(scene, r, 2 * total, reference, "everything, without the records") == 0);
     gdr_renderer_destroy(r);
 
     /* A budget below the coarsest pages is refused. */
@@ -526,6 +714,8 @@ static void run(const gdr_scene *scene, const char *path)
     printf("a 1 KiB budget: %s\n", err.message);
     gdr_renderer_destroy(small);
 
+    if (paged && budget)
+        damaged_records(scene, path, budget);
     if (paged && budget)
         truncated_while_streaming(scene, paged, path, budget);
     if (paged && budget)

@@ -18,7 +18,6 @@
 #include "test_util.h"
 
 #define CLUSTER_RECORD 72 /* bytes of a cluster's record in CLDT (docs/CACHE_FORMAT.md) */
-#define GROUP_RECORD 32   /* bytes of a group's */
 #define NODE_RECORD 48    /* bytes of a hierarchy node's in LODH, after each mesh's 8 bytes of counts */
 
 static uint8_t *read_file(const char *path, size_t *size)
@@ -118,7 +117,7 @@ static uint8_t *damaged(const gdr_scene *s, const uint8_t *data, size_t size, co
         uint64_t at = start;
         for (uint32_t m = 0; m < meshes[k]; m++) {
             const gdr_mesh_clusters *c = &s->meshes[m].clusters;
-            at += cldt ? (uint64_t)c->cluster_count * CLUSTER_RECORD + (uint64_t)c->group_count * GROUP_RECORD
+            at += cldt ? (uint64_t)c->cluster_count * CLUSTER_RECORD
                        : 8 + (uint64_t)c->lod_node_count * NODE_RECORD;
         }
         if (cldt) {

@@ -60,18 +60,18 @@ static void fix_header(uint8_t *data)
  * whole geometry more. */
 static void check_sections(const uint8_t *only, size_t only_size, const uint8_t *full, size_t full_size)
 {
-    static const char *const geometry[] = {"GEOM", "VCOL", "CLGM"};
+    static const char *const geometry[] = {"GEOM", "VCOL", "CLGM", "CLDT"};
     CHECK(get32(only + FLAGS_AT) == PAGES_ONLY && get32(full + FLAGS_AT) == 0);
     CHECK(entry_of(only, "PAGE") != NULL && entry_of(full, "PAGE") != NULL);
     uint64_t geometry_bytes = 0;
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < 4; k++) {
         CHECK(entry_of(only, geometry[k]) == NULL);
         const uint8_t *e = entry_of(full, geometry[k]);
         CHECK(e != NULL);
         geometry_bytes += e ? get64(e + 16) : 0;
     }
     uint32_t count = get32(only + 16);
-    CHECK(count + 3 == get32(full + 16));
+    CHECK(count + 4 == get32(full + 16));
     for (uint32_t i = 0; i < count; i++) {
         const uint8_t *e = only + 64 + (size_t)i * 32;
         char id[5] = {0};
@@ -82,7 +82,7 @@ static void check_sections(const uint8_t *only, size_t only_size, const uint8_t 
             CHECK(memcmp(only + get64(e + 8), full + get64(f + 8), (size_t)get64(e + 16)) == 0);
     }
     /* The file is its sections, the table and under 8 bytes of padding each, nothing more. */
-    CHECK(full_size - only_size >= geometry_bytes + 3 * 32 && full_size - only_size < geometry_bytes + 3 * 40);
+    CHECK(full_size - only_size >= geometry_bytes + 4 * 32 && full_size - only_size < geometry_bytes + 4 * 40);
     printf("pages alone: %zu bytes, with the whole geometry %zu (its sections %llu)\n", only_size, full_size,
            (unsigned long long)geometry_bytes);
 }
@@ -100,7 +100,10 @@ static int same_records(const gdr_scene *a, const gdr_scene *b)
             memcmp(&x->quantization, &y->quantization, sizeof x->quantization) != 0 ||
             p->cluster_count != q->cluster_count || p->group_count != q->group_count ||
             p->lod_node_count != q->lod_node_count ||
-            memcmp(p->clusters, q->clusters, sizeof *p->clusters * p->cluster_count) != 0 ||
+            (p->clusters || q->clusters) != 0 || p->refinement_count != q->refinement_count ||
+            memcmp(p->size_classes, q->size_classes, sizeof p->size_classes) != 0 ||
+            memcmp(p->refinements, q->refinements, sizeof *p->refinements * p->refinement_count) != 0 ||
+            memcmp(p->group_bounds, q->group_bounds, sizeof *p->group_bounds * p->group_count) != 0 ||
             memcmp(p->groups, q->groups, sizeof *p->groups * p->group_count) != 0 ||
             memcmp(p->lod_nodes, q->lod_nodes, sizeof *p->lod_nodes * p->lod_node_count) != 0)
             return 0;
@@ -147,7 +150,19 @@ static void check_streamed(const char *only, const char *full)
     CHECK(gdr_cache_read_for_streaming(only, NULL, &a, NULL, &read_a, &err) == GDR_OK);
     CHECK(gdr_cache_read_for_streaming(full, NULL, &b, NULL, &read_b, &err) == GDR_OK);
     CHECK(a && b && a->geometry_in_pages && same_records(a, b));
-    CHECK(read_a + 3 * 32 == read_b); /* the same reads but three table entries: none of the whole geometry */
+    /* The same reads but four table entries: none of the whole geometry, no cluster record (CLDT). */
+    CHECK(read_a + 4 * 32 == read_b);
+    /* No per-cluster record in the scene or among the bytes read: the pages hold them. */
+    uint64_t clusters = 0, without = 0;
+    for (uint32_t m = 0; a && m < a->mesh_count; m++) {
+        const gdr_mesh_clusters *c = &a->meshes[m].clusters;
+        clusters += c->cluster_count;
+        without += c->cluster_count > 0 && !c->clusters && c->group_bounds && c->refinements;
+    }
+    printf("read for streaming: %llu bytes for %llu clusters, %llu of %u meshes without their records\n",
+           (unsigned long long)read_a, (unsigned long long)clusters, (unsigned long long)without,
+           a ? a->mesh_count : 0);
+    CHECK(a && clusters > 0 && without == a->mesh_count && read_a < 72 * clusters);
     gdr_scene_destroy(a);
     gdr_scene_destroy(b);
     gdr_paged_cache *pa = NULL, *pb = NULL;
@@ -307,6 +322,51 @@ static void check_damage(const char *only, const char *bad, const uint8_t *bytes
     gdr_paged_cache_close(pages);
 }
 
+/* What 'CLGR' gives a scene read for streaming, against the clusters it was written from: the groups,
+ * each group's cluster bounds (the enclosing sphere of its clusters' spheres, to the bit), its
+ * refinements (refined groups in order of first use, with their clusters) and the size classes. */
+static void check_groups_from_clusters(const gdr_scene *scene, const char *path)
+{
+    gdr_error err = {0};
+    gdr_scene *s = NULL;
+    CHECK(gdr_cache_read_for_streaming(path, NULL, &s, NULL, NULL, &err) == GDR_OK && s);
+    uint32_t wrong = 0, refinements = 0;
+    for (uint32_t m = 0; s && m < scene->mesh_count; m++) {
+        const gdr_mesh_clusters *c = &scene->meshes[m].clusters, *r = &s->meshes[m].clusters;
+        uint32_t classes[GDR_CLUSTER_SIZE_CLASSES] = {0}, k = 0;
+        for (uint32_t i = 0; i < c->cluster_count; i++)
+            classes[gdr_cluster_size_class(c->clusters[i].vertex_count, c->clusters[i].triangle_count)]++;
+        wrong += memcmp(classes, r->size_classes, sizeof classes) != 0;
+        wrong += memcmp(c->groups, r->groups, sizeof *c->groups * c->group_count) != 0;
+        for (uint32_t g = 0; g < c->group_count; g++) {
+            const gdr_cluster_group *gr = &c->groups[g];
+            gdr_vec4 spheres[256];
+            uint32_t refined[256], counts[256], n = 0;
+            for (uint32_t i = 0; i < gr->cluster_count && i < 256; i++) {
+                const gdr_cluster *cl = &c->clusters[gr->first_cluster + i];
+                spheres[i] = cl->sphere;
+                uint32_t j = 0;
+                while (j < n && refined[j] != cl->refined_group)
+                    j++;
+                if (cl->refined_group != GDR_NO_INDEX && j == n)
+                    refined[n] = cl->refined_group, counts[n++] = 0;
+                if (cl->refined_group != GDR_NO_INDEX)
+                    counts[j]++;
+            }
+            gdr_vec4 bounds = gdr_lod_enclosing_sphere(spheres, gr->cluster_count < 256 ? gr->cluster_count : 256);
+            wrong += memcmp(&bounds, &r->group_bounds[g], sizeof bounds) != 0;
+            for (uint32_t j = 0; j < n; j++, k++)
+                wrong += k >= r->refinement_count || r->refinements[k].group != g ||
+                         r->refinements[k].refined_group != refined[j] || r->refinements[k].cluster_count != counts[j];
+        }
+        wrong += k != r->refinement_count;
+        refinements += r->refinement_count;
+    }
+    printf("CLGR against the clusters: %u refinements, %u differences\n", refinements, wrong);
+    CHECK(s && refinements > 0 && wrong == 0);
+    gdr_scene_destroy(s);
+}
+
 int main(void)
 {
     gdr_scene *scene = NULL;
@@ -326,6 +386,7 @@ int main(void)
     whole.whole_geometry = 1;
     CHECK(gdr_cache_write(only, scene, &write, &err) == GDR_OK);
     CHECK(gdr_cache_write(full, scene, &whole, &err) == GDR_OK);
+    check_groups_from_clusters(scene, only);
     gdr_scene_destroy(scene);
     size_t only_size = 0, full_size = 0;
     uint8_t *only_bytes = test_read_file(only, &only_size), *full_bytes = test_read_file(full, &full_size);

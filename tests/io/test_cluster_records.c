@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "gdr/io.h"
+#include "gpu_shared/raster_bin.h"
 #include "render/cluster_records.h"
 #include "test_util.h"
 
@@ -18,8 +19,10 @@
 static void fill_serial(GdrGpuMeshlet *out, const gdr_cluster_record_layout *l)
 {
     for (uint32_t m = 0; m < l->mesh_count; m++)
-        for (uint32_t i = 0; i < l->clusters[m]->cluster_count; i++)
+        for (uint32_t i = 0; i < l->clusters[m]->cluster_count; i++) {
             out[l->first[m] + i] = gdr_cluster_record(l->clusters[m], i, l->vertex_base[m], l->byte_base[m]);
+            out[l->first[m] + i].cluster_id = l->first[m] + i;
+        }
 }
 
 static int check_layout(const gdr_cluster_record_layout *l, uint32_t total, gdr_thread_pool *pool)
@@ -75,8 +78,25 @@ static void check_nodes(const gdr_mesh_clusters *const *clusters, uint32_t mesh_
     free(parallel);
 }
 
+/* The tiny raster classes of a streamed scene come from its clusters' size classes (its records are
+ * in the pages): every cluster size has the tiny class of its size class's upper bound. */
+static void check_size_classes(void)
+{
+    uint32_t wrong = 0;
+    for (uint32_t v = 1; v <= GDR_CLUSTER_MAX_VERTICES; v++)
+        for (uint32_t t = 1; t <= GDR_CLUSTER_MAX_TRIANGLES; t++) {
+            uint32_t b = gdr_cluster_size_class(v, t), size = v > t ? v : t;
+            wrong += gdr_raster_tiny_class(v, t) != gdr_raster_tiny_class(1u << b, 1u << b);
+            wrong += size > (1u << b) || (b > 0 && size <= (1u << (b - 1)));
+        }
+    printf("size classes: %u of %u cluster sizes in the wrong class\n", wrong,
+           GDR_CLUSTER_MAX_VERTICES * GDR_CLUSTER_MAX_TRIANGLES);
+    CHECK(wrong == 0);
+}
+
 int main(void)
 {
+    check_size_classes();
     gdr_error err = {0};
     gdr_scene *scene = NULL;
     gdr_load_options load = {.no_progress = 1};

@@ -62,6 +62,24 @@ static void print_cache_bytes(const char *path, uint64_t source_triangles)
     gdr_paged_cache_close(paged);
 }
 
+/* The triangles and vertices of every cluster of a scene read for streaming, whose clusters' records
+ * are in its pages: the page index counts them (each page its groups' clusters'). */
+static void count_paged_clusters(const char *path, uint64_t *triangles, uint64_t *vertices)
+{
+    gdr_paged_cache *paged = NULL;
+    gdr_error err = {0};
+    if (gdr_paged_cache_open(path, &paged, &err) != GDR_OK)
+        return;
+    for (uint32_t m = 0; m < gdr_paged_cache_mesh_count(paged); m++) {
+        const gdr_paged_mesh *pm = gdr_paged_cache_mesh(paged, m);
+        for (uint32_t p = 0; p < pm->page_count; p++) {
+            *triangles += pm->pages[p].triangle_count;
+            *vertices += pm->pages[p].vertex_count;
+        }
+    }
+    gdr_paged_cache_close(paged);
+}
+
 /* Whether `input` is a .gdrc whose geometry is in its pages alone: then it is read as for streaming
  * (everything printed here comes from the records that read takes). */
 static int cache_pages_only(const char *input)
@@ -177,11 +195,13 @@ int gdr_cmd_info(int argc, char **argv)
         unique_triangles += scene->meshes[i].index_count / 3;
         clusters += c->cluster_count;
         level0 += c->level0_cluster_count;
-        for (uint32_t k = 0; k < c->cluster_count; k++) {
+        for (uint32_t k = 0; c->clusters && k < c->cluster_count; k++) {
             cluster_triangles += c->clusters[k].triangle_count;
             cluster_vertices += c->clusters[k].vertex_count;
         }
     }
+    if (scene->geometry_in_pages) /* the records are in the pages */
+        count_paged_clusters(input, &cluster_triangles, &cluster_vertices);
     printf("scene:       %s\n", input);
     printf("meshes:      %u (%llu vertices, %llu triangles)\n", scene->mesh_count, (unsigned long long)vertices,
            (unsigned long long)unique_triangles);

@@ -195,13 +195,15 @@ void stats_print_streaming(FILE *out, const gdr_streaming_stats *st)
     fprintf(out, "streaming loader    %llu pages, %llu bytes read in %.1f ms busy: %.1f MB/s; %u in its queue\n",
             (unsigned long long)st->loader_pages, (unsigned long long)st->loader_bytes_read, st->loader_busy_ms,
             st->loader_mb_s, st->loader_queue_depth);
-    uint64_t tables = st->cluster_record_bytes + st->hierarchy_bytes + st->node_count_bytes + st->page_table_bytes;
+    /* The cluster records live in the record pool, a slot's room beside each pool slot: they follow
+     * the pool, not the scene. */
+    uint64_t tables = st->hierarchy_bytes + st->node_count_bytes + st->page_table_bytes;
     double per_triangle = st->source_triangles ? 1.0 / (double)st->source_triangles : 0.0;
-    fprintf(out, "streaming resident  %llu bytes beside the pool, %.2f per source triangle: cluster records %.2f, "
-            "hierarchy %.3f, node counts %.4f, page table %.4f\n", (unsigned long long)tables,
-            (double)tables * per_triangle, (double)st->cluster_record_bytes * per_triangle,
-            (double)st->hierarchy_bytes * per_triangle, (double)st->node_count_bytes * per_triangle,
-            (double)st->page_table_bytes * per_triangle);
+    fprintf(out, "streaming resident  %llu bytes beside the pool, %.3f per source triangle: hierarchy %.3f, node "
+            "counts %.4f, page table %.4f; the pool's cluster records %llu bytes\n", (unsigned long long)tables,
+            (double)tables * per_triangle, (double)st->hierarchy_bytes * per_triangle,
+            (double)st->node_count_bytes * per_triangle, (double)st->page_table_bytes * per_triangle,
+            (unsigned long long)st->cluster_record_bytes);
     fprintf(out, "streaming totals    %llu uploads (%llu bytes), %llu evictions, %u pages refused%s%s\n",
             (unsigned long long)st->uploads_total, (unsigned long long)st->upload_bytes_total,
             (unsigned long long)st->evictions_total, st->pages_refused, st->pages_refused ? ": " : "",
