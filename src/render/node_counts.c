@@ -108,11 +108,65 @@ static void add_ref(gdr_node_counts *nc, uint32_t group, uint32_t leaf, uint32_t
         list[(*len)++] = (node_ref){leaf, clusters};
 }
 
-static gdr_status build_refs(gdr_node_counts *nc, const gdr_mesh_clusters *const *meshes, const uint32_t *offsets,
-                             gdr_error *err)
+/* The per-mesh passes of the creation, one task per mesh on a thread pool: each writes only its own
+ * mesh's nodes (parents, counts) and groups (references), so the result does not depend on the
+ * threads. */
+typedef struct create_job {
+    gdr_node_counts *nc;
+    const gdr_mesh_clusters *const *meshes;
+    const uint32_t *offsets;
+} create_job;
+
+/* Mesh m's parents and its groups' reference counts. */
+static void link_task(void *user, uint32_t m, uint32_t worker)
 {
-    for (uint32_t m = 0; m < nc->mesh_count; m++)
-        for_each_ref(nc, meshes[m], offsets[m], nc->group_base[m], count_ref);
+    const create_job *job = user;
+    (void)worker;
+    link_parents(job->nc, job->meshes[m], job->offsets[m]);
+    for_each_ref(job->nc, job->meshes[m], job->offsets[m], job->nc->group_base[m], count_ref);
+}
+
+/* Mesh m's counts with every group absent, from its groups' references. */
+static void count_absent_from_refs(gdr_node_counts *nc, uint32_t m)
+{
+    for (uint32_t g = nc->group_base[m]; g < nc->group_base[m + 1]; g++)
+        for (uint32_t i = 0; i < nc->ref_len[g]; i++) {
+            const node_ref *ref = &nc->refs[nc->ref_first[g] + i];
+            for (uint32_t node = ref->leaf; node != NO_NODE; node = nc->parent[node])
+                nc->counts[node] += ref->count;
+        }
+}
+
+/* Mesh m's references, then its counts with every group absent. A mesh read for streaming has no
+ * clusters to count: each group's references add up the same counts along their paths. */
+static void count_task(void *user, uint32_t m, uint32_t worker)
+{
+    const create_job *job = user;
+    gdr_node_counts *nc = job->nc;
+    (void)worker;
+    for_each_ref(nc, job->meshes[m], job->offsets[m], nc->group_base[m], add_ref);
+    if (job->meshes[m]->clusters)
+        gdr_lod_nodes_count_absent_refined(job->meshes[m], nc->resident + nc->group_base[m],
+                                           nc->counts + job->offsets[m]);
+    else
+        count_absent_from_refs(nc, m);
+}
+
+/* Runs task over every mesh, on the pool where there is one. */
+static void for_each_mesh(gdr_thread_pool *pool, const create_job *job, gdr_task_fn *task)
+{
+    if (pool)
+        gdr_thread_pool_run(pool, job->nc->mesh_count, task, (void *)job);
+    else
+        for (uint32_t m = 0; m < job->nc->mesh_count; m++)
+            task((void *)job, m, 0);
+}
+
+/* The groups' references: counted per mesh (link_task), placed, then filled with the counts
+ * (count_task). */
+static gdr_status build_refs(gdr_node_counts *nc, const create_job *job, gdr_thread_pool *pool, gdr_error *err)
+{
+    for_each_mesh(pool, job, link_task);
     uint64_t total = 0;
     for (uint32_t g = 0; g < nc->group_total; g++) {
         nc->ref_first[g] = (uint32_t)total;
@@ -122,8 +176,7 @@ static gdr_status build_refs(gdr_node_counts *nc, const gdr_mesh_clusters *const
     if (total > UINT32_MAX || !(nc->refs = malloc(sizeof *nc->refs * (total ? total : 1))))
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "node counts: out of memory for %llu references",
                              (unsigned long long)total);
-    for (uint32_t m = 0; m < nc->mesh_count; m++)
-        for_each_ref(nc, meshes[m], offsets[m], nc->group_base[m], add_ref);
+    for_each_mesh(pool, job, count_task);
     return GDR_OK;
 }
 
@@ -158,19 +211,16 @@ static gdr_status allocate(gdr_node_counts *nc, const gdr_mesh_clusters *const *
     return GDR_OK;
 }
 
-/* Mesh m's counts with every group absent, from its groups' references. */
-static void count_absent_from_refs(gdr_node_counts *nc, uint32_t m)
-{
-    for (uint32_t g = nc->group_base[m]; g < nc->group_base[m + 1]; g++)
-        for (uint32_t i = 0; i < nc->ref_len[g]; i++) {
-            const node_ref *ref = &nc->refs[nc->ref_first[g] + i];
-            for (uint32_t node = ref->leaf; node != NO_NODE; node = nc->parent[node])
-                nc->counts[node] += ref->count;
-        }
-}
 
 gdr_status gdr_node_counts_create(const gdr_mesh_clusters *const *meshes, const uint32_t *node_offsets,
                                   uint32_t mesh_count, gdr_node_counts **out, gdr_error *err)
+{
+    return gdr_node_counts_create_on(meshes, node_offsets, mesh_count, NULL, out, err);
+}
+
+gdr_status gdr_node_counts_create_on(const gdr_mesh_clusters *const *meshes, const uint32_t *node_offsets,
+                                     uint32_t mesh_count, gdr_thread_pool *pool, gdr_node_counts **out,
+                                     gdr_error *err)
 {
     *out = NULL;
     gdr_node_counts *nc = calloc(1, sizeof *nc);
@@ -187,25 +237,17 @@ gdr_status gdr_node_counts_create(const gdr_mesh_clusters *const *meshes, const 
         }
         nc->group_base[mesh_count] = groups;
         memset(nc->parent, 0xff, sizeof *nc->parent * nc->node_total);
-        for (uint32_t m = 0; m < mesh_count; m++)
-            link_parents(nc, meshes[m], node_offsets[m]);
-        status = build_refs(nc, meshes, node_offsets, err);
+        create_job job = {nc, meshes, node_offsets};
+        status = build_refs(nc, &job, pool, err);
     }
     if (status != GDR_OK) {
         gdr_node_counts_destroy(nc);
         return status;
     }
-    /* Every group absent: the whole counts, every node changed. A mesh read for streaming has no
-     * clusters to count: each group's references add up the same counts along their paths. */
-    for (uint32_t m = 0; m < mesh_count; m++) {
-        if (meshes[m]->clusters)
-            gdr_lod_nodes_count_absent_refined(meshes[m], nc->resident + nc->group_base[m],
-                                               nc->counts + node_offsets[m]);
-        else
-            count_absent_from_refs(nc, m);
+    /* Every group absent (the counts build_refs made): every node changed. */
+    for (uint32_t m = 0; m < mesh_count; m++)
         for (uint32_t n = 0; n < meshes[m]->lod_node_count; n++)
             mark_changed(nc, node_offsets[m] + n);
-    }
     *out = nc;
     return GDR_OK;
 }

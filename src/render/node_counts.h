@@ -13,6 +13,7 @@
 
 #include "gdr/core.h"
 #include "gdr/mesh_clusters.h"
+#include "gdr/thread_pool.h"
 
 typedef struct gdr_node_counts gdr_node_counts;
 
@@ -25,6 +26,10 @@ typedef struct gdr_node_run {
  * absent and every node changed (the first runs cover them all). The clusters must outlive it. */
 gdr_status gdr_node_counts_create(const gdr_mesh_clusters *const *meshes, const uint32_t *node_offsets,
                                   uint32_t mesh_count, gdr_node_counts **out, gdr_error *err);
+/* The same, the per-mesh work on `pool` (NULL: this thread), one task per mesh: the same counts. */
+gdr_status gdr_node_counts_create_on(const gdr_mesh_clusters *const *meshes, const uint32_t *node_offsets,
+                                     uint32_t mesh_count, gdr_thread_pool *pool, gdr_node_counts **out,
+                                     gdr_error *err);
 void gdr_node_counts_destroy(gdr_node_counts *counts);
 
 /* Group `group` of mesh `mesh` becomes resident or absent. Returns the nodes whose count it changed

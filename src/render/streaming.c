@@ -14,6 +14,7 @@
  * and never reads a record no resident page wrote. */
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "gdr/paged_cache.h"
 #include "geometry/lod_cut.h"
@@ -755,6 +756,23 @@ gdr_status gdr_streaming_begin_frame(gdr_renderer *r, gdr_frame_slot *slot, gdr_
 }
 
 /* The node counts over the scene's hierarchies, every group absent (as the page table starts). */
+/* Threads for the node counts' creation, one per processor, where several meshes hold enough nodes
+ * to gain from them (a billion-triangle field of 1,000 meshes: 270 ms on one thread); NULL otherwise
+ * (the same counts on this thread). */
+static gdr_thread_pool *node_count_pool(const gdr_scene *scene)
+{
+    uint64_t nodes = 0;
+    for (uint32_t m = 0; m < scene->mesh_count; m++)
+        nodes += scene->meshes[m].clusters.lod_node_count;
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    uint32_t threads = cpus < 1 ? 1 : cpus > GDR_THREAD_POOL_MAX_THREADS ? GDR_THREAD_POOL_MAX_THREADS : (uint32_t)cpus;
+    gdr_thread_pool *pool = NULL;
+    gdr_error ignored = {0};
+    if (threads > 1 && scene->mesh_count > 1 && nodes >= 65536)
+        (void)gdr_thread_pool_create(threads, &pool, &ignored);
+    return pool;
+}
+
 static gdr_status create_node_counts(gdr_renderer *r, gdr_error *err)
 {
     gdr_streaming *s = &r->stream;
@@ -769,8 +787,10 @@ static gdr_status create_node_counts(gdr_renderer *r, gdr_error *err)
         clusters[m] = &s->scene->meshes[m].clusters;
         offsets[m] = g->cpu_meshes[m].lod_node_offset;
     }
+    gdr_thread_pool *pool = status == GDR_OK ? node_count_pool(s->scene) : NULL;
     if (status == GDR_OK)
-        status = gdr_node_counts_create(clusters, offsets, meshes, &s->node_counts, err);
+        status = gdr_node_counts_create_on(clusters, offsets, meshes, pool, &s->node_counts, err);
+    gdr_thread_pool_destroy(pool);
     uint32_t nodes = status == GDR_OK ? gdr_node_counts_node_total(s->node_counts) : 0;
     if (status == GDR_OK && !(s->node_runs = malloc(sizeof *s->node_runs * (nodes ? nodes : 1))))
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "streaming: out of memory for the node counts");

@@ -204,6 +204,26 @@ static void run_without_clusters(const gdr_scene *scene)
     gdr_node_counts *a = NULL, *b = NULL;
     CHECK(gdr_node_counts_create(whole, offsets, 2, &a, &err) == GDR_OK);
     CHECK(gdr_node_counts_create(streamed, offsets, 2, &b, &err) == GDR_OK);
+    /* Made on four threads, one task a mesh: the same counts, from the clusters and from the
+     * refinements. */
+    gdr_thread_pool *pool = NULL;
+    gdr_node_counts *c = NULL, *d = NULL;
+    CHECK(gdr_thread_pool_create(4, &pool, &err) == GDR_OK);
+    CHECK(gdr_node_counts_create_on(whole, offsets, 2, pool, &c, &err) == GDR_OK);
+    CHECK(gdr_node_counts_create_on(streamed, offsets, 2, pool, &d, &err) == GDR_OK);
+    gdr_thread_pool_destroy(pool);
+    uint32_t threaded_differ = !a || !c || !d || memcmp(gdr_node_counts_words(a), gdr_node_counts_words(c), 4ull * total) ||
+                               memcmp(gdr_node_counts_words(a), gdr_node_counts_words(d), 4ull * total);
+    for (uint32_t k = 0; !threaded_differ && k < 2000; k++) {
+        uint64_t pick = 7 + k;
+        uint32_t m = (uint32_t)(pick % 2), group = (uint32_t)((pick * 2654435761u) % whole[m]->group_count);
+        threaded_differ += gdr_node_counts_set(c, m, group, true) != gdr_node_counts_set(d, m, group, true);
+    }
+    threaded_differ += c && d && memcmp(gdr_node_counts_words(c), gdr_node_counts_words(d), 4ull * total) != 0;
+    printf("made on four threads: %s\n", threaded_differ ? "the counts differ" : "the same counts");
+    CHECK(threaded_differ == 0);
+    gdr_node_counts_destroy(c);
+    gdr_node_counts_destroy(d);
     uint64_t rng = 777;
     uint32_t differ = 0, sets = 0;
     for (uint32_t k = 0; a && b && k < 4000; k++, sets++) {
