@@ -74,4 +74,19 @@ uint32_t gdr_lod_cut_select_hierarchical_resident(const gdr_mesh_clusters *clust
  * passes(g) = (depth(g) < depth and g is not the root). */
 uint32_t gdr_lod_cut_select_depth(const gdr_mesh_clusters *clusters, uint32_t depth, uint8_t *selected);
 
+/* Group `group`'s first refinement in c->refinements (they are in group order: a binary search), or
+ * c->refinement_count where it has none. */
+static inline uint32_t gdr_lod_first_refinement(const gdr_mesh_clusters *c, uint32_t group)
+{
+    uint32_t lo = 0, hi = c->refinement_count;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (c->refinements[mid].group < group)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
 #endif

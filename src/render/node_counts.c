@@ -52,19 +52,13 @@ static void link_parents(gdr_node_counts *nc, const gdr_mesh_clusters *c, uint32
 }
 
 /* Leaf n's refinements in a mesh read for streaming (no clusters): visit(group of each, leaf, its
- * clusters). The refinements are in group order: a binary search finds the leaf's group's. */
+ * clusters). */
 static void for_each_leaf_refinement(gdr_node_counts *nc, const gdr_mesh_clusters *c, uint32_t n, uint32_t offset,
                                      uint32_t group_base, void (*visit)(gdr_node_counts *, uint32_t, uint32_t, uint32_t))
 {
-    uint32_t group = c->lod_nodes[n].group, lo = 0, hi = c->refinement_count;
-    while (lo < hi) {
-        uint32_t mid = lo + (hi - lo) / 2;
-        if (c->refinements[mid].group < group)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    for (uint32_t k = lo; k < c->refinement_count && c->refinements[k].group == group; k++)
+    uint32_t group = c->lod_nodes[n].group;
+    for (uint32_t k = gdr_lod_first_refinement(c, group); k < c->refinement_count && c->refinements[k].group == group;
+         k++)
         if (c->refinements[k].refined_group < c->group_count)
             visit(nc, group_base + c->refinements[k].refined_group, offset + n, c->refinements[k].cluster_count);
 }

@@ -264,25 +264,11 @@ static void *stage(gdr_frame_slot *slot, stream_copies *c, uint64_t bytes)
     return at;
 }
 
-/* Group `group`'s first refinement in c (they are in group order), or c->refinement_count. */
-static uint32_t first_refinement(const gdr_mesh_clusters *c, uint32_t group)
-{
-    uint32_t lo = 0, hi = c->refinement_count;
-    while (lo < hi) {
-        uint32_t mid = lo + (hi - lo) / 2;
-        if (c->refinements[mid].group < group)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
-}
-
 /* A group's clusters in a page (`count` of them at pc) against its refinements in a scene read for
  * streaming: the same refined groups in the same order of first use, as many clusters of each. */
 static bool refinements_match(const gdr_mesh_clusters *c, uint32_t group, const gdr_page_cluster *pc, uint32_t count)
 {
-    uint32_t first = first_refinement(c, group), end = first, seen[GDR_CLUSTER_MAX_TRIANGLES], n = 0;
+    uint32_t first = gdr_lod_first_refinement(c, group), end = first, seen[GDR_CLUSTER_MAX_TRIANGLES], n = 0;
     while (end < c->refinement_count && c->refinements[end].group == group)
         end++;
     for (uint32_t i = 0; i < count; i++) {
