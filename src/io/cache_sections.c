@@ -734,12 +734,17 @@ static gdr_status place_mesh_groups(cache_read_state *st, reader *data, uint32_t
 }
 #undef CLGR
 
+/* How much decoding a mesh's part of a section costs (cache_decode.c's threads follow it). */
+typedef uint64_t mesh_work_fn(const gdr_mesh_clusters *c);
+static uint64_t group_work(const gdr_mesh_clusters *c) { return c->group_count; }
+static uint64_t cluster_work(const gdr_mesh_clusters *c) { return c->cluster_count; }
+
 /* Every mesh's counts and place first, in order, up to the first that fails; then the meshes
  * placed, decoded at once (cache_decode.c). A failure of an earlier mesh's data comes before a later
  * mesh's counts, as when each mesh was read whole before the next. */
 static gdr_status read_in_meshes(cache_read_state *st, reader *data, const char *id,
                                  gdr_status (*place)(cache_read_state *, reader *, uint32_t, size_t *, gdr_error *),
-                                 cache_mesh_decode_fn *decode, bool by_clusters, gdr_error *err)
+                                 cache_mesh_decode_fn *decode, mesh_work_fn *work, gdr_error *err)
 {
     size_t *at = malloc(sizeof *at * (st->mesh_count ? st->mesh_count : 1));
     if (!at)
@@ -750,8 +755,7 @@ static gdr_status read_in_meshes(cache_read_state *st, reader *data, const char 
     uint64_t records = 0;
     for (; ready < st->mesh_count && placed == GDR_OK; ready++) {
         placed = place(st, data, ready, &at[ready], err);
-        const gdr_mesh_clusters *c = &st->scene->meshes[ready].clusters;
-        records += by_clusters ? c->cluster_count : c->group_count;
+        records += work(&st->scene->meshes[ready].clusters);
     }
     if (placed != GDR_OK)
         ready--; /* the failed mesh is not decoded */
@@ -765,7 +769,7 @@ static gdr_status read_in_meshes(cache_read_state *st, reader *data, const char 
 
 static gdr_status read_cluster_groups(cache_read_state *st, reader *data, gdr_error *err)
 {
-    return read_in_meshes(st, data, "CLGR", place_mesh_groups, decode_mesh_groups, false, err);
+    return read_in_meshes(st, data, "CLGR", place_mesh_groups, decode_mesh_groups, group_work, err);
 }
 
 /* --- CLDT (per mesh: its cluster records; absent where the pages alone hold them) ---------------- */
@@ -803,7 +807,7 @@ static gdr_status read_cluster_data(cache_read_state *st, reader *data, gdr_erro
 {
     if (st->paged)
         return GDR_OK; /* the pages hold the records */
-    return read_in_meshes(st, data, "CLDT", place_mesh_clusters, decode_mesh_clusters, true, err);
+    return read_in_meshes(st, data, "CLDT", place_mesh_clusters, decode_mesh_clusters, cluster_work, err);
 }
 
 #define CLGM(fmt, ...) gdr_error_set(err, GDR_ERROR_PARSE, "%s: section 'CLGM': mesh %u" fmt, name, m, __VA_ARGS__)
@@ -915,16 +919,10 @@ static gdr_status place_mesh_hierarchy(cache_read_state *st, reader *r, uint32_t
     return GDR_OK;
 }
 
-typedef struct hierarchy_decode {
-    cache_read_state *st;
-    const reader *data;
-    size_t *at; /* per mesh: its nodes' offset in data */
-} hierarchy_decode;
-
 /* Mesh m's nodes, then the whole hierarchy checked against the mesh's clusters. */
 static gdr_status decode_mesh_hierarchy(void *user, uint32_t m, gdr_error *err)
 {
-    const hierarchy_decode *d = user;
+    const mesh_decode *d = user;
     gdr_mesh_clusters *c = &d->st->scene->meshes[m].clusters;
     if (c->lod_node_count == 0)
         return GDR_OK;
@@ -947,30 +945,14 @@ static gdr_status decode_mesh_hierarchy(void *user, uint32_t m, gdr_error *err)
     return GDR_OK;
 }
 
-/* Every hierarchy is checked whole (gdr_mesh_clusters_check_hierarchy) against the clusters read:
- * every mesh's count placed first, in order, up to the first that fails, then the meshes placed
- * decoded and checked at once (cache_decode.c), the first failure in mesh order refusing the file. */
+static uint64_t hierarchy_work(const gdr_mesh_clusters *c) { return (uint64_t)c->lod_node_count + c->cluster_count; }
+
+/* Every hierarchy is checked whole (gdr_mesh_clusters_check_hierarchy) against the clusters read,
+ * the meshes decoded and checked at once (read_in_meshes), the first failure in mesh order refusing
+ * the file. */
 static gdr_status read_hierarchy(cache_read_state *st, reader *r, gdr_error *err)
 {
-    size_t *at = malloc(sizeof *at * (st->mesh_count ? st->mesh_count : 1));
-    if (!at)
-        return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "%s: out of memory for %u meshes", st->name,
-                             st->mesh_count);
-    gdr_status placed = GDR_OK;
-    uint32_t ready = 0;
-    uint64_t records = 0;
-    for (; ready < st->mesh_count && placed == GDR_OK; ready++) {
-        placed = place_mesh_hierarchy(st, r, ready, &at[ready], err);
-        records += st->scene->meshes[ready].clusters.lod_node_count + st->scene->meshes[ready].clusters.cluster_count;
-    }
-    if (placed != GDR_OK)
-        ready--; /* the failed mesh is not decoded */
-    hierarchy_decode d = {st, r, at};
-    gdr_status status = cache_decode_meshes(ready, records, decode_mesh_hierarchy, &d, err);
-    free(at);
-    if (status != GDR_OK)
-        return status;
-    return placed != GDR_OK ? placed : expect_end(st, r, "LODH", err);
+    return read_in_meshes(st, r, "LODH", place_mesh_hierarchy, decode_mesh_hierarchy, hierarchy_work, err);
 }
 
 /* --- MATL: materials --------------------------------------------------------------------------- */

@@ -12,7 +12,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include <xxhash.h>
+
+#include "cache_checksums.h"
 
 #include "gdr/gdr.h"
 #include "io/io_internal.h"
@@ -156,24 +157,6 @@ static uint8_t *cache_entry(uint8_t *data, const char *id)
     return NULL;
 }
 
-/* Every checksum again after a deliberate edit, so that the edit reaches the section's reader. */
-static void fix_checksums(uint8_t *data)
-{
-    uint32_t count;
-    memcpy(&count, data + 16, 4);
-    for (uint32_t i = 0; i < count; i++) {
-        uint8_t *e = data + 64 + (size_t)i * 32;
-        uint64_t offset, length, h;
-        memcpy(&offset, e + 8, 8);
-        memcpy(&length, e + 16, 8);
-        h = XXH3_64bits(data + offset, (size_t)length);
-        memcpy(e + 24, &h, 8);
-    }
-    uint64_t h = XXH3_64bits(data + 64, (size_t)count * 32);
-    memcpy(data + 32, &h, 8);
-    h = XXH3_64bits(data, 40);
-    memcpy(data + 40, &h, 8);
-}
 
 /* A cache keeps the import's warnings: read again, they are said again, with control characters
  * escaped; a section out of its limits is refused by name. */
@@ -232,13 +215,13 @@ static void test_report_section(void)
         uint8_t *copy = malloc(size);
         memcpy(copy, bytes, size);
         memcpy(copy + offset + 12, &length, 4);
-        fix_checksums(copy);
+        test_cache_fix_checksums(copy, size);
         CHECK_FAILS(gdr_cache_read_memory(copy, size, "long.gdrc", &s, NULL, &err), err, GDR_ERROR_PARSE);
         CHECK(strstr(err.message, "long.gdrc: section 'REPT': warning 0"));
         memcpy(copy, bytes, size);
         memcpy(copy + offset + 4, &kept, 4);
         memcpy(copy + offset + 8, &kept, 4);
-        fix_checksums(copy);
+        test_cache_fix_checksums(copy, size);
         CHECK_FAILS(gdr_cache_read_memory(copy, size, "many.gdrc", &s, NULL, &err), err, GDR_ERROR_PARSE);
         CHECK(strstr(err.message, "many.gdrc: section 'REPT': 1000000 warnings kept"));
         /* A flipped byte without fixed checksums: corrupted. */
