@@ -2,6 +2,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "cli_args.h"
 #include "commands.h"
@@ -204,6 +205,13 @@ static gdr_status render_pose(gdr_renderer *renderer, gdr_frame_desc *frame, con
     return status;
 }
 
+static double monotonic_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
+}
+
 /* The frames asked for: o->frames of one view, or with a camera path (path->count > 0) one frame per
  * pose (the path repeated to make --frames N, N the path's length by default; with --settle, each
  * pose's settled frame), each frame's figures a row of *rows (malloc'ed; the JSON's "path"); the
@@ -224,9 +232,12 @@ static gdr_status render_frames(gdr_renderer *renderer, gdr_frame_desc *frame, c
         frame->camera.position = path->poses[f % path->count].position;
         frame->camera.rotation = path->poses[f % path->count].rotation;
         frame->read_back = read_back && f + 1 == frames;
+        double start = monotonic_ms();
         status = render_pose(renderer, frame, o, stats, err);
-        if (status == GDR_OK)
+        if (status == GDR_OK) {
             (*rows)[f] = stats_path_row(stats);
+            (*rows)[f].wall_ms = monotonic_ms() - start;
+        }
     }
     return status;
 }

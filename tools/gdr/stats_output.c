@@ -253,8 +253,11 @@ void stats_add_memory_json(cJSON *object, const gdr_frame_stats *s)
 stats_path_frame stats_path_row(const gdr_frame_stats *s)
 {
     const gdr_streaming_stats *st = &s->streaming;
-    return (stats_path_frame){s->gpu_ms_per_frame, s->triangles, st->lod_error_px, st->wanted_pages,
-                              st->resident_pages, st->uploads, st->evictions, st->requests};
+    stats_path_frame row = {s->gpu_ms_per_frame, s->cpu_ms_per_frame, 0.0, s->triangles, st->lod_error_px,
+                            st->wanted_pages, st->resident_pages, st->uploads, st->evictions, st->requests,
+                            .pass_count = s->pass_count};
+    memcpy(row.passes, s->passes, sizeof row.passes);
+    return row;
 }
 
 static void add_path_json(cJSON *root, const stats_context *context)
@@ -267,6 +270,8 @@ static void add_path_json(cJSON *root, const stats_context *context)
             break;
         cJSON_AddNumberToObject(row, "frame", i);
         cJSON_AddNumberToObject(row, "gpu_ms", f->gpu_ms);
+        cJSON_AddNumberToObject(row, "cpu_ms", f->cpu_ms);
+        cJSON_AddNumberToObject(row, "wall_ms", f->wall_ms);
         cJSON_AddNumberToObject(row, "triangles", (double)f->triangles);
         cJSON_AddNumberToObject(row, "lod_error_px", f->lod_error_px);
         cJSON_AddNumberToObject(row, "wanted_pages", f->wanted_pages);
@@ -274,6 +279,9 @@ static void add_path_json(cJSON *root, const stats_context *context)
         cJSON_AddNumberToObject(row, "uploads", f->uploads);
         cJSON_AddNumberToObject(row, "evictions", f->evictions);
         cJSON_AddNumberToObject(row, "requests", f->requests);
+        cJSON *passes = cJSON_AddObjectToObject(row, "gpu_ms_passes");
+        for (uint32_t p = 0; passes && p < f->pass_count; p++)
+            cJSON_AddNumberToObject(passes, f->passes[p].name, f->passes[p].gpu_ms);
     }
 }
 

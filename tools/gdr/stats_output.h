@@ -9,9 +9,13 @@
 /* One frame along a camera path (gdr render --camera-path): what a plot along the path needs. */
 typedef struct stats_path_frame {
     double gpu_ms;
+    double cpu_ms;                     /* the renderer's recording and submission of the frame */
+    double wall_ms;                    /* the pose's whole time on the host, settling frames included */
     uint64_t triangles;
     float lod_error_px;                /* streamed: the threshold drawn with */
     uint32_t wanted_pages, resident_pages, uploads, evictions, requests;
+    gdr_pass_timing passes[GDR_MAX_PASSES]; /* the frame's passes on the GPU */
+    uint32_t pass_count;
 } stats_path_frame;
 
 typedef struct stats_context {
