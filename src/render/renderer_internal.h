@@ -3,6 +3,7 @@
 #define GDR_RENDERER_INTERNAL_H
 
 #include "gdr/renderer.h"
+#include "gdr/thread_pool.h"
 #include "render/frame_plan.h"
 #include "render/renderer_debug.h"
 #include "render/materials.h"
@@ -139,6 +140,7 @@ typedef struct gdr_frame_slot {
 typedef struct gdr_streaming {
     bool enabled;
     bool wait_for_loads;
+    gdr_thread_pool *set_up_pool; /* from the open to the first pages' arrival (NULL: one thread) */
     bool meshes_changed;    /* a page 0 set its mesh's root shortcut: the meshes are uploaded again */
     uint32_t records_per_slot; /* the most clusters a page holds: a slot's room in the record pool */
     const gdr_scene *scene;             /* the caller's: clusters and LOD hierarchies */

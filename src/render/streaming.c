@@ -166,6 +166,24 @@ static gdr_status check_staging_fits(const gdr_renderer *r, uint64_t bytes, gdr_
     return GDR_OK;
 }
 
+/* Threads for the set-up's work a mesh at a time (the residency's page graph, the node counts), one
+ * per processor, where several meshes hold enough nodes to gain from them (a billion-triangle field
+ * of 1,000 meshes: 270 ms of node counts on one thread); NULL otherwise (the same results on this
+ * thread). */
+static gdr_thread_pool *set_up_pool(const gdr_scene *scene)
+{
+    uint64_t nodes = 0;
+    for (uint32_t m = 0; m < scene->mesh_count; m++)
+        nodes += scene->meshes[m].clusters.lod_node_count;
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    uint32_t threads = cpus < 1 ? 1 : cpus > GDR_THREAD_POOL_MAX_THREADS ? GDR_THREAD_POOL_MAX_THREADS : (uint32_t)cpus;
+    gdr_thread_pool *pool = NULL;
+    gdr_error ignored = {0};
+    if (threads > 1 && scene->mesh_count > 1 && nodes >= 65536)
+        (void)gdr_thread_pool_create(threads, &pool, &ignored);
+    return pool;
+}
+
 gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr_streaming_desc *desc, gdr_error *err)
 {
     gdr_streaming *s = &r->stream;
@@ -188,6 +206,8 @@ gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr
                               .budget_bytes = desc->geometry_budget_bytes ? desc->geometry_budget_bytes
                                                                           : default_budget(r),
                               .upload_budget_bytes = s->upload_budget};
+    s->set_up_pool = set_up_pool(scene);
+    res.pool = s->set_up_pool;
     if (status == GDR_OK)
         status = gdr_residency_create(&res, &s->residency, err);
     if (status == GDR_OK) {
@@ -235,6 +255,7 @@ void gdr_streaming_destroy(gdr_renderer *r)
     if (r->ctx)
         gdr_vk_buffer_destroy(r->ctx, &s->pool);
     gdr_node_counts_destroy(s->node_counts);
+    gdr_thread_pool_destroy(s->set_up_pool);
     free(s->pending), free(s->slot_page), free(s->page_base), free(s->mesh_dirty), free(s->node_runs);
     free(s->requests), free(s->loads), free(s->dirty_list), free(s->copies), free(s->words);
     memset(s, 0, sizeof *s);
@@ -741,24 +762,6 @@ gdr_status gdr_streaming_begin_frame(gdr_renderer *r, gdr_frame_slot *slot, gdr_
     return status;
 }
 
-/* The node counts over the scene's hierarchies, every group absent (as the page table starts). */
-/* Threads for the node counts' creation, one per processor, where several meshes hold enough nodes
- * to gain from them (a billion-triangle field of 1,000 meshes: 270 ms on one thread); NULL otherwise
- * (the same counts on this thread). */
-static gdr_thread_pool *node_count_pool(const gdr_scene *scene)
-{
-    uint64_t nodes = 0;
-    for (uint32_t m = 0; m < scene->mesh_count; m++)
-        nodes += scene->meshes[m].clusters.lod_node_count;
-    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-    uint32_t threads = cpus < 1 ? 1 : cpus > GDR_THREAD_POOL_MAX_THREADS ? GDR_THREAD_POOL_MAX_THREADS : (uint32_t)cpus;
-    gdr_thread_pool *pool = NULL;
-    gdr_error ignored = {0};
-    if (threads > 1 && scene->mesh_count > 1 && nodes >= 65536)
-        (void)gdr_thread_pool_create(threads, &pool, &ignored);
-    return pool;
-}
-
 static gdr_status create_node_counts(gdr_renderer *r, gdr_error *err)
 {
     gdr_streaming *s = &r->stream;
@@ -773,10 +776,8 @@ static gdr_status create_node_counts(gdr_renderer *r, gdr_error *err)
         clusters[m] = &s->scene->meshes[m].clusters;
         offsets[m] = g->cpu_meshes[m].lod_node_offset;
     }
-    gdr_thread_pool *pool = status == GDR_OK ? node_count_pool(s->scene) : NULL;
     if (status == GDR_OK)
-        status = gdr_node_counts_create_on(clusters, offsets, meshes, pool, &s->node_counts, err);
-    gdr_thread_pool_destroy(pool);
+        status = gdr_node_counts_create_on(clusters, offsets, meshes, s->set_up_pool, &s->node_counts, err);
     uint32_t nodes = status == GDR_OK ? gdr_node_counts_node_total(s->node_counts) : 0;
     if (status == GDR_OK && !(s->node_runs = malloc(sizeof *s->node_runs * (nodes ? nodes : 1))))
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "streaming: out of memory for the node counts");
@@ -815,6 +816,8 @@ gdr_status gdr_streaming_start(gdr_renderer *r, gdr_error *err)
     free(absent);
     if (status == GDR_OK)
         status = create_node_counts(r, err);
+    gdr_thread_pool_destroy(s->set_up_pool); /* the set-up's last work a mesh at a time */
+    s->set_up_pool = NULL;
     count_resident_tables(r);
     bool wait = s->wait_for_loads;
     s->wait_for_loads = true;

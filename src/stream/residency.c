@@ -78,25 +78,67 @@ static uint32_t page_parents(const gdr_residency *res, uint32_t m, uint32_t p, u
     return unique;
 }
 
-/* Parent and child page lists of every page. */
-static int build_edges(gdr_residency *res)
+/* One mesh's page parent lists, each page's written at the end of the one before, from the mesh's
+ * share of `parents` (its parent edges bound its pages' lists); each page's count into
+ * parent_first[page + 1]. A task per mesh: meshes write to disjoint places. */
+typedef struct edge_job {
+    gdr_residency *res;
+    const uint64_t *mesh_edges; /* the mesh's share of parents starts here */
+} edge_job;
+
+static void mesh_page_parents(void *user, uint32_t m, uint32_t worker)
+{
+    (void)worker;
+    const edge_job *job = user;
+    gdr_residency *res = job->res;
+    uint64_t at = job->mesh_edges[m];
+    for (uint32_t p = 0; p < gdr_paged_cache_mesh(res->cache, m)->page_count; p++) {
+        uint32_t n = page_parents(res, m, p, res->parents + at);
+        res->parent_first[res->page_base[m] + p + 1] = n;
+        at += n;
+    }
+}
+
+/* The lists packed together in page order: parent_first from the counts, each mesh's lists moved
+ * down from its share (shares only ever move towards the start, in order). */
+static void pack_parents(gdr_residency *res, const uint64_t *mesh_edges)
+{
+    uint32_t n = 0;
+    for (uint32_t m = 0; m < res->mesh_count; m++) {
+        uint32_t first = res->page_base[m], pages = gdr_paged_cache_mesh(res->cache, m)->page_count, count = 0;
+        for (uint32_t p = 0; p < pages; p++) {
+            uint32_t c = res->parent_first[first + p + 1];
+            res->parent_first[first + p] = n + count;
+            count += c;
+        }
+        memmove(res->parents + n, res->parents + mesh_edges[m], sizeof *res->parents * count);
+        n += count;
+    }
+    res->parent_first[res->page_total] = n;
+}
+
+/* Parent and child page lists of every page; the parents a task per mesh on `pool` (may be NULL). */
+static int build_edges(gdr_residency *res, gdr_thread_pool *pool)
 {
     uint64_t edges = 0;
-    for (uint32_t m = 0; m < res->mesh_count; m++)
+    uint64_t *mesh_edges = malloc(sizeof *mesh_edges * ((size_t)res->mesh_count + 1));
+    for (uint32_t m = 0; mesh_edges && m < res->mesh_count; m++) {
+        mesh_edges[m] = edges;
         edges += gdr_paged_cache_mesh(res->cache, m)->parent_count;
+    }
     res->parents = malloc(sizeof *res->parents * (edges ? edges : 1));
     res->children = malloc(sizeof *res->children * (edges ? edges : 1));
     res->parent_first = calloc((size_t)res->page_total + 1, sizeof *res->parent_first);
     res->child_first = calloc((size_t)res->page_total + 1, sizeof *res->child_first);
-    if (!res->parents || !res->children || !res->parent_first || !res->child_first)
+    if (!mesh_edges || !res->parents || !res->children || !res->parent_first || !res->child_first) {
+        free(mesh_edges);
         return 0;
-    uint32_t n = 0;
-    for (uint32_t m = 0; m < res->mesh_count; m++)
-        for (uint32_t p = 0; p < gdr_paged_cache_mesh(res->cache, m)->page_count; p++) {
-            res->parent_first[res->page_base[m] + p] = n;
-            n += page_parents(res, m, p, res->parents + n);
-        }
-    res->parent_first[res->page_total] = n;
+    }
+    edge_job job = {res, mesh_edges};
+    gdr_thread_pool_run(pool, res->mesh_count, mesh_page_parents, &job);
+    pack_parents(res, mesh_edges);
+    free(mesh_edges);
+    uint32_t n = res->parent_first[res->page_total];
     for (uint32_t e = 0; e < n; e++)
         res->child_first[res->parents[e] + 1]++;
     for (uint32_t i = 0; i < res->page_total; i++)
@@ -160,7 +202,7 @@ gdr_status gdr_residency_create(const gdr_residency_desc *desc, gdr_residency **
     res->lru_head = res->lru_tail = UINT32_MAX;
     gdr_status status = GDR_OK;
     if (!res->page_base || !res->pages || !res->page_mesh || !res->scratch || !res->lru_prev || !res->lru_next ||
-        !build_edges(res))
+        !build_edges(res, desc->pool))
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "residency of %u pages", res->page_total);
     if (status == GDR_OK)
         status = size_pool(res, desc, err);

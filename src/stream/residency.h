@@ -19,6 +19,7 @@
 
 #include "gdr/core.h"
 #include "gdr/paged_cache.h"
+#include "gdr/thread_pool.h"
 
 /* A group the GPU wanted and found absent; larger priority first (e.g. its projected error). */
 typedef struct gdr_stream_request {
@@ -49,6 +50,8 @@ typedef struct gdr_residency_desc {
     const gdr_paged_cache *cache;
     uint64_t budget_bytes;        /* the pool: at least every mesh's page 0 */
     uint64_t upload_budget_bytes; /* decoded bytes loaded per frame at most (0: no limit) */
+    gdr_thread_pool *pool;        /* threads for the page graph's creation (NULL: this thread); the
+                                     same graph for any pool */
 } gdr_residency_desc;
 
 typedef struct gdr_residency gdr_residency;

@@ -8,7 +8,8 @@
  * each frame's loads stay within the upload budget (requests beyond it wait), eviction never
  * takes a pinned page, a page the latest cut used or one with a resident child; a still camera
  * converges to the full cut within a bounded number of frames; a damaged page is refused by name,
- * stays absent and the cut stays exact; two runs give the same frames. */
+ * stays absent and the cut stays exact; two runs give the same frames, the second with the
+ * residency's page graph made on threads. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,6 +18,7 @@
 #include "geometry/lod_cut.h"
 #include "gdr/io.h"
 #include "gdr/paged_cache.h"
+#include "gdr/thread_pool.h"
 #include "stream/page_loader.h"
 #include "stream/residency.h"
 #include "test_util.h"
@@ -182,13 +184,14 @@ static gdr_vec3 camera_at(uint32_t frame)
 /* Runs the path and the still camera; returns the trace. converged_at: the first frame from which
  * the cut equals the full cut (UINT32_MAX: never). */
 static uint64_t simulate(const gdr_scene *scene, const char *path, uint64_t budget, uint64_t upload_budget,
-                         uint32_t *converged_at, uint32_t *failed_pages, uint32_t *deferred_frames)
+                         gdr_thread_pool *pool, uint32_t *converged_at, uint32_t *failed_pages,
+                         uint32_t *deferred_frames)
 {
     sim s = {.scene = scene, .budget = budget, .upload_budget = upload_budget, .trace = 14695981039346656037ull,
              .same_walk = 1};
     gdr_error err = {0};
     CHECK(gdr_paged_cache_open(path, &s.cache, &err) == GDR_OK);
-    gdr_residency_desc desc = {s.cache, budget, upload_budget};
+    gdr_residency_desc desc = {s.cache, budget, upload_budget, pool};
     CHECK(s.cache && gdr_residency_create(&desc, &s.res, &err) == GDR_OK);
     if (!s.res)
         fprintf(stderr, "%s\n", err.message);
@@ -353,14 +356,18 @@ int main(void)
            (unsigned long long)total, (unsigned long long)budget, (unsigned long long)upload);
 
     uint32_t converged, failed, deferred;
-    uint64_t trace = simulate(scene, path, budget, upload, &converged, &failed, &deferred);
+    uint64_t trace = simulate(scene, path, budget, upload, NULL, &converged, &failed, &deferred);
     printf("converged at frame %u (camera still from frame %u); %u frames deferred requests\n", converged,
            PATH_FRAMES, deferred);
     CHECK(converged < PATH_FRAMES + STILL_FRAMES / 2);
     CHECK(failed == 0 && deferred > 0);
+    /* The same frames again, the residency's page graph made on four threads. */
     uint32_t converged2, failed2, deferred2;
-    CHECK(simulate(scene, path, budget, upload, &converged2, &failed2, &deferred2) == trace);
+    gdr_thread_pool *pool = NULL;
+    CHECK(gdr_thread_pool_create(4, &pool, &err) == GDR_OK);
+    CHECK(simulate(scene, path, budget, upload, pool, &converged2, &failed2, &deferred2) == trace);
     CHECK(converged2 == converged);
+    gdr_thread_pool_destroy(pool);
 
     check_eviction_rules(path);
 
@@ -375,7 +382,7 @@ int main(void)
 
     /* A damaged page of the nearest mesh: refused, its groups stay absent, every cut stays exact. */
     write_damaged(path, damaged, 0, 2);
-    simulate(scene, damaged, budget, upload, &converged, &failed, &deferred);
+    simulate(scene, damaged, budget, upload, NULL, &converged, &failed, &deferred);
     CHECK(failed == 1 && converged == UINT32_MAX);
     remove(damaged);
     remove(path);
