@@ -189,6 +189,22 @@ if len(rows) != 2 or (sys.argv[2] != "") != all(settled):
     sys.exit(1)
 PY
 done
+# --warm-up: frames at the first pose before the rows, in none of them: the first pose's row then
+# finds its pages there (nothing asked for, nothing copied; without it, it asks). Each row names where its
+# frame went (every pass's GPU time, the renderer's CPU time, the pose's wall time).
+expect 0 "stream a path after a warm-up" "$gdr" render "$work/unique.gdrc" $tiny --geometry-budget 1 \
+    --camera-path "$work/settle.path" --warm-up 60 --stats "$work/warm.json" --validate
+python3 - "$work/warm.json" <<'PY' || failures=$((failures + 1))
+import json, sys
+rows = json.load(open(sys.argv[1]))["path"]
+quiet = [r["requests"] == 0 and r["uploads"] == 0 for r in rows]
+timed = all(r["wall_ms"] > 0 and r["cpu_ms"] > 0 and abs(sum(r["gpu_ms_passes"].values()) - r["gpu_ms"]) < 1e-3
+            for r in rows)
+if len(rows) != 2 or not quiet[0] or not timed:
+    print(f"FAIL: --warm-up 60: rows {rows}")
+    sys.exit(1)
+PY
+expect 2 "--warm-up not a count" "$gdr" render "$work/unique.gdrc" $tiny --geometry-budget 1 --warm-up -3
 expect 2 "--settle without a path" "$gdr" render "$work/unique.gdrc" $tiny --geometry-budget 1 --settle 5
 expect 2 "--settle in the viewer" "$gdr" view "$work/unique.gdrc" $tiny --geometry-budget 1 --settle 5
 # Streaming any scene: a built-in scene, a glTF and an OBJ without a prior gdr build get their paged

@@ -57,7 +57,7 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
             continue;
         /* The options that take a value (an unknown one is reported as such). */
         static const char *const known[] = {
-            "--out", "-o", "--stats", "--width", "--height", "--frames", "--camera-path", "--settle", "--camera",
+            "--out", "-o", "--stats", "--width", "--height", "--frames", "--camera-path", "--settle", "--warm-up", "--camera",
             "--camera-index", "--cull", "--meshlet-cull", "--cone-cull", "--triangle-cull", "--occlusion",
             "--lod-hierarchy", "--point-level", "--pipeline", "--raster", "--sw-threshold", "--view", "--lod-error",
             "--min-screen-size", "--clip-plane", "--lod-depth", "--device", "--geometry-budget",
@@ -79,6 +79,8 @@ int render_options_parse(const char *command, int argc, char **argv, render_opti
             o->camera_path = value;
         else if (strcmp(arg, "--settle") == 0)
             ok = cli_parse_u32(arg, value, 1, 100000, &o->settle_frames);
+        else if (strcmp(arg, "--warm-up") == 0)
+            ok = cli_parse_u32(arg, value, 0, 100000, &o->warm_up_frames);
         else if (strcmp(arg, "--camera") == 0)
             ok = o->has_camera = cli_parse_camera(arg, value, &o->camera_position, &o->camera_rotation);
         else if (strcmp(arg, "--camera-index") == 0)
@@ -215,19 +217,28 @@ static double monotonic_ms(void)
 /* The frames asked for: o->frames of one view, or with a camera path (path->count > 0) one frame per
  * pose (the path repeated to make --frames N, N the path's length by default; with --settle, each
  * pose's settled frame), each frame's figures a row of *rows (malloc'ed; the JSON's "path"); the
- * statistics are the last call's. */
+ * statistics are the last call's. With --warm-up N, N frames at the first pose come before them, in
+ * no row or statistic. */
 static gdr_status render_frames(gdr_renderer *renderer, gdr_frame_desc *frame, const render_options *o,
                                 const camera_path *path, gdr_frame_stats *stats, stats_path_frame **rows,
                                 gdr_error *err)
 {
+    if (path->count) {
+        frame->camera.position = path->poses[0].position;
+        frame->camera.rotation = path->poses[0].rotation;
+    }
+    bool read_back = frame->read_back;
+    frame->read_back = false;
+    gdr_status status = o->warm_up_frames ? gdr_renderer_render(renderer, frame, o->warm_up_frames, NULL, err) : GDR_OK;
+    frame->read_back = read_back;
+    if (status != GDR_OK)
+        return status;
     if (path->count == 0)
         return gdr_renderer_render(renderer, frame, o->frames, stats, err);
-    gdr_status status = GDR_OK;
     uint32_t frames = o->frames_given ? o->frames : path->count;
     *rows = calloc(frames, sizeof **rows);
     if (!*rows)
         return gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "render: out of memory for %u frames' figures", frames);
-    bool read_back = frame->read_back;
     for (uint32_t f = 0; f < frames && status == GDR_OK; f++) {
         frame->camera.position = path->poses[f % path->count].position;
         frame->camera.rotation = path->poses[f % path->count].rotation;

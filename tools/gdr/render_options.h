@@ -31,6 +31,7 @@ typedef struct render_options {
     const char *camera_path; /* --camera-path FILE: one pose per frame (docs/VIEWER.md) */
     bool frames_given;
     uint32_t settle_frames; /* --settle N: with a camera path, each pose drawn until streaming settles */
+    uint32_t warm_up_frames; /* --warm-up N: frames at the first pose before those measured */
     uint32_t geometry_budget_mib, upload_budget_mib; /* streaming (docs/STREAMING.md): 0 unless given */
     gdr_load_options load;   /* its warning sink is `warnings`, its report `report` */
     cli_warnings warnings;   /* counted; --strict makes them errors (exit GDR_EXIT_STRICT) */
