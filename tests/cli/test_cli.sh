@@ -207,6 +207,7 @@ PY
 expect 2 "--warm-up not a count" "$gdr" render "$work/unique.gdrc" $tiny --geometry-budget 1 --warm-up -3
 expect 2 "--settle without a path" "$gdr" render "$work/unique.gdrc" $tiny --geometry-budget 1 --settle 5
 expect 2 "--settle in the viewer" "$gdr" view "$work/unique.gdrc" $tiny --geometry-budget 1 --settle 5
+expect 2 "--warm-up in the viewer" "$gdr" view "$work/unique.gdrc" $tiny --geometry-budget 1 --warm-up 5
 # Streaming any scene: a built-in scene, a glTF and an OBJ without a prior gdr build get their paged
 # cache built in the cache folder (once: a second run reads it), and a glTF streamed with room for
 # everything converges to the image of that cache uploaded whole; --no-cache cannot stream a file.

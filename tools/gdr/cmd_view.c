@@ -394,8 +394,8 @@ int gdr_cmd_view(int argc, char **argv)
     int result = render_options_parse("view", argc, argv, &o, view_extra_option, &v);
     if (result)
         return result;
-    if (o.out_png || o.stats_json || o.settle_frames) {
-        fprintf(stderr, "gdr view: --out, --stats and --settle are gdr render's; use --screenshot FILE\n");
+    if (o.out_png || o.stats_json || o.settle_frames || o.warm_up_frames) {
+        fprintf(stderr, "gdr view: --out, --stats, --settle and --warm-up are gdr render's; use --screenshot FILE\n");
         return 2;
     }
     view_app app = {.o = &o, .v = &v};
