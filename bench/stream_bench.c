@@ -216,6 +216,10 @@ int main(int argc, char **argv)
                      "\"first_frame_ms\": %.1f, \"whole_scene_load_ms\": %.1f,\n",
                 budget_mib, upload_mib, (unsigned long long)stats.streaming.pool_bytes, stats.streaming.slot_bytes,
                 stats.streaming.slot_count, t_open, (unsigned long long)open_bytes, t_setup, t_first, t_load);
+        fprintf(out, "    \"setup_steps_ms\": {\"open\": %.1f, \"scene\": %.1f, \"node_counts\": %.1f, "
+                     "\"first_pages\": %.1f},\n",
+                stats.streaming.setup_open_ms, stats.streaming.setup_scene_ms, stats.streaming.setup_node_counts_ms,
+                stats.streaming.setup_first_pages_ms);
         if (whole) {
             print_view(out, "whole_view", &whole_a, ",");
             print_view(out, "whole_jump", &whole_b, ",");

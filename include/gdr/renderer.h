@@ -298,6 +298,11 @@ typedef struct gdr_streaming_stats {
      * once per mesh). */
     uint64_t cluster_record_bytes, hierarchy_bytes, node_count_bytes, page_table_bytes;
     uint64_t source_triangles;
+    /* The set-up's steps, host milliseconds: the open (the paged cache checked against the scene,
+     * the residency and its page graph, the tables, the loader, the pool), the scene's upload with
+     * the frame slots and the rest of the renderer's scene state, the node counts over every
+     * hierarchy, and every mesh's coarsest page read, checked and copied. */
+    double setup_open_ms, setup_scene_ms, setup_node_counts_ms, setup_first_pages_ms;
     char refused[GDR_ERROR_MESSAGE_MAX];          /* the last refused page's message (file, mesh, page, why) */
 } gdr_streaming_stats;
 

@@ -168,7 +168,9 @@ static gdr_status set_scene(gdr_renderer *r, const gdr_scene *scene, const gdr_s
     if (stream && !r->ctx->has_mesh_shader)
         return gdr_error_set(err, GDR_ERROR_UNSUPPORTED, "streaming draws with the mesh pipeline, not available on "
                              "'%s': %s", r->ctx->properties.deviceName, r->ctx->mesh_shader_missing);
+    double start = gdr_now_ms();
     gdr_status status = stream ? gdr_streaming_open(r, scene, stream, err) : GDR_OK;
+    double opened = gdr_now_ms();
     if (status == GDR_OK)
         status = gdr_gpu_scene_upload(r, scene, err);
     if (status == GDR_OK)
@@ -190,6 +192,10 @@ static gdr_status set_scene(gdr_renderer *r, const gdr_scene *scene, const gdr_s
         status = gdr_occlusion_scene_create(r, err);
     if (status == GDR_OK)
         status = gdr_gpu_scene_write_refs(r, err);
+    if (stream) {
+        r->stream.stats.setup_open_ms = opened - start;
+        r->stream.stats.setup_scene_ms = gdr_now_ms() - opened;
+    }
     if (status == GDR_OK && stream)
         status = gdr_streaming_start(r, err);
     if (status == GDR_OK)

@@ -814,8 +814,11 @@ gdr_status gdr_streaming_start(gdr_renderer *r, gdr_error *err)
     gdr_status status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->page_table, 0, absent,
                                              sizeof *absent * g->group_total, err);
     free(absent);
+    double start = gdr_now_ms();
     if (status == GDR_OK)
         status = create_node_counts(r, err);
+    s->stats.setup_node_counts_ms = gdr_now_ms() - start;
+    start = gdr_now_ms();
     gdr_thread_pool_destroy(s->set_up_pool); /* the set-up's last work a mesh at a time */
     s->set_up_pool = NULL;
     count_resident_tables(r);
@@ -849,6 +852,7 @@ gdr_status gdr_streaming_start(gdr_renderer *r, gdr_error *err)
         status = gdr_vk_buffer_upload(r->ctx, &r->staging, &g->meshes, 0, g->cpu_meshes,
                                       sizeof(GdrGpuMesh) * g->mesh_count, err);
     s->meshes_changed = false;
+    s->stats.setup_first_pages_ms = gdr_now_ms() - start;
     for (uint32_t m = 0; status == GDR_OK && m < g->mesh_count; m++)
         if (gdr_residency_page_slot(s->residency, m, 0) == UINT32_MAX && paged_mesh(s, m)->page_count)
             status = gdr_error_set(err, GDR_ERROR_PARSE, "streaming: mesh %u's coarsest page could not be read: %s", m,

@@ -504,7 +504,7 @@ static gdr_scene *read_for_streaming(const char *path);
 
 /* The cluster records of a streamed scene live in the record pool: room for the largest page's
  * records beside each pool slot, so they follow the pool, not the scene (before, a record per
- * cluster of the scene). */
+ * cluster of the scene). The statistics also time the set-up's steps. */
 static void check_record_pool(const gdr_scene *scene, gdr_renderer *r, const char *path)
 {
     gdr_paged_cache *cache = NULL;
@@ -528,6 +528,11 @@ static void check_record_pool(const gdr_scene *scene, gdr_renderer *r, const cha
            (unsigned long long)(clusters * 128u)); /* 128 bytes a record (GdrGpuMeshlet) */
     CHECK(st->cluster_record_bytes == (uint64_t)st->slot_count * largest * 128u);
     CHECK(st->cluster_record_bytes < clusters * 128u);
+    /* The set-up's steps were timed, each a part of what it took. */
+    printf("set-up: open %.2f ms, scene %.2f ms, node counts %.2f ms, first pages %.2f ms\n", st->setup_open_ms,
+           st->setup_scene_ms, st->setup_node_counts_ms, st->setup_first_pages_ms);
+    CHECK(st->setup_open_ms > 0.0 && st->setup_scene_ms > 0.0 && st->setup_node_counts_ms > 0.0 &&
+          st->setup_first_pages_ms > 0.0 && st->setup_first_pages_ms < 60e3);
 }
 
 /* A page whose records disagree with the file's account of its clusters ('CLGR'), every checksum

@@ -204,6 +204,8 @@ void stats_print_streaming(FILE *out, const gdr_streaming_stats *st)
             (double)tables * per_triangle, (double)st->hierarchy_bytes * per_triangle,
             (double)st->node_count_bytes * per_triangle, (double)st->page_table_bytes * per_triangle,
             (unsigned long long)st->cluster_record_bytes);
+    fprintf(out, "streaming set-up    open %.1f ms, scene %.1f ms, node counts %.1f ms, first pages %.1f ms\n",
+            st->setup_open_ms, st->setup_scene_ms, st->setup_node_counts_ms, st->setup_first_pages_ms);
     fprintf(out, "streaming totals    %llu uploads (%llu bytes), %llu evictions, %u pages refused%s%s\n",
             (unsigned long long)st->uploads_total, (unsigned long long)st->upload_bytes_total,
             (unsigned long long)st->evictions_total, st->pages_refused, st->pages_refused ? ": " : "",
@@ -234,7 +236,9 @@ static void add_streaming_json(cJSON *object, const gdr_streaming_stats *st)
         {"loader_queue_depth", st->loader_queue_depth},
         {"cluster_record_bytes", (double)st->cluster_record_bytes}, {"hierarchy_bytes", (double)st->hierarchy_bytes},
         {"node_count_bytes", (double)st->node_count_bytes}, {"page_table_bytes", (double)st->page_table_bytes},
-        {"source_triangles", (double)st->source_triangles}};
+        {"source_triangles", (double)st->source_triangles}, {"setup_open_ms", st->setup_open_ms},
+        {"setup_scene_ms", st->setup_scene_ms}, {"setup_node_counts_ms", st->setup_node_counts_ms},
+        {"setup_first_pages_ms", st->setup_first_pages_ms}};
     for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++)
         cJSON_AddNumberToObject(o, fields[i].name, fields[i].value);
 }
