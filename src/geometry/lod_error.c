@@ -714,6 +714,8 @@ typedef struct probe_state {
     const lod_build *b;
     lod_scratch *s;
     float worst;  /* squared: the largest distance so far (at least the samples' largest) */
+    float checked; /* squared: the largest of the floor (D1) and the bounds the group's own surface settled
+                      (probe_d2) */
     float at_most, below; /* squared: a probe bound at most / below these changes nothing (per probe) */
     int failed;   /* out of memory */
 } probe_state;
@@ -782,26 +784,43 @@ static float walk_bound_d2(probe_state *ps, walk_end *at, gdr_vec3 p, uint32_t *
 
 /* Upper bound (squared) of the distance from p to S0: to the level-0 triangles around the position
  * a walk ends at (the position nearest to p among its neighbours; on a regular surface the triangle
- * nearest to p is among these). Where that bound is more than twice the largest distance so far,
- * the exact distance to the level-0 triangles around the group's samples or around its simplified
- * corners is taken instead (the walk can stop far away on meshes of long thin triangles). *at receives where the walk ended (the
- * next probe of the triangle starts there). */
+ * nearest to p is among these). Where that bound would raise the largest so far and is more than
+ * twice the largest distance checked (D1, or a bound the group's own surface settled), the exact
+ * distance to the level-0 triangles around the simplified triangles' corners is taken, and where
+ * that is still more than twice the largest checked, the smaller of it and the exact distance to
+ * the level-0 triangles around the group's samples, which becomes a distance checked (the walk can
+ * stop far away on meshes of long thin triangles or on a crumpled surface). Only that measure
+ * raises the reference: with the largest bound so far as the reference, each loose bound accepted
+ * raised what the next was compared with, and a chain of them climbed (DamagedHelmet's first-step
+ * groups stated 0.08-0.25 of the radius for a distance of 0.004-0.011: docs/GEOMETRY.md), and the
+ * corners' triangles alone can be as loose. So every bound stated is at most twice a distance
+ * checked. *at receives where the walk ended (the next probe of the triangle starts there). */
 static float probe_d2(probe_state *ps, walk_end *at, gdr_vec3 p, uint32_t *triangle)
 {
     float d = walk_bound_d2(ps, at, p, triangle);
-    if (d <= 4.0f * ps->worst || ps->failed) /* squared: up to twice the largest so far */
+    if (d <= ps->worst || d <= 4.0f * ps->checked || ps->failed) /* squared: raises nothing, or within twice */
         return d;
-    if ((!ps->s->region_built && !build_region(ps->b, ps->s)) || (!ps->s->span_built && !build_span(ps->b, ps->s))) {
+    if (!ps->s->span_built && !build_span(ps->b, ps->s)) {
         ps->failed = 1;
         return d;
     }
-    float exact, spanned;
-    uint32_t nearest = lod_triangle_grid_nearest(&ps->s->region_grid, p, point_triangle_d2, &exact);
+    float exact = INFINITY, spanned;
+    uint32_t nearest = 0;
     uint32_t nearest_spanned = lod_triangle_grid_nearest(&ps->s->span_grid, p, point_triangle_d2, &spanned);
-    if (!(exact < d) && !(spanned < d))
-        return d;
-    *triangle = spanned < exact ? ps->s->span_refs[nearest_spanned] : ps->s->region_refs[nearest];
-    return spanned < exact ? spanned : exact;
+    if (!(spanned <= 4.0f * ps->checked)) {
+        if (!ps->s->region_built && !build_region(ps->b, ps->s)) {
+            ps->failed = 1;
+            return d;
+        }
+        nearest = lod_triangle_grid_nearest(&ps->s->region_grid, p, point_triangle_d2, &exact);
+    }
+    if (exact < d || spanned < d) {
+        *triangle = spanned < exact ? ps->s->span_refs[nearest_spanned] : ps->s->region_refs[nearest];
+        d = spanned < exact ? spanned : exact;
+    }
+    if (exact < INFINITY) /* the group's own surface measured */
+        ps->checked = d > ps->checked ? d : ps->checked;
+    return d;
 }
 
 /* A triangle's coarse probes decide whether it is refined: refined unless its largest is below this
@@ -1015,7 +1034,7 @@ static float probe_shared(probe_state *ps, lod_scratch *s, uint32_t t, int n, in
  * memory. */
 static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor, float cap)
 {
-    probe_state ps = {b, s, floor * floor, 0.0f, 0.0f, 0};
+    probe_state ps = {b, s, floor * floor, floor * floor, 0.0f, 0.0f, 0};
     float cap2 = cap * cap;
     s->region_built = 0;
     s->span_built = 0;
