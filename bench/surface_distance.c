@@ -25,8 +25,9 @@ static dvec sub(dvec a, dvec b) { return (dvec){a.x - b.x, a.y - b.y, a.z - b.z}
 static double dot(dvec a, dvec b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 static dvec mad(dvec a, dvec b, double t) { return (dvec){a.x + b.x * t, a.y + b.y * t, a.z + b.z * t}; }
 
-/* Squared distance from p to triangle abc (closest point by Voronoi region, in double). */
-static double point_triangle_d2(dvec p, dvec a, dvec b, dvec c)
+/* Squared distance from p to triangle abc (closest point by Voronoi region, in double); the
+ * closest point in *closest where not NULL. */
+static double point_triangle_closest(dvec p, dvec a, dvec b, dvec c, dvec *closest)
 {
     dvec ab = sub(b, a), ac = sub(c, a), ap = sub(p, a), q;
     double d1 = dot(ab, ap), d2 = dot(ac, ap);
@@ -50,8 +51,12 @@ static double point_triangle_d2(dvec p, dvec a, dvec b, dvec c)
         q = den > 0 ? mad(mad(a, ab, vb / den), ac, vc / den) : a;
     }
     dvec d = sub(p, q);
+    if (closest)
+        *closest = q;
     return dot(d, d);
 }
+
+static double point_triangle_d2(dvec p, dvec a, dvec b, dvec c) { return point_triangle_closest(p, a, b, c, NULL); }
 
 static int cell_of(const triangle_grid *g, double x, int k)
 {
@@ -151,18 +156,42 @@ void triangle_grid_destroy(triangle_grid *g)
     free(g);
 }
 
-static void visit(const triangle_grid *g, int x, int y, int z, dvec p, double *best)
+static void visit(const triangle_grid *g, int x, int y, int z, dvec p, double *best, uint32_t *nearest)
 {
     size_t c = ((size_t)z * g->dim[1] + y) * g->dim[0] + x;
     for (uint32_t i = g->start[c]; i < g->start[c + 1]; i++) {
         const uint32_t *t = g->s.indices + (size_t)g->items[i] * 3;
         double d = point_triangle_d2(p, dv(g->s.positions[t[0]]), dv(g->s.positions[t[1]]), dv(g->s.positions[t[2]]));
-        *best = d < *best ? d : *best;
+        if (d < *best) {
+            *best = d;
+            *nearest = g->items[i];
+        }
     }
 }
 
-/* Shells of cells around p's cell, until the next shell cannot hold anything nearer. */
+/* The barycentric coordinates of triangle t's point nearest to p. */
+static void closest_barycentric(const triangle_grid *g, uint32_t t, dvec p, double w[3])
+{
+    const uint32_t *i = g->s.indices + (size_t)t * 3;
+    dvec a = dv(g->s.positions[i[0]]), b = dv(g->s.positions[i[1]]), c = dv(g->s.positions[i[2]]), q;
+    point_triangle_closest(p, a, b, c, &q);
+    dvec v0 = sub(b, a), v1 = sub(c, a), v2 = sub(q, a);
+    double d00 = dot(v0, v0), d01 = dot(v0, v1), d11 = dot(v1, v1), d20 = dot(v2, v0), d21 = dot(v2, v1);
+    double den = d00 * d11 - d01 * d01;
+    w[1] = den > 0 ? (d11 * d20 - d01 * d21) / den : 0;
+    w[2] = den > 0 ? (d00 * d21 - d01 * d20) / den : 0;
+    w[0] = 1 - w[1] - w[2];
+}
+
 double triangle_grid_distance(const triangle_grid *g, gdr_vec3 point)
+{
+    uint32_t nearest;
+    double d = triangle_grid_nearest(g, point, &nearest, NULL);
+    return d;
+}
+
+/* Shells of cells around p's cell, until the next shell cannot hold anything nearer. */
+double triangle_grid_nearest(const triangle_grid *g, gdr_vec3 point, uint32_t *nearest, double barycentric[3])
 {
     dvec p = dv(point);
     const double q[3] = {p.x, p.y, p.z};
@@ -179,6 +208,7 @@ double triangle_grid_distance(const triangle_grid *g, gdr_vec3 point)
     int max_r = g->dim[0] > g->dim[1] ? g->dim[0] : g->dim[1];
     max_r = g->dim[2] > max_r ? g->dim[2] : max_r;
     double best = INFINITY;
+    *nearest = UINT32_MAX;
     for (int r = 0; r <= max_r; r++) {
         double reach = (r - 1) * g->cell + outside;
         if (r > 0 && best < INFINITY && reach > 0 && reach * reach >= best)
@@ -192,10 +222,12 @@ double triangle_grid_distance(const triangle_grid *g, gdr_vec3 point)
                 int shell = r == 0 || z == at[2] - r || z == at[2] + r || y == at[1] - r || y == at[1] + r;
                 for (int x = at[0] - r; x <= at[0] + r; x += shell ? 1 : 2 * r)
                     if (x >= 0 && x < g->dim[0])
-                        visit(g, x, y, z, p, &best);
+                        visit(g, x, y, z, p, &best, nearest);
             }
         }
     }
+    if (barycentric && *nearest != UINT32_MAX)
+        closest_barycentric(g, *nearest, p, barycentric);
     return sqrt(best);
 }
 

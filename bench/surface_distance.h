@@ -23,6 +23,9 @@ triangle_grid *triangle_grid_create(surface s);
 void triangle_grid_destroy(triangle_grid *g);
 /* Distance from p to the nearest triangle. */
 double triangle_grid_distance(const triangle_grid *g, gdr_vec3 p);
+/* The same, also naming the nearest triangle (index into the surface's triangles; UINT32_MAX for an
+ * empty surface) and, where barycentric is not NULL, the coordinates of its point nearest to p. */
+double triangle_grid_nearest(const triangle_grid *g, gdr_vec3 p, uint32_t *nearest, double barycentric[3]);
 
 /* The largest distance from samples of `from` to the surface indexed by `to`. Samples: every vertex
  * used, every centroid, and on triangles longer than `spacing` a barycentric grid of about that
