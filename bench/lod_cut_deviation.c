@@ -159,6 +159,49 @@ static surface read_cut(const char *path, gdr_scene **keep)
 
 /* --- calibration ------------------------------------------------------------------------------------ */
 
+/* The cut at mesh-space threshold t with the groups' errors taken from `error` (the root: infinite):
+ * its triangles. */
+static size_t cut_by(const gdr_mesh *m, const double *error, double t, uint32_t *indices)
+{
+    const gdr_mesh_clusters *c = &m->clusters;
+    size_t n = 0;
+    for (uint32_t i = 0; i < c->cluster_count; i++) {
+        const gdr_cluster *k = &c->clusters[i];
+        double refined = k->refined_group == GDR_NO_INDEX ? 0 : error[k->refined_group];
+        double own = k->group == GDR_NO_INDEX || !isfinite(c->groups[k->group].error) ? INFINITY : error[k->group];
+        if (!(refined <= t && !(own <= t)))
+            continue;
+        for (uint32_t j = 0; j < k->triangle_count * 3; j++)
+            indices[n++] = c->vertices[k->vertex_offset + c->triangles[k->triangle_offset + j]];
+    }
+    return n / 3;
+}
+
+/* Cuts by the stated errors and by the measured ones, side by side at mesh-space thresholds: what a
+ * tighter error (in shape, not in scale: the thresholds differ) would gain at equal triangles. */
+static void compare_cuts(const gdr_mesh *m, const triangle_grid *full_grid, const double *tight, double spacing)
+{
+    const gdr_mesh_clusters *c = &m->clusters;
+    double *stated = xmalloc(c->group_count * sizeof *stated);
+    for (uint32_t g = 0; g < c->group_count; g++)
+        stated[g] = c->groups[g].error;
+    size_t total = 0;
+    for (uint32_t i = 0; i < c->cluster_count; i++)
+        total += c->clusters[i].triangle_count * 3u;
+    uint32_t *indices = xmalloc(total * sizeof *indices);
+    printf("\ncuts by the stated errors and by the measured ones (mesh-space thresholds)\n");
+    printf("errors    thresh  triangles  stated   cut->full: max  rms   full->cut: max  rms   normal rms\n");
+    for (int pass = 0; pass < 2; pass++)
+        for (int i = 0; i <= 16; i += 2) {
+            double t = m->bounds.w * pow(10.0, -3.0 + i / 8.0);
+            size_t n = cut_by(m, pass ? tight : stated, t, indices);
+            report(pass ? "measured" : "stated", t / m->bounds.w * 1e4, m, full_grid,
+                   (surface){m->positions, m->vertex_count, indices, n}, m->normals, 0, spacing);
+        }
+    free(indices);
+    free(stated);
+}
+
 static int compare_double(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -212,6 +255,7 @@ static void calibration(const gdr_mesh *m, const triangle_grid *full_grid, doubl
                ratio[n / 10], ratio[n / 2], ratio[n * 9 / 10], ratio[n - 1], sum_stated / n / u, sum_tight / n / u);
     }
     free(ratio);
+    compare_cuts(m, full_grid, tight, spacing);
     free(indices);
     free(own);
     free(tight);
