@@ -142,6 +142,15 @@ static dvec normal_at(const uint32_t *corner, const double w[3])
  * point against the full surface's nearest point. */
 static void measure(const uint32_t *out, size_t triangles, double *normal_rms, double *distance_rms)
 {
+    /* Each full triangle's centroid and the distance to its farthest corner, to skip the far ones. */
+    static dvec centre[TRIANGLES];
+    static double reach[TRIANGLES];
+    for (uint32_t f = 0; f < TRIANGLES; f++) {
+        dvec a = position(indices[f * 3]), b = position(indices[f * 3 + 1]), c = position(indices[f * 3 + 2]);
+        centre[f] = (dvec){(a.x + b.x + c.x) / 3, (a.y + b.y + c.y) / 3, (a.z + b.z + c.z) / 3};
+        reach[f] = sqrt(fmax(dot(sub(a, centre[f]), sub(a, centre[f])),
+                             fmax(dot(sub(b, centre[f]), sub(b, centre[f])), dot(sub(c, centre[f]), sub(c, centre[f])))));
+    }
     const int steps = 4;
     double normal2 = 0, distance2 = 0, total = 0;
     for (size_t t = 0; t < triangles; t++) {
@@ -156,7 +165,9 @@ static void measure(const uint32_t *out, size_t triangles, double *normal_rms, d
                 dvec p = add_scaled(add_scaled(add_scaled((dvec){0, 0, 0}, a, w[0]), b, w[1]), e, w[2]);
                 uint32_t nearest = 0;
                 for (uint32_t f = 0; f < TRIANGLES; f++) {
-                    double fw[3];
+                    double fw[3], far = sqrt(dot(sub(p, centre[f]), sub(p, centre[f]))) - reach[f];
+                    if (far > 0 && far * far >= best) /* the triangle's sphere lies farther than the best */
+                        continue;
                     const uint32_t *g = indices + f * 3;
                     double d = closest(p, position(g[0]), position(g[1]), position(g[2]), fw);
                     if (d < best)
