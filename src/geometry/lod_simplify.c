@@ -31,7 +31,7 @@
  * of |delta n| times the square root of its triangle's area (a surface tilted by that angle over
  * the triangle's size), squared, times NORMAL_WEIGHT. Chosen by measurement (docs/GEOMETRY.md). */
 #define UV_WEIGHT 0.5
-#define NORMAL_WEIGHT 1.0
+#define NORMAL_WEIGHT 0.5
 /* A triangle may turn by at most about 75 degrees in one collapse. */
 #define MIN_NORMAL_COS 0.25
 
