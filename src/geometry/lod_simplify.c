@@ -303,7 +303,7 @@ static double corner_attribute_error(const run *r, const lod_simplify_corner *f,
     if (in->normals) {
         const gdr_vec3 nb = in->normals[mb];
         double dx = f->normal_at_q[0] - nb.x, dy = f->normal_at_q[1] - nb.y, dz = f->normal_at_q[2] - nb.z;
-        error += (dx * dx + dy * dy + dz * dz) * f->area * NORMAL_WEIGHT;
+        error += (dx * dx + dy * dy + dz * dz) * f->area * (in->normal_weight > 0.0 ? in->normal_weight : NORMAL_WEIGHT);
     }
     return error * f->area;
 }

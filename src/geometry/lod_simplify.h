@@ -24,6 +24,7 @@ typedef struct lod_simplify_input {
     const float *positions; /* 3 per position */
     const uint8_t *locked;  /* per position: never moves */
     size_t target_index_count;
+    double normal_weight;   /* the normal term's weight (lod_simplify.c); 0: the default, NORMAL_WEIGHT */
 } lod_simplify_input;
 
 typedef struct lod_simplify_result {
