@@ -10,11 +10,14 @@
 #include "geometry/cluster_bounds.h"
 #include "geometry/lod_internal.h"
 
-/* Below one cluster (the lone cluster of the whole mesh simplified further) the normals weigh as
- * little as they did before they were raised for the scans' shading: such a cluster is drawn for an
- * instance a few pixels across, where its geometric error decides how coarse it may be and no
- * shading is seen (docs/GEOMETRY.md, "Shading at equal triangles"). */
-#define LOD_LONE_NORMAL_WEIGHT 0.1
+/* The normals weigh as little as they did before they were raised for the scans' shading in two
+ * places (docs/GEOMETRY.md, "Shading at equal triangles"): below one cluster (the lone cluster of the
+ * whole mesh simplified further), drawn for an instance a few pixels across, where its geometric
+ * error decides how coarse it may be and no shading is seen; and on a textured mesh, whose
+ * appearance the texture slide guards and whose coarse steps, simplified to keep their normals,
+ * crossed charts with larger slides (100,000 DamagedHelmets 1-3 px across drew 7.5 times the
+ * triangles). */
+#define LOD_LOW_NORMAL_WEIGHT 0.1
 
 /* The smallest float >= x. */
 static float round_up_to_float(double x)
@@ -264,7 +267,8 @@ void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker)
                              .uvs = b->opt.ignore_uvs ? NULL : b->mesh->uvs, .normals = b->mesh->normals, .position_count = position_count,
                              .positions = s->local_positions, .locked = s->position_locked,
                              .target_index_count = target,
-                             .normal_weight = count == 1 && b->frontier_count == 1 ? LOD_LONE_NORMAL_WEIGHT : 0.0};
+                             .normal_weight = (count == 1 && b->frontier_count == 1) || !b->opt.ignore_uvs
+                                                ? LOD_LOW_NORMAL_WEIGHT : 0.0};
     lod_simplify_result out = {0};
     if (b->sloppy) /* a step that formed no group, again as one whole-frontier group (lod_sloppy.c) */
         out.index_count = gdr_lod_simplify_sloppy(s, index_count, local_count);
