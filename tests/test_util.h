@@ -3,6 +3,7 @@
 #define GDR_TEST_UTIL_H
 
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -14,6 +15,17 @@ static int test_failure_count;
     do {                                                                               \
         if (!(cond)) {                                                                 \
             fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond);   \
+            test_failure_count++;                                                      \
+        }                                                                              \
+    } while (0)
+
+/* CHECK with a printf-style message saying what was found. */
+#define CHECK_MSG(cond, ...)                                                           \
+    do {                                                                               \
+        if (!(cond)) {                                                                 \
+            fprintf(stderr, "%s:%d: ", __FILE__, __LINE__);                            \
+            fprintf(stderr, __VA_ARGS__);                                              \
+            fprintf(stderr, "\n");                                                     \
             test_failure_count++;                                                      \
         }                                                                              \
     } while (0)
@@ -82,6 +94,17 @@ static inline float test_random(unsigned *state)
     x ^= x >> 17;
     x ^= x << 5;
     *state = x;
+    return (float)(x >> 8) / 16777216.0f;
+}
+
+/* A deterministic value in [0, 1) from an index (an integer hash), for inputs made per element. */
+static inline float test_hash_unit(uint32_t x)
+{
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    x ^= x >> 16;
     return (float)(x >> 8) / 16777216.0f;
 }
 

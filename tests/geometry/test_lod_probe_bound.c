@@ -23,32 +23,10 @@
 #include "geometry/lod_grid.h"
 #include "geometry/lod_internal.h"
 #include "point_distance.h"
+#include "test_util.h"
 
 #define QUADS 120
 #define MAX_RATIO 2.5
-
-static int failures;
-
-#define CHECK(cond, ...)                                                                                       \
-    do {                                                                                                       \
-        if (!(cond)) {                                                                                         \
-            fprintf(stderr, "test_lod_probe_bound: %s:%d: ", __FILE__, __LINE__);                              \
-            fprintf(stderr, __VA_ARGS__);                                                                      \
-            fprintf(stderr, "\n");                                                                             \
-            failures++;                                                                                        \
-        }                                                                                                      \
-    } while (0)
-
-/* A deterministic value in [-1, 1) from an index. */
-static float hash11(uint32_t x)
-{
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return (float)(x >> 8) / 8388608.0f - 1.0f;
-}
 
 /* A unit square of QUADS x QUADS quads, jittered in the plane and folded by a wave whose crests
  * wander: folds a few quads apart, which a group's simplified triangles span. */
@@ -58,8 +36,8 @@ static void crumpled_sheet(gdr_vec3 *p, uint32_t *idx)
         for (uint32_t x = 0; x <= QUADS; x++) {
             uint32_t i = y * (QUADS + 1) + x;
             float u = (float)x / QUADS, v = (float)y / QUADS;
-            p[i] = (gdr_vec3){u + 0.004f * hash11(2 * i), v + 0.004f * hash11(2 * i + 1),
-                              0.05f * sinf(40.0f * u + 7.0f * sinf(9.0f * v))};
+            float du = 2.0f * test_hash_unit(2 * i) - 1.0f, dv = 2.0f * test_hash_unit(2 * i + 1) - 1.0f;
+            p[i] = (gdr_vec3){u + 0.004f * du, v + 0.004f * dv, 0.05f * sinf(40.0f * u + 7.0f * sinf(9.0f * v))};
         }
     uint32_t k = 0;
     for (uint32_t y = 0; y < QUADS; y++)
@@ -159,13 +137,11 @@ int main(void)
     printf("crumpled sheet of %u triangles: %u groups, deviation at most %.3fx the larger of D1 and the distance "
            "measured, %u below it\n",
            QUADS * QUADS * 2, k.groups, k.worst_ratio, k.under);
-    CHECK(k.groups > 10, "only %u groups formed", k.groups);
-    CHECK(k.under == 0, "%u groups state less than their measured distance to full detail", k.under);
-    CHECK(k.worst_ratio <= MAX_RATIO, "a group states %.3fx the larger of D1 and its measured distance",
+    CHECK_MSG(k.groups > 10, "only %u groups formed", k.groups);
+    CHECK_MSG(k.under == 0, "%u groups state less than their measured distance to full detail", k.under);
+    CHECK_MSG(k.worst_ratio <= MAX_RATIO, "a group states %.3fx the larger of D1 and its measured distance",
           k.worst_ratio);
     lod_triangle_grid_free(&k.full);
     gdr_scene_destroy(s);
-    if (failures)
-        fprintf(stderr, "test_lod_probe_bound: %d failure(s)\n", failures);
-    return failures != 0;
+    return test_finish("test_lod_probe_bound");
 }

@@ -12,23 +12,12 @@
 #include <stdlib.h>
 
 #include "geometry/lod_simplify.h"
+#include "test_util.h"
 
 #define RINGS 40    /* latitude rings, poles excluded: RINGS - 1 rings of vertices */
 #define SEGMENTS 64 /* longitude */
 #define POSITIONS ((RINGS - 1) * SEGMENTS + 2)
 #define TRIANGLES ((RINGS - 2) * SEGMENTS * 2 + 2 * SEGMENTS)
-
-static int failures;
-
-#define CHECK(cond, ...)                                                                                       \
-    do {                                                                                                       \
-        if (!(cond)) {                                                                                         \
-            fprintf(stderr, "test_lod_shading: %s:%d: ", __FILE__, __LINE__);                                  \
-            fprintf(stderr, __VA_ARGS__);                                                                      \
-            fprintf(stderr, "\n");                                                                             \
-            failures++;                                                                                        \
-        }                                                                                                      \
-    } while (0)
 
 typedef struct dvec {
     double x, y, z;
@@ -42,17 +31,6 @@ static dvec normalize(dvec a)
 {
     double l = sqrt(dot(a, a));
     return l > 0 ? (dvec){a.x / l, a.y / l, a.z / l} : a;
-}
-
-/* A deterministic value in [-1, 1) from an index. */
-static double noise(uint32_t x)
-{
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return (double)(x >> 8) / 8388608.0 - 1.0;
 }
 
 static float positions[POSITIONS * 3];
@@ -70,7 +48,8 @@ static void build_surface(void)
         double phi = 2 * pi * (double)(p % SEGMENTS) / SEGMENTS;
         dvec d = {sin(theta) * cos(phi), sin(theta) * sin(phi), cos(theta)};
         /* A few broad bumps and a scanner's roughness. */
-        double r = 1.0 + 0.04 * sin(3 * theta) * cos(2 * phi) + 0.03 * sin(5 * phi + theta) + 0.004 * noise(p);
+        double rough = 2.0 * test_hash_unit(p) - 1.0;
+        double r = 1.0 + 0.04 * sin(3 * theta) * cos(2 * phi) + 0.03 * sin(5 * phi + theta) + 0.004 * rough;
         positions[p * 3] = (float)(d.x * r), positions[p * 3 + 1] = (float)(d.y * r);
         positions[p * 3 + 2] = (float)(d.z * r);
     }
@@ -203,19 +182,17 @@ int main(void)
                                  .target_index_count = TRIANGLES * 3 / levels[l].divisor};
         lod_simplify_scratch scratch = {0};
         lod_simplify_result result;
-        CHECK(lod_simplify(&scratch, &in, out, &result), "out of memory");
+        CHECK_MSG(lod_simplify(&scratch, &in, out, &result), "out of memory");
         size_t kept = result.index_count / 3;
-        CHECK(kept * levels[l].divisor <= TRIANGLES * 11 / 10, "1/%u: kept %zu of %u triangles",
+        CHECK_MSG(kept * levels[l].divisor <= TRIANGLES * 11 / 10, "1/%u: kept %zu of %u triangles",
               levels[l].divisor, kept, TRIANGLES);
         double normal_rms, distance_rms;
         measure(out, kept, &normal_rms, &distance_rms);
         printf("test_lod_shading: %u -> %zu triangles, normals %.4f rms, distance %.5f rms\n", TRIANGLES, kept,
                normal_rms, distance_rms);
-        CHECK(normal_rms <= levels[l].normal_rms, "1/%u: the normals deviate %.4f rms (at most %.3f)",
+        CHECK_MSG(normal_rms <= levels[l].normal_rms, "1/%u: the normals deviate %.4f rms (at most %.3f)",
               levels[l].divisor, normal_rms, levels[l].normal_rms);
         lod_simplify_scratch_free(&scratch);
     }
-    if (failures)
-        fprintf(stderr, "test_lod_shading: %d failure(s)\n", failures);
-    return failures ? 1 : 0;
+    return test_finish("test_lod_shading");
 }

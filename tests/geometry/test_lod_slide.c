@@ -9,33 +9,11 @@
 #include <stdlib.h>
 
 #include "geometry/lod_simplify.h"
+#include "test_util.h"
 
 #define QUADS 12
 #define POSITIONS ((QUADS + 1) * (QUADS + 1))
 #define TRIANGLES (QUADS * QUADS * 2)
-
-static int failures;
-
-#define CHECK(cond, ...)                                                                                       \
-    do {                                                                                                       \
-        if (!(cond)) {                                                                                         \
-            fprintf(stderr, "test_lod_slide: %s:%d: ", __FILE__, __LINE__);                                    \
-            fprintf(stderr, __VA_ARGS__);                                                                      \
-            fprintf(stderr, "\n");                                                                             \
-            failures++;                                                                                        \
-        }                                                                                                      \
-    } while (0)
-
-/* A deterministic value in [0, 1) from an index. */
-static float hash01(uint32_t x)
-{
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return (float)(x >> 8) / 16777216.0f;
-}
 
 static float edge_length(const float *positions, uint32_t a, uint32_t b)
 {
@@ -68,7 +46,7 @@ int main(void)
             uint32_t p00 = y * (QUADS + 1) + x, p10 = p00 + 1, p01 = p00 + QUADS + 1, p11 = p01 + 1;
             uint32_t tris[2][3] = {{p00, p10, p11}, {p00, p11, p01}};
             for (int t = 0; t < 2; t++) {
-                float ox = 1000.0f * hash01(w), oy = 1000.0f * hash01(w + 7777u);
+                float ox = 1000.0f * test_hash_unit(w), oy = 1000.0f * test_hash_unit(w + 7777u);
                 for (int k = 0; k < 3; k++, w++) {
                     const float *p = positions + tris[t][k] * 3;
                     indices[w] = w;
@@ -85,9 +63,9 @@ int main(void)
                              .locked = locked, .target_index_count = TRIANGLES * 3 / 4};
     lod_simplify_scratch scratch = {0};
     lod_simplify_result result;
-    CHECK(lod_simplify(&scratch, &in, out, &result), "out of memory");
+    CHECK_MSG(lod_simplify(&scratch, &in, out, &result), "out of memory");
     size_t kept = result.index_count / 3;
-    CHECK(kept < TRIANGLES / 2, "simplified %zu of %u triangles only", kept, TRIANGLES);
+    CHECK_MSG(kept < TRIANGLES / 2, "simplified %zu of %u triangles only", kept, TRIANGLES);
     float longest = 0.0f;
     for (size_t t = 0; t < kept; t++)
         for (int k = 0; k < 3; k++) {
@@ -95,13 +73,11 @@ int main(void)
                                   vertex_position[out[t * 3 + (size_t)(k + 1) % 3]]);
             longest = e > longest ? e : longest;
         }
-    CHECK(result.slide > 0.0f, "no slide stated, though every collapse crossed charts");
-    CHECK(result.slide <= longest, "slide %g is above the longest output edge %g", (double)result.slide,
+    CHECK_MSG(result.slide > 0.0f, "no slide stated, though every collapse crossed charts");
+    CHECK_MSG(result.slide <= longest, "slide %g is above the longest output edge %g", (double)result.slide,
           (double)longest);
     printf("test_lod_slide: %u -> %zu triangles, slide %.4f, longest output edge %.4f\n", TRIANGLES, kept,
            (double)result.slide, (double)longest);
     lod_simplify_scratch_free(&scratch);
-    if (failures)
-        fprintf(stderr, "test_lod_slide: %d failure(s)\n", failures);
-    return failures ? 1 : 0;
+    return test_finish("test_lod_slide");
 }
