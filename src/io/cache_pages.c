@@ -542,8 +542,9 @@ static gdr_status read_groups(const char *name, reader *r, uint32_t m, gdr_paged
     return GDR_OK;
 }
 
-/* The page order is a permutation of the groups, the first group the root (infinite error), and
- * every edge goes to a deeper group (so the DAG has no cycle). */
+/* The page order is a permutation of the groups, the first group the root (infinite error), the
+ * groups' parent lists do not overlap, and every edge goes to a deeper group (so the DAG has no
+ * cycle). */
 static gdr_status check_order_and_edges(const char *name, uint32_t m, const gdr_paged_mesh *pm, gdr_error *err)
 {
     uint8_t *seen = calloc(pm->group_count, 1);
@@ -561,6 +562,14 @@ static gdr_status check_order_and_edges(const char *name, uint32_t m, const gdr_
     free(seen);
     if (status == GDR_OK && !isinf(pm->groups[pm->page_groups[0]].error))
         status = PAGE_ERR("%s: section 'PAGE': mesh %u: page 0 does not start with the root group", name, m);
+    /* Each edge belongs to one group: lists that overlap would make readers that gather them per
+     * page (the residency's page graph) write more than the mesh's edges. */
+    uint64_t listed = 0;
+    for (uint32_t g = 0; g < pm->group_count; g++)
+        listed += pm->groups[g].parent_count;
+    if (status == GDR_OK && listed > pm->parent_count)
+        status = PAGE_ERR("%s: section 'PAGE': mesh %u: its groups list %llu parent edges, the index holds %u "
+                          "(lists overlap)", name, m, (unsigned long long)listed, pm->parent_count);
     for (uint32_t g = 0; g < pm->group_count && status == GDR_OK; g++)
         for (uint32_t e = pm->groups[g].parent_first; e < pm->groups[g].parent_first + pm->groups[g].parent_count; e++)
             if (pm->parents[e] >= pm->group_count || pm->groups[pm->parents[e]].depth <= pm->groups[g].depth)
