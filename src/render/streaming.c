@@ -762,6 +762,7 @@ gdr_status gdr_streaming_begin_frame(gdr_renderer *r, gdr_frame_slot *slot, gdr_
     return status;
 }
 
+/* The node counts over the scene's hierarchies, every group absent (as the page table starts). */
 static gdr_status create_node_counts(gdr_renderer *r, gdr_error *err)
 {
     gdr_streaming *s = &r->stream;
