@@ -153,6 +153,8 @@ static surface read_cut(const char *path, gdr_scene **keep)
     gdr_import_options o = {.no_progress = 1};
     if (gdr_import_obj(path, &o, keep, NULL, &err) != GDR_OK)
         die(path, err.message);
+    if ((*keep)->mesh_count == 0 || (*keep)->meshes[0].index_count < 3)
+        die(path, "holds no triangles");
     const gdr_mesh *m = &(*keep)->meshes[0];
     return (surface){m->positions, m->vertex_count, m->indices, m->index_count / 3};
 }
@@ -261,6 +263,20 @@ static void calibration(const gdr_mesh *m, const triangle_grid *full_grid, doubl
     free(tight);
 }
 
+/* Whether `list` is pixel thresholds above 0 separated by commas. */
+static int thresholds_valid(const char *list)
+{
+    for (const char *t = list;;) {
+        char *end;
+        double px = strtod(t, &end);
+        if (end == t || (*end && *end != ',') || !(px > 0.0 && px <= 1e6))
+            return 0;
+        if (!*end)
+            return 1;
+        t = end + 1;
+    }
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 3) {
@@ -279,18 +295,26 @@ int main(int argc, char **argv)
             with_calibration = 1;
         else if (!strcmp(argv[i], "--thresholds") && i + 1 < argc)
             thresholds = argv[++i];
-        else if (!strcmp(argv[i], "--height") && i + 1 < argc)
-            height = (float)atof(argv[++i]);
+        else if (!strcmp(argv[i], "--height") && i + 1 < argc) {
+            char *end;
+            height = strtof(argv[++i], &end);
+            if (end == argv[i] || *end || !(height >= 1.0f && height <= 16384.0f))
+                die(argv[i], "--height: expected a number of pixels in [1, 16384]");
+        }
         else if (!strcmp(argv[i], "--ref") && i + 1 < argc)
             i++;
         else {
             fprintf(stderr, "lod_cut_deviation: %s: unknown option\n", argv[i]);
             return 2;
         }
+    if (!thresholds_valid(thresholds))
+        die(thresholds, "--thresholds: expected pixel thresholds above 0, separated by commas");
     gdr_scene *scene = NULL;
     gdr_error err = {0};
     if (gdr_import_file(argv[1], &(gdr_import_options){.no_progress = 1}, &scene, NULL, &err) != GDR_OK)
         die(argv[1], err.message);
+    if (scene->mesh_count == 0 || scene->meshes[0].index_count < 3)
+        die(argv[1], "holds no triangles");
     const gdr_mesh *m = &scene->meshes[0];
     surface full = {m->positions, m->vertex_count, m->indices, m->index_count / 3};
     triangle_grid *full_grid = triangle_grid_create(full);
@@ -319,10 +343,11 @@ int main(int argc, char **argv)
     }
     for (int i = 3; i + 1 < argc; i++)
         if (!strcmp(argv[i], "--ref")) {
-            double px = atof(argv[++i]);
+            char *end;
+            double px = strtod(argv[++i], &end);
             const char *path = strchr(argv[i], '=');
-            if (!path)
-                die(argv[i], "expected T=FILE.obj");
+            if (!path || end != path || !(px > 0.0 && px <= 1e6))
+                die(argv[i], "--ref: expected T=FILE.obj, T a pixel threshold above 0");
             gdr_scene *keep = NULL;
             surface s = read_cut(path + 1, &keep);
             report("reference", px, m, full_grid, s, keep->meshes[0].normals, 0, spacing);
