@@ -18,7 +18,8 @@ typedef struct gdr_page_result {
 
 typedef struct gdr_page_loader gdr_page_loader;
 
-#define GDR_PAGE_LOADER_MAX_THREADS 8
+/* Decoding, not reading, limits a worker (docs/STREAMING.md): a large machine's cores all help. */
+#define GDR_PAGE_LOADER_MAX_THREADS 32
 
 /* `threads` workers (0: one per processor but one, at most GDR_PAGE_LOADER_MAX_THREADS). */
 gdr_status gdr_page_loader_create(gdr_paged_cache *cache, uint32_t threads, gdr_page_loader **out, gdr_error *err);
