@@ -277,6 +277,24 @@ static int thresholds_valid(const char *list)
     }
 }
 
+/* Each --ref T=FILE.obj of the command line: another builder's cut, reported beside gdr's. */
+static void report_references(int argc, char **argv, const gdr_mesh *m, const triangle_grid *full_grid,
+                              double spacing)
+{
+    for (int i = 3; i + 1 < argc; i++)
+        if (!strcmp(argv[i], "--ref")) {
+            char *end;
+            double px = strtod(argv[++i], &end);
+            const char *path = strchr(argv[i], '=');
+            if (!path || end != path || !(px > 0.0 && px <= 1e6))
+                die(argv[i], "--ref: expected T=FILE.obj, T a pixel threshold above 0");
+            gdr_scene *keep = NULL;
+            surface s = read_cut(path + 1, &keep);
+            report("reference", px, m, full_grid, s, keep->meshes[0].normals, 0, spacing);
+            gdr_scene_destroy(keep);
+        }
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 3) {
@@ -341,18 +359,7 @@ int main(int argc, char **argv)
         report("gdr", px, m, full_grid, (surface){m->positions, m->vertex_count, indices, n}, m->normals, stated, spacing);
         t = *end == ',' ? end + 1 : end;
     }
-    for (int i = 3; i + 1 < argc; i++)
-        if (!strcmp(argv[i], "--ref")) {
-            char *end;
-            double px = strtod(argv[++i], &end);
-            const char *path = strchr(argv[i], '=');
-            if (!path || end != path || !(px > 0.0 && px <= 1e6))
-                die(argv[i], "--ref: expected T=FILE.obj, T a pixel threshold above 0");
-            gdr_scene *keep = NULL;
-            surface s = read_cut(path + 1, &keep);
-            report("reference", px, m, full_grid, s, keep->meshes[0].normals, 0, spacing);
-            gdr_scene_destroy(keep);
-        }
+    report_references(argc, argv, m, full_grid, spacing);
     if (with_calibration)
         calibration(m, full_grid, spacing);
     triangle_grid_destroy(full_grid);

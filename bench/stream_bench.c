@@ -150,6 +150,38 @@ static int run_whole(const bench_options *o, const gdr_frame_desc *frame, const 
     return ok;
 }
 
+/* What a run measured: the open (ms, bytes read), the set-up, the first frame after the open's
+ * start, the whole scene's load (with --whole), the first streamed frame's figures and the views. */
+typedef struct bench_results {
+    double open_ms, setup_ms, first_frame_ms, load_ms;
+    uint64_t open_bytes;
+    gdr_frame_stats stats;
+    view_result whole_a, whole_b, near, far;
+} bench_results;
+
+static void print_results(FILE *out, const bench_options *o, const bench_results *res)
+{
+    const gdr_frame_stats *stats = &res->stats;
+    const gdr_streaming_stats *st = &stats->streaming;
+    fprintf(out, "{\n    \"scene\": \"%s\", \"device\": \"%s\", \"driver\": \"%s\", \"width\": %u, \"height\": %u,\n",
+            o->path, stats->device, stats->driver, o->width, o->height);
+    fprintf(out, "    \"budget_mib\": %u, \"upload_mib\": %u, \"pool_bytes\": %llu, \"slot_bytes\": %u, "
+                 "\"slots\": %u,\n    \"open_ms\": %.1f, \"open_bytes\": %llu, \"streamed_setup_ms\": %.1f, "
+                 "\"first_frame_ms\": %.1f, \"whole_scene_load_ms\": %.1f,\n",
+            o->budget_mib, o->upload_mib, (unsigned long long)st->pool_bytes, st->slot_bytes, st->slot_count,
+            res->open_ms, (unsigned long long)res->open_bytes, res->setup_ms, res->first_frame_ms, res->load_ms);
+    fprintf(out, "    \"setup_steps_ms\": {\"open\": %.1f, \"scene\": %.1f, \"node_counts\": %.1f, "
+                 "\"first_pages\": %.1f},\n",
+            st->setup_open_ms, st->setup_scene_ms, st->setup_node_counts_ms, st->setup_first_pages_ms);
+    if (o->whole) {
+        print_view(out, "whole_view", &res->whole_a, ",");
+        print_view(out, "whole_jump", &res->whole_b, ",");
+    }
+    print_view(out, "streamed_view", &res->near, ",");
+    print_view(out, "streamed_jump", &res->far, "");
+    fprintf(out, "}\n");
+}
+
 int main(int argc, char **argv)
 {
     bench_options o;
@@ -157,18 +189,16 @@ int main(int argc, char **argv)
     if (usage)
         return usage;
     const char *path = o.path, *json = o.json;
-    uint32_t budget_mib = o.budget_mib, upload_mib = o.upload_mib, width = o.width, height = o.height;
-    int whole = o.whole;
+    bench_results res = {0};
     gdr_error err = {0};
     gdr_scene *scene = NULL;
     /* The open: the cache without the geometry its pages hold. */
-    uint64_t open_bytes = 0;
     double t_open = now_ms();
-    if (gdr_cache_read_for_streaming(path, NULL, &scene, NULL, &open_bytes, &err) != GDR_OK) {
+    if (gdr_cache_read_for_streaming(path, NULL, &scene, NULL, &res.open_bytes, &err) != GDR_OK) {
         fprintf(stderr, "stream_bench: %s\n", err.message);
         return 1;
     }
-    t_open = now_ms() - t_open;
+    res.open_ms = now_ms() - t_open;
     /* View A: the scene's camera; view B: the jump to the far side, looking back. */
     gdr_camera a = scene->camera_count ? scene->cameras[0] : gdr_scene_framing_camera(scene);
     float centre_z = 0.0f;
@@ -181,53 +211,32 @@ int main(int argc, char **argv)
     gdr_frame_desc jump = frame;
     jump.camera = b;
 
-    gdr_renderer_desc desc = {.width = width, .height = height};
+    gdr_renderer_desc desc = {.width = o.width, .height = o.height};
     gdr_renderer *r = NULL;
-    view_result whole_a = {0}, whole_b = {0}, near = {0}, far = {0};
-    gdr_frame_stats stats = {0};
     gdr_paged_cache *paged = NULL;
-    gdr_streaming_desc stream = {.cache = NULL, .geometry_budget_bytes = (uint64_t)budget_mib << 20,
-                                 .upload_budget_bytes = (uint64_t)upload_mib << 20};
-    double t_setup = 0, t_first = 0, t_load = 0;
+    gdr_streaming_desc stream = {.cache = NULL, .geometry_budget_bytes = (uint64_t)o.budget_mib << 20,
+                                 .upload_budget_bytes = (uint64_t)o.upload_mib << 20};
     int ok = gdr_renderer_create(&desc, &r, &err) == GDR_OK;
     if (ok) {
         double t0 = now_ms();
         ok = gdr_paged_cache_open(path, &paged, &err) == GDR_OK;
         stream.cache = paged;
         ok = ok && gdr_renderer_set_scene_streamed(r, scene, &stream, &err) == GDR_OK;
-        t_setup = now_ms() - t0;
-        ok = ok && gdr_renderer_render(r, &frame, 1, &stats, &err) == GDR_OK;
-        t_first = t_open + now_ms() - t0; /* from the open's start */
-        ok = ok && converge(r, &frame, &near) && converge(r, &jump, &far);
+        res.setup_ms = now_ms() - t0;
+        ok = ok && gdr_renderer_render(r, &frame, 1, &res.stats, &err) == GDR_OK;
+        res.first_frame_ms = res.open_ms + now_ms() - t0; /* from the open's start */
+        ok = ok && converge(r, &frame, &res.near) && converge(r, &jump, &res.far);
     }
     if (!ok)
         fprintf(stderr, "stream_bench: streamed: %s\n", err.message);
     gdr_renderer_destroy(r);
     gdr_paged_cache_close(paged);
     /* The whole upload after the streamed run, whose frames have brought the GPU's clocks up. */
-    if (ok && whole)
-        ok = run_whole(&o, &frame, &jump, &whole_a, &whole_b, &t_load);
+    if (ok && o.whole)
+        ok = run_whole(&o, &frame, &jump, &res.whole_a, &res.whole_b, &res.load_ms);
     FILE *out = json ? fopen(json, "w") : stdout;
-    if (ok && out) {
-        fprintf(out, "{\n    \"scene\": \"%s\", \"device\": \"%s\", \"driver\": \"%s\", \"width\": %u, \"height\": %u,\n",
-                path, stats.device, stats.driver, width, height);
-        fprintf(out, "    \"budget_mib\": %u, \"upload_mib\": %u, \"pool_bytes\": %llu, \"slot_bytes\": %u, "
-                     "\"slots\": %u,\n    \"open_ms\": %.1f, \"open_bytes\": %llu, \"streamed_setup_ms\": %.1f, "
-                     "\"first_frame_ms\": %.1f, \"whole_scene_load_ms\": %.1f,\n",
-                budget_mib, upload_mib, (unsigned long long)stats.streaming.pool_bytes, stats.streaming.slot_bytes,
-                stats.streaming.slot_count, t_open, (unsigned long long)open_bytes, t_setup, t_first, t_load);
-        fprintf(out, "    \"setup_steps_ms\": {\"open\": %.1f, \"scene\": %.1f, \"node_counts\": %.1f, "
-                     "\"first_pages\": %.1f},\n",
-                stats.streaming.setup_open_ms, stats.streaming.setup_scene_ms, stats.streaming.setup_node_counts_ms,
-                stats.streaming.setup_first_pages_ms);
-        if (whole) {
-            print_view(out, "whole_view", &whole_a, ",");
-            print_view(out, "whole_jump", &whole_b, ",");
-        }
-        print_view(out, "streamed_view", &near, ",");
-        print_view(out, "streamed_jump", &far, "");
-        fprintf(out, "}\n");
-    }
+    if (ok && out)
+        print_results(out, &o, &res);
     if (out && out != stdout)
         fclose(out);
     gdr_scene_destroy(scene);

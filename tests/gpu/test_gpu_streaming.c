@@ -234,6 +234,19 @@ static void check_budgets(const gdr_frame_stats *stats, uint64_t budget)
     CHECK(stats->streaming.requests_dropped == 0);
 }
 
+/* Twenty frames of `frame` from a renderer whose cache was damaged: each within the budgets, each
+ * cut checked against the history (started here; the caller frees it), the last one's figures in
+ * *stats. Stops at the first frame that fails. */
+static void draw_after_damage(const gdr_scene *scene, gdr_renderer *r, const gdr_frame_desc *frame, uint64_t budget,
+                              gdr_frame_stats *stats, frame_check *check)
+{
+    uint8_t *image = malloc(WIDTH * HEIGHT * 4);
+    history_init(scene, check);
+    for (uint32_t i = 0; r && image && i < 20 && draw(scene, r, frame, image, stats, check); i++)
+        check_budgets(stats, budget);
+    free(image);
+}
+
 /* The pool bytes of every page together; *slot receives a slot's size (the largest page's, rounded
  * up to 256 bytes as the residency does). */
 static uint64_t pool_bytes(const char *path, uint64_t *slot)
@@ -396,12 +409,10 @@ static void damaged_page(const gdr_scene *scene, const gdr_scene *paged, const c
 
     gdr_renderer *r = streamed_renderer(paged, path, budget);
     CHECK(r != NULL);
-    uint8_t *image = malloc(WIDTH * HEIGHT * 4), *resident = malloc(c->group_count);
+    uint8_t *resident = malloc(c->group_count);
     gdr_frame_stats stats = {0};
     frame_check check;
-    history_init(scene, &check);
-    for (uint32_t i = 0; r && image && i < 20 && draw(scene, r, &frame, image, &stats, &check); i++)
-        check_budgets(&stats, budget);
+    draw_after_damage(scene, r, &frame, budget, &stats, &check);
     char expected[64];
     snprintf(expected, sizeof expected, "mesh %u page %u", mesh, page);
     printf("damaged page %u of mesh %u (group %u): %u refused, \"%s\"\n", page, mesh, group,
@@ -411,7 +422,7 @@ static void damaged_page(const gdr_scene *scene, const gdr_scene *paged, const c
     CHECK(r && resident && gdr_renderer_read_residency(r, mesh, resident, &err) == GDR_OK && !resident[group]);
     CHECK(!check.full && check.drawn > 0 && check.evicted_in_use == 0);
     history_free(&check);
-    free(image), free(resident);
+    free(resident);
     gdr_renderer_destroy(r);
 }
 
@@ -566,13 +577,10 @@ static void damaged_records(gdr_scene *scene, const char *path, uint64_t budget)
     gdr_scene *paged = read_for_streaming(copy);
     gdr_renderer *r = paged ? streamed_renderer(paged, copy, budget) : NULL;
     CHECK(r != NULL);
-    uint8_t *image = malloc(WIDTH * HEIGHT * 4);
     gdr_frame_desc frame = view_frame(0);
     gdr_frame_stats stats = {0};
     frame_check check;
-    history_init(scene, &check);
-    for (uint32_t i = 0; r && image && i < 20 && draw(scene, r, &frame, image, &stats, &check); i++)
-        check_budgets(&stats, budget);
+    draw_after_damage(scene, r, &frame, budget, &stats, &check);
     char expected[64];
     snprintf(expected, sizeof expected, "mesh %u page %u: ", mesh, page);
     printf("damaged records in page %u of mesh %u (group %u, cluster %u): %u refused, \"%s\"\n", page, mesh, group,
@@ -581,7 +589,6 @@ static void damaged_records(gdr_scene *scene, const char *path, uint64_t budget)
           strstr(stats.streaming.refused, expected) && strstr(stats.streaming.refused, "refined groups"));
     CHECK(check.drawn > 0 && check.evicted_in_use == 0);
     history_free(&check);
-    free(image);
     gdr_renderer_destroy(r);
     gdr_scene_destroy(paged);
     unlink(copy);
@@ -609,20 +616,16 @@ static void truncated_while_streaming(const gdr_scene *scene, const gdr_scene *p
     CHECK(r != NULL && size > 0);
     /* The last pages hold the finest groups: half of the page data goes. */
     CHECK(r && truncate(copy, size - size / 8) == 0);
-    uint8_t *image = malloc(WIDTH * HEIGHT * 4);
     gdr_frame_stats stats = {0};
     frame_check check;
-    history_init(scene, &check);
     gdr_frame_desc frame = view_frame(1);
-    for (uint32_t i = 0; r && image && i < 20 && draw(scene, r, &frame, image, &stats, &check); i++)
-        check_budgets(&stats, budget);
+    draw_after_damage(scene, r, &frame, budget, &stats, &check);
     printf("file cut short while streaming: %u pages refused, \"%s\"\n", stats.streaming.pages_refused,
            stats.streaming.refused);
     CHECK(stats.streaming.pages_refused >= 1 && strstr(stats.streaming.refused, copy) &&
           strstr(stats.streaming.refused, " page "));
     CHECK(check.drawn > 0 && check.evicted_in_use == 0);
     history_free(&check);
-    free(image);
     gdr_renderer_destroy(r);
     unlink(copy);
 }
