@@ -65,123 +65,168 @@ static int build_paged(const char *input, const char *output, uint32_t page_byte
     return 0;
 }
 
-int gdr_cmd_build(int argc, char **argv)
+/* The command line of gdr build. */
+typedef struct build_options {
+    const char *input, *output;
+    int no_progress, pvs_wanted, allow_outside_files, whole_geometry, help;
+    uint32_t page_bytes, pvs_samples, threads;
+    float pvs_cell;
+    gdr_budget budget;
+    cli_warnings warnings;
+} build_options;
+
+/* --pages=KIB; false after printing why the size is refused. */
+static bool parse_page_size(const char *kib_text, uint32_t *page_bytes)
 {
-    const char *input = NULL, *output = NULL;
-    int no_progress = 0, pvs_wanted = 0, allow_outside_files = 0, whole_geometry = 0;
-    uint32_t page_bytes = 0, pvs_samples = 0, threads = 0;
-    float pvs_cell = 0.0f;
-    gdr_budget budget = {0};
-    cli_warnings warnings = {0};
-    for (int i = 1; i < argc; i++) {
-        if ((strcmp(argv[i], "-o") == 0 || strcmp(argv[i], "--out") == 0) && i + 1 < argc) {
-            output = argv[++i];
-        } else if (strcmp(argv[i], "--no-progress") == 0) {
-            no_progress = 1;
-        } else if (strcmp(argv[i], "--strict") == 0) {
-            warnings.strict = true;
-        } else if (strcmp(argv[i], "--pvs") == 0) {
-            if (!cli_needs_cull(argv[i]))
-                return 2;
-            pvs_wanted = 1;
-        } else if (strcmp(argv[i], "--pvs-cell") == 0 && i + 1 < argc) {
-            if (!cli_needs_cull(argv[i]) || !cli_parse_float(argv[i], argv[i + 1], 0.01f, 1e6f, &pvs_cell))
-                return 2;
-            pvs_wanted = 1;
-            i++;
-        } else if (strcmp(argv[i], "--pvs-samples") == 0 && i + 1 < argc) {
-            if (!cli_needs_cull(argv[i]) || !cli_parse_u32(argv[i], argv[i + 1], 1, 4096, &pvs_samples))
-                return 2;
-            pvs_wanted = 1;
-            i++;
-        } else if (strcmp(argv[i], "--pages") == 0) {
-            page_bytes = GDR_PAGE_BYTES_DEFAULT;
-        } else if (strncmp(argv[i], "--pages=", 8) == 0) {
-            char *end;
-            unsigned long kib = strtoul(argv[i] + 8, &end, 10);
-            if (*end || end == argv[i] + 8 || argv[i][8] == '-' || kib < GDR_PAGE_BYTES_MIN / 1024 ||
-                kib > GDR_PAGE_BYTES_MAX / 1024) {
-                fprintf(stderr, "gdr: build: --pages=%s: expected kibibytes in [%u, %u]\n", argv[i] + 8,
-                        GDR_PAGE_BYTES_MIN / 1024, GDR_PAGE_BYTES_MAX / 1024);
-                return 2;
-            }
-            page_bytes = (uint32_t)kib * 1024u;
-        } else if (strcmp(argv[i], "--whole-geometry") == 0) {
-            whole_geometry = 1;
-        } else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
-            if (!cli_parse_u32(argv[i], argv[i + 1], 1, 256, &threads))
-                return 2;
-            i++;
-        } else if (strcmp(argv[i], "--allow-outside-files") == 0) {
-            allow_outside_files = 1;
-        } else if (strcmp(argv[i], "--budget") == 0 && i + 1 < argc) {
-            if (!cli_parse_budget(argv[i], argv[i + 1], &budget))
-                return 2;
-            i++;
-        } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            build_usage();
-            return 0;
-        } else if (argv[i][0] == '-' || input) {
+    char *end;
+    unsigned long kib = strtoul(kib_text, &end, 10);
+    if (*end || end == kib_text || kib_text[0] == '-' || kib < GDR_PAGE_BYTES_MIN / 1024 ||
+        kib > GDR_PAGE_BYTES_MAX / 1024) {
+        fprintf(stderr, "gdr: build: --pages=%s: expected kibibytes in [%u, %u]\n", kib_text, GDR_PAGE_BYTES_MIN / 1024,
+                GDR_PAGE_BYTES_MAX / 1024);
+        return false;
+    }
+    *page_bytes = (uint32_t)kib * 1024u;
+    return true;
+}
+
+/* The precomputed-visibility options at argv[*i] (advancing *i past a value): 1 taken, 0 not one of
+ * them, -1 refused (printed why). */
+static int parse_pvs_option(build_options *o, int argc, char **argv, int *i)
+{
+    const char *arg = argv[*i];
+    bool has_value = *i + 1 < argc;
+    bool ok;
+    if (strcmp(arg, "--pvs") == 0)
+        ok = cli_needs_cull(arg);
+    else if (strcmp(arg, "--pvs-cell") == 0 && has_value)
+        ok = cli_needs_cull(arg) && cli_parse_float(arg, argv[++*i], 0.01f, 1e6f, &o->pvs_cell);
+    else if (strcmp(arg, "--pvs-samples") == 0 && has_value)
+        ok = cli_needs_cull(arg) && cli_parse_u32(arg, argv[++*i], 1, 4096, &o->pvs_samples);
+    else
+        return 0;
+    o->pvs_wanted = 1;
+    return ok ? 1 : -1;
+}
+
+/* One argument (with its value) at argv[*i]: 1 taken, 0 not an option of gdr build, -1 refused. */
+static int parse_build_option(build_options *o, int argc, char **argv, int *i)
+{
+    const char *arg = argv[*i];
+    bool has_value = *i + 1 < argc;
+    if ((strcmp(arg, "-o") == 0 || strcmp(arg, "--out") == 0) && has_value)
+        o->output = argv[++*i];
+    else if (strcmp(arg, "--no-progress") == 0)
+        o->no_progress = 1;
+    else if (strcmp(arg, "--strict") == 0)
+        o->warnings.strict = true;
+    else if (strcmp(arg, "--pages") == 0)
+        o->page_bytes = GDR_PAGE_BYTES_DEFAULT;
+    else if (strncmp(arg, "--pages=", 8) == 0)
+        return parse_page_size(arg + 8, &o->page_bytes) ? 1 : -1;
+    else if (strcmp(arg, "--whole-geometry") == 0)
+        o->whole_geometry = 1;
+    else if (strcmp(arg, "--threads") == 0 && has_value)
+        return cli_parse_u32(arg, argv[++*i], 1, 256, &o->threads) ? 1 : -1;
+    else if (strcmp(arg, "--allow-outside-files") == 0)
+        o->allow_outside_files = 1;
+    else if (strcmp(arg, "--budget") == 0 && has_value)
+        return cli_parse_budget(arg, argv[++*i], &o->budget) ? 1 : -1;
+    else if (strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0)
+        o->help = 1;
+    else
+        return parse_pvs_option(o, argc, argv, i);
+    return 1;
+}
+
+/* Parses the command line into *o: 0, or the exit status after printing why (2; 0 for --help). */
+static int parse_build_options(int argc, char **argv, build_options *o)
+{
+    *o = (build_options){0};
+    for (int i = 1; i < argc && !o->help; i++) {
+        int taken = parse_build_option(o, argc, argv, &i);
+        if (taken < 0)
+            return 2;
+        if (taken > 0)
+            continue;
+        if (argv[i][0] == '-' || o->input) {
             fprintf(stderr, "gdr: build: unexpected argument '%s'\n", argv[i]);
             build_usage();
             return 2;
-        } else {
-            input = argv[i];
         }
+        o->input = argv[i];
     }
-    if (!input || !output) {
+    if (o->help) {
+        build_usage();
+        return -1;
+    }
+    if (!o->input || !o->output) {
         build_usage();
         return 2;
     }
-    if (whole_geometry && !page_bytes) {
+    if (o->whole_geometry && !o->page_bytes) {
         fputs("gdr: build: --whole-geometry is for a cache with --pages (one without pages holds it anyway)\n", stderr);
         return 2;
     }
+    return 0;
+}
+
+/* The precomputed visibility baked into the cache (--pvs): before writing, so that a failed bake
+ * leaves no file. Without --pvs, a .gdrc input's is carried over. */
+static gdr_status bake_pvs(const build_options *o, gdr_scene *scene, gdr_pvs **pvs, gdr_error *err)
+{
+    if (!o->pvs_wanted)
+        return GDR_OK;
+    cli_pvs_destroy(*pvs);
+    *pvs = NULL;
+    return cli_pvs_bake(scene, o->pvs_cell, o->pvs_samples, pvs, err);
+}
+
+/* A scene from a file (or a built-in scene without pages): loaded whole, then written. A source's
+ * files are recorded in the cache written, and the import's warnings kept in it. */
+static int build_whole(build_options *o)
+{
     gdr_error err = {0};
-    if (page_bytes && !pvs_wanted && gdr_scene_spec_is_builtin(input))
-        return build_paged(input, output, page_bytes, threads, no_progress, whole_geometry);
     gdr_scene *scene = NULL;
     gdr_source_list sources = {0};
-    gdr_status status;
-    gdr_pvs *pvs = NULL; /* a .gdrc input's precomputed visibility is carried over unless rebaked */
-    /* A .gdrc input's precomputed visibility is carried over unless rebaked; a source's files are
-     * recorded in the cache written. */
-    gdr_import_report report = {0}; /* the import's warnings, kept in the cache */
-    gdr_load_options load = {.no_cache = 1, .no_progress = no_progress, .budget = budget,
-                             .allow_outside_files = allow_outside_files, .pvs = &pvs, .sources = &sources,
-                             .warning = cli_warning, .warning_user = &warnings, .report = &report};
-    status = gdr_scene_load(input, &load, &scene, &err);
-    int strict = status == GDR_OK ? cli_strict_check(&warnings, input) : 0;
-    if (strict) {
-        gdr_import_report_free(&report);
-        cli_pvs_destroy(pvs);
-        gdr_source_list_free(&sources);
-        gdr_scene_destroy(scene);
-        return strict;
-    }
-    if (status == GDR_OK && pvs && !pvs_wanted)
-        cli_pvs_print_kept(input, pvs);
-    if (status == GDR_OK && page_bytes)
+    gdr_pvs *pvs = NULL;
+    gdr_import_report report = {0};
+    gdr_load_options load = {.no_cache = 1, .no_progress = o->no_progress, .budget = o->budget,
+                             .allow_outside_files = o->allow_outside_files, .pvs = &pvs, .sources = &sources,
+                             .warning = cli_warning, .warning_user = &o->warnings, .report = &report};
+    gdr_status status = gdr_scene_load(o->input, &load, &scene, &err);
+    int strict = status == GDR_OK ? cli_strict_check(&o->warnings, o->input) : 0;
+    if (!strict && status == GDR_OK && pvs && !o->pvs_wanted)
+        cli_pvs_print_kept(o->input, pvs);
+    if (!strict && status == GDR_OK && o->page_bytes)
         status = quantize(scene, &err);
-    if (status == GDR_OK && pvs_wanted) {
-        cli_pvs_destroy(pvs);
-        pvs = NULL;
-        status = cli_pvs_bake(scene, pvs_cell, pvs_samples, &pvs, &err); /* before writing: a failed bake leaves no file */
-    }
-    if (status == GDR_OK) {
+    if (!strict && status == GDR_OK)
+        status = bake_pvs(o, scene, &pvs, &err);
+    if (!strict && status == GDR_OK) {
         gdr_cache_write_options write = {.source = {gdr_cache_build_options(), &sources}, .pvs = pvs,
-                                         .page_bytes = page_bytes, .whole_geometry = whole_geometry,
+                                         .page_bytes = o->page_bytes, .whole_geometry = o->whole_geometry,
                                          .report = &report};
-        status = gdr_cache_write(output, scene, &write, &err);
+        status = gdr_cache_write(o->output, scene, &write, &err);
     }
-    if (status == GDR_OK)
-        printf("%s: %u meshes, %u instances, %llu triangles, %u materials, %u textures, %u cameras\n", output,
+    if (!strict && status == GDR_OK)
+        printf("%s: %u meshes, %u instances, %llu triangles, %u materials, %u textures, %u cameras\n", o->output,
                scene->mesh_count, scene->instance_count, (unsigned long long)gdr_scene_triangle_count(scene),
                scene->material_count, scene->texture_count, scene->camera_count);
-    int result = status == GDR_OK ? 0 : cli_load_failed(input, &err);
+    int result = strict ? strict : status == GDR_OK ? 0 : cli_load_failed(o->input, &err);
     cli_pvs_destroy(pvs);
     gdr_import_report_free(&report);
     gdr_source_list_free(&sources);
     gdr_scene_destroy(scene);
     return result;
+}
+
+int gdr_cmd_build(int argc, char **argv)
+{
+    build_options o;
+    int usage = parse_build_options(argc, argv, &o);
+    if (usage)
+        return usage < 0 ? 0 : usage;
+    if (o.page_bytes && !o.pvs_wanted && gdr_scene_spec_is_builtin(o.input))
+        return build_paged(o.input, o.output, o.page_bytes, o.threads, o.no_progress, o.whole_geometry);
+    return build_whole(&o);
 }
