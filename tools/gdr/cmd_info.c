@@ -130,6 +130,84 @@ static void print_textures(const gdr_scene *scene)
     }
 }
 
+/* Parses gdr info's arguments into *options and *input: 0, or the exit status after the usage
+ * (0 for --help). */
+static int parse_info_options(int argc, char **argv, gdr_load_options *options, cli_warnings *warnings,
+                              const char **input)
+{
+    for (int i = 1; i < argc; i++) {
+        const char *arg = argv[i];
+        bool has_value = i + 1 < argc;
+        if (strcmp(arg, "--no-cache") == 0)
+            options->no_cache = 1;
+        else if (strcmp(arg, "--cache-dir") == 0 && has_value)
+            options->cache_dir = argv[++i];
+        else if (strcmp(arg, "--cache-max") == 0 && has_value) {
+            if (!cli_parse_cache_max(arg, argv[++i], &options->cache_max_bytes))
+                return 2;
+        } else if (strcmp(arg, "--strict") == 0)
+            warnings->strict = true;
+        else if (strcmp(arg, "--allow-outside-files") == 0)
+            options->allow_outside_files = 1;
+        else if (strcmp(arg, "--budget") == 0 && has_value) {
+            if (!cli_parse_budget(arg, argv[++i], &options->budget))
+                return 2;
+        } else if (strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0 || arg[0] == '-' || *input) {
+            fputs(INFO_USAGE, stderr);
+            return strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0 ? -1 : 2;
+        } else
+            *input = arg;
+    }
+    if (!*input) {
+        fputs(INFO_USAGE, stderr);
+        return 2;
+    }
+    return 0;
+}
+
+/* The scene's geometry summed over its meshes. */
+typedef struct geometry_totals {
+    uint64_t vertices, unique_triangles, clusters, level0, cluster_triangles, cluster_vertices, nodes;
+    uint32_t node_levels;
+} geometry_totals;
+
+static geometry_totals sum_geometry(const gdr_scene *scene, const char *input)
+{
+    geometry_totals t = {0};
+    for (uint32_t i = 0; i < scene->mesh_count; i++) {
+        const gdr_mesh_clusters *c = &scene->meshes[i].clusters;
+        t.nodes += c->lod_node_count;
+        t.node_levels = c->lod_node_levels > t.node_levels ? c->lod_node_levels : t.node_levels;
+        t.vertices += scene->meshes[i].vertex_count;
+        t.unique_triangles += scene->meshes[i].index_count / 3;
+        t.clusters += c->cluster_count;
+        t.level0 += c->level0_cluster_count;
+        for (uint32_t k = 0; c->clusters && k < c->cluster_count; k++) {
+            t.cluster_triangles += c->clusters[k].triangle_count;
+            t.cluster_vertices += c->clusters[k].vertex_count;
+        }
+    }
+    if (scene->geometry_in_pages) /* the records are in the pages */
+        count_paged_clusters(input, &t.cluster_triangles, &t.cluster_vertices);
+    return t;
+}
+
+static void print_geometry(const gdr_scene *scene, const char *input, const geometry_totals *t)
+{
+    printf("scene:       %s\n", input);
+    printf("meshes:      %u (%llu vertices, %llu triangles)\n", scene->mesh_count, (unsigned long long)t->vertices,
+           (unsigned long long)t->unique_triangles);
+    printf("clusters:    %llu (%.1f triangles, %.1f vertices each on average", (unsigned long long)t->clusters,
+           t->clusters ? (double)t->cluster_triangles / (double)t->clusters : 0.0,
+           t->clusters ? (double)t->cluster_vertices / (double)t->clusters : 0.0);
+    if (t->level0 != t->clusters)
+        printf("; %llu at level 0", (unsigned long long)t->level0);
+    printf(")\n");
+    printf("lod nodes:   %llu (hierarchies of up to %u levels)\n", (unsigned long long)t->nodes, t->node_levels);
+    printf("instances:   %u\n", scene->instance_count);
+    printf("triangles:   %llu (over all instances)\n", (unsigned long long)gdr_scene_triangle_count(scene));
+}
+
 int gdr_cmd_info(int argc, char **argv)
 {
     if (argc == 2 && strcmp(argv[1], "--passes") == 0) {
@@ -137,97 +215,36 @@ int gdr_cmd_info(int argc, char **argv)
         return fflush(stdout) == 0 && !ferror(stdout) ? 0 : 1;
     }
     const char *input = NULL;
-    gdr_load_options options = {0};
     cli_warnings warnings = {0};
     gdr_import_report report = {0};
-    options.warning = cli_warning;
-    options.warning_user = &warnings;
-    options.report = &report;
-    for (int i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "--no-cache") == 0) {
-            options.no_cache = 1;
-        } else if (strcmp(argv[i], "--cache-dir") == 0 && i + 1 < argc) {
-            options.cache_dir = argv[++i];
-        } else if (strcmp(argv[i], "--cache-max") == 0 && i + 1 < argc) {
-            if (!cli_parse_cache_max(argv[i], argv[i + 1], &options.cache_max_bytes))
-                return 2;
-            i++;
-        } else if (strcmp(argv[i], "--strict") == 0) {
-            warnings.strict = true;
-        } else if (strcmp(argv[i], "--allow-outside-files") == 0) {
-            options.allow_outside_files = 1;
-        } else if (strcmp(argv[i], "--budget") == 0 && i + 1 < argc) {
-            if (!cli_parse_budget(argv[i], argv[i + 1], &options.budget))
-                return 2;
-            i++;
-        } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0 || argv[i][0] == '-' || input) {
-            fputs(INFO_USAGE, stderr);
-            return strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0 ? 0 : 2;
-        } else {
-            input = argv[i];
-        }
-    }
-    if (!input) {
-        fputs(INFO_USAGE, stderr);
-        return 2;
-    }
+    gdr_pvs *pvs = NULL; /* a cache's precomputed visibility is described too */
+    gdr_load_options options = {.warning = cli_warning, .warning_user = &warnings, .report = &report, .pvs = &pvs};
+    int usage = parse_info_options(argc, argv, &options, &warnings, &input);
+    if (usage)
+        return usage < 0 ? 0 : usage;
     gdr_error err = {0};
     gdr_scene *scene = NULL;
-    gdr_pvs *pvs = NULL;
-    options.pvs = &pvs; /* a cache's precomputed visibility is described too */
     options.geometry_in_pages = cache_pages_only(input);
     gdr_status status = gdr_scene_load(input, &options, &scene, &err);
     int strict = status == GDR_OK ? cli_strict_check(&warnings, input) : 0;
-    if (status != GDR_OK || strict) {
-        gdr_import_report_free(&report);
-        cli_pvs_destroy(pvs);
-        gdr_scene_destroy(scene);
-        return status != GDR_OK ? cli_load_failed(input, &err) : strict;
+    if (status == GDR_OK && !strict) {
+        geometry_totals totals = sum_geometry(scene, input);
+        print_geometry(scene, input, &totals);
+        printf("materials:   %u\n", scene->material_count);
+        print_textures(scene);
+        printf("cameras:     %u\n", scene->camera_count);
+        printf("extensions:  %s\n", scene->extensions ? scene->extensions : "(none)");
+        print_quantization(scene);
+        cli_pvs_print_info(pvs);
+        size_t length = strlen(input);
+        if (length > 5 && strcmp(input + length - 5, ".gdrc") == 0)
+            print_cache_bytes(input, totals.unique_triangles);
+        print_cache_location(&report, options.no_cache, input);
+        if (warnings.count)
+            printf("warnings:    %u\n", warnings.count);
     }
-    uint64_t vertices = 0, unique_triangles = 0, clusters = 0, level0 = 0, cluster_triangles = 0;
-    uint64_t cluster_vertices = 0, nodes = 0;
-    uint32_t node_levels = 0;
-    for (uint32_t i = 0; i < scene->mesh_count; i++) {
-        const gdr_mesh_clusters *c = &scene->meshes[i].clusters;
-        nodes += c->lod_node_count;
-        node_levels = c->lod_node_levels > node_levels ? c->lod_node_levels : node_levels;
-        vertices += scene->meshes[i].vertex_count;
-        unique_triangles += scene->meshes[i].index_count / 3;
-        clusters += c->cluster_count;
-        level0 += c->level0_cluster_count;
-        for (uint32_t k = 0; c->clusters && k < c->cluster_count; k++) {
-            cluster_triangles += c->clusters[k].triangle_count;
-            cluster_vertices += c->clusters[k].vertex_count;
-        }
-    }
-    if (scene->geometry_in_pages) /* the records are in the pages */
-        count_paged_clusters(input, &cluster_triangles, &cluster_vertices);
-    printf("scene:       %s\n", input);
-    printf("meshes:      %u (%llu vertices, %llu triangles)\n", scene->mesh_count, (unsigned long long)vertices,
-           (unsigned long long)unique_triangles);
-    printf("clusters:    %llu (%.1f triangles, %.1f vertices each on average", (unsigned long long)clusters,
-           clusters ? (double)cluster_triangles / (double)clusters : 0.0,
-           clusters ? (double)cluster_vertices / (double)clusters : 0.0);
-    if (level0 != clusters)
-        printf("; %llu at level 0", (unsigned long long)level0);
-    printf(")\n");
-    printf("lod nodes:   %llu (hierarchies of up to %u levels)\n", (unsigned long long)nodes, node_levels);
-    printf("instances:   %u\n", scene->instance_count);
-    printf("triangles:   %llu (over all instances)\n", (unsigned long long)gdr_scene_triangle_count(scene));
-    printf("materials:   %u\n", scene->material_count);
-    print_textures(scene);
-    printf("cameras:     %u\n", scene->camera_count);
-    printf("extensions:  %s\n", scene->extensions ? scene->extensions : "(none)");
-    print_quantization(scene);
-    cli_pvs_print_info(pvs);
-    size_t length = strlen(input);
-    if (length > 5 && strcmp(input + length - 5, ".gdrc") == 0)
-        print_cache_bytes(input, unique_triangles);
-    print_cache_location(&report, options.no_cache, input);
-    if (warnings.count)
-        printf("warnings:    %u\n", warnings.count);
     gdr_import_report_free(&report);
     cli_pvs_destroy(pvs);
     gdr_scene_destroy(scene);
-    return 0;
+    return status != GDR_OK ? cli_load_failed(input, &err) : strict;
 }

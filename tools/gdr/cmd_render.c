@@ -96,6 +96,59 @@ static gdr_status load_scene(render_options *o, gdr_scene **scene, gdr_pvs **pvs
     return render_options_load(o, scene, err);
 }
 
+/* The scene the options name, checked against them: loaded, within --strict, holding the
+ * precomputed visibility --pvs on needs and the camera --camera-index names. 0, or the exit status
+ * after printing why. */
+static int load_checked_scene(render_options *o, gdr_scene **scene, gdr_pvs **pvs, gdr_error *err)
+{
+    if (load_scene(o, scene, pvs, err) != GDR_OK)
+        return cli_load_failed(o->scene, err);
+    int strict = cli_strict_check(&o->warnings, o->scene);
+    if (strict)
+        return strict;
+    if (o->pvs == GDR_CULL_ON && !*pvs) {
+        fprintf(stderr, "gdr: --pvs on: %s holds no precomputed visibility (write it with gdr build %s -o FILE.gdrc "
+                "--pvs)\n", o->scene, o->scene);
+        return 2;
+    }
+    if (o->has_camera_index && o->camera_index >= (*scene)->camera_count)
+        return cli_camera_index_refused("render", o->camera_index, *scene, &o->report);
+    return 0;
+}
+
+/* The last frame's image (--out), the statistics printed and in --stats, and the validation
+ * layer's verdict: 0, or the exit status. */
+static int write_outputs(gdr_renderer *renderer, const render_options *o, const stats_context *context,
+                         const gdr_frame_stats *stats, gdr_error *err)
+{
+    if (o->out_png) {
+        uint8_t *pixels = malloc((size_t)o->width * o->height * 4);
+        if (!pixels)
+            return 1;
+        gdr_status status = gdr_renderer_read_color(renderer, pixels, err);
+        if (status == GDR_OK)
+            status = gdr_write_png(o->out_png, pixels, o->width, o->height, err);
+        free(pixels);
+        if (status != GDR_OK)
+            return fail(err);
+    }
+    stats_print(stdout, context, stats);
+    if (o->out_png)
+        printf("image               %s\n", o->out_png);
+    int result = 0;
+    if (o->stats_json) {
+        char *json = stats_to_json(context, stats);
+        if (!json || gdr_write_file_atomic(o->stats_json, json, strlen(json), err) != GDR_OK)
+            result = json ? fail(err) : 1;
+        free(json);
+    }
+    if (result == 0 && stats->validation_messages > 0) {
+        fprintf(stderr, "gdr: the validation layer reported %u message(s)\n", stats->validation_messages);
+        result = 3;
+    }
+    return result;
+}
+
 int gdr_cmd_render(int argc, char **argv)
 {
     render_options o;
@@ -122,62 +175,26 @@ int gdr_cmd_render(int argc, char **argv)
     gdr_renderer *renderer = NULL;
     gdr_paged_cache *paged = NULL;
     gdr_frame_stats stats;
-    uint8_t *pixels = NULL;
     stats_path_frame *rows = NULL;
     int result = 0;
-    if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK) {
+    if (gdr_renderer_create(&desc, &renderer, &err) != GDR_OK)
         result = cli_renderer_failed(&err);
-        goto done;
+    else
+        result = load_checked_scene(&o, &scene, &pvs, &err);
+    if (result == 0) {
+        gdr_frame_desc frame = render_options_frame(&o, render_options_camera(scene, &o));
+        if (render_options_set_scene(renderer, scene, &o, &paged, &err) != GDR_OK ||
+            gdr_renderer_set_pvs(renderer, pvs, &err) != GDR_OK ||
+            render_frames(renderer, &frame, &o, &path, &stats, &rows, &err) != GDR_OK)
+            result = fail(&err);
     }
-    if (load_scene(&o, &scene, &pvs, &err) != GDR_OK) {
-        result = cli_load_failed(o.scene, &err);
-        goto done;
+    if (result == 0) {
+        stats_context context = {o.scene, o.width, o.height, o.cull ? "on" : "off", gdr_view_name(o.view), rows,
+                                 rows ? (o.frames_given ? o.frames : path.count) : 0};
+        result = write_outputs(renderer, &o, &context, &stats, &err);
     }
-    if ((result = cli_strict_check(&o.warnings, o.scene)) != 0)
-        goto done;
-    if (o.pvs == GDR_CULL_ON && !pvs) {
-        fprintf(stderr, "gdr: --pvs on: %s holds no precomputed visibility (write it with gdr build %s -o FILE.gdrc "
-                "--pvs)\n", o.scene, o.scene);
-        result = 2;
-        goto done;
-    }
-    if (o.has_camera_index && o.camera_index >= scene->camera_count) {
-        result = cli_camera_index_refused("render", o.camera_index, scene, &o.report);
-        goto done;
-    }
-    gdr_frame_desc frame = render_options_frame(&o, render_options_camera(scene, &o));
-    if (render_options_set_scene(renderer, scene, &o, &paged, &err) != GDR_OK || gdr_renderer_set_pvs(renderer, pvs, &err) != GDR_OK ||
-        render_frames(renderer, &frame, &o, &path, &stats, &rows, &err) != GDR_OK) {
-        result = fail(&err);
-        goto done;
-    }
-    if (o.out_png) {
-        pixels = malloc((size_t)o.width * o.height * 4);
-        if (!pixels || gdr_renderer_read_color(renderer, pixels, &err) != GDR_OK ||
-            gdr_write_png(o.out_png, pixels, o.width, o.height, &err) != GDR_OK) {
-            result = pixels ? fail(&err) : 1;
-            goto done;
-        }
-    }
-    stats_context context = {o.scene, o.width, o.height, o.cull ? "on" : "off", gdr_view_name(o.view), rows,
-                             rows ? (o.frames_given ? o.frames : path.count) : 0};
-    stats_print(stdout, &context, &stats);
-    if (o.out_png)
-        printf("image               %s\n", o.out_png);
-    if (o.stats_json) {
-        char *json = stats_to_json(&context, &stats);
-        if (!json || gdr_write_file_atomic(o.stats_json, json, strlen(json), &err) != GDR_OK)
-            result = json ? fail(&err) : 1;
-        free(json);
-    }
-    if (result == 0 && stats.validation_messages > 0) {
-        fprintf(stderr, "gdr: the validation layer reported %u message(s)\n", stats.validation_messages);
-        result = 3;
-    }
-done:
     gdr_import_report_free(&o.report);
     camera_path_free(&path);
-    free(pixels);
     free(rows);
     gdr_renderer_destroy(renderer);
     gdr_paged_cache_close(paged);
