@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "geometry/lod_internal.h"
+#include "geometry/lod_sort.h"
 
 #define NO_SOURCE UINT32_MAX
 
@@ -645,11 +646,11 @@ static int build_triangle_region(const lod_build *b, lod_scratch *s, region_posi
         for (uint32_t k = b->adjacency_start[p]; k < b->adjacency_start[p] + (around < limit ? around : limit); k++)
             (*refs)[n++] = b->adjacency[k] >> 2; /* the triangle, whichever corner */
     }
-    qsort(*refs, n, sizeof **refs, compare_u32);
-    size_t unique = 0;
-    for (size_t i = 0; i < n; i++)
-        if (i == 0 || (*refs)[i] != (*refs)[i - 1])
-            (*refs)[unique++] = (*refs)[i];
+    /* The corners' array sorts the list first: each listing is a distinct corner of its triangle, so
+     * n is at most 3 x the distinct triangles, which the corners need anyway (no memory more). */
+    if (!gdr_lod_reserve(corners, corners_cap, n + 1, sizeof **corners))
+        return 0;
+    size_t unique = lod_sort_unique_u32(*refs, n, *corners);
     /* The triangles' corners as mesh vertex indices, over the mesh's own positions: a group near the
      * DAG's root gathers most of the mesh, and a copy of its corners' positions would cost each
      * worker 36 bytes per level-0 triangle. */
@@ -701,10 +702,9 @@ static int build_span(const lod_build *b, lod_scratch *s)
         return 0;
     for (size_t i = 0; i < corners; i++)
         s->span_positions[i] = b->position_id[s->local_to_mesh[s->out_corners[i]]];
-    qsort(s->span_positions, corners, sizeof *s->span_positions, compare_u32);
-    for (size_t i = 0; i < corners; i++) /* each position once: a hub's fan is listed once */
-        if (i == 0 || s->span_positions[i] != s->span_positions[i - 1])
-            s->span_positions[unique++] = s->span_positions[i];
+    if (!LOD_RESERVE(s, span_refs, corners + 1)) /* free until build_triangle_region: the sort's scratch */
+        return 0;
+    unique = lod_sort_unique_u32(s->span_positions, corners, s->span_refs); /* a hub's fan is listed once */
     return build_triangle_region(b, s, corner_position, unique, LOD_RING_LIMIT, &s->span_refs, &s->span_refs_cap, &s->span_corners,
                                  &s->span_corners_cap, &s->span_grid);
 }
