@@ -30,7 +30,7 @@ static uint32_t cell_coordinate(const lod_grid *g, float x, int k)
     float c = (x - g->lo[k]) * g->inv_cell;
     if (!(c > 0.0f))
         return 0;
-    return c >= (float)(g->dim[k] - 1) ? g->dim[k] - 1 : (uint32_t)c;
+    return c >= g->top[k] ? g->dim[k] - 1 : (uint32_t)c;
 }
 
 /* The points lie on a surface: about two per occupied cell when the cell edge is about twice the
@@ -72,6 +72,8 @@ static void choose_cells(lod_grid *g, const float hi[3], uint32_t n, double spac
             cell = extent[k] / (float)g->dim[k] * 1.0001f;
     g->cell = cell;
     g->inv_cell = 1.0f / cell;
+    for (int k = 0; k < 3; k++)
+        g->top[k] = (float)(g->dim[k] - 1);
 }
 
 static uint32_t point_cell(const lod_grid *g, gdr_vec3 p)
@@ -264,7 +266,7 @@ static uint32_t tri_cell(const lod_triangle_grid *g, float x, int k)
     float c = (x - g->lo[k]) * g->inv_cell;
     if (!(c > 0.0f))
         return 0;
-    return c >= (float)(g->dim[k] - 1) ? g->dim[k] - 1 : (uint32_t)c;
+    return c >= g->top[k] ? g->dim[k] - 1 : (uint32_t)c;
 }
 
 /* Triangle t's box in cells: each axis's smallest and largest coordinate, then their cells (the
@@ -347,6 +349,7 @@ static void tri_choose_cells(lod_triangle_grid *g, uint32_t n)
     g->cell = shape.cell;
     g->inv_cell = shape.inv_cell;
     memcpy(g->dim, shape.dim, sizeof g->dim);
+    memcpy(g->top, shape.top, sizeof g->top);
 }
 
 /* --- listing a triangle in the cells it crosses ------------------------------------------------ */
