@@ -485,25 +485,45 @@ static void settle_cost(run *r, evaluation *e, uint32_t i)
     s->exact[i] = 1;
 }
 
+/* Whether neighbour j comes before neighbour m in the order: by cost, ties by position index. */
+static int comes_before(const lod_simplify_scratch *s, uint32_t j, uint32_t m)
+{
+    return s->costs[j] < s->costs[m] || (s->costs[j] == s->costs[m] && s->neighbours[j] < s->neighbours[m]);
+}
+
 /* The neighbour not yet taken with the smallest cost (ties by position index), INFINITY's included,
  * or NONE when all are taken. A geometric part is a lower bound of its whole cost (both as floats),
  * so only the candidate that leads by its lower bound has its whole cost computed; the order is the
- * one the whole costs give. */
+ * one the whole costs give. The scan also finds the runner-up: once the leader's whole cost is
+ * known, the first is the leader or the runner-up (the other costs did not change), with no scan
+ * again unless the runner-up's whole cost is needed too. Not where a cost is NaN: the first of a
+ * scan then depends on the order of the scan, which is kept. */
 static uint32_t next_cheapest(run *r, evaluation *e)
 {
     lod_simplify_scratch *s = r->s;
     for (;;) {
-        uint32_t m = NONE;
+        uint32_t m = NONE, runner = NONE;
+        int nan = 0;
         for (uint32_t j = 0; j < e->count; j++) {
             if (s->taken[j])
                 continue;
-            if (m == NONE || s->costs[j] < s->costs[m] ||
-                (s->costs[j] == s->costs[m] && s->neighbours[j] < s->neighbours[m]))
+            nan |= s->costs[j] != s->costs[j];
+            if (m == NONE || comes_before(s, j, m)) {
+                runner = m;
                 m = j;
+            } else if (runner == NONE || comes_before(s, j, runner)) {
+                runner = j;
+            }
         }
         if (m == NONE || s->exact[m])
             return m;
         settle_cost(r, e, m);
+        if (nan || s->costs[m] != s->costs[m])
+            continue; /* scan again */
+        if (runner == NONE || !comes_before(s, runner, m))
+            return m;
+        if (s->exact[runner])
+            return runner;
     }
 }
 
@@ -680,6 +700,34 @@ static void build_lists(run *r)
     }
 }
 
+/* For every corner c (at position pa, the next corner of its triangle at pb), the entries of pa's
+ * corner list whose triangle holds pb, into along[c]: how many triangles lie along the edge pa-pb as
+ * build_quadrics counts them. One pass over each position's list counts every position its
+ * triangles hold (a triangle once per entry), instead of a pass over the list per edge. */
+static void count_along(run *r, uint32_t *along)
+{
+    lod_simplify_scratch *s = r->s;
+    for (uint32_t pa = 0; pa < r->in->position_count; pa++) {
+        uint32_t t = ++s->token;
+        for (uint32_t c = s->head[pa]; c != NONE; c = s->next[c]) {
+            uint32_t base = c - c % 3, q[3];
+            for (uint32_t j = 0; j < 3; j++)
+                q[j] = corner_position(r, base + j);
+            for (uint32_t j = 0; j < 3; j++) {
+                if ((j > 0 && q[j] == q[0]) || (j > 1 && q[j] == q[1]))
+                    continue; /* a position the triangle holds twice counts once */
+                if (s->mark[q[j]] != t) {
+                    s->mark[q[j]] = t;
+                    s->slot[q[j]] = 0;
+                }
+                s->slot[q[j]]++;
+            }
+        }
+        for (uint32_t c = s->head[pa]; c != NONE; c = s->next[c])
+            along[c] = s->slot[corner_position(r, c - c % 3 + (c % 3 + 1) % 3)];
+    }
+}
+
 /* Area-weighted triangle planes, and for each open border edge (one triangle along it, or more than
  * two: a non-manifold edge) a plane through it perpendicular to its triangle. */
 static void build_quadrics(run *r)
@@ -687,6 +735,8 @@ static void build_quadrics(run *r)
     lod_simplify_scratch *s = r->s;
     const lod_simplify_input *in = r->in;
     memset(s->quadric, 0, (size_t)in->position_count * QUADRIC_SIZE * sizeof *s->quadric);
+    uint32_t *along_edge = s->fan; /* free until the first evaluation */
+    count_along(r, along_edge);
     size_t nt = in->index_count / 3;
     for (size_t t = 0; t < nt; t++) {
         if (!s->alive[t])
@@ -705,10 +755,7 @@ static void build_quadrics(run *r)
                               -dot(nrm, p[0]), 0.5 * len);
         for (uint32_t j = 0; j < 3; j++) {
             uint32_t pa = corner_position(r, (uint32_t)t * 3 + j), pb = corner_position(r, (uint32_t)t * 3 + (j + 1) % 3);
-            uint32_t along = 0;
-            for (uint32_t c = s->head[pa]; c != NONE; c = s->next[c])
-                along += triangle_holds(r, c / 3, pb);
-            if (along == 2)
+            if (along_edge[t * 3 + j] == 2)
                 continue;
             s->flags[pa] |= FLAG_BORDER;
             s->flags[pb] |= FLAG_BORDER;
