@@ -485,45 +485,25 @@ static void settle_cost(run *r, evaluation *e, uint32_t i)
     s->exact[i] = 1;
 }
 
-/* Whether neighbour j comes before neighbour m in the order: by cost, ties by position index. */
-static int comes_before(const lod_simplify_scratch *s, uint32_t j, uint32_t m)
-{
-    return s->costs[j] < s->costs[m] || (s->costs[j] == s->costs[m] && s->neighbours[j] < s->neighbours[m]);
-}
-
 /* The neighbour not yet taken with the smallest cost (ties by position index), INFINITY's included,
  * or NONE when all are taken. A geometric part is a lower bound of its whole cost (both as floats),
  * so only the candidate that leads by its lower bound has its whole cost computed; the order is the
- * one the whole costs give. The scan also finds the runner-up: once the leader's whole cost is
- * known, the first is the leader or the runner-up (the other costs did not change), with no scan
- * again unless the runner-up's whole cost is needed too. Not where a cost is NaN: the first of a
- * scan then depends on the order of the scan, which is kept. */
+ * one the whole costs give. */
 static uint32_t next_cheapest(run *r, evaluation *e)
 {
     lod_simplify_scratch *s = r->s;
     for (;;) {
-        uint32_t m = NONE, runner = NONE;
-        int nan = 0;
+        uint32_t m = NONE;
         for (uint32_t j = 0; j < e->count; j++) {
             if (s->taken[j])
                 continue;
-            nan |= s->costs[j] != s->costs[j];
-            if (m == NONE || comes_before(s, j, m)) {
-                runner = m;
+            if (m == NONE || s->costs[j] < s->costs[m] ||
+                (s->costs[j] == s->costs[m] && s->neighbours[j] < s->neighbours[m]))
                 m = j;
-            } else if (runner == NONE || comes_before(s, j, runner)) {
-                runner = j;
-            }
         }
         if (m == NONE || s->exact[m])
             return m;
         settle_cost(r, e, m);
-        if (nan || s->costs[m] != s->costs[m])
-            continue; /* scan again */
-        if (runner == NONE || !comes_before(s, runner, m))
-            return m;
-        if (s->exact[runner])
-            return runner;
     }
 }
 
