@@ -138,11 +138,29 @@ static int build_adjacency(lod_build *b, uint32_t level0)
     return 1;
 }
 
-/* An adjacency entry's cluster, and its triangle's first byte in the cluster's triangles. */
-static const gdr_cluster *ring_cluster(const lod_build *b, uint32_t entry) { return &b->clusters[entry >> 9]; }
-static const uint8_t *ring_triangle(const lod_build *b, const gdr_cluster *c, uint32_t entry)
+/* An adjacency entry's triangle (its three corners as bytes into its cluster's vertices), and its
+ * cluster's vertices: from the compact table of the level-0 clusters' offsets, which stays in the
+ * nearest cache where the clusters (72 bytes each) do not. */
+static const uint8_t *ring_triangle(const lod_build *b, uint32_t entry)
 {
-    return gdr_lod_cluster_triangles(b, c) + (size_t)(entry >> 2 & 127) * 3;
+    return b->triangles + b->level0_offsets[(size_t)(entry >> 9) * 2 + 1] + (size_t)(entry >> 2 & 127) * 3;
+}
+static const uint32_t *ring_vertices(const lod_build *b, uint32_t entry)
+{
+    return b->vertices + b->level0_offsets[(size_t)(entry >> 9) * 2];
+}
+
+/* The compact table of the level-0 clusters' offsets (ring_triangle). */
+static int build_level0_offsets(lod_build *b, uint32_t level0)
+{
+    b->level0_offsets = malloc(((size_t)level0 + 1) * 2 * sizeof *b->level0_offsets);
+    if (!b->level0_offsets)
+        return 0;
+    for (uint32_t c = 0; c < level0; c++) {
+        b->level0_offsets[(size_t)c * 2] = b->clusters[c].vertex_offset;
+        b->level0_offsets[(size_t)c * 2 + 1] = b->clusters[c].triangle_offset;
+    }
+    return 1;
 }
 
 /* Each position used by level 0 is owned by the first level-0 cluster that uses it. */
@@ -177,7 +195,7 @@ int gdr_lod_error_setup(lod_build *b)
     b->sample_vertex = malloc(((size_t)b->position_count + 1) * sizeof *b->sample_vertex);
     if (!b->sample_vertex || level0 >= (1u << 23)) /* adjacency entries hold the cluster in 23 bits */
         return 0;
-    return build_adjacency(b, level0) && assign_level0_samples(b, level0);
+    return build_adjacency(b, level0) && build_level0_offsets(b, level0) && assign_level0_samples(b, level0);
 }
 
 void gdr_lod_error_free(lod_build *b)
@@ -185,6 +203,7 @@ void gdr_lod_error_free(lod_build *b)
     free(b->sample_vertex);
     free(b->adjacency_start);
     free(b->adjacency);
+    free(b->level0_offsets);
     free(b->samples);
     free(b->cluster_sample_first);
     free(b->cluster_sample_count);
@@ -550,9 +569,8 @@ static uint32_t ring_end(const lod_build *b, uint32_t position)
 static float ring_entry_d2(const lod_build *b, uint32_t entry, gdr_vec3 p)
 {
     const gdr_vec3 *x = b->mesh->positions;
-    const gdr_cluster *c = ring_cluster(b, entry);
-    const uint8_t *t = ring_triangle(b, c, entry);
-    const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+    const uint8_t *t = ring_triangle(b, entry);
+    const uint32_t *v = ring_vertices(b, entry);
     return point_triangle_d2(p, x[v[t[0]]], x[v[t[1]]], x[v[t[2]]]);
 }
 
@@ -606,9 +624,8 @@ static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p, int
         uint32_t nearest_entry = UINT32_MAX;
         for (uint32_t k = b->adjacency_start[at], end = ring_end(b, at); k < end; k++) {
             uint32_t entry = b->adjacency[k];
-            const gdr_cluster *c = ring_cluster(b, entry);
-            const uint8_t *t = ring_triangle(b, c, entry);
-            const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+            const uint8_t *t = ring_triangle(b, entry);
+            const uint32_t *v = ring_vertices(b, entry);
             const uint8_t *o = other_corners[entry & 3]; /* not the corner at `at`: no nearer than `best` */
             const uint32_t other[2] = {v[t[o[0]]], v[t[o[1]]]};
             float sum = 0.0f;
@@ -675,9 +692,8 @@ static int build_triangle_region(const lod_build *b, lod_scratch *s, region_posi
     if (!gdr_lod_reserve(corners, corners_cap, unique * 3 + 1, sizeof **corners))
         return 0;
     for (size_t i = 0; i < unique; i++) {
-        const gdr_cluster *c = ring_cluster(b, (*refs)[i] << 2);
-        const uint8_t *t = ring_triangle(b, c, (*refs)[i] << 2);
-        const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+        const uint8_t *t = ring_triangle(b, (*refs)[i] << 2);
+        const uint32_t *v = ring_vertices(b, (*refs)[i] << 2);
         for (int k = 0; k < 3; k++)
             (*corners)[i * 3 + (size_t)k] = v[t[k]];
     }
@@ -872,9 +888,8 @@ typedef struct probe_lattice {
 static gdr_vec4 level0_plane(const lod_build *b, uint32_t triangle)
 {
     const gdr_vec3 *x = b->mesh->positions;
-    const gdr_cluster *c = ring_cluster(b, triangle << 2);
-    const uint8_t *t = ring_triangle(b, c, triangle << 2);
-    const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+    const uint8_t *t = ring_triangle(b, triangle << 2);
+    const uint32_t *v = ring_vertices(b, triangle << 2);
     gdr_vec3 a = x[v[t[0]]], e1 = sub3(x[v[t[1]]], a), e2 = sub3(x[v[t[2]]], a);
     gdr_vec3 n = {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x};
     float length = sqrtf(dot3(n, n));

@@ -200,6 +200,8 @@ typedef struct lod_build {
     uint32_t *sample_vertex;   /* position id -> a mesh vertex at that position */
     uint32_t *adjacency_start; /* position id -> level-0 triangles around it: adjacency[start[p] .. start[p + 1]) */
     uint32_t *adjacency;       /* level-0 triangles as cluster << 7 | triangle */
+    uint32_t *level0_offsets;  /* per level-0 cluster: its vertex offset, its triangle offset (compact: the
+                                  walks read them for every triangle they look at) */
     uint32_t *samples;         /* frontier cluster c owns samples[first[c] .. + count[c]) */
     uint32_t sample_count;
     uint32_t *cluster_sample_first, *cluster_sample_count;
