@@ -407,7 +407,7 @@ static float sample_triangle_d2(const lod_scratch *s, uint32_t i, uint32_t t, in
  * first in output order; UINT32_MAX when none. */
 static uint32_t across_edge(const lod_scratch *s, uint32_t t, int k)
 {
-    uint32_t a = s->out_corners[(size_t)t * 3 + k], b = s->out_corners[(size_t)t * 3 + (k + 1) % 3];
+    uint32_t a = s->out_corners[(size_t)t * 3 + k], b = s->out_corners[(size_t)t * 3 + (k == 2 ? 0 : k + 1)];
     for (uint32_t i = s->ring_start[a]; i < s->ring_start[a + 1]; i++) {
         const uint32_t *u = s->out_corners + (size_t)s->ring[i] * 3;
         if (s->ring[i] != t && (u[0] == b || u[1] == b || u[2] == b))
@@ -1024,7 +1024,7 @@ static void triangle_corners(const lod_scratch *s, uint32_t t, gdr_vec3 v[3])
  * two group vertices as t's edge k; UINT32_MAX when none. */
 static uint32_t earlier_edge(const lod_scratch *s, uint32_t t, int k)
 {
-    uint32_t a = s->out_corners[(size_t)t * 3 + k], b = s->out_corners[(size_t)t * 3 + (k + 1) % 3];
+    uint32_t a = s->out_corners[(size_t)t * 3 + k], b = s->out_corners[(size_t)t * 3 + (k == 2 ? 0 : k + 1)];
     for (uint32_t i = s->ring_start[a]; i < s->ring_start[a + 1] && s->ring[i] < t; i++) {
         const uint32_t *u = s->out_corners + (size_t)s->ring[i] * 3;
         for (int j = 0; j < 3; j++)

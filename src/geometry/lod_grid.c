@@ -375,7 +375,7 @@ static void clip_plane(const clip_polygon *in, int k, double at, double sign, cl
     out->n = 0;
     out->overflow = in->overflow;
     for (int i = 0; i < in->n && !out->overflow; i++) {
-        const double *a = in->p[i], *b = in->p[(i + 1) % in->n];
+        const double *a = in->p[i], *b = in->p[i + 1 < in->n ? i + 1 : 0];
         double da = sign * (a[k] - at), db = sign * (b[k] - at);
         int crosses = (da >= 0.0) != (db >= 0.0);
         if (out->n + (da >= 0.0) + crosses > CLIP_MAX) {
