@@ -236,11 +236,11 @@ uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squ
         at[k] = (int32_t)cell_coordinate(g, q[k], k);
     uint32_t best = UINT32_MAX;
     float best_d2 = INFINITY;
-    for (int32_t r = 0;; r++) {
-        visit_shell(g, at, r, q, &best, &best_d2);
-        if (search_done(g->lo, g->cell, g->dim, at, r, q, best_d2))
-            break;
-    }
+    /* The shell of radius 0 is q's own cell (visited directly: most queries end after it or the
+     * next), then shells outwards until no cell left can hold anything nearer. */
+    visit_cell(g, (uint32_t)at[0], (uint32_t)at[1], (uint32_t)at[2], q, &best, &best_d2);
+    for (int32_t r = 0; !search_done(g->lo, g->cell, g->dim, at, r, q, best_d2);)
+        visit_shell(g, at, ++r, q, &best, &best_d2);
     *distance_squared = best_d2;
     return best;
 }
