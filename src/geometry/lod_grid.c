@@ -135,12 +135,14 @@ int lod_grid_build(lod_grid *g, const gdr_vec3 *points, uint32_t n, double cells
     return 1;
 }
 
-static void visit_cell(const lod_grid *g, uint32_t x, uint32_t y, uint32_t z, const float q[3], uint32_t *best,
-                       float *best_d2)
+/* The nearest of the points listed in cells first .. last - 1 (cell indices, consecutive along x:
+ * their lists lie one after another) into best; ties: the lowest index. */
+static void visit_cells(const lod_grid *g, size_t first, size_t last, const float q[3], uint32_t *best,
+                        float *best_d2)
 {
-    uint32_t c = (z * g->dim[1] + y) * g->dim[0] + x, found = *best;
+    uint32_t found = *best;
     float found_d2 = *best_d2; /* in locals: through the pointers, every store would be reloaded */
-    for (uint32_t i = g->start[c], end = g->start[c + 1]; i < end; i++) {
+    for (uint32_t i = g->start[first], end = g->start[last]; i < end; i++) {
         uint32_t item = g->items[i];
         const gdr_vec3 p = g->points[item];
         float dx = p.x - q[0], dy = p.y - q[1], dz = p.z - q[2];
@@ -152,6 +154,13 @@ static void visit_cell(const lod_grid *g, uint32_t x, uint32_t y, uint32_t z, co
     }
     *best = found;
     *best_d2 = found_d2;
+}
+
+static void visit_cell(const lod_grid *g, uint32_t x, uint32_t y, uint32_t z, const float q[3], uint32_t *best,
+                       float *best_d2)
+{
+    size_t c = ((size_t)z * g->dim[1] + y) * g->dim[0] + x;
+    visit_cells(g, c, c + 1, q, best, best_d2);
 }
 
 /* Distance from q to the nearest cell the search has not reached once every cell within Chebyshev
@@ -201,8 +210,9 @@ static void reach_range(const lod_grid *g, const float q[3], float reach, int k,
     *hi = b < *hi ? b : *hi;
 }
 
-/* Searches the cells at Chebyshev distance r from `at` (its shell) that lie within the best
- * distance so far of q along every axis; the others hold nothing nearer. */
+/* Searches the cells at Chebyshev distance r > 0 from `at` (its shell) that lie within the best
+ * distance so far of q along every axis; the others hold nothing nearer. A row of cells on the
+ * shell is one run of the items' list. */
 static void visit_shell(const lod_grid *g, const int32_t at[3], int32_t r, const float q[3], uint32_t *best,
                         float *best_d2)
 {
@@ -213,16 +223,20 @@ static void visit_shell(const lod_grid *g, const int32_t at[3], int32_t r, const
         lo[k] = lo[k] > 0 ? lo[k] : 0;
         hi[k] = hi[k] < (int32_t)g->dim[k] - 1 ? hi[k] : (int32_t)g->dim[k] - 1;
     }
+    if (lo[0] > hi[0])
+        return;
     for (int32_t z = lo[2]; z <= hi[2]; z++)
         for (int32_t y = lo[1]; y <= hi[1]; y++) {
-            int shell = z == at[2] - r || z == at[2] + r || y == at[1] - r || y == at[1] + r;
-            for (int32_t x = lo[0]; x <= hi[0]; x++) {
-                if (!shell && x != at[0] - r && x != at[0] + r) {
-                    x = at[0] + r - 1; /* inside the shell: jump to its far face */
-                    continue;
-                }
-                visit_cell(g, (uint32_t)x, (uint32_t)y, (uint32_t)z, q, best, best_d2);
+            size_t row = ((size_t)z * g->dim[1] + (uint32_t)y) * g->dim[0];
+            if (z == at[2] - r || z == at[2] + r || y == at[1] - r || y == at[1] + r) {
+                visit_cells(g, row + (uint32_t)lo[0], row + (uint32_t)hi[0] + 1, q, best, best_d2); /* the row's run */
+                continue;
             }
+            /* a row through the inside: only the shell's two faces (r > 0: two cells) */
+            if (at[0] - r >= lo[0])
+                visit_cells(g, row + (uint32_t)(at[0] - r), row + (uint32_t)(at[0] - r) + 1, q, best, best_d2);
+            if (at[0] + r <= hi[0])
+                visit_cells(g, row + (uint32_t)(at[0] + r), row + (uint32_t)(at[0] + r) + 1, q, best, best_d2);
         }
 }
 
