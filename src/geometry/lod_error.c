@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "geometry/lod_internal.h"
+#include "geometry/lod_sort.h"
 
 #define NO_SOURCE UINT32_MAX
 
@@ -137,11 +138,29 @@ static int build_adjacency(lod_build *b, uint32_t level0)
     return 1;
 }
 
-/* An adjacency entry's cluster, and its triangle's first byte in the cluster's triangles. */
-static const gdr_cluster *ring_cluster(const lod_build *b, uint32_t entry) { return &b->clusters[entry >> 9]; }
-static const uint8_t *ring_triangle(const lod_build *b, const gdr_cluster *c, uint32_t entry)
+/* An adjacency entry's triangle (its three corners as bytes into its cluster's vertices), and its
+ * cluster's vertices: from the compact table of the level-0 clusters' offsets, which stays in the
+ * nearest cache where the clusters (72 bytes each) do not. */
+static const uint8_t *ring_triangle(const lod_build *b, uint32_t entry)
 {
-    return gdr_lod_cluster_triangles(b, c) + (size_t)(entry >> 2 & 127) * 3;
+    return b->triangles + b->level0_offsets[(size_t)(entry >> 9) * 2 + 1] + (size_t)(entry >> 2 & 127) * 3;
+}
+static const uint32_t *ring_vertices(const lod_build *b, uint32_t entry)
+{
+    return b->vertices + b->level0_offsets[(size_t)(entry >> 9) * 2];
+}
+
+/* The compact table of the level-0 clusters' offsets (ring_triangle). */
+static int build_level0_offsets(lod_build *b, uint32_t level0)
+{
+    b->level0_offsets = malloc(((size_t)level0 + 1) * 2 * sizeof *b->level0_offsets);
+    if (!b->level0_offsets)
+        return 0;
+    for (uint32_t c = 0; c < level0; c++) {
+        b->level0_offsets[(size_t)c * 2] = b->clusters[c].vertex_offset;
+        b->level0_offsets[(size_t)c * 2 + 1] = b->clusters[c].triangle_offset;
+    }
+    return 1;
 }
 
 /* Each position used by level 0 is owned by the first level-0 cluster that uses it. */
@@ -176,7 +195,7 @@ int gdr_lod_error_setup(lod_build *b)
     b->sample_vertex = malloc(((size_t)b->position_count + 1) * sizeof *b->sample_vertex);
     if (!b->sample_vertex || level0 >= (1u << 23)) /* adjacency entries hold the cluster in 23 bits */
         return 0;
-    return build_adjacency(b, level0) && assign_level0_samples(b, level0);
+    return build_adjacency(b, level0) && build_level0_offsets(b, level0) && assign_level0_samples(b, level0);
 }
 
 void gdr_lod_error_free(lod_build *b)
@@ -184,6 +203,7 @@ void gdr_lod_error_free(lod_build *b)
     free(b->sample_vertex);
     free(b->adjacency_start);
     free(b->adjacency);
+    free(b->level0_offsets);
     free(b->samples);
     free(b->cluster_sample_first);
     free(b->cluster_sample_count);
@@ -314,20 +334,38 @@ static float ring_d2(const lod_scratch *s, uint32_t l, gdr_vec3 p, uint32_t *nea
 }
 
 /* Keeps the k->limit largest sample distance bounds seen (squared, ascending, with their sample):
- * all other samples lie within the smallest of them of their cluster. */
+ * all other samples lie within the smallest of them of their cluster. The place is found by binary
+ * search and the tail moved at once: with the 1,025 bounds a group may keep (keep_more) a scan that
+ * moves one entry at a time cost 2.5% of a build. A new bound goes after those equal to it while
+ * the list fills, and before them once it is full (the smallest is dropped), as the scans did; the
+ * list is sorted because no distance is NaN (point_triangle_foot_d2 returns at most the squared
+ * distance to a corner, a sum of squares). */
 static void keep_largest(lod_kept *k, float d, uint32_t sample)
 {
-    uint32_t at;
-    if (k->count < k->limit) { /* not full: insert from the end */
-        for (at = k->count++; at > 0 && k->d2[at - 1] > d; at--) {
-            k->d2[at] = k->d2[at - 1];
-            k->sample[at] = k->sample[at - 1];
+    uint32_t at, lo, hi;
+    if (k->count < k->limit) { /* not full: after the last bound at most d */
+        for (lo = 0, hi = k->count; lo < hi;) {
+            uint32_t mid = lo + (hi - lo) / 2;
+            if (k->d2[mid] > d)
+                hi = mid;
+            else
+                lo = mid + 1;
         }
-    } else if (d > k->d2[0]) { /* full: drop the smallest, insert from the start */
-        for (at = 0; at + 1 < k->count && k->d2[at + 1] < d; at++) {
-            k->d2[at] = k->d2[at + 1];
-            k->sample[at] = k->sample[at + 1];
+        at = lo;
+        memmove(&k->d2[at + 1], &k->d2[at], (k->count - at) * sizeof k->d2[0]);
+        memmove(&k->sample[at + 1], &k->sample[at], (k->count - at) * sizeof k->sample[0]);
+        k->count++;
+    } else if (d > k->d2[0]) { /* full: drop the smallest, before the first bound at least d */
+        for (lo = 1, hi = k->count; lo < hi;) {
+            uint32_t mid = lo + (hi - lo) / 2;
+            if (k->d2[mid] < d)
+                lo = mid + 1;
+            else
+                hi = mid;
         }
+        at = lo - 1;
+        memmove(&k->d2[0], &k->d2[1], at * sizeof k->d2[0]);
+        memmove(&k->sample[0], &k->sample[1], at * sizeof k->sample[0]);
     } else {
         return;
     }
@@ -369,7 +407,7 @@ static float sample_triangle_d2(const lod_scratch *s, uint32_t i, uint32_t t, in
  * first in output order; UINT32_MAX when none. */
 static uint32_t across_edge(const lod_scratch *s, uint32_t t, int k)
 {
-    uint32_t a = s->out_corners[(size_t)t * 3 + k], b = s->out_corners[(size_t)t * 3 + (k + 1) % 3];
+    uint32_t a = s->out_corners[(size_t)t * 3 + k], b = s->out_corners[(size_t)t * 3 + (k == 2 ? 0 : k + 1)];
     for (uint32_t i = s->ring_start[a]; i < s->ring_start[a + 1]; i++) {
         const uint32_t *u = s->out_corners + (size_t)s->ring[i] * 3;
         if (s->ring[i] != t && (u[0] == b || u[1] == b || u[2] == b))
@@ -531,9 +569,8 @@ static uint32_t ring_end(const lod_build *b, uint32_t position)
 static float ring_entry_d2(const lod_build *b, uint32_t entry, gdr_vec3 p)
 {
     const gdr_vec3 *x = b->mesh->positions;
-    const gdr_cluster *c = ring_cluster(b, entry);
-    const uint8_t *t = ring_triangle(b, c, entry);
-    const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+    const uint8_t *t = ring_triangle(b, entry);
+    const uint32_t *v = ring_vertices(b, entry);
     return point_triangle_d2(p, x[v[t[0]]], x[v[t[1]]], x[v[t[2]]]);
 }
 
@@ -587,9 +624,8 @@ static uint32_t walk_towards(const lod_build *b, uint32_t start, gdr_vec3 p, int
         uint32_t nearest_entry = UINT32_MAX;
         for (uint32_t k = b->adjacency_start[at], end = ring_end(b, at); k < end; k++) {
             uint32_t entry = b->adjacency[k];
-            const gdr_cluster *c = ring_cluster(b, entry);
-            const uint8_t *t = ring_triangle(b, c, entry);
-            const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+            const uint8_t *t = ring_triangle(b, entry);
+            const uint32_t *v = ring_vertices(b, entry);
             const uint8_t *o = other_corners[entry & 3]; /* not the corner at `at`: no nearer than `best` */
             const uint32_t other[2] = {v[t[o[0]]], v[t[o[1]]]};
             float sum = 0.0f;
@@ -645,20 +681,19 @@ static int build_triangle_region(const lod_build *b, lod_scratch *s, region_posi
         for (uint32_t k = b->adjacency_start[p]; k < b->adjacency_start[p] + (around < limit ? around : limit); k++)
             (*refs)[n++] = b->adjacency[k] >> 2; /* the triangle, whichever corner */
     }
-    qsort(*refs, n, sizeof **refs, compare_u32);
-    size_t unique = 0;
-    for (size_t i = 0; i < n; i++)
-        if (i == 0 || (*refs)[i] != (*refs)[i - 1])
-            (*refs)[unique++] = (*refs)[i];
+    /* The corners' array sorts the list first: each listing is a distinct corner of its triangle, so
+     * n is at most 3 x the distinct triangles, which the corners need anyway (no memory more). */
+    if (!gdr_lod_reserve(corners, corners_cap, n + 1, sizeof **corners))
+        return 0;
+    size_t unique = lod_sort_unique_u32(*refs, n, *corners);
     /* The triangles' corners as mesh vertex indices, over the mesh's own positions: a group near the
      * DAG's root gathers most of the mesh, and a copy of its corners' positions would cost each
      * worker 36 bytes per level-0 triangle. */
     if (!gdr_lod_reserve(corners, corners_cap, unique * 3 + 1, sizeof **corners))
         return 0;
     for (size_t i = 0; i < unique; i++) {
-        const gdr_cluster *c = ring_cluster(b, (*refs)[i] << 2);
-        const uint8_t *t = ring_triangle(b, c, (*refs)[i] << 2);
-        const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+        const uint8_t *t = ring_triangle(b, (*refs)[i] << 2);
+        const uint32_t *v = ring_vertices(b, (*refs)[i] << 2);
         for (int k = 0; k < 3; k++)
             (*corners)[i * 3 + (size_t)k] = v[t[k]];
     }
@@ -701,10 +736,9 @@ static int build_span(const lod_build *b, lod_scratch *s)
         return 0;
     for (size_t i = 0; i < corners; i++)
         s->span_positions[i] = b->position_id[s->local_to_mesh[s->out_corners[i]]];
-    qsort(s->span_positions, corners, sizeof *s->span_positions, compare_u32);
-    for (size_t i = 0; i < corners; i++) /* each position once: a hub's fan is listed once */
-        if (i == 0 || s->span_positions[i] != s->span_positions[i - 1])
-            s->span_positions[unique++] = s->span_positions[i];
+    if (!LOD_RESERVE(s, span_refs, corners + 1)) /* free until build_triangle_region: the sort's scratch */
+        return 0;
+    unique = lod_sort_unique_u32(s->span_positions, corners, s->span_refs); /* a hub's fan is listed once */
     return build_triangle_region(b, s, corner_position, unique, LOD_RING_LIMIT, &s->span_refs, &s->span_refs_cap, &s->span_corners,
                                  &s->span_corners_cap, &s->span_grid);
 }
@@ -854,9 +888,8 @@ typedef struct probe_lattice {
 static gdr_vec4 level0_plane(const lod_build *b, uint32_t triangle)
 {
     const gdr_vec3 *x = b->mesh->positions;
-    const gdr_cluster *c = ring_cluster(b, triangle << 2);
-    const uint8_t *t = ring_triangle(b, c, triangle << 2);
-    const uint32_t *v = gdr_lod_cluster_vertices(b, c);
+    const uint8_t *t = ring_triangle(b, triangle << 2);
+    const uint32_t *v = ring_vertices(b, triangle << 2);
     gdr_vec3 a = x[v[t[0]]], e1 = sub3(x[v[t[1]]], a), e2 = sub3(x[v[t[2]]], a);
     gdr_vec3 n = {e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x};
     float length = sqrtf(dot3(n, n));
@@ -991,7 +1024,7 @@ static void triangle_corners(const lod_scratch *s, uint32_t t, gdr_vec3 v[3])
  * two group vertices as t's edge k; UINT32_MAX when none. */
 static uint32_t earlier_edge(const lod_scratch *s, uint32_t t, int k)
 {
-    uint32_t a = s->out_corners[(size_t)t * 3 + k], b = s->out_corners[(size_t)t * 3 + (k + 1) % 3];
+    uint32_t a = s->out_corners[(size_t)t * 3 + k], b = s->out_corners[(size_t)t * 3 + (k == 2 ? 0 : k + 1)];
     for (uint32_t i = s->ring_start[a]; i < s->ring_start[a + 1] && s->ring[i] < t; i++) {
         const uint32_t *u = s->out_corners + (size_t)s->ring[i] * 3;
         for (int j = 0; j < 3; j++)
@@ -1036,9 +1069,6 @@ static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor,
 {
     probe_state ps = {b, s, floor * floor, floor * floor, 0.0f, 0.0f, 0};
     float cap2 = cap * cap;
-    s->region_built = 0;
-    s->span_built = 0;
-    s->grid_holds_samples = 0;
     if (!LOD_RESERVE(s, coarse_d2, (size_t)s->out_triangle_count + 1) ||
         !LOD_RESERVE(s, edge_d2, (size_t)s->out_triangle_count * 3 + 1))
         return -1.0f;
@@ -1161,6 +1191,12 @@ int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *member
 {
     if (!output_triangles(s, r, local_count) || !gather_samples(b, s, members, count))
         return 0;
+    /* The grids of the level-0 triangles around the samples and the corners, and of the samples, are
+     * built when the probes first need them and kept for the group: group_floor probes again over
+     * the same triangles and samples. */
+    s->region_built = 0;
+    s->span_built = 0;
+    s->grid_holds_samples = 0;
     s->top.count = 0; /* a group without samples keeps none */
     s->top.limit = LOD_KEPT_FIRST;
     float to_simplified = s->gathered ? samples_to_simplified(b, s, local_count) : 0.0f;

@@ -30,7 +30,7 @@ static uint32_t cell_coordinate(const lod_grid *g, float x, int k)
     float c = (x - g->lo[k]) * g->inv_cell;
     if (!(c > 0.0f))
         return 0;
-    return c >= (float)(g->dim[k] - 1) ? g->dim[k] - 1 : (uint32_t)c;
+    return c >= g->top[k] ? g->dim[k] - 1 : (uint32_t)c;
 }
 
 /* The points lie on a surface: about two per occupied cell when the cell edge is about twice the
@@ -72,6 +72,8 @@ static void choose_cells(lod_grid *g, const float hi[3], uint32_t n, double spac
             cell = extent[k] / (float)g->dim[k] * 1.0001f;
     g->cell = cell;
     g->inv_cell = 1.0f / cell;
+    for (int k = 0; k < 3; k++)
+        g->top[k] = (float)(g->dim[k] - 1);
 }
 
 static uint32_t point_cell(const lod_grid *g, gdr_vec3 p)
@@ -133,12 +135,14 @@ int lod_grid_build(lod_grid *g, const gdr_vec3 *points, uint32_t n, double cells
     return 1;
 }
 
-static void visit_cell(const lod_grid *g, uint32_t x, uint32_t y, uint32_t z, const float q[3], uint32_t *best,
-                       float *best_d2)
+/* The nearest of the points listed in cells first .. last - 1 (cell indices, consecutive along x:
+ * their lists lie one after another) into best; ties: the lowest index. */
+static void visit_cells(const lod_grid *g, size_t first, size_t last, const float q[3], uint32_t *best,
+                        float *best_d2)
 {
-    uint32_t c = (z * g->dim[1] + y) * g->dim[0] + x, found = *best;
+    uint32_t found = *best;
     float found_d2 = *best_d2; /* in locals: through the pointers, every store would be reloaded */
-    for (uint32_t i = g->start[c], end = g->start[c + 1]; i < end; i++) {
+    for (uint32_t i = g->start[first], end = g->start[last]; i < end; i++) {
         uint32_t item = g->items[i];
         const gdr_vec3 p = g->points[item];
         float dx = p.x - q[0], dy = p.y - q[1], dz = p.z - q[2];
@@ -150,6 +154,13 @@ static void visit_cell(const lod_grid *g, uint32_t x, uint32_t y, uint32_t z, co
     }
     *best = found;
     *best_d2 = found_d2;
+}
+
+static void visit_cell(const lod_grid *g, uint32_t x, uint32_t y, uint32_t z, const float q[3], uint32_t *best,
+                       float *best_d2)
+{
+    size_t c = ((size_t)z * g->dim[1] + y) * g->dim[0] + x;
+    visit_cells(g, c, c + 1, q, best, best_d2);
 }
 
 /* Distance from q to the nearest cell the search has not reached once every cell within Chebyshev
@@ -199,8 +210,9 @@ static void reach_range(const lod_grid *g, const float q[3], float reach, int k,
     *hi = b < *hi ? b : *hi;
 }
 
-/* Searches the cells at Chebyshev distance r from `at` (its shell) that lie within the best
- * distance so far of q along every axis; the others hold nothing nearer. */
+/* Searches the cells at Chebyshev distance r > 0 from `at` (its shell) that lie within the best
+ * distance so far of q along every axis; the others hold nothing nearer. A row of cells on the
+ * shell is one run of the items' list. */
 static void visit_shell(const lod_grid *g, const int32_t at[3], int32_t r, const float q[3], uint32_t *best,
                         float *best_d2)
 {
@@ -211,16 +223,20 @@ static void visit_shell(const lod_grid *g, const int32_t at[3], int32_t r, const
         lo[k] = lo[k] > 0 ? lo[k] : 0;
         hi[k] = hi[k] < (int32_t)g->dim[k] - 1 ? hi[k] : (int32_t)g->dim[k] - 1;
     }
+    if (lo[0] > hi[0])
+        return;
     for (int32_t z = lo[2]; z <= hi[2]; z++)
         for (int32_t y = lo[1]; y <= hi[1]; y++) {
-            int shell = z == at[2] - r || z == at[2] + r || y == at[1] - r || y == at[1] + r;
-            for (int32_t x = lo[0]; x <= hi[0]; x++) {
-                if (!shell && x != at[0] - r && x != at[0] + r) {
-                    x = at[0] + r - 1; /* inside the shell: jump to its far face */
-                    continue;
-                }
-                visit_cell(g, (uint32_t)x, (uint32_t)y, (uint32_t)z, q, best, best_d2);
+            size_t row = ((size_t)z * g->dim[1] + (uint32_t)y) * g->dim[0];
+            if (z == at[2] - r || z == at[2] + r || y == at[1] - r || y == at[1] + r) {
+                visit_cells(g, row + (uint32_t)lo[0], row + (uint32_t)hi[0] + 1, q, best, best_d2); /* the row's run */
+                continue;
             }
+            /* a row through the inside: only the shell's two faces (r > 0: two cells) */
+            if (at[0] - r >= lo[0])
+                visit_cells(g, row + (uint32_t)(at[0] - r), row + (uint32_t)(at[0] - r) + 1, q, best, best_d2);
+            if (at[0] + r <= hi[0])
+                visit_cells(g, row + (uint32_t)(at[0] + r), row + (uint32_t)(at[0] + r) + 1, q, best, best_d2);
         }
 }
 
@@ -234,11 +250,11 @@ uint32_t lod_grid_nearest(const lod_grid *g, gdr_vec3 point, float *distance_squ
         at[k] = (int32_t)cell_coordinate(g, q[k], k);
     uint32_t best = UINT32_MAX;
     float best_d2 = INFINITY;
-    for (int32_t r = 0;; r++) {
-        visit_shell(g, at, r, q, &best, &best_d2);
-        if (search_done(g->lo, g->cell, g->dim, at, r, q, best_d2))
-            break;
-    }
+    /* The shell of radius 0 is q's own cell (visited directly: most queries end after it or the
+     * next), then shells outwards until no cell left can hold anything nearer. */
+    visit_cell(g, (uint32_t)at[0], (uint32_t)at[1], (uint32_t)at[2], q, &best, &best_d2);
+    for (int32_t r = 0; !search_done(g->lo, g->cell, g->dim, at, r, q, best_d2);)
+        visit_shell(g, at, ++r, q, &best, &best_d2);
     *distance_squared = best_d2;
     return best;
 }
@@ -264,7 +280,7 @@ static uint32_t tri_cell(const lod_triangle_grid *g, float x, int k)
     float c = (x - g->lo[k]) * g->inv_cell;
     if (!(c > 0.0f))
         return 0;
-    return c >= (float)(g->dim[k] - 1) ? g->dim[k] - 1 : (uint32_t)c;
+    return c >= g->top[k] ? g->dim[k] - 1 : (uint32_t)c;
 }
 
 /* Triangle t's box in cells: each axis's smallest and largest coordinate, then their cells (the
@@ -347,6 +363,7 @@ static void tri_choose_cells(lod_triangle_grid *g, uint32_t n)
     g->cell = shape.cell;
     g->inv_cell = shape.inv_cell;
     memcpy(g->dim, shape.dim, sizeof g->dim);
+    memcpy(g->top, shape.top, sizeof g->top);
 }
 
 /* --- listing a triangle in the cells it crosses ------------------------------------------------ */
@@ -372,7 +389,7 @@ static void clip_plane(const clip_polygon *in, int k, double at, double sign, cl
     out->n = 0;
     out->overflow = in->overflow;
     for (int i = 0; i < in->n && !out->overflow; i++) {
-        const double *a = in->p[i], *b = in->p[(i + 1) % in->n];
+        const double *a = in->p[i], *b = in->p[i + 1 < in->n ? i + 1 : 0];
         double da = sign * (a[k] - at), db = sign * (b[k] - at);
         int crosses = (da >= 0.0) != (db >= 0.0);
         if (out->n + (da >= 0.0) + crosses > CLIP_MAX) {

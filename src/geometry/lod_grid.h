@@ -15,6 +15,7 @@ typedef struct lod_grid {
     float lo[3];
     float cell, inv_cell;
     uint32_t dim[3];
+    float top[3]; /* dim - 1 as floats, to which a coordinate's cell is clamped (computed once) */
     uint32_t *start, *items; /* cell c holds items[start[c] .. start[c + 1]) */
     size_t start_cap, items_cap;
     lod_point_tree tree; /* what answers instead where the cells would be crowded (use_tree) */
@@ -45,6 +46,7 @@ typedef struct lod_triangle_grid {
     float lo[3];
     float cell, inv_cell;
     uint32_t dim[3];
+    float top[3]; /* dim - 1 as floats, to which a coordinate's cell is clamped (computed once) */
     uint32_t count; /* triangles */
     uint32_t cell_limit; /* a query looks at up to this many triangles of a cell (set by the build;
                             a caller with few queries may lift it: exact, see lod_grid.c) */

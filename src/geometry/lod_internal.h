@@ -200,6 +200,8 @@ typedef struct lod_build {
     uint32_t *sample_vertex;   /* position id -> a mesh vertex at that position */
     uint32_t *adjacency_start; /* position id -> level-0 triangles around it: adjacency[start[p] .. start[p + 1]) */
     uint32_t *adjacency;       /* level-0 triangles as cluster << 7 | triangle */
+    uint32_t *level0_offsets;  /* per level-0 cluster: its vertex offset, its triangle offset (compact: the
+                                  walks read them for every triangle they look at) */
     uint32_t *samples;         /* frontier cluster c owns samples[first[c] .. + count[c]) */
     uint32_t sample_count;
     uint32_t *cluster_sample_first, *cluster_sample_count;
@@ -254,7 +256,13 @@ gdr_status gdr_lod_build_observed(gdr_mesh *mesh, const gdr_lod_options *options
 /* Grows *p (a pointer to an array) to hold at least `need` elements of `size` bytes; returns 0 when
  * out of memory. */
 int gdr_lod_reserve(void *p, size_t *cap, size_t need, size_t size);
-#define LOD_RESERVE(s, field, need) gdr_lod_reserve(&(s)->field, &(s)->field##_cap, (need), sizeof *(s)->field)
+/* gdr_lod_reserve with the common case (room enough) inline: the simplifier reserves its fan arrays
+ * at every evaluation. */
+static inline int gdr_lod_reserve_inline(void *p, size_t *cap, size_t need, size_t size)
+{
+    return need <= *cap || gdr_lod_reserve(p, cap, need, size);
+}
+#define LOD_RESERVE(s, field, need) gdr_lod_reserve_inline(&(s)->field, &(s)->field##_cap, (need), sizeof *(s)->field)
 
 static inline size_t gdr_lod_align4(size_t n) { return (n + 3) & ~(size_t)3; }
 /* The root of x in a union-find forest over parent[] (halving the path on the way). */

@@ -45,6 +45,12 @@ typedef struct run {
 
 static inline uint32_t wedge_position(const run *r, uint32_t w) { return r->in->vertex_position[w]; }
 static inline uint32_t corner_position(const run *r, uint32_t c) { return wedge_position(r, r->s->tri[c]); }
+/* The corner j steps on from corner c in its triangle (j < 3), with one division rather than two. */
+static inline uint32_t corner_after(uint32_t c, uint32_t j)
+{
+    uint32_t k = c % 3, m = k + j;
+    return c - k + (m >= 3 ? m - 3 : m);
+}
 
 static inline void load(const run *r, uint32_t p, double out[3])
 {
@@ -164,9 +170,9 @@ static uint32_t gather_neighbours(run *r, const uint32_t *fan, uint32_t n, uint3
     if (n)
         s->mark[corner_position(r, fan[0])] = t; /* not its own neighbour (a degenerate triangle) */
     for (uint32_t i = 0; i < n; i++) {
-        uint32_t c = fan[i], base = c - c % 3;
+        uint32_t c = fan[i];
         for (uint32_t j = 1; j < 3; j++) {
-            uint32_t q = corner_position(r, base + (c % 3 + j) % 3);
+            uint32_t q = corner_position(r, corner_after(c, j));
             if (s->mark[q] != t) {
                 s->mark[q] = t;
                 out[k++] = q;
@@ -185,8 +191,8 @@ static uint32_t gather_candidates(run *r, uint32_t a, const uint32_t *fan, uint3
     uint32_t k = 0, t = ++s->token;
     s->mark[a] = t; /* not its own neighbour (a degenerate triangle) */
     for (uint32_t i = 0; i < n; i++) {
-        uint32_t c = fan[i], base = c - c % 3;
-        uint32_t x = corner_position(r, base + (c % 3 + 1) % 3), y = corner_position(r, base + (c % 3 + 2) % 3);
+        uint32_t c = fan[i];
+        uint32_t x = corner_position(r, corner_after(c, 1)), y = corner_position(r, corner_after(c, 2));
         for (uint32_t j = 0; j < 2; j++) {
             uint32_t q = j ? y : x;
             if (q == a || (j && y == x))
@@ -226,10 +232,10 @@ static double prepare_fan(run *r, const uint32_t *fan, uint32_t n)
     double total = 0.0;
     for (uint32_t i = 0; i < n; i++) {
         lod_simplify_corner *f = &r->s->info[i];
-        uint32_t c = fan[i], base = c - c % 3, w[3];
+        uint32_t c = fan[i], w[3];
         double p[3][3];
         for (uint32_t j = 0; j < 3; j++) {
-            w[j] = r->s->tri[base + (c % 3 + j) % 3];
+            w[j] = r->s->tri[corner_after(c, j)];
             load(r, wedge_position(r, w[j]), p[j]);
         }
         f->wedge = w[0];
@@ -346,8 +352,8 @@ static uint32_t edge_triangles(const run *r, uint32_t b, const uint32_t *fan, ui
 {
     uint32_t k = 0;
     for (uint32_t i = 0; i < n; i++) {
-        uint32_t c = fan[i], base = c - c % 3;
-        k += corner_position(r, base + (c % 3 + 1) % 3) == b || corner_position(r, base + (c % 3 + 2) % 3) == b;
+        uint32_t c = fan[i];
+        k += corner_position(r, corner_after(c, 1)) == b || corner_position(r, corner_after(c, 2)) == b;
     }
     return k;
 }
@@ -409,12 +415,12 @@ static int keeps_orientation(const run *r, uint32_t a, uint32_t b, const uint32_
     double pa[3], pb[3];
     load(r, a, pa), load(r, b, pb);
     for (uint32_t i = 0; i < n; i++) {
-        uint32_t c = fan[i], base = c - c % 3;
+        uint32_t c = fan[i];
         if (triangle_holds(r, c / 3, b))
             continue;
         double p1[3], p2[3], e1[3], e2[3], f1[3], f2[3], n0[3], n1[3];
-        load(r, corner_position(r, base + (c % 3 + 1) % 3), p1);
-        load(r, corner_position(r, base + (c % 3 + 2) % 3), p2);
+        load(r, corner_position(r, corner_after(c, 1)), p1);
+        load(r, corner_position(r, corner_after(c, 2)), p2);
         sub(p1, pa, e1), sub(p2, pa, e2), sub(p1, pb, f1), sub(p2, pb, f2);
         cross(e1, e2, n0), cross(f1, f2, n1);
         double l0 = dot(n0, n0), l1 = dot(n1, n1);
@@ -445,8 +451,8 @@ static int keeps_topology(run *r, uint32_t a, uint32_t b, const uint32_t *fan, u
     }
     uint32_t *fan_b = s->fan_b, m = gather_fan(r, b, fan_b);
     for (uint32_t i = 0; i < m; i++) {
-        uint32_t c = fan_b[i], base = c - c % 3;
-        uint32_t x = corner_position(r, base + (c % 3 + 1) % 3), y = corner_position(r, base + (c % 3 + 2) % 3);
+        uint32_t c = fan_b[i];
+        uint32_t x = corner_position(r, corner_after(c, 1)), y = corner_position(r, corner_after(c, 2));
         if ((x != a && s->mark[x] == near_a) || (y != a && s->mark[y] == near_a))
             return 0;
         if (x == a || y == a || s->mark[x] != third || s->mark[y] != third)
@@ -680,6 +686,34 @@ static void build_lists(run *r)
     }
 }
 
+/* For every corner c (at position pa, the next corner of its triangle at pb), the entries of pa's
+ * corner list whose triangle holds pb, into along[c]: how many triangles lie along the edge pa-pb as
+ * build_quadrics counts them. One pass over each position's list counts every position its
+ * triangles hold (a triangle once per entry), instead of a pass over the list per edge. */
+static void count_along(run *r, uint32_t *along)
+{
+    lod_simplify_scratch *s = r->s;
+    for (uint32_t pa = 0; pa < r->in->position_count; pa++) {
+        uint32_t t = ++s->token;
+        for (uint32_t c = s->head[pa]; c != NONE; c = s->next[c]) {
+            uint32_t base = c - c % 3, q[3];
+            for (uint32_t j = 0; j < 3; j++)
+                q[j] = corner_position(r, base + j);
+            for (uint32_t j = 0; j < 3; j++) {
+                if ((j > 0 && q[j] == q[0]) || (j > 1 && q[j] == q[1]))
+                    continue; /* a position the triangle holds twice counts once */
+                if (s->mark[q[j]] != t) {
+                    s->mark[q[j]] = t;
+                    s->slot[q[j]] = 0;
+                }
+                s->slot[q[j]]++;
+            }
+        }
+        for (uint32_t c = s->head[pa]; c != NONE; c = s->next[c])
+            along[c] = s->slot[corner_position(r, corner_after(c, 1))];
+    }
+}
+
 /* Area-weighted triangle planes, and for each open border edge (one triangle along it, or more than
  * two: a non-manifold edge) a plane through it perpendicular to its triangle. */
 static void build_quadrics(run *r)
@@ -687,6 +721,8 @@ static void build_quadrics(run *r)
     lod_simplify_scratch *s = r->s;
     const lod_simplify_input *in = r->in;
     memset(s->quadric, 0, (size_t)in->position_count * QUADRIC_SIZE * sizeof *s->quadric);
+    uint32_t *along_edge = s->fan; /* free until the first evaluation */
+    count_along(r, along_edge);
     size_t nt = in->index_count / 3;
     for (size_t t = 0; t < nt; t++) {
         if (!s->alive[t])
@@ -705,10 +741,7 @@ static void build_quadrics(run *r)
                               -dot(nrm, p[0]), 0.5 * len);
         for (uint32_t j = 0; j < 3; j++) {
             uint32_t pa = corner_position(r, (uint32_t)t * 3 + j), pb = corner_position(r, (uint32_t)t * 3 + (j + 1) % 3);
-            uint32_t along = 0;
-            for (uint32_t c = s->head[pa]; c != NONE; c = s->next[c])
-                along += triangle_holds(r, c / 3, pb);
-            if (along == 2)
+            if (along_edge[t * 3 + j] == 2)
                 continue;
             s->flags[pa] |= FLAG_BORDER;
             s->flags[pb] |= FLAG_BORDER;
