@@ -1108,7 +1108,7 @@ static int collect_excess(lod_scratch *s, group_result *r, float floor)
  * D2, and the smallest kept bound once the kept bounds are full. Where D1 is set by the few samples
  * farther than all others and the members' errors, D2 is measured again down to that level: the
  * part of its error that no redirection of samples can lower. Both measures bound D2: the smaller
- * is left in *to_full. Not where that level is above LOD_REDIRECT_GAIN of the error, and no
+ * is left in *to_full, but not below the group's texture slide, which *to_full holds already. Not where that level is above LOD_REDIRECT_GAIN of the error, and no
  * further once D2 is: no redirection would pay. */
 static float group_floor(const lod_build *b, lod_scratch *s, const group_result *r, float to_simplified,
                          float *to_full)
@@ -1117,6 +1117,8 @@ static float group_floor(const lod_build *b, lod_scratch *s, const group_result 
     float floor = r->error > rest ? r->error : rest;
     if (to_simplified > floor && *to_full >= 0.0f && floor <= LOD_REDIRECT_GAIN * *to_full) {
         float again = simplified_to_full(b, s, floor, LOD_REDIRECT_GAIN * *to_full);
+        if (again >= 0.0f && again < r->slide)
+            again = r->slide; /* the texture slides that far on the simplified surface, as measured first */
         *to_full = again < *to_full ? again : *to_full;
     }
     return *to_full > floor ? *to_full : floor;
