@@ -6,7 +6,8 @@
  * field continues across the collapsed edge), else the wedge of b that best continues wa's field:
  * wa's surviving triangles' affine uv and normal, extrapolated to b's position, compared with each
  * wedge of b. The cost of a collapse is the mean squared distance of a's Garland-Heckbert quadric
- * at b plus that attribute error averaged over a's fan (both squared lengths). A heap keeps each
+ * at b plus the normals' error averaged over a's fan plus the largest texture slide it charges a
+ * triangle, at most the triangle's longest edge (all squared lengths). A heap keeps each
  * position's cheapest collapse as last evaluated; a popped position is evaluated again and moves
  * only if it is still no dearer than the next one (lazy re-evaluation). Collapses run in passes: a
  * position moved onto waits for the next pass, and a pass ends past 1.5 x the cost that would
@@ -27,10 +28,12 @@
 /* Weight of an open border's edge plane, per squared edge length: keeps borders in place against
  * the area-weighted planes of the surface. */
 #define BORDER_WEIGHT 4.0
-/* A texture slide (mesh length) costs its square times this; a normal's change costs as a length
- * of |delta n| times the square root of its triangle's area (a surface tilted by that angle over
- * the triangle's size), squared, times NORMAL_WEIGHT. Chosen by measurement (docs/GEOMETRY.md). */
-#define UV_WEIGHT 0.5
+/* The largest texture slide of a collapse (mesh length, capped by the triangle's longest edge)
+ * costs its square times this, as a squared distance does: the slide enters the group's error as
+ * the deviation does. A normal's change costs as a length of |delta n| times the square root of its
+ * triangle's area (a surface tilted by that angle over the triangle's size), squared, times
+ * NORMAL_WEIGHT, averaged over the fan by area. Chosen by measurement (docs/GEOMETRY.md). */
+#define UV_WEIGHT 1.0
 #define NORMAL_WEIGHT 0.5
 /* A triangle may turn by at most about 75 degrees in one collapse. */
 #define MIN_NORMAL_COS 0.25
@@ -268,17 +271,21 @@ static double prepare_fan(run *r, const uint32_t *fan, uint32_t n)
 }
 
 /* For each corner of the fan whose triangle survives moving onto the target (not holds_b), its
- * triangle's affine uv and normal extrapolated over its plane to q, the target's position (once per
- * target: every wedge of the target is compared with them). */
+ * triangle's longest edge once moved there, and its affine uv and normal extrapolated over its plane
+ * to q, the target's position (once per target: every wedge of the target is compared with them). */
 static void extrapolate_fan(const run *r, uint32_t n, const double q[3])
 {
     for (uint32_t i = 0; i < n; i++) {
         lod_simplify_corner *f = &r->s->info[i];
-        if (f->holds_b || f->inv_det == 0.0)
+        if (f->holds_b)
             continue;
-        double d[3];
+        double d[3], e12[3];
         sub(q, f->p0, d);
+        sub(f->e1, f->e2, e12);
         double r1 = dot(d, f->e1), r2 = dot(d, f->e2);
+        f->edge2_at_q = fmax(fmax(f->g11 - 2.0 * r1 + dot(d, d), f->g22 - 2.0 * r2 + dot(d, d)), dot(e12, e12));
+        if (f->inv_det == 0.0)
+            continue;
         double u = (f->g22 * r1 - f->g12 * r2) * f->inv_det, v = (f->g11 * r2 - f->g12 * r1) * f->inv_det;
         if (f->uv_scale > 0.0)
             for (int k = 0; k < 2; k++)
@@ -290,32 +297,32 @@ static void extrapolate_fan(const run *r, uint32_t n, const double q[3])
 }
 
 /* The error of giving a fan corner the attributes of wedge wb at the target (extrapolate_fan):
- * its triangle's uv and normal there against wb's. Returns the area-weighted squared length;
- * *slide2 gets the texture slide (squared mesh length). */
+ * its triangle's normal there against wb's, as an area-weighted squared length (returned), and its
+ * uv against wb's: the texture slide, a squared mesh length (*slide2). */
 static double corner_attribute_error(const run *r, const lod_simplify_corner *f, uint32_t wb, double *slide2)
 {
     const lod_simplify_input *in = r->in;
     *slide2 = 0.0;
     if (f->inv_det == 0.0)
         return 0.0;
-    double error = 0.0;
     const uint32_t mb = in->vertex_source[wb];
     if (f->uv_scale > 0.0) {
         const gdr_vec2 tb = in->uvs[mb];
         double du = f->uv_at_q[0] - tb.x, dv = f->uv_at_q[1] - tb.y;
         *slide2 = (du * du + dv * dv) * f->uv_scale;
-        error += *slide2 * UV_WEIGHT;
     }
-    if (in->normals) {
-        const gdr_vec3 nb = in->normals[mb];
-        double dx = f->normal_at_q[0] - nb.x, dy = f->normal_at_q[1] - nb.y, dz = f->normal_at_q[2] - nb.z;
-        error += (dx * dx + dy * dy + dz * dz) * f->area * (in->normal_weight > 0.0 ? in->normal_weight : NORMAL_WEIGHT);
-    }
-    return error * f->area;
+    if (!in->normals)
+        return 0.0;
+    const gdr_vec3 nb = in->normals[mb];
+    double dx = f->normal_at_q[0] - nb.x, dy = f->normal_at_q[1] - nb.y, dz = f->normal_at_q[2] - nb.z;
+    return (dx * dx + dy * dy + dz * dz) * f->area * (in->normal_weight > 0.0 ? in->normal_weight : NORMAL_WEIGHT) *
+           f->area;
 }
 
-/* The error of wedge wa taking wedge wb when a moves to q = b's position: over wa's triangles that
- * survive (those not holding b). */
+/* The error of wedge wa taking wedge wb when a moves to q = b's position, over wa's triangles that
+ * survive (those not holding b): the normals' area-weighted error (returned), and in *slide2 the
+ * largest slide a triangle would be charged for it, at most the triangle's longest edge (squared),
+ * as the group's error counts it (output_slide). */
 static double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, double *slide2)
 {
     double error = 0.0;
@@ -326,6 +333,7 @@ static double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, do
             continue;
         double s2;
         error += corner_attribute_error(r, f, wb, &s2);
+        s2 = s2 < f->edge2_at_q ? s2 : f->edge2_at_q;
         *slide2 = s2 > *slide2 ? s2 : *slide2;
     }
     return error;
@@ -359,9 +367,12 @@ static uint32_t edge_triangles(const run *r, uint32_t b, const uint32_t *fan, ui
 }
 
 /* The cost of moving a (fan prepared in s->info, its area, wedges) onto b, its geometric part
- * (pair_geometry, finite) given: that plus the attribute error's mean over a's fan (both squared
- * lengths); sets s->choice for a's wedges and s->choice_slide to the texture slide each of them is
- * charged taking it. */
+ * (pair_geometry, finite) given: that plus the normals' error averaged over a's fan by area plus the
+ * largest texture slide a surviving triangle would be charged, at most its longest edge (all squared
+ * lengths). The slide is weighed as the group's error counts it (output_slide: the largest over the
+ * triangles, capped by their size), not averaged by area: a slide on a thin triangle or across charts
+ * sets the group's error as much as one on a large triangle does. Sets s->choice for a's wedges (each
+ * the wedge of b with the least normal error plus slide). */
 static double pair_cost(run *r, uint32_t b, double geometry, const uint32_t *fan, uint32_t n, double area,
                         const uint32_t *wedges, uint32_t wedge_count)
 {
@@ -374,10 +385,10 @@ static double pair_cost(run *r, uint32_t b, double geometry, const uint32_t *fan
     load(r, b, q);
     extrapolate_fan(r, n, q);
     uint32_t b_wedges = NONE;
-    double attribute = 0.0;
+    double normal = 0.0, slide2 = 0.0, scale = area > 0.0 ? 1.0 / area : 0.0;
     for (uint32_t k = 0; k < wedge_count; k++) {
         uint32_t wa = wedges[k], best = NONE;
-        double best_error = INFINITY, best_slide = 0.0, e, s2;
+        double best_error = INFINITY, best_normal = 0.0, best_slide2 = 0.0, e, n2, s2;
         /* the wedges of b that share a triangle along a-b with wa */
         for (uint32_t i = 0; i < n; i++) {
             if (s->info[i].wedge != wa || !s->info[i].holds_b)
@@ -385,8 +396,11 @@ static double pair_cost(run *r, uint32_t b, double geometry, const uint32_t *fan
             uint32_t c = fan[i], base = c - c % 3;
             for (uint32_t j = 0; j < 3; j++) {
                 uint32_t wb = s->tri[base + j];
-                if (wedge_position(r, wb) == b && wb != best && (e = wedge_error(r, n, wa, wb, &s2)) < best_error)
-                    best = wb, best_error = e, best_slide = s2;
+                if (wedge_position(r, wb) != b || wb == best)
+                    continue;
+                n2 = wedge_error(r, n, wa, wb, &s2) * scale;
+                if ((e = n2 + s2 * UV_WEIGHT) < best_error)
+                    best = wb, best_error = e, best_normal = n2, best_slide2 = s2;
             }
         }
         if (best == NONE) { /* a seam or hard-edge corner: the wedge of b that best continues wa */
@@ -394,17 +408,19 @@ static double pair_cost(run *r, uint32_t b, double geometry, const uint32_t *fan
                 uint32_t m = gather_fan(r, b, s->fan_b);
                 b_wedges = gather_wedges(r, s->fan_b, m, s->wedges_b);
             }
-            for (uint32_t j = 0; j < b_wedges; j++)
-                if ((e = wedge_error(r, n, wa, s->wedges_b[j], &s2)) < best_error || best == NONE)
-                    best = s->wedges_b[j], best_error = e, best_slide = s2;
+            for (uint32_t j = 0; j < b_wedges; j++) {
+                n2 = wedge_error(r, n, wa, s->wedges_b[j], &s2) * scale;
+                if ((e = n2 + s2 * UV_WEIGHT) < best_error || best == NONE)
+                    best = s->wedges_b[j], best_error = e, best_normal = n2, best_slide2 = s2;
+            }
         }
         if (best == NONE)
             return INFINITY;
         s->choice[wa] = best;
-        s->choice_slide[wa] = (float)sqrt(best_slide);
-        attribute += best_error;
+        normal += best_normal;
+        slide2 = best_slide2 > slide2 ? best_slide2 : slide2;
     }
-    return geometry + (area > 0.0 ? attribute / area : 0.0);
+    return geometry + normal + slide2 * UV_WEIGHT;
 }
 
 /* --- validity ----------------------------------------------------------------------------------------- */
@@ -567,11 +583,16 @@ static void collapse(run *r, uint32_t a, uint32_t b)
         return;
     uint32_t wedge_count = gather_wedges(r, s->fan, n, s->wedges);
     pair_cost(r, b, pair_geometry(r, a, b, edge_triangles(r, b, s->fan, n)), s->fan, n, prepare_fan(r, s->fan, n), s->wedges,
-              wedge_count); /* sets s->choice */
-    for (uint32_t k = 0; k < wedge_count; k++) { /* the slide charged to the wedges a's corners take */
-        uint32_t wb = s->choice[s->wedges[k]];
-        float slide = s->choice_slide[s->wedges[k]];
-        s->wedge_slide[wb] = slide > s->wedge_slide[wb] ? slide : s->wedge_slide[wb];
+              wedge_count); /* sets s->choice, and s->info for b */
+    for (uint32_t i = 0; i < n; i++) { /* the slide charged to each surviving triangle whose corner moves */
+        const lod_simplify_corner *f = &s->info[i];
+        double s2;
+        if (f->holds_b)
+            continue;
+        corner_attribute_error(r, f, s->choice[f->wedge], &s2);
+        float slide = (float)sqrt(s2);
+        uint32_t t = s->fan[i] / 3;
+        s->tri_slide[t] = slide > s->tri_slide[t] ? slide : s->tri_slide[t];
     }
     for (uint32_t i = 0; i < n; i++) {
         uint32_t c = s->fan[i];
@@ -617,7 +638,7 @@ static int reserve(lod_simplify_scratch *s, const lod_simplify_input *in)
            LOD_RESERVE(s, fan_b, nc) && LOD_RESERVE(s, wedges, in->vertex_count) &&
            LOD_RESERVE(s, wedges_b, in->vertex_count) &&
            LOD_RESERVE(s, choice, in->vertex_count) && LOD_RESERVE(s, costs, np) && LOD_RESERVE(s, slot, np) &&
-           LOD_RESERVE(s, wedge_slide, in->vertex_count) && LOD_RESERVE(s, choice_slide, in->vertex_count);
+           LOD_RESERVE(s, tri_slide, nc / 3 + 1);
 }
 
 /* The k-th smallest of n values (reordering them). */
@@ -760,21 +781,23 @@ static void build_quadrics(run *r)
     }
 }
 
-/* The largest texture slide of the output triangles (wedges): a triangle's is the largest slide a
- * collapse charged to its corners' wedges, but at most its longest edge. A slide confined to a
+/* The largest texture slide of the output triangles: a triangle's is the largest slide a collapse
+ * charged to it (moving one of its corners), but at most its longest edge. A slide confined to a
  * triangle changes at most the pixels the triangle covers, as a surface moved by the triangle's size
  * would: where a seam corner takes the uv of another chart its slide in mesh length can exceed the
  * model, while the texels it spoils lie within its triangles. A collapse's slide is measured against
  * the level it simplifies, as before (not summed over the collapses of a group: summed, it kept
  * WaterBottle at 34% of its triangles at 256 x 144 pixels instead of 27%, at the same image). */
-static float output_slide(const run *r, const uint32_t *wedges, size_t triangles)
+static float output_slide(const run *r)
 {
     float largest = 0.0f;
-    for (size_t t = 0; t < triangles; t++) {
-        const uint32_t *w = wedges + t * 3;
-        float slide = 0.0f, edge2 = 0.0f;
+    size_t nt = r->in->index_count / 3;
+    for (size_t t = 0; t < nt; t++) {
+        if (!r->s->alive[t] || r->s->tri_slide[t] == 0.0f)
+            continue;
+        const uint32_t *w = r->s->tri + t * 3;
+        float slide = r->s->tri_slide[t], edge2 = 0.0f;
         for (int k = 0; k < 3; k++) {
-            slide = r->s->wedge_slide[w[k]] > slide ? r->s->wedge_slide[w[k]] : slide;
             double p[3], q[3], d[3];
             load(r, wedge_position(r, w[k]), p);
             load(r, wedge_position(r, w[(k + 1) % 3]), q);
@@ -796,7 +819,7 @@ int lod_simplify(lod_simplify_scratch *s, const lod_simplify_input *in, uint32_t
     run r = {.s = s, .in = in};
     build_lists(&r);
     build_quadrics(&r);
-    memset(s->wedge_slide, 0, in->vertex_count * sizeof *s->wedge_slide);
+    memset(s->tri_slide, 0, (in->index_count / 3) * sizeof *s->tri_slide);
     s->heap_count = 0;
     r.pass = 1;
     uint32_t pass_start = UINT32_MAX;
@@ -846,7 +869,7 @@ int lod_simplify(lod_simplify_scratch *s, const lod_simplify_input *in, uint32_t
             for (uint32_t j = 0; j < 3; j++)
                 out[k++] = s->tri[t * 3 + j];
     res->index_count = k;
-    res->slide = output_slide(&r, out, k / 3);
+    res->slide = output_slide(&r);
     return 1;
 }
 
@@ -869,8 +892,7 @@ void lod_simplify_scratch_free(lod_simplify_scratch *s)
     free(s->wedges);
     free(s->wedges_b);
     free(s->choice);
-    free(s->wedge_slide);
-    free(s->choice_slide);
+    free(s->tri_slide);
     free(s->costs);
     free(s->geometry);
     free(s->exact);

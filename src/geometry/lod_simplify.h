@@ -30,8 +30,8 @@ typedef struct lod_simplify_input {
 typedef struct lod_simplify_result {
     size_t index_count;  /* triangles kept, written as wedge ids */
     uint32_t collapses;
-    float slide;         /* the largest texture slide of an output triangle: charged by a collapse to one
-                            of its corners' wedges, at most its longest edge (mesh units) */
+    float slide;         /* the largest texture slide of an output triangle: charged to it by a collapse
+                            that moved one of its corners, at most its longest edge (mesh units) */
 } lod_simplify_result;
 
 /* A position's cheapest collapse as last evaluated (the heap holds at most one per position). */
@@ -48,6 +48,7 @@ typedef struct lod_simplify_corner {
     double p0[3], e1[3], e2[3], g11, g12, g22, inv_det, area, uv_scale;
     double t0[2], t1[2], t2[2], n0[3], n1[3], n2[3];
     double uv_at_q[2], normal_at_q[3]; /* the uv and normal extrapolated to the target evaluated */
+    double edge2_at_q;                 /* the squared longest edge of the triangle moved to the target */
     uint32_t wedge, other[2]; /* the corner's wedge, the positions of the triangle's other corners */
     int holds_b;              /* the triangle holds the position evaluated as target */
 } lod_simplify_corner;
@@ -89,10 +90,10 @@ typedef struct lod_simplify_scratch {
     size_t edge_count_cap;
     uint32_t *slot;       /* per position: its index among the neighbours gathered (with mark) */
     size_t slot_cap;
-    /* per wedge: the largest texture slide (mesh length) a collapse charged to a corner taking it
-     * (wedge_slide), and of the collapse evaluated, the slide charged to it taking its choice */
-    float *wedge_slide, *choice_slide;
-    size_t wedge_slide_cap, choice_slide_cap;
+    /* per triangle: the largest texture slide (mesh length) a collapse charged to it, moving one of its
+     * corners onto another position's wedge */
+    float *tri_slide;
+    size_t tri_slide_cap;
     lod_simplify_corner *info; /* per corner of the fan evaluated */
     size_t info_cap;
 } lod_simplify_scratch;
