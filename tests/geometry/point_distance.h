@@ -3,6 +3,7 @@
 #define GDR_TEST_POINT_DISTANCE_H
 
 #include <math.h>
+#include <stdint.h>
 
 #include "gdr/geometry.h"
 
@@ -38,6 +39,15 @@ static inline double point_triangle(dvec3 p, dvec3 a, dvec3 b, dvec3 c)
             best = fmin(best, fabs(d3_dot(w, n)) / sqrt(nn));
     }
     return best;
+}
+
+/* The length of the edge between positions a and b of a packed array (3 floats a position). */
+static inline float packed_edge_length(const float *positions, uint32_t a, uint32_t b)
+{
+    float d[3];
+    for (int k = 0; k < 3; k++)
+        d[k] = positions[a * 3 + (uint32_t)k] - positions[b * 3 + (uint32_t)k];
+    return sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
 }
 
 #endif

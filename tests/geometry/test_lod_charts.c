@@ -12,20 +12,13 @@
 #include <stdlib.h>
 
 #include "geometry/lod_simplify.h"
+#include "point_distance.h"
 #include "test_util.h"
 
 #define QUADS 48
 #define CHART 3 /* quads per chart side: 256 charts */
 #define POSITIONS ((QUADS + 1) * (QUADS + 1))
 #define TRIANGLES (QUADS * QUADS * 2)
-
-static float edge_length(const float *positions, uint32_t a, uint32_t b)
-{
-    float d[3];
-    for (int k = 0; k < 3; k++)
-        d[k] = positions[a * 3 + (uint32_t)k] - positions[b * 3 + (uint32_t)k];
-    return sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-}
 
 /* A gently rolling unit sheet (the geometric costs are not all zero), its grid's positions. */
 static void sheet_positions(float *positions)
@@ -89,7 +82,7 @@ int main(void)
     double sum = 0.0;
     for (size_t t = 0; t < kept; t++)
         for (int j = 0; j < 3; j++)
-            sum += edge_length(positions, vertex_position[out[t * 3 + (size_t)j]],
+            sum += packed_edge_length(positions, vertex_position[out[t * 3 + (size_t)j]],
                                vertex_position[out[t * 3 + (size_t)(j + 1) % 3]]);
     double mean = kept ? sum / (3.0 * (double)kept) : 0.0;
     printf("test_lod_charts: %u triangles in %u charts -> %zu, slide %.4f, mean edge %.4f (%.2fx)\n", TRIANGLES,

@@ -9,19 +9,12 @@
 #include <stdlib.h>
 
 #include "geometry/lod_simplify.h"
+#include "point_distance.h"
 #include "test_util.h"
 
 #define QUADS 12
 #define POSITIONS ((QUADS + 1) * (QUADS + 1))
 #define TRIANGLES (QUADS * QUADS * 2)
-
-static float edge_length(const float *positions, uint32_t a, uint32_t b)
-{
-    float d[3];
-    for (int k = 0; k < 3; k++)
-        d[k] = positions[a * 3 + (uint32_t)k] - positions[b * 3 + (uint32_t)k];
-    return sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-}
 
 int main(void)
 {
@@ -69,7 +62,7 @@ int main(void)
     float longest = 0.0f;
     for (size_t t = 0; t < kept; t++)
         for (int k = 0; k < 3; k++) {
-            float e = edge_length(positions, vertex_position[out[t * 3 + (size_t)k]],
+            float e = packed_edge_length(positions, vertex_position[out[t * 3 + (size_t)k]],
                                   vertex_position[out[t * 3 + (size_t)(k + 1) % 3]]);
             longest = e > longest ? e : longest;
         }
