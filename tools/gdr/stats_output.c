@@ -23,7 +23,8 @@ static void stats_print_pvs(FILE *out, const gdr_pvs_stats *pvs)
         fprintf(out, "pvs                 on: camera in none of the %u baked cells, nothing culled by it\n", pvs->cells);
 }
 
-void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats *s)
+/* The scene, the device, the target and the instances' culling. */
+static void print_scene_lines(FILE *out, const stats_context *context, const gdr_frame_stats *s)
 {
     fprintf(out, "scene               %s\n", context->scene);
     fprintf(out, "device              %s (%s)\n", s->device, s->driver);
@@ -41,60 +42,90 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
         fprintf(out, "instances_points    %u (drawn as their point level)\n", s->instances_points);
     stats_print_pvs(out, &s->pvs);
     fprintf(out, "triangles           %llu\n", (unsigned long long)s->triangles);
-    if (s->pipeline == GDR_PIPELINE_MESH) {
-        fprintf(out, "meshlets_total      %llu\n", (unsigned long long)s->meshlets_total);
-        fprintf(out, "meshlets_tested     %u (of visible instances)\n", s->meshlets_tested);
-        fprintf(out, "meshlets_frustum_culled %u\n", s->meshlets_frustum_culled);
-        fprintf(out, "meshlets_cone_culled %u\n", s->meshlets_cone_culled);
-        fprintf(out, "meshlets_visible    %u\n", s->meshlets_visible);
-        fprintf(out, "triangles_culled    %u back-facing, %u covering no sample\n", s->triangles_backface_culled,
-                s->triangles_small_culled);
-        fprintf(out, "task_workgroups     %u (in 1 indirect mesh-tasks launch; %u lost to overflow)\n",
-                s->task_workgroups, s->task_overflow);
-        fprintf(out, "raster              %s (%s)\n", gdr_raster_name(s->raster.mode), s->raster.reason);
-        if (s->raster.mode != GDR_RASTER_FORWARD) {
-            const uint32_t *tiny = s->raster.sw_tiny_class_clusters;
-            fprintf(out, "raster_clusters     compute %u (%u tiny: %u/%u/%u of 8/16/32; %llu triangles), "
-                         "mesh shaders %u (%llu triangles)", s->raster.sw_clusters, s->raster.sw_tiny_clusters, tiny[0],
-                    tiny[1], tiny[2], (unsigned long long)s->raster.sw_triangles, s->raster.hw_clusters,
-                    (unsigned long long)s->raster.hw_triangles);
-            if (s->raster.mode == GDR_RASTER_HYBRID)
-                fprintf(out, "; threshold %g px", (double)s->raster.sw_threshold_px);
-            fprintf(out, s->raster.overflow ? "; %u lost to overflow\n" : "\n", s->raster.overflow);
-            fprintf(out, "raster_gpu_ms       cluster cull %.4f, mesh shaders %.4f, compute %.4f, resolve %.4f "
-                         "(part of draw)\n", s->raster.cull_ms, s->raster.hw_ms, s->raster.sw_ms, s->raster.resolve_ms);
-        }
-        if (s->traversal.applied)
-            fprintf(out, "lod_hierarchy       %u levels; nodes %u tested (%u late), %u LOD-culled, %u outside the frustum, "
-                         "%u deferred, %u occluded%s\n", s->traversal.levels, s->traversal.nodes_tested,
-                    s->traversal.late_nodes_tested, s->traversal.nodes_lod_culled, s->traversal.nodes_frustum_culled,
-                    s->traversal.nodes_early_occluded, s->traversal.nodes_occluded,
-                    s->traversal.overflow ? "; VISITS LOST TO OVERFLOW" : "");
-        if (s->traversal.overflow)
-            fprintf(out, "traversal_overflow  %u node visits did not fit (their clusters were not drawn)\n",
-                    s->traversal.overflow);
-        if (s->lod.applied) {
-            fprintf(out, "meshlets_lod_culled %u (not in the LOD cut)\n", s->lod.meshlets_culled);
-            fprintf(out, "lod_depths          clusters/triangles drawn per DAG depth:");
-            for (uint32_t d = 0; d < s->lod.depth_count; d++)
-                fprintf(out, " %u:%u/%llu", d, s->lod.clusters_per_depth[d],
-                        (unsigned long long)s->lod.triangles_per_depth[d]);
-            fputc('\n', out);
-        }
-    } else if (s->pipeline == GDR_PIPELINE_CPU) {
+}
+
+/* The rasteriser's choice and, where compute rasterises, its split of the clusters. */
+static void print_raster_lines(FILE *out, const gdr_frame_stats *s)
+{
+    fprintf(out, "raster              %s (%s)\n", gdr_raster_name(s->raster.mode), s->raster.reason);
+    if (s->raster.mode == GDR_RASTER_FORWARD)
+        return;
+    const uint32_t *tiny = s->raster.sw_tiny_class_clusters;
+    fprintf(out, "raster_clusters     compute %u (%u tiny: %u/%u/%u of 8/16/32; %llu triangles), "
+                 "mesh shaders %u (%llu triangles)", s->raster.sw_clusters, s->raster.sw_tiny_clusters, tiny[0],
+            tiny[1], tiny[2], (unsigned long long)s->raster.sw_triangles, s->raster.hw_clusters,
+            (unsigned long long)s->raster.hw_triangles);
+    if (s->raster.mode == GDR_RASTER_HYBRID)
+        fprintf(out, "; threshold %g px", (double)s->raster.sw_threshold_px);
+    fprintf(out, s->raster.overflow ? "; %u lost to overflow\n" : "\n", s->raster.overflow);
+    fprintf(out, "raster_gpu_ms       cluster cull %.4f, mesh shaders %.4f, compute %.4f, resolve %.4f "
+                 "(part of draw)\n", s->raster.cull_ms, s->raster.hw_ms, s->raster.sw_ms, s->raster.resolve_ms);
+}
+
+/* The LOD hierarchy's traversal and the cut's clusters by DAG depth. */
+static void print_lod_lines(FILE *out, const gdr_frame_stats *s)
+{
+    if (s->traversal.applied)
+        fprintf(out, "lod_hierarchy       %u levels; nodes %u tested (%u late), %u LOD-culled, %u outside the frustum, "
+                     "%u deferred, %u occluded%s\n", s->traversal.levels, s->traversal.nodes_tested,
+                s->traversal.late_nodes_tested, s->traversal.nodes_lod_culled, s->traversal.nodes_frustum_culled,
+                s->traversal.nodes_early_occluded, s->traversal.nodes_occluded,
+                s->traversal.overflow ? "; VISITS LOST TO OVERFLOW" : "");
+    if (s->traversal.overflow)
+        fprintf(out, "traversal_overflow  %u node visits did not fit (their clusters were not drawn)\n",
+                s->traversal.overflow);
+    if (!s->lod.applied)
+        return;
+    fprintf(out, "meshlets_lod_culled %u (not in the LOD cut)\n", s->lod.meshlets_culled);
+    fprintf(out, "lod_depths          clusters/triangles drawn per DAG depth:");
+    for (uint32_t d = 0; d < s->lod.depth_count; d++)
+        fprintf(out, " %u:%u/%llu", d, s->lod.clusters_per_depth[d], (unsigned long long)s->lod.triangles_per_depth[d]);
+    fputc('\n', out);
+}
+
+/* What the pipeline drew: the mesh pipeline's clusters, rasteriser and LOD, or the draws of the
+ * others. */
+static void print_pipeline_lines(FILE *out, const gdr_frame_stats *s)
+{
+    if (s->pipeline == GDR_PIPELINE_CPU) {
         fprintf(out, "draws               %u (in %u draw calls recorded by the CPU)\n", s->draws, s->draw_calls);
         fprintf(out, "cpu_cull_ms_per_frame %.4f\n", s->cpu_cull_ms_per_frame);
-    } else {
+        return;
+    }
+    if (s->pipeline != GDR_PIPELINE_MESH) {
         fprintf(out, "draws               %u (in %u indirect draw call)\n", s->draws, s->draw_calls);
+        return;
     }
-    if (s->occlusion.applied) {
-        fprintf(out, "occlusion early     instances %u drawn, %u deferred (behind last frame's pyramid); clusters %u drawn, "
-                "%u deferred; %u overflow\n", s->occlusion.instances_early_drawn, s->occlusion.instances_early_occluded,
-                s->occlusion.meshlets_early_drawn, s->occlusion.meshlets_early_occluded, s->occlusion.overflow);
-        fprintf(out, "occlusion late      instances %u tested, %u occluded, %u drawn; clusters %u tested, %u occluded, "
-                "%u drawn\n", s->occlusion.instances_late_tested, s->occlusion.instances_late_occluded, s->occlusion.instances_late_drawn,
-                s->occlusion.meshlets_late_tested, s->occlusion.meshlets_late_occluded, s->occlusion.meshlets_late_drawn);
-    }
+    fprintf(out, "meshlets_total      %llu\n", (unsigned long long)s->meshlets_total);
+    fprintf(out, "meshlets_tested     %u (of visible instances)\n", s->meshlets_tested);
+    fprintf(out, "meshlets_frustum_culled %u\n", s->meshlets_frustum_culled);
+    fprintf(out, "meshlets_cone_culled %u\n", s->meshlets_cone_culled);
+    fprintf(out, "meshlets_visible    %u\n", s->meshlets_visible);
+    fprintf(out, "triangles_culled    %u back-facing, %u covering no sample\n", s->triangles_backface_culled,
+            s->triangles_small_culled);
+    fprintf(out, "task_workgroups     %u (in 1 indirect mesh-tasks launch; %u lost to overflow)\n", s->task_workgroups,
+            s->task_overflow);
+    print_raster_lines(out, s);
+    print_lod_lines(out, s);
+}
+
+/* The two occlusion phases. */
+static void print_occlusion_lines(FILE *out, const gdr_frame_stats *s)
+{
+    if (!s->occlusion.applied)
+        return;
+    fprintf(out, "occlusion early     instances %u drawn, %u deferred (behind last frame's pyramid); clusters %u drawn, "
+            "%u deferred; %u overflow\n", s->occlusion.instances_early_drawn, s->occlusion.instances_early_occluded,
+            s->occlusion.meshlets_early_drawn, s->occlusion.meshlets_early_occluded, s->occlusion.overflow);
+    fprintf(out, "occlusion late      instances %u tested, %u occluded, %u drawn; clusters %u tested, %u occluded, "
+            "%u drawn\n", s->occlusion.instances_late_tested, s->occlusion.instances_late_occluded,
+            s->occlusion.instances_late_drawn, s->occlusion.meshlets_late_tested, s->occlusion.meshlets_late_occluded,
+            s->occlusion.meshlets_late_drawn);
+}
+
+/* Time a frame (CPU, GPU, per pass) and memory. */
+static void print_cost_lines(FILE *out, const gdr_frame_stats *s)
+{
     fprintf(out, "cpu_ms_per_frame    %.4f (of which vkQueueSubmit2 %.4f; commands recorded in %u of the frames, "
             "the others submitted again)\n", s->cpu_ms_per_frame, s->cpu_submit_ms_per_frame, s->frames_recorded);
     fprintf(out, "gpu_ms_per_frame    %.4f\n", s->gpu_ms_per_frame);
@@ -104,6 +135,14 @@ void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats 
             (unsigned long long)s->memory.scene_bytes, (unsigned long long)s->memory.frame_bytes);
     fprintf(out, "gpu_texture_bytes   %llu (%u textures sampled compressed, %u decoded to RGBA8)\n",
             (unsigned long long)s->memory.texture_bytes, s->memory.textures_compressed, s->memory.textures_decoded);
+}
+
+void stats_print(FILE *out, const stats_context *context, const gdr_frame_stats *s)
+{
+    print_scene_lines(out, context, s);
+    print_pipeline_lines(out, s);
+    print_occlusion_lines(out, s);
+    print_cost_lines(out, s);
     stats_print_streaming(out, &s->streaming);
     fprintf(out, "validation_messages %u\n", s->validation_messages);
 }
