@@ -31,6 +31,12 @@ typedef void gdr_task_fn(void *user, uint32_t task_index, uint32_t worker_index)
  * 0 picks the number of online processors. */
 GDR_API gdr_status gdr_thread_pool_create(uint32_t thread_count, gdr_thread_pool **out, gdr_error *err);
 GDR_API void gdr_thread_pool_destroy(gdr_thread_pool *pool);
+/* The online processors, at least 1, at most GDR_THREAD_POOL_MAX_THREADS. */
+GDR_API uint32_t gdr_processor_count(void);
+/* A pool of one thread per processor where `worth_it` (the caller's work is large enough to gain from
+ * threads) and the machine has more than one; NULL otherwise, or where the pool cannot be made: the
+ * functions that take a pool then run on the calling thread. */
+GDR_API gdr_thread_pool *gdr_thread_pool_create_if(int worth_it);
 /* 1 for a NULL pool. */
 GDR_API uint32_t gdr_thread_pool_thread_count(const gdr_thread_pool *pool);
 /* Runs fn(user, i, worker) for every i in [0, task_count); pool may be NULL. */

@@ -60,14 +60,26 @@ static void *worker_main(void *arg)
     return NULL;
 }
 
+uint32_t gdr_processor_count(void)
+{
+    long online = sysconf(_SC_NPROCESSORS_ONLN);
+    return online < 1 ? 1 : online > GDR_THREAD_POOL_MAX_THREADS ? GDR_THREAD_POOL_MAX_THREADS : (uint32_t)online;
+}
+
+gdr_thread_pool *gdr_thread_pool_create_if(int worth_it)
+{
+    gdr_thread_pool *pool = NULL;
+    gdr_error ignored = {0};
+    if (worth_it && gdr_processor_count() > 1)
+        (void)gdr_thread_pool_create(0, &pool, &ignored);
+    return pool;
+}
+
 gdr_status gdr_thread_pool_create(uint32_t thread_count, gdr_thread_pool **out, gdr_error *err)
 {
     *out = NULL;
-    if (thread_count == 0) {
-        long online = sysconf(_SC_NPROCESSORS_ONLN);
-        thread_count = online < 1 ? 1 : online > GDR_THREAD_POOL_MAX_THREADS ? GDR_THREAD_POOL_MAX_THREADS
-                                                                             : (uint32_t)online;
-    }
+    if (thread_count == 0)
+        thread_count = gdr_processor_count();
     if (thread_count > GDR_THREAD_POOL_MAX_THREADS)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "thread pool: %u threads exceeds %u",
                              thread_count, GDR_THREAD_POOL_MAX_THREADS);

@@ -8,7 +8,6 @@
 #include <stdatomic.h>
 #include <stdbool.h>
 #include <stdlib.h>
-#include <unistd.h>
 
 #include "gdr/thread_pool.h"
 
@@ -24,8 +23,7 @@ static uint32_t thread_count(void)
     uint32_t set = atomic_load(&decode_threads);
     if (set)
         return set > GDR_THREAD_POOL_MAX_THREADS ? GDR_THREAD_POOL_MAX_THREADS : set;
-    long n = sysconf(_SC_NPROCESSORS_ONLN);
-    return n < 1 ? 1 : n > GDR_THREAD_POOL_MAX_THREADS ? GDR_THREAD_POOL_MAX_THREADS : (uint32_t)n;
+    return gdr_processor_count();
 }
 
 typedef struct decode_job {

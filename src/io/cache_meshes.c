@@ -10,7 +10,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 #include <xxhash.h>
 
 #include "core/output_file.h"
@@ -285,12 +284,6 @@ static gdr_status check_skeleton(const cache_write_input *in, const char *path, 
     return GDR_OK;
 }
 
-static uint32_t processors(void)
-{
-    long n = sysconf(_SC_NPROCESSORS_ONLN);
-    return n < 1 ? 1 : n > GDR_THREAD_POOL_MAX_THREADS ? GDR_THREAD_POOL_MAX_THREADS : (uint32_t)n;
-}
-
 /* Makes every mesh on `workers` threads and spools it; the first failure in mesh order, if any. */
 static gdr_status build_meshes(build_job *job, uint32_t workers, gdr_error *err)
 {
@@ -324,7 +317,7 @@ gdr_status gdr_cache_write_meshes(const char *path, const gdr_scene *skeleton, c
     gdr_status status = check_skeleton(&in, path, err);
     if (status != GDR_OK)
         return status;
-    uint32_t threads = meshes->thread_count ? meshes->thread_count : processors();
+    uint32_t threads = meshes->thread_count ? meshes->thread_count : gdr_processor_count();
     uint32_t workers = threads < skeleton->mesh_count ? threads : skeleton->mesh_count;
     workers = workers ? workers : 1;
     build_job job = {.path = path, .source = meshes, .in = &in, .mesh_count = skeleton->mesh_count,

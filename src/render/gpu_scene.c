@@ -3,7 +3,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "gdr/geometry.h" /* gdr_lod_enclosing_sphere */
 #include "gpu_shared/point_level.h"
@@ -105,13 +104,7 @@ static gdr_thread_pool *setup_pool(const gdr_mesh_clusters *const *clusters, uin
     uint64_t records = 0;
     for (uint32_t m = 0; m < mesh_count; m++)
         records += clusters[m]->cluster_count;
-    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-    uint32_t threads = cpus < 1 ? 1 : cpus > GDR_THREAD_POOL_MAX_THREADS ? GDR_THREAD_POOL_MAX_THREADS : (uint32_t)cpus;
-    gdr_thread_pool *pool = NULL;
-    gdr_error ignored = {0};
-    if (threads > 1 && records >= 2 * RECORD_CHUNK)
-        (void)gdr_thread_pool_create(threads, &pool, &ignored);
-    return pool;
+    return gdr_thread_pool_create_if(records >= 2 * RECORD_CHUNK);
 }
 
 /* Each mesh's cluster fields, offsets and root shortcut; whole (not streamed): its vertex references

@@ -14,7 +14,6 @@
  * and never reads a record no resident page wrote. */
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "gdr/paged_cache.h"
 #include "geometry/lod_cut.h"
@@ -175,13 +174,7 @@ static gdr_thread_pool *set_up_pool(const gdr_scene *scene)
     uint64_t nodes = 0;
     for (uint32_t m = 0; m < scene->mesh_count; m++)
         nodes += scene->meshes[m].clusters.lod_node_count;
-    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-    uint32_t threads = cpus < 1 ? 1 : cpus > GDR_THREAD_POOL_MAX_THREADS ? GDR_THREAD_POOL_MAX_THREADS : (uint32_t)cpus;
-    gdr_thread_pool *pool = NULL;
-    gdr_error ignored = {0};
-    if (threads > 1 && scene->mesh_count > 1 && nodes >= 65536)
-        (void)gdr_thread_pool_create(threads, &pool, &ignored);
-    return pool;
+    return gdr_thread_pool_create_if(scene->mesh_count > 1 && nodes >= 65536);
 }
 
 gdr_status gdr_streaming_open(gdr_renderer *r, const gdr_scene *scene, const gdr_streaming_desc *desc, gdr_error *err)

@@ -6,7 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
+
+#include "gdr/thread_pool.h"
 
 struct gdr_page_loader {
     gdr_paged_cache *cache;
@@ -79,8 +80,8 @@ static void *loader_main(void *user)
 /* 0: one per processor but the one the frames run on, at least one, at most the maximum. */
 static uint32_t worker_count(uint32_t asked)
 {
-    long processors = sysconf(_SC_NPROCESSORS_ONLN);
-    uint32_t n = asked ? asked : processors > 2 ? (uint32_t)(processors - 1) : 1u;
+    uint32_t processors = gdr_processor_count();
+    uint32_t n = asked ? asked : processors > 2 ? processors - 1 : 1u;
     return n < GDR_PAGE_LOADER_MAX_THREADS ? n : GDR_PAGE_LOADER_MAX_THREADS;
 }
 
