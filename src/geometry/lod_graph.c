@@ -11,28 +11,6 @@
 
 _Static_assert(sizeof(idx_t) == sizeof(int32_t), "METIS built with 32-bit idx_t");
 
-/* Sorts records by their 64-bit key (LSD radix, stable; byte positions where every key agrees
- * are skipped). tmp holds n records. */
-static void radix_sort(key_record *a, key_record *tmp, size_t n)
-{
-    for (int shift = 0; shift < 64; shift += 8) {
-        size_t count[256] = {0};
-        for (size_t i = 0; i < n; i++)
-            count[(a[i].key >> shift) & 255]++;
-        if (n == 0 || count[(a[0].key >> shift) & 255] == n)
-            continue;
-        size_t sum = 0;
-        for (int d = 0; d < 256; d++) {
-            size_t c = count[d];
-            count[d] = sum;
-            sum += c;
-        }
-        for (size_t i = 0; i < n; i++)
-            tmp[count[(a[i].key >> shift) & 255]++] = a[i];
-        memcpy(a, tmp, n * sizeof *a);
-    }
-}
-
 /* Key of the undirected edge between two positions. */
 static uint64_t edge_key(uint32_t a, uint32_t b) { return a < b ? (uint64_t)a << 32 | b : (uint64_t)b << 32 | a; }
 
@@ -165,7 +143,7 @@ static int build_graph(lod_build *b, gdr_thread_pool *pool, uint32_t worker, clu
     key_record *tmp = malloc((total ? total : 1) * sizeof *tmp);
     if (!tmp)
         return 0;
-    radix_sort(edges, tmp, total);
+    lod_sort_key_records(edges, tmp, total);
     free(tmp);
     size_t pair_count = sharing_pairs(edges, total, NULL);
     key_record *pairs = malloc((pair_count ? pair_count : 1) * sizeof *pairs);
@@ -173,7 +151,7 @@ static int build_graph(lod_build *b, gdr_thread_pool *pool, uint32_t worker, clu
     int ok = pairs && pairs_tmp;
     if (ok) {
         sharing_pairs(edges, total, pairs);
-        radix_sort(pairs, pairs_tmp, pair_count);
+        lod_sort_key_records(pairs, pairs_tmp, pair_count);
         ok = graph_from_pairs(g, n, pairs, pair_count);
     }
     free(pairs);

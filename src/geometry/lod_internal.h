@@ -15,6 +15,7 @@
 #include "gdr/thread_pool.h"
 #include "geometry/lod_grid.h"
 #include "geometry/lod_simplify.h"
+#include "geometry/lod_sort.h"
 #include "gdr/geometry.h"
 #include "gdr/scene.h"
 
@@ -38,12 +39,6 @@
 
 _Static_assert(GDR_CLUSTER_MAX_VERTICES <= 64, "boundary edges are counted in a 64 x 64 table");
 
-/* A 64-bit key with a payload, for radix sorting. */
-typedef struct key_record {
-    uint64_t key;
-    uint32_t value;
-    uint32_t pad;
-} key_record;
 
 /* Progress shared by the meshes of one call; only worker 0 (the calling thread) draws. */
 typedef struct lod_progress {

@@ -1,4 +1,4 @@
-/* Sorting lists of 32-bit ids for the DAG build (lod_sort.h).
+/* Sorting for the DAG build (lod_sort.h).
  *
  * The error measurement collects the level-0 triangles around a group's samples or corners (each
  * listed once per corner it has there) and needs them sorted and each once; qsort's comparisons
@@ -75,4 +75,24 @@ size_t lod_sort_unique_u32(uint32_t *v, size_t n, uint32_t *scratch)
     if (from != v)
         memcpy(v, from, n * sizeof *v);
     return drop_repeats(v, n);
+}
+
+void lod_sort_key_records(key_record *a, key_record *tmp, size_t n)
+{
+    for (int shift = 0; shift < 64; shift += 8) {
+        size_t count[256] = {0};
+        for (size_t i = 0; i < n; i++)
+            count[(a[i].key >> shift) & 255]++;
+        if (n == 0 || count[(a[0].key >> shift) & 255] == n)
+            continue;
+        size_t sum = 0;
+        for (int d = 0; d < 256; d++) {
+            size_t c = count[d];
+            count[d] = sum;
+            sum += c;
+        }
+        for (size_t i = 0; i < n; i++)
+            tmp[count[(a[i].key >> shift) & 255]++] = a[i];
+        memcpy(a, tmp, n * sizeof *a);
+    }
 }
