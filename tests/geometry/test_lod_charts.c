@@ -83,7 +83,7 @@ int main(void)
     for (size_t t = 0; t < kept; t++)
         for (int j = 0; j < 3; j++)
             sum += packed_edge_length(positions, vertex_position[out[t * 3 + (size_t)j]],
-                               vertex_position[out[t * 3 + (size_t)(j + 1) % 3]]);
+                                      vertex_position[out[t * 3 + (size_t)(j + 1) % 3]]);
     double mean = kept ? sum / (3.0 * (double)kept) : 0.0;
     printf("test_lod_charts: %u triangles in %u charts -> %zu, slide %.4f, mean edge %.4f (%.2fx)\n", TRIANGLES,
            (QUADS / CHART) * (QUADS / CHART), kept, (double)result.slide, mean, (double)result.slide / mean);

@@ -63,7 +63,7 @@ int main(void)
     for (size_t t = 0; t < kept; t++)
         for (int k = 0; k < 3; k++) {
             float e = packed_edge_length(positions, vertex_position[out[t * 3 + (size_t)k]],
-                                  vertex_position[out[t * 3 + (size_t)(k + 1) % 3]]);
+                                         vertex_position[out[t * 3 + (size_t)(k + 1) % 3]]);
             longest = e > longest ? e : longest;
         }
     CHECK_MSG(result.slide > 0.0f, "no slide stated, though every collapse crossed charts");
