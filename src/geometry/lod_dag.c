@@ -851,9 +851,9 @@ static void stats_add(gdr_lod_stats *sum, const gdr_lod_stats *s)
 }
 
 /* Builds one mesh's DAG with `pool` (NULL: on the calling thread, as worker `worker`). */
-static gdr_status build_one(gdr_mesh *mesh, const gdr_lod_options *o, gdr_thread_pool *pool, uint32_t worker,
-                            lod_progress *progress, const lod_observer *observer, gdr_lod_stats *stats,
-                            gdr_error *err)
+static gdr_status build_one(gdr_mesh *mesh, const gdr_lod_options *o, const lod_texture_set *texture,
+                            gdr_thread_pool *pool, uint32_t worker, lod_progress *progress,
+                            const lod_observer *observer, gdr_lod_stats *stats, gdr_error *err)
 {
     const gdr_mesh_clusters *c = &mesh->clusters;
     if (c->level0_cluster_count == 0 || c->level0_cluster_count > c->cluster_count || !c->clusters)
@@ -863,7 +863,7 @@ static gdr_status build_one(gdr_mesh *mesh, const gdr_lod_options *o, gdr_thread
     gdr_status status = check_level0(mesh, err);
     if (status != GDR_OK)
         return status;
-    lod_build b = {.mesh = mesh, .opt = *o, .observer = observer, .pool = pool, .worker_base = worker,
+    lod_build b = {.mesh = mesh, .opt = *o, .texture = texture, .observer = observer, .pool = pool, .worker_base = worker,
                    .progress = progress, .scratch_count = gdr_thread_pool_thread_count(pool)};
     status = build_mesh(&b, err);
     if (status == GDR_OK && (status = gdr_mesh_clusters_build_hierarchy(&mesh->clusters, err)) != GDR_OK)
@@ -902,7 +902,7 @@ gdr_status gdr_lod_build_observed(gdr_mesh *mesh, const gdr_lod_options *options
     gdr_progress_begin(&progress.bar, "LOD DAG", mesh->clusters.level0_cluster_count ? mesh->index_count / 3 : 1,
                        o.no_progress);
     atomic_init(&progress.done, 0);
-    status = build_one(mesh, &o, pool, 0, &progress, observer, stats, err);
+    status = build_one(mesh, &o, NULL, pool, 0, &progress, observer, stats, err);
     gdr_progress_end(&progress.bar);
     gdr_thread_pool_destroy(pool);
     return status;
@@ -915,6 +915,7 @@ typedef struct scene_job {
     const gdr_lod_options *opt;
     const uint32_t *small; /* mesh indices built one per task */
     const uint8_t *textured; /* per mesh: an instance has a textured material */
+    const lod_scene_textures *textures; /* what the textured meshes' materials sample */
     lod_progress *progress;
     gdr_lod_stats *stats;  /* per mesh */
     gdr_status *status;    /* per mesh */
@@ -941,12 +942,15 @@ static void mark_textured_meshes(const gdr_scene *scene, uint8_t *textured)
     }
 }
 
-/* Builds mesh m with the scene's options, its uvs ignored where nothing samples a texture. */
+/* Builds mesh m with the scene's options, its uvs ignored where nothing samples a texture, its
+ * slides weighed by what its textures show where they slide. */
 static gdr_status build_scene_mesh(scene_job *job, uint32_t m, gdr_thread_pool *pool, uint32_t worker)
 {
     gdr_lod_options o = *job->opt;
     o.ignore_uvs = o.ignore_uvs || !job->textured[m];
-    return build_one(&job->scene->meshes[m], &o, pool, worker, job->progress, NULL, &job->stats[m], &job->errors[m]);
+    const lod_texture_set *texture = job->textures->sets[m].count ? &job->textures->sets[m] : NULL;
+    return build_one(&job->scene->meshes[m], &o, texture, pool, worker, job->progress, NULL, &job->stats[m],
+                     &job->errors[m]);
 }
 
 static void small_mesh_task(void *user, uint32_t i, uint32_t worker)
@@ -985,6 +989,7 @@ gdr_status gdr_scene_build_lod(gdr_scene *scene, const gdr_lod_options *options,
     gdr_status *statuses = calloc(n ? n : 1, sizeof *statuses);
     gdr_error *errors = calloc(n ? n : 1, sizeof *errors);
     gdr_thread_pool *pool = NULL;
+    lod_scene_textures textures = {0};
     if (!small || !built || !textured || !mesh_stats || !statuses || !errors) {
         status = gdr_error_set(err, GDR_ERROR_OUT_OF_MEMORY, "gdr_scene_build_lod: out of memory");
         goto done;
@@ -1007,8 +1012,12 @@ gdr_status gdr_scene_build_lod(gdr_scene *scene, const gdr_lod_options *options,
     gdr_progress_begin(&progress.bar, "LOD DAG", total, o.no_progress);
     atomic_init(&progress.done, 0);
     mark_textured_meshes(scene, textured);
-    scene_job job = {.scene = scene, .opt = &o, .small = small, .textured = textured, .progress = &progress,
-                     .stats = mesh_stats, .status = statuses, .errors = errors};
+    if ((status = lod_scene_textures_build(scene, textured, &textures, err)) != GDR_OK) {
+        gdr_progress_end(&progress.bar);
+        goto done;
+    }
+    scene_job job = {.scene = scene, .opt = &o, .small = small, .textured = textured, .textures = &textures,
+                     .progress = &progress, .stats = mesh_stats, .status = statuses, .errors = errors};
     gdr_thread_pool_run(pool, small_count, small_mesh_task, &job);
     for (uint32_t m = 0; m < n; m++)
         if (built[m] && scene->meshes[m].index_count / 3 >= LOD_SMALL_MESH_TRIANGLES)
@@ -1028,6 +1037,7 @@ gdr_status gdr_scene_build_lod(gdr_scene *scene, const gdr_lod_options *options,
         }
     }
 done:
+    lod_scene_textures_free(&textures);
     gdr_thread_pool_destroy(pool);
     free(small);
     free(built);

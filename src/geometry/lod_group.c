@@ -266,7 +266,7 @@ void gdr_lod_simplify_group_task(void *user, uint32_t g, uint32_t worker)
                              .vertex_position = s->vertex_position, .vertex_source = s->local_to_mesh,
                              .uvs = b->opt.ignore_uvs ? NULL : b->mesh->uvs, .normals = b->mesh->normals, .position_count = position_count,
                              .positions = s->local_positions, .locked = s->position_locked,
-                             .target_index_count = target,
+                             .target_index_count = target, .texture = b->texture,
                              .normal_weight = (count == 1 && b->frontier_count == 1) || !b->opt.ignore_uvs
                                                 ? LOD_LOW_NORMAL_WEIGHT : 0.0};
     lod_simplify_result out = {0};

@@ -180,6 +180,7 @@ typedef struct lod_observer {
 typedef struct lod_build {
     gdr_mesh *mesh;
     gdr_lod_options opt;
+    const lod_texture_set *texture; /* the textures the mesh's materials sample (NULL: unknown) */
     const lod_observer *observer; /* NULL but in tests */
     gdr_thread_pool *pool;
     uint32_t worker_base; /* worker index offset of this build's scratch (0: draws progress) */

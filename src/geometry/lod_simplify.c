@@ -296,9 +296,23 @@ static void extrapolate_fan(const run *r, uint32_t n, const double q[3])
     }
 }
 
+/* The largest change the texture shows over a fan corner's slide to uv tb: over the box of its
+ * triangle's uvs before, the uv its field continues to at the target, and tb (lod_texture.h). Every
+ * texel the triangle shows before and after the move lies in that box. */
+static double slide_variation(const run *r, const lod_simplify_corner *f, gdr_vec2 tb)
+{
+    const double uv[5][2] = {{f->t0[0], f->t0[1]},
+                             {f->t0[0] + f->t1[0], f->t0[1] + f->t1[1]},
+                             {f->t0[0] + f->t2[0], f->t0[1] + f->t2[1]},
+                             {f->uv_at_q[0], f->uv_at_q[1]},
+                             {tb.x, tb.y}};
+    return lod_texture_variation(r->in->texture, uv, 5);
+}
+
 /* The error of giving a fan corner the attributes of wedge wb at the target (extrapolate_fan):
  * its triangle's normal there against wb's, as an area-weighted squared length (returned), and its
- * uv against wb's: the texture slide, a squared mesh length (*slide2). */
+ * uv against wb's: the texture slide, a mesh length times the largest change the texture shows
+ * under it (slide_variation), squared (*slide2). */
 static double corner_attribute_error(const run *r, const lod_simplify_corner *f, uint32_t wb, double *slide2)
 {
     const lod_simplify_input *in = r->in;
@@ -310,6 +324,10 @@ static double corner_attribute_error(const run *r, const lod_simplify_corner *f,
         const gdr_vec2 tb = in->uvs[mb];
         double du = f->uv_at_q[0] - tb.x, dv = f->uv_at_q[1] - tb.y;
         *slide2 = (du * du + dv * dv) * f->uv_scale;
+        if (*slide2 > 0.0 && in->texture) {
+            double v = slide_variation(r, f, tb);
+            *slide2 *= v * v;
+        }
     }
     if (!in->normals)
         return 0.0;

@@ -10,6 +10,7 @@
 #include <stdint.h>
 
 #include "gdr/math.h"
+#include "geometry/lod_texture.h"
 
 /* A group's triangles over local vertices (wedges); each wedge lies at one local position. */
 typedef struct lod_simplify_input {
@@ -25,13 +26,16 @@ typedef struct lod_simplify_input {
     const uint8_t *locked;  /* per position: never moves */
     size_t target_index_count;
     double normal_weight;   /* the normal term's weight (lod_simplify.c); 0: the default, NORMAL_WEIGHT */
+    const lod_texture_set *texture; /* what the uvs sample, to weigh a slide by the change the texture shows
+                                       under it (lod_texture.h); NULL: unknown, a slide counts whole */
 } lod_simplify_input;
 
 typedef struct lod_simplify_result {
     size_t index_count;  /* triangles kept, written as wedge ids */
     uint32_t collapses;
     float slide;         /* the largest texture slide of an output triangle: charged to it by a collapse
-                            that moved one of its corners, at most its longest edge (mesh units) */
+                            that moved one of its corners, times the largest change the texture shows
+                            under it (0 to 1), at most its longest edge (mesh units) */
 } lod_simplify_result;
 
 /* A position's cheapest collapse as last evaluated (the heap holds at most one per position). */
