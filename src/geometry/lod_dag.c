@@ -884,6 +884,12 @@ gdr_status gdr_mesh_build_lod_dag(gdr_mesh *mesh, const gdr_lod_options *options
 gdr_status gdr_lod_build_observed(gdr_mesh *mesh, const gdr_lod_options *options, const lod_observer *observer,
                                   gdr_lod_stats *stats, gdr_error *err)
 {
+    return gdr_lod_build_textured(mesh, options, NULL, observer, stats, err);
+}
+
+gdr_status gdr_lod_build_textured(gdr_mesh *mesh, const gdr_lod_options *options, const lod_texture_set *texture,
+                                  const lod_observer *observer, gdr_lod_stats *stats, gdr_error *err)
+{
     if (!mesh)
         return gdr_error_set(err, GDR_ERROR_INVALID_ARGUMENT, "gdr_mesh_build_lod_dag: mesh must not be NULL");
     if (stats)
@@ -902,7 +908,7 @@ gdr_status gdr_lod_build_observed(gdr_mesh *mesh, const gdr_lod_options *options
     gdr_progress_begin(&progress.bar, "LOD DAG", mesh->clusters.level0_cluster_count ? mesh->index_count / 3 : 1,
                        o.no_progress);
     atomic_init(&progress.done, 0);
-    status = build_one(mesh, &o, NULL, pool, 0, &progress, observer, stats, err);
+    status = build_one(mesh, &o, texture, pool, 0, &progress, observer, stats, err);
     gdr_progress_end(&progress.bar);
     gdr_thread_pool_destroy(pool);
     return status;

@@ -248,6 +248,10 @@ typedef struct lod_build {
 /* gdr_mesh_build_lod_dag with an observer (NULL: the same), for tests. */
 gdr_status gdr_lod_build_observed(gdr_mesh *mesh, const gdr_lod_options *options, const lod_observer *observer,
                                   gdr_lod_stats *stats, gdr_error *err);
+/* gdr_lod_build_observed with the textures the mesh's uvs sample (NULL: unknown, as there), for tests;
+ * gdr_scene_build_lod finds them from the mesh's materials. */
+gdr_status gdr_lod_build_textured(gdr_mesh *mesh, const gdr_lod_options *options, const lod_texture_set *texture,
+                                  const lod_observer *observer, gdr_lod_stats *stats, gdr_error *err);
 
 /* Grows *p (a pointer to an array) to hold at least `need` elements of `size` bytes; returns 0 when
  * out of memory. */
