@@ -254,7 +254,7 @@ static uint32_t material_refs(const gdr_material *m, const gdr_texture_ref *refs
     int alpha = m->alpha_mode != GDR_ALPHA_OPAQUE;
     const gdr_texture_ref *all[5] = {&m->base_color_texture, &m->metallic_roughness_texture, &m->normal_texture,
                                      &m->occlusion_texture, &m->emissive_texture};
-    const uint32_t reads[5] = {alpha ? 0xfu : 0x7u, 0x6u, 0x7u, 0x1u, 0x7u}; /* RGB(A), GB, RGB, R, RGB */
+    const uint32_t reads[5] = {alpha ? 0xfu : 0x7u, 0x6u, 0x3u, 0x1u, 0x7u}; /* RGB(A), GB, RG (z is rebuilt), R, RGB */
     const double factors[5] = {
         fmax(largest3(m->base_color.x, m->base_color.y, m->base_color.z), alpha ? m->base_color.w : 0.0),
         fmax(m->metallic_factor, m->roughness_factor), fmax(fabs(m->normal_scale), 1.0), m->occlusion_strength,
