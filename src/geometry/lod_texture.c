@@ -16,24 +16,32 @@
 
 static uint32_t cells_of(uint32_t n, uint32_t per) { return (n + per - 1) / per; }
 
+/* Each channel's minimum into lo and maximum into hi over n RGBA values `stride` bytes apart, with
+ * lo and hi as they were (kept in locals: the compiler need not reload them past the stores). */
+static void span_range(const uint8_t *v, uint32_t n, size_t stride, uint8_t *lo, uint8_t *hi)
+{
+    uint8_t l0 = lo[0], l1 = lo[1], l2 = lo[2], l3 = lo[3], h0 = hi[0], h1 = hi[1], h2 = hi[2], h3 = hi[3];
+    for (uint32_t i = 0; i < n; i++, v += stride) {
+        l0 = v[0] < l0 ? v[0] : l0, l1 = v[1] < l1 ? v[1] : l1, l2 = v[2] < l2 ? v[2] : l2, l3 = v[3] < l3 ? v[3] : l3;
+        h0 = v[0] > h0 ? v[0] : h0, h1 = v[1] > h1 ? v[1] : h1, h2 = v[2] > h2 ? v[2] : h2, h3 = v[3] > h3 ? v[3] : h3;
+    }
+    lo[0] = l0, lo[1] = l1, lo[2] = l2, lo[3] = l3, hi[0] = h0, hi[1] = h1, hi[2] = h2, hi[3] = h3;
+}
+
 /* Level 0: each cell's channels over its texels. */
 static void first_level(lod_texture_pyramid *p, const uint8_t *rgba)
 {
     uint32_t w = cells_of(p->width, LOD_TEXTURE_CELL), h = cells_of(p->height, LOD_TEXTURE_CELL);
     for (uint32_t cy = 0; cy < h; cy++)
         for (uint32_t cx = 0; cx < w; cx++) {
-            uint8_t *lo = p->lo[0] + ((size_t)cy * w + cx) * 4, *hi = p->hi[0] + ((size_t)cy * w + cx) * 4;
-            memset(lo, 255, 4), memset(hi, 0, 4);
-            uint32_t x1 = (cx + 1) * LOD_TEXTURE_CELL, y1 = (cy + 1) * LOD_TEXTURE_CELL;
-            x1 = x1 < p->width ? x1 : p->width, y1 = y1 < p->height ? y1 : p->height;
-            for (uint32_t y = cy * LOD_TEXTURE_CELL; y < y1; y++)
-                for (uint32_t x = cx * LOD_TEXTURE_CELL; x < x1; x++) {
-                    const uint8_t *t = rgba + ((size_t)y * p->width + x) * 4;
-                    for (int k = 0; k < 4; k++) {
-                        lo[k] = t[k] < lo[k] ? t[k] : lo[k];
-                        hi[k] = t[k] > hi[k] ? t[k] : hi[k];
-                    }
-                }
+            uint8_t lo[4] = {255, 255, 255, 255}, hi[4] = {0, 0, 0, 0};
+            uint32_t x0 = cx * LOD_TEXTURE_CELL, y0 = cy * LOD_TEXTURE_CELL;
+            uint32_t nx = p->width - x0 < LOD_TEXTURE_CELL ? p->width - x0 : LOD_TEXTURE_CELL;
+            uint32_t y1 = y0 + LOD_TEXTURE_CELL < p->height ? y0 + LOD_TEXTURE_CELL : p->height;
+            for (uint32_t y = y0; y < y1; y++)
+                span_range(rgba + ((size_t)y * p->width + x0) * 4, nx, 4, lo, hi);
+            memcpy(p->lo[0] + ((size_t)cy * w + cx) * 4, lo, 4);
+            memcpy(p->hi[0] + ((size_t)cy * w + cx) * 4, hi, 4);
         }
 }
 
@@ -43,8 +51,7 @@ static void next_level(lod_texture_pyramid *p, uint32_t l)
     uint32_t w = p->level_width[l], h = p->level_height[l], pw = p->level_width[l - 1], ph = p->level_height[l - 1];
     for (uint32_t cy = 0; cy < h; cy++)
         for (uint32_t cx = 0; cx < w; cx++) {
-            uint8_t *lo = p->lo[l] + ((size_t)cy * w + cx) * 4, *hi = p->hi[l] + ((size_t)cy * w + cx) * 4;
-            memset(lo, 255, 4), memset(hi, 0, 4);
+            uint8_t lo[4] = {255, 255, 255, 255}, hi[4] = {0, 0, 0, 0};
             for (uint32_t y = cy * 2; y < cy * 2 + 2 && y < ph; y++)
                 for (uint32_t x = cx * 2; x < cx * 2 + 2 && x < pw; x++) {
                     const uint8_t *a = p->lo[l - 1] + ((size_t)y * pw + x) * 4, *b = p->hi[l - 1] + ((size_t)y * pw + x) * 4;
@@ -53,6 +60,8 @@ static void next_level(lod_texture_pyramid *p, uint32_t l)
                         hi[k] = b[k] > hi[k] ? b[k] : hi[k];
                     }
                 }
+            memcpy(p->lo[l] + ((size_t)cy * w + cx) * 4, lo, 4);
+            memcpy(p->hi[l] + ((size_t)cy * w + cx) * 4, hi, 4);
         }
 }
 
@@ -145,7 +154,8 @@ static int axis_ranges(double u0, double u1, uint32_t size, uint32_t mode, int64
 }
 
 /* Each channel's minimum and maximum over the texels [x0, x1] x [y0, y1] (within the texture),
- * widened to whole cells of the level where the range spans at most 4 x 4 cells. */
+ * widened to whole cells of the level where the range spans at most 4 x 4 cells, into lo and hi
+ * as they were. */
 static void range_of(const lod_texture_pyramid *p, const int64_t x[2], const int64_t y[2], uint8_t lo[4], uint8_t hi[4])
 {
     uint64_t cx0 = (uint64_t)x[0] / LOD_TEXTURE_CELL, cx1 = (uint64_t)x[1] / LOD_TEXTURE_CELL;
@@ -154,14 +164,14 @@ static void range_of(const lod_texture_pyramid *p, const int64_t x[2], const int
     while (l + 1 < p->levels && ((cx1 >> l) - (cx0 >> l) > 3 || (cy1 >> l) - (cy0 >> l) > 3))
         l++;
     uint32_t w = p->level_width[l];
+    uint8_t l0 = lo[0], l1 = lo[1], l2 = lo[2], l3 = lo[3], h0 = hi[0], h1 = hi[1], h2 = hi[2], h3 = hi[3];
     for (uint64_t cy = cy0 >> l; cy <= (cy1 >> l) && cy < p->level_height[l]; cy++)
         for (uint64_t cx = cx0 >> l; cx <= (cx1 >> l) && cx < w; cx++) {
             const uint8_t *a = p->lo[l] + (cy * w + cx) * 4, *b = p->hi[l] + (cy * w + cx) * 4;
-            for (int k = 0; k < 4; k++) {
-                lo[k] = a[k] < lo[k] ? a[k] : lo[k];
-                hi[k] = b[k] > hi[k] ? b[k] : hi[k];
-            }
+            l0 = a[0] < l0 ? a[0] : l0, l1 = a[1] < l1 ? a[1] : l1, l2 = a[2] < l2 ? a[2] : l2, l3 = a[3] < l3 ? a[3] : l3;
+            h0 = b[0] > h0 ? b[0] : h0, h1 = b[1] > h1 ? b[1] : h1, h2 = b[2] > h2 ? b[2] : h2, h3 = b[3] > h3 ? b[3] : h3;
         }
+    lo[0] = l0, lo[1] = l1, lo[2] = l2, lo[3] = l3, hi[0] = h0, hi[1] = h1, hi[2] = h2, hi[3] = h3;
 }
 
 /* One use's change over the box of the uvs, in [0, 1] before its weight. */
