@@ -1018,6 +1018,8 @@ gdr_status gdr_scene_build_lod(gdr_scene *scene, const gdr_lod_options *options,
     gdr_progress_begin(&progress.bar, "LOD DAG", total, o.no_progress);
     atomic_init(&progress.done, 0);
     mark_textured_meshes(scene, textured);
+    for (uint32_t m = 0; m < n; m++)
+        textured[m] &= built[m]; /* the textures' ranges only for meshes built here */
     if ((status = lod_scene_textures_build(scene, textured, &textures, err)) != GDR_OK) {
         gdr_progress_end(&progress.bar);
         goto done;

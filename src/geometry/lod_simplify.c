@@ -7,7 +7,8 @@
  * wa's surviving triangles' affine uv and normal, extrapolated to b's position, compared with each
  * wedge of b. The cost of a collapse is the mean squared distance of a's Garland-Heckbert quadric
  * at b plus the normals' error averaged over a's fan plus the largest texture slide it charges a
- * triangle, at most the triangle's longest edge (all squared lengths). A heap keeps each
+ * triangle, weighed by the change the texture shows where it slides (lod_texture.h) and at most the
+ * triangle's longest edge (all squared lengths). A heap keeps each
  * position's cheapest collapse as last evaluated; a popped position is evaluated again and moves
  * only if it is still no dearer than the next one (lazy re-evaluation). Collapses run in passes: a
  * position moved onto waits for the next pass, and a pass ends past 1.5 x the cost that would
@@ -28,8 +29,8 @@
 /* Weight of an open border's edge plane, per squared edge length: keeps borders in place against
  * the area-weighted planes of the surface. */
 #define BORDER_WEIGHT 4.0
-/* The largest texture slide of a collapse (mesh length, capped by the triangle's longest edge)
- * costs its square times this, as a squared distance does: the slide enters the group's error as
+/* The largest texture slide of a collapse (mesh length times the change the texture shows under it,
+ * capped by the triangle's longest edge) costs its square times this, as a squared distance does: the slide enters the group's error as
  * the deviation does. A normal's change costs as a length of |delta n| times the square root of its
  * triangle's area (a surface tilted by that angle over the triangle's size), squared, times
  * NORMAL_WEIGHT, averaged over the fan by area. Chosen by measurement (docs/GEOMETRY.md). */
