@@ -1087,17 +1087,27 @@ static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor,
  * (probe_d2): squared. */
 #define LOD_LOOSE 4.0f
 
-/* D2 measured again where its bound decides the group's error: above D1, the texture slide and the
- * members' errors. A bound taken within twice the largest checked may be twice the distance, and
- * there nothing else covers it; so the probes are measured again from that level up, each bound that
- * would raise D2 past the largest checked measured exactly over the group's own surface (a distance
- * to some level-0 triangles: never below the distance to S0, so still a bound). Both measures bound
- * D2: the smaller is returned. */
+/* D2's bound is measured again only where it is at least this share of the mesh's bounding radius
+ * (tight_d2). */
+#define LOD_TIGHT_D2_SHARE 0.1f
+
+/* D2 measured again where its bound decides the error of a group at the coarse end: above D1, the
+ * texture slide and the members' errors, of a group holding at least a quarter of the mesh's samples,
+ * and at least LOD_TIGHT_D2_SHARE of the mesh's radius. A bound taken within twice the largest
+ * checked may be twice the distance, and there nothing else covers it; so the probes are measured
+ * again from that level up, each bound that would raise D2 past the largest checked measured exactly
+ * over the group's own surface (a distance to some level-0 triangles: never below the distance to S0,
+ * so still a bound). Both measures bound D2: the smaller is returned. Such a group passes only where
+ * the whole model spans a few tens of pixels (a pixel of a 16 x 9 view of a framed model is about
+ * 0.3 of its radius, of 64 x 36 about 0.08): finer, the loose bound is kept, which guards shading
+ * and silhouettes that the distance does not weigh (docs/GEOMETRY.md, "The coarse end of a textured
+ * mesh"). The quarter bounds the cost: at most four such groups a step, at the DAG's top. */
 static float tight_d2(const lod_build *b, lod_scratch *s, const group_result *r, float to_simplified, float to_full)
 {
     float level = to_simplified > r->slide ? to_simplified : r->slide;
     level = level > r->error ? level : r->error;
-    if (!(to_full > level) || (size_t)s->gathered * 4 < b->position_count)
+    if (!(to_full > level) || (size_t)s->gathered * 4 < b->position_count ||
+        to_full < LOD_TIGHT_D2_SHARE * b->mesh->bounds.w)
         return to_full;
     float again = simplified_to_full(b, s, level, to_full, 1.0f);
     return again >= 0.0f && again < to_full ? again : to_full;
