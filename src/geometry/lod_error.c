@@ -743,6 +743,10 @@ static int build_span(const lod_build *b, lod_scratch *s)
                                  &s->span_corners_cap, &s->span_grid);
 }
 
+/* A walk bound up to twice the largest distance checked is taken without the exact measure
+ * (probe_d2): squared. */
+#define LOD_LOOSE 4.0f
+
 /* What probing a group's simplified triangles needs. */
 typedef struct probe_state {
     const lod_build *b;
@@ -753,7 +757,10 @@ typedef struct probe_state {
     float at_most, below; /* squared: a probe bound at most / below these changes nothing (per probe) */
     int failed;   /* out of memory */
     float loose;  /* a walk bound up to this times the largest checked (squared) is taken as it is: 4
-                     (twice), or 1 where the bound is measured to decide the group's error (tight_d2) */
+                     (twice), or 1 in tight_d2's pass, which measures over the corners' triangles only
+                     (no grid of the group's own surface is built for it: at the DAG's top that grid
+                     covers most of the mesh, and the blob's peak heap rose from 79 to 129 B per
+                     triangle) */
 } probe_state;
 
 /* The group's sample nearest to p; UINT32_MAX when out of memory. The point grid, which indexed the
@@ -843,7 +850,8 @@ static float probe_d2(probe_state *ps, walk_end *at, gdr_vec3 p, uint32_t *trian
     float exact = INFINITY, spanned;
     uint32_t nearest = 0;
     uint32_t nearest_spanned = lod_triangle_grid_nearest(&ps->s->span_grid, p, point_triangle_d2, &spanned);
-    if (!(spanned <= ps->loose * ps->checked)) {
+    int own_surface = ps->s->region_built || ps->loose == LOD_LOOSE; /* not built for tight_d2 */
+    if (!(spanned <= ps->loose * ps->checked) && own_surface) {
         if (!ps->s->region_built && !build_region(ps->b, ps->s)) {
             ps->failed = 1;
             return d;
@@ -1083,10 +1091,6 @@ static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor,
     return ps.failed ? -1.0f : ps.worst > cap2 ? INFINITY : sqrtf(ps.worst);
 }
 
-/* A walk bound up to twice the largest distance checked is taken without the exact measure
- * (probe_d2): squared. */
-#define LOD_LOOSE 4.0f
-
 /* D2's bound is measured again only where it is at least this share of the mesh's bounding radius
  * (tight_d2): a tenth took watch.glb at 64 x 36 pixels from 41.1 to 37.9 dB, white-claw-can.glb at
  * 256 x 144 to 39.96 dB with no share at all. */
@@ -1097,8 +1101,9 @@ static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor,
  * and at least LOD_TIGHT_D2_SHARE of the mesh's radius. A bound taken within twice the largest
  * checked may be twice the distance, and there nothing else covers it; so the probes are measured
  * again from that level up, each bound that would raise D2 past the largest checked measured exactly
- * over the group's own surface (a distance to some level-0 triangles: never below the distance to S0,
- * so still a bound). Both measures bound D2: the smaller is returned. Such groups are drawn at 1 px
+ * over the level-0 triangles around the simplified triangles' corners, and over the group's own
+ * surface where its grid is built already (distances to some level-0 triangles: never below the
+ * distance to S0, so still bounds). Both measures bound D2: the smaller is returned. Such groups are drawn at 1 px
  * where the whole model spans some tens of pixels or fewer (a pixel of a 16 x 9 view of a framed
  * model is about 0.3 of its radius, of 64 x 36 about 0.08). Finer, the loose bound is kept, which
  * guards shading and silhouettes that the distance does not weigh (docs/GEOMETRY.md, "The coarse

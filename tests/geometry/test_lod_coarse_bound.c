@@ -7,15 +7,15 @@
  * D2, twice its D1, where a pixel allows 0.38. Where D2's bound is above everything else the group's
  * error holds (D1, the texture slide, the members' errors) and the group holds at least a quarter of
  * the mesh's samples, D2 is measured again with every bound that would raise it past the largest
- * checked measured exactly over the group's own surface (tight_d2).
+ * checked measured exactly over the level-0 triangles around the simplified corners (tight_d2).
  *
  * The check, on a charted torus (every chart border a uv seam, so the coarse groups cross charts
  * and state slides) and on a crumpled sheet mapped by its plane (test_lod_probe_bound's, where walks
  * stop in folds; its slides are small, so D2 decides): every group holding at least a third of the
  * samples and stating at least a quarter of the mesh's radius states a deviation no
- * larger than the largest of D1, its slide, its members' errors and 1.25 times the exact distance from
- * its simplified triangles to level 0 at a barycentric grid of 8 steps (the group's own surface may
- * lie a little farther than all of level 0, and the probes' points are not the grid's); and every
+ * larger than the largest of D1, its slide, its members' errors and 1.6 times the exact distance from
+ * its simplified triangles to level 0 at a barycentric grid of 8 steps (1.45x: the corners' triangles
+ * are not all of level 0, and the probes' points are not the grid's); and every
  * group's deviation and error are at least that distance (they stay bounds). Before, the sheet's
  * coarse groups stated up to 1.9x. */
 #include <math.h>
@@ -31,7 +31,7 @@
 #include "point_distance.h"
 #include "test_util.h"
 
-#define MAX_RATIO 1.25
+#define MAX_RATIO 1.6
 /* The groups checked: those holding at least a third of the samples and stating at least this share
  * of the mesh's radius (lod_error.c measures D2 where its bound decides such a group's error: a
  * quarter of the samples, a quarter of the radius). */
