@@ -743,6 +743,10 @@ static int build_span(const lod_build *b, lod_scratch *s)
                                  &s->span_corners_cap, &s->span_grid);
 }
 
+/* A walk bound up to twice the largest distance checked is taken without the exact measure
+ * (probe_d2): squared. */
+#define LOD_LOOSE 4.0f
+
 /* What probing a group's simplified triangles needs. */
 typedef struct probe_state {
     const lod_build *b;
@@ -752,6 +756,11 @@ typedef struct probe_state {
                       (probe_d2) */
     float at_most, below; /* squared: a probe bound at most / below these changes nothing (per probe) */
     int failed;   /* out of memory */
+    float loose;  /* a walk bound up to this times the largest checked (squared) is taken as it is: 4
+                     (twice), or 1 in tight_d2's pass, which measures over the corners' triangles only
+                     (no grid of the group's own surface is built for it: at the DAG's top that grid
+                     covers most of the mesh, and the blob's peak heap rose from 79 to 129 B per
+                     triangle) */
 } probe_state;
 
 /* The group's sample nearest to p; UINT32_MAX when out of memory. The point grid, which indexed the
@@ -832,7 +841,7 @@ static float walk_bound_d2(probe_state *ps, walk_end *at, gdr_vec3 p, uint32_t *
 static float probe_d2(probe_state *ps, walk_end *at, gdr_vec3 p, uint32_t *triangle)
 {
     float d = walk_bound_d2(ps, at, p, triangle);
-    if (d <= ps->worst || d <= 4.0f * ps->checked || ps->failed) /* squared: raises nothing, or within twice */
+    if (d <= ps->worst || d <= ps->loose * ps->checked || ps->failed) /* squared: raises nothing, or within twice */
         return d;
     if (!ps->s->span_built && !build_span(ps->b, ps->s)) {
         ps->failed = 1;
@@ -841,7 +850,8 @@ static float probe_d2(probe_state *ps, walk_end *at, gdr_vec3 p, uint32_t *trian
     float exact = INFINITY, spanned;
     uint32_t nearest = 0;
     uint32_t nearest_spanned = lod_triangle_grid_nearest(&ps->s->span_grid, p, point_triangle_d2, &spanned);
-    if (!(spanned <= 4.0f * ps->checked)) {
+    int own_surface = ps->s->region_built || ps->loose == LOD_LOOSE; /* not built for tight_d2 */
+    if (!(spanned <= ps->loose * ps->checked) && own_surface) {
         if (!ps->s->region_built && !build_region(ps->b, ps->s)) {
             ps->failed = 1;
             return d;
@@ -1065,9 +1075,9 @@ static float probe_shared(probe_state *ps, lod_scratch *s, uint32_t t, int n, in
  * triangles share is probed once on each grid (by the first; the second counts its probes as its
  * own). Returns INFINITY as soon as the largest exceeds `cap` (no bound then), -1 when out of
  * memory. */
-static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor, float cap)
+static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor, float cap, float loose)
 {
-    probe_state ps = {b, s, floor * floor, floor * floor, 0.0f, 0.0f, 0};
+    probe_state ps = {b, s, floor * floor, floor * floor, 0.0f, 0.0f, 0, loose};
     float cap2 = cap * cap;
     if (!LOD_RESERVE(s, coarse_d2, (size_t)s->out_triangle_count + 1) ||
         !LOD_RESERVE(s, edge_d2, (size_t)s->out_triangle_count * 3 + 1))
@@ -1079,6 +1089,35 @@ static float simplified_to_full(const lod_build *b, lod_scratch *s, float floor,
         if (!(s->coarse_d2[t] < refine_share(coarse_worst)))
             probe_shared(&ps, s, t, LOD_FINE_STEPS, 1);
     return ps.failed ? -1.0f : ps.worst > cap2 ? INFINITY : sqrtf(ps.worst);
+}
+
+/* D2's bound is measured again only where it is at least this share of the mesh's bounding radius
+ * (tight_d2): a tenth took watch.glb at 64 x 36 pixels from 41.1 to 37.9 dB, white-claw-can.glb at
+ * 256 x 144 to 39.96 dB with no share at all. */
+#define LOD_TIGHT_D2_SHARE 0.25f
+
+/* D2 measured again where its bound decides the error of a group at the coarse end: above D1, the
+ * texture slide and the members' errors, of a group holding at least a quarter of the mesh's samples,
+ * and at least LOD_TIGHT_D2_SHARE of the mesh's radius. A bound taken within twice the largest
+ * checked may be twice the distance, and there nothing else covers it; so the probes are measured
+ * again from that level up, each bound that would raise D2 past the largest checked measured exactly
+ * over the level-0 triangles around the simplified triangles' corners, and over the group's own
+ * surface where its grid is built already (distances to some level-0 triangles: never below the
+ * distance to S0, so still bounds). Both measures bound D2: the smaller is returned. Such groups are drawn at 1 px
+ * where the whole model spans some tens of pixels or fewer (a pixel of a 16 x 9 view of a framed
+ * model is about 0.3 of its radius, of 64 x 36 about 0.08). Finer, the loose bound is kept, which
+ * guards shading and silhouettes that the distance does not weigh (docs/GEOMETRY.md, "The coarse
+ * end of a textured mesh"). The quarter of the samples bounds the cost: at most four such groups a
+ * step, at the DAG's top. */
+static float tight_d2(const lod_build *b, lod_scratch *s, const group_result *r, float to_simplified, float to_full)
+{
+    float level = to_simplified > r->slide ? to_simplified : r->slide;
+    level = level > r->error ? level : r->error;
+    if (!(to_full > level) || (size_t)s->gathered * 4 < b->position_count ||
+        to_full < LOD_TIGHT_D2_SHARE * b->mesh->bounds.w)
+        return to_full;
+    float again = simplified_to_full(b, s, level, to_full, 1.0f);
+    return again >= 0.0f && again < to_full ? again : to_full;
 }
 
 /* The samples in order of the new cluster they pass to, into r. */
@@ -1147,7 +1186,7 @@ static float group_floor(const lod_build *b, lod_scratch *s, const group_result 
     float kept = kept_bound(&s->top), rest = kept > 0.0f ? sqrtf(kept) : 0.0f;
     float floor = r->error > rest ? r->error : rest;
     if (to_simplified > floor && *to_full >= 0.0f && floor <= LOD_REDIRECT_GAIN * *to_full) {
-        float again = simplified_to_full(b, s, floor, LOD_REDIRECT_GAIN * *to_full);
+        float again = simplified_to_full(b, s, floor, LOD_REDIRECT_GAIN * *to_full, LOD_LOOSE);
         if (again >= 0.0f && again < r->slide)
             again = r->slide; /* the texture slides that far on the simplified surface, as measured first */
         *to_full = again < *to_full ? again : *to_full;
@@ -1200,7 +1239,9 @@ int gdr_lod_group_deviation(lod_build *b, lod_scratch *s, const uint32_t *member
     s->top.count = 0; /* a group without samples keeps none */
     s->top.limit = LOD_KEPT_FIRST;
     float to_simplified = s->gathered ? samples_to_simplified(b, s, local_count) : 0.0f;
-    float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified, INFINITY);
+    float to_full = to_simplified < 0.0f ? 0.0f : simplified_to_full(b, s, to_simplified, INFINITY, LOD_LOOSE);
+    if (to_simplified >= 0.0f && to_full >= 0.0f)
+        to_full = tight_d2(b, s, r, to_simplified, to_full);
     if (to_full >= 0.0f && r->slide > to_full)
         to_full = r->slide; /* the texture slides that far on the simplified surface */
     /* Measured again (the same largest distance), over the vertex grid the probes may have taken.

@@ -358,6 +358,28 @@ static double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, do
     return error;
 }
 
+/* The largest slide (squared) a triangle of a's fan that survives the move already carries, as the
+ * group's error states it (output_slide: capped by its longest edge), where the move stretches that
+ * edge and so raises the capped slide; 0 where none does. A collapse that lengthens a triangle an
+ * earlier collapse slid across charts raises the group's slide as much as a new slide would: a
+ * sliver charged while short and stretched later set DamagedHelmet's coarse slide (0.39 units) at
+ * no cost to the collapse that stretched it. */
+static double stretched_slide2(const run *r, const uint32_t *fan, uint32_t n)
+{
+    double largest = 0.0;
+    for (uint32_t i = 0; i < n; i++) {
+        const lod_simplify_corner *f = &r->s->info[i];
+        double carried = r->s->tri_slide[fan[i] / 3];
+        if (f->holds_b || carried == 0.0)
+            continue;
+        double e12 = f->g11 + f->g22 - 2.0 * f->g12, edge2 = fmax(fmax(f->g11, f->g22), e12);
+        double before = fmin(carried * carried, edge2), after = fmin(carried * carried, f->edge2_at_q);
+        if (after > before && after > largest)
+            largest = after;
+    }
+    return largest;
+}
+
 /* The geometric part of the cost of moving a onto b, whose edge with a holds edge_triangles of a's
  * triangles: the quadric's mean squared distance at b, or INFINITY where the collapse is not allowed
  * (no triangle along a-b, or more than two; a border position not along a border edge). The whole
@@ -404,7 +426,7 @@ static double pair_cost(run *r, uint32_t b, double geometry, const uint32_t *fan
     load(r, b, q);
     extrapolate_fan(r, n, q);
     uint32_t b_wedges = NONE;
-    double normal = 0.0, slide2 = 0.0, scale = area > 0.0 ? 1.0 / area : 0.0;
+    double normal = 0.0, slide2 = stretched_slide2(r, fan, n), scale = area > 0.0 ? 1.0 / area : 0.0;
     for (uint32_t k = 0; k < wedge_count; k++) {
         uint32_t wa = wedges[k], best = NONE;
         double best_error = INFINITY, best_normal = 0.0, best_slide2 = 0.0, e, n2, s2;

@@ -2,11 +2,13 @@
  * fewer triangles than charts, the simplifier must give some corners the uv of another chart, and
  * the slide the group states is the largest over its triangles (each charged at most its longest
  * edge: the texels it spoils lie inside it). So which crossings it takes decides the group's error:
- * the slide stated must stay within 2.5 times the mean edge of the simplified sheet (2.1x). Before
+ * the slide stated must stay within 1.75 times the mean edge of the simplified sheet (1.48x). Before
  * the collapses' cost weighed a slide as the group states it (the largest a triangle is charged,
  * capped by its size), crossings were ordered by how far apart the charts lie in the atlas, which
  * says nothing of the triangle they spoil, and long triangles spanning charts set the slide (3.3x
- * the mean edge here). */
+ * the mean edge here); and before a collapse that stretches a triangle an earlier one slid was
+ * charged the slide it raises (the cap grows with the triangle), slivers charged while short and
+ * stretched later at no cost set it (2.08x). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -89,7 +91,7 @@ int main(void)
            (QUADS / CHART) * (QUADS / CHART), kept, (double)result.slide, mean, (double)result.slide / mean);
     CHECK_MSG(kept <= (size_t)TRIANGLES / 8, "simplified to %zu of %u triangles only", kept, TRIANGLES);
     CHECK_MSG(result.slide > 0.0f, "no slide stated, though charts had to be crossed");
-    CHECK_MSG(result.slide <= 2.5 * mean, "slide %g is above 2.5 times the mean edge %g", (double)result.slide, mean);
+    CHECK_MSG(result.slide <= 1.75 * mean, "slide %g is above 1.75 times the mean edge %g", (double)result.slide, mean);
     lod_simplify_scratch_free(&scratch);
     return test_finish("test_lod_charts");
 }
