@@ -524,6 +524,36 @@ static int keeps_topology(run *r, uint32_t a, uint32_t b, const uint32_t *fan, u
     return 1;
 }
 
+/* Moving a onto a locked b keeps every edge between b and another locked position x that a
+ * triangle removed by the move (one holding a and b) runs along: a triangle of a's fan holding x and
+ * not b must survive to carry it (it becomes b, x, ...). Where a's edge to x is open none does: a
+ * triangle hanging off the group's border into a mesh hole (the bunny's: a's only triangle) would
+ * vanish with its edge b-x, the group would no longer meet its neighbour there, lod_group.c would
+ * reject the whole group, and its clusters would stay a level behind at every step. */
+static int keeps_locked_edges(const run *r, uint32_t a, uint32_t b, const uint32_t *fan, uint32_t n)
+{
+    const uint8_t *locked = r->in->locked;
+    if (!locked[b])
+        return 1;
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t c = fan[i];
+        uint32_t x = corner_position(r, corner_after(c, 1)), y = corner_position(r, corner_after(c, 2));
+        if (x != b && y != b)
+            continue;
+        x = x == b ? y : x; /* the removed triangle's third corner */
+        if (x == a || x == b || !locked[x])
+            continue;
+        int carried = 0;
+        for (uint32_t k = 0; k < n && !carried; k++) {
+            uint32_t t = fan[k] / 3;
+            carried = !triangle_holds(r, t, b) && triangle_holds(r, t, x);
+        }
+        if (!carried)
+            return 0;
+    }
+    return 1;
+}
+
 /* --- collapses ------------------------------------------------------------------------------------------ */
 
 /* One evaluation of a position a: its fan, neighbours and wedges; per neighbour the cost of moving
@@ -597,7 +627,8 @@ static double best_collapse(run *r, uint32_t a, int valid, uint32_t *target)
             return INFINITY;
         if (valid && s->pass[b] == r->pass)
             continue;
-        if (!valid || (keeps_orientation(r, a, b, s->fan, e.n) && keeps_topology(r, a, b, s->fan, e.n))) {
+        if (!valid || (keeps_orientation(r, a, b, s->fan, e.n) && keeps_topology(r, a, b, s->fan, e.n) &&
+                       keeps_locked_edges(r, a, b, s->fan, e.n))) {
             *target = b;
             return s->costs[m];
         }
