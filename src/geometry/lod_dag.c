@@ -968,6 +968,44 @@ static void small_mesh_task(void *user, uint32_t i, uint32_t worker)
 
 static int needs_dag(const gdr_mesh *m) { return m->clusters.level0_cluster_count > 0 && m->clusters.group_count == 0; }
 
+/* Marks the meshes whose DAG is built here (built), lists the small ones (built one per task), and
+ * returns their triangles, for the progress bar. */
+static uint64_t select_meshes(const gdr_scene *scene, uint8_t *built, uint32_t *small, uint32_t *small_count)
+{
+    uint64_t total = 0;
+    for (uint32_t m = 0; m < scene->mesh_count; m++)
+        if (needs_dag(&scene->meshes[m])) {
+            total += scene->meshes[m].index_count / 3;
+            built[m] = 1;
+            if (scene->meshes[m].index_count / 3 < LOD_SMALL_MESH_TRIANGLES)
+                small[(*small_count)++] = m;
+        }
+    return total;
+}
+
+/* The first mesh's failure as the scene's error; on failure every built mesh goes back to level 0,
+ * else their statistics are summed into stats. */
+static gdr_status finish_meshes(gdr_scene *scene, const scene_job *job, const uint8_t *built, gdr_lod_stats *stats,
+                                gdr_error *err)
+{
+    gdr_status status = GDR_OK;
+    uint32_t n = scene->mesh_count;
+    for (uint32_t m = 0; m < n && status == GDR_OK; m++)
+        if (built[m] && job->status[m] != GDR_OK)
+            status = gdr_error_set(err, job->status[m], "meshes[%u]: %s", m, job->errors[m].message);
+    for (uint32_t m = 0; m < n; m++) {
+        if (!built[m])
+            continue;
+        if (status != GDR_OK) {
+            truncate_to_level0(&scene->meshes[m].clusters);
+            gdr_mesh_clusters_build_hierarchy(&scene->meshes[m].clusters, NULL);
+        } else if (stats) {
+            stats_add(stats, &job->stats[m]);
+        }
+    }
+    return status;
+}
+
 gdr_status gdr_scene_build_lod(gdr_scene *scene, const gdr_lod_options *options, gdr_lod_stats *stats,
                                gdr_error *err)
 {
@@ -1005,15 +1043,8 @@ gdr_status gdr_scene_build_lod(gdr_scene *scene, const gdr_lod_options *options,
         if (status != GDR_OK)
             goto done;
     }
-    uint64_t total = 0;
     uint32_t small_count = 0;
-    for (uint32_t m = 0; m < n; m++)
-        if (needs_dag(&scene->meshes[m])) {
-            total += scene->meshes[m].index_count / 3;
-            built[m] = 1;
-            if (scene->meshes[m].index_count / 3 < LOD_SMALL_MESH_TRIANGLES)
-                small[small_count++] = m;
-        }
+    uint64_t total = select_meshes(scene, built, small, &small_count);
     lod_progress progress;
     gdr_progress_begin(&progress.bar, "LOD DAG", total, o.no_progress);
     atomic_init(&progress.done, 0);
@@ -1031,19 +1062,7 @@ gdr_status gdr_scene_build_lod(gdr_scene *scene, const gdr_lod_options *options,
         if (built[m] && scene->meshes[m].index_count / 3 >= LOD_SMALL_MESH_TRIANGLES)
             statuses[m] = build_scene_mesh(&job, m, pool, 0);
     gdr_progress_end(&progress.bar);
-    for (uint32_t m = 0; m < n && status == GDR_OK; m++)
-        if (built[m] && statuses[m] != GDR_OK)
-            status = gdr_error_set(err, statuses[m], "meshes[%u]: %s", m, errors[m].message);
-    for (uint32_t m = 0; m < n; m++) {
-        if (!built[m])
-            continue;
-        if (status != GDR_OK) {
-            truncate_to_level0(&scene->meshes[m].clusters);
-            gdr_mesh_clusters_build_hierarchy(&scene->meshes[m].clusters, NULL);
-        } else if (stats) {
-            stats_add(stats, &mesh_stats[m]);
-        }
-    }
+    status = finish_meshes(scene, &job, built, stats, err);
 done:
     lod_scene_textures_free(&textures);
     gdr_thread_pool_destroy(pool);

@@ -25,10 +25,8 @@
 
 #include "gdr/geometry.h"
 #include "gdr/scene.h"
-#include "geometry/lod_grid.h"
-#include "geometry/lod_internal.h"
 #include "charted_torus.h"
-#include "point_distance.h"
+#include "group_distance.h"
 #include "test_util.h"
 
 #define MAX_RATIO 1.6
@@ -37,12 +35,6 @@
  * quarter of the samples, a quarter of the radius). */
 #define COARSE_SHARE 0.25
 
-static float point_triangle_d2_float(gdr_vec3 p, gdr_vec3 a, gdr_vec3 b, gdr_vec3 c)
-{
-    double d = point_triangle(d3(p), d3(a), d3(b), d3(c));
-    return (float)(d * d);
-}
-
 typedef struct coarse_check {
     lod_triangle_grid full; /* level 0, every triangle of a cell looked at: exact */
     double worst_ratio;     /* the largest deviation / max(other parts, measured distance) of a coarse group */
@@ -50,32 +42,6 @@ typedef struct coarse_check {
     uint32_t checked;       /* coarse groups stating at least COARSE_SHARE of the radius: their ratio checked */
     uint32_t decided;       /* checked groups whose measured distance is above their other parts */
 } coarse_check;
-
-/* The exact distance to level 0, largest over a barycentric grid of 8 steps on each triangle of the
- * clusters r made. */
-static double measured_distance(const coarse_check *k, const lod_build *b, const group_result *r)
-{
-    const gdr_vec3 *pos = b->mesh->positions;
-    double worst = 0;
-    for (uint32_t i = 0; i < r->cluster_count; i++) {
-        const gdr_cluster *c = &b->clusters[r->first_cluster + i];
-        const uint32_t *v = gdr_lod_cluster_vertices(b, c);
-        const uint8_t *t = gdr_lod_cluster_triangles(b, c);
-        for (uint32_t j = 0; j < c->triangle_count; j++) {
-            gdr_vec3 a = pos[v[t[3 * j]]], e = pos[v[t[3 * j + 1]]], f = pos[v[t[3 * j + 2]]];
-            for (int s = 0; s <= 8; s++)
-                for (int w = 0; s + w <= 8; w++) {
-                    float fs = (float)s / 8.0f, fw = (float)w / 8.0f, fz = 1.0f - fs - fw;
-                    gdr_vec3 q = {fz * a.x + fs * e.x + fw * f.x, fz * a.y + fs * e.y + fw * f.y,
-                                  fz * a.z + fs * e.z + fw * f.z};
-                    float d2;
-                    lod_triangle_grid_nearest(&k->full, q, point_triangle_d2_float, &d2);
-                    worst = fmax(worst, sqrt(d2));
-                }
-        }
-    }
-    return worst;
-}
 
 /* The largest error of the groups g's members came from (0 for level-0 members). */
 static double members_error(const lod_build *b, const lod_step_view *v, uint32_t g)
@@ -96,7 +62,7 @@ static void observe_step(void *user, const lod_build *b, const lod_step_view *v)
         const group_result *r = &v->results[g];
         if (!r->formed)
             continue;
-        double measured = measured_distance(k, b, r), deviation = r->deviation;
+        double measured = group_level0_distance(&k->full, b, r), deviation = r->deviation;
         k->under += b->groups[r->group].error < measured * (1.0 - 1e-5) || deviation < measured * (1.0 - 1e-5);
         uint32_t samples = r->cluster_sample_first[r->cluster_count];
         if ((size_t)samples * 3 < b->position_count)
@@ -117,32 +83,13 @@ static void observe_step(void *user, const lod_build *b, const lod_step_view *v)
     }
 }
 
-#define QUADS 120
-
-/* A unit square of QUADS x QUADS quads mapped by its plane coordinates (one chart: its slides are
- * small), jittered in the plane and folded by a wave whose crests wander (test_lod_probe_bound's
- * sheet): folds a few quads apart, where probes' walks stop far from their foot. */
+/* The crumpled sheet mapped by its plane (one chart: its slides are small). */
 static uint32_t add_crumpled_sheet(gdr_scene *s)
 {
-    static gdr_vec3 p[(QUADS + 1) * (QUADS + 1)];
-    static gdr_vec2 uv[(QUADS + 1) * (QUADS + 1)];
-    static uint32_t idx[QUADS * QUADS * 6];
-    for (uint32_t y = 0; y <= QUADS; y++)
-        for (uint32_t x = 0; x <= QUADS; x++) {
-            uint32_t i = y * (QUADS + 1) + x;
-            float u = (float)x / QUADS, v = (float)y / QUADS;
-            float du = 2.0f * test_hash_unit(2 * i) - 1.0f, dv = 2.0f * test_hash_unit(2 * i + 1) - 1.0f;
-            p[i] = (gdr_vec3){u + 0.004f * du, v + 0.004f * dv, 0.05f * sinf(40.0f * u + 7.0f * sinf(9.0f * v))};
-            uv[i] = (gdr_vec2){p[i].x, p[i].y};
-        }
-    uint32_t k = 0;
-    for (uint32_t y = 0; y < QUADS; y++)
-        for (uint32_t x = 0; x < QUADS; x++) {
-            uint32_t a = y * (QUADS + 1) + x, b = a + 1, c = a + QUADS + 1, d = c + 1;
-            uint32_t t[6] = {a, b, d, a, d, c};
-            for (int j = 0; j < 6; j++)
-                idx[k++] = t[j];
-        }
+    static gdr_vec3 p[CRUMPLED_VERTICES];
+    static gdr_vec2 uv[CRUMPLED_VERTICES];
+    static uint32_t idx[CRUMPLED_INDICES];
+    crumpled_sheet(p, uv, idx);
     uint32_t mesh = 0;
     gdr_error err = {0};
     charted_torus_check(gdr_scene_add_mesh(s, "crumpled", p, NULL, uv, (uint32_t)(sizeof p / sizeof *p), idx,
@@ -183,6 +130,6 @@ static void check_mesh(int which, uint32_t segments, uint32_t sides)
 int main(void)
 {
     check_mesh(0, 96, 32);
-    check_mesh(1, QUADS, QUADS);
+    check_mesh(1, CRUMPLED_QUADS, CRUMPLED_QUADS);
     return test_finish("test_lod_coarse_bound");
 }
