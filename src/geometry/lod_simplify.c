@@ -320,8 +320,12 @@ static double slide_variation(const run *r, const lod_simplify_corner *f, gdr_ve
 /* The error of giving a fan corner the attributes of wedge wb at the target (extrapolate_fan):
  * its triangle's normal there against wb's, as an area-weighted squared length (returned), and its
  * uv against wb's: the texture slide, a mesh length times the largest change the texture shows
- * under it (slide_variation), squared (*slide2). */
-static double corner_attribute_error(const run *r, const lod_simplify_corner *f, uint32_t wb, double *slide2)
+ * under it (slide_variation), squared (*slide2). A caller that keeps only the largest slide above
+ * `counts_above`, capped by the triangle's longest edge (wedge_error), gives that bound: where the slide
+ * unweighted (the change is at most 1) or that edge is no more than it, the slide cannot count,
+ * the texture is not read and *slide2 is 0. -INFINITY: always measured. */
+static double corner_attribute_error(const run *r, const lod_simplify_corner *f, uint32_t wb, double *slide2,
+                                     double counts_above)
 {
     const lod_simplify_input *in = r->in;
     *slide2 = 0.0;
@@ -332,7 +336,9 @@ static double corner_attribute_error(const run *r, const lod_simplify_corner *f,
         const gdr_vec2 tb = in->uvs[mb];
         double du = f->uv_at_q[0] - tb.x, dv = f->uv_at_q[1] - tb.y;
         *slide2 = (du * du + dv * dv) * f->uv_scale;
-        if (*slide2 > 0.0 && in->texture) {
+        if (*slide2 > 0.0 && in->texture && (*slide2 <= counts_above || f->edge2_at_q <= counts_above))
+            *slide2 = 0.0;
+        else if (*slide2 > 0.0 && in->texture) {
             double v = slide_variation(r, f, tb);
             *slide2 *= v * v;
         }
@@ -358,7 +364,7 @@ static double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, do
         if (f->wedge != wa || f->holds_b)
             continue;
         double s2;
-        error += corner_attribute_error(r, f, wb, &s2);
+        error += corner_attribute_error(r, f, wb, &s2, *slide2);
         s2 = s2 < f->edge2_at_q ? s2 : f->edge2_at_q;
         *slide2 = s2 > *slide2 ? s2 : *slide2;
     }
@@ -674,7 +680,7 @@ static void collapse(run *r, uint32_t a, uint32_t b)
         double s2;
         if (f->holds_b)
             continue;
-        corner_attribute_error(r, f, s->choice[f->wedge], &s2);
+        corner_attribute_error(r, f, s->choice[f->wedge], &s2, -INFINITY);
         float slide = (float)sqrt(s2);
         uint32_t t = s->fan[i] / 3;
         s->tri_slide[t] = slide > s->tri_slide[t] ? slide : s->tri_slide[t];
