@@ -324,7 +324,7 @@ static double slide_variation(const run *r, const lod_simplify_corner *f, gdr_ve
  * `counts_above`, capped by the triangle's longest edge (wedge_error), gives that bound: where the slide
  * unweighted (the change is at most 1) or that edge is no more than it, the slide cannot count,
  * the texture is not read and *slide2 is 0. -INFINITY: always measured. */
-static double corner_attribute_error(const run *r, const lod_simplify_corner *f, uint32_t wb, double *slide2,
+static inline double corner_attribute_error(const run *r, const lod_simplify_corner *f, uint32_t wb, double *slide2,
                                      double counts_above)
 {
     const lod_simplify_input *in = r->in;
@@ -413,7 +413,7 @@ static double stretched_slide2(const run *r, const uint32_t *fan, uint32_t n)
  * (no triangle along a-b, or more than two; a border position not along a border edge). The whole
  * cost is never below it (the attribute error is a sum of squares), so it orders the candidates
  * before their attribute errors are computed. */
-static double pair_geometry(const run *r, uint32_t a, uint32_t b, uint32_t edge_triangles)
+static inline double pair_geometry(const run *r, uint32_t a, uint32_t b, uint32_t edge_triangles)
 {
     const lod_simplify_scratch *s = r->s;
     if (edge_triangles == 0 || edge_triangles > 2 || ((s->flags[a] & FLAG_BORDER) && edge_triangles != 1))
