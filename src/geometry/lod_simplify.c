@@ -82,7 +82,7 @@ static inline void cross(const double a[3], const double b[3], double o[3])
 /* --- quadrics: a2 ab ac ad b2 bc bd c2 cd d2 of w (n.x + d)^2, and the sum of the weights w ------------ */
 #define QUADRIC_SIZE 11
 
-static void quadric_add_plane(double *q, const double n[3], double d, double w)
+static inline void quadric_add_plane(double *q, const double n[3], double d, double w)
 {
     q[0] += w * n[0] * n[0], q[1] += w * n[0] * n[1], q[2] += w * n[0] * n[2], q[3] += w * n[0] * d;
     q[4] += w * n[1] * n[1], q[5] += w * n[1] * n[2], q[6] += w * n[1] * d;
@@ -358,7 +358,7 @@ static inline double corner_attribute_error(const run *r, const lod_simplify_cor
  * times `scale` plus the slide is below `beaten` (INFINITY: it keeps wb whatever its cost): on a
  * textured mesh the normals' error is summed first, and where it alone reaches `beaten` the slides,
  * which would look the texture up, are not measured (*slide2 is then 0). */
-static double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, double *slide2, double scale,
+static inline double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, double *slide2, double scale,
                           double beaten)
 {
     double error = 0.0;
