@@ -324,8 +324,8 @@ static double slide_variation(const run *r, const lod_simplify_corner *f, gdr_ve
  * `counts_above`, capped by the triangle's longest edge (wedge_error), gives that bound: where the slide
  * unweighted (the change is at most 1) or that edge is no more than it, the slide cannot count,
  * the texture is not read and *slide2 is 0. -INFINITY: always measured. */
-static inline double corner_attribute_error(const run *r, const lod_simplify_corner *f, uint32_t wb, double *slide2,
-                                     double counts_above)
+static inline double corner_attribute_error(const run *r, const lod_simplify_corner *f, uint32_t wb,
+                                            double *slide2, double counts_above)
 {
     const lod_simplify_input *in = r->in;
     *slide2 = 0.0;
@@ -354,26 +354,11 @@ static inline double corner_attribute_error(const run *r, const lod_simplify_cor
 /* The error of wedge wa taking wedge wb when a moves to q = b's position, over wa's triangles that
  * survive (those not holding b): the normals' area-weighted error (returned), and in *slide2 the
  * largest slide a triangle would be charged for it, at most the triangle's longest edge (squared),
- * as the group's error counts it (output_slide). The caller keeps wb only where the normals' error
- * times `scale` plus the slide is below `beaten` (INFINITY: it keeps wb whatever its cost): on a
- * textured mesh the normals' error is summed first, and where it alone reaches `beaten` the slides,
- * which would look the texture up, are not measured (*slide2 is then 0). */
-static inline double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, double *slide2, double scale,
-                          double beaten)
+ * as the group's error counts it (output_slide). */
+static inline double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, double *slide2)
 {
     double error = 0.0;
     *slide2 = 0.0;
-    if (r->in->texture && beaten < INFINITY) {
-        for (uint32_t i = 0; i < n; i++) {
-            const lod_simplify_corner *f = &r->s->info[i];
-            double s2;
-            if (f->wedge == wa && !f->holds_b)
-                error += corner_attribute_error(r, f, wb, &s2, INFINITY);
-        }
-        if (error * scale >= beaten)
-            return error;
-        error = 0.0;
-    }
     for (uint32_t i = 0; i < n; i++) {
         const lod_simplify_corner *f = &r->s->info[i];
         if (f->wedge != wa || f->holds_b)
@@ -467,7 +452,7 @@ static double pair_cost(run *r, uint32_t b, double geometry, const uint32_t *fan
                 uint32_t wb = s->tri[base + j];
                 if (wedge_position(r, wb) != b || wb == best)
                     continue;
-                n2 = wedge_error(r, n, wa, wb, &s2, scale, best_error) * scale;
+                n2 = wedge_error(r, n, wa, wb, &s2) * scale;
                 if ((e = n2 + s2 * UV_WEIGHT) < best_error)
                     best = wb, best_error = e, best_normal = n2, best_slide2 = s2;
             }
@@ -478,7 +463,7 @@ static double pair_cost(run *r, uint32_t b, double geometry, const uint32_t *fan
                 b_wedges = gather_wedges(r, s->fan_b, m, s->wedges_b);
             }
             for (uint32_t j = 0; j < b_wedges; j++) {
-                n2 = wedge_error(r, n, wa, s->wedges_b[j], &s2, scale, best == NONE ? INFINITY : best_error) * scale;
+                n2 = wedge_error(r, n, wa, s->wedges_b[j], &s2) * scale;
                 if ((e = n2 + s2 * UV_WEIGHT) < best_error || best == NONE)
                     best = s->wedges_b[j], best_error = e, best_normal = n2, best_slide2 = s2;
             }
