@@ -336,7 +336,8 @@ static inline double corner_attribute_error(const run *r, const lod_simplify_cor
         const gdr_vec2 tb = in->uvs[mb];
         double du = f->uv_at_q[0] - tb.x, dv = f->uv_at_q[1] - tb.y;
         *slide2 = (du * du + dv * dv) * f->uv_scale;
-        if (*slide2 > 0.0 && in->texture && (*slide2 <= counts_above || f->edge2_at_q <= counts_above))
+        int cannot_count = !in->every_slide && (*slide2 <= counts_above || f->edge2_at_q <= counts_above);
+        if (*slide2 > 0.0 && in->texture && cannot_count)
             *slide2 = 0.0;
         else if (*slide2 > 0.0 && in->texture) {
             double v = slide_variation(r, f, tb);
