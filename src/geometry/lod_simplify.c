@@ -45,6 +45,10 @@ typedef struct run {
     const lod_simplify_input *in;
     size_t triangles; /* alive */
     int failed;       /* out of memory */
+    /* The position and target of the last whole cost computed (settle_cost): s->info and s->choice
+     * still describe that move, so collapse() need not compute it again. NONE: none since the last
+     * evaluation began. */
+    uint32_t settled_a, settled_b;
 } run;
 
 static inline uint32_t wedge_position(const run *r, uint32_t w) { return r->in->vertex_position[w]; }
@@ -67,6 +71,9 @@ static inline void sub(const double a[3], const double b[3], double o[3])
     o[0] = a[0] - b[0], o[1] = a[1] - b[1], o[2] = a[2] - b[2];
 }
 static inline double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+/* fmax and fmin (a NaN gives way to the other value) without libm's call: the same results. */
+static inline double max2(double x, double y) { return x > y || y != y ? x : y; }
+static inline double min2(double x, double y) { return x < y || y != y ? x : y; }
 static inline void cross(const double a[3], const double b[3], double o[3])
 {
     o[0] = a[1] * b[2] - a[2] * b[1], o[1] = a[2] * b[0] - a[0] * b[2], o[2] = a[0] * b[1] - a[1] * b[0];
@@ -75,7 +82,7 @@ static inline void cross(const double a[3], const double b[3], double o[3])
 /* --- quadrics: a2 ab ac ad b2 bc bd c2 cd d2 of w (n.x + d)^2, and the sum of the weights w ------------ */
 #define QUADRIC_SIZE 11
 
-static void quadric_add_plane(double *q, const double n[3], double d, double w)
+static inline void quadric_add_plane(double *q, const double n[3], double d, double w)
 {
     q[0] += w * n[0] * n[0], q[1] += w * n[0] * n[1], q[2] += w * n[0] * n[2], q[3] += w * n[0] * d;
     q[4] += w * n[1] * n[1], q[5] += w * n[1] * n[2], q[6] += w * n[1] * d;
@@ -284,7 +291,7 @@ static void extrapolate_fan(const run *r, uint32_t n, const double q[3])
         sub(q, f->p0, d);
         sub(f->e1, f->e2, e12);
         double r1 = dot(d, f->e1), r2 = dot(d, f->e2);
-        f->edge2_at_q = fmax(fmax(f->g11 - 2.0 * r1 + dot(d, d), f->g22 - 2.0 * r2 + dot(d, d)), dot(e12, e12));
+        f->edge2_at_q = max2(max2(f->g11 - 2.0 * r1 + dot(d, d), f->g22 - 2.0 * r2 + dot(d, d)), dot(e12, e12));
         if (f->inv_det == 0.0)
             continue;
         double u = (f->g22 * r1 - f->g12 * r2) * f->inv_det, v = (f->g11 * r2 - f->g12 * r1) * f->inv_det;
@@ -313,8 +320,12 @@ static double slide_variation(const run *r, const lod_simplify_corner *f, gdr_ve
 /* The error of giving a fan corner the attributes of wedge wb at the target (extrapolate_fan):
  * its triangle's normal there against wb's, as an area-weighted squared length (returned), and its
  * uv against wb's: the texture slide, a mesh length times the largest change the texture shows
- * under it (slide_variation), squared (*slide2). */
-static double corner_attribute_error(const run *r, const lod_simplify_corner *f, uint32_t wb, double *slide2)
+ * under it (slide_variation), squared (*slide2). A caller that keeps only the largest slide above
+ * `counts_above`, capped by the triangle's longest edge (wedge_error), gives that bound: where the slide
+ * unweighted (the change is at most 1) or that edge is no more than it, the slide cannot count,
+ * the texture is not read and *slide2 is 0. -INFINITY: always measured. */
+static inline double corner_attribute_error(const run *r, const lod_simplify_corner *f, uint32_t wb,
+                                            double *slide2, double counts_above)
 {
     const lod_simplify_input *in = r->in;
     *slide2 = 0.0;
@@ -325,7 +336,10 @@ static double corner_attribute_error(const run *r, const lod_simplify_corner *f,
         const gdr_vec2 tb = in->uvs[mb];
         double du = f->uv_at_q[0] - tb.x, dv = f->uv_at_q[1] - tb.y;
         *slide2 = (du * du + dv * dv) * f->uv_scale;
-        if (*slide2 > 0.0 && in->texture) {
+        int cannot_count = !in->every_slide && (*slide2 <= counts_above || f->edge2_at_q <= counts_above);
+        if (*slide2 > 0.0 && in->texture && cannot_count)
+            *slide2 = 0.0;
+        else if (*slide2 > 0.0 && in->texture) {
             double v = slide_variation(r, f, tb);
             *slide2 *= v * v;
         }
@@ -342,7 +356,7 @@ static double corner_attribute_error(const run *r, const lod_simplify_corner *f,
  * survive (those not holding b): the normals' area-weighted error (returned), and in *slide2 the
  * largest slide a triangle would be charged for it, at most the triangle's longest edge (squared),
  * as the group's error counts it (output_slide). */
-static double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, double *slide2)
+static inline double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, double *slide2)
 {
     double error = 0.0;
     *slide2 = 0.0;
@@ -351,7 +365,7 @@ static double wedge_error(const run *r, uint32_t n, uint32_t wa, uint32_t wb, do
         if (f->wedge != wa || f->holds_b)
             continue;
         double s2;
-        error += corner_attribute_error(r, f, wb, &s2);
+        error += corner_attribute_error(r, f, wb, &s2, *slide2);
         s2 = s2 < f->edge2_at_q ? s2 : f->edge2_at_q;
         *slide2 = s2 > *slide2 ? s2 : *slide2;
     }
@@ -372,8 +386,8 @@ static double stretched_slide2(const run *r, const uint32_t *fan, uint32_t n)
         double carried = r->s->tri_slide[fan[i] / 3];
         if (f->holds_b || carried == 0.0)
             continue;
-        double e12 = f->g11 + f->g22 - 2.0 * f->g12, edge2 = fmax(fmax(f->g11, f->g22), e12);
-        double before = fmin(carried * carried, edge2), after = fmin(carried * carried, f->edge2_at_q);
+        double e12 = f->g11 + f->g22 - 2.0 * f->g12, edge2 = max2(max2(f->g11, f->g22), e12);
+        double before = min2(carried * carried, edge2), after = min2(carried * carried, f->edge2_at_q);
         if (after > before && after > largest)
             largest = after;
     }
@@ -385,7 +399,7 @@ static double stretched_slide2(const run *r, const uint32_t *fan, uint32_t n)
  * (no triangle along a-b, or more than two; a border position not along a border edge). The whole
  * cost is never below it (the attribute error is a sum of squares), so it orders the candidates
  * before their attribute errors are computed. */
-static double pair_geometry(const run *r, uint32_t a, uint32_t b, uint32_t edge_triangles)
+static inline double pair_geometry(const run *r, uint32_t a, uint32_t b, uint32_t edge_triangles)
 {
     const lod_simplify_scratch *s = r->s;
     if (edge_triangles == 0 || edge_triangles > 2 || ((s->flags[a] & FLAG_BORDER) && edge_triangles != 1))
@@ -576,6 +590,7 @@ static void settle_cost(run *r, evaluation *e, uint32_t i)
     s->costs[i] = (float)pair_cost(r, s->neighbours[i], s->geometry[i], s->fan, e->n, e->area, s->wedges,
                                    e->wedge_count);
     s->exact[i] = 1;
+    r->settled_a = e->a, r->settled_b = s->neighbours[i];
 }
 
 /* The neighbour not yet taken with the smallest cost (ties by position index), INFINITY's included,
@@ -606,6 +621,7 @@ static double best_collapse(run *r, uint32_t a, int valid, uint32_t *target)
 {
     lod_simplify_scratch *s = r->s;
     *target = NONE;
+    r->settled_a = r->settled_b = NONE;
     if (r->in->locked[a] || (s->flags[a] & FLAG_REMOVED) || (valid && s->pass[a] == r->pass))
         return INFINITY;
     evaluation e = {.a = a, .n = gather_fan(r, a, s->fan)};
@@ -646,22 +662,26 @@ static void queue(run *r, uint32_t p)
     }
 }
 
-/* Moves a onto b (the checks passed). */
+/* Moves a onto b (the checks passed). The evaluation that chose b computed its whole cost last
+ * where it settled no other neighbour after it: s->fan, s->info and s->choice then hold that move
+ * (nothing has changed since; the checks write neither) and are not computed again. */
 static void collapse(run *r, uint32_t a, uint32_t b)
 {
     lod_simplify_scratch *s = r->s;
     uint32_t n = gather_fan(r, a, s->fan);
     if (!reserve_fan(r, n))
         return;
-    uint32_t wedge_count = gather_wedges(r, s->fan, n, s->wedges);
-    pair_cost(r, b, pair_geometry(r, a, b, edge_triangles(r, b, s->fan, n)), s->fan, n, prepare_fan(r, s->fan, n), s->wedges,
-              wedge_count); /* sets s->choice, and s->info for b */
+    if (r->settled_a != a || r->settled_b != b) {
+        uint32_t wedge_count = gather_wedges(r, s->fan, n, s->wedges);
+        pair_cost(r, b, pair_geometry(r, a, b, edge_triangles(r, b, s->fan, n)), s->fan, n, prepare_fan(r, s->fan, n),
+                  s->wedges, wedge_count); /* sets s->choice, and s->info for b */
+    }
     for (uint32_t i = 0; i < n; i++) { /* the slide charged to each surviving triangle whose corner moves */
         const lod_simplify_corner *f = &s->info[i];
         double s2;
         if (f->holds_b)
             continue;
-        corner_attribute_error(r, f, s->choice[f->wedge], &s2);
+        corner_attribute_error(r, f, s->choice[f->wedge], &s2, -INFINITY);
         float slide = (float)sqrt(s2);
         uint32_t t = s->fan[i] / 3;
         s->tri_slide[t] = slide > s->tri_slide[t] ? slide : s->tri_slide[t];
@@ -888,7 +908,7 @@ int lod_simplify(lod_simplify_scratch *s, const lod_simplify_input *in, uint32_t
     *res = (lod_simplify_result){0};
     if (!reserve(s, in))
         return 0;
-    run r = {.s = s, .in = in};
+    run r = {.s = s, .in = in, .settled_a = NONE, .settled_b = NONE};
     build_lists(&r);
     build_quadrics(&r);
     memset(s->tri_slide, 0, (in->index_count / 3) * sizeof *s->tri_slide);

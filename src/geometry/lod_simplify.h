@@ -28,6 +28,8 @@ typedef struct lod_simplify_input {
     double normal_weight;   /* the normal term's weight (lod_simplify.c); 0: the default, NORMAL_WEIGHT */
     const lod_texture_set *texture; /* what the uvs sample, to weigh a slide by the change the texture shows
                                        under it (lod_texture.h); NULL: unknown, a slide counts whole */
+    int every_slide; /* for tests: look the texture up for every slide, also where it cannot count
+                        (the output is the same) */
 } lod_simplify_input;
 
 typedef struct lod_simplify_result {

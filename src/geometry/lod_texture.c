@@ -208,7 +208,9 @@ double lod_texture_variation(const lod_texture_set *set, const double (*uv)[2], 
     double largest = 0.0;
     for (uint32_t i = 0; i < set->count && largest < 1.0; i++) {
         const lod_texture_use *u = &set->uses[i];
-        if (u->weight > 0.0) {
+        /* A use's change is at most its weight (use_variation is at most 1): one whose weight is no
+         * more than the largest so far cannot raise it, and is not measured. */
+        if (u->weight > largest) {
             double v = use_variation(u, uv, count) * u->weight;
             largest = v > largest ? v : largest;
         }

@@ -12,6 +12,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "geometry/lod_simplify.h"
 #include "point_distance.h"
@@ -49,6 +50,40 @@ static uint32_t chart_wedge(uint32_t p, uint32_t c, const float *positions, uint
     uvs[*w] = (gdr_vec2){20.0f * test_hash_unit(c) + q[0], 20.0f * test_hash_unit(c + 7777u) + q[1]};
     normals[*w] = (gdr_vec3){0.0f, 0.0f, 1.0f};
     return *w;
+}
+
+/* The same sheet under a texture of blocks of colour: the simplifier skips the lookups of slides
+ * that cannot raise the largest of a move's (lod_simplify.c, corner_attribute_error); with every
+ * slide looked up (in->every_slide) it must keep the same triangles, collapses and slide. */
+static void check_texture_lookups_skipped(lod_simplify_input *in, lod_simplify_scratch *scratch)
+{
+    enum { SIZE = 64 };
+    static uint8_t rgba[SIZE * SIZE * 4];
+    static uint32_t skipped[TRIANGLES * 3], every[TRIANGLES * 3];
+    for (uint32_t i = 0; i < SIZE * SIZE; i++) {
+        uint32_t block = (i / SIZE / 8) * 8 + i % SIZE / 8;
+        for (int k = 0; k < 4; k++)
+            rgba[i * 4 + (uint32_t)k] = (uint8_t)(255.0f * test_hash_unit(block * 4u + (uint32_t)k));
+    }
+    lod_texture_pyramid pyramid;
+    CHECK(lod_texture_pyramid_build(&pyramid, rgba, SIZE, SIZE));
+    lod_texture_use use = {.pyramid = &pyramid, .m = {{0.05, 0}, {0, 0.05}}, .channels = 0x7, .weight = 1.0};
+    lod_texture_set set = {&use, 1};
+    lod_simplify_result a, b;
+    in->texture = &set;
+    in->every_slide = 0;
+    CHECK_MSG(lod_simplify(scratch, in, skipped, &a), "out of memory");
+    in->every_slide = 1;
+    CHECK_MSG(lod_simplify(scratch, in, every, &b), "out of memory");
+    in->texture = NULL;
+    in->every_slide = 0;
+    printf("test_lod_charts: under a texture %zu triangles, %u collapses, slide %.4f; every slide looked up: %zu, "
+           "%u, %.4f\n", a.index_count / 3, a.collapses, (double)a.slide, b.index_count / 3, b.collapses,
+           (double)b.slide);
+    CHECK_MSG(a.index_count == b.index_count && a.collapses == b.collapses && a.slide == b.slide &&
+                  memcmp(skipped, every, a.index_count * sizeof *skipped) == 0,
+              "skipping the lookups that cannot count changed the simplified triangles");
+    lod_texture_pyramid_free(&pyramid);
 }
 
 int main(void)
@@ -92,6 +127,7 @@ int main(void)
     CHECK_MSG(kept <= (size_t)TRIANGLES / 8, "simplified to %zu of %u triangles only", kept, TRIANGLES);
     CHECK_MSG(result.slide > 0.0f, "no slide stated, though charts had to be crossed");
     CHECK_MSG(result.slide <= 1.75 * mean, "slide %g is above 1.75 times the mean edge %g", (double)result.slide, mean);
+    check_texture_lookups_skipped(&in, &scratch);
     lod_simplify_scratch_free(&scratch);
     return test_finish("test_lod_charts");
 }

@@ -151,6 +151,49 @@ static void check_simple_textures(void)
     lod_texture_pyramid_free(&pc);
 }
 
+/* Several uses of one set, weights in any order (some equal, some 0, some above 1): the set's change
+ * is exactly the largest of its uses' weighed changes, each measured alone, capped at 1. Guards
+ * lod_texture_variation's skipping of a use whose weight cannot raise the largest so far. */
+static void check_set_is_largest_use(void)
+{
+    uint8_t *rgba[3] = {patchy_texture(37, 21), patchy_texture(64, 64), patchy_texture(5, 130)};
+    const uint32_t w[3] = {37, 64, 5}, h[3] = {21, 64, 130};
+    lod_texture_pyramid p[3];
+    for (int k = 0; k < 3; k++)
+        CHECK(lod_texture_pyramid_build(&p[k], rgba[k], w[k], h[k]));
+    static const double weights[] = {0.0, 0.1, 0.25, 0.25, 0.5, 0.9, 1.0, 1.5};
+    uint32_t mismatched = 0, raised = 0;
+    for (int i = 0; i < 3000; i++) {
+        lod_texture_use u[5];
+        uint32_t count = 1u + rng() % 5u;
+        for (uint32_t k = 0; k < count; k++)
+            u[k] = (lod_texture_use){.pyramid = &p[rng() % 3], .sampler = (uint32_t)(rng() % 3),
+                                     .m = {{1, 0}, {0, 1}}, .channels = 1u + rng() % 15u,
+                                     .weight = weights[rng() % (sizeof weights / sizeof weights[0])]};
+        double size = i % 4 == 0 ? uniform(0.0, 1.0) : uniform(0.0, 0.1), uv[3][2];
+        double cu = uniform(-2.0, 2.0), cv = uniform(-2.0, 2.0);
+        for (int k = 0; k < 3; k++)
+            uv[k][0] = cu + uniform(0.0, size), uv[k][1] = cv + uniform(0.0, size);
+        double want = 0.0;
+        for (uint32_t k = 0; k < count; k++) {
+            lod_texture_set alone = {&u[k], 1};
+            double v = lod_texture_variation(&alone, (const double(*)[2])uv, 3);
+            raised += k > 0 && v > want;
+            want = v > want ? v : want;
+        }
+        lod_texture_set set = {u, count};
+        mismatched += lod_texture_variation(&set, (const double(*)[2])uv, 3) != want;
+    }
+    printf("test_lod_texture_variation: 3000 sets of up to 5 uses, %u where a later use raised the largest, %u "
+           "mismatched\n", raised, mismatched);
+    CHECK_MSG(mismatched == 0, "%u sets' change is not their largest use's", mismatched);
+    CHECK_MSG(raised > 0, "no set where a later use mattered: the check is empty");
+    for (int k = 0; k < 3; k++) {
+        lod_texture_pyramid_free(&p[k]);
+        free(rgba[k]);
+    }
+}
+
 /* --- the DAG ------------------------------------------------------------------------------------------ */
 
 typedef struct slide_count {
@@ -282,6 +325,7 @@ int main(void)
     check_against_brute_force(37, 21);
     check_against_brute_force(64, 64);
     check_against_brute_force(5, 130);
+    check_set_is_largest_use();
     check_dags();
     return test_finish("test_lod_texture_variation");
 }
