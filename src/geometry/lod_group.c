@@ -55,13 +55,14 @@ static void shrink_enclosing_centre(const gdr_vec4 *s, size_t n, double best[3])
     double c[3] = {best[0], best[1], best[2]};
     double best_radius = enclosing_radius(s, n, c, &far);
     for (int k = 0; k < LOD_SPHERE_ITERATIONS; k++) {
-        double d[3] = {(double)s[far].x - c[0], (double)s[far].y - c[1], (double)s[far].z - c[2]};
+        const double centre[3] = {s[far].x, s[far].y, s[far].z}, radius = s[far].w;
+        double d[3] = {centre[0] - c[0], centre[1] - c[1], centre[2] - c[2]};
         double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (len == 0.0) /* c is that sphere's centre: any point of its surface is as far */
+            d[0] = len = 1.0;
         double step = 1.0 / (k + 2);
-        for (int a = 0; a < 3; a++) {
-            double p = (double)(&s[far].x)[a] + (len > 0 ? (double)s[far].w * d[a] / len : (a == 0 ? s[far].w : 0));
-            c[a] += (p - c[a]) * step;
-        }
+        for (int a = 0; a < 3; a++)
+            c[a] += (centre[a] + radius * d[a] / len - c[a]) * step;
         double r = enclosing_radius(s, n, c, &far);
         if (r < best_radius) {
             best_radius = r;
