@@ -26,8 +26,54 @@ static float round_up_to_float(double x)
     return (double)f < x ? nextafterf(f, INFINITY) : f;
 }
 
+/* The distance from `c` to the far side of the farthest sphere of the list: the radius a sphere
+ * centred at `c` needs to contain them all. */
+static double enclosing_radius(const gdr_vec4 *s, size_t n, const double c[3], size_t *farthest)
+{
+    double radius = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        double dx = (double)s[i].x - c[0], dy = (double)s[i].y - c[1], dz = (double)s[i].z - c[2];
+        double d = sqrt(dx * dx + dy * dy + dz * dz) + s[i].w;
+        if (d > radius || i == 0) {
+            radius = d;
+            *farthest = i;
+        }
+    }
+    return radius;
+}
+
+/* Moves `c` towards the point of the list's spheres farthest from it by 1/(k + 2) of the way, for
+ * k = 0, 1, ... (Badoiu and Clarkson's iteration for the smallest enclosing ball, taken over the
+ * spheres' far points), and keeps the centre that needed the smallest radius. The box centre it
+ * starts from can need up to sqrt(3) times the smallest radius, and a group's sphere encloses those
+ * of the groups below it, so the slack compounded over the DAG's depths. */
+#define LOD_SPHERE_ITERATIONS 48
+
+static void shrink_enclosing_centre(const gdr_vec4 *s, size_t n, double best[3])
+{
+    size_t far = 0;
+    double c[3] = {best[0], best[1], best[2]};
+    double best_radius = enclosing_radius(s, n, c, &far);
+    for (int k = 0; k < LOD_SPHERE_ITERATIONS; k++) {
+        const double centre[3] = {s[far].x, s[far].y, s[far].z}, radius = s[far].w;
+        double d[3] = {centre[0] - c[0], centre[1] - c[1], centre[2] - c[2]};
+        double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (len == 0.0) /* c is that sphere's centre: any point of its surface is as far */
+            d[0] = len = 1.0;
+        double step = 1.0 / (k + 2);
+        for (int a = 0; a < 3; a++)
+            c[a] += (centre[a] + radius * d[a] / len - c[a]) * step;
+        double r = enclosing_radius(s, n, c, &far);
+        if (r < best_radius) {
+            best_radius = r;
+            memcpy(best, c, sizeof c);
+        }
+    }
+}
+
 /* A sphere containing every sphere of the list, in double, rounded up, with a relative slack of
- * 1e-6 so that containment survives float evaluation of the distances. */
+ * 1e-6 so that containment survives float evaluation of the distances. Its centre is the best
+ * found from the box centre (above); whatever the centre, the radius is the exact one it needs. */
 gdr_vec4 gdr_lod_enclosing_sphere(const gdr_vec4 *s, size_t n)
 {
     double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
@@ -38,16 +84,13 @@ gdr_vec4 gdr_lod_enclosing_sphere(const gdr_vec4 *s, size_t n)
             hi[k] = c[k] + r > hi[k] ? c[k] + r : hi[k];
         }
     }
-    float centre[3];
-    for (int k = 0; k < 3; k++)
-        centre[k] = (float)(0.5 * (lo[k] + hi[k]));
-    double radius = 0.0;
-    for (size_t i = 0; i < n; i++) {
-        double dx = (double)s[i].x - centre[0], dy = (double)s[i].y - centre[1], dz = (double)s[i].z - centre[2];
-        double d = sqrt(dx * dx + dy * dy + dz * dz) + s[i].w;
-        radius = d > radius ? d : radius;
-    }
-    return (gdr_vec4){centre[0], centre[1], centre[2], round_up_to_float(radius * (1.0 + 1e-6))};
+    double box[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
+    if (n > 1)
+        shrink_enclosing_centre(s, n, box);
+    double centre[3] = {(float)box[0], (float)box[1], (float)box[2]};
+    size_t far = 0;
+    double radius = n ? enclosing_radius(s, n, centre, &far) : 0.0;
+    return (gdr_vec4){(float)centre[0], (float)centre[1], (float)centre[2], round_up_to_float(radius * (1.0 + 1e-6))};
 }
 
 static int compare_u64(const void *a, const void *b)

@@ -45,6 +45,28 @@ int main(void)
     CHECK(contains_all(both, pair, 2));
     CHECK_NEAR(both.w, 4.0, 1e-4);
 
+    /* A sphere and a point off along the box's diagonal: the box's centre needs 25.98 (the point's
+     * distance from it), the smallest sphere is the span from the sphere's far side to the point,
+     * 10 + 20 sqrt(3) = 44.64, radius 22.32. Group spheres enclose those of the groups below them,
+     * so slack here compounds over the DAG's depths. */
+    gdr_vec4 corner[2] = {{0.0f, 0.0f, 0.0f, 10.0f}, {20.0f, 20.0f, 20.0f, 0.0f}};
+    gdr_vec4 span = gdr_lod_enclosing_sphere(corner, 2);
+    CHECK(contains_all(span, corner, 2));
+    CHECK(span.w <= 1.01f * 0.5f * (10.0f + 20.0f * sqrtf(3.0f)));
+
+    /* Points on a quarter circle of radius 10 and a sphere of radius 1 at its centre: the box
+     * [-1, 10]^2 is centred at (4.5, 4.5), which needs 4.5 sqrt(2) + 1 = 7.36; the smallest sphere
+     * is centred at (t, t) with sqrt((10 - t)^2 + t^2) = sqrt(2) t + 1, t = 99 / (20 + 2 sqrt(2)),
+     * radius 7.13. */
+    gdr_vec4 arc[8];
+    for (int i = 0; i < 7; i++)
+        arc[i] = (gdr_vec4){10.0f * cosf(0.2617994f * (float)i), 10.0f * sinf(0.2617994f * (float)i), 0.0f, 0.0f};
+    arc[7] = (gdr_vec4){0.0f, 0.0f, 0.0f, 1.0f};
+    gdr_vec4 around = gdr_lod_enclosing_sphere(arc, 8);
+    CHECK(contains_all(around, arc, 8));
+    double t = 99.0 / (20.0 + 2.0 * sqrt(2.0));
+    CHECK(around.w <= 1.01 * (sqrt(2.0) * t + 1.0));
+
     /* Clouds far from the origin, of very different radii: containment in float must hold. */
     uint32_t state = 12345u;
     for (int trial = 0; trial < 200; trial++) {
