@@ -24,6 +24,7 @@ typedef struct meshlet_arrays {
  * corners, each part lists its vertices in first-use order. Positions are float triples indexed by
  * the meshlets' vertices. Returns 0, or -1 when out of memory (`a` then unchanged). Where nothing
  * splits, `a` is left as it is. */
-int gdr_meshlets_split_far_parts(meshlet_arrays *a, const float *positions);
+int gdr_meshlets_split_far_parts(meshlet_arrays *a, const float *positions, uint32_t max_vertices,
+                                 uint32_t max_triangles);
 
 #endif
