@@ -275,7 +275,7 @@ static gdr_status meshlets_of(const gdr_mesh *mesh, const gdr_meshlet_options *o
                                       o->cone_weight);
     /* Meshlets that jumped to a far triangle are cut at the jump (meshlet_split.c). */
     meshlet_arrays split = {meshlets, count, r->vertices, r->triangles};
-    int split_failed = count > 0 && gdr_meshlets_split_far_parts(&split, positions, o->max_vertices, o->max_triangles) != 0;
+    int split_failed = count > 0 && gdr_meshlets_split_far_parts(&split, positions) != 0;
     meshlets = split.meshlets, count = split.count, r->vertices = split.vertices, r->triangles = split.triangles;
     r->clusters = count > 0 && !split_failed ? malloc(count * sizeof *r->clusters) : NULL;
     if (!r->clusters) {
