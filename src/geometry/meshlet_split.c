@@ -111,9 +111,8 @@ static void unite(uint8_t *parent, uint32_t a, uint32_t b)
 }
 
 /* The components of meshlet m (triangles sharing a vertex): component[t] for each triangle, in the
- * order of their first triangle, with their boxes; returns the count and the mean edge length. */
-static uint32_t components(const struct meshopt_Meshlet *m, const uint32_t *vertices, const uint8_t *tri,
-                           const float *positions, uint8_t *component, box *boxes, double *mean_edge)
+ * order of their first triangle; returns their count. */
+static uint32_t components(const struct meshopt_Meshlet *m, const uint8_t *tri, uint8_t *component)
 {
     uint8_t parent[MAX_LOCAL], number[MAX_LOCAL];
     for (uint32_t v = 0; v < m->vertex_count; v++)
@@ -123,12 +122,23 @@ static uint32_t components(const struct meshopt_Meshlet *m, const uint32_t *vert
         unite(parent, tri[3 * t], tri[3 * t + 2]);
     }
     uint32_t count = 0;
-    double edges = 0.0;
     for (uint32_t t = 0; t < m->triangle_count; t++) {
         uint32_t root = find(parent, tri[3 * t]);
         if (number[root] == UINT8_MAX)
-            box_empty(&boxes[count]), number[root] = (uint8_t)count++;
+            number[root] = (uint8_t)count++;
         component[t] = number[root];
+    }
+    return count;
+}
+
+/* The components' boxes; returns the meshlet's mean edge length. */
+static double component_boxes(const struct meshopt_Meshlet *m, const uint32_t *vertices, const uint8_t *tri,
+                              const float *positions, const uint8_t *component, uint32_t count, box *boxes)
+{
+    for (uint32_t i = 0; i < count; i++)
+        box_empty(&boxes[i]);
+    double edges = 0.0;
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
         const float *corner[3];
         for (int k = 0; k < 3; k++) {
             corner[k] = positions + 3 * (size_t)vertices[m->vertex_offset + tri[3 * t + k]];
@@ -136,8 +146,7 @@ static uint32_t components(const struct meshopt_Meshlet *m, const uint32_t *vert
         }
         edges += distance(corner[0], corner[1]) + distance(corner[1], corner[2]) + distance(corner[2], corner[0]);
     }
-    *mean_edge = edges / (3.0 * m->triangle_count);
-    return count;
+    return edges / (3.0 * m->triangle_count);
 }
 
 /* The parts of meshlet m: part[t] for each of its triangles, numbered by first triangle; returns
@@ -147,13 +156,20 @@ static uint32_t components(const struct meshopt_Meshlet *m, const uint32_t *vert
 static uint32_t meshlet_parts(const struct meshopt_Meshlet *m, const uint32_t *vertices, const uint8_t *triangles,
                               const float *positions, uint8_t *part, double *whole, double *largest)
 {
-    box boxes[MAX_TRIANGLES];
-    double mean_edge;
     const uint8_t *tri = triangles + m->triangle_offset;
-    uint32_t count = components(m, vertices, tri, positions, part, boxes, &mean_edge);
+    uint32_t count = components(m, tri, part);
+    if (count == 1) { /* most meshlets: one box over its vertices */
+        box b;
+        box_empty(&b);
+        for (uint32_t v = 0; v < m->vertex_count; v++)
+            box_add(&b, positions + 3 * (size_t)vertices[m->vertex_offset + v]);
+        *whole = *largest = half_diagonal(&b);
+        return 1;
+    }
+    box boxes[MAX_TRIANGLES];
+    double link = LINK_EDGES * component_boxes(m, vertices, tri, positions, part, count, boxes);
     /* Single linkage: components whose boxes come within `link` are one part. A meshlet has at most
      * one component per triangle (its vertex limit keeps that near 21), so pairs are cheap. */
-    double link = LINK_EDGES * mean_edge;
     uint8_t joined[MAX_TRIANGLES], number[MAX_TRIANGLES];
     for (uint32_t i = 0; i < count; i++)
         joined[i] = (uint8_t)i, number[i] = UINT8_MAX;
