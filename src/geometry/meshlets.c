@@ -10,6 +10,7 @@
 #include "gdr/thread_pool.h"
 #include "geometry/cluster_bounds.h"
 #include "geometry/meshlet_chunks.h"
+#include "geometry/meshlet_split.h"
 #include "geometry/vertex_weld.h"
 #include "gdr/geometry.h"
 #include "gdr/scene.h"
@@ -272,7 +273,11 @@ static gdr_status meshlets_of(const gdr_mesh *mesh, const gdr_meshlet_options *o
         count = meshopt_buildMeshlets(meshlets, r->vertices, r->triangles, indices, index_count, positions,
                                       vertex_count, sizeof(float) * 3, o->max_vertices, o->max_triangles,
                                       o->cone_weight);
-    r->clusters = count > 0 ? malloc(count * sizeof *r->clusters) : NULL;
+    /* Meshlets that jumped to a far triangle are cut at the jump (meshlet_split.c). */
+    meshlet_arrays split = {meshlets, count, r->vertices, r->triangles};
+    int split_failed = count > 0 && gdr_meshlets_split_far_parts(&split, positions) != 0;
+    meshlets = split.meshlets, count = split.count, r->vertices = split.vertices, r->triangles = split.triangles;
+    r->clusters = count > 0 && !split_failed ? malloc(count * sizeof *r->clusters) : NULL;
     if (!r->clusters) {
         free(meshlets);
         return meshlets && r->vertices && r->triangles && count == 0 ? GDR_ERROR_INVALID_ARGUMENT

@@ -24,7 +24,7 @@
 const char *gdr_cache_build_options(void)
 {
     /* Bump when the importers' or the geometry processing's output for the same input changes. */
-    return "import=1;meshlets=2;lod=11";
+    return "import=1;meshlets=3;lod=11";
 }
 
 /* --- writing --------------------------------------------------------------------------------- */

@@ -252,6 +252,93 @@ static void test_meshes(void)
     gdr_scene_destroy(s);
 }
 
+/* Far-apart patches: `patches` flat grids of 9 x 7 cells (126 triangles, 80 vertices: neither
+ * divides the cluster limits), 1000 apart along x. meshoptimizer 0.18 fills a patch, then takes the
+ * nearest free triangle however far: the last cluster of a patch reached into the next one. */
+#define PATCH_CELLS_X 9u
+#define PATCH_CELLS_Z 7u
+#define PATCH_VERTICES ((PATCH_CELLS_X + 1) * (PATCH_CELLS_Z + 1))
+
+static gdr_scene *make_patches(uint32_t patches)
+{
+    gdr_scene *s = NULL;
+    gdr_error err = {0};
+    CHECK(gdr_scene_create(&s, &err) == GDR_OK);
+    uint32_t side = PATCH_CELLS_X + 1;
+    gdr_vec3 *p = malloc(sizeof *p * PATCH_VERTICES * patches);
+    uint32_t *idx = malloc(sizeof *idx * 6 * PATCH_CELLS_X * PATCH_CELLS_Z * patches), n = 0;
+    for (uint32_t k = 0; k < patches; k++) {
+        uint32_t base = k * PATCH_VERTICES;
+        for (uint32_t z = 0; z <= PATCH_CELLS_Z; z++)
+            for (uint32_t x = 0; x < side; x++)
+                p[base + z * side + x] = (gdr_vec3){1000.0f * (float)k + 0.1f * (float)x, 0.0f, 0.1f * (float)z};
+        for (uint32_t z = 0; z < PATCH_CELLS_Z; z++)
+            for (uint32_t x = 0; x < PATCH_CELLS_X; x++) {
+                uint32_t a = base + z * side + x, b = a + 1, c = a + side, d = c + 1;
+                uint32_t quad[6] = {a, c, b, b, c, d};
+                memcpy(idx + n, quad, sizeof quad);
+                n += 6;
+            }
+    }
+    add_mesh(s, "patches", p, PATCH_VERTICES * patches, idx, n);
+    free(p);
+    free(idx);
+    return s;
+}
+
+/* The number of clusters whose vertices lie in more than one patch. */
+static uint32_t clusters_spanning_patches(const gdr_mesh_clusters *mc)
+{
+    uint32_t spanning = 0;
+    for (uint32_t i = 0; i < mc->level0_cluster_count; i++) {
+        const gdr_cluster *c = &mc->clusters[i];
+        uint32_t patch = mc->vertices[c->vertex_offset] / PATCH_VERTICES;
+        for (uint32_t v = 1; v < c->vertex_count; v++)
+            if (mc->vertices[c->vertex_offset + v] / PATCH_VERTICES != patch) {
+                spanning++;
+                break;
+            }
+    }
+    return spanning;
+}
+
+/* No level-0 cluster spans two far-apart patches, and the guarantees hold: two patches (one
+ * chunk), and 300 patches (37,800 triangles: two chunks) with 1 and 3 threads, the same bytes. */
+static void test_far_parts(void)
+{
+    gdr_scene *two = make_patches(2), *many = make_patches(300);
+    gdr_error err = {0};
+    gdr_mesh_clusters mc = {0}, threaded = {0};
+    CHECK(gdr_meshlets_build(&two->meshes[0], NULL, &mc, &err) == GDR_OK);
+    CHECK(check_cluster_layout(&two->meshes[0], &mc, GDR_CLUSTER_MAX_VERTICES, GDR_CLUSTER_MAX_TRIANGLES));
+    CHECK(check_cluster_coverage(&two->meshes[0], &mc));
+    CHECK(check_cluster_spheres(&two->meshes[0], &mc));
+    uint32_t spanning = clusters_spanning_patches(&mc);
+    printf("two patches: %u clusters, %u spanning both\n", mc.cluster_count, spanning);
+    CHECK(spanning == 0);
+    gdr_mesh_clusters_free(&mc);
+
+    CHECK(gdr_meshlets_build(&many->meshes[0], &(gdr_meshlet_options){.thread_count = 1}, &mc, &err) == GDR_OK);
+    CHECK(gdr_meshlets_build(&many->meshes[0], &(gdr_meshlet_options){.thread_count = 3}, &threaded, &err) ==
+          GDR_OK);
+    CHECK(check_cluster_layout(&many->meshes[0], &mc, GDR_CLUSTER_MAX_VERTICES, GDR_CLUSTER_MAX_TRIANGLES));
+    CHECK(check_cluster_coverage(&many->meshes[0], &mc));
+    CHECK(check_cluster_spheres(&many->meshes[0], &mc));
+    spanning = clusters_spanning_patches(&mc);
+    printf("300 patches: %u clusters, %u spanning two\n", mc.cluster_count, spanning);
+    CHECK(spanning == 0);
+    CHECK(mc.cluster_count == threaded.cluster_count && mc.triangle_byte_count == threaded.triangle_byte_count &&
+          mc.vertex_count == threaded.vertex_count);
+    CHECK(mc.cluster_count == threaded.cluster_count &&
+          memcmp(mc.clusters, threaded.clusters, sizeof *mc.clusters * mc.cluster_count) == 0 &&
+          memcmp(mc.vertices, threaded.vertices, sizeof *mc.vertices * mc.vertex_count) == 0 &&
+          memcmp(mc.triangles, threaded.triangles, mc.triangle_byte_count) == 0);
+    gdr_mesh_clusters_free(&mc);
+    gdr_mesh_clusters_free(&threaded);
+    gdr_scene_destroy(two);
+    gdr_scene_destroy(many);
+}
+
 /* The convention, on a flat grid facing +Y: seen from below every cluster is culled, from above
  * none is. A reversed axis or comparison fails this. */
 static void test_cone_convention(void)
@@ -487,6 +574,7 @@ static void test_file(const char *relative)
 int main(void)
 {
     test_meshes();
+    test_far_parts();
     test_cone_convention();
     test_bad_input();
     test_scene_build();
