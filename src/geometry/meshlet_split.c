@@ -295,7 +295,7 @@ int gdr_meshlets_split_far_parts(meshlet_arrays *a, const float *positions)
     double *sizes = malloc(3 * a->count * sizeof *sizes);
     uint8_t *part = malloc(triangles);
     int status = parts && sizes && part ? 0 : -1;
-    double *whole = sizes + a->count, *largest = sizes + 2 * a->count;
+    double *whole = status == 0 ? sizes + a->count : NULL, *largest = status == 0 ? sizes + 2 * a->count : NULL;
     for (size_t i = 0, first = 0; status == 0 && i < a->count; i++) {
         parts[i] = meshlet_parts(&a->meshlets[i], a->vertices, a->triangles, positions, part + first, &whole[i],
                                  &largest[i]);
