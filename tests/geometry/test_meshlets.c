@@ -50,6 +50,21 @@ static void add_soup(gdr_scene *s, unsigned seed, uint32_t triangles)
     free(idx);
 }
 
+/* The two triangles of each cell of a grid of cells_x x cells_z cells whose vertex (x, z) is
+ * base + z * side + x, counter-clockwise seen from +Y, appended at idx[n]; returns the new count. */
+static uint32_t grid_quads(uint32_t *idx, uint32_t n, uint32_t base, uint32_t side, uint32_t cells_x,
+                           uint32_t cells_z)
+{
+    for (uint32_t z = 0; z < cells_z; z++)
+        for (uint32_t x = 0; x < cells_x; x++) {
+            uint32_t a = base + z * side + x, b = a + 1, c = a + side, d = c + 1;
+            uint32_t quad[6] = {a, c, b, b, c, d};
+            memcpy(idx + n, quad, sizeof quad);
+            n += 6;
+        }
+    return n;
+}
+
 /* A bumpy height field far from the origin: normal cones of all widths, float rounding at 1e4. */
 static void add_terrain(gdr_scene *s, unsigned seed, uint32_t cells, float offset)
 {
@@ -60,14 +75,7 @@ static void add_terrain(gdr_scene *s, unsigned seed, uint32_t cells, float offse
         for (uint32_t x = 0; x < side; x++)
             p[z * side + x] = (gdr_vec3){offset + 0.1f * (float)x, test_random_range(&seed, -0.08f, 0.08f),
                                          offset + 0.1f * (float)z};
-    for (uint32_t z = 0; z < cells; z++)
-        for (uint32_t x = 0; x < cells; x++) {
-            uint32_t a = z * side + x, b = a + 1, c = a + side, d = c + 1;
-            /* Counter-clockwise seen from +Y. */
-            uint32_t quad[6] = {a, c, b, b, c, d};
-            memcpy(idx + n, quad, sizeof quad);
-            n += 6;
-        }
+    n = grid_quads(idx, n, 0, side, cells, cells);
     add_mesh(s, "terrain", p, side * side, idx, n);
     free(p);
     free(idx);
@@ -272,13 +280,7 @@ static gdr_scene *make_patches(uint32_t patches)
         for (uint32_t z = 0; z <= PATCH_CELLS_Z; z++)
             for (uint32_t x = 0; x < side; x++)
                 p[base + z * side + x] = (gdr_vec3){1000.0f * (float)k + 0.1f * (float)x, 0.0f, 0.1f * (float)z};
-        for (uint32_t z = 0; z < PATCH_CELLS_Z; z++)
-            for (uint32_t x = 0; x < PATCH_CELLS_X; x++) {
-                uint32_t a = base + z * side + x, b = a + 1, c = a + side, d = c + 1;
-                uint32_t quad[6] = {a, c, b, b, c, d};
-                memcpy(idx + n, quad, sizeof quad);
-                n += 6;
-            }
+        n = grid_quads(idx, n, base, side, PATCH_CELLS_X, PATCH_CELLS_Z);
     }
     add_mesh(s, "patches", p, PATCH_VERTICES * patches, idx, n);
     free(p);
