@@ -16,7 +16,7 @@
 #include "gdr/geometry.h"
 #include "gdr/io.h"
 #include "gdr/scene.h"
-#include "procedural/procedural_meshes.h"
+#include "procedural_set.h"
 
 static int by_value(const void *a, const void *b)
 {
@@ -34,20 +34,8 @@ static gdr_scene *load(const char *name)
 {
     gdr_scene *s = NULL;
     gdr_error err = {0};
-    uint32_t u = 0, v = 0;
-    int procedural = 1;
     gdr_status st = gdr_scene_create(&s, &err);
-    if (!strcmp(name, "blob"))
-        st = gdr_procedural_blob(s, 6, NULL, &err);
-    else if (!strcmp(name, "knot"))
-        st = gdr_procedural_torus_knot(s, 500, 100, NULL, &err);
-    else if (!strcmp(name, "torus-1m"))
-        st = gdr_procedural_torus(s, 1.0f, 0.35f, 1000, 500, NULL, &err);
-    else if (sscanf(name, "torus-%ux%u", &u, &v) == 2)
-        st = gdr_procedural_torus(s, 1.0f, 0.35f, u, v, NULL, &err);
-    else
-        procedural = 0;
-    if (procedural) {
+    if (st == GDR_OK && bench_procedural_mesh(s, name, NULL, &st, &err)) {
         if (st == GDR_OK)
             st = gdr_scene_build_clusters(s, NULL, &err);
         if (st == GDR_OK)

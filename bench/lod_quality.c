@@ -39,7 +39,7 @@
 #include "gdr/geometry.h"
 #include "gdr/io.h"
 #include "gdr/scene.h"
-#include "procedural/procedural_meshes.h"
+#include "procedural_set.h"
 #include "io/loaders.h"
 
 #define SWEEP_STEPS 21         /* thresholds 10^(-4 + i / 8) of the radius */
@@ -147,19 +147,11 @@ static gdr_scene *load_mesh(const char *name)
 {
     gdr_scene *scene = NULL;
     gdr_error err = {0};
-    uint32_t m = 0, seg_u = 0, seg_v = 0;
+    uint32_t m = 0;
     if (gdr_scene_create(&scene, &err) != GDR_OK)
         die(name, err.message);
     gdr_status s = GDR_OK;
-    if (!strcmp(name, "blob"))
-        s = gdr_procedural_blob(scene, 6, &m, &err);
-    else if (!strcmp(name, "knot"))
-        s = gdr_procedural_torus_knot(scene, 500, 100, &m, &err);
-    else if (!strcmp(name, "torus-1m"))
-        s = gdr_procedural_torus(scene, 1.0f, 0.35f, 1000, 500, &m, &err);
-    else if (sscanf(name, "torus-%ux%u", &seg_u, &seg_v) == 2) /* torus-1m's shape, smaller */
-        s = gdr_procedural_torus(scene, 1.0f, 0.35f, seg_u, seg_v, &m, &err);
-    else {
+    if (!bench_procedural_mesh(scene, name, &m, &s, &err)) {
         static const char *const files[][2] = {
             {"wuson", "WusonOBJ.obj"}, {"spider", "spider.obj"}, {"regr01", "regr01.obj"}};
         for (size_t i = 0; i < sizeof files / sizeof files[0]; i++)
